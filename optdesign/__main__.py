@@ -1,0 +1,5 @@
+import sys
+
+from optdesign.cli import main
+
+sys.exit(main())

@@ -1,0 +1,97 @@
+"""Command line: ``optdesign reproduce|solve|pareto|bench ...``.
+
+Errors that a user can act on (:class:`optdesign.errors.OptDesignError`) are printed as
+one line naming the field, with exit code 2 and no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from optdesign.errors import OptDesignError
+
+#: subcommand name -> function(subparsers) that registers it. Add one line per command.
+COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {}
+
+
+def command(name: str):
+    """Decorator registering a subcommand builder."""
+
+    def deco(fn):
+        COMMANDS[name] = fn
+        return fn
+
+    return deco
+
+
+def default_out(prefix: str) -> Path:
+    """A new output folder under the working directory, e.g. ``optdesign-out/duan2017-...``."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    base = Path.cwd() / "optdesign-out" / f"{prefix}-{stamp}"
+    path, k = base, 1
+    while path.exists():
+        k += 1
+        path = base.with_name(f"{base.name}-{k}")
+    return path
+
+
+@command("reproduce")
+def _reproduce(sub):
+    from optdesign.reproduce import REPRODUCTIONS
+
+    p = sub.add_parser("reproduce", help="recompute a source paper's numbers and plots")
+    p.add_argument("paper", choices=sorted(REPRODUCTIONS))
+    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+
+    def run(args):
+        from optdesign.reproduce import run as run_reproduction
+
+        out = args.out or default_out(args.paper)
+        return run_reproduction(args.paper, out)
+
+    p.set_defaults(func=run)
+
+
+def _load_plugins() -> None:
+    # Subcommands living in other modules register themselves on import.
+    import importlib
+
+    for module in PLUGIN_MODULES:
+        importlib.import_module(module)
+
+
+#: Modules that register further subcommands with @command (solve, pareto, bench ...).
+PLUGIN_MODULES: list[str] = []
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every registered subcommand."""
+    _load_plugins()
+    parser = argparse.ArgumentParser(
+        prog="optdesign",
+        description="Design optimisation of ball-screw actuator transmissions.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    for builder in COMMANDS.values():
+        builder(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``optdesign`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        code = args.func(args)
+    except OptDesignError as exc:
+        print(f"optdesign: error: {exc}", file=sys.stderr)
+        return 2
+    return int(code or 0)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,97 @@
+"""One math namespace for two back-ends: CasADi symbols and NumPy arrays.
+
+Every model formula in :mod:`optdesign.models` is written once with these functions.
+Called with CasADi ``SX``/``MX``/``DM`` arguments they build CasADi expressions (exact
+derivatives for the solvers); called with floats or NumPy arrays they evaluate
+numerically with NumPy broadcasting (plots, sweeps, Monte Carlo, NSGA-II).
+
+Conventions for grids: in NumPy mode the deflection grid runs along the *last* axis and
+design parameters broadcast against it (e.g. shape ``(pop, 1)`` against ``(n_phi,)``);
+in CasADi mode the grid is a column vector and designs are scalars. The aggregations
+(:func:`grid_max`, :func:`grid_min`, :func:`grid_mean`) reduce over the grid in both.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+_CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
+
+pi = np.pi
+
+
+def is_symbolic(*xs: Any) -> bool:
+    """True if any argument is a CasADi object (the expression must stay in CasADi)."""
+    return any(isinstance(x, _CASADI_TYPES) for x in xs)
+
+
+def _unary(ca_fn, np_fn):
+    def fn(x):
+        return ca_fn(x) if isinstance(x, _CASADI_TYPES) else np_fn(x)
+
+    fn.__doc__ = f"Element-wise {np_fn.__name__} on CasADi or NumPy input."
+    return fn
+
+
+sin = _unary(ca.sin, np.sin)
+cos = _unary(ca.cos, np.cos)
+tan = _unary(ca.tan, np.tan)
+sqrt = _unary(ca.sqrt, np.sqrt)
+arcsin = _unary(ca.asin, np.arcsin)
+arccos = _unary(ca.acos, np.arccos)
+arctan = _unary(ca.atan, np.arctan)
+exp = _unary(ca.exp, np.exp)
+log = _unary(ca.log, np.log)
+fabs = _unary(ca.fabs, np.abs)
+
+
+def arctan2(y, x):
+    """Element-wise two-argument arctangent."""
+    return ca.atan2(y, x) if is_symbolic(y, x) else np.arctan2(y, x)
+
+
+def fmax(a, b):
+    """Element-wise maximum."""
+    return ca.fmax(a, b) if is_symbolic(a, b) else np.maximum(a, b)
+
+
+def fmin(a, b):
+    """Element-wise minimum."""
+    return ca.fmin(a, b) if is_symbolic(a, b) else np.minimum(a, b)
+
+
+def power(x, e):
+    """Element-wise power ``x**e``."""
+    return x**e
+
+
+def where(cond, a, b):
+    """Element-wise choice: ``a`` where ``cond`` holds, else ``b``."""
+    if is_symbolic(cond, a, b):
+        return ca.if_else(cond, a, b)
+    return np.where(cond, a, b)
+
+
+def grid_max(x):
+    """Maximum over the deflection grid (last axis in NumPy, the column in CasADi)."""
+    return ca.mmax(x) if is_symbolic(x) else np.max(x, axis=-1)
+
+
+def grid_min(x):
+    """Minimum over the deflection grid."""
+    return ca.mmin(x) if is_symbolic(x) else np.min(x, axis=-1)
+
+
+def grid_mean(x):
+    """Mean over the deflection grid."""
+    if is_symbolic(x):
+        return ca.sum1(x) / x.shape[0]
+    return np.mean(x, axis=-1)
+
+
+def grid_sum(x):
+    """Sum over the deflection grid."""
+    return ca.sum1(x) if is_symbolic(x) else np.sum(x, axis=-1)

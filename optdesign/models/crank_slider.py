@@ -1,0 +1,118 @@
+"""Crank-slider kinematics (seed 000 eq. 1-5, Fig. 2; physics.md 1.1 and 2.3).
+
+Output shaft axis O at the origin; the arm of length R carries pin B at
+(R sin a, R cos a) with a = phi0 + phi (phi the deflection, phi0 the neutral angle);
+the nut pin C = (m, n) slides on the line y = n parallel to the screw axis; the rod BC
+has length l. With u = R cos a - n and s = sqrt(l^2 - u^2) (the rod's run along the
+screw axis):
+
+    m(phi)     = R sin a - s                               (eq. 2)
+    dm/dphi    = R cos a - u R sin a / s
+    d|BC|/dphi = (dm/dphi) s / l        (rate of the pin distance with the nut held)
+
+All functions accept floats, NumPy arrays or CasADi symbols (see models._math).
+``floor`` guards the square root of the assembly margin for solvers: with ``floor=None``
+the NumPy path returns NaN where the linkage cannot assemble (the mechanism layer checks
+and names the angle); a solver passes a small positive floor so no NaN ever reaches it.
+"""
+
+from __future__ import annotations
+
+from optdesign.models import _math as m
+from optdesign.models.ratio import ratio_from_nut_velocity
+
+
+def arm_angle(phi, phi0=0.0):
+    """Arm angle a = phi0 + phi, measured from the perpendicular to the screw axis."""
+    return phi0 + phi
+
+
+def rod_rise(R, n, phi, phi0=0.0):
+    """u = R cos a - n: the rod's extent perpendicular to the screw axis (mm)."""
+    return R * m.cos(arm_angle(phi, phi0)) - n
+
+
+def assembly_margin(R, l, n, phi, phi0=0.0):
+    """l^2 - u^2 (mm^2); the linkage assembles only where it is positive."""
+    u = rod_rise(R, n, phi, phi0)
+    return l**2 - u**2
+
+
+def rod_run(R, l, n, phi, phi0=0.0, floor=None):
+    """s = sqrt(l^2 - u^2): the rod's extent along the screw axis (mm)."""
+    margin = assembly_margin(R, l, n, phi, phi0)
+    if floor is not None:
+        margin = m.fmax(margin, floor)
+    return m.sqrt(margin)
+
+
+def nut_position(R, l, n, phi, phi0=0.0, floor=None):
+    """Nut pin abscissa m(phi) = R sin a - sqrt(l^2 - u^2) (mm), eq. 2."""
+    a = arm_angle(phi, phi0)
+    return R * m.sin(a) - rod_run(R, l, n, phi, phi0, floor)
+
+
+def nut_velocity(R, l, n, phi, phi0=0.0, floor=None):
+    """dm/dphi = R cos a - u R sin a / s (mm/rad): derivative of eq. 2."""
+    a = arm_angle(phi, phi0)
+    u = R * m.cos(a) - n
+    s = rod_run(R, l, n, phi, phi0, floor)
+    return R * m.cos(a) - u * R * m.sin(a) / s
+
+
+def ratio(R, l, n, p, i_a, phi, phi0=0.0, floor=None):
+    """Exact reduction ratio i(phi) = 2 pi i_a (dm/dphi) / p."""
+    return ratio_from_nut_velocity(nut_velocity(R, l, n, phi, phi0, floor), p, i_a)
+
+
+def rod_length_rate(R, l, n, phi, phi0=0.0, floor=None):
+    """d|BC|/dphi with the nut held (mm/rad) = (dm/dphi) s / l (physics.md 2.3)."""
+    s = rod_run(R, l, n, phi, phi0, floor)
+    return nut_velocity(R, l, n, phi, phi0, floor) * s / l
+
+
+def transmission_angle(R, l, n, phi, phi0=0.0, floor=None):
+    """Angle at B between the arm (B->O) and the rod (B->C), in rad; 90 deg is ideal.
+
+    cos(mu) = (s sin a + u cos a) / l.
+    """
+    a = arm_angle(phi, phi0)
+    u = R * m.cos(a) - n
+    s = rod_run(R, l, n, phi, phi0, floor)
+    return m.arccos((s * m.sin(a) + u * m.cos(a)) / l)
+
+
+def transmission_angle_cos(R, l, n, phi, phi0=0.0, floor=None):
+    """cos of the transmission angle (smooth; constraints use it instead of arccos)."""
+    a = arm_angle(phi, phi0)
+    u = R * m.cos(a) - n
+    s = rod_run(R, l, n, phi, phi0, floor)
+    return (s * m.sin(a) + u * m.cos(a)) / l
+
+
+def rod_inclination(R, l, n, phi, phi0=0.0, floor=None):
+    """Signed inclination of the rod to the screw axis, atan2(u, s), in rad."""
+    u = rod_rise(R, n, phi, phi0)
+    return m.arctan2(u, rod_run(R, l, n, phi, phi0, floor))
+
+
+def sensitivity_rod_length(R, l, n, phi, phi0=0.0, floor=None):
+    """Output rotation per unit change of the effective rod length (rad/mm)."""
+    return 1.0 / rod_length_rate(R, l, n, phi, phi0, floor)
+
+
+def sensitivity_axial(R, l, n, phi, phi0=0.0, floor=None):
+    """Output rotation per unit axial (nut-side) clearance (rad/mm) = 1/(dm/dphi)."""
+    return 1.0 / nut_velocity(R, l, n, phi, phi0, floor)
+
+
+def sensitivity_lateral(R, l, n, phi, phi0=0.0, floor=None):
+    """Output rotation per unit clearance of the nut slide across the screw axis (rad/mm).
+
+    Moving C by dy with the nut held changes the loop closure
+    (R sin a - m)^2 + (R cos a - n)^2 = l^2; implicit differentiation gives
+    da/dn = u / (s dm/dphi).
+    """
+    u = rod_rise(R, n, phi, phi0)
+    s = rod_run(R, l, n, phi, phi0, floor)
+    return m.fabs(u) / (s * m.fabs(nut_velocity(R, l, n, phi, phi0, floor)))

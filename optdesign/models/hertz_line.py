@@ -1,0 +1,41 @@
+"""Hertz line contact of a pin: contact half-width and flattening (seed 000 eq. 10-11).
+
+The paper treats a pin of diameter D, length L, under a normal force F as a cylinder on
+a flat of the same material:
+
+    b     = sqrt(4 D (F/L) (1 - nu^2) / (pi E))        contact half-width   (eq. 10)
+    Delta = D/2 - sqrt(D^2/4 - b^2)                    flattening           (eq. 11)
+
+**Reading implemented.** Delta is the equation's value for *one* body (0.00552 mm for the
+paper's 10 mm pin, 20 mm long, 20 kN). The paper prints 0.012 mm; flattening of both the
+pin and its bore, 2 Delta = 0.0110 mm, comes close to it, and the clearance chains of
+optdesign count 2 Delta per pin joint for that reason (see models.clearance).
+
+Delta is evaluated in the algebraically identical form b^2 / (D/2 + sqrt(D^2/4 - b^2)),
+which does not lose digits to cancellation when b << D. First-order form: b^2 / D
+(a monomial in D, F, L: what the geometric-programming formulation uses).
+
+Limits: eq. 10 is a cylinder on a flat; a pin in a bore with small clearance is a
+conforming contact where the half-width grows and Hertz stops holding once the arc is
+wide (physics.md 9). Where b approaches D/2 the formula has no real value.
+"""
+
+from __future__ import annotations
+
+from optdesign.models import _math as m
+
+
+def contact_half_width(D, F, L, E, nu):
+    """Contact half-width b (mm), eq. 10. D, L in mm; F in N; E in MPa."""
+    return m.sqrt(4.0 * D * (F / L) * (1.0 - nu**2) / (m.pi * E))
+
+
+def pin_flattening(D, F, L, E, nu):
+    """Flattening Delta (mm) of one body, eq. 11 (cancellation-free form)."""
+    b2 = 4.0 * D * (F / L) * (1.0 - nu**2) / (m.pi * E)
+    return b2 / (0.5 * D + m.sqrt(0.25 * D**2 - b2))
+
+
+def pin_flattening_first_order(D, F, L, E, nu):
+    """First-order flattening b^2 / D = 4 (F/L)(1 - nu^2)/(pi E) (mm); independent of D."""
+    return 4.0 * (F / L) * (1.0 - nu**2) / (m.pi * E)

@@ -1,0 +1,63 @@
+"""Lead screw relations (seed 001; physics.md 4 and 8).
+
+lambda: lead angle, tan(lambda) = p / (pi d_m); phi_f: friction angle, tan(phi_f) = mu.
+"""
+
+from __future__ import annotations
+
+from optdesign.models import _math as m
+
+
+def lead_angle(p, d_m):
+    """Lead angle lambda = atan(p / (pi d_m)) (rad)."""
+    return m.arctan(p / (m.pi * d_m))
+
+
+def friction_angle(mu):
+    """Friction angle phi_f = atan(mu) (rad)."""
+    return m.arctan(mu)
+
+
+def efficiency_forward(lam, phi_f):
+    """Efficiency driving the nut by the screw, tan(lambda) / tan(lambda + phi_f)."""
+    return m.tan(lam) / m.tan(lam + phi_f)
+
+
+def efficiency_backdrive(lam, phi_f):
+    """Efficiency when the axial load drives the screw, tan(lambda - phi_f) / tan(lambda).
+
+    Zero or negative means the screw self-locks.
+    """
+    return m.tan(lam - phi_f) / m.tan(lam)
+
+
+def drive_torque(P, d_m, lam, phi_f):
+    """Screw torque (N*mm) to push an axial load P (N): (d_m/2) P tan(lambda + phi_f), eq. 1."""
+    return 0.5 * d_m * P * m.tan(lam + phi_f)
+
+
+def torsional_stiffness(K_axial, d_m, h, lam, phi_f):
+    """Torsional stiffness at the screw (N*mm/rad) equivalent to an axial stiffness (N/mm).
+
+    K_theta = (d_m/2) K (h/2 pi) tan(lambda + phi_f), seed 001 eq. 5; h is the lead (mm).
+    """
+    return 0.5 * d_m * K_axial * h / (2.0 * m.pi) * m.tan(lam + phi_f)
+
+
+def axial_stiffness(K_theta, d_m, h, lam, phi_f):
+    """Axial stiffness (N/mm) equivalent to a torsional stiffness, seed 001 eq. 7.
+
+    K = 4 pi K_theta / (d_m h tan(lambda + phi_f)), the inverse of
+    :func:`torsional_stiffness`.
+    """
+    return 4.0 * m.pi * K_theta / (d_m * h * m.tan(lam + phi_f))
+
+
+def series_stiffness(*stiffnesses):
+    """Stiffness of members in series, 1/K = sum 1/K_i (same units for all K_i)."""
+    if not stiffnesses:
+        raise ValueError("series_stiffness needs at least one stiffness")
+    total = 0.0
+    for k in stiffnesses:
+        total = total + 1.0 / k
+    return 1.0 / total

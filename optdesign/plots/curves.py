@@ -1,0 +1,34 @@
+"""Curves over the deflection range: ratio, backlash."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+
+def plot_curves(
+    phi_deg: np.ndarray,
+    curves: Mapping[str, np.ndarray],
+    ylabel: str,
+    title: str,
+    path: Path,
+    styles: Mapping[str, str] | None = None,
+) -> Path:
+    """Plot several curves against the deflection (degrees) into a PNG at ``path``."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
+    for label, y in curves.items():
+        ax.plot(phi_deg, y, (styles or {}).get(label, "-"), label=label)
+    ax.set_xlabel("deflection phi (deg)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
