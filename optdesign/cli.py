@@ -65,7 +65,9 @@ def _load_plugins() -> None:
 
 
 #: Modules that register further subcommands with @command (solve, pareto, bench ...).
-PLUGIN_MODULES: list[str] = []
+PLUGIN_MODULES: list[str] = [
+    "optdesign.commands.solve",
+]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -48,6 +48,16 @@ log = _unary(ca.log, np.log)
 fabs = _unary(ca.fabs, np.abs)
 
 
+def sqrt_domain(x):
+    """Square root for a quantity that is non-negative wherever the model is valid.
+
+    NumPy path: plain ``sqrt`` (NaN outside the domain, so invalid designs show up).
+    CasADi path: ``sqrt(fmax(x, 0))`` so that a solver's iterate outside the domain never
+    produces NaN; a constraint of the problem keeps the solution inside.
+    """
+    return ca.sqrt(ca.fmax(x, 0)) if isinstance(x, _CASADI_TYPES) else np.sqrt(x)
+
+
 def arctan2(y, x):
     """Element-wise two-argument arctangent."""
     return ca.atan2(y, x) if is_symbolic(y, x) else np.arctan2(y, x)

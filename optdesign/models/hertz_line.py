@@ -33,7 +33,7 @@ def contact_half_width(D, F, L, E, nu):
 def pin_flattening(D, F, L, E, nu):
     """Flattening Delta (mm) of one body, eq. 11 (cancellation-free form)."""
     b2 = 4.0 * D * (F / L) * (1.0 - nu**2) / (m.pi * E)
-    return b2 / (0.5 * D + m.sqrt(0.25 * D**2 - b2))
+    return b2 / (0.5 * D + m.sqrt_domain(0.25 * D**2 - b2))
 
 
 def pin_flattening_first_order(D, F, L, E, nu):

@@ -12,6 +12,9 @@ from pathlib import Path
 #: name -> module path. Add one line per reproduction.
 REPRODUCTIONS: dict[str, str] = {
     "duan2017": "optdesign.reproduce.duan2017",
+    "prsm-contact": "optdesign.reproduce.prsm_contact",
+    "yang2016": "optdesign.reproduce.yang2016",
+    "li2016": "optdesign.reproduce.li2016",
 }
 
 

@@ -1,0 +1,1 @@
+"""CLI subcommands beyond ``reproduce``; each module registers itself with cli.command."""

@@ -1,0 +1,177 @@
+"""``optdesign solve FILE``: the optimal design of a problem file, with its evidence."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from optdesign.cli import command, default_out
+from optdesign.report import format_table
+from optdesign.solvers.result import Result
+
+#: formulation name -> function(problem, args) -> Result. "auto" picks among them.
+FORMULATIONS: dict = {}
+
+
+def formulation(name: str):
+    """Register a formulation's solve function for ``--formulation NAME``."""
+
+    def deco(fn):
+        FORMULATIONS[name] = fn
+        return fn
+
+    return deco
+
+
+@formulation("nlp")
+def _solve_nlp(problem, args) -> Result:
+    from optdesign.studies.solve import solve_nlp
+
+    return solve_nlp(
+        problem,
+        starts=args.starts,
+        seed=args.seed,
+        workers=args.workers,
+        plugin=args.solver,
+        objective=args.objective,
+    )
+
+
+def choose_formulation(problem, requested: str) -> str:
+    """The formulation to use: the requested one, or for ``auto`` the first that applies
+    (see :data:`AUTO_ORDER`)."""
+    if requested != "auto":
+        return requested
+    for name, applies in AUTO_ORDER:
+        if applies(problem):
+            return name
+    return "nlp"
+
+
+#: (formulation, predicate) tried in order by ``--formulation auto``.
+AUTO_ORDER: list = []
+
+
+@command("solve")
+def _solve(sub):
+    p = sub.add_parser("solve", help="find the optimal design of a problem file")
+    p.add_argument("file", type=Path, help="problem file (TOML)")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument("--json", action="store_true", help="print the result JSON to stdout")
+    p.add_argument("--formulation", default="auto", help="auto (default), nlp, ...")
+    p.add_argument("--solver", default="ipopt", help="CasADi nlpsol plugin (default ipopt)")
+    p.add_argument("--objective", default=None, help="objective to minimise (default: file's)")
+    p.add_argument("--starts", type=int, default=None, help="multistart count (default: file's)")
+    p.add_argument("--seed", type=int, default=None, help="multistart seed (default: file's)")
+    p.add_argument("--workers", type=int, default=1, help="local processes for the starts")
+    p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
+    p.set_defaults(func=run_solve)
+
+
+def run_solve(args) -> int:
+    from optdesign.errors import ProblemError
+    from optdesign.problem import load_problem
+
+    problem = load_problem(args.file)
+    name = choose_formulation(problem, args.formulation)
+    if name not in FORMULATIONS:
+        raise ProblemError(
+            f"--formulation: unknown formulation {name!r} (known: auto, {', '.join(FORMULATIONS)})"
+        )
+    result = FORMULATIONS[name](problem, args)
+    write_files = args.out is not None or not args.json
+    out = args.out or default_out(f"solve-{problem.name}")
+    if write_files:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "result.json").write_text(result.to_json())
+        if not args.no_plot and result.design:
+            from optdesign.plots.solution import plot_solution
+
+            start = problem.design_dict(problem.start())
+            plot_solution(
+                problem, {"initial design": start, "optimum": result.design}, out / "solution.png"
+            )
+    if args.json:
+        print(result.to_json())
+    else:
+        print(summary(problem, result))
+        if write_files:
+            print(
+                f"\nwrote {out / 'result.json'}"
+                + ("" if args.no_plot else f" and {out / 'solution.png'}")
+            )
+    return 0 if result.success else 1
+
+
+def summary(problem, result: Result) -> str:
+    """Readable summary: status, objective, design table, active and violated constraints."""
+    lines = [f"problem   {problem.name} ({problem.mechanism_kind})"]
+    lines.append(
+        f"status    {result.status} (solver {result.solver}, {result.formulation}, "
+        f"{result.message or result.termination.value}); independent check: "
+        f"{'passed' if result.verified else 'FAILED' if result.verified is False else 'n/a'}"
+    )
+    obj_name = result.extra.get("objective_name", problem.objective_names[0])
+    unit = {
+        "backlash": "deg",
+        "backlash_rss": "deg",
+        "size": "mm",
+        "nut_travel": "mm",
+        "motor_torque": "N*mm",
+    }.get(obj_name, "")
+    lines.append(f"objective {obj_name} = {result.objective:.8g} {unit}".rstrip())
+    lines.append(f"time      {result.wall_time_s:.3f} s")
+    if result.multistart:
+        ms = result.multistart
+        lines.append(
+            f"multistart {ms.n_at_best} of {ms.n_starts} starts reached the best point "
+            f"(within {ms.tolerance:g} relative; {ms.n_converged} converged; seed {ms.seed})"
+        )
+    for k, v in result.extra.items():
+        if k.startswith("note"):
+            lines.append(f"note      {v}")
+    rows = []
+    for var in problem.variables:
+        val = result.design.get(var.name, float("nan"))
+        if var.free:
+            at = ""
+            tol = 1e-6 * max(1.0, abs(var.upper - var.lower))
+            if abs(val - var.lower) < tol:
+                at = "at lower bound"
+            elif abs(val - var.upper) < tol:
+                at = "at upper bound"
+            bounds = f"[{var.lower:g}, {var.upper:g}]"
+        else:
+            bounds, at = "fixed", ""
+        shown = f"{val:.6g}" if var.unit != "rad" else f"{val:.6g} ({np.degrees(val):.3f} deg)"
+        rows.append([var.name, var.description, shown, var.unit, bounds, at])
+    lines += ["", format_table(["variable", "what", "value", "unit", "bounds", ""], rows)]
+    if result.objectives:
+        lines += [
+            "",
+            "objectives at this design: "
+            + ", ".join(f"{k} = {v:.6g}" for k, v in result.objectives.items()),
+        ]
+    envelope = [r for r in result.active if "_envelope[" in r.name]
+    limits = [r for r in result.active if "_envelope[" not in r.name]
+    if envelope:
+        where = sorted({r.name.split("[", 1)[1].rstrip("]") for r in envelope})
+        lines += ["", f"objective attained at: {', '.join(where)}"]
+    if limits:
+        lines += ["", "active constraints (what limits the optimum):"]
+        lines += [f"  {r.describe()}" for r in limits[:25]]
+        if len(limits) > 25:
+            lines.append(f"  ... and {len(limits) - 25} more")
+    if result.violated:
+        lines += ["", "violated constraints:"]
+        lines += [f"  {r.describe()}" for r in result.violated[:25]]
+        if len(result.violated) > 25:
+            lines.append(f"  ... and {len(result.violated) - 25} more")
+    if not result.success:
+        lines += [
+            "",
+            "no feasible design found"
+            + (": the requirements above conflict within the bounds" if result.violated else ""),
+        ]
+    return "\n".join(lines)

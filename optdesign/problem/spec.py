@@ -1,0 +1,217 @@
+"""Schema of a problem file, validated with pydantic; every quantity may carry a unit.
+
+Quantities are converted to the internal units (mm, N, MPa, N*mm, rad) on load by
+:func:`optdesign.units.to_internal`; a bare number is taken as already internal.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, model_validator
+
+from optdesign.errors import InputError
+from optdesign.models.fits import Fit
+from optdesign.units import to_internal
+
+
+def _quantity(dimension: str):
+    def convert(value: Any, info: ValidationInfo) -> float:
+        try:
+            return to_internal(value, dimension, info.field_name or dimension)
+        except InputError as exc:
+            raise ValueError(exc.reason) from None
+
+    return BeforeValidator(convert)
+
+
+Length = Annotated[float, _quantity("length")]
+Angle = Annotated[float, _quantity("angle")]
+Moment = Annotated[float, _quantity("moment")]
+Pressure = Annotated[float, _quantity("pressure")]
+Force = Annotated[float, _quantity("force")]
+Dimensionless = Annotated[float, _quantity("dimensionless")]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+#: Design variables each mechanism knows, and their dimension.
+VARIABLE_DIMENSIONS: dict[str, dict[str, str]] = {
+    "crank_slider": {
+        "R": "length",
+        "l": "length",
+        "n": "length",
+        "p": "length",
+        "phi0": "angle",
+        "i_a": "dimensionless",
+        "d": "length",
+        "pin_length": "length",
+        "pin_length_ratio": "dimensionless",
+    },
+    "fork": {
+        "R": "length",
+        "p": "length",
+        "phi0": "angle",
+        "i_a": "dimensionless",
+        "d": "length",
+        "pin_length": "length",
+        "pin_length_ratio": "dimensionless",
+    },
+}
+
+#: What each variable is, for tables and errors.
+VARIABLE_DESCRIPTIONS: dict[str, str] = {
+    "R": "arm length",
+    "l": "rod length",
+    "n": "offset of the screw axis",
+    "p": "screw lead",
+    "phi0": "neutral angle",
+    "i_a": "gear ratio",
+    "d": "pin diameter",
+    "pin_length": "pin length L",
+    "pin_length_ratio": "pin length ratio L/d",
+}
+
+#: Objective names a problem may minimise.
+OBJECTIVES = ("ripple", "backlash", "backlash_rss", "size", "nut_travel", "motor_torque")
+
+
+class Deflection(_Model):
+    """The deflection range and its grid."""
+
+    min: Angle
+    max: Angle
+    points: int = Field(61, ge=3, le=2001)
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if not self.min < self.max:
+            raise ValueError(f"min ({self.min} rad) must be below max ({self.max} rad)")
+        return self
+
+
+class Band(_Model):
+    """A dimensionless band [min, max]; either side may be omitted."""
+
+    min: float | None = None
+    max: float | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.min is not None and self.max is not None and self.min > self.max:
+            raise ValueError(f"min ({self.min}) is above max ({self.max})")
+        return self
+
+
+class AngleBand(_Model):
+    """An angle band [min, max]."""
+
+    min: Angle | None = None
+    max: Angle | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.min is not None and self.max is not None and self.min > self.max:
+            raise ValueError(f"min ({self.min} rad) is above max ({self.max} rad)")
+        return self
+
+
+class Material(_Model):
+    """Elastic constants of a pin material."""
+
+    E: Pressure = 2.1e5
+    nu: float = 0.3
+
+    @model_validator(mode="after")
+    def _physical(self):
+        if self.E <= 0:
+            raise ValueError(f"E must be positive, got {self.E}")
+        if not 0.0 < self.nu < 0.5:
+            raise ValueError(f"nu must lie in (0, 0.5), got {self.nu}")
+        return self
+
+
+class Materials(_Model):
+    pin: Material = Material()
+
+
+class Clearances(_Model):
+    """Fixed clearances of the joints that are not sized by the problem (seed 000 Fig. 8-9).
+
+    A, B: axial (screw bearings, screw/nut), C: nut slide across the screw axis
+    (crank-slider), O: output shaft (angle).
+    """
+
+    A: Length = 0.0
+    B: Length = 0.0
+    C: Length = 0.0
+    O: Angle = 0.0
+
+
+class Requirements(_Model):
+    """What a design must meet. Omitted requirements are not imposed."""
+
+    deflection: Deflection
+    hinge_moment: Moment
+    mean_ratio: Band | None = None
+    nut_travel_max: Length | None = None
+    transmission_angle: AngleBand | None = None
+    rod_inclination_max: Angle | None = None
+    assembly_margin_min: float = Field(
+        0.01, ge=0.0, lt=1.0, description="smallest (l^2 - u^2)/l^2 over the grid"
+    )
+    pin_bearing_pressure_max: Pressure | None = None
+    pin_shear_stress_max: Pressure | None = None
+    pin_shear_planes: int | None = Field(None, ge=1, le=2)
+    motor_torque_max: Moment | None = None
+    eta_screw: float = Field(1.0, gt=0.0, le=1.0)
+    eta_gear: float = Field(1.0, gt=0.0, le=1.0)
+    backlash_max: Angle | None = None
+    ripple_max: float | None = Field(None, gt=0.0)
+    fit: str = "H7/g6"
+    fit_clearance: Literal["min", "max"] = "max"
+
+    @model_validator(mode="after")
+    def _fit(self):
+        try:
+            Fit.parse(self.fit)
+        except InputError as exc:
+            raise ValueError(exc.reason) from None
+        return self
+
+
+class Objective(_Model):
+    """Objective(s) to minimise; several for Pareto fronts."""
+
+    minimize: list[Literal[OBJECTIVES]]  # type: ignore[valid-type]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _listify(cls, data):
+        if isinstance(data, dict) and isinstance(data.get("minimize"), str):
+            data = dict(data, minimize=[data["minimize"]])
+        return data
+
+
+class SolverOptions(_Model):
+    """Defaults of ``optdesign solve`` for this problem (the CLI may override them)."""
+
+    starts: int = Field(8, ge=1, le=10_000)
+    seed: int = 0
+    ipopt: dict[str, Any] = Field(default_factory=dict)
+
+
+class ProblemSpec(_Model):
+    """A whole problem file."""
+
+    name: str
+    description: str = ""
+    mechanism: Literal["crank_slider", "fork"]
+    variables: dict[str, Any]
+    requirements: Requirements
+    materials: Materials = Materials()
+    clearances: Clearances = Clearances()
+    objective: Objective
+    solver: SolverOptions = SolverOptions()

@@ -1,0 +1,1 @@
+"""Studies: solve a problem, trace Pareto fronts, benchmark solvers."""
