@@ -3,8 +3,8 @@
 Run:  /work/venv/bin/python benchmarks/bench_monte_carlo.py [--n 4000000] [--seed 7]
 
 Samples the transmission-error sources of seed 003 (lead, backlash, coaxiality,
-deformation from the stiffness chain, encoder, mounting, rod pins, environment), maps
-them to the output angle of the seed-000 crank-slider (R=90, l=80, n=50 mm, p=5 mm,
+deformation of the stiffness chain under a 500 N*m hinge moment, encoder, mounting, rod
+pins, environment), maps them to the output angle of the seed-000 crank-slider (R=90, l=80, n=50 mm, p=5 mm,
 i_a=2) through its kinematics, and prints samples per second, best of ``--repeat`` runs.
 Two cases: a fixed deflection, and a deflection drawn per sample over the +-30 deg stroke
 (kinematics evaluated per sample). The result is reproducible from the seed; the timing
