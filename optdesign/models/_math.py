@@ -22,6 +22,9 @@ _CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
 
 pi = np.pi
 
+#: Smallest argument of a guarded square root on the CasADi path.
+SQRT_GUARD = 1e-12
+
 
 def is_symbolic(*xs: Any) -> bool:
     """True if any argument is a CasADi object (the expression must stay in CasADi)."""
@@ -52,10 +55,12 @@ def sqrt_domain(x):
     """Square root for a quantity that is non-negative wherever the model is valid.
 
     NumPy path: plain ``sqrt`` (NaN outside the domain, so invalid designs show up).
-    CasADi path: ``sqrt(fmax(x, 0))`` so that a solver's iterate outside the domain never
-    produces NaN; a constraint of the problem keeps the solution inside.
+    CasADi path: ``sqrt(fmax(x, 1e-12))`` so that a solver's iterate outside the domain
+    never produces NaN, in the value or in its derivatives (sqrt'(0) is infinite, and
+    infinity times the zero derivative of fmax is NaN); a constraint of the problem keeps
+    the solution inside, where the guard is inactive.
     """
-    return ca.sqrt(ca.fmax(x, 0)) if isinstance(x, _CASADI_TYPES) else np.sqrt(x)
+    return ca.sqrt(ca.fmax(x, SQRT_GUARD)) if isinstance(x, _CASADI_TYPES) else np.sqrt(x)
 
 
 def arctan2(y, x):

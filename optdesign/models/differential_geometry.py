@@ -119,8 +119,12 @@ class Surface:
         Name of the CasADi Function.
     """
 
-    def __init__(self, builder: Callable[[ca.SX, ca.SX, ca.SX], ca.SX], n_params: int = 0,
-                 name: str = "surface"):
+    def __init__(
+        self,
+        builder: Callable[[ca.SX, ca.SX, ca.SX], ca.SX],
+        n_params: int = 0,
+        name: str = "surface",
+    ):
         u, v = ca.SX.sym("u"), ca.SX.sym("v")
         p = ca.SX.sym("p", n_params)
         r = builder(u, v, p)

@@ -149,9 +149,7 @@ def eccentricity_from_curvature_difference(F_rho: float) -> float:
     lo = 1e-300
     if curvature_difference_from_k2(lo) < F_rho:
         raise InputError("F_rho", f"{F_rho!r} too close to 1: ellipse beyond double precision")
-    k2 = brentq(
-        lambda t: curvature_difference_from_k2(t) - F_rho, lo, 1.0, xtol=1e-300, rtol=1e-15
-    )
+    k2 = brentq(lambda t: curvature_difference_from_k2(t) - F_rho, lo, 1.0, xtol=1e-300, rtol=1e-15)
     return math.sqrt(1.0 - k2)
 
 

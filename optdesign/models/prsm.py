@@ -85,14 +85,17 @@ class PRSMGeometry:
 
     def __post_init__(self):
         if not (isinstance(self.n_starts, int | np.integer) and self.n_starts >= 3):
-            raise InputError("n_starts", f"need an integer >= 3 (d_r = d_s/(n-2)), got {self.n_starts}")
+            raise InputError(
+                "n_starts", f"need an integer >= 3 (d_r = d_s/(n-2)), got {self.n_starts}"
+            )
         if not (math.isfinite(self.d_s) and self.d_s > 0):
             raise InputError("d_s", f"screw diameter must be positive, got {self.d_s}")
         if not (math.isfinite(self.pitch) and self.pitch > 0):
             raise InputError("pitch", f"pitch must be positive, got {self.pitch}")
         if not math.radians(5.0) < self.beta < math.radians(80.0):
             raise InputError(
-                "beta", f"flank half-angle must lie in (5, 80) deg, got {math.degrees(self.beta):.4g} deg"
+                "beta",
+                f"flank half-angle must lie in (5, 80) deg, got {math.degrees(self.beta):.4g} deg",
             )
         if self.roller_arc is not None and not (
             math.isfinite(self.roller_arc) and self.roller_arc > self.pitch
@@ -104,8 +107,9 @@ class PRSMGeometry:
         # roller: the axial tooth height p/(2 tan beta) must stay well inside the roller.
         if self.pitch / (2.0 * math.tan(self.beta)) >= 0.5 * self.r_r:
             raise InputError(
-                "pitch", f"tooth height p/(2 tan beta) = {self.pitch / (2 * math.tan(self.beta)):.4g}"
-                f" mm does not fit a roller of radius {self.r_r:.4g} mm"
+                "pitch",
+                f"tooth height p/(2 tan beta) = {self.pitch / (2 * math.tan(self.beta)):.4g}"
+                f" mm does not fit a roller of radius {self.r_r:.4g} mm",
             )
 
     @property
@@ -150,8 +154,11 @@ class PRSMGeometry:
 
     def helix_angle(self, part: str) -> float:
         """Helix angle atan(l / (pi d)) (rad) of ``"screw"``, ``"roller"`` or ``"nut"``."""
-        lead, d = {"screw": (self.lead_s, self.d_s), "roller": (self.lead_r, self.d_r),
-                   "nut": (self.lead_n, self.d_n)}[part]
+        lead, d = {
+            "screw": (self.lead_s, self.d_s),
+            "roller": (self.lead_r, self.d_r),
+            "nut": (self.lead_n, self.d_n),
+        }[part]
         return math.atan(lead / (math.pi * d))
 
     @property
@@ -252,8 +259,10 @@ class PRSMContact:
         g = self.g
         out = {}
         for key, (part, xi) in {
-            "screw": ("screw", +1), "roller_lower": ("roller", -1),
-            "roller_upper": ("roller", +1), "nut": ("nut", -1),
+            "screw": ("screw", +1),
+            "roller_lower": ("roller", -1),
+            "roller_upper": ("roller", +1),
+            "nut": ("nut", -1),
         }.items():
             r0, lead = _part_params(g, part)
             arc = g.roller_profile_radius if part == "roller" else None
@@ -273,11 +282,20 @@ class PRSMContact:
         psi = ca.SX.sym("psi")
         a = g.r_s + g.r_r
         centre = ca.vertcat(a * ca.cos(psi), a * ca.sin(psi), x[4])
-        pa = thread_flank(x[0], x[1], kind=part, xi=xi_a, r0=r0a, pitch=g.pitch, lead=lead_a,
-                          beta=g.beta)
-        pb = centre + thread_flank(x[2], x[3], kind="roller", xi=xi_b, r0=g.r_r,
-                                   pitch=g.pitch, lead=g.lead_r, beta=g.beta,
-                                   arc_radius=g.roller_profile_radius)
+        pa = thread_flank(
+            x[0], x[1], kind=part, xi=xi_a, r0=r0a, pitch=g.pitch, lead=lead_a, beta=g.beta
+        )
+        pb = centre + thread_flank(
+            x[2],
+            x[3],
+            kind="roller",
+            xi=xi_b,
+            r0=g.r_r,
+            pitch=g.pitch,
+            lead=g.lead_r,
+            beta=g.beta,
+            arc_radius=g.roller_profile_radius,
+        )
         Ja = ca.jacobian(pa, x[0:2])
         Jb = ca.jacobian(pb, x[2:4])
         ta_u = Ja[:, 0] / ca.norm_2(Ja[:, 0])
@@ -296,10 +314,20 @@ class PRSMContact:
         # Body 1 at its nominal radius facing the roller axis; roller at its nominal
         # radius on the line of centres (towards the screw, or away from it to the nut).
         theta_b = psi + math.pi if side == "screw" else psi
-        za = thread_flank(r0a, psi, kind=part, xi=xi_a, r0=r0a, pitch=g.pitch, lead=lead_a,
-                          beta=g.beta)[2]
-        zb = thread_flank(g.r_r, theta_b, kind="roller", xi=xi_b, r0=g.r_r, pitch=g.pitch,
-                          lead=g.lead_r, beta=g.beta, arc_radius=g.roller_profile_radius)[2]
+        za = thread_flank(
+            r0a, psi, kind=part, xi=xi_a, r0=r0a, pitch=g.pitch, lead=lead_a, beta=g.beta
+        )[2]
+        zb = thread_flank(
+            g.r_r,
+            theta_b,
+            kind="roller",
+            xi=xi_b,
+            r0=g.r_r,
+            pitch=g.pitch,
+            lead=g.lead_r,
+            beta=g.beta,
+            arc_radius=g.roller_profile_radius,
+        )[2]
         return np.array([r0a, psi, g.r_r, theta_b, za - zb])
 
     def contact(self, side: str, psi: float = 0.0, tol: float = 1e-12) -> ThreadContact:
@@ -331,7 +359,9 @@ class PRSMContact:
                 break
             x = x - np.linalg.solve(np.asarray(J), r)
         if not res < 1e-9:
-            raise InputError("geometry", f"no tangent {side}-roller contact found (residual {res:.3g})")
+            raise InputError(
+                "geometry", f"no tangent {side}-roller contact found (residual {res:.3g})"
+            )
         return self._analyse(side, psi, x, res)
 
     def _analyse(self, side: str, psi: float, x: np.ndarray, res: float) -> ThreadContact:

@@ -116,8 +116,16 @@ def thread_flank(
     return np.array([x, y, z])
 
 
-def flank_builder(kind: str, xi: int, r0: float, pitch: float, lead: float, beta: float,
-                  start: int = 0, arc_radius: float | None = None):
+def flank_builder(
+    kind: str,
+    xi: int,
+    r0: float,
+    pitch: float,
+    lead: float,
+    beta: float,
+    start: int = 0,
+    arc_radius: float | None = None,
+):
     """A ``builder(u, v, p)`` for :class:`~optdesign.models.differential_geometry.Surface`.
 
     u = rho, v = theta; the geometry is baked in as numbers (p unused).
@@ -125,7 +133,15 @@ def flank_builder(kind: str, xi: int, r0: float, pitch: float, lead: float, beta
 
     def builder(u, v, _p):
         return thread_flank(
-            u, v, kind=kind, xi=xi, r0=r0, pitch=pitch, lead=lead, beta=beta, start=start,
+            u,
+            v,
+            kind=kind,
+            xi=xi,
+            r0=r0,
+            pitch=pitch,
+            lead=lead,
+            beta=beta,
+            start=start,
             arc_radius=arc_radius,
         )
 

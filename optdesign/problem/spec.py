@@ -8,7 +8,15 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from optdesign.errors import InputError
 from optdesign.models.fits import Fit
@@ -173,13 +181,14 @@ class Requirements(_Model):
     fit: str = "H7/g6"
     fit_clearance: Literal["min", "max"] = "max"
 
-    @model_validator(mode="after")
-    def _fit(self):
+    @field_validator("fit")
+    @classmethod
+    def _fit(cls, value: str) -> str:
         try:
-            Fit.parse(self.fit)
+            Fit.parse(value)
         except InputError as exc:
             raise ValueError(exc.reason) from None
-        return self
+        return value
 
 
 class Objective(_Model):
@@ -203,6 +212,63 @@ class SolverOptions(_Model):
     ipopt: dict[str, Any] = Field(default_factory=dict)
 
 
+def _band_table(data: Any) -> Any:
+    # ``R = "0.05 mm"`` is short for ``R = { band = "0.05 mm" }``.
+    return {"band": data} if isinstance(data, str | int | float) else data
+
+
+class _Tolerance(_Model):
+    @model_validator(mode="after")
+    def _non_negative(self):
+        if self.band < 0:  # type: ignore[attr-defined]
+            raise ValueError(f"band must be >= 0, got {self.band}")  # type: ignore[attr-defined]
+        return self
+
+
+class LengthTolerance(_Tolerance):
+    """Manufacturing tolerance +-band of a length: uniform on [-band, band] or normal with
+    sigma = band/3 (a process capability Cp = 1)."""
+
+    band: Length
+    distribution: Literal["normal", "uniform"] = "normal"
+
+
+class AngleTolerance(_Tolerance):
+    """Manufacturing tolerance +-band of an angle (see :class:`LengthTolerance`)."""
+
+    band: Angle
+    distribution: Literal["normal", "uniform"] = "normal"
+
+
+_LengthTol = Annotated[LengthTolerance, BeforeValidator(_band_table)]
+_AngleTol = Annotated[AngleTolerance, BeforeValidator(_band_table)]
+
+
+class Tolerances(_Model):
+    """Manufacturing scatter of a design, for robust design (formulations/robust.py).
+
+    R, l, n, p, d: length tolerances; phi0: angle tolerance. ``fit = "uniform"`` draws
+    each pin joint's fit clearance uniformly between the fit's smallest and largest
+    clearance (``"fixed"``: the requirement's ``fit_clearance``). ``samples`` and ``seed``
+    fix the sample-average approximation; ``risk`` is the minimised statistic of the
+    objective over the samples: ``"cvar"`` (mean of the worst 1 - alpha) or
+    ``"mean_std"`` (mean + k std).
+    """
+
+    R: _LengthTol | None = None
+    l: _LengthTol | None = None
+    n: _LengthTol | None = None
+    p: _LengthTol | None = None
+    d: _LengthTol | None = None
+    phi0: _AngleTol | None = None
+    fit: Literal["fixed", "uniform"] = "fixed"
+    samples: int = Field(32, ge=1, le=2000)
+    seed: int = 0
+    risk: Literal["cvar", "mean_std"] = "cvar"
+    alpha: float = Field(0.9, ge=0.0, lt=1.0)
+    k: float = Field(2.0, ge=0.0)
+
+
 class ProblemSpec(_Model):
     """A whole problem file."""
 
@@ -215,3 +281,4 @@ class ProblemSpec(_Model):
     clearances: Clearances = Clearances()
     objective: Objective
     solver: SolverOptions = SolverOptions()
+    tolerances: Tolerances | None = None

@@ -93,7 +93,7 @@ def multistart(
         n_converged=sum(r.success for r in results),
         n_at_best=n_at_best,
         tolerance=rel_tol,
-        objectives=[r.objective for r in results],
+        objectives=[r.objective if r.success else math.nan for r in results],
         seed=seed,
         workers=workers,
     )

@@ -29,8 +29,9 @@ def reference_geometry(**changes) -> PRSMGeometry:
 
     Keyword arguments override fields (e.g. ``pitch=3.0`` or ``roller_arc=10.0``).
     """
-    return replace(PRSMGeometry(d_s=30.0, n_starts=5, pitch=2.0, beta=math.radians(45.0)),
-                   **changes)
+    return replace(
+        PRSMGeometry(d_s=30.0, n_starts=5, pitch=2.0, beta=math.radians(45.0)), **changes
+    )
 
 
 @dataclass(frozen=True)
@@ -61,8 +62,9 @@ class ContactSweep:
         return float(r[np.argmax(np.abs(r))])
 
 
-def sweep_geometries(x: Sequence[float], geometries: Sequence[PRSMGeometry], Q: float = 1000.0,
-                     psi: float = 0.0) -> ContactSweep:
+def sweep_geometries(
+    x: Sequence[float], geometries: Sequence[PRSMGeometry], Q: float = 1000.0, psi: float = 0.0
+) -> ContactSweep:
     """Contact at both sides for each geometry, at load Q (N) and position psi (rad)."""
     keys = ("omega", "e", "e0", "e0_nearest", "area", "area0")
     out = {k: {s: np.empty(len(geometries)) for s in SIDES} for k in keys}
@@ -88,8 +90,12 @@ def _with_arc(g: PRSMGeometry, arc_ratio: float | None) -> PRSMGeometry:
     return replace(g, roller_arc=arc_ratio * g.r_r / math.sin(g.beta))
 
 
-def sweep_pitch(pitches: Sequence[float], base: PRSMGeometry | None = None,
-                Q: float = 1000.0, arc_ratio: float | None = None) -> ContactSweep:
+def sweep_pitch(
+    pitches: Sequence[float],
+    base: PRSMGeometry | None = None,
+    Q: float = 1000.0,
+    arc_ratio: float | None = None,
+) -> ContactSweep:
     """omega and eccentricity against the pitch (mm), other fields from ``base``.
 
     ``arc_ratio``: if given, the roller arc radius is ``arc_ratio * r_r / sin(beta)``.
@@ -99,12 +105,15 @@ def sweep_pitch(pitches: Sequence[float], base: PRSMGeometry | None = None,
     return sweep_geometries(pitches, geoms, Q)
 
 
-def sweep_flank_angle(betas_deg: Sequence[float], base: PRSMGeometry | None = None,
-                      Q: float = 1000.0, arc_ratio: float | None = None) -> ContactSweep:
+def sweep_flank_angle(
+    betas_deg: Sequence[float],
+    base: PRSMGeometry | None = None,
+    Q: float = 1000.0,
+    arc_ratio: float | None = None,
+) -> ContactSweep:
     """omega and eccentricity against the flank half-angle (deg); ``arc_ratio`` as above."""
     base = reference_geometry() if base is None else base
-    geoms = [_with_arc(replace(base, beta=math.radians(float(b))), arc_ratio)
-             for b in betas_deg]
+    geoms = [_with_arc(replace(base, beta=math.radians(float(b))), arc_ratio) for b in betas_deg]
     return sweep_geometries(betas_deg, geoms, Q)
 
 
