@@ -402,6 +402,25 @@ class DesignProblem:
                         "worst-case output backlash",
                     )
                 )
+        if req.screw is not None:
+            self._screw_constraints(con, mech, phi, M_h, labels)
+        if req.lock is not None:
+            lock_force = self._lock_force(mech, phi, M_h)
+            obj["lock_force"] = ObjectiveTerm(
+                "lock_force", "max", lock_force, "N", "magnet force of the motor-shaft lock"
+            )
+            if req.lock.force_max is not None:
+                con.append(
+                    ConstraintBlock(
+                        "lock_force",
+                        lock_force,
+                        None,
+                        req.lock.force_max,
+                        labels,
+                        "N",
+                        "magnet force of the motor-shaft lock",
+                    )
+                )
         if req.motor_torque_max is not None:
             con.append(
                 ConstraintBlock(
@@ -415,6 +434,50 @@ class DesignProblem:
                 )
             )
         return Expressions(obj, con, mech)
+
+    def _screw_constraints(self, con, mech, phi, M_h, labels) -> None:
+        """Buckling and yield of the screw shaft under the nut force at every angle."""
+        from optdesign.models.screw_sizing import buckling_load, yield_load
+
+        sz = self.spec.requirements.screw
+        F_a = mech.nut_force(phi, M_h)
+        if sz.buckling_length is not None:
+            P1 = buckling_load(sz.root_diameter, sz.buckling_length, sz.mounting)
+            con.append(
+                ConstraintBlock(
+                    "screw_buckling",
+                    F_a,
+                    None,
+                    float(P1),
+                    labels,
+                    "N",
+                    f"nut force <= buckling load ({sz.mounting})",
+                )
+            )
+        if sz.check_yield:
+            con.append(
+                ConstraintBlock(
+                    "screw_yield",
+                    F_a,
+                    None,
+                    float(yield_load(sz.root_diameter)),
+                    labels,
+                    "N",
+                    "nut force <= permissible shaft load",
+                )
+            )
+
+    def _lock_force(self, mech, phi, M_h):
+        """Magnet force the lock needs at each angle (N), seed 002 coupled to the drive."""
+        from optdesign.models.lock import FrictionPlateLock, PinLock, motor_shaft_lock_load
+
+        lk = self.spec.requirements.lock
+        if lk.kind == "friction_plate":
+            lock = FrictionPlateLock(lk.r1, lk.r2, lk.mu)
+        else:
+            lock = PinLock(lk.radius, bearing="guide" if lk.kind == "pin_rolling" else None)
+        load = motor_shaft_lock_load(mech, phi, M_h, lk.eta_screw_back, lk.eta_gear_back)
+        return lock.force(load.moment)
 
     # --- numeric evaluation (NumPy path) ------------------------------------------------
     def evaluate(self, x: np.ndarray) -> dict[str, Any]:

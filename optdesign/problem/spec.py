@@ -83,7 +83,15 @@ VARIABLE_DESCRIPTIONS: dict[str, str] = {
 }
 
 #: Objective names a problem may minimise.
-OBJECTIVES = ("ripple", "backlash", "backlash_rss", "size", "nut_travel", "motor_torque")
+OBJECTIVES = (
+    "ripple",
+    "backlash",
+    "backlash_rss",
+    "size",
+    "nut_travel",
+    "motor_torque",
+    "lock_force",
+)
 
 
 class Deflection(_Model):
@@ -158,6 +166,49 @@ class Clearances(_Model):
     O: Angle = 0.0
 
 
+class ScrewSizing(_Model):
+    """Catalogue sizing checks of the screw shaft under the nut force (physics.md 8)."""
+
+    root_diameter: Length
+    buckling_length: Length | None = None
+    mounting: Literal["fixed-free", "supported-supported", "fixed-supported", "fixed-fixed"] = (
+        "fixed-supported"
+    )
+    check_yield: bool = True
+
+    @model_validator(mode="after")
+    def _positive(self):
+        if self.root_diameter <= 0:
+            raise ValueError(f"root_diameter must be positive, got {self.root_diameter}")
+        if self.buckling_length is not None and self.buckling_length <= 0:
+            raise ValueError(f"buckling_length must be positive, got {self.buckling_length}")
+        return self
+
+
+class MotorLock(_Model):
+    """Power-off lock on the motor shaft (seed 002): what it must hold and its force."""
+
+    kind: Literal["friction_plate", "pin", "pin_rolling"]
+    radius: Length | None = None
+    r1: Length | None = None
+    r2: Length | None = None
+    mu: float = Field(0.3, gt=0.0)
+    eta_screw_back: float = Field(1.0, le=1.0)
+    eta_gear_back: float = Field(1.0, gt=0.0, le=1.0)
+    force_max: Force | None = None
+
+    @model_validator(mode="after")
+    def _geometry(self):
+        if self.kind == "friction_plate":
+            if self.r1 is None or self.r2 is None:
+                raise ValueError("a friction_plate lock needs r1 and r2")
+            if not 0 <= self.r1 < self.r2:
+                raise ValueError(f"need 0 <= r1 < r2, got r1={self.r1}, r2={self.r2}")
+        elif self.radius is None or self.radius <= 0:
+            raise ValueError(f"a {self.kind} lock needs a positive radius")
+        return self
+
+
 class Requirements(_Model):
     """What a design must meet. Omitted requirements are not imposed."""
 
@@ -180,6 +231,8 @@ class Requirements(_Model):
     ripple_max: float | None = Field(None, gt=0.0)
     fit: str = "H7/g6"
     fit_clearance: Literal["min", "max"] = "max"
+    screw: ScrewSizing | None = None
+    lock: MotorLock | None = None
 
     @field_validator("fit")
     @classmethod

@@ -1,0 +1,85 @@
+"""Screw sizing and motor-shaft lock (issue 7) as requirements and objectives of problems."""
+
+import numpy as np
+import pytest
+
+from optdesign.errors import ProblemError
+from optdesign.mechanisms import CrankSlider
+from optdesign.models.lock import PinLock, motor_shaft_lock_load
+from optdesign.models.screw_sizing import buckling_load
+from optdesign.problem import problem_from_dict
+from optdesign.studies.solve import solve_nlp
+
+
+def _problem(**req):
+    objective = req.pop("_objective", "ripple")
+    data = {
+        "name": "drive",
+        "mechanism": "crank_slider",
+        "variables": {
+            "R": {"lower": 30, "upper": 120},
+            "l": {"lower": 40, "upper": 200},
+            "n": {"lower": 0, "upper": 150},
+            "p": {"lower": 2, "upper": 10},
+            "phi0": {"lower": -0.6, "upper": 0.6},
+            "i_a": 2,
+        },
+        "requirements": {
+            "deflection": {"min": "-30 deg", "max": "30 deg", "points": 31},
+            "hinge_moment": "500 N*m",
+            "mean_ratio": {"min": 200, "max": 260},
+            "nut_travel_max": "110 mm",
+            "transmission_angle": {"min": "40 deg", "max": "140 deg"},
+            "rod_inclination_max": "30 deg",
+            **req,
+        },
+        "objective": {"minimize": objective},
+    }
+    return problem_from_dict(data)
+
+
+def test_lock_force_objective_matches_the_model():
+    lock = {"kind": "pin", "radius": "40 mm", "eta_screw_back": 0.9}
+    problem = _problem(lock=lock, _objective="lock_force")
+    res = solve_nlp(problem, starts=4)
+    assert res.status == "optimal" and res.verified
+    d = res.design
+    mech = CrankSlider(d["R"], d["l"], d["n"], d["p"], d["i_a"], d["phi0"])
+    load = motor_shaft_lock_load(mech, problem.phi, 500e3, 0.9, 1.0, PinLock(40.0))
+    assert res.objective == pytest.approx(float(load.force), rel=1e-7)
+    # the paper's pin lock: f_a = 0.35 M / R
+    assert float(load.force) == pytest.approx(0.35 * float(load.moment_max) / 40.0, rel=1e-12)
+    # the least lock force wants the smallest nut force: the mean ratio sits at its top
+    assert res.objectives["ripple"] < 0.2
+    names = {r.name for r in res.active}
+    assert "mean_ratio" in names
+
+
+def test_screw_buckling_is_imposed_and_named_when_it_cannot_be_met():
+    # la = 500 mm: P1 = 10 * 12.5^4 / 500^2 * 1e4 = 9766 N, met by the ripple optimum
+    ok = _problem(screw={"root_diameter": "12.5 mm", "buckling_length": "500 mm"})
+    res = solve_nlp(ok, starts=3)
+    assert res.status == "optimal"
+    x = np.array([res.design[v.name] for v in ok.free])
+    F = ok.evaluate(x)["constraints"]["screw_buckling"][0]
+    P1 = buckling_load(12.5, 500.0)
+    assert P1 == pytest.approx(9765.625)
+    assert np.max(F) <= P1 * (1 + 1e-6)
+    # la = 1500 mm: P1 = 1085 N, below any nut force that carries 500 N*m over a 110 mm travel
+    bad = _problem(screw={"root_diameter": "12.5 mm", "buckling_length": "1500 mm"})
+    res = solve_nlp(bad, starts=3)
+    assert not res.success
+    assert any(v.name.startswith("screw_buckling") for v in res.violated)
+
+
+@pytest.mark.parametrize(
+    ("lock", "message"),
+    [
+        ({"kind": "friction_plate", "r1": "30 mm"}, "r1 and r2"),
+        ({"kind": "pin"}, "positive radius"),
+        ({"kind": "pin", "radius": "40 N"}, "requirements.lock.radius"),
+    ],
+)
+def test_lock_requirement_errors(lock, message):
+    with pytest.raises(ProblemError, match=message):
+        _problem(lock=lock)
