@@ -236,3 +236,13 @@ def test_solve_cli_summary(tmp_path, capsys):
     assert code == 0
     assert "status    optimal" in text and "arm length" in text and "multistart" in text
     assert "active constraints" in text
+
+
+def test_multistart_on_two_processes_matches_in_process():
+    problem = load_problem(PROBLEMS / "fork_min_backlash.toml")
+    one = solve_nlp(problem, starts=4, seed=5, workers=1)
+    two = solve_nlp(problem, starts=4, seed=5, workers=2)
+    assert two.multistart.workers == 2
+    assert two.objective == pytest.approx(one.objective, rel=1e-9)
+    assert two.multistart.n_at_best == one.multistart.n_at_best
+    np.testing.assert_allclose(two.multistart.objectives, one.multistart.objectives, rtol=1e-9)
