@@ -246,3 +246,23 @@ def test_multistart_on_two_processes_matches_in_process():
     assert two.objective == pytest.approx(one.objective, rel=1e-9)
     assert two.multistart.n_at_best == one.multistart.n_at_best
     np.testing.assert_allclose(two.multistart.objectives, one.multistart.objectives, rtol=1e-9)
+
+
+def test_optimal_ranges_expose_non_unique_optima():
+    from optdesign.studies.solve import optimal_ranges
+
+    fork = load_problem(PROBLEMS / "fork_min_backlash.toml")
+    res = solve_nlp(fork, starts=2)
+    ranges = optimal_ranges(fork, res)
+    R = res.design["R"]
+    # R and d are pinned by travel and bearing pressure; the lead only has to keep the mean
+    # ratio c R / p inside [200, 260], c = mean of 2 pi i_a / cos^2 phi over the grid
+    c = np.mean(2 * np.pi * 2 / np.cos(fork.phi) ** 2)
+    assert ranges["p"] == pytest.approx((c * R / 260, c * R / 200), rel=1e-6)
+    assert ranges["R"][1] - ranges["R"][0] < 1e-4
+    assert ranges["d"][1] - ranges["d"][0] < 1e-4
+    ripple = load_problem(PROBLEMS / "cs_min_ripple.toml")
+    res = solve_nlp(ripple, starts=2)
+    ranges = optimal_ranges(ripple, res)
+    assert ranges["R"][1] / ranges["R"][0] > 2  # ripple is scale-invariant in R, l, n, p
+    assert ranges["phi0"][1] - ranges["phi0"][0] < 1e-3

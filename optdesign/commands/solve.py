@@ -28,6 +28,14 @@ def formulation(name: str):
 def _solve_nlp(problem, args) -> Result:
     from optdesign.studies.solve import solve_nlp
 
+    if any(v.discrete for v in problem.free):  # never solve catalogue variables as continuous
+        from optdesign.errors import ProblemError
+
+        raise ProblemError(
+            "--formulation nlp: variables "
+            + ", ".join(v.name for v in problem.free if v.discrete)
+            + " take catalogue values; use --formulation catalogue (or auto)"
+        )
     return solve_nlp(
         problem,
         starts=args.starts,
@@ -36,6 +44,13 @@ def _solve_nlp(problem, args) -> Result:
         plugin=args.solver,
         objective=args.objective,
     )
+
+
+@formulation("robust")
+def _solve_robust(problem, args) -> Result:
+    from optdesign.studies.robust import solve_robust_cli
+
+    return solve_robust_cli(problem, args)
 
 
 def choose_formulation(problem, requested: str) -> str:
@@ -66,6 +81,11 @@ def _solve(sub):
     p.add_argument("--seed", type=int, default=None, help="multistart seed (default: file's)")
     p.add_argument("--workers", type=int, default=1, help="local processes for the starts")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
+    p.add_argument(
+        "--no-ranges",
+        action="store_true",
+        help="skip the ranges of the variables over the optimal set (2 solves per variable)",
+    )
     p.set_defaults(func=run_solve)
 
 
@@ -80,6 +100,15 @@ def run_solve(args) -> int:
             f"--formulation: unknown formulation {name!r} (known: auto, {', '.join(FORMULATIONS)})"
         )
     result = FORMULATIONS[name](problem, args)
+    if result.success and not getattr(args, "no_ranges", False) and result.design:
+        from optdesign.studies.solve import optimal_ranges
+
+        try:
+            result.extra["optimal_ranges"] = optimal_ranges(
+                problem, result, objective=result.extra.get("objective_name")
+            )
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.extra["optimal_ranges_error"] = str(exc)
     write_files = args.out is not None or not args.json
     out = args.out or default_out(f"solve-{problem.name}")
     if write_files:
@@ -146,7 +175,22 @@ def summary(problem, result: Result) -> str:
             bounds, at = "fixed", ""
         shown = f"{val:.6g}" if var.unit != "rad" else f"{val:.6g} ({np.degrees(val):.3f} deg)"
         rows.append([var.name, var.description, shown, var.unit, bounds, at])
-    lines += ["", format_table(["variable", "what", "value", "unit", "bounds", ""], rows)]
+    ranges = result.extra.get("optimal_ranges", {})
+    for row in rows:
+        lo_hi = ranges.get(row[0])
+        if lo_hi and lo_hi[1] - lo_hi[0] > 1e-4 * max(1.0, abs(lo_hi[1])):
+            row.append(f"optimal for any value in [{lo_hi[0]:.6g}, {lo_hi[1]:.6g}]")
+        else:
+            row.append("")
+    lines += [
+        "",
+        format_table(["variable", "what", "value", "unit", "bounds", "", "optimal set"], rows),
+    ]
+    if any(r[-1] for r in rows):
+        lines.append(
+            "(the optimum is not unique: the variables marked above can move within their range,"
+            " together, without changing the objective by more than 1e-6 relative)"
+        )
     if result.objectives:
         lines += [
             "",

@@ -154,6 +154,12 @@ def build_nlp(
 
     values: dict[str, Any] = {}
     wanted = set(weights) | set(epsilon)
+    free_names = {v.name for v in free}
+    for name in list(wanted):
+        if name in free_names:
+            # a design variable as objective: ranges of non-unique optima (studies.solve)
+            values[name] = design[name]
+            wanted.discard(name)
     for name in wanted:
         if name not in ex.objectives:
             raise ProblemError(

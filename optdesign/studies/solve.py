@@ -78,6 +78,36 @@ def solve_nlp(
     return finish(problem, result, objective)
 
 
+def optimal_ranges(
+    problem: DesignProblem, result: Result, rel: float = 1e-6, objective: str | None = None
+) -> dict[str, tuple[float, float]]:
+    """Range of each free variable over the (near-)optimal set.
+
+    Minimises and maximises each variable subject to the requirements and to the objective
+    staying within ``rel`` of the optimum, warm-started at the optimum. A wide range means
+    the optimum does not fix that variable (e.g. the lead p in a backlash problem, or the
+    size of a ripple-optimal linkage, since ripple is invariant when R, l, n, p scale
+    together). Variables whose searches fail keep their optimal value on that side.
+    """
+    objective = objective or problem.objective_names[0]
+    limit = result.objective + rel * max(abs(result.objective), 1e-12)
+    x_opt = np.array([result.design[v.name] for v in problem.free])
+    ranges = {}
+    for var in problem.free:
+        ends = []
+        for sign in (1.0, -1.0):
+            nlp = build_nlp(problem, objective={var.name: sign}, epsilon={objective: limit})
+            r = CasadiNLPSolver(nlp, options={"max_iter": 200}).solve(x_opt)
+            ok = r.success and r.max_violation <= 1e-6
+            ends.append(r.design[var.name] if ok else result.design[var.name])
+        lo, hi = min(ends), max(ends)
+        ranges[var.name] = (
+            float(min(lo, result.design[var.name])),
+            float(max(hi, result.design[var.name])),
+        )
+    return ranges
+
+
 def finish(problem: DesignProblem, result: Result, objective: str | None = None) -> Result:
     """Check the result on the NumPy path, fill every objective and the full design."""
     objective = objective or problem.objective_names[0]
