@@ -21,11 +21,17 @@ def plot_curves(
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     for label, y in curves.items():
         ax.plot(phi_deg, y, (styles or {}).get(label, "-"), label=label)
-    ax.set_xlabel("deflection phi (deg)")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
-    ax.grid(True, alpha=0.3)
-    ax.legend()
+    return save_deflection_figure(fig, [ax], path)
+
+
+def save_deflection_figure(fig, axes, path: Path) -> Path:
+    """Label the deflection axis, add grid and legend to ``axes``, save ``fig`` as PNG."""
+    for ax in axes:
+        ax.set_xlabel("deflection phi (deg)")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -8,6 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from optdesign.plots.curves import save_deflection_figure
 from optdesign.problem.design_problem import DesignProblem
 
 
@@ -35,13 +36,4 @@ def plot_solution(
     if has_pin:
         axes[1].set_ylabel("worst-case backlash (deg)")
         axes[1].set_title("output backlash over the stroke")
-    for ax in axes:
-        ax.set_xlabel("deflection phi (deg)")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save_deflection_figure(fig, axes, path)

@@ -108,30 +108,29 @@ class Deflection(_Model):
         return self
 
 
-class Band(_Model):
-    """A dimensionless band [min, max]; either side may be omitted."""
+class _OrderedBand(_Model):
+    """A band [min, max]; either side may be omitted, min may not exceed max."""
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        lo, hi = self.min, self.max  # type: ignore[attr-defined]
+        if lo is not None and hi is not None and lo > hi:
+            raise ValueError(f"min ({lo}) is above max ({hi})")
+        return self
+
+
+class Band(_OrderedBand):
+    """A dimensionless band [min, max]."""
 
     min: float | None = None
     max: float | None = None
 
-    @model_validator(mode="after")
-    def _ordered(self):
-        if self.min is not None and self.max is not None and self.min > self.max:
-            raise ValueError(f"min ({self.min}) is above max ({self.max})")
-        return self
 
-
-class AngleBand(_Model):
-    """An angle band [min, max]."""
+class AngleBand(_OrderedBand):
+    """An angle band [min, max] (rad once parsed)."""
 
     min: Angle | None = None
     max: Angle | None = None
-
-    @model_validator(mode="after")
-    def _ordered(self):
-        if self.min is not None and self.max is not None and self.min > self.max:
-            raise ValueError(f"min ({self.min} rad) is above max ({self.max} rad)")
-        return self
 
 
 class Material(_Model):
@@ -335,3 +334,5 @@ class ProblemSpec(_Model):
     objective: Objective
     solver: SolverOptions = SolverOptions()
     tolerances: Tolerances | None = None
+    #: A design to compare with (e.g. a paper's); checked by optdesign.studies.reference.
+    reference: dict[str, Any] | None = None
