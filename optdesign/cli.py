@@ -67,6 +67,7 @@ def _load_plugins() -> None:
 #: Modules that register further subcommands with @command (solve, pareto, bench ...).
 PLUGIN_MODULES: list[str] = [
     "optdesign.commands.solve",
+    "optdesign.commands.gp_catalogue",
 ]
 
 

@@ -100,7 +100,12 @@ def run_solve(args) -> int:
             f"--formulation: unknown formulation {name!r} (known: auto, {', '.join(FORMULATIONS)})"
         )
     result = FORMULATIONS[name](problem, args)
-    if result.success and not getattr(args, "no_ranges", False) and result.design:
+    # Ranges of the optimal set: for continuous NLP optima only (a GP optimum is of the
+    # first-order model, a catalogue optimum of fixed items).
+    continuous_nlp = result.formulation.startswith("nlp") and not any(
+        v.discrete for v in problem.free
+    )
+    if result.success and continuous_nlp and not args.no_ranges and result.design:
         from optdesign.studies.solve import optimal_ranges
 
         try:

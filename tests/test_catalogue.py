@@ -1,0 +1,75 @@
+"""Catalogue variables (issue 4): branch and bound vs enumeration, relaxation bound."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from optdesign.errors import ProblemError
+from optdesign.problem import load_problem, problem_from_dict
+from optdesign.studies.catalogue import is_on_catalogue, relaxation_bound, solve_catalogue
+
+ROOT = Path(__file__).resolve().parents[1]
+CATALOGUE = ROOT / "problems" / "cs_min_backlash_catalogue.toml"
+#: Continuous optimum of cs_min_backlash (known; the relaxation of the catalogue problem).
+RELAXED = 0.0362197
+
+
+def _small_catalogue():
+    """The shipped problem with 2 leads x 3 pins around the optimum (6 combinations)."""
+    data = tomllib.loads(CATALOGUE.read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["5 mm", "6 mm", "8 mm"]}
+    return problem_from_dict(data)
+
+
+def test_loader_reads_the_iso_catalogues():
+    problem = load_problem(CATALOGUE)
+    assert problem.by_name["p"].values == (2, 2.5, 3, 4, 5, 6, 8, 10)
+    assert problem.by_name["d"].values == (4, 5, 6, 8, 10, 12, 16, 20, 25)
+
+
+def test_branch_and_bound_equals_enumeration_small_catalogue():
+    problem = _small_catalogue()
+    enum = solve_catalogue(problem, method="enumerate", starts=2)
+    bnb = solve_catalogue(problem, method="bnb", starts=2)
+    assert enum.status == "optimal" and bnb.status == "optimal"
+    assert bnb.objective == pytest.approx(enum.objective, rel=1e-6)
+    # p = 6, d = 6 is the best pair (p = 5 with d = 6 gives 0.03703 deg)
+    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    assert bnb.objective == pytest.approx(0.0363462, rel=1e-5)
+    assert is_on_catalogue(problem, bnb.design) and bnb.verified
+    # the relaxation (p in [5, 6], d in [5, 8] continuous) bounds the discrete optimum
+    assert relaxation_bound(bnb) < bnb.objective
+    assert len(enum.extra["catalogue"]["enumerated"]) == 6
+    assert bnb.extra["catalogue"]["nlp_solves"] < enum.extra["catalogue"]["nlp_solves"]
+
+
+@pytest.mark.slow
+def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
+    problem = load_problem(CATALOGUE)
+    bnb = solve_catalogue(problem, method="bnb", starts=3)
+    enum = solve_catalogue(problem, method="enumerate", starts=2)
+    assert bnb.objective == pytest.approx(enum.objective, rel=1e-6)
+    assert relaxation_bound(bnb) == pytest.approx(RELAXED, rel=1e-5)
+    assert relaxation_bound(bnb) < bnb.objective
+    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+
+
+def test_catalogue_problem_is_never_solved_as_continuous():
+    from optdesign.cli import _load_plugins
+    from optdesign.commands.solve import FORMULATIONS, choose_formulation
+
+    _load_plugins()
+    problem = load_problem(CATALOGUE)
+    assert choose_formulation(problem, "auto") == "catalogue"
+
+    class Args:
+        starts, seed, workers, solver, objective = 1, 0, 1, "ipopt", None
+
+    with pytest.raises(ProblemError, match="catalogue values"):
+        FORMULATIONS["nlp"](problem, Args())
+    with pytest.raises(ProblemError, match=r"variable p: .*catalogue"):
+        FORMULATIONS["gp"](problem, Args())

@@ -1,0 +1,132 @@
+"""Geometric-programming formulation (issue 4): tracer algebra, GP vs exact NLP, diagnosis."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from optdesign.errors import ProblemError
+from optdesign.formulations.gp import NotGP, Signomial, build_gp, is_gp
+from optdesign.models.fits import fit_clearance
+from optdesign.problem import load_problem, problem_from_dict
+from optdesign.studies.gp import require_gp, solve_gp_problem
+
+ROOT = Path(__file__).resolve().parents[1]
+FORK = ROOT / "problems" / "fork_min_backlash.toml"
+#: Known exact optimum of fork_min_backlash (Ipopt multistart, confirmed by DE).
+FORK_NLP_OPTIMUM = 0.0194989
+
+#: The paper's crank-slider with its linkage fixed: only the lead and the pins are sized.
+CS_FIXED = {
+    "name": "cs_fixed_linkage",
+    "mechanism": "crank_slider",
+    "variables": {
+        "R": 90,
+        "l": 80,
+        "n": 50,
+        "phi0": 0.0,
+        "p": {"lower": 2, "upper": 10},
+        "d": {"lower": 4, "upper": 30},
+        "i_a": 2,
+        "pin_length_ratio": 1.5,
+    },
+    "requirements": {
+        "deflection": {"min": "-30 deg", "max": "30 deg", "points": 61},
+        "hinge_moment": "500 N*m",
+        "mean_ratio": {"min": 200, "max": 260},
+        "nut_travel_max": "110 mm",
+        "pin_bearing_pressure_max": "100 MPa",
+        "pin_shear_stress_max": "200 MPa",
+        "pin_shear_planes": 2,
+    },
+    "objective": {"minimize": "backlash"},
+}
+
+
+def test_tracer_merges_like_terms_into_a_monomial():
+    names = ("R", "d")
+    R = Signomial.variable(names, 0, np.array([90.0, 10.0]))
+    t = np.tan(np.radians(30.0))
+    travel = R * np.tan(np.radians(30.0)) - R * np.tan(np.radians(-30.0))
+    assert list(travel.terms) == [(1.0, 0.0)]
+    assert travel.terms[(1.0, 0.0)] == pytest.approx(2 * t, rel=1e-14)
+    # a difference that does not cancel stays a signomial; abs of it is not DGP
+    assert isinstance(abs(R - 50.0), NotGP)
+    assert isinstance(np.cos(R), NotGP)
+
+
+def test_iso286_fit_is_a_posynomial_that_matches_the_numbers():
+    names = ("d",)
+    D = Signomial.variable(names, 0, np.array([10.0]))
+    c = fit_clearance(D, "H7/g6", "max")
+    assert all(np.all(np.asarray(v) > 0) for v in c.terms.values())  # posynomial
+    for d in (4.0, 10.0, 25.0):
+        assert c.evaluate(np.array([d])) == pytest.approx(fit_clearance(d, "H7/g6", "max"))
+    assert 1e3 * c.evaluate(np.array([10.0])) == pytest.approx(30.9, abs=0.05)
+
+
+def test_fork_gp_agrees_with_exact_nlp_and_is_certified():
+    problem = load_problem(FORK)
+    assert is_gp(problem)
+    r = solve_gp_problem(problem, nlp_starts=2)
+    assert r.status == "optimal" and r.verified
+    # GP (first-order Hertz) vs exact NLP: within 0.1 % (acceptance), here ~0.01 %
+    assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
+    assert r.extra["nlp_exact"]["objective"] == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-5)
+    assert r.objective == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-3)
+    # the exact model at the GP design is the exact optimum too (same active set)
+    assert r.objectives["backlash"] == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-5)
+    cert = r.extra["certificate"]
+    assert cert["lower_bound"] <= r.objective * (1 + 1e-9)
+    assert cert["gap_rel"] < 1e-6
+    # nut travel 2 R tan 30 <= 110 is what fixes R
+    assert r.design["R"] == pytest.approx(110 / (2 * np.tan(np.radians(30))), rel=1e-6)
+
+
+def test_fixed_linkage_crank_slider_is_a_gp():
+    problem = problem_from_dict(copy.deepcopy(CS_FIXED))
+    gp = build_gp(problem)
+    assert gp.is_gp, gp.explain()
+    # 61 grid rows per stress block collapse to the one that dominates
+    assert len(gp.rows) < gp.n_rows_before_pruning
+    r = solve_gp_problem(problem, nlp_starts=2)
+    assert r.status == "optimal"
+    assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
+    assert r.extra["certificate"]["gap_rel"] < 1e-6
+
+
+def test_diagnosis_names_the_offending_term():
+    data = copy.deepcopy(CS_FIXED)
+    data["variables"]["R"] = {"lower": 75, "upper": 105}  # free arm: u = R cos a - n
+    problem = problem_from_dict(data)
+    gp = build_gp(problem)
+    assert not gp.is_gp
+    bad = {c.name: c for c in gp.failures()}
+    # the assembly margin l^2 - (R cos a - n)^2 is a signomial in R; cvxpy agrees
+    margin = bad["assembly_margin"]
+    assert "signomial" in margin.reason and "R^2" in margin.term
+    assert margin.cvxpy_is_dgp is False
+    assert "backlash" in bad and "R" in bad["backlash"].term
+    with pytest.raises(ProblemError, match=r"assembly_margin.*signomial"):
+        require_gp(problem)
+
+
+def test_cli_gp_on_a_non_gp_problem_names_the_variable(capsys):
+    from optdesign.cli import main
+
+    code = main(["solve", str(ROOT / "problems" / "cs_min_backlash.toml"), "--formulation", "gp"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "variable phi0" in err and "cos(phi0" in err
+
+
+def test_auto_picks_gp_for_the_fork_and_nlp_for_the_crank_slider():
+    from optdesign.cli import _load_plugins
+    from optdesign.commands.solve import choose_formulation
+
+    _load_plugins()
+    assert choose_formulation(load_problem(FORK), "auto") == "gp"
+    assert choose_formulation(load_problem(ROOT / "problems/cs_min_backlash.toml"), "auto") == "nlp"
