@@ -68,6 +68,7 @@ def _load_plugins() -> None:
 PLUGIN_MODULES: list[str] = [
     "optdesign.commands.solve",
     "optdesign.commands.gp_catalogue",
+    "optdesign.commands.pareto",
 ]
 
 

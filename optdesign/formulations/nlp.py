@@ -153,13 +153,16 @@ def build_nlp(
         return float(v) if np.isfinite(v) and v > 0 else 1.0
 
     values: dict[str, Any] = {}
-    wanted = set(weights) | set(epsilon)
+    # An ordered list, not a set: the order of the aux variables and rows must be the same
+    # in every process, so that solutions and multipliers can warm-start other workers.
     free_names = {v.name for v in free}
-    for name in list(wanted):
+    wanted = []
+    for name in [*weights, *epsilon]:
         if name in free_names:
             # a design variable as objective: ranges of non-unique optima (studies.solve)
             values[name] = design[name]
-            wanted.discard(name)
+        elif name not in wanted:
+            wanted.append(name)
     for name in wanted:
         if name not in ex.objectives:
             raise ProblemError(

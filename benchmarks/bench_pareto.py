@@ -1,0 +1,110 @@
+"""Pareto front of cs_min_backlash (ripple vs backlash): quality and cost, in one run.
+
+- hypervolume of the default 50-point epsilon-constraint front, of the uniform-epsilon
+  front and of NSGA-II (population 100, 500 generations, 3 seeds) as a fraction of the
+  dense reference front's (benchmarks/data/cs_min_backlash_reference_front.csv, made by
+  benchmarks/reference_front.py); reference point: the reference front's nadir + 10 % of
+  its range in each objective;
+- wall time of the epsilon front over NSGA-II's (solver builds included: the per-process
+  solver cache is emptied before each timed run);
+- wall time of the epsilon front with 1 and with 2 local worker processes.
+
+    /work/venv/bin/python benchmarks/bench_pareto.py [--points 50] [--seeds 0 1 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from optdesign.problem import load_problem
+from optdesign.studies import runner
+from optdesign.studies.front_metrics import hypervolume, non_dominated, reference_point
+from optdesign.studies.pareto import epsilon_constraint_front, nsga2_front, read_front_csv
+
+ROOT = Path(__file__).resolve().parents[1]
+REFERENCE = ROOT / "benchmarks" / "data" / "cs_min_backlash_reference_front.csv"
+OBJECTIVES = ["ripple", "backlash"]
+
+
+def timed_front(problem, points, workers, tag, **kw):
+    runner._CACHE.clear()  # include the solver builds in every timed run
+    out = Path(tempfile.mkdtemp(prefix=f"bench-pareto-{tag}-"))
+    t0 = time.perf_counter()
+    front = epsilon_constraint_front(problem, OBJECTIVES, points, out=out, workers=workers, **kw)
+    return front, time.perf_counter() - t0
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--points", type=int, default=50)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    ap.add_argument("--pop", type=int, default=100)
+    ap.add_argument("--generations", type=int, default=500)
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "data" / "bench_pareto.json")
+    args = ap.parse_args()
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
+    R = read_front_csv(REFERENCE, OBJECTIVES)
+    R = R[non_dominated(R)]
+    ref = reference_point(R)
+    hv_ref = hypervolume(R, ref)
+    print(f"reference front: {len(R)} points, HV {hv_ref:.6g} (reference point {ref})")
+    results: dict = {"reference": {"points": len(R), "hv": hv_ref, "ref_point": ref.tolist()}}
+
+    eps, t_eps = timed_front(problem, args.points, 1, "eps")
+    hv = hypervolume(eps.F, ref)
+    results["epsilon"] = {
+        "points": len(eps.points),
+        "failed": eps.metrics["n_failed"],
+        "hv_ratio": hv / hv_ref,
+        "time_s": t_eps,
+        "n_solves": eps.info["n_solves"],
+        "n_retried": eps.info["n_retried"],
+        "spacing": eps.metrics["spacing"],
+    }
+    print(
+        f"epsilon ({args.points} pts, 1 worker): HV {100 * hv / hv_ref:.3f} % of reference, "
+        f"{t_eps:.2f} s, {eps.info['n_solves']} solves, {eps.metrics['n_failed']} failed"
+    )
+
+    uni, t_uni = timed_front(problem, args.points, 1, "uniform", spacing="uniform", name="uniform")
+    results["uniform"] = {"hv_ratio": hypervolume(uni.F, ref) / hv_ref, "time_s": t_uni}
+    print(
+        f"uniform epsilon ({args.points} pts): HV "
+        f"{100 * results['uniform']['hv_ratio']:.3f} %, {t_uni:.2f} s"
+    )
+
+    ns = []
+    for seed in args.seeds:
+        t0 = time.perf_counter()
+        f = nsga2_front(problem, OBJECTIVES, args.pop, args.generations, seed=seed)
+        t = time.perf_counter() - t0
+        ns.append({"seed": seed, "hv_ratio": hypervolume(f.F, ref) / hv_ref, "time_s": t})
+        print(
+            f"NSGA-II seed {seed}: HV {100 * ns[-1]['hv_ratio']:.3f} %, {t:.2f} s, "
+            f"{len(f.points)} non-dominated"
+        )
+    results["nsga2"] = ns
+    t_ns = float(np.mean([r["time_s"] for r in ns]))
+    results["time_ratio_eps_over_nsga2"] = t_eps / t_ns
+    print(f"time epsilon / NSGA-II (mean of seeds): {t_eps / t_ns:.3f}")
+
+    _, t1 = timed_front(problem, args.points, 1, "w1")
+    _, t2 = timed_front(problem, args.points, 2, "w2")
+    results["workers"] = {"t1_s": t1, "t2_s": t2, "speedup": t1 / t2}
+    print(f"workers: 1 -> {t1:.2f} s, 2 -> {t2:.2f} s, speed-up {t1 / t2:.2f}x")
+    results["load_average"] = os.getloadavg()
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(results, indent=1))
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,175 @@
+"""``optdesign pareto FILE --objectives A,B[,C]``: the Pareto front of a problem file.
+
+Writes ``front.csv``, ``front.json``, ``front.png`` and one JSONL store per method (the
+points as they finish; ``--resume`` continues from them) to the output folder.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from optdesign.cli import command, default_out
+from optdesign.errors import InputError
+from optdesign.report import format_table
+
+METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
+
+
+@command("pareto")
+def _pareto(sub):
+    p = sub.add_parser("pareto", help="Pareto front of two or three objectives")
+    p.add_argument("file", type=Path, help="problem file (TOML)")
+    p.add_argument(
+        "--objectives", required=True, help="two or three objectives, e.g. ripple,backlash"
+    )
+    p.add_argument("--points", type=int, default=50, help="points of the front (default 50)")
+    p.add_argument(
+        "--method",
+        default="epsilon",
+        help="comma list of epsilon (default; evenly spread along the front), uniform "
+        "(epsilon evenly spaced), weighted_sum, nsga2; or 'all'",
+    )
+    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument("--resume", action="store_true", help="continue the run stored in --out")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="local processes (default: the CPU count)",
+    )
+    p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
+    p.add_argument("--starts", type=int, default=None, help="anchor multistarts (default: file's)")
+    p.add_argument("--seed", type=int, default=None, help="seed (default: file's)")
+    p.add_argument("--pop", type=int, default=100, help="NSGA-II population (default 100)")
+    p.add_argument("--generations", type=int, default=500, help="NSGA-II generations")
+    p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run_pareto)
+
+
+def run_pareto(args) -> int:
+    from optdesign.plots.front import plot_fronts
+    from optdesign.problem import load_problem
+    from optdesign.studies import pareto as pa
+
+    problem = load_problem(args.file)
+    objectives = [s.strip() for s in args.objectives.split(",") if s.strip()]
+    methods = (
+        list(METHOD_NAMES)
+        if args.method == "all"
+        else [s.strip() for s in args.method.split(",") if s.strip()]
+    )
+    for m in methods:
+        if m not in METHOD_NAMES:
+            raise InputError("--method", f"unknown method {m!r} (known: {', '.join(METHOD_NAMES)})")
+    if args.points < 2:
+        raise InputError("--points", "need at least 2 points")
+    if args.resume and args.out is None:
+        raise InputError("--resume", "give the --out folder of the run to resume")
+    out = args.out or default_out(f"pareto-{problem.name}")
+    out.mkdir(parents=True, exist_ok=True)
+    progress = not args.no_progress
+    seed = args.seed if args.seed is not None else problem.spec.solver.seed
+    fronts = []
+    common = dict(
+        out=out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        resume=args.resume,
+        progress=progress,
+        starts=args.starts,
+        seed=seed,
+    )
+    for m in methods:
+        if m == "nsga2":
+            fronts.append(
+                pa.nsga2_front(problem, objectives, args.pop, args.generations, seed=seed)
+            )
+        else:
+            fronts.append(pa.METHODS[m](problem, objectives, args.points, **common))
+    if len(fronts) > 1:
+        # Hypervolumes of different methods are comparable only with one reference point.
+        from optdesign.studies.front_metrics import hypervolume, reference_point
+
+        allF = np.vstack([f.F for f in fronts if len(f.F)])
+        ref = reference_point(allF)
+        for f in fronts:
+            f.metrics["hypervolume_common"] = hypervolume(f.F, ref)
+            f.metrics["common_reference_point"] = ref.tolist()
+    pa.write_front_csv(fronts, problem, out / "front.csv")
+    pa.write_front_json(
+        fronts,
+        out / "front.json",
+        problem=problem.name,
+        objectives=objectives,
+        points=args.points,
+        created=time.strftime("%Y-%m-%d %H:%M:%S"),
+    )
+    if not args.no_plot:
+        plot_fronts(problem, fronts, out / "front.png")
+    print(summary(problem, fronts))
+    print(
+        f"\nwrote {out / 'front.csv'}, {out / 'front.json'}"
+        + ("" if args.no_plot else f", {out / 'front.png'}")
+    )
+    return 0 if all(f.points for f in fronts) else 1
+
+
+def summary(problem, fronts) -> str:
+    """One line per method (points, failures, metrics, time) and the main front's points."""
+    rows = []
+    for f in fronts:
+        m = f.metrics
+        rows.append(
+            [
+                f.method,
+                str(len(f.points)),
+                str(m.get("n_failed", 0)),
+                f"{m.get('hypervolume', 0.0):.6g}",
+                f"{m['hypervolume_common']:.6g}" if "hypervolume_common" in m else "-",
+                f"{m.get('spacing', 0.0):.3g}",
+                f"{m.get('spread', 0.0):.3g}",
+                f"{f.wall_time_s:.2f}",
+            ]
+        )
+    lines = [f"problem   {problem.name}: objectives {', '.join(fronts[0].objectives)}", ""]
+    lines.append(
+        format_table(
+            [
+                "method",
+                "non-dominated",
+                "failed",
+                "HV own ref",
+                "HV common ref",
+                "spacing",
+                "spread",
+                "time s",
+            ],
+            rows,
+        )
+    )
+    lines.append(
+        "(reference points: nadir + 10 % of the range of the front itself (own) or of all "
+        "fronts together (common))"
+    )
+    main = fronts[0]
+    pts = main.points
+    step = max(1, len(pts) // 12)
+    shown = pts[::step] + ([pts[-1]] if pts and pts[-1] is not pts[::step][-1] else [])
+    rows = []
+    for p in shown:
+        rows.append(
+            [
+                *(f"{p.objectives[k]:.6g}" for k in main.objectives),
+                ", ".join(f"{v.name}={p.design[v.name]:.4g}" for v in problem.free),
+                p.status,
+                ", ".join(sorted({a.split("[")[0] for a in p.active}))[:60],
+            ]
+        )
+    lines += ["", f"{main.method} front ({len(pts)} points, every {step}th shown):"]
+    lines.append(format_table([*main.objectives, "design", "status", "active"], rows))
+    return "\n".join(lines)

@@ -1,0 +1,260 @@
+"""Pareto fronts: metrics by hand, certified epsilon-constraint fronts, resume, NSGA-II,
+three objectives, the CLI."""
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from optdesign.problem import load_problem
+from optdesign.problem.design_problem import relative_violation
+from optdesign.studies.front_metrics import (
+    hypervolume,
+    non_dominated,
+    reference_point,
+    spacing,
+    spread,
+)
+from optdesign.studies.pareto import (
+    _pymoo_problem,
+    epsilon_constraint_front,
+    nsga2_front,
+    weighted_sum_front,
+)
+from optdesign.studies.runner import read_store
+from optdesign.studies.verify import verify_design
+
+PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
+
+
+@pytest.fixture(scope="module")
+def cs():
+    return load_problem(PROBLEMS / "cs_min_backlash.toml")
+
+
+@pytest.fixture(scope="module")
+def fork():
+    return load_problem(PROBLEMS / "fork_min_backlash.toml")
+
+
+# --- metrics -------------------------------------------------------------------------------
+def test_hypervolume_of_a_staircase_by_hand():
+    F = np.array([[1.0, 3.0], [2.0, 2.0], [3.0, 1.0]])
+    # Boxes to (4, 4): x in [1,2] height 1, [2,3] height 2, [3,4] height 3 -> 6.
+    assert hypervolume(F, np.array([4.0, 4.0])) == pytest.approx(6.0)
+    # A dominated point adds nothing.
+    assert hypervolume(np.vstack([F, [3.5, 3.5]]), np.array([4.0, 4.0])) == pytest.approx(6.0)
+    # Default reference: nadir (3, 3) + 10 % of the range (2) = (3.2, 3.2).
+    assert reference_point(F) == pytest.approx([3.2, 3.2])
+    assert hypervolume(F) == pytest.approx(0.2 * 1.0 + 1.2 * 1.0 + 2.2 * 0.2)
+
+
+def test_non_dominated_and_spacing():
+    F = np.array([[1, 3], [2, 2], [2, 2], [3, 1], [2.5, 2.5], [np.nan, 0]], dtype=float)
+    assert non_dominated(F).tolist() == [True, True, False, True, False, False]
+    line = np.column_stack([np.linspace(0, 1, 6), np.linspace(1, 0, 6)])
+    assert spacing(line) == pytest.approx(0.0, abs=1e-12)
+    assert spread(line) == pytest.approx(0.0, abs=1e-12)
+    uneven = np.array([[0, 1], [0.1, 0.9], [0.2, 0.8], [1, 0]], dtype=float)
+    assert spacing(uneven) > 0.2
+    assert spread(uneven) > 0.5
+
+
+# --- epsilon-constraint --------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def cs_front(cs, tmp_path_factory):
+    out = tmp_path_factory.mktemp("cs_front")
+    return epsilon_constraint_front(cs, ["ripple", "backlash"], 10, out=out, starts=2)
+
+
+def test_epsilon_front_anchors_are_the_known_optima(cs_front):
+    anchors = cs_front.info["anchors"]
+    assert anchors["ripple"]["ripple"] == pytest.approx(0.0121114, rel=1e-4)
+    assert anchors["backlash"]["backlash"] == pytest.approx(0.0362197, rel=1e-4)
+    # Lexicographic tie-break: at least ripple the backlash is far below the ~0.07 deg an
+    # arbitrary minimum-ripple design (scaled linkage) has.
+    assert anchors["ripple"]["backlash"] < 0.045
+    F = cs_front.F
+    assert len(F) == 10 and cs_front.metrics["n_nondominated"] == 10
+    assert F[0, 0] == pytest.approx(0.0121114, rel=1e-4)
+    assert F[-1, 1] == pytest.approx(0.0362197, rel=1e-4)
+    # Monotone trade-off: ripple up, backlash down.
+    assert np.all(np.diff(F[:, 0]) > 0) and np.all(np.diff(F[:, 1]) < 0)
+
+
+def test_every_epsilon_point_is_feasible_by_the_numpy_check(cs, cs_front):
+    for p in cs_front.points:
+        x = np.array([p.design[v.name] for v in cs.free])
+        ok, violated, objectives = verify_design(cs, x, tol=1e-6)
+        assert ok, (p.id, [v.describe() for v in violated])
+        assert relative_violation(objectives["ripple"], None, p.eps["ripple"]) <= 1e-6
+        assert objectives["backlash"] == pytest.approx(p.objectives["backlash"], rel=1e-9)
+        assert p.status == "optimal" and p.verified
+        assert "ripple_max" in p.active or p is cs_front.points[-1]
+
+
+def test_points_are_evenly_spread_along_the_front(cs_front):
+    F = cs_front.F
+    Z = (F - F.min(axis=0)) / (F.max(axis=0) - F.min(axis=0))
+    gaps = np.abs(np.diff(Z, axis=0)).sum(axis=1)  # L1, total 2 for a monotone front
+    assert gaps.sum() == pytest.approx(2.0, rel=1e-6)
+    assert gaps.max() < 1.6 * gaps.mean()  # uniform epsilon gives 5x on this front
+
+
+def test_interrupted_run_resumes_to_the_same_front(fork, tmp_path):
+    objectives = ["size", "backlash"]
+    full = epsilon_constraint_front(fork, objectives, 8, out=tmp_path / "a", starts=2)
+    seen = []
+
+    def interrupt(rec):
+        seen.append(rec["id"])
+        if len(seen) == 5:  # 2 anchors + 3 points
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        epsilon_constraint_front(
+            fork, objectives, 8, out=tmp_path / "b", starts=2, on_record=interrupt
+        )
+    store = tmp_path / "b" / "epsilon.jsonl"
+    assert len(read_store(store)[1]) == 5
+    again = []
+    resumed = epsilon_constraint_front(
+        fork,
+        objectives,
+        8,
+        out=tmp_path / "b",
+        starts=2,
+        resume=True,
+        on_record=lambda r: again.append(r["id"]),
+    )
+    assert len(again) == 5  # the other 5 points only
+    assert resumed.F == pytest.approx(full.F, rel=1e-9)
+    assert len(resumed.points) == 8
+
+
+def test_epsilon_front_on_local_processes_matches_in_process(fork, tmp_path):
+    one = epsilon_constraint_front(fork, ["size", "backlash"], 8, out=tmp_path / "1", starts=2)
+    two = epsilon_constraint_front(
+        fork, ["size", "backlash"], 8, out=tmp_path / "2", starts=2, workers=2
+    )
+    # Two chains (one from each anchor) instead of one: the epsilon values differ a little
+    # (each chain predicts its own), but the points lie on the same curve.
+    assert len(two.points) == 8
+    A, B = one.F, two.F
+    assert B[[0, -1]] == pytest.approx(A[[0, -1]], rel=1e-6)  # the anchors
+    assert B[:, 1] == pytest.approx(np.interp(B[:, 0], A[:, 0], A[:, 1]), rel=1.5e-2)
+    assert two.metrics["hypervolume"] == pytest.approx(one.metrics["hypervolume"], rel=1e-2)
+
+
+def test_front_on_a_dask_cluster_matches_local(fork, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    local = epsilon_constraint_front(fork, ["size", "backlash"], 6, out=tmp_path / "l", starts=2)
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        remote = epsilon_constraint_front(
+            fork,
+            ["size", "backlash"],
+            6,
+            out=tmp_path / "d",
+            starts=2,
+            scheduler=client.scheduler.address,
+        )
+    assert len(remote.points) == 6 and all(p.verified for p in remote.points)
+    assert remote.F[[0, -1]] == pytest.approx(local.F[[0, -1]], rel=1e-6)
+    assert remote.metrics["hypervolume"] == pytest.approx(local.metrics["hypervolume"], rel=1e-2)
+
+
+@pytest.mark.slow
+def test_three_objective_front(cs, tmp_path):
+    from optdesign.plots.front import plot_fronts
+
+    front = epsilon_constraint_front(cs, ["ripple", "backlash", "size"], 4, out=tmp_path, starts=2)
+    F = front.F
+    assert F.shape[1] == 3 and len(F) >= 4
+    assert non_dominated(F).all()
+    for p in front.points:
+        x = np.array([p.design[v.name] for v in cs.free])
+        assert verify_design(cs, x)[0]
+        for k, e in p.eps.items():
+            assert p.objectives[k] <= e * (1 + 1e-6) + 1e-12
+    # The size anchor is the smallest linkage; its size is on the front.
+    assert F[:, 2].min() == pytest.approx(front.info["anchors"]["size"]["size"], rel=1e-6)
+    png = plot_fronts(cs, [front], tmp_path / "front3.png")
+    assert png.stat().st_size > 10_000
+
+
+# --- baselines -----------------------------------------------------------------------------
+def test_nsga2_uses_the_vectorised_numpy_path(cs):
+    pp = _pymoo_problem(cs, ["ripple", "backlash"])
+    X = np.vstack([cs.start(), cs.lower() + 0.3 * (cs.upper() - cs.lower())])
+    out = {}
+    pp._evaluate(X, out)
+    ev = cs.evaluate(X)
+    assert out["F"][:, 1] == pytest.approx(ev["objectives"]["backlash"])
+    # G <= 0 exactly when the problem's own relative violation is 0.
+    assert ((out["G"].max(axis=1) <= 0) == (ev["violation"] <= 0)).all()
+    front = nsga2_front(cs, ["ripple", "backlash"], pop_size=20, generations=15, seed=1)
+    assert front.points and all(p.verified for p in front.points)
+    for p in front.points:
+        x = np.array([p.design[v.name] for v in cs.free])
+        assert verify_design(cs, x)[0]
+
+
+def test_weighted_sum_points_lie_on_the_epsilon_front(fork, tmp_path):
+    ws = weighted_sum_front(fork, ["size", "backlash"], 5, out=tmp_path, starts=2)
+    eps = epsilon_constraint_front(fork, ["size", "backlash"], 12, out=tmp_path, starts=2)
+    assert len(ws.points) >= 3
+    # No weighted-sum point beats the epsilon front (the fork's front is convex, so the
+    # weighted sum finds true front points): each is within 1e-5 of being dominated.
+    E = eps.F
+    for f in ws.F:
+        backlash_at = np.interp(f[0], E[:, 0], E[:, 1])
+        assert f[1] >= backlash_at * (1 - 1e-2)
+
+
+def test_cli_writes_front_files(fork, tmp_path):
+    from optdesign.cli import main
+
+    out = tmp_path / "run"
+    code = main(
+        [
+            "pareto",
+            str(PROBLEMS / "fork_min_backlash.toml"),
+            "--objectives",
+            "size,backlash",
+            "--points",
+            "6",
+            "--out",
+            str(out),
+            "--workers",
+            "1",
+            "--starts",
+            "2",
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    rows = list(csv.DictReader((out / "front.csv").open()))
+    assert len(rows) == 6
+    assert {"size", "backlash", "R", "p", "d", "status", "active"} <= set(rows[0])
+    assert all(r["status"] == "optimal" for r in rows)
+    assert (out / "front.json").exists() and (out / "front.png").exists()
+    assert (
+        main(
+            [
+                "pareto",
+                str(PROBLEMS / "fork_min_backlash.toml"),
+                "--objectives",
+                "size,bogus",
+                "--out",
+                str(out / "x"),
+                "--no-progress",
+            ]
+        )
+        == 2
+    )

@@ -1,0 +1,102 @@
+"""The generic task runner: JSONL store, dependencies, resume, local processes, Dask."""
+
+import json
+
+import pytest
+
+from optdesign.errors import OptDesignError
+from optdesign.studies.runner import read_store, run_tasks
+
+
+def _chain_fn(task, deps):
+    # value = previous value * 2 + increment: any order or resume mistake changes the sum.
+    prev = deps[task["after"][0]]["value"] if task.get("after") else 1
+    return {"value": prev * 2 + task["inc"]}
+
+
+def _tasks(n=8):
+    tasks = []
+    for i in range(n):
+        t = {"id": f"t{i}", "inc": i}
+        if i > 0 and i != 4:  # two chains: t0..t3 and t4..t7
+            t["after"] = [f"t{i - 1}"]
+        tasks.append(t)
+    return tasks
+
+
+def _expected(n=8):
+    out, v = {}, None
+    for i in range(n):
+        v = (1 if i in (0, 4) else v) * 2 + i
+        out[f"t{i}"] = v
+    return out
+
+
+def test_chains_are_computed_in_order_and_stored(tmp_path):
+    store = tmp_path / "s.jsonl"
+    done = run_tasks(_tasks(), _chain_fn, store, key="k1")
+    assert {k: r["value"] for k, r in done.items()} == _expected()
+    assert done["t3"]["value"] == 27  # by hand: 2, 5, 12, 27
+    assert done["t7"]["value"] == 2 * (2 * (2 * 6 + 5) + 6) + 7
+    lines = store.read_text().splitlines()
+    assert json.loads(lines[0]) == {"__store__": 1, "key": "k1"}
+    assert len(lines) == 9
+
+
+def test_resume_after_interruption_does_not_recompute(tmp_path):
+    store = tmp_path / "s.jsonl"
+    seen = []
+
+    def stop_after_three(rec):
+        seen.append(rec["id"])
+        if len(seen) == 3:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_tasks(_tasks(), _chain_fn, store, key="k", on_record=stop_after_three)
+    assert len(read_store(store)[1]) == 3
+    computed = []
+    done = run_tasks(
+        _tasks(), _chain_fn, store, resume=True, key="k", on_record=lambda r: computed.append(r)
+    )
+    assert len(computed) == 5  # only the missing ones
+    assert {k: r["value"] for k, r in done.items()} == _expected()
+    # A different run must not resume from this store.
+    with pytest.raises(OptDesignError, match="another run"):
+        run_tasks(_tasks(), _chain_fn, store, resume=True, key="other")
+
+
+def test_torn_last_line_is_ignored(tmp_path):
+    store = tmp_path / "s.jsonl"
+    run_tasks(_tasks(4), _chain_fn, store, key="k")
+    text = store.read_text()
+    store.write_text(text[: len(text) - 5])  # killed while writing the last record
+    _, records = read_store(store)
+    assert sorted(records) == ["t0", "t1", "t2"]
+    done = run_tasks(_tasks(4), _chain_fn, store, resume=True, key="k")
+    assert done["t3"]["value"] == _expected(4)["t3"]
+
+
+def test_local_processes_give_the_same_records(tmp_path):
+    done = run_tasks(_tasks(), _chain_fn, tmp_path / "p.jsonl", workers=2)
+    assert {k: r["value"] for k, r in done.items()} == _expected()
+
+
+def test_dask_local_cluster(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        done = run_tasks(
+            _tasks(), _chain_fn, tmp_path / "d.jsonl", scheduler=client.scheduler.address
+        )
+    assert {k: r["value"] for k, r in done.items()} == _expected()
+    assert len(read_store(tmp_path / "d.jsonl")[1]) == 8
+
+
+def test_unknown_dependency_is_an_error(tmp_path):
+    with pytest.raises(ValueError, match="unknown dependencies"):
+        run_tasks([{"id": "a", "after": ["zz"]}], _chain_fn, tmp_path / "x.jsonl")
