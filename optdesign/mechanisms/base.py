@@ -10,6 +10,7 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.models import _math as m
+from optdesign.models._checks import require_positive
 from optdesign.models.clearance import pin_joint_clearance, root_sum_square, worst_case
 from optdesign.models.fits import Fit
 from optdesign.models.loads import force_from_rate, motor_torque
@@ -17,28 +18,6 @@ from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity, r
 
 #: Joint kinds: how a clearance at the joint moves the output (see Mechanism.sensitivity).
 JOINT_KINDS = ("rod_length", "axial", "lateral", "slot_normal", "angular")
-
-
-def require_positive(name: str, value: Any) -> None:
-    """Raise InputError naming ``name`` unless the numeric ``value`` is finite and > 0.
-
-    Symbolic values are not checked (the solver's bounds keep them in range).
-    """
-    if m.is_symbolic(value):
-        return
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)):
-        raise InputError(name, f"must be finite, got {value!r}")
-    if np.any(arr <= 0):
-        raise InputError(name, f"must be positive, got {value!r}")
-
-
-def require_finite(name: str, value: Any) -> None:
-    """Raise InputError naming ``name`` unless the numeric ``value`` is finite."""
-    if m.is_symbolic(value):
-        return
-    if not np.all(np.isfinite(np.asarray(value, dtype=float))):
-        raise InputError(name, f"must be finite, got {value!r}")
 
 
 @dataclass(frozen=True)

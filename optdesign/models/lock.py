@@ -29,6 +29,7 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.models import _math as m
+from optdesign.models._checks import require_nonnegative, require_positive
 from optdesign.models.loads import backdriven_motor_torque
 
 #: Pressure laws of a friction annulus: a new lining (uniform pressure) and a worn-in one
@@ -40,22 +41,6 @@ BEARING_PLACES = ("guide", "tip")
 
 #: The paper's bound on the angle between the bearing plane and the plane of F1 (rad).
 MISALIGNMENT_DEFAULT = float(np.radians(0.5))
-
-
-def _check_positive(field: str, value: Any) -> None:
-    if m.is_symbolic(value):
-        return
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise InputError(field, f"must be finite and > 0, got {value!r}")
-
-
-def _check_nonnegative(field: str, value: Any) -> None:
-    if m.is_symbolic(value):
-        return
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
-        raise InputError(field, f"must be finite and >= 0, got {value!r}")
 
 
 # --- friction-plate lock ---------------------------------------------------------------
@@ -71,8 +56,8 @@ def friction_radius(r1, r2, law: str = "uniform_pressure"):
         ``"uniform_wear"``: r_f = (r1 + r2)/2 (p r constant, a worn-in lining; the smaller
         of the two, so the conservative choice for the spring force).
     """
-    _check_nonnegative("r1", r1)
-    _check_positive("r2", r2)
+    require_nonnegative("r1", r1)
+    require_positive("r2", r2)
     if not m.is_symbolic(r1, r2) and np.any(np.asarray(r2) <= np.asarray(r1)):
         raise InputError("r2", f"outer radius must exceed inner radius r1={r1!r}, got {r2!r}")
     if law == "uniform_pressure":
@@ -100,7 +85,7 @@ def friction_plate_force(M, r1, r2, mu, law: str = "uniform_pressure", faces: in
     faces
         Number of friction faces in series (the paper: one pair of plates, 1).
     """
-    _check_positive("mu", mu)
+    require_positive("mu", mu)
     if not isinstance(faces, int) or faces < 1:
         raise InputError("faces", f"must be a positive integer, got {faces!r}")
     return M / (faces * mu * friction_radius(r1, r2, law))
@@ -115,7 +100,7 @@ def pin_guide_reactions(F1, lever_ratio=4.0):
     about the lower contact: F2 La2 = F1 (La1 + La2); about the middle one: F3 La2 = F1 La1.
     With La2 = 4 La1 (the paper): F2 = 1.25 F1, F3 = 0.25 F1, F2 + F3 = 1.5 F1.
     """
-    _check_positive("lever_ratio", lever_ratio)
+    require_positive("lever_ratio", lever_ratio)
     F2 = F1 * (1.0 + 1.0 / lever_ratio)
     F3 = F1 / lever_ratio
     return F2, F3
@@ -142,9 +127,9 @@ def pin_lock_force(M, R, mu_h=0.1, lever_ratio=4.0, spring_fraction=0.1):
     spring_fraction
         Return spring force as a fraction of F1 (it only has to push the pin out).
     """
-    _check_positive("R", R)
-    _check_nonnegative("mu_h", mu_h)
-    _check_nonnegative("spring_fraction", spring_fraction)
+    require_positive("R", R)
+    require_nonnegative("mu_h", mu_h)
+    require_nonnegative("spring_fraction", spring_fraction)
     F1 = M / R
     F2, F3 = pin_guide_reactions(F1, lever_ratio)
     return mu_h * (F1 + F2 + F3) + spring_fraction * F1
@@ -206,11 +191,11 @@ def pin_lock_force_rolling(
     bearing
         ``"guide"`` or ``"tip"``, see assumption 2.
     """
-    _check_positive("R", R)
-    _check_nonnegative("mu_h", mu_h)
-    _check_nonnegative("mu_g", mu_g)
-    _check_nonnegative("misalignment", misalignment)
-    _check_nonnegative("spring_fraction", spring_fraction)
+    require_positive("R", R)
+    require_nonnegative("mu_h", mu_h)
+    require_nonnegative("mu_g", mu_g)
+    require_nonnegative("misalignment", misalignment)
+    require_nonnegative("spring_fraction", spring_fraction)
     F1 = M / R
     F2, F3 = pin_guide_reactions(F1, lever_ratio)
     if bearing == "guide":

@@ -11,12 +11,11 @@ revolutions or hours. Efficiency of the screw: :mod:`optdesign.models.screw`.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.models import _math as m
+from optdesign.models._checks import require_positive
 from optdesign.models.screw import series_stiffness
 
 #: Young's modulus of screw steel used by the catalogues (MPa).
@@ -58,14 +57,6 @@ def _factor(table: dict[str, float], mounting: str) -> float:
         raise InputError("mounting", f"{mounting!r} not in {sorted(table)}") from None
 
 
-def _check_positive(field: str, value: Any) -> None:
-    if m.is_symbolic(value):
-        return
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise InputError(field, f"must be finite and > 0, got {value!r}")
-
-
 def second_moment(d1):
     """Second moment of area of the root circle, I = pi d1^4 / 64 (mm^4)."""
     return m.pi * d1**4 / 64.0
@@ -99,8 +90,8 @@ def buckling_load(d1, la, mounting: str = "fixed-supported", form: str = "catalo
     safety
         Safety factor on the Euler load, Euler form only (catalogues: 0.5).
     """
-    _check_positive("d1", d1)
-    _check_positive("la", la)
+    require_positive("d1", d1)
+    require_positive("la", la)
     if form == "catalogue":
         return _factor(BUCKLING_FACTOR, mounting) * d1**4 / la**2 * 1e4
     if form == "euler":
@@ -111,7 +102,7 @@ def buckling_load(d1, la, mounting: str = "fixed-supported", form: str = "catalo
 
 def yield_load(d1, sigma=SIGMA_ALLOWABLE):
     """Permissible tensile/compressive load of the shaft P2 = sigma pi d1^2 / 4 (N)."""
-    _check_positive("d1", d1)
+    require_positive("d1", d1)
     return sigma * root_area(d1)
 
 
@@ -127,8 +118,8 @@ def critical_speed(d1, lb, mounting: str = "fixed-supported"):
     mounting
         End conditions, keys of :data:`CRITICAL_SPEED_FACTOR`.
     """
-    _check_positive("d1", d1)
-    _check_positive("lb", lb)
+    require_positive("d1", d1)
+    require_positive("lb", lb)
     return _factor(CRITICAL_SPEED_FACTOR, mounting) * d1 / lb**2 * 1e7
 
 
@@ -169,15 +160,15 @@ def rated_life_revolutions(Ca, Fa, f_w=1.2):
     f_w
         Load factor: 1.0-1.2 smooth, 1.2-1.5 normal, 1.5-2 with impact.
     """
-    _check_positive("Ca", Ca)
-    _check_positive("Fa", Fa)
-    _check_positive("f_w", f_w)
+    require_positive("Ca", Ca)
+    require_positive("Fa", Fa)
+    require_positive("f_w", f_w)
     return (Ca / (f_w * Fa)) ** 3 * 1e6
 
 
 def rated_life_hours(Ca, Fa, speed, f_w=1.2):
     """Rated life in hours, L / (60 N) with the mean speed N (min^-1)."""
-    _check_positive("speed", speed)
+    require_positive("speed", speed)
     return rated_life_revolutions(Ca, Fa, f_w) / (60.0 * speed)
 
 
@@ -188,8 +179,8 @@ def shaft_stiffness(d1, L, mounting: str = "fixed-free", E=E_STEEL):
     ``"fixed-fixed"`` (both ends axially fixed): 4 A E / L, its minimum, with the nut at
     mid-span L/2.
     """
-    _check_positive("d1", d1)
-    _check_positive("L", L)
+    require_positive("d1", d1)
+    require_positive("L", L)
     if mounting == "fixed-free":
         return root_area(d1) * E / L
     if mounting == "fixed-fixed":

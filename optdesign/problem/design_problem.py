@@ -503,15 +503,7 @@ class DesignProblem:
             pop = X.shape[0]
             objectives = {}
             for name, term in ex.objectives.items():
-                e = np.broadcast_to(np.asarray(term.expr, dtype=float), (pop, len(self.phi)))
-                if term.kind == "spread":
-                    hi, lo = e.max(axis=-1), e.min(axis=-1)
-                    val = (hi - lo) / (hi + lo)
-                elif term.kind == "max":
-                    val = e.max(axis=-1)
-                else:
-                    val = np.asarray(term.expr, dtype=float).reshape(pop, -1)[:, 0]
-                objectives[name] = val
+                objectives[name] = term_values(term, pop, len(self.phi))
             constraints = {}
             worst = np.zeros(pop)
             for block in ex.constraints:
@@ -532,6 +524,17 @@ class DesignProblem:
 
     def describe_variable(self, name: str) -> str:
         return VARIABLE_DESCRIPTIONS.get(name, name)
+
+
+def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
+    """Value of an objective term for each of ``pop`` designs on the NumPy path."""
+    e = np.broadcast_to(np.asarray(term.expr, dtype=float), (pop, n_phi))
+    if term.kind == "spread":
+        hi, lo = e.max(axis=-1), e.min(axis=-1)
+        return (hi - lo) / (hi + lo)
+    if term.kind == "max":
+        return e.max(axis=-1)
+    return e[:, 0]
 
 
 def relative_violation(values, lower, upper):

@@ -33,7 +33,7 @@ from optdesign.formulations.robust import (
     sampled_objective,
     tolerances_of,
 )
-from optdesign.problem.design_problem import DesignProblem, relative_violation
+from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
 from optdesign.report import format_table
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.multistart import multistart, sobol_starts
@@ -93,14 +93,7 @@ def sample_values(
             fit = [samples.fit[idx, j : j + 1] for j in range(samples.fit.shape[1])]
         with np.errstate(invalid="ignore", divide="ignore"):
             term, ex = sampled_objective(problem, d, objective, fit)
-            e = np.broadcast_to(np.asarray(term.expr, dtype=float), (pop, len(problem.phi)))
-            if term.kind == "spread":
-                hi, lo = e.max(axis=-1), e.min(axis=-1)
-                val = (hi - lo) / (hi + lo)
-            elif term.kind == "max":
-                val = e.max(axis=-1)
-            else:
-                val = e[:, 0]
+            val = term_values(term, pop, len(problem.phi))
             worst = np.zeros(pop)
             for block in ex.constraints:
                 c = np.asarray(block.expr, dtype=float).reshape(pop, -1)
