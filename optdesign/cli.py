@@ -69,6 +69,7 @@ PLUGIN_MODULES: list[str] = [
     "optdesign.commands.solve",
     "optdesign.commands.gp_catalogue",
     "optdesign.commands.pareto",
+    "optdesign.commands.bench",
 ]
 
 

@@ -1,0 +1,414 @@
+"""SciPy back-ends behind the common :class:`Result`: SLSQP and trust-constr on an
+:class:`~optdesign.formulations.nlp.NLP` (derivatives exact from CasADi or by finite
+differences), and differential evolution on a vectorised NumPy objective.
+
+- :class:`ScipyNLPSolver` turns the NLP into CasADi Functions for f, grad f, g, jac g
+  (and, for trust-constr, the Hessians of f and of lam' g), or hands SciPy only f and g
+  when ``derivatives="fd"`` (SLSQP then differences itself; trust-constr uses 2-point
+  gradients and BFGS Hessians). A wall-time limit is enforced inside the function
+  evaluations, so every method stops, whatever its own callbacks support.
+- :func:`differential_evolution` is the global reference: it sees only a vectorised
+  ``objective(X) -> (value, violation)`` (population rows), typically
+  :meth:`DesignProblem.evaluate`, and handles catalogue variables as integer indices.
+
+None of this knows a mechanism.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, ClassVar
+
+import casadi as ca
+import numpy as np
+import scipy.optimize as so
+
+from optdesign.formulations.nlp import NLP
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+
+
+class _TimeUp(Exception):
+    """Raised from inside a function evaluation when the wall-time limit is reached."""
+
+
+class ScipyNLPSolver:
+    """SLSQP or trust-constr on an NLP in scaled variables.
+
+    Parameters
+    ----------
+    nlp
+        The formulation (epigraph or naive).
+    method
+        ``"SLSQP"`` or ``"trust-constr"``.
+    derivatives
+        ``"exact"`` (CasADi gradients, Jacobians and, for trust-constr, Hessians) or
+        ``"fd"`` (finite differences; trust-constr then uses BFGS Hessians).
+    options
+        SciPy ``options`` (``maxiter``, ``ftol``/``gtol`` ...), merged over the defaults.
+    time_limit
+        Wall-time limit of one solve (s); the last iterate is returned as
+        ``time_limit``.
+    """
+
+    DEFAULTS: ClassVar[dict[str, dict[str, Any]]] = {
+        "SLSQP": {"maxiter": 500, "ftol": 1e-10},
+        "trust-constr": {"maxiter": 2000, "gtol": 1e-8, "xtol": 1e-10},
+    }
+
+    def __init__(
+        self,
+        nlp: NLP,
+        method: str = "SLSQP",
+        derivatives: str = "exact",
+        options: Mapping[str, Any] | None = None,
+        time_limit: float = math.inf,
+    ):
+        if method not in self.DEFAULTS:
+            raise ValueError(f"method {method!r}: use 'SLSQP' or 'trust-constr'")
+        if derivatives not in ("exact", "fd"):
+            raise ValueError(f"derivatives {derivatives!r}: use 'exact' or 'fd'")
+        self.nlp = nlp
+        self.method = method
+        self.derivatives = derivatives
+        self.options = {**self.DEFAULTS[method], **(options or {})}
+        self.time_limit = time_limit
+        z, f, g = nlp.z, nlp.f, nlp.g
+        self.f_fun = ca.Function("f", [z], [f])
+        self.g_fun = ca.Function("g", [z], [g])
+        self.values_fun = ca.Function("values", [z], [ca.vertcat(*nlp.objective_values.values())])
+        if derivatives == "exact":
+            self.grad_fun = ca.Function("grad_f", [z], [ca.gradient(f, z)])
+            self.jac_fun = ca.Function("jac_g", [z], [ca.jacobian(g, z)])
+            if method == "trust-constr":
+                lam = (
+                    ca.SX.sym("lam", g.shape[0])
+                    if isinstance(z, ca.SX)
+                    else ca.MX.sym("lam", g.shape[0])
+                )
+                self.hess_f_fun = ca.Function("hess_f", [z], [ca.hessian(f, z)[0]])
+                self.hess_g_fun = ca.Function(
+                    "hess_g", [z, lam], [ca.hessian(ca.dot(lam, g), z)[0]]
+                )
+        # SLSQP wants g(z) >= 0 and h(z) = 0: one row per finite bound.
+        lb, ub = nlp.lbg, nlp.ubg
+        self._eq = np.flatnonzero(np.isfinite(lb) & np.isfinite(ub) & (lb == ub))
+        self._lo = np.flatnonzero(np.isfinite(lb) & ~(np.isfinite(ub) & (lb == ub)))
+        self._hi = np.flatnonzero(np.isfinite(ub) & ~(np.isfinite(lb) & (lb == ub)))
+
+    @property
+    def name(self) -> str:
+        return f"scipy-{self.method.lower()}-{self.derivatives}"
+
+    # --- counted, time-limited evaluations -------------------------------------------------
+    def _tick(self, key: str, z) -> None:
+        self.n_evals[key] = self.n_evals.get(key, 0) + 1
+        self._last = np.array(z, dtype=float)
+        if time.perf_counter() - self._t0 > self.time_limit:
+            raise _TimeUp
+
+    def _f(self, z):
+        self._tick("f", z)
+        return float(self.f_fun(z))
+
+    def _grad(self, z):
+        self._tick("grad_f", z)
+        return np.asarray(self.grad_fun(z), dtype=float).ravel()
+
+    def _g(self, z):
+        self._tick("g", z)
+        return np.asarray(self.g_fun(z), dtype=float).ravel()
+
+    def _jac(self, z):
+        self._tick("jac_g", z)
+        return np.asarray(ca.densify(self.jac_fun(z)), dtype=float)
+
+    def _hess_f(self, z):
+        self._tick("hess_f", z)
+        return np.asarray(ca.densify(self.hess_f_fun(z)), dtype=float)
+
+    def _hess_g(self, z, v):
+        self._tick("hess_g", z)
+        return np.asarray(ca.densify(self.hess_g_fun(z, v)), dtype=float)
+
+    def _constraints(self) -> Any:
+        nlp = self.nlp
+        exact = self.derivatives == "exact"
+        if self.method == "trust-constr":
+            if exact:
+                return [
+                    so.NonlinearConstraint(
+                        self._g, nlp.lbg, nlp.ubg, jac=self._jac, hess=self._hess_g
+                    )
+                ]
+            return [
+                so.NonlinearConstraint(self._g, nlp.lbg, nlp.ubg, jac="2-point", hess=so.BFGS())
+            ]
+        lo, hi, eq = self._lo, self._hi, self._eq
+        lb, ub = nlp.lbg, nlp.ubg
+
+        def ineq(z):
+            g = self._g(z)
+            return np.concatenate([g[lo] - lb[lo], ub[hi] - g[hi]])
+
+        def ineq_jac(z):
+            J = self._jac(z)
+            return np.vstack([J[lo], -J[hi]])
+
+        cons = [{"type": "ineq", "fun": ineq, **({"jac": ineq_jac} if exact else {})}]
+        if len(eq):
+            cons.append(
+                {
+                    "type": "eq",
+                    "fun": lambda z: self._g(z)[eq] - lb[eq],
+                    **({"jac": lambda z: self._jac(z)[eq]} if exact else {}),
+                }
+            )
+        return cons
+
+    def solve(self, x0: np.ndarray | None = None, z0: np.ndarray | None = None) -> Result:
+        """Solve from design ``x0`` (or scaled ``z0``)."""
+        nlp = self.nlp
+        if z0 is None:
+            if x0 is None:
+                raise ValueError("give x0 or z0")
+            z0 = nlp.z_from_x(x0)
+        z0 = np.asarray(z0, dtype=float).ravel()
+        # Aux variables may have infinite bounds: SciPy takes +-inf in Bounds.
+        bounds = so.Bounds(nlp.lbz, nlp.ubz)
+        z0 = np.clip(z0, nlp.lbz, nlp.ubz)
+        self.n_evals: dict[str, int] = {}
+        self._last = z0.copy()
+        self._t0 = time.perf_counter()
+        exact = self.derivatives == "exact"
+        kwargs: dict[str, Any] = {
+            "method": self.method,
+            "bounds": bounds,
+            "constraints": self._constraints(),
+            "options": dict(self.options),
+        }
+        if self.method == "trust-constr":
+            kwargs["jac"] = self._grad if exact else "2-point"
+            kwargs["hess"] = self._hess_f if exact else so.BFGS()
+        else:
+            kwargs["jac"] = self._grad if exact else None
+        try:
+            res = so.minimize(self._f, z0, **kwargs)
+            z, iters, message = (
+                np.asarray(res.x, dtype=float),
+                int(res.get("nit", 0)),
+                str(res.message),
+            )
+            status, term = self._status(res)
+        except _TimeUp:
+            z, iters, message = self._last, None, f"wall-time limit {self.time_limit:g} s reached"
+            status, term = "time_limit", TerminationCondition.MAX_TIME
+        except (ValueError, np.linalg.LinAlgError, RuntimeError) as exc:
+            wall = time.perf_counter() - self._t0
+            return Result(
+                "failed",
+                float("nan"),
+                {},
+                self.name,
+                f"nlp-{nlp.form}",
+                wall,
+                TerminationCondition.ERROR,
+                SolutionStatus.NO_SOLUTION,
+                message=f"{type(exc).__name__}: {exc}",
+                n_evals=dict(self.n_evals),
+            )
+        wall = time.perf_counter() - self._t0
+        return self._result(z, status, term, message, iters, wall)
+
+    def _status(self, res) -> tuple[str, TerminationCondition]:
+        if self.method == "SLSQP":
+            if res.status == 0:
+                return "optimal", TerminationCondition.CONVERGED
+            if res.status == 9:
+                return "max_iterations", TerminationCondition.MAX_ITERATIONS
+            if res.status == 4:  # inequality constraints incompatible
+                return "infeasible", TerminationCondition.INFEASIBLE
+            return "failed", TerminationCondition.NUMERICAL_ERROR
+        # trust-constr: 1 gtol (KKT met), 2 xtol (steps too small: accepted as converged
+        # when feasible, the gap metric tells the rest), 0 maxiter.
+        if res.status == 1:
+            return "optimal", TerminationCondition.CONVERGED
+        if res.status == 2:
+            return "optimal", TerminationCondition.ACCEPTABLE
+        if res.status == 0:
+            return "max_iterations", TerminationCondition.MAX_ITERATIONS
+        return "failed", TerminationCondition.NUMERICAL_ERROR
+
+    def _result(self, z, status, term, message, iters, wall) -> Result:
+        nlp = self.nlp
+        g = np.asarray(self.g_fun(z), dtype=float).ravel()
+        # Same row reports as the CasADi back-end (it only needs ``self.nlp``).
+        violated, active = CasadiNLPSolver.reports(self, g, np.zeros_like(g))  # type: ignore[arg-type]
+        max_viol = max(
+            (
+                r.amount / max(1.0, abs(r.upper if r.upper is not None else r.lower))
+                for r in violated
+            ),
+            default=0.0,
+        )
+        if status == "optimal" and violated:
+            status, term = "infeasible", TerminationCondition.INFEASIBLE
+        if status == "optimal":
+            sol_status = SolutionStatus.OPTIMAL
+        elif not violated:
+            sol_status = SolutionStatus.FEASIBLE
+        else:
+            sol_status = SolutionStatus.INFEASIBLE
+        values = np.asarray(self.values_fun(z), dtype=float).ravel()
+        x = nlp.x_from_z(z)
+        return Result(
+            status=status,
+            objective=float(self.f_fun(z)) * nlp.f_scale,
+            design=dict(zip(nlp.design_names, x.tolist(), strict=True)),
+            solver=self.name,
+            formulation=f"nlp-{nlp.form}",
+            wall_time_s=wall,
+            termination=term,
+            solution_status=sol_status,
+            message=message,
+            objectives=dict(zip(nlp.objective_values, values.tolist(), strict=True)),
+            iterations=iters,
+            n_evals=dict(self.n_evals),
+            violated=violated,
+            active=active,
+            max_violation=float(max_viol),
+            raw={"z": np.asarray(z, dtype=float)},
+        )
+
+
+def differential_evolution(
+    evaluate: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+    lower: np.ndarray,
+    upper: np.ndarray,
+    names: Sequence[str],
+    catalogues: Mapping[int, Sequence[float]] | None = None,
+    seed: int = 0,
+    popsize: int = 15,
+    maxiter: int = 300,
+    tol: float = 1e-8,
+    time_limit: float = math.inf,
+) -> Result:
+    """Global reference: SciPy differential evolution on a vectorised objective.
+
+    Parameters
+    ----------
+    evaluate
+        ``X (pop, n) -> (objective (pop,), violation (pop,))``, violation 0 when
+        feasible (e.g. from :meth:`DesignProblem.evaluate`).
+    lower, upper, names
+        Box and names of the free variables.
+    catalogues
+        Column -> catalogue values; those columns are searched as integer indices.
+    seed, popsize, maxiter, tol
+        SciPy options (``polish`` is off: the result is DE's own).
+    time_limit
+        Wall-time limit (s), checked between generations.
+
+    Returns
+    -------
+    Result
+        ``optimal`` when the population converged to a feasible point (no optimality
+        proof: a reference), ``feasible`` when stopped by the time or generation limit at
+        a feasible point (``termination`` says which), ``infeasible`` otherwise.
+    """
+    lower = np.asarray(lower, dtype=float)
+    upper = np.asarray(upper, dtype=float)
+    catalogues = {k: np.asarray(v, dtype=float) for k, v in (catalogues or {}).items()}
+    lo, hi = lower.copy(), upper.copy()
+    integrality = np.zeros(len(lower), dtype=bool)
+    for k, vals in catalogues.items():
+        lo[k], hi[k], integrality[k] = 0.0, len(vals) - 1.0, True
+
+    def to_design(U: np.ndarray) -> np.ndarray:
+        X = np.array(U, dtype=float, copy=True)
+        for k, vals in catalogues.items():
+            X[:, k] = vals[np.clip(np.rint(X[:, k]).astype(int), 0, len(vals) - 1)]
+        return X
+
+    counts = {"f": 0, "populations": 0}
+    cache: dict[str, Any] = {}
+
+    def _eval(U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        # SciPy asks for the objective and then the constraint of the same population:
+        # evaluate once.
+        if U.shape[0] == 0:  # SciPy asks for the energies of no feasible member
+            return np.zeros(0), np.zeros(0)
+        key = U.tobytes()
+        if cache.get("key") != key:
+            f, v = evaluate(to_design(U))
+            counts["f"] += U.shape[0]
+            counts["populations"] += 1
+            cache.update(
+                key=key,
+                f=np.where(np.isfinite(f), f, 1e300),
+                v=np.nan_to_num(v, nan=1e300, posinf=1e300),
+            )
+        return cache["f"], cache["v"]
+
+    def func(UT: np.ndarray) -> np.ndarray:
+        U = np.atleast_2d(UT.T) if UT.ndim == 2 else UT[None, :]
+        return _eval(U)[0]
+
+    def cons(UT: np.ndarray) -> np.ndarray:
+        U = np.atleast_2d(UT.T) if UT.ndim == 2 else UT[None, :]
+        return _eval(U)[1][None, :]
+
+    t0 = time.perf_counter()
+    timed_out = {"flag": False}
+
+    def callback(*_args, **_kw) -> bool:
+        if time.perf_counter() - t0 > time_limit:
+            timed_out["flag"] = True
+            return True
+        return False
+
+    res = so.differential_evolution(
+        func,
+        so.Bounds(lo, hi),
+        constraints=so.NonlinearConstraint(cons, -np.inf, 0.0),
+        integrality=integrality if catalogues else None,
+        seed=seed,
+        popsize=popsize,
+        maxiter=maxiter,
+        tol=tol,
+        polish=False,
+        vectorized=True,
+        updating="deferred",
+        callback=callback,
+    )
+    wall = time.perf_counter() - t0
+    X = to_design(np.asarray(res.x, dtype=float)[None, :])
+    f, v = evaluate(X)
+    feasible = bool(np.isfinite(f[0]) and v[0] <= 0.0)
+    # DE proves nothing either way: "optimal" means its population converged; stopped by
+    # the time or generation limit, its best feasible member is still a design
+    # ("feasible"; the benchmark's gap says how good), an infeasible one is not.
+    if timed_out["flag"]:
+        status, term = "feasible", TerminationCondition.MAX_TIME
+    elif res.success:
+        status, term = "optimal", TerminationCondition.CONVERGED
+    else:
+        status, term = "feasible", TerminationCondition.MAX_ITERATIONS
+    if not feasible:
+        status, term = "infeasible", TerminationCondition.INFEASIBLE
+    return Result(
+        status=status,
+        objective=float(f[0]),
+        design=dict(zip(names, X[0].tolist(), strict=True)),
+        solver="scipy-de",
+        formulation="numpy",
+        wall_time_s=wall,
+        termination=term,
+        solution_status=SolutionStatus.FEASIBLE if feasible else SolutionStatus.INFEASIBLE,
+        message=str(res.message),
+        iterations=int(res.nit),
+        n_evals=dict(counts),
+        max_violation=float(v[0]),
+    )

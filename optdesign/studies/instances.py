@@ -1,0 +1,213 @@
+"""Benchmark instance families: random requirements generated from (family, seed).
+
+Each family draws the requirements of a crank-slider or shifting-fork problem
+(deflection range 20-40 deg, hinge moment, mean-ratio band, nut-travel limit, fit class,
+catalogue or continuous screw lead) and states them as a *problem dict*, the parsed form of
+a problem file, so that every instance goes through
+:func:`optdesign.problem.problem_from_dict` and its validation exactly like a TOML file.
+
+An instance is reproducible from ``(family, seed)`` alone: the generator is
+``numpy.random.default_rng([crc32(family), seed])``. The shipped problem files are a family
+of their own (``shipped``, seeds 0..2).
+"""
+
+from __future__ import annotations
+
+import copy
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from optdesign.problem import DesignProblem, problem_from_dict
+
+#: Fits drawn for the pin joints (all supported by :class:`optdesign.models.fits.Fit`).
+FITS = ("H7/g6", "H7/f7", "H8/f7", "H7/h6")
+
+#: Catalogue windows of the ISO 3408 leads (mm): three values each, so that enumerating
+#: the catalogue costs three continuous solves.
+LEAD_WINDOWS = ((2.0, 3.0), (3.0, 5.0), (4.0, 6.0), (5.0, 8.0), (6.0, 10.0))
+
+#: Probability that an instance takes its lead from the catalogue.
+P_CATALOGUE = 0.3
+
+#: Shipped problem files (family ``shipped``, seed = index).
+SHIPPED = ("cs_min_ripple", "cs_min_backlash", "fork_min_backlash")
+
+#: family -> (mechanism, objectives). A two-objective family is a Pareto-front instance.
+FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
+    "cs_ripple": ("crank_slider", ("ripple",)),
+    "cs_backlash": ("crank_slider", ("backlash",)),
+    "cs_size": ("crank_slider", ("size",)),
+    "cs_torque": ("crank_slider", ("motor_torque",)),
+    "fork_backlash": ("fork", ("backlash",)),
+    "fork_size": ("fork", ("size",)),
+    "fork_torque": ("fork", ("motor_torque",)),
+    "cs_front": ("crank_slider", ("ripple", "backlash")),
+    "fork_front": ("fork", ("backlash", "size")),
+}
+
+#: Families of single-objective instances (the fork's ripple depends on the deflection
+#: range alone, so a fork ripple family would be a constant: left out).
+SINGLE_FAMILIES = tuple(f for f, (_, obj) in FAMILIES.items() if len(obj) == 1)
+FRONT_FAMILIES = tuple(f for f, (_, obj) in FAMILIES.items() if len(obj) > 1)
+
+
+@dataclass(frozen=True)
+class Instance:
+    """One benchmark instance.
+
+    Attributes
+    ----------
+    family, seed
+        Identity; :func:`make_instance` rebuilds the same ``data`` from them.
+    data
+        The problem dict (parsed-TOML form).
+    """
+
+    family: str
+    seed: int
+    data: dict[str, Any]
+
+    @property
+    def id(self) -> str:
+        return f"{self.family}-{self.seed:03d}"
+
+    @property
+    def objectives(self) -> list[str]:
+        obj = self.data["objective"]["minimize"]
+        return [obj] if isinstance(obj, str) else list(obj)
+
+    @property
+    def is_front(self) -> bool:
+        return len(self.objectives) > 1
+
+    @property
+    def mechanism(self) -> str:
+        return self.data["mechanism"]
+
+    def problem(self) -> DesignProblem:
+        """The validated problem (same validation as a problem file)."""
+        return problem_from_dict(copy.deepcopy(self.data), source=self.id)
+
+
+def _rng(family: str, seed: int) -> np.random.Generator:
+    return np.random.default_rng([zlib.crc32(family.encode()), int(seed)])
+
+
+def instance_dict(family: str, seed: int) -> dict[str, Any]:
+    """The problem dict of instance ``(family, seed)``.
+
+    Raises
+    ------
+    KeyError
+        Unknown family.
+    """
+    if family == "shipped":
+        return _shipped(seed)
+    if family not in FAMILIES:
+        raise KeyError(
+            f"unknown instance family {family!r} (known: shipped, {', '.join(FAMILIES)})"
+        )
+    mechanism, objectives = FAMILIES[family]
+    rng = _rng(family, seed)
+    phi_max = float(rng.uniform(20.0, 40.0))
+    points = int(rng.choice([31, 41, 61]))
+    hinge = float(rng.uniform(200.0, 800.0))
+    centre = float(rng.uniform(160.0, 280.0))
+    width = float(rng.uniform(0.15, 0.30)) * centre
+    travel = float(rng.uniform(80.0, 140.0))
+    fit = str(rng.choice(FITS))
+    if rng.random() < P_CATALOGUE:
+        lo, hi = LEAD_WINDOWS[int(rng.integers(len(LEAD_WINDOWS)))]
+        lead: dict[str, Any] = {"catalogue": "ISO 3408", "lower": f"{lo} mm", "upper": f"{hi} mm"}
+    else:
+        lead = {"lower": "2 mm", "upper": "10 mm"}
+    variables: dict[str, Any] = {"R": {"lower": "30 mm", "upper": "120 mm"}}
+    if mechanism == "crank_slider":
+        variables["l"] = {"lower": "40 mm", "upper": "200 mm"}
+        variables["n"] = {"lower": "0 mm", "upper": "150 mm"}
+    variables["p"] = lead
+    if mechanism == "crank_slider":
+        variables["phi0"] = {"lower": "-0.6 rad", "upper": "0.6 rad"}
+    variables["i_a"] = 2
+    requirements: dict[str, Any] = {
+        "deflection": {"min": f"{-phi_max} deg", "max": f"{phi_max} deg", "points": points},
+        "hinge_moment": f"{hinge} N*m",
+        "mean_ratio": {"min": centre - width / 2, "max": centre + width / 2},
+        "nut_travel_max": f"{travel} mm",
+        "fit": fit,
+        "fit_clearance": "max",
+    }
+    if mechanism == "crank_slider":
+        requirements["transmission_angle"] = {"min": "40 deg", "max": "140 deg"}
+        requirements["rod_inclination_max"] = "30 deg"
+    needs_pin = any(o.startswith("backlash") for o in objectives) or rng.random() < 0.5
+    if needs_pin:
+        variables["d"] = {"lower": "4 mm", "upper": "30 mm"}
+        variables["pin_length_ratio"] = float(rng.choice([1.0, 1.5, 2.0]))
+        requirements["pin_bearing_pressure_max"] = f"{float(rng.uniform(60.0, 120.0))} MPa"
+        requirements["pin_shear_stress_max"] = "200 MPa"
+        requirements["pin_shear_planes"] = 2 if mechanism == "crank_slider" else 1
+    return {
+        "name": f"{family}-{seed:03d}",
+        "description": f"benchmark instance {family} seed {seed}",
+        "mechanism": mechanism,
+        "variables": variables,
+        "requirements": requirements,
+        "materials": {"pin": {"E": "2.1e5 MPa", "nu": 0.3}},
+        "objective": {"minimize": list(objectives)},
+    }
+
+
+def _shipped(seed: int) -> dict[str, Any]:
+    import tomllib
+
+    if not 0 <= seed < len(SHIPPED):
+        raise KeyError(f"shipped instance {seed}: there are {len(SHIPPED)} (0..{len(SHIPPED) - 1})")
+    path = problems_dir() / f"{SHIPPED[seed]}.toml"
+    data = tomllib.loads(path.read_text())
+    data.setdefault("name", SHIPPED[seed])
+    return data
+
+
+def problems_dir() -> Path:
+    """The shipped ``problems/`` folder of the source tree."""
+    return Path(__file__).resolve().parents[2] / "problems"
+
+
+def make_instance(family: str, seed: int) -> Instance:
+    """Instance ``(family, seed)``."""
+    return Instance(family, int(seed), instance_dict(family, seed))
+
+
+def suite(name: str, fronts: bool = True) -> list[Instance]:
+    """The instances of suite ``name``.
+
+    ``default``: the three shipped problems and 14 seeds of each single-objective family
+    (101 instances), plus 3 seeds of each front family when ``fronts``; ``quick``: three
+    instances covering a crank-slider, a fork with a catalogue lead (a GP) and the
+    shipped crank-slider backlash problem, plus one front instance when ``fronts``.
+    """
+    if name == "default":
+        out = [make_instance("shipped", k) for k in range(len(SHIPPED))]
+        out += [make_instance(f, s) for f in SINGLE_FAMILIES for s in range(14)]
+        if fronts:
+            out += [make_instance(f, s) for f in FRONT_FAMILIES for s in range(3)]
+        return out
+    if name == "quick":
+        out = [
+            make_instance("cs_ripple", 0),
+            make_instance("fork_backlash", QUICK_FORK_SEED),
+            make_instance("shipped", 1),
+        ]
+        if fronts:
+            out.append(make_instance("fork_front", 0))
+        return out
+    raise KeyError(f"unknown suite {name!r} (known: default, quick)")
+
+
+#: Seed of the quick suite's fork instance: its lead comes from the catalogue.
+QUICK_FORK_SEED = 8
