@@ -136,3 +136,17 @@ def test_monte_carlo_with_no_scatter_is_the_nominal_value(problem):
         problem, dict(zip("R l n p phi0 d".split(), X_NOMINAL, strict=True)), samples=samples
     )
     assert mc.quantile == pytest.approx(0.0362197, rel=1e-5) and mc.std < 1e-12
+
+
+def test_auto_picks_robust_for_a_file_with_tolerances():
+    from optdesign.cli import build_parser
+    from optdesign.commands.solve import choose_formulation
+
+    build_parser()  # registers the formulations and their auto predicates
+    from optdesign.problem import load_problem
+
+    robust = load_problem(FILE)
+    plain = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
+    assert choose_formulation(robust, "auto") == "robust"
+    assert choose_formulation(plain, "auto") == "nlp"
+    assert choose_formulation(robust, "nlp") == "nlp"

@@ -64,8 +64,9 @@ def choose_formulation(problem, requested: str) -> str:
     return "nlp"
 
 
-#: (formulation, predicate) tried in order by ``--formulation auto``.
-AUTO_ORDER: list = []
+#: (formulation, predicate) tried in order by ``--formulation auto``. A file with
+#: ``[tolerances]`` asks for a robust design; tolerances are never ignored silently.
+AUTO_ORDER: list = [("robust", lambda problem: problem.spec.tolerances is not None)]
 
 
 @command("solve")
