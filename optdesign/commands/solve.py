@@ -148,13 +148,16 @@ def summary(problem, result: Result) -> str:
         f"{'passed' if result.verified else 'FAILED' if result.verified is False else 'n/a'}"
     )
     obj_name = result.extra.get("objective_name", problem.objective_names[0])
-    unit = {
-        "backlash": "deg",
+    units = {
         "backlash_rss": "deg",
+        "backlash": "deg",
         "size": "mm",
         "nut_travel": "mm",
         "motor_torque": "N*mm",
-    }.get(obj_name, "")
+        "lock_force": "N",
+    }
+    # a robust objective such as "CVaR_0.9(backlash)" has the unit of what it is taken of
+    unit = next((u for name, u in units.items() if name in obj_name), "")
     lines.append(f"objective {obj_name} = {result.objective:.8g} {unit}".rstrip())
     lines.append(f"time      {result.wall_time_s:.3f} s")
     if result.multistart:
