@@ -243,9 +243,15 @@ def build_nlp(
     aux_lb_s = [lb / s if np.isfinite(lb) else lb for lb, (_, s) in zip(aux_lb, aux, strict=True)]
     aux_ub_s = [ub / s if np.isfinite(ub) else ub for ub, (_, s) in zip(aux_ub, aux, strict=True)]
     aux_init = ca.Function("aux_init", [zd], [ca.vertcat(*aux_start)]) if aux_start else None
+    # Common subexpression elimination: the model builds each constraint block from its
+    # own copy of the mechanism's expressions, so the same subexpressions appear many
+    # times (cs_min_backlash: 15 900 SX instructions for g, 4 200 after). Same values, but
+    # ~3x faster evaluations and derivative generation (Ipopt set-up 0.36 -> 0.14 s).
+    f_out, g_all, *value_list = ca.cse([ca.SX(f_raw / f_scale), g_all, *values.values()])
+    values = dict(zip(values, value_list, strict=True))
     return NLP(
         z=z,
-        f=f_raw / f_scale,
+        f=f_out,
         g=g_all,
         lbz=np.concatenate([np.zeros(n), aux_lb_s]),
         ubz=np.concatenate([np.ones(n), aux_ub_s]),

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import casadi as ca
 import numpy as np
@@ -199,24 +199,168 @@ class CasadiNLPSolver:
     def reports(self, g: np.ndarray, lam_g: np.ndarray):
         """Violated and active constraint rows, in the constraints' own units."""
         nlp = self.nlp
+        g = np.asarray(g, dtype=float).ravel()
+        lo_all = np.asarray(nlp.lbg, dtype=float)
+        hi_all = np.asarray(nlp.ubg, dtype=float)
+        # Vectorised screening (a Python loop over the ~550 rows cost ~5 ms a solve);
+        # reports are built only for the violated and active rows, in row order.
+        flo, fhi, fg = np.isfinite(lo_all), np.isfinite(hi_all), np.isfinite(g)
+        with np.errstate(invalid="ignore"):
+            amounts = np.maximum(np.where(flo, lo_all - g, 0.0), np.where(fhi, g - hi_all, 0.0))
+            is_viol = ~fg | (amounts > FEAS_TOL)
+            is_act = ~is_viol & ((flo & (g - lo_all < FEAS_TOL)) | (fhi & (hi_all - g < FEAS_TOL)))
         violated, active = [], []
-        for k, name in enumerate(nlp.g_names):
+        for k in np.flatnonzero(is_viol | is_act):
+            name = nlp.g_names[k]
             s = nlp.g_scale[k]
-            lo, hi = nlp.lbg[k], nlp.ubg[k]
+            lo, hi = lo_all[k], hi_all[k]
             raw = g[k] * s
             lo_raw = None if not np.isfinite(lo) else lo * s
             hi_raw = None if not np.isfinite(hi) else hi * s
-            amount = max(
-                lo - g[k] if np.isfinite(lo) else 0.0, g[k] - hi if np.isfinite(hi) else 0.0
-            )
+            amount = amounts[k]
             violation = float(max(amount, 0.0) * s) if amount > FEAS_TOL else 0.0
             rep = ConstraintReport(name, float(raw), lo_raw, hi_raw, violation, nlp.g_units[k])
-            if not np.isfinite(g[k]) or amount > FEAS_TOL:
-                if not np.isfinite(g[k]):
+            if is_viol[k]:
+                if not fg[k]:
                     rep.amount = float("inf")
                 violated.append(rep)
-            elif (np.isfinite(lo) and g[k] - lo < FEAS_TOL) or (
-                np.isfinite(hi) and hi - g[k] < FEAS_TOL
-            ):
+            else:
                 active.append(rep)
         return violated, active
+
+
+class CasadiSLSQPSolver(CasadiNLPSolver):
+    """SciPy SLSQP on an :class:`NLP` with exact CasADi first derivatives.
+
+    Same interface and :class:`Result` as :class:`CasadiNLPSolver` (violated and active
+    rows, ``raw`` with ``z``, ``lam_x`` and ``lam_g``), so callers can swap them. It is
+    cheap to build (one gradient and one Jacobian, no Hessian: ~0.07 s against ~0.4 s
+    for an Ipopt solver with exact Hessian on the 552-row epigraph NLPs) and, being an
+    active-set method with a small dense QP per iteration, several times faster per solve
+    on these small problems (issue 6 benchmark). The constraint bounds are read from
+    ``nlp`` at every solve, so changing ``nlp.ubg`` between solves (epsilon sweeps) works.
+    Its multipliers (SciPy >= 1.16 returns them) are mapped to CasADi's sign convention
+    (``lam_g > 0`` at an active upper bound, ``< 0`` at an active lower bound); bound
+    multipliers are not returned by SciPy and are reported as zero. It takes no dual warm
+    start (``lam_x0``/``lam_g0`` are accepted and ignored).
+
+    Parameters
+    ----------
+    nlp
+        The formulation.
+    options
+        SciPy SLSQP options, merged over ``{"maxiter": 200, "ftol": 1e-10}``.
+    """
+
+    DEFAULTS: ClassVar[dict[str, Any]] = {"maxiter": 200, "ftol": 1e-10}
+
+    def __init__(self, nlp: NLP, options: Mapping[str, Any] | None = None):
+        self.nlp = nlp
+        self.plugin = "slsqp"
+        self.options = {**self.DEFAULTS, **(options or {})}
+        z = nlp.z
+        # One function for f, grad f, g and jac g: SLSQP asks for them at the same point.
+        self.all_fun = ca.Function(
+            "fgj", [z], [nlp.f, ca.gradient(nlp.f, z), nlp.g, ca.jacobian(nlp.g, z)]
+        )
+        self.g_fun = ca.Function("g", [z], [nlp.g])
+        self.values_fun = ca.Function("values", [z], [ca.vertcat(*nlp.objective_values.values())])
+        self._key: bytes | None = None
+        self._val: tuple = ()
+        self.n_evals: dict[str, int] = {}
+
+    def _eval(self, z) -> tuple:
+        z = np.asarray(z, dtype=float)
+        key = z.tobytes()
+        if key != self._key:
+            f, gf, g, jg = self.all_fun(z)
+            self._val = (
+                float(f),
+                np.asarray(gf, dtype=float).ravel(),
+                np.asarray(g, dtype=float).ravel(),
+                jg.full(),
+            )
+            self._key = key
+            self.n_evals["fgj"] = self.n_evals.get("fgj", 0) + 1
+        return self._val
+
+    def solve(
+        self,
+        x0: np.ndarray | None = None,
+        z0: np.ndarray | None = None,
+        lam_x0: np.ndarray | None = None,
+        lam_g0: np.ndarray | None = None,
+    ) -> Result:
+        """Solve from design ``x0`` (or scaled ``z0``)."""
+        import scipy.optimize as so
+
+        nlp = self.nlp
+        if z0 is None:
+            if x0 is None:
+                raise ValueError("give x0 or z0")
+            z0 = nlp.z_from_x(x0)
+        z0 = np.clip(np.asarray(z0, dtype=float).ravel(), nlp.lbz, nlp.ubz)
+        lb, ub = np.asarray(nlp.lbg, dtype=float), np.asarray(nlp.ubg, dtype=float)
+        eq = np.flatnonzero(np.isfinite(lb) & (lb == ub))
+        lo = np.flatnonzero(np.isfinite(lb) & ~(lb == ub))
+        hi = np.flatnonzero(np.isfinite(ub) & ~(lb == ub))
+        cons = [
+            {
+                "type": "ineq",
+                "fun": lambda z: np.concatenate(
+                    [self._eval(z)[2][lo] - lb[lo], ub[hi] - self._eval(z)[2][hi]]
+                ),
+                "jac": lambda z: np.vstack([self._eval(z)[3][lo], -self._eval(z)[3][hi]]),
+            }
+        ]
+        if len(eq):
+            cons.insert(
+                0,
+                {
+                    "type": "eq",
+                    "fun": lambda z: self._eval(z)[2][eq] - lb[eq],
+                    "jac": lambda z: self._eval(z)[3][eq],
+                },
+            )
+        self.n_evals = {}
+        t0 = time.perf_counter()
+        try:
+            res = so.minimize(
+                lambda z: self._eval(z)[0],
+                z0,
+                jac=lambda z: self._eval(z)[1],
+                method="SLSQP",
+                bounds=so.Bounds(nlp.lbz, nlp.ubz),
+                constraints=cons,
+                options=dict(self.options),
+            )
+        except (ValueError, np.linalg.LinAlgError, RuntimeError) as exc:
+            return Result(
+                "failed",
+                float("nan"),
+                {},
+                self.plugin,
+                f"nlp-{nlp.form}",
+                time.perf_counter() - t0,
+                TerminationCondition.ERROR,
+                SolutionStatus.NO_SOLUTION,
+                message=f"{type(exc).__name__}: {exc}",
+            )
+        wall = time.perf_counter() - t0
+        z = np.asarray(res.x, dtype=float)
+        lam_g = np.zeros(len(lb))
+        mult = np.asarray(res.get("multipliers", np.zeros(0)), dtype=float).ravel()
+        if len(mult) == len(eq) + len(lo) + len(hi):
+            # SciPy: equalities first, then the inequalities in the order given above.
+            lam_g[eq] = -mult[: len(eq)]
+            lam_g[lo] -= mult[len(eq) : len(eq) + len(lo)]
+            lam_g[hi] += mult[len(eq) + len(lo) :]
+        f = self._eval(z)[0]
+        sol = {"x": z, "f": f, "lam_g": lam_g, "lam_x": np.zeros(len(z))}
+        stats = {
+            "return_status": f"SLSQP: {res.message}",
+            "success": bool(res.success),
+            "iter_count": int(res.get("nit", 0)),
+            **{f"n_call_{k}": v for k, v in self.n_evals.items()},
+        }
+        return self.result_from(z, sol, stats, wall)

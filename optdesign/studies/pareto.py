@@ -18,6 +18,13 @@ With three objectives ``[A, B, C]``: rows ``A <= e1`` (e1 evenly spaced); the he
 row is ``min B s.t. A <= e1`` (the smallest feasible e2), then ``min C s.t. A <= e1,
 B <= e2`` for e2 evenly spaced from there to B's nadir, each row a warm-started chain.
 
+Solvers: one formulation per process (:func:`_target_nlp`); every point, the sweep and
+the anchors' multistarts are solved by SLSQP with exact CasADi derivatives, warm from the
+neighbour's design, with Ipopt for any start SLSQP does not solve; the tie-breaks -
+degenerate by construction - by Ipopt. An anchor's multistart stops once ``agree`` (3)
+starts agree on the best value; its record says how many starts ran and agreed.
+(``solver="ipopt"``, ``agree=None`` give the former Ipopt-only, all-starts computation.)
+
 Every point is checked on the NumPy path (:func:`optdesign.studies.verify.verify_design`,
 plus the epsilon bounds) to 1e-6 relative; a point that fails the check is kept with
 status ``infeasible`` and left out of the front, as are dominated points.
@@ -36,22 +43,24 @@ import hashlib
 import json
 import math
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import build_nlp
+from optdesign.formulations.nlp import NLP, build_nlp
 from optdesign.problem.design_problem import DesignProblem, relative_violation
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver, CasadiSLSQPSolver
 from optdesign.solvers.multistart import best_of, sobol_starts
 from optdesign.solvers.result import Result
 from optdesign.studies.front_metrics import front_metrics, non_dominated
-from optdesign.studies.runner import cached, run_tasks
+from optdesign.studies.runner import cached, process_pool, run_tasks
 from optdesign.studies.solve import finish
 from optdesign.studies.verify import VERIFY_TOL
 
@@ -66,6 +75,21 @@ WARM_OPTIONS: dict[str, Any] = {
     "warm_start_mult_bound_push": 1e-9,
     "mu_init": 1e-6,
 }
+
+#: Ipopt options of the lexicographic tie-breaks. Their start is an optimum of the
+#: objective fixed before, so it is feasible (to the slack) and close to the tie-break's
+#: optimum: a small initial barrier parameter and bound push keep Ipopt there instead of
+#: pushing it back into the interior. Measured on cs_min_backlash from 6 multistart
+#: optima: the backlash anchor's tie-break took 25-48 iterations (default options: 62-101,
+#: and 500 = failure from one start), the ripple anchor's 22-41 (default 22-40), same
+#: optima to 1e-8.
+TIE_OPTIONS: dict[str, Any] = {"mu_init": 1e-5, "bound_push": 1e-6, "bound_frac": 1e-6}
+
+#: CasADi's symbolic layer is not thread-safe and ``nlpsol`` releases the GIL: two threads
+#: of a threaded Dask worker building solvers at once crashed the process (segfault in
+#: nlpsol, seen in tests/test_pareto.py's Dask test). Every symbolic construction in this
+#: module (formulations, solver set-up) holds this lock; solves run unlocked.
+_CASADI_LOCK = threading.RLock()
 
 #: Relative slack on the anchor values in lexicographic tie-breaks and at the sweep ends.
 ANCHOR_SLACK = 1e-7
@@ -193,7 +217,15 @@ class EpsSolver:
     """``min target s.t. other objectives <= eps`` built once; eps changes per solve.
 
     The epsilon rows are built with an infinite limit and their upper bounds are set per
-    solve, so one CasADi solver serves the whole sweep (and its warm starts).
+    solve, so one solver serves the anchors' multistarts, the tie-breaks and the whole
+    sweep (and its warm starts). The primary solver is SLSQP with exact CasADi first
+    derivatives (:class:`~optdesign.solvers.casadi_nlp.CasadiSLSQPSolver`: ~0.03 s to
+    build, 3-6x faster per solve than Ipopt on these NLPs); a start it does not solve
+    (SLSQP reports failure, or the iterate violates a row) is solved again by Ipopt
+    (exact Hessian) from the same start, that solver being built only when first needed.
+    The lexicographic tie-breaks always use Ipopt (``use="tie"``), see
+    :func:`_anchor_task`. ``method="ipopt"`` uses Ipopt throughout (``warm`` then selects
+    the warm-start options), as before.
     """
 
     def __init__(
@@ -201,30 +233,65 @@ class EpsSolver:
         problem: DesignProblem,
         target: str | Mapping[str, float],
         eps_names: Sequence[str],
-        warm: bool,
+        warm: bool = False,
         options: Mapping[str, Any] | None = None,
         normalise: Mapping[str, tuple[float, float]] | None = None,
+        method: str = "slsqp",
     ):
+        if method not in ("slsqp", "ipopt"):
+            raise ProblemError(f"solver {method!r}: use 'slsqp' or 'ipopt'")
         self.problem = problem
-        self.nlp = build_nlp(
-            problem, objective=target, epsilon={k: np.inf for k in eps_names}, normalise=normalise
-        )
+        self.method = method
+        with _CASADI_LOCK:
+            self.nlp = _target_nlp(problem, target, eps_names, normalise)
         self.base_ubg = self.nlp.ubg.copy()
         self.rows = {k: self.nlp.g_names.index(f"{k}_max") for k in eps_names}
         self.limits = problem.objective_limits()
-        opts = dict(problem.spec.solver.ipopt)
-        if warm:
-            opts.update(WARM_OPTIONS)
-        opts.update(options or {})
-        self.solver = CasadiNLPSolver(self.nlp, "ipopt", opts)
+        self.ipopt_options = dict(problem.spec.solver.ipopt)
+        if warm and method == "ipopt":
+            self.ipopt_options.update(WARM_OPTIONS)
+        self.ipopt_options.update(options or {})
+        self._ipopt: CasadiNLPSolver | None = None
+        self._ipopt_tie: CasadiNLPSolver | None = None
+        self._slsqp: CasadiSLSQPSolver | None = None
         self.z_names = list(self.nlp.design_names) + list(self.nlp.aux_names)
+
+    @property
+    def solver(self) -> CasadiNLPSolver:
+        """The primary solver (built on first use, like :attr:`ipopt`: a worker that only
+        runs this NLP's tie-break never builds its SLSQP functions)."""
+        if self.method == "ipopt":
+            return self.ipopt
+        if self._slsqp is None:
+            with _CASADI_LOCK:
+                self._slsqp = CasadiSLSQPSolver(self.nlp)
+        return self._slsqp
+
+    @property
+    def ipopt(self) -> CasadiNLPSolver:
+        """The Ipopt solver of the same NLP (built on first use: ~0.15 s, exact Hessian)."""
+        if self._ipopt is None:
+            with _CASADI_LOCK:
+                self._ipopt = CasadiNLPSolver(self.nlp, "ipopt", self.ipopt_options)
+        return self._ipopt
+
+    @property
+    def ipopt_tie(self) -> CasadiNLPSolver:
+        """Ipopt with :data:`TIE_OPTIONS` (lexicographic tie-breaks; built on first use)."""
+        if self._ipopt_tie is None:
+            with _CASADI_LOCK:
+                self._ipopt_tie = CasadiNLPSolver(
+                    self.nlp, "ipopt", {**self.ipopt_options, **TIE_OPTIONS}
+                )
+        return self._ipopt_tie
 
     def set_eps(self, eps: Mapping[str, float]) -> None:
         ubg = self.base_ubg.copy()
         for k, v in eps.items():
             limit = min(float(v), self.limits.get(k, np.inf))
             ubg[self.rows[k]] = limit / self.nlp.g_scale[self.rows[k]]
-        self.solver.nlp.ubg = ubg
+        # Both solvers hold this same NLP object and read its bounds at every solve.
+        self.nlp.ubg = ubg
 
     def warm_args(self, raw: Mapping[str, Any] | None, x: np.ndarray | None) -> dict[str, Any]:
         """Solver start from a neighbour's raw solution (names aligned), else from x."""
@@ -251,19 +318,87 @@ class EpsSolver:
             return out
         return {"x0": np.asarray(x if x is not None else self.problem.start(), dtype=float)}
 
-    def solve(self, eps: Mapping[str, float], **start) -> Result:
+    def solve(
+        self, eps: Mapping[str, float], fallback: bool = True, use: str | None = None, **start
+    ) -> Result:
+        """Solve with the epsilon bounds ``eps`` from ``start`` (``x0`` or ``z0``...).
+
+        With SLSQP as primary solver and ``fallback``, a start SLSQP does not solve is
+        solved again by Ipopt from the same primal start (without SLSQP's partial
+        multipliers); ``result.extra["fallback"]`` then holds SLSQP's message.
+        ``use="ipopt"`` solves with Ipopt directly, ``use="tie"`` with Ipopt and
+        :data:`TIE_OPTIONS`.
+        """
         self.set_eps(eps)
-        result = self.solver.solve(**start)
+        if use in ("ipopt", "tie"):
+            result = (self.ipopt_tie if use == "tie" else self.ipopt).solve(**start)
+            fallback = False
+        else:
+            result = self.solver.solve(**start)
+        if fallback and self.method == "slsqp" and not result.success:
+            primal = {k: v for k, v in start.items() if k in ("x0", "z0")}
+            first = result
+            result = self.ipopt.solve(**primal)
+            result.extra["fallback"] = f"{first.status}: {first.message}"
+            result.wall_time_s += first.wall_time_s
         if result.raw:
             result.raw["z_names"] = self.z_names
             result.raw["g_names"] = list(self.nlp.g_names)
         return result
 
 
+def _target_nlp(
+    problem: DesignProblem,
+    target: str | Mapping[str, float],
+    eps_names: Sequence[str],
+    normalise: Mapping[str, tuple[float, float]] | None = None,
+) -> NLP:
+    """``min target s.t. eps_names <= inf`` (bounds set per solve), from one formulation.
+
+    Every solver of a front (each objective as target, the others as epsilon rows) is
+    derived from one :func:`build_nlp` of the front's objectives, built once per process:
+    the same variables and rows (an unused epsilon row has an infinite bound), only the
+    objective differs. One formulation build (~0.1 s) per process instead of one per
+    target - with 2 workers each worker needs both targets for the anchors and
+    tie-breaks - and any point's solution and multipliers can start another target's
+    solve.
+    """
+    if not isinstance(target, str) or normalise:
+        return build_nlp(
+            problem, objective=target, epsilon={k: np.inf for k in eps_names}, normalise=normalise
+        )
+    names = sorted({target, *eps_names})
+    base = cached(
+        ("front-nlp", problem_key(problem), tuple(names)),
+        lambda: build_nlp(problem, objective=names[0], epsilon={k: np.inf for k in names}),
+    )
+    value = base.objective_values[target]
+    # Objective scaled to ~1 at the start design, as build_nlp scales its objective.
+    f0 = float(ca.Function("f0", [base.z], [value])(base.z_from_x(problem.start())))
+    f_scale = abs(f0) if np.isfinite(f0) and abs(f0) > 1e-12 else 1.0
+    return replace(
+        base,
+        f=value / f_scale,
+        f_scale=f_scale,
+        objective=target,
+        lbg=base.lbg.copy(),
+        ubg=base.ubg.copy(),
+        lbz=base.lbz.copy(),
+        ubz=base.ubz.copy(),
+    )
+
+
 def _eps_solver(
-    problem: DesignProblem, target, eps_names: Sequence[str], warm: bool, normalise=None
+    problem: DesignProblem,
+    target,
+    eps_names: Sequence[str],
+    warm: bool = False,
+    normalise=None,
+    method: str = "slsqp",
 ) -> EpsSolver:
     eps_names = sorted(eps_names)  # one solver per NLP, whatever order the caller names
+    # SLSQP takes no dual warm start: one solver per NLP serves cold and warm solves.
+    warm = bool(warm) and method == "ipopt"
     key = (
         "eps",
         problem_key(problem),
@@ -271,8 +406,12 @@ def _eps_solver(
         tuple(eps_names),
         warm,
         json.dumps(normalise, sort_keys=True),
+        method,
     )
-    return cached(key, lambda: EpsSolver(problem, target, eps_names, warm, normalise=normalise))
+    return cached(
+        key,
+        lambda: EpsSolver(problem, target, eps_names, warm, normalise=normalise, method=method),
+    )
 
 
 def _record(
@@ -297,7 +436,7 @@ def _record(
         key=lambda s: (s.split("[")[0], s),
     )
     raw = result.raw or {}
-    return _clean(
+    rec = _clean(
         {
             "status": status,
             "verified": result.verified,
@@ -311,13 +450,25 @@ def _record(
             "violated": [r.name for r in result.violated][:20],
             "wall_time_s": result.wall_time_s,
             "iterations": result.iterations,
-            "raw": {
-                k: np.asarray(v).tolist() if k in ("z", "lam_x", "lam_g") else v
-                for k, v in raw.items()
-            },
+            "solver": result.solver,
+            **({"fallback": result.extra["fallback"]} if result.extra.get("fallback") else {}),
             **dict(extra or {}),
         }
     )
+    # The raw vectors (~550 multipliers) bypass the recursive _clean: it cost ~2 ms a point.
+    rec["raw"] = {
+        k: _json_vector(v) if k in ("z", "lam_x", "lam_g") else _clean(v) for k, v in raw.items()
+    }
+    return rec
+
+
+def _json_vector(v) -> list:
+    """A float vector as a JSON-able list (non-finite entries as None, like _clean)."""
+    a = np.asarray(v, dtype=float).ravel()
+    out = a.tolist()
+    if not np.isfinite(a).all():
+        out = [x if math.isfinite(x) else None for x in out]
+    return out
 
 
 def _ok(rec: Mapping[str, Any] | None) -> bool:
@@ -329,23 +480,50 @@ def _anchor_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, 
 
     The multistart solves ``min order[0] s.t. order[1] <= inf`` with the same (cached)
     solver the tie-break of the other anchor uses, so a worker builds each NLP once.
+    With ``task["agree"] = k`` the multistart stops as soon as k successful starts agree
+    on the best value (within :func:`best_of`'s 1e-6 relative); the record's
+    ``multistart`` says how many starts were planned, how many ran and how many agreed.
+    If no start succeeds with SLSQP, the starts are solved again with Ipopt fallback.
     """
     problem: DesignProblem = task["problem"]
     order: list[str] = task["order"]
+    method = task.get("solver", "slsqp")
+    agree = task.get("agree")
     t0 = time.perf_counter()
     others = order[1:]
-    solver = _eps_solver(problem, order[0], others, warm=False)
+    solver = _eps_solver(problem, order[0], others, method=method)
     free_eps = {k: np.inf for k in others}
     pts = [problem.start()]
     if task["starts"] > 1:
         pts += list(
             sobol_starts(problem.lower(), problem.upper(), task["starts"] - 1, task["seed"])
         )
-    results = [solver.solve(free_eps, x0=x0) for x0 in pts]
+    results: list[Result] = []
+    n_at_best = 0
+    for x0 in pts:
+        # No per-start Ipopt fallback: a start that fails is just a failed start.
+        results.append(solver.solve(free_eps, fallback=False, x0=x0))
+        best, n_at_best = best_of(results)
+        if agree and n_at_best >= agree:
+            break
+    n_solves = len(results)
+    if n_at_best == 0 and method == "slsqp":
+        results = []
+        for x0 in pts:
+            results.append(solver.solve(free_eps, x0=x0))
+            best, n_at_best = best_of(results)
+            if agree and n_at_best >= agree:
+                break
+        n_solves += len(results)
     best, n_at_best = best_of(results)
     rec = _record(problem, best, order[0], {})
-    rec["multistart"] = {"n_starts": len(pts), "n_at_best": n_at_best}
-    n_solves = len(pts)
+    rec["multistart"] = {
+        "n_starts": len(results),
+        "n_planned": len(pts),
+        "n_at_best": n_at_best,
+        "agree": agree,
+        "stopped_early": len(results) < len(pts),
+    }
     fixed: dict[str, float] = {}
     for k, name in enumerate(order[1:], start=1):
         if not _ok(rec):
@@ -353,11 +531,18 @@ def _anchor_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, 
         prev = order[k - 1]
         fixed[prev] = rec["objectives"][prev] * (1 + ANCHOR_SLACK) + 1e-12
         rest = [o for o in order if o not in fixed and o != name]
-        tie = _eps_solver(problem, name, [*fixed, *rest], warm=False)
-        res = tie.solve({**fixed, **{o: np.inf for o in rest}}, x0=np.asarray(rec["x"]))
+        tie = _eps_solver(problem, name, [*fixed, *rest], method=method)
+        # The tie-break's feasible set is (almost) the set of optima of the objectives
+        # fixed before: degenerate, and SLSQP was measured to stall there or stop 2e-4
+        # short of Ipopt's value (cs_min_backlash, anchor backlash). Ipopt solves it.
+        res = tie.solve({**fixed, **{o: np.inf for o in rest}}, x0=np.asarray(rec["x"]), use="tie")
         n_solves += 1
         cand = _record(problem, res, name, fixed)
-        if _ok(cand):
+        # The start is feasible for the tie-break (the bound is its own value plus slack):
+        # a result worse than the start is a solver failure, not a tie-break (default
+        # Ipopt once returned ripple 0.99996 "optimal" from a start at 0.0555).
+        start_value = rec["objectives"][name]
+        if _ok(cand) and cand["objectives"][name] <= start_value * (1 + 1e-9) + 1e-15:
             cand["multistart"] = rec["multistart"]
             rec = cand
     rec["kind"] = "anchor"
@@ -418,7 +603,8 @@ def _eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any
         eps = _row_eps(task, deps.get(task["row_head"]))
     else:
         eps = _arc_eps(task, nb)
-    solver = _eps_solver(problem, target, list(eps), warm=True)
+    method = task.get("solver", "slsqp")
+    solver = _eps_solver(problem, target, list(eps), warm=True, method=method)
     n_solves = 1
     if nb is not None and _ok(nb):
         start = solver.warm_args(nb.get("raw"), np.asarray(nb["x"]))
@@ -440,7 +626,7 @@ def _eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any
     n_cold = max(task.get("retry_starts", 0) if retry else 0, task.get("extra_starts", 0))
     if n_cold > 0:
         # Seeded per point, so a resumed or parallel run draws the same starts.
-        cold = _eps_solver(problem, target, list(eps), warm=False)
+        cold = _eps_solver(problem, target, list(eps), method=method)
         pts = sobol_starts(
             problem.lower(), problem.upper(), n_cold, task.get("seed", 0) + 7919 * task["index"]
         )
@@ -453,7 +639,7 @@ def _eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any
                 not _ok(rec) or cand["objectives"][target] < rec["objectives"][target]
             ):
                 rec = cand
-    rec["slope"] = _slope(problem, target, eps, rec) if _ok(rec) else None
+    rec["slope"] = _slope(problem, target, eps, rec, method) if _ok(rec) else None
     rec.update(
         kind="eps",
         retried=why,
@@ -463,12 +649,12 @@ def _eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any
     return rec
 
 
-def _slope(problem, target, eps, rec) -> float | None:
+def _slope(problem, target, eps, rec, method: str = "slsqp") -> float | None:
     """dB/dA at the point from the multiplier of the (single) epsilon row."""
     if len(eps) != 1:
         return None
     (a,) = eps
-    solver = _eps_solver(problem, target, [a], warm=True)
+    solver = _eps_solver(problem, target, [a], warm=True, method=method)
     raw = rec.get("raw") or {}
     if raw.get("g_names") != solver.nlp.g_names:
         return None
@@ -531,6 +717,11 @@ class WeightedSolver:
         return result
 
 
+def _locked(build, *args):
+    with _CASADI_LOCK:
+        return build(*args)
+
+
 def _ws_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
     """One weighted-sum point (normalised objectives), started from its neighbour."""
     problem: DesignProblem = task["problem"]
@@ -539,7 +730,7 @@ def _ws_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
     normalise = {k: tuple(v) for k, v in task["normalise"].items()}
     objectives = list(weights)
     key = ("ws", problem_key(problem), tuple(objectives), json.dumps(normalise, sort_keys=True))
-    solver = cached(key, lambda: WeightedSolver(problem, objectives, normalise))
+    solver = cached(key, lambda: _locked(WeightedSolver, problem, objectives, normalise))
     nb = deps.get(task.get("warm") or "", None)
     raw = (nb or {}).get("raw") or {}
     if _ok(nb) and raw.get("z_names") == solver.z_names:
@@ -645,8 +836,16 @@ def compute_anchors(
     seed: int | None = None,
     key: str | None = None,
     on_record: Callable | None = None,
+    solver: str = "slsqp",
+    agree: int | None = None,
+    pool=None,
 ) -> dict[str, dict[str, Any]]:
-    """Lexicographic anchors (one per objective), run as tasks of ``store``."""
+    """Lexicographic anchors (one per objective), run as tasks of ``store``.
+
+    ``solver`` is the primary NLP solver (``"slsqp"`` with Ipopt fallback, or
+    ``"ipopt"``); ``agree`` stops each anchor's multistart once that many starts agree on
+    the best value (None: run every start).
+    """
     starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
     tasks = []
@@ -660,10 +859,21 @@ def compute_anchors(
                 "order": order,
                 "starts": starts,
                 "seed": seed,
+                "solver": solver,
+                "agree": agree,
             }
         )
     done = run_tasks(
-        tasks, _anchor_task, store, workers, scheduler, resume, progress, key, on_record
+        tasks,
+        _anchor_task,
+        store,
+        workers,
+        scheduler,
+        resume,
+        progress,
+        key,
+        on_record,
+        pool=pool,
     )
     for name in objectives:
         rec = done[f"anchor-{name}"]
@@ -699,6 +909,8 @@ def epsilon_constraint_front(
     eps_values: Sequence[float] | None = None,
     name: str = "epsilon",
     on_record: Callable | None = None,
+    solver: str = "slsqp",
+    agree: int | None = 3,
 ) -> Front:
     """Epsilon-constraint front of two or three objectives.
 
@@ -729,6 +941,13 @@ def epsilon_constraint_front(
         spacing uses at most 2: one from each anchor).
     eps_values
         Explicit epsilon values of A (two objectives; overrides ``spacing``).
+    solver
+        ``"slsqp"`` (default): SciPy SLSQP with exact CasADi derivatives, warm from the
+        neighbour's design, Ipopt (built on first use) for a start SLSQP does not solve;
+        ``"ipopt"``: Ipopt throughout, warm-started primal and dual.
+    agree
+        Anchor multistart stops once this many starts agree on the best value (None:
+        always all ``starts``); each anchor record says how many ran and agreed.
     """
     objectives = _check_objectives(problem, objectives)
     if spacing not in ("arc", "uniform"):
@@ -747,127 +966,136 @@ def epsilon_constraint_front(
         extra=extra_starts,
         spacing=spacing,
         eps=None if eps_values is None else list(eps_values),
+        solver=solver,
+        agree=agree,
     )
     n_chains = chunks or (2 if scheduler is not None and workers <= 1 else workers)
-    anchors = compute_anchors(
-        problem,
-        objectives,
-        store,
-        workers,
-        scheduler,
-        resume,
-        f"{name}: anchors" if progress else False,
-        starts,
-        seed,
-        key,
-        on_record,
-    )
-    common = {
-        "problem": problem,
-        "retry_starts": retry_starts,
-        "extra_starts": extra_starts,
-        "seed": seed,
-    }
-    tasks: list[dict[str, Any]] = []
-    if len(objectives) == 2:
-        a, b = objectives
-        lo = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
-        hi = anchors[b]["objectives"][a]
-        if eps_values is None and spacing == "uniform":
-            eps_values = list(np.linspace(lo, hi, n_points))
-        if eps_values is not None:
-            n_points = len(eps_values)
-        frame = {
-            "a0": anchors[a]["objectives"][a],
-            "b0": anchors[a]["objectives"][b],
-            "ra": max(hi - anchors[a]["objectives"][a], 1e-300),
-            "rb": max(anchors[a]["objectives"][b] - anchors[b]["objectives"][b], 1e-300),
-            "a_lo": lo,
-            "a_hi": hi,
+    # One pool for both phases: the workers keep the solvers they built for the anchors.
+    with process_pool(workers if scheduler is None else 1) as pool:
+        anchors = compute_anchors(
+            problem,
+            objectives,
+            store,
+            workers,
+            scheduler,
+            resume,
+            f"{name}: anchors" if progress else False,
+            starts,
+            seed,
+            key,
+            on_record,
+            solver=solver,
+            agree=agree,
+            pool=pool,
+        )
+        common = {
+            "solver": solver,
+            "problem": problem,
+            "retry_starts": retry_starts,
+            "extra_starts": extra_starts,
+            "seed": seed,
         }
-        h = 2.0 / max(n_points - 1, 1)
-        n_chains = min(n_chains, 2) if eps_values is None else n_chains
-        parts = _chunks(n_points, n_chains)
-        for j, part in enumerate(parts):
-            # First chain ascends from anchor A, the last descends from anchor B, middle
-            # ones (explicit epsilon only) start cold and are checked by multistart.
-            descending = j == len(parts) - 1 and len(parts) > 1
-            seq = part[::-1] if descending else part
-            prev = f"anchor-{b}" if descending else (f"anchor-{a}" if j == 0 else None)
-            for i in seq:
-                task = {
-                    **common,
-                    "id": f"{name}-{i:04d}",
-                    "target": b,
-                    "warm": prev,
-                    "after": [prev] if prev else [],
-                    "index": i,
-                }
-                if eps_values is not None:
-                    task["eps"] = {a: float(eps_values[i])}
-                elif i in (0, n_points - 1):
-                    task["eps"] = {a: lo if i == 0 else hi}
-                else:
-                    task.update(
-                        eps_name=a,
-                        arc=i * h,
-                        frame=frame,
-                        fallback_eps=float(lo + (hi - lo) * i / (n_points - 1)),
-                    )
-                tasks.append(task)
-                prev = task["id"]
-    else:
-        a, b, c = objectives
-        n_side = max(2, math.ceil(math.sqrt(n_points)))
-        lo_a = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
-        hi_a = max(r["objectives"][a] for r in anchors.values())
-        hi_b = max(r["objectives"][b] for r in anchors.values())
-        # Row r fixes A <= e1[r]. Its head (min B s.t. A <= e1, a chain along e1 from
-        # anchor A) gives the smallest feasible e2 of the row, so that the row's grid
-        # e2 in [B_min(e1), B_max] holds no infeasible corner; each row is then a
-        # warm-started chain of min C s.t. A <= e1, B <= e2 from the tightest e2 up.
-        prev = f"anchor-{a}"
-        for r, v1 in enumerate(np.linspace(lo_a, hi_a, n_side)):
-            head = {
-                **common,
-                "id": f"{name}-{r:03d}-head",
-                "target": b,
-                "eps": {a: float(v1), c: np.inf},
-                "warm": prev,
-                "after": [prev],
-                "index": r * (n_side + 1),
-                "head": True,
+        tasks: list[dict[str, Any]] = []
+        if len(objectives) == 2:
+            a, b = objectives
+            lo = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
+            hi = anchors[b]["objectives"][a]
+            if eps_values is None and spacing == "uniform":
+                eps_values = list(np.linspace(lo, hi, n_points))
+            if eps_values is not None:
+                n_points = len(eps_values)
+            frame = {
+                "a0": anchors[a]["objectives"][a],
+                "b0": anchors[a]["objectives"][b],
+                "ra": max(hi - anchors[a]["objectives"][a], 1e-300),
+                "rb": max(anchors[a]["objectives"][b] - anchors[b]["objectives"][b], 1e-300),
+                "a_lo": lo,
+                "a_hi": hi,
             }
-            tasks.append(head)
-            prev, row_prev = head["id"], head["id"]
-            for k in range(n_side):
-                task = {
+            h = 2.0 / max(n_points - 1, 1)
+            n_chains = min(n_chains, 2) if eps_values is None else n_chains
+            parts = _chunks(n_points, n_chains)
+            for j, part in enumerate(parts):
+                # First chain ascends from anchor A, the last descends from anchor B, middle
+                # ones (explicit epsilon only) start cold and are checked by multistart.
+                descending = j == len(parts) - 1 and len(parts) > 1
+                seq = part[::-1] if descending else part
+                prev = f"anchor-{b}" if descending else (f"anchor-{a}" if j == 0 else None)
+                for i in seq:
+                    task = {
+                        **common,
+                        "id": f"{name}-{i:04d}",
+                        "target": b,
+                        "warm": prev,
+                        "after": [prev] if prev else [],
+                        "index": i,
+                    }
+                    if eps_values is not None:
+                        task["eps"] = {a: float(eps_values[i])}
+                    elif i in (0, n_points - 1):
+                        task["eps"] = {a: lo if i == 0 else hi}
+                    else:
+                        task.update(
+                            eps_name=a,
+                            arc=i * h,
+                            frame=frame,
+                            fallback_eps=float(lo + (hi - lo) * i / (n_points - 1)),
+                        )
+                    tasks.append(task)
+                    prev = task["id"]
+        else:
+            a, b, c = objectives
+            n_side = max(2, math.ceil(math.sqrt(n_points)))
+            lo_a = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
+            hi_a = max(r["objectives"][a] for r in anchors.values())
+            hi_b = max(r["objectives"][b] for r in anchors.values())
+            # Row r fixes A <= e1[r]. Its head (min B s.t. A <= e1, a chain along e1 from
+            # anchor A) gives the smallest feasible e2 of the row, so that the row's grid
+            # e2 in [B_min(e1), B_max] holds no infeasible corner; each row is then a
+            # warm-started chain of min C s.t. A <= e1, B <= e2 from the tightest e2 up.
+            prev = f"anchor-{a}"
+            for r, v1 in enumerate(np.linspace(lo_a, hi_a, n_side)):
+                head = {
                     **common,
-                    "id": f"{name}-{r:03d}-{k:03d}",
-                    "target": c,
-                    "eps_row": {a: float(v1)},
-                    "row_head": head["id"],
-                    "b_name": b,
-                    "b_hi": float(hi_b),
-                    "frac": k / (n_side - 1),
-                    "warm": row_prev,
-                    "after": sorted({row_prev, head["id"]}),
-                    "index": r * (n_side + 1) + k + 1,
-                    "jump": None,  # grid steps are large: jumps are expected
+                    "id": f"{name}-{r:03d}-head",
+                    "target": b,
+                    "eps": {a: float(v1), c: np.inf},
+                    "warm": prev,
+                    "after": [prev],
+                    "index": r * (n_side + 1),
+                    "head": True,
                 }
-                tasks.append(task)
-                row_prev = task["id"]
-    done = run_tasks(
-        tasks,
-        _eps_task,
-        store,
-        workers,
-        scheduler,
-        True,  # the anchors are in the store already
-        f"{name}: points" if progress else False,
-        key,
-        on_record,
-    )
+                tasks.append(head)
+                prev, row_prev = head["id"], head["id"]
+                for k in range(n_side):
+                    task = {
+                        **common,
+                        "id": f"{name}-{r:03d}-{k:03d}",
+                        "target": c,
+                        "eps_row": {a: float(v1)},
+                        "row_head": head["id"],
+                        "b_name": b,
+                        "b_hi": float(hi_b),
+                        "frac": k / (n_side - 1),
+                        "warm": row_prev,
+                        "after": sorted({row_prev, head["id"]}),
+                        "index": r * (n_side + 1) + k + 1,
+                        "jump": None,  # grid steps are large: jumps are expected
+                    }
+                    tasks.append(task)
+                    row_prev = task["id"]
+        done = run_tasks(
+            tasks,
+            _eps_task,
+            store,
+            workers,
+            scheduler,
+            True,  # the anchors are in the store already
+            f"{name}: points" if progress else False,
+            key,
+            on_record,
+            pool=pool,
+        )
     pts = [_point(done[t["id"]], name) for t in sorted(tasks, key=lambda t: t["index"])]
     info = {
         "anchors": {k: v["objectives"] for k, v in anchors.items()},

@@ -26,8 +26,9 @@ from __future__ import annotations
 import json
 import os
 import threading
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -100,6 +101,7 @@ def run_tasks(
     key: str | None = None,
     on_record: Callable[[Record], None] | None = None,
     known: Mapping[str, Record] | None = None,
+    pool: ProcessPoolExecutor | None = None,
 ) -> dict[str, Record]:
     """Run ``tasks`` through ``fn``, storing each record as it finishes.
 
@@ -128,6 +130,10 @@ def run_tasks(
     known
         Records computed elsewhere (id -> record) that tasks may name in ``after``; they
         are not written to this store.
+    pool
+        An open process pool (see :func:`process_pool`) to run local tasks on instead of
+        a new one, so that consecutive phases of one computation share the workers and
+        their per-process caches (solvers built once per worker, not once per phase).
 
     Returns
     -------
@@ -174,6 +180,9 @@ def run_tasks(
         if on_record is not None:
             on_record(record)
 
+    def mark(record: Record) -> None:
+        done[record["id"]] = record
+
     def ready(t: Mapping[str, Any]) -> bool:
         return all(a in done for a in t.get("after", []))
 
@@ -184,7 +193,11 @@ def run_tasks(
         if scheduler is not None:
             _run_dask(pending, fn, scheduler, ready, deps_of, finished)
         elif workers > 1 and len(pending) > 1:
-            _run_pool(pending, fn, workers, ready, deps_of, finished)
+            if pool is not None:
+                _run_on(pool, pending, fn, workers, ready, deps_of, finished, mark)
+            else:
+                with process_pool(workers) as own:
+                    _run_on(own, pending, fn, workers, ready, deps_of, finished, mark)
         else:
             queue = list(pending)
             while queue:
@@ -200,30 +213,92 @@ def run_tasks(
     return {i: done[i] for i in ids if i in done}
 
 
-def _run_pool(pending, fn, workers, ready, deps_of, finished) -> None:
+@contextmanager
+def process_pool(workers: int) -> Iterator[ProcessPoolExecutor | None]:
+    """A local process pool of ``workers`` processes (None for ``workers <= 1``).
+
+    Pass it to several :func:`run_tasks` calls (``pool=``) to keep the same worker
+    processes, and so their caches, across phases; it is shut down on exit.
+    """
+    if workers <= 1:
+        yield None
+        return
+    with ProcessPoolExecutor(max_workers=workers, initializer=_init_process) as pool:
+        yield pool
+
+
+def _run_on(pool, pending, fn, workers, ready, deps_of, finished, mark) -> None:
     # Submit a task as soon as its dependencies are in; never more in flight than workers,
     # so that a chain's next point goes to a free worker as soon as its neighbour is done.
     queue = list(pending)
-    with ProcessPoolExecutor(max_workers=workers, initializer=_init_process) as pool:
-        running: dict[Any, dict] = {}
-        while queue or running:
-            while len(running) < workers:
-                t = next((t for t in queue if ready(t)), None)
-                if t is None:
-                    break
-                queue.remove(t)
-                running[pool.submit(_call, fn, t, deps_of(t))] = t
-            if not running:
-                raise ValueError("run_tasks: dependency cycle")
-            finished_futs, _ = wait(running, return_when=FIRST_COMPLETED)
-            for fut in finished_futs:
-                running.pop(fut)
-                finished(fut.result())
+    running: dict[Any, dict] = {}
+
+    def submit_ready() -> None:
+        while len(running) < workers:
+            t = next((t for t in queue if ready(t)), None)
+            if t is None:
+                break
+            queue.remove(t)
+            running[pool.submit(_call, fn, t, deps_of(t))] = t
+
+    while queue or running:
+        submit_ready()
+        if not running:
+            raise ValueError("run_tasks: dependency cycle")
+        finished_futs, _ = wait(running, return_when=FIRST_COMPLETED)
+        records = []
+        for fut in finished_futs:
+            running.pop(fut)
+            records.append(fut.result())
+            mark(records[-1])
+        # The next tasks of the chains go out before the store write (an fsync each,
+        # ~1 ms, was serial latency on every step of every chain); a run killed in
+        # between just recomputes the unstored records on resume.
+        submit_ready()
+        for record in records:
+            finished(record)
 
 
 def _init_process() -> None:
     # One solver thread per process: the processes are the parallelism.
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+    # The environment variable is read when a BLAS library loads; forked workers inherit
+    # NumPy's and SciPy's OpenBLAS already loaded with one thread per core. Two workers
+    # each running two BLAS threads (SLSQP's QP) on 2 cores ran ~3x slower per point.
+    limit_blas_threads(1)
+
+
+def limit_blas_threads(n: int = 1) -> int:
+    """Set the thread count of every OpenBLAS already loaded in this process.
+
+    Returns how many libraries were limited (0 where there is no OpenBLAS or no
+    ``/proc``; nothing else changes then).
+    """
+    import ctypes
+
+    try:
+        with open("/proc/self/maps") as fh:
+            libs = {line.split()[-1] for line in fh if "openblas" in line.lower()}
+    except OSError:
+        return 0
+    count = 0
+    for lib in sorted(libs):
+        try:
+            handle = ctypes.CDLL(lib)
+        except OSError:
+            continue
+        for symbol in (
+            "openblas_set_num_threads",
+            "openblas_set_num_threads64_",
+            "scipy_openblas_set_num_threads",
+            "scipy_openblas_set_num_threads64_",
+        ):
+            fn = getattr(handle, symbol, None)
+            if fn is not None:
+                fn(ctypes.c_int(n))
+                count += 1
+                break
+    return count
 
 
 def _run_dask(pending, fn, scheduler, ready, deps_of, finished) -> None:
