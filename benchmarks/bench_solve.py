@@ -22,7 +22,7 @@ from scipy.optimize import differential_evolution
 
 from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver, CasadiSLSQPSolver
 from optdesign.studies.global_check import penalised_objective
 from optdesign.studies.solve import solve_nlp
 
@@ -63,6 +63,10 @@ def main() -> None:
         times.append(r.wall_time_s)
         results.append(r)
     one_solve = float(np.median(times))
+    # the same NLP by SLSQP with exact CasADi derivatives (the Pareto sweeps' solver)
+    slsqp = CasadiSLSQPSolver(solver.nlp)
+    slsqp_runs = [slsqp.solve(problem.start()) for _ in range(args.repeats)]
+    one_slsqp = float(np.median([r.wall_time_s for r in slsqp_runs]))
 
     t0 = time.perf_counter()
     ms = solve_nlp(problem)
@@ -101,6 +105,8 @@ def main() -> None:
         "one_ipopt_solve_median_s": one_solve,
         "one_ipopt_solve_iterations": results[0].iterations,
         "one_solve_reaches_optimum": bool(abs(results[0].objective - target) <= 1e-6 * target),
+        "one_slsqp_solve_median_s": one_slsqp,
+        "one_slsqp_solve_objective": slsqp_runs[0].objective,
         "multistart_time_s": multistart_time,
         "multistart_starts": ms.multistart.n_starts,
         "multistart_at_best": ms.multistart.n_at_best,
@@ -109,6 +115,7 @@ def main() -> None:
         "de_nfev": de_evals,
         "de_reached_target": [not np.isnan(t) for t in de_times],
         "ratio_de_over_one_solve": de_time / one_solve,
+        "ratio_de_over_one_slsqp_solve": de_time / one_slsqp,
         "ratio_de_over_multistart": de_time / multistart_time,
     }
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
