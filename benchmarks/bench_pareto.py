@@ -24,6 +24,11 @@ import tempfile
 import time
 from pathlib import Path
 
+# One BLAS thread, as in the workers, and set before NumPy loads its BLAS (NSGA-II and the
+# 1-worker run then use one core, like each of the 2 workers).
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import numpy as np
 
 from optdesign.problem import load_problem
@@ -69,7 +74,6 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5, help="1-vs-2-worker pairs")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "data" / "bench_pareto.json")
     args = ap.parse_args()
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
     problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
     R = read_front_csv(REFERENCE, OBJECTIVES)
     R = R[non_dominated(R)]
