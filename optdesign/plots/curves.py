@@ -8,6 +8,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from optdesign.plots import save_figure
+
 
 def plot_curves(
     phi_deg: np.ndarray,
@@ -32,9 +34,4 @@ def save_deflection_figure(fig, axes, path: Path) -> Path:
         ax.set_xlabel("deflection phi (deg)")
         ax.grid(True, alpha=0.3)
         ax.legend()
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -10,6 +10,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from optdesign.plots import save_figure
 from optdesign.problem.design_problem import DesignProblem
 
 _UNITS = {"backlash": "deg", "backlash_rss": "deg", "size": "mm", "nut_travel": "mm"}
@@ -124,9 +125,4 @@ def plot_fronts(
         p = main.points[i]
         text = ", ".join(f"{o}={p.objectives[o]:.4g}" for o in objectives)
         draw_linkage(sub, problem, p.design, f"{chr(65 + k)}: {text}")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

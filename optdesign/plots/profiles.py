@@ -8,6 +8,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from optdesign.plots import save_figure
+
 
 def plot_profiles(
     profiles: Mapping[str, tuple[np.ndarray, np.ndarray]],
@@ -51,8 +53,4 @@ def plot_profiles(
     n_rows = -(-len(labels) // 6)
     fig.tight_layout(rect=(0.0, 0.04 * n_rows + 0.02, 1.0, 1.0))
     fig.legend(handles, labels, loc="lower center", ncol=6, fontsize=8, frameon=False)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, tight=False)

@@ -37,12 +37,27 @@ def run(out: Path) -> int:
     rows = [
         Comparison("eta(alpha_s = 10 deg, beta = 45 deg)", 0.975, float(_eta(10.0, 45.0))),
         Comparison("eta with f_k = f_r = 0 (eq. 8-9)", 1.0, float(_eta(10.0, 45.0, 0.0, 0.0))),
-        Comparison("helix angle of peak eta at beta = 45 deg", 10.0, alpha_peak, "deg",
-                   "paper: 'near 10 deg'"),
-        Comparison("beta where eta(10 deg) reaches 99 % of eta(90 deg)", 45.0, beta_level, "deg",
-                   "paper: levels off ~45 deg"),
-        Comparison("eq. 14 at 10/45 deg vs bench", None, float(_eta(10.0, 45.0)), "",
-                   "paper measured > 0.74 (RV21X2, not eq. 14)"),
+        Comparison(
+            "helix angle of peak eta at beta = 45 deg",
+            10.0,
+            alpha_peak,
+            "deg",
+            "paper: 'near 10 deg'",
+        ),
+        Comparison(
+            "beta where eta(10 deg) reaches 99 % of eta(90 deg)",
+            45.0,
+            beta_level,
+            "deg",
+            "paper: levels off ~45 deg",
+        ),
+        Comparison(
+            "eq. 14 at 10/45 deg vs bench",
+            None,
+            float(_eta(10.0, 45.0)),
+            "",
+            "paper measured > 0.74 (RV21X2, not eq. 14)",
+        ),
     ]
     print("Seed 003 (Li et al. 2016): planetary roller screw efficiency, eq. 14")
     print("Inputs (SI -> mm): r_s = 0.04 m = 40 mm, r_RP = 0.01 m = 10 mm,")
@@ -51,10 +66,8 @@ def run(out: Path) -> int:
     print("conclusions use beta up to 90 deg and alpha around 5-15 deg, as plotted here.\n")
     print(comparison_table(rows))
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # optdesign.plots selects the Agg back-end before pyplot loads
+    from optdesign.plots import plt, save_figure
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
     for a in (2.0, 5.0, 10.0, 15.0, 20.0, 30.0):
@@ -71,10 +84,7 @@ def run(out: Path) -> int:
     ax2.legend(fontsize=7)
     ax2.grid(True, alpha=0.3)
     fig.suptitle("Roller screw efficiency, eq. 14 (trends of Fig. 7)")
-    fig.tight_layout()
-    p1 = out / "li2016_efficiency.png"
-    fig.savefig(p1, dpi=120)
-    plt.close(fig)
+    p1 = save_figure(fig, out / "li2016_efficiency.png")
 
     # Error budget of the screw on its own (nut side, mm), illustrative values.
     P, d_s = 5.0, 40.0
@@ -98,10 +108,15 @@ def run(out: Path) -> int:
     mc = run_monte_carlo(sources, 200_000, seed=2016, **kw)
     print("\nError budget, eq. 6 (illustrative values; the paper prints none), nut side:")
     print(f"  systematic {1e3 * float(b.systematic):.3f} um +- RSS {1e3 * float(b.rss):.3f} um")
-    print(f"  Monte Carlo (200 000 samples, seed 2016): mean {1e3 * mc.mean:.3f} um, "
-          f"sd {1e3 * mc.std:.3f} um")
-    print(format_table(["source", "share of mean-square error (%)"],
-                       [[k, 100 * v] for k, v in mc.ranking()]))
+    print(
+        f"  Monte Carlo (200 000 samples, seed 2016): mean {1e3 * mc.mean:.3f} um, "
+        f"sd {1e3 * mc.std:.3f} um"
+    )
+    print(
+        format_table(
+            ["source", "share of mean-square error (%)"], [[k, 100 * v] for k, v in mc.ranking()]
+        )
+    )
     p2 = plot_ranking(mc, out / "li2016_sensitivity.png", "Sensitivity ranking (illustrative)")
     print(f"\nwrote {p1}\nwrote {p2}")
     ok = abs(float(_eta(10.0, 45.0)) - 0.975) < 1e-3

@@ -325,10 +325,8 @@ def run(out: Path) -> int:
 
 
 def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # optdesign.plots selects the Agg back-end before pyplot loads
+    from optdesign.plots import plt, save_figure
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for s in SIDES:
@@ -339,9 +337,7 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
         title="Principal-plane angle along the contact position",
     )
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(out / "prsm_omega_position.png", dpi=120)
-    plt.close(fig)
+    save_figure(fig, out / "prsm_omega_position.png")
 
     fig, axs = plt.subplots(1, 2, figsize=(10, 4))
     for s in SIDES:
@@ -363,9 +359,7 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
     axs[1].set(xlabel="flank half-angle (deg)", ylabel="omega (deg)", title="omega vs beta")
     for a in axs:
         a.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "prsm_omega_structure.png", dpi=120)
-    plt.close(fig)
+    save_figure(fig, out / "prsm_omega_structure.png")
 
     for name, x, sw, xl in (
         ("pitch", PITCHES, sp, "pitch (mm)"),
@@ -377,9 +371,7 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
             ax.plot(x, sw.e0[s], "--", label=f"{s}, omega = 0")
         ax.set(xlabel=xl, ylabel="eccentricity e", title=f"Eccentricity vs {name}")
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / f"prsm_eccentricity_{name}.png", dpi=120)
-        plt.close(fig)
+        save_figure(fig, out / f"prsm_eccentricity_{name}.png")
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for s in SIDES:
@@ -391,6 +383,4 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
         title="Contact-ellipse area vs load",
     )
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "prsm_area_load.png", dpi=120)
-    plt.close(fig)
+    save_figure(fig, out / "prsm_area_load.png")

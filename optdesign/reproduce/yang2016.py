@@ -55,14 +55,34 @@ def run(out: Path) -> int:
     rows = [
         Comparison("pin lock f_a / (M/R) (eq. 5)", 0.35, f_a * R_PIN_MM / M),
         Comparison("pin / friction plate (eq. 6)", 9.25, 100 * f_a / F_plate, "%"),
-        Comparison("rolling pin / friction plate, guide reading", 6.32, 100 * f_b / F_plate,
-                   "%", "reconstructed eq. 8"),
-        Comparison("rolling pin / friction plate, tip reading", 6.32, 100 * f_b_tip / F_plate,
-                   "%", "alternative reading"),
-        Comparison("guide reading, bearing aligned", None, 100 * f_b_aligned / F_plate, "%",
-                   "misalignment 0"),
-        Comparison("pin / friction plate, uniform wear", None, 100 * f_a / F_plate_wear, "%",
-                   "worn-in plates"),
+        Comparison(
+            "rolling pin / friction plate, guide reading",
+            6.32,
+            100 * f_b / F_plate,
+            "%",
+            "reconstructed eq. 8",
+        ),
+        Comparison(
+            "rolling pin / friction plate, tip reading",
+            6.32,
+            100 * f_b_tip / F_plate,
+            "%",
+            "alternative reading",
+        ),
+        Comparison(
+            "guide reading, bearing aligned",
+            None,
+            100 * f_b_aligned / F_plate,
+            "%",
+            "misalignment 0",
+        ),
+        Comparison(
+            "pin / friction plate, uniform wear",
+            None,
+            100 * f_a / F_plate_wear,
+            "%",
+            "worn-in plates",
+        ),
     ]
     print("Seed 002 (Yang & Chen 2016): magnet force of motor-shaft locks")
     print("Inputs (SI -> mm): r1 = 0.03 m = 30 mm, r2 = 0.04 m = 40 mm, mu = 0.3, R = 40 mm,")
@@ -91,10 +111,8 @@ def run(out: Path) -> int:
     print(f"M_h = 500 N*m, ball screw eta' = {float(eta_back):.4f}, gear eta' = 0.98:")
     print(format_table(["lock", "max motor-shaft moment (N*m)", "magnet force (N)"], table))
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # optdesign.plots selects the Agg back-end before pyplot loads
+    from optdesign.plots import plt, save_figure
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     ax.plot(np.degrees(phi), np.asarray(load.moment) / 1e3)
@@ -102,10 +120,7 @@ def run(out: Path) -> int:
     ax.set_ylabel("motor-shaft moment (N*m)")
     ax.set_title("Hinge moment 500 N*m reflected to the motor shaft")
     ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    path = out / "yang2016_motor_shaft_moment.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = save_figure(fig, out / "yang2016_motor_shaft_moment.png")
     print(f"\nwrote {path}")
     ok = abs(100 * f_a / F_plate - 9.25) < 0.01
     return 0 if ok else 1

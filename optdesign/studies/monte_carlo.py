@@ -121,7 +121,7 @@ def run_monte_carlo(
         y2 += np.dot(y, y)
         y_abs = max(y_abs, float(np.max(np.abs(y))))
         if kept is not None:
-            kept[done:done + nc] = y
+            kept[done : done + nc] = y
         done += nc
     mean = y1 / n
     var = max(y2 / n - mean**2, 0.0) * n / (n - 1)
@@ -144,10 +144,8 @@ def run_monte_carlo(
 
 def plot_ranking(result: MonteCarloResult, path: Path, title: str = "") -> Path:
     """Bar plot of the sensitivity ranking in percent (like seed 003 Fig. 6b)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # optdesign.plots selects the Agg back-end before pyplot loads
+    from optdesign.plots import plt, save_figure
 
     ranked = result.ranking()
     fig, ax = plt.subplots(figsize=(7, 3.5))
@@ -155,7 +153,4 @@ def plot_ranking(result: MonteCarloResult, path: Path, title: str = "") -> Path:
     ax.set_ylabel("share of mean-square error (%)")
     ax.set_title(title or "Sensitivity ranking (Monte Carlo)")
     ax.tick_params(axis="x", rotation=30)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
