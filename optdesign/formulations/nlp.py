@@ -80,6 +80,39 @@ class NLP:
         return np.concatenate([zd, aux])
 
 
+@dataclass
+class ConstraintRows:
+    """Constraint rows lower/scale <= expr/scale <= upper/scale, with their names and units.
+
+    Every row is divided by a typical magnitude (its bound, or its size at the start
+    design) so that one solver tolerance fits all; ``scales`` keeps the divisors so that
+    reports give values in the constraint's own unit.
+    """
+
+    exprs: list[Any] = field(default_factory=list)
+    lbg: list[float] = field(default_factory=list)
+    ubg: list[float] = field(default_factory=list)
+    names: list[str] = field(default_factory=list)
+    units: list[str] = field(default_factory=list)
+    scales: list[float] = field(default_factory=list)
+
+    def add(self, expr, lo, hi, scale, name, labels, unit) -> None:
+        """Add ``lo <= expr <= hi`` (element-wise), each row named ``name[label]``."""
+        expr = ca.vec(ca.SX(expr))
+        k = expr.shape[0]
+        self.exprs.append(expr / scale)
+        self.lbg.extend([-np.inf if lo is None else lo / scale] * k)
+        self.ubg.extend([np.inf if hi is None else hi / scale] * k)
+        labs = labels if len(labels) == k else [str(j) for j in range(k)]
+        self.names.extend([f"{name}[{lab}]" if lab else name for lab in labs])
+        self.units.extend([unit] * k)
+        self.scales.extend([scale] * k)
+
+    def g(self):
+        """All rows as one CasADi column."""
+        return ca.vertcat(*self.exprs) if self.exprs else ca.SX(0, 1)
+
+
 def build_nlp(
     problem: DesignProblem,
     objective: str | Mapping[str, float] | None = None,
@@ -130,23 +163,8 @@ def build_nlp(
     aux_lb: list[float] = []
     aux_ub: list[float] = []
     aux_start: list[Any] = []  # expressions of zd giving the tightest aux values
-    g_rows: list[Any] = []
-    lbg: list[float] = []
-    ubg: list[float] = []
-    names: list[str] = []
-    units: list[str] = []
-    scales: list[float] = []
-
-    def add_rows(expr, lo, hi, scale, name, labels, unit):
-        expr = ca.vec(ca.SX(expr)) if not isinstance(expr, ca.SX) else ca.vec(expr)
-        k = expr.shape[0]
-        g_rows.append(expr / scale)
-        lbg.extend([-np.inf if lo is None else lo / scale] * k)
-        ubg.extend([np.inf if hi is None else hi / scale] * k)
-        labs = labels if len(labels) == k else [str(j) for j in range(k)]
-        names.extend([f"{name}[{lab}]" if lab else name for lab in labs])
-        units.extend([unit] * k)
-        scales.extend([scale] * k)
+    rows = ConstraintRows()
+    add_rows = rows.add
 
     def typical(value) -> float:
         v = np.nanmax(np.abs(np.asarray(value, dtype=float)))
@@ -230,7 +248,7 @@ def build_nlp(
     za = ca.SX.sym("za", len(aux))
     syms = [a for a, _ in aux]
     scaled = [s * za[k] for k, (_, s) in enumerate(aux)]
-    g_all = ca.vertcat(*g_rows) if g_rows else ca.SX(0, 1)
+    g_all = rows.g()
     if syms:
         sym_vec = ca.vertcat(*syms)
         rep = ca.vertcat(*scaled)
@@ -255,11 +273,11 @@ def build_nlp(
         g=g_all,
         lbz=np.concatenate([np.zeros(n), aux_lb_s]),
         ubz=np.concatenate([np.ones(n), aux_ub_s]),
-        lbg=np.array(lbg),
-        ubg=np.array(ubg),
-        g_names=names,
-        g_units=units,
-        g_scale=np.array(scales),
+        lbg=np.array(rows.lbg),
+        ubg=np.array(rows.ubg),
+        g_names=rows.names,
+        g_units=rows.units,
+        g_scale=np.array(rows.scales),
         n_design=n,
         x_lo=x_lo,
         x_span=x_span,

@@ -37,7 +37,7 @@ import casadi as ca
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import NLP, build_nlp
+from optdesign.formulations.nlp import NLP, ConstraintRows, build_nlp
 from optdesign.models.fits import Fit
 from optdesign.problem.design_problem import DesignProblem, ObjectiveTerm
 from optdesign.problem.spec import Tolerances
@@ -260,18 +260,8 @@ def build_robust_nlp(
         v_scale = spread0 if np.isfinite(spread0) and spread0 > 0 else 1.0
 
     aux, aux_lb, aux_ub, aux_init, aux_names = [], [], [], [], []
-    rows, lbg, ubg, names, units, scales = [], [], [], [], [], []
-
-    def add(expr, lo, hi, s, name, labels, unit):
-        expr = ca.vec(ca.SX(expr))
-        m_rows = expr.shape[0]
-        rows.append(expr / s)
-        lbg.extend([-np.inf if lo is None else lo / s] * m_rows)
-        ubg.extend([np.inf if hi is None else hi / s] * m_rows)
-        labs = labels if len(labels) == m_rows else [str(j) for j in range(m_rows)]
-        names.extend([f"{name}[{lab}]" if lab else name for lab in labs])
-        units.extend([unit] * m_rows)
-        scales.extend([s] * m_rows)
+    rows = ConstraintRows()
+    add = rows.add
 
     values = []  # per-sample objective, scaled (~1)
     nominal_term, _ = sampled_objective(problem, design, objective, guarded=True)
@@ -364,18 +354,18 @@ def build_robust_nlp(
     init_parts.append(ca.vertcat(*aux_init))
     aux_init_fun = ca.Function("robust_aux_init", [zd], [ca.vertcat(*init_parts)])
     label = risk_label(risk, alpha, k, objective)
-    g = ca.vertcat(base.g, *rows)
+    g = ca.vertcat(base.g, *rows.exprs)
     return NLP(
         z=z,
         f=f,
         g=g,
         lbz=np.concatenate([base.lbz, aux_lb]),
         ubz=np.concatenate([base.ubz, aux_ub]),
-        lbg=np.concatenate([base.lbg, lbg]),
-        ubg=np.concatenate([base.ubg, ubg]),
-        g_names=base.g_names + names,
-        g_units=base.g_units + units,
-        g_scale=np.concatenate([base.g_scale, scales]),
+        lbg=np.concatenate([base.lbg, rows.lbg]),
+        ubg=np.concatenate([base.ubg, rows.ubg]),
+        g_names=base.g_names + rows.names,
+        g_units=base.g_units + rows.units,
+        g_scale=np.concatenate([base.g_scale, rows.scales]),
         n_design=n,
         x_lo=base.x_lo,
         x_span=base.x_span,
