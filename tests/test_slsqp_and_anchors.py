@@ -8,7 +8,8 @@ import pytest
 
 from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver, CasadiSLSQPSolver
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.pareto import epsilon_constraint_front
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
@@ -19,7 +20,7 @@ def test_slsqp_reaches_ipopt_optimum_with_consistent_multipliers(name):
     problem = load_problem(PROBLEMS / f"{name}.toml")
     nlp = build_nlp(problem)
     ipopt = CasadiNLPSolver(nlp).solve(problem.start())
-    slsqp = CasadiSLSQPSolver(nlp).solve(problem.start())
+    slsqp = ScipyNLPSolver(nlp, "SLSQP", "exact").solve(problem.start())
     assert ipopt.status == slsqp.status == "optimal"
     assert slsqp.objective == pytest.approx(ipopt.objective, rel=1e-6)
     li, ls = ipopt.raw["lam_g"], slsqp.raw["lam_g"]
@@ -47,7 +48,7 @@ def test_slsqp_reaches_ipopt_optimum_with_consistent_multipliers(name):
 def test_slsqp_reads_changed_bounds_between_solves():
     problem = load_problem(PROBLEMS / "fork_min_backlash.toml")
     nlp = build_nlp(problem, epsilon={"size": np.inf})
-    solver = CasadiSLSQPSolver(nlp)
+    solver = ScipyNLPSolver(nlp, "SLSQP", "exact")
     free = solver.solve(problem.start())
     row = nlp.g_names.index("size_max")
     nlp.ubg = nlp.ubg.copy()

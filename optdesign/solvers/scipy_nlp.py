@@ -2,9 +2,9 @@
 :class:`~optdesign.formulations.nlp.NLP` (derivatives exact from CasADi or by finite
 differences), and differential evolution on a vectorised NumPy objective.
 
-- :class:`ScipyNLPSolver` turns the NLP into CasADi Functions for f, grad f, g, jac g
-  (and, for trust-constr, the Hessians of f and of lam' g), or hands SciPy only f and g
-  when ``derivatives="fd"`` (SLSQP then differences itself; trust-constr uses 2-point
+- :class:`ScipyNLPSolver` turns the NLP into one CasADi Function for f, grad f, g and
+  jac g (and, for trust-constr, the Hessians of f and of lam' g), or hands SciPy only f
+  and g when ``derivatives="fd"`` (SLSQP then differences itself; trust-constr uses 2-point
   gradients and BFGS Hessians). A wall-time limit is enforced inside the function
   evaluations, so every method stops, whatever its own callbacks support.
 - :func:`differential_evolution` is the global reference: it sees only a vectorised
@@ -35,7 +35,23 @@ class _TimeUp(Exception):
 
 
 class ScipyNLPSolver:
-    """SLSQP or trust-constr on an NLP in scaled variables.
+    """SLSQP or trust-constr on an NLP in scaled variables (the one SciPy NLP back-end).
+
+    Same ``solve`` interface and :class:`Result` as
+    :class:`~optdesign.solvers.casadi_nlp.CasadiNLPSolver` (violated and active rows,
+    ``raw`` with ``z``, ``lam_x`` and ``lam_g``), so callers can swap them: the Pareto
+    sweeps use SLSQP with exact derivatives, the solver benchmark every combination.
+
+    - The constraint and variable bounds are read from ``nlp`` at every solve, so
+      changing ``nlp.ubg`` between solves (epsilon sweeps) works.
+    - With exact derivatives, f, grad f, g and jac g come from one CasADi Function
+      evaluated once per point (SciPy asks for them at the same point); the Hessians of
+      trust-constr are separate Functions.
+    - SLSQP's multipliers (SciPy >= 1.16 returns them) are mapped to CasADi's sign
+      convention in ``raw["lam_g"]`` (``> 0`` at an active upper bound, ``< 0`` at an
+      active lower bound); SciPy returns no bound multipliers, so ``raw["lam_x"]`` is
+      zero, and trust-constr's ``raw["lam_g"]`` is zero too. There is no dual warm start
+      (``lam_x0``/``lam_g0`` are accepted and ignored).
 
     Parameters
     ----------
@@ -51,6 +67,12 @@ class ScipyNLPSolver:
     time_limit
         Wall-time limit of one solve (s); the last iterate is returned as
         ``time_limit``.
+
+    Notes
+    -----
+    ``n_evals`` counts SciPy's requests (``f``, ``grad_f``, ``g``, ``jac_g``, ``hess_f``,
+    ``hess_g``, the names the benchmark summary reads) and, with exact derivatives, the
+    combined CasADi evaluations (``fgj``).
     """
 
     DEFAULTS: ClassVar[dict[str, dict[str, Any]]] = {
@@ -80,8 +102,7 @@ class ScipyNLPSolver:
         self.g_fun = ca.Function("g", [z], [g])
         self.values_fun = ca.Function("values", [z], [ca.vertcat(*nlp.objective_values.values())])
         if derivatives == "exact":
-            self.grad_fun = ca.Function("grad_f", [z], [ca.gradient(f, z)])
-            self.jac_fun = ca.Function("jac_g", [z], [ca.jacobian(g, z)])
+            self.fgj_fun = ca.Function("fgj", [z], [f, ca.gradient(f, z), g, ca.jacobian(g, z)])
             if method == "trust-constr":
                 lam = (
                     ca.SX.sym("lam", g.shape[0])
@@ -92,11 +113,10 @@ class ScipyNLPSolver:
                 self.hess_g_fun = ca.Function(
                     "hess_g", [z, lam], [ca.hessian(ca.dot(lam, g), z)[0]]
                 )
-        # SLSQP wants g(z) >= 0 and h(z) = 0: one row per finite bound.
-        lb, ub = nlp.lbg, nlp.ubg
-        self._eq = np.flatnonzero(np.isfinite(lb) & np.isfinite(ub) & (lb == ub))
-        self._lo = np.flatnonzero(np.isfinite(lb) & ~(np.isfinite(ub) & (lb == ub)))
-        self._hi = np.flatnonzero(np.isfinite(ub) & ~(np.isfinite(lb) & (lb == ub)))
+        self.n_evals: dict[str, int] = {}
+        # One-point caches: the exact (f, grad f, g, jac g) and, with finite differences,
+        # g (SLSQP asks for its inequality and equality rows at the same point).
+        self._cache: dict[str, tuple[bytes, Any]] = {}
 
     @property
     def name(self) -> str:
@@ -109,21 +129,47 @@ class ScipyNLPSolver:
         if time.perf_counter() - self._t0 > self.time_limit:
             raise _TimeUp
 
+    def _cached(self, kind: str, z) -> Any:
+        """``fgj`` -> (f, grad f, g, jac g) or ``g`` -> g at ``z``, evaluated once per point."""
+        z = np.asarray(z, dtype=float)
+        key = z.tobytes()
+        hit = self._cache.get(kind)
+        if hit is not None and hit[0] == key:
+            return hit[1]
+        if kind == "fgj":
+            f, gf, g, jg = self.fgj_fun(z)
+            val: Any = (
+                float(f),
+                np.asarray(gf, dtype=float).ravel(),
+                np.asarray(g, dtype=float).ravel(),
+                np.asarray(ca.densify(jg), dtype=float),
+            )
+            self.n_evals["fgj"] = self.n_evals.get("fgj", 0) + 1
+        else:
+            val = np.asarray(self.g_fun(z), dtype=float).ravel()
+        self._cache[kind] = (key, val)
+        return val
+
     def _f(self, z):
         self._tick("f", z)
+        if self.derivatives == "exact":
+            return self._cached("fgj", z)[0]
         return float(self.f_fun(z))
 
+    # The cached arrays are handed out as copies: SciPy may keep or modify what it gets.
     def _grad(self, z):
         self._tick("grad_f", z)
-        return np.asarray(self.grad_fun(z), dtype=float).ravel()
+        return self._cached("fgj", z)[1].copy()
 
     def _g(self, z):
         self._tick("g", z)
-        return np.asarray(self.g_fun(z), dtype=float).ravel()
+        if self.derivatives == "exact":
+            return self._cached("fgj", z)[2].copy()
+        return self._cached("g", z).copy()
 
     def _jac(self, z):
         self._tick("jac_g", z)
-        return np.asarray(ca.densify(self.jac_fun(z)), dtype=float)
+        return self._cached("fgj", z)[3].copy()
 
     def _hess_f(self, z):
         self._tick("hess_f", z)
@@ -133,21 +179,22 @@ class ScipyNLPSolver:
         self._tick("hess_g", z)
         return np.asarray(ca.densify(self.hess_g_fun(z, v)), dtype=float)
 
-    def _constraints(self) -> Any:
-        nlp = self.nlp
+    @staticmethod
+    def _split_rows(lb: np.ndarray, ub: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Rows of SLSQP's ``h(z) = 0`` and ``g(z) >= 0``: one per finite bound."""
+        both = np.isfinite(lb) & np.isfinite(ub) & (lb == ub)
+        eq = np.flatnonzero(both)
+        lo = np.flatnonzero(np.isfinite(lb) & ~both)
+        hi = np.flatnonzero(np.isfinite(ub) & ~both)
+        return eq, lo, hi
+
+    def _constraints(self, lb: np.ndarray, ub: np.ndarray, rows: tuple[np.ndarray, ...]) -> Any:
         exact = self.derivatives == "exact"
         if self.method == "trust-constr":
             if exact:
-                return [
-                    so.NonlinearConstraint(
-                        self._g, nlp.lbg, nlp.ubg, jac=self._jac, hess=self._hess_g
-                    )
-                ]
-            return [
-                so.NonlinearConstraint(self._g, nlp.lbg, nlp.ubg, jac="2-point", hess=so.BFGS())
-            ]
-        lo, hi, eq = self._lo, self._hi, self._eq
-        lb, ub = nlp.lbg, nlp.ubg
+                return [so.NonlinearConstraint(self._g, lb, ub, jac=self._jac, hess=self._hess_g)]
+            return [so.NonlinearConstraint(self._g, lb, ub, jac="2-point", hess=so.BFGS())]
+        eq, lo, hi = rows
 
         def ineq(z):
             g = self._g(z)
@@ -159,6 +206,7 @@ class ScipyNLPSolver:
 
         cons = [{"type": "ineq", "fun": ineq, **({"jac": ineq_jac} if exact else {})}]
         if len(eq):
+            # SciPy puts the equality rows first (in its multipliers too), whatever the order.
             cons.append(
                 {
                     "type": "eq",
@@ -168,25 +216,50 @@ class ScipyNLPSolver:
             )
         return cons
 
-    def solve(self, x0: np.ndarray | None = None, z0: np.ndarray | None = None) -> Result:
-        """Solve from design ``x0`` (or scaled ``z0``)."""
+    def solve(
+        self,
+        x0: np.ndarray | None = None,
+        z0: np.ndarray | None = None,
+        lam_x0: np.ndarray | None = None,
+        lam_g0: np.ndarray | None = None,
+    ) -> Result:
+        """Solve from design ``x0`` (or scaled ``z0``).
+
+        Parameters
+        ----------
+        x0, z0
+            Start: a design vector, or the scaled NLP vector (takes precedence).
+        lam_x0, lam_g0
+            Accepted for the :class:`CasadiNLPSolver` interface and ignored (SciPy takes
+            no dual warm start).
+
+        Returns
+        -------
+        Result
+            Status from SciPy's (``optimal``, ``max_iterations``, ``infeasible``,
+            ``failed``, or ``time_limit``), ``infeasible`` if an ``optimal`` point
+            violates a row.
+        """
+        del lam_x0, lam_g0
         nlp = self.nlp
         if z0 is None:
             if x0 is None:
                 raise ValueError("give x0 or z0")
             z0 = nlp.z_from_x(x0)
-        z0 = np.asarray(z0, dtype=float).ravel()
+        # Bounds read now, not at construction: epsilon sweeps change nlp.ubg between solves.
+        lbz, ubz = np.asarray(nlp.lbz, dtype=float), np.asarray(nlp.ubz, dtype=float)
+        lb, ub = np.asarray(nlp.lbg, dtype=float), np.asarray(nlp.ubg, dtype=float)
+        rows = self._split_rows(lb, ub)
         # Aux variables may have infinite bounds: SciPy takes +-inf in Bounds.
-        bounds = so.Bounds(nlp.lbz, nlp.ubz)
-        z0 = np.clip(z0, nlp.lbz, nlp.ubz)
-        self.n_evals: dict[str, int] = {}
+        z0 = np.clip(np.asarray(z0, dtype=float).ravel(), lbz, ubz)
+        self.n_evals = {}
         self._last = z0.copy()
         self._t0 = time.perf_counter()
         exact = self.derivatives == "exact"
         kwargs: dict[str, Any] = {
             "method": self.method,
-            "bounds": bounds,
-            "constraints": self._constraints(),
+            "bounds": so.Bounds(lbz, ubz),
+            "constraints": self._constraints(lb, ub, rows),
             "options": dict(self.options),
         }
         if self.method == "trust-constr":
@@ -194,6 +267,7 @@ class ScipyNLPSolver:
             kwargs["hess"] = self._hess_f if exact else so.BFGS()
         else:
             kwargs["jac"] = self._grad if exact else None
+        lam_g = np.zeros(len(lb))
         try:
             res = so.minimize(self._f, z0, **kwargs)
             z, iters, message = (
@@ -202,6 +276,8 @@ class ScipyNLPSolver:
                 str(res.message),
             )
             status, term = self._status(res)
+            if self.method == "SLSQP":
+                lam_g = self._lam_g(res, len(lb), rows)
         except _TimeUp:
             z, iters, message = self._last, None, f"wall-time limit {self.time_limit:g} s reached"
             status, term = "time_limit", TerminationCondition.MAX_TIME
@@ -220,7 +296,22 @@ class ScipyNLPSolver:
                 n_evals=dict(self.n_evals),
             )
         wall = time.perf_counter() - self._t0
-        return self._result(z, status, term, message, iters, wall)
+        return self._result(z, lam_g, status, term, message, iters, wall)
+
+    @staticmethod
+    def _lam_g(res, m: int, rows: tuple[np.ndarray, ...]) -> np.ndarray:
+        """SLSQP's multipliers as CasADi's ``lam_g`` (zero if SciPy returned none)."""
+        eq, lo, hi = rows
+        lam_g = np.zeros(m)
+        mult = np.asarray(res.get("multipliers", np.zeros(0)), dtype=float).ravel()
+        if len(mult) == len(eq) + len(lo) + len(hi):
+            # SciPy: equalities first, then the inequalities (lower rows, then upper rows,
+            # as built in _constraints); its multipliers are >= 0 for g(z) >= 0, CasADi's
+            # are the gradient signs of the bound that is active.
+            lam_g[eq] = -mult[: len(eq)]
+            lam_g[lo] -= mult[len(eq) : len(eq) + len(lo)]
+            lam_g[hi] += mult[len(eq) + len(lo) :]
+        return lam_g
 
     def _status(self, res) -> tuple[str, TerminationCondition]:
         if self.method == "SLSQP":
@@ -241,11 +332,11 @@ class ScipyNLPSolver:
             return "max_iterations", TerminationCondition.MAX_ITERATIONS
         return "failed", TerminationCondition.NUMERICAL_ERROR
 
-    def _result(self, z, status, term, message, iters, wall) -> Result:
+    def _result(self, z, lam_g, status, term, message, iters, wall) -> Result:
         nlp = self.nlp
         g = np.asarray(self.g_fun(z), dtype=float).ravel()
         # Same row reports as the CasADi back-end (it only needs ``self.nlp``).
-        violated, active = CasadiNLPSolver.reports(self, g, np.zeros_like(g))  # type: ignore[arg-type]
+        violated, active = CasadiNLPSolver.reports(self, g, lam_g)  # type: ignore[arg-type]
         max_viol = max(
             (
                 r.amount / max(1.0, abs(r.upper if r.upper is not None else r.lower))
@@ -263,6 +354,7 @@ class ScipyNLPSolver:
             sol_status = SolutionStatus.INFEASIBLE
         values = np.asarray(self.values_fun(z), dtype=float).ravel()
         x = nlp.x_from_z(z)
+        z = np.asarray(z, dtype=float)
         return Result(
             status=status,
             objective=float(self.f_fun(z)) * nlp.f_scale,
@@ -279,7 +371,7 @@ class ScipyNLPSolver:
             violated=violated,
             active=active,
             max_violation=float(max_viol),
-            raw={"z": np.asarray(z, dtype=float)},
+            raw={"z": z, "lam_x": np.zeros(len(z)), "lam_g": lam_g},
         )
 
 

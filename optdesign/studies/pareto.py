@@ -56,9 +56,10 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, build_nlp
 from optdesign.problem.design_problem import DesignProblem, relative_violation
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver, CasadiSLSQPSolver
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.multistart import best_of, sobol_starts
 from optdesign.solvers.result import Result
+from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.front_metrics import front_metrics, non_dominated
 from optdesign.studies.runner import cached, process_pool, run_tasks
 from optdesign.studies.solve import finish
@@ -84,6 +85,10 @@ WARM_OPTIONS: dict[str, Any] = {
 #: and 500 = failure from one start), the ripple anchor's 22-41 (default 22-40), same
 #: optima to 1e-8.
 TIE_OPTIONS: dict[str, Any] = {"mu_init": 1e-5, "bound_push": 1e-6, "bound_frac": 1e-6}
+
+#: SLSQP options of the sweeps (over ScipyNLPSolver's defaults): a start still running
+#: at 200 iterations is handed to Ipopt rather than left to the benchmark default 500.
+SLSQP_OPTIONS: dict[str, Any] = {"maxiter": 200}
 
 #: CasADi's symbolic layer is not thread-safe and ``nlpsol`` releases the GIL: two threads
 #: of a threaded Dask worker building solvers at once crashed the process (segfault in
@@ -219,7 +224,7 @@ class EpsSolver:
     The epsilon rows are built with an infinite limit and their upper bounds are set per
     solve, so one solver serves the anchors' multistarts, the tie-breaks and the whole
     sweep (and its warm starts). The primary solver is SLSQP with exact CasADi first
-    derivatives (:class:`~optdesign.solvers.casadi_nlp.CasadiSLSQPSolver`: ~0.03 s to
+    derivatives (:class:`~optdesign.solvers.scipy_nlp.ScipyNLPSolver`: ~0.03 s to
     build, 3-6x faster per solve than Ipopt on these NLPs); a start it does not solve
     (SLSQP reports failure, or the iterate violates a row) is solved again by Ipopt
     (exact Hessian) from the same start, that solver being built only when first needed.
@@ -253,18 +258,18 @@ class EpsSolver:
         self.ipopt_options.update(options or {})
         self._ipopt: CasadiNLPSolver | None = None
         self._ipopt_tie: CasadiNLPSolver | None = None
-        self._slsqp: CasadiSLSQPSolver | None = None
+        self._slsqp: ScipyNLPSolver | None = None
         self.z_names = list(self.nlp.design_names) + list(self.nlp.aux_names)
 
     @property
-    def solver(self) -> CasadiNLPSolver:
+    def solver(self) -> CasadiNLPSolver | ScipyNLPSolver:
         """The primary solver (built on first use, like :attr:`ipopt`: a worker that only
         runs this NLP's tie-break never builds its SLSQP functions)."""
         if self.method == "ipopt":
             return self.ipopt
         if self._slsqp is None:
             with _CASADI_LOCK:
-                self._slsqp = CasadiSLSQPSolver(self.nlp)
+                self._slsqp = ScipyNLPSolver(self.nlp, "SLSQP", "exact", SLSQP_OPTIONS)
         return self._slsqp
 
     @property
