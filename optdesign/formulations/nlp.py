@@ -70,6 +70,14 @@ class NLP:
         z = np.asarray(z, dtype=float).ravel()
         return self.x_lo + self.x_span * z[: self.n_design]
 
+    def start(self, x0=None, z0=None) -> np.ndarray:
+        """The solver's start vector: ``z0`` as given, else built from the design ``x0``."""
+        if z0 is not None:
+            return np.asarray(z0, dtype=float).ravel()
+        if x0 is None:
+            raise ValueError("give x0 or z0")
+        return self.z_from_x(x0)
+
     def z_from_x(self, x) -> np.ndarray:
         """Full start vector from a design: aux variables set to their tightest values."""
         x = np.asarray(x, dtype=float).ravel()

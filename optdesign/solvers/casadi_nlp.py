@@ -94,10 +94,7 @@ class CasadiNLPSolver:
     ) -> Result:
         """Solve from design ``x0`` (or scaled ``z0``); duals warm-start if given."""
         nlp = self.nlp
-        if z0 is None:
-            if x0 is None:
-                raise ValueError("give x0 or z0")
-            z0 = nlp.z_from_x(x0)
+        z0 = nlp.start(x0, z0)
         args: dict[str, Any] = {
             "x0": z0,
             "lbx": nlp.lbz,

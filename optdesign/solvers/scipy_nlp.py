@@ -242,10 +242,7 @@ class ScipyNLPSolver:
         """
         del lam_x0, lam_g0
         nlp = self.nlp
-        if z0 is None:
-            if x0 is None:
-                raise ValueError("give x0 or z0")
-            z0 = nlp.z_from_x(x0)
+        z0 = nlp.start(x0, z0)
         # Bounds read now, not at construction: epsilon sweeps change nlp.ubg between solves.
         lbz, ubz = np.asarray(nlp.lbz, dtype=float), np.asarray(nlp.ubz, dtype=float)
         lb, ub = np.asarray(nlp.lbg, dtype=float), np.asarray(nlp.ubg, dtype=float)
