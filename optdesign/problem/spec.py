@@ -45,28 +45,24 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-#: Design variables each mechanism knows, and their dimension.
+#: Design variables of the crank-slider, and their dimension.
+_CRANK_SLIDER_VARIABLES: dict[str, str] = {
+    "R": "length",
+    "l": "length",
+    "n": "length",
+    "p": "length",
+    "phi0": "angle",
+    "i_a": "dimensionless",
+    "d": "length",
+    "pin_length": "length",
+    "pin_length_ratio": "dimensionless",
+}
+
+#: Design variables each mechanism knows. The fork has no rod and no offset: its lever
+#: R is the distance from the output axis to the pin's line.
 VARIABLE_DIMENSIONS: dict[str, dict[str, str]] = {
-    "crank_slider": {
-        "R": "length",
-        "l": "length",
-        "n": "length",
-        "p": "length",
-        "phi0": "angle",
-        "i_a": "dimensionless",
-        "d": "length",
-        "pin_length": "length",
-        "pin_length_ratio": "dimensionless",
-    },
-    "fork": {
-        "R": "length",
-        "p": "length",
-        "phi0": "angle",
-        "i_a": "dimensionless",
-        "d": "length",
-        "pin_length": "length",
-        "pin_length_ratio": "dimensionless",
-    },
+    "crank_slider": _CRANK_SLIDER_VARIABLES,
+    "fork": {k: v for k, v in _CRANK_SLIDER_VARIABLES.items() if k not in ("l", "n")},
 }
 
 #: What each variable is, for tables and errors.
