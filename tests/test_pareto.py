@@ -109,7 +109,7 @@ def test_interrupted_run_resumes_to_the_same_front(fork, tmp_path):
 
     def interrupt(rec):
         seen.append(rec["id"])
-        if len(seen) == 5:  # 2 anchors + 3 points
+        if len(seen) == 7:  # 2 anchors (multistart + tie-break each) + 3 points
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
@@ -117,7 +117,7 @@ def test_interrupted_run_resumes_to_the_same_front(fork, tmp_path):
             fork, objectives, 8, out=tmp_path / "b", starts=2, on_record=interrupt
         )
     store = tmp_path / "b" / "epsilon.jsonl"
-    assert len(read_store(store)[1]) == 5
+    assert len(read_store(store)[1]) == 7
     again = []
     resumed = epsilon_constraint_front(
         fork,

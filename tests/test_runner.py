@@ -100,3 +100,109 @@ def test_dask_local_cluster(tmp_path):
 def test_unknown_dependency_is_an_error(tmp_path):
     with pytest.raises(ValueError, match="unknown dependencies"):
         run_tasks([{"id": "a", "after": ["zz"]}], _chain_fn, tmp_path / "x.jsonl")
+
+
+def _step_fn(task, deps):
+    # A point's value depends on the neighbour it started from: 10 * index + side, so a
+    # test sees from which side each point was computed.
+    if task.get("fail"):
+        raise ValueError(f"task {task['id']} fails on purpose")
+    if task.get("die"):
+        import os
+
+        os._exit(3)
+    return {"index": task["index"], "side": task["dir"]}
+
+
+class _Meet:
+    """Two chains from both ends of 0..n-1 that stop where they meet (expand)."""
+
+    def __init__(self, n):
+        self.n, self.claimed, self.calls = n, set(), 0
+
+    def task(self, i, d, after):
+        self.claimed.add(i)
+        return {"id": f"p{i:02d}", "index": i, "dir": d, "after": after}
+
+    def __call__(self, task, record, done):
+        self.calls += 1
+        if task["id"] == "start":
+            return [self.task(0, 1, ["start"]), self.task(self.n - 1, -1, ["start"])]
+        j = task["index"] + task["dir"]
+        if 0 <= j < self.n and j not in self.claimed:
+            return [self.task(j, task["dir"], [task["id"]])]
+        return []
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_expand_adds_tasks_as_records_come_in(tmp_path, workers):
+    meet = _Meet(9)
+    done = run_tasks(
+        [{"id": "start", "index": -1, "dir": 0}],
+        _step_fn,
+        tmp_path / "m.jsonl",
+        workers=workers,
+        expand=meet,
+    )
+    points = sorted(r["index"] for k, r in done.items() if k != "start")
+    assert points == list(range(9))  # every point once, none twice
+    sides = [done[f"p{i:02d}"]["side"] for i in range(9)]
+    # Each chain is contiguous from its end: +1 on the left, -1 on the right.
+    k = sides.index(-1)
+    assert sides == [1] * k + [-1] * (9 - k)
+    if workers == 1:
+        assert k == 5  # one worker: the chains alternate and meet in the middle
+    assert len(read_store(tmp_path / "m.jsonl")[1]) == 10
+
+
+def test_expand_replays_stored_records_on_resume(tmp_path):
+    store = tmp_path / "m.jsonl"
+    seen = []
+
+    def stop(rec):
+        seen.append(rec["id"])
+        if len(seen) == 4:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_tasks(
+            [{"id": "start", "index": -1, "dir": 0}],
+            _step_fn,
+            store,
+            expand=_Meet(9),
+            on_record=stop,
+        )
+    assert len(read_store(store)[1]) == 4
+    computed = []
+    meet = _Meet(9)
+    done = run_tasks(
+        [{"id": "start", "index": -1, "dir": 0}],
+        _step_fn,
+        store,
+        resume=True,
+        expand=meet,
+        on_record=lambda r: computed.append(r["id"]),
+    )
+    assert len(computed) == 6  # 10 tasks, 4 stored
+    assert sorted(k for k in done if k != "start") == [f"p{i:02d}" for i in range(9)]
+    assert meet.calls == 10  # stored records were expanded too
+
+
+def test_worker_errors_reach_the_caller(tmp_path):
+    with pytest.raises(ValueError, match="p01 fails on purpose"):
+        run_tasks(
+            [
+                {"id": "p00", "index": 0, "dir": 1},
+                {"id": "p01", "index": 1, "dir": 1, "fail": True},
+            ],
+            _step_fn,
+            tmp_path / "e.jsonl",
+            workers=2,
+        )
+    with pytest.raises(OptDesignError, match="exit code 3"):
+        run_tasks(
+            [{"id": "p00", "index": 0, "dir": 1, "die": True}, {"id": "p01", "index": 1, "dir": 1}],
+            _step_fn,
+            tmp_path / "d.jsonl",
+            workers=2,
+        )

@@ -61,7 +61,7 @@ from optdesign.solvers.multistart import best_of, sobol_starts
 from optdesign.solvers.result import Result
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.front_metrics import front_metrics, non_dominated
-from optdesign.studies.runner import cached, process_pool, run_tasks
+from optdesign.studies.runner import cached, forks_workers, process_pool, run_tasks
 from optdesign.studies.solve import finish
 from optdesign.studies.verify import VERIFY_TOL
 
@@ -480,15 +480,15 @@ def _ok(rec: Mapping[str, Any] | None) -> bool:
     return bool(rec) and rec["status"] in ("optimal", "feasible") and rec.get("verified") is True
 
 
-def _anchor_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
-    """Individual optimum of ``order[0]`` (multistart), then lexicographic tie-breaks.
+def _multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """Individual optimum of ``order[0]`` by seeded multistart (first half of an anchor).
 
-    The multistart solves ``min order[0] s.t. order[1] <= inf`` with the same (cached)
-    solver the tie-break of the other anchor uses, so a worker builds each NLP once.
-    With ``task["agree"] = k`` the multistart stops as soon as k successful starts agree
-    on the best value (within :func:`best_of`'s 1e-6 relative); the record's
-    ``multistart`` says how many starts were planned, how many ran and how many agreed.
-    If no start succeeds with SLSQP, the starts are solved again with Ipopt fallback.
+    Solves ``min order[0] s.t. order[1:] <= inf`` with the same (cached) solver the
+    tie-break of another anchor uses, so a worker builds each NLP once. With
+    ``task["agree"] = k`` the multistart stops as soon as k successful starts agree on the
+    best value (within :func:`best_of`'s 1e-6 relative); the record's ``multistart`` says
+    how many starts were planned, how many ran and how many agreed. If no start succeeds
+    with SLSQP, the starts are solved again with Ipopt fallback.
     """
     problem: DesignProblem = task["problem"]
     order: list[str] = task["order"]
@@ -529,6 +529,28 @@ def _anchor_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, 
         "agree": agree,
         "stopped_early": len(results) < len(pts),
     }
+    rec.update(
+        kind="anchor-multistart",
+        order=order,
+        n_solves=n_solves,
+        wall_time_s=time.perf_counter() - t0,
+    )
+    return rec
+
+
+def _tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """Lexicographic tie-breaks from a multistart optimum (second half of an anchor).
+
+    An individual optimum is often not unique (the ripple of a crank-slider is invariant
+    to scaling R, l, n, p together): ``order[1]`` is minimised with ``order[0]`` held at
+    its optimum (plus :data:`ANCHOR_SLACK`), then ``order[2]`` with both held, ...
+    """
+    problem: DesignProblem = task["problem"]
+    order: list[str] = task["order"]
+    method = task.get("solver", "slsqp")
+    t0 = time.perf_counter()
+    rec = dict(deps[task["multistart"]])
+    n_solves = 0
     fixed: dict[str, float] = {}
     for k, name in enumerate(order[1:], start=1):
         if not _ok(rec):
@@ -550,6 +572,7 @@ def _anchor_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, 
         if _ok(cand) and cand["objectives"][name] <= start_value * (1 + 1e-9) + 1e-15:
             cand["multistart"] = rec["multistart"]
             rec = cand
+    rec.pop("id", None)
     rec["kind"] = "anchor"
     rec["order"] = order
     rec["n_solves"] = n_solves
@@ -829,6 +852,64 @@ def make_front(
     return front
 
 
+def _front_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """The one task function of a front's run: dispatches on ``task["kind"]``."""
+    return _TASK_KINDS[task["kind"]](task, deps)
+
+
+_TASK_KINDS: dict[str, Callable[[Mapping[str, Any], Mapping[str, Any]], dict[str, Any]]] = {
+    "anchor-multistart": _multistart_task,
+    "anchor": _tie_task,
+    "eps": _eps_task,
+}
+
+
+def anchor_tasks(
+    problem: DesignProblem,
+    objectives: Sequence[str],
+    starts: int,
+    seed: int,
+    solver: str = "slsqp",
+    agree: int | None = None,
+) -> list[dict[str, Any]]:
+    """Two tasks per objective: its multistart (``anchor-{name}-ms``), then its
+    lexicographic tie-breaks (``anchor-{name}``, the anchor). The multistarts come first
+    in the list, so that with several workers they run side by side."""
+    m = len(objectives)
+    ms, ties = [], []
+    for k, name in enumerate(objectives):
+        order = [name] + [objectives[(k + j) % m] for j in range(1, m)]
+        common = {"problem": problem, "order": order, "solver": solver}
+        ms.append(
+            {
+                **common,
+                "id": f"anchor-{name}-ms",
+                "kind": "anchor-multistart",
+                "starts": starts,
+                "seed": seed,
+                "agree": agree,
+            }
+        )
+        ties.append(
+            {
+                **common,
+                "id": f"anchor-{name}",
+                "kind": "anchor",
+                "multistart": f"anchor-{name}-ms",
+                "after": [f"anchor-{name}-ms"],
+            }
+        )
+    return ms + ties
+
+
+def _check_anchor(rec: Mapping[str, Any], name: str) -> None:
+    if not _ok(rec):
+        raise ProblemError(
+            f"anchor {name}: no verified optimum of {name} found (status {rec['status']}, "
+            f"violated: {', '.join(rec.get('violated', [])) or 'none reported'})"
+        )
+
+
 def compute_anchors(
     problem: DesignProblem,
     objectives: Sequence[str],
@@ -853,24 +934,9 @@ def compute_anchors(
     """
     starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
-    tasks = []
-    m = len(objectives)
-    for k, name in enumerate(objectives):
-        order = [name] + [objectives[(k + j) % m] for j in range(1, m)]
-        tasks.append(
-            {
-                "id": f"anchor-{name}",
-                "problem": problem,
-                "order": order,
-                "starts": starts,
-                "seed": seed,
-                "solver": solver,
-                "agree": agree,
-            }
-        )
     done = run_tasks(
-        tasks,
-        _anchor_task,
+        anchor_tasks(problem, objectives, starts, seed, solver, agree),
+        _front_task,
         store,
         workers,
         scheduler,
@@ -881,19 +947,130 @@ def compute_anchors(
         pool=pool,
     )
     for name in objectives:
-        rec = done[f"anchor-{name}"]
-        if not _ok(rec):
-            raise ProblemError(
-                f"anchor {name}: no verified optimum of {name} found (status {rec['status']}, "
-                f"violated: {', '.join(rec.get('violated', [])) or 'none reported'})"
-            )
+        _check_anchor(done[f"anchor-{name}"], name)
     return {name: done[f"anchor-{name}"] for name in objectives}
 
 
-def _chunks(n: int, k: int) -> list[list[int]]:
-    k = max(1, min(k, n))
-    edges = np.linspace(0, n, k + 1).round().astype(int)
-    return [list(range(edges[j], edges[j + 1])) for j in range(k)]
+class _TwoChains:
+    """The tasks of a two-objective sweep, decided as records come in (``expand`` of
+    :func:`run_tasks`).
+
+    Two warm-started chains: one ascends from anchor A (points 0, 1, ...), the other
+    descends from anchor B (n-1, n-2, ...). A finished point adds its successor unless
+    the other chain has it already, so the chains meet wherever they meet: with two
+    workers, the chain whose anchor is ready first does more points, instead of a worker
+    idling while the other anchor's tie-break runs. With one worker they alternate and
+    meet in the middle (deterministic).
+
+    Arc spacing (default) normalises the objectives by a frame taken from anchor A and
+    anchor B's *multistart* optimum: chain A can then start while B's tie-break (an Ipopt
+    solve and its build, the longest step of the anchors) still runs. B's tie-break only
+    lowers A's value at B's optimum (on cs_min_backlash, ripple 0.05594 -> 0.05550), so
+    the frame's range of A is ~1 % wider than the front's; the last point (epsilon = A at
+    the tie-broken anchor B) is exact. Uniform or explicit epsilon values need both
+    tie-broken anchors before the first point.
+    """
+
+    def __init__(
+        self,
+        objectives: Sequence[str],
+        n: int,
+        name: str,
+        common: Mapping[str, Any],
+        spacing: str,
+        eps_values: Sequence[float] | None,
+    ):
+        self.a, self.b = objectives
+        self.n, self.name, self.common, self.spacing = n, name, dict(common), spacing
+        self.eps_values = None if eps_values is None else [float(v) for v in eps_values]
+        self.frame: dict[str, float] | None = None
+        self.claimed: set[int] = set()
+        self.tasks: list[dict[str, Any]] = []
+
+    def __call__(
+        self, task: Mapping[str, Any], record: Mapping[str, Any], done: Mapping[str, Any]
+    ) -> list[dict[str, Any]]:
+        a, b, n = self.a, self.b, self.n
+        tie_a, ms_b, tie_b = f"anchor-{a}", f"anchor-{b}-ms", f"anchor-{b}"
+        new: list[dict[str, Any]] = []
+        if self.frame is None and tie_a in done and ms_b in done:
+            need = (tie_a, ms_b) if self.spacing == "arc" and self.eps_values is None else None
+            if need is not None or tie_b in done:
+                _check_anchor(done[tie_a], a)
+                far = done[ms_b] if need is not None else done[tie_b]
+                _check_anchor(far, b)
+                self._make_frame(done[tie_a], far, done.get(tie_b))
+                new.append(self._point(0, +1, tie_a, done))
+        if self.frame is not None and tie_b in done and n - 1 not in self.claimed:
+            _check_anchor(done[tie_b], b)
+            new.append(self._point(n - 1, -1, tie_b, done))
+        if task.get("kind") == "eps" and task["id"].startswith(f"{self.name}-"):
+            # The ascending chain stops before n-1: that point's epsilon is A at the
+            # tie-broken anchor B, which the descending chain starts from.
+            j = task["index"] + task["dir"]
+            if 0 < j < n - 1 and j not in self.claimed:
+                new.append(self._point(j, task["dir"], task["id"], done))
+        return new
+
+    def _make_frame(self, anchor_a, far_b, tie_b) -> None:
+        a, b = self.a, self.b
+        lo = anchor_a["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
+        hi = far_b["objectives"][a]
+        if self.eps_values is None and self.spacing == "uniform":
+            hi = tie_b["objectives"][a]
+            self.eps_values = [float(v) for v in np.linspace(lo, hi, self.n)]
+        self.frame = {
+            "a0": anchor_a["objectives"][a],
+            "b0": anchor_a["objectives"][b],
+            "ra": max(hi - anchor_a["objectives"][a], 1e-300),
+            "rb": max(anchor_a["objectives"][b] - far_b["objectives"][b], 1e-300),
+            "a_lo": lo,
+            "a_hi": max(hi, lo),
+        }
+
+    def _point(self, i: int, d: int, warm: str, done: Mapping[str, Any]) -> dict[str, Any]:
+        a, n, f = self.a, self.n, self.frame
+        assert f is not None
+        self.claimed.add(i)
+        task = {
+            **self.common,
+            "id": f"{self.name}-{i:04d}",
+            "kind": "eps",
+            "target": self.b,
+            "warm": warm,
+            "after": [warm],
+            "index": i,
+            "dir": d,
+        }
+        if self.eps_values is not None:
+            task["eps"] = {a: self.eps_values[i]}
+        elif i == 0:
+            task["eps"] = {a: f["a_lo"]}
+        elif i == n - 1:
+            task["eps"] = {a: done[f"anchor-{self.b}"]["objectives"][a]}
+        else:
+            task.update(
+                eps_name=a,
+                arc=i * 2.0 / max(n - 1, 1),
+                frame=f,
+                fallback_eps=float(f["a_lo"] + (f["a_hi"] - f["a_lo"]) * i / (n - 1)),
+            )
+        self.tasks.append(task)
+        return task
+
+
+def prebuild_solvers(problem: DesignProblem, objectives: Sequence[str], method: str) -> None:
+    """Build, in this process, the formulation and the primary solvers every target of a
+    front needs (cached), before a pool of local workers is started: forked workers
+    inherit them (see :func:`optdesign.studies.runner.cached`) instead of each building
+    its own copy. Ipopt solvers are still built on first use, where they are needed."""
+    if not forks_workers():
+        return  # spawned workers would not inherit anything
+    for target in objectives:
+        others = [o for o in objectives if o != target]
+        solver = _eps_solver(problem, target, others, method=method)
+        if method == "slsqp":
+            solver.solver  # noqa: B018 - builds the SLSQP functions
 
 
 def epsilon_constraint_front(
@@ -910,7 +1087,6 @@ def epsilon_constraint_front(
     retry_starts: int = 4,
     extra_starts: int = 0,
     spacing: str = "arc",
-    chunks: int | None = None,
     eps_values: Sequence[float] | None = None,
     name: str = "epsilon",
     on_record: Callable | None = None,
@@ -941,9 +1117,6 @@ def epsilon_constraint_front(
         Two objectives: ``"arc"`` (default) places the points evenly along the front (L1
         arc length in normalised objectives, predicted from the neighbour's multiplier);
         ``"uniform"`` spaces epsilon evenly (sparse where the front is steep).
-    chunks
-        Warm-started chains the sweep is split into (default: ``workers``; ``"arc"``
-        spacing uses at most 2: one from each anchor).
     eps_values
         Explicit epsilon values of A (two objectives; overrides ``spacing``).
     solver
@@ -953,16 +1126,30 @@ def epsilon_constraint_front(
     agree
         Anchor multistart stops once this many starts agree on the best value (None:
         always all ``starts``); each anchor record says how many ran and agreed.
+
+    Notes
+    -----
+    Two objectives run as one task graph (:class:`_TwoChains`): the anchors' multistarts,
+    their tie-breaks and the two chains of the sweep, each task starting as soon as what
+    it needs is in. With one worker the chains alternate and the front is deterministic;
+    with several, where the two chains meet depends on timing, and so does from which
+    side (and so from which warm start) each point near the meeting point was solved -
+    the same optimum to the solver's tolerance.
     """
     objectives = _check_objectives(problem, objectives)
     if spacing not in ("arc", "uniform"):
         raise ProblemError(f"spacing {spacing!r}: use 'arc' or 'uniform'")
+    if eps_values is not None:
+        n_points = len(eps_values)
+    if n_points < 2:
+        raise ProblemError(f"--points: a front needs at least 2 points, got {n_points}")
     t0 = time.perf_counter()
     store = _store(out, name)
     starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
     key = _run_key(
         problem,
+        layout=2,  # anchor and chain task ids of this version
         objectives=objectives,
         n=n_points,
         starts=starts,
@@ -974,143 +1161,141 @@ def epsilon_constraint_front(
         solver=solver,
         agree=agree,
     )
-    n_chains = chunks or (2 if scheduler is not None and workers <= 1 else workers)
-    # One pool for both phases: the workers keep the solvers they built for the anchors.
+    common = {
+        "solver": solver,
+        "problem": problem,
+        "retry_starts": retry_starts,
+        "extra_starts": extra_starts,
+        "seed": seed,
+    }
+    first = anchor_tasks(problem, objectives, starts, seed, solver, agree)
+    if workers > 1 and scheduler is None:
+        prebuild_solvers(problem, objectives, solver)
+    label = f"{name}: points" if progress else False
     with process_pool(workers if scheduler is None else 1) as pool:
-        anchors = compute_anchors(
-            problem,
-            objectives,
-            store,
-            workers,
-            scheduler,
-            resume,
-            f"{name}: anchors" if progress else False,
-            starts,
-            seed,
-            key,
-            on_record,
-            solver=solver,
-            agree=agree,
-            pool=pool,
-        )
-        common = {
-            "solver": solver,
-            "problem": problem,
-            "retry_starts": retry_starts,
-            "extra_starts": extra_starts,
-            "seed": seed,
-        }
-        tasks: list[dict[str, Any]] = []
         if len(objectives) == 2:
-            a, b = objectives
-            lo = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
-            hi = anchors[b]["objectives"][a]
-            if eps_values is None and spacing == "uniform":
-                eps_values = list(np.linspace(lo, hi, n_points))
-            if eps_values is not None:
-                n_points = len(eps_values)
-            frame = {
-                "a0": anchors[a]["objectives"][a],
-                "b0": anchors[a]["objectives"][b],
-                "ra": max(hi - anchors[a]["objectives"][a], 1e-300),
-                "rb": max(anchors[a]["objectives"][b] - anchors[b]["objectives"][b], 1e-300),
-                "a_lo": lo,
-                "a_hi": hi,
-            }
-            h = 2.0 / max(n_points - 1, 1)
-            n_chains = min(n_chains, 2) if eps_values is None else n_chains
-            parts = _chunks(n_points, n_chains)
-            for j, part in enumerate(parts):
-                # First chain ascends from anchor A, the last descends from anchor B, middle
-                # ones (explicit epsilon only) start cold and are checked by multistart.
-                descending = j == len(parts) - 1 and len(parts) > 1
-                seq = part[::-1] if descending else part
-                prev = f"anchor-{b}" if descending else (f"anchor-{a}" if j == 0 else None)
-                for i in seq:
-                    task = {
-                        **common,
-                        "id": f"{name}-{i:04d}",
-                        "target": b,
-                        "warm": prev,
-                        "after": [prev] if prev else [],
-                        "index": i,
-                    }
-                    if eps_values is not None:
-                        task["eps"] = {a: float(eps_values[i])}
-                    elif i in (0, n_points - 1):
-                        task["eps"] = {a: lo if i == 0 else hi}
-                    else:
-                        task.update(
-                            eps_name=a,
-                            arc=i * h,
-                            frame=frame,
-                            fallback_eps=float(lo + (hi - lo) * i / (n_points - 1)),
-                        )
-                    tasks.append(task)
-                    prev = task["id"]
+            sweep = _TwoChains(objectives, n_points, name, common, spacing, eps_values)
+            done = run_tasks(
+                first,
+                _front_task,
+                store,
+                workers,
+                scheduler,
+                resume,
+                label,
+                key,
+                on_record,
+                pool=pool,
+                expand=sweep,
+            )
+            tasks = sweep.tasks
         else:
-            a, b, c = objectives
-            n_side = max(2, math.ceil(math.sqrt(n_points)))
-            lo_a = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
-            hi_a = max(r["objectives"][a] for r in anchors.values())
-            hi_b = max(r["objectives"][b] for r in anchors.values())
-            # Row r fixes A <= e1[r]. Its head (min B s.t. A <= e1, a chain along e1 from
-            # anchor A) gives the smallest feasible e2 of the row, so that the row's grid
-            # e2 in [B_min(e1), B_max] holds no infeasible corner; each row is then a
-            # warm-started chain of min C s.t. A <= e1, B <= e2 from the tightest e2 up.
-            prev = f"anchor-{a}"
-            for r, v1 in enumerate(np.linspace(lo_a, hi_a, n_side)):
-                head = {
-                    **common,
-                    "id": f"{name}-{r:03d}-head",
-                    "target": b,
-                    "eps": {a: float(v1), c: np.inf},
-                    "warm": prev,
-                    "after": [prev],
-                    "index": r * (n_side + 1),
-                    "head": True,
-                }
-                tasks.append(head)
-                prev, row_prev = head["id"], head["id"]
-                for k in range(n_side):
-                    task = {
-                        **common,
-                        "id": f"{name}-{r:03d}-{k:03d}",
-                        "target": c,
-                        "eps_row": {a: float(v1)},
-                        "row_head": head["id"],
-                        "b_name": b,
-                        "b_hi": float(hi_b),
-                        "frac": k / (n_side - 1),
-                        "warm": row_prev,
-                        "after": sorted({row_prev, head["id"]}),
-                        "index": r * (n_side + 1) + k + 1,
-                        "jump": None,  # grid steps are large: jumps are expected
-                    }
-                    tasks.append(task)
-                    row_prev = task["id"]
-        done = run_tasks(
-            tasks,
-            _eps_task,
-            store,
-            workers,
-            scheduler,
-            True,  # the anchors are in the store already
-            f"{name}: points" if progress else False,
-            key,
-            on_record,
-            pool=pool,
-        )
+            # Three objectives: the rows need every anchor (the nadir of B), so the
+            # anchors run first, then the rows in parallel.
+            done = run_tasks(
+                first,
+                _front_task,
+                store,
+                workers,
+                scheduler,
+                resume,
+                f"{name}: anchors" if progress else False,
+                key,
+                on_record,
+                pool=pool,
+            )
+            for k in objectives:
+                _check_anchor(done[f"anchor-{k}"], k)
+            tasks = _three_objective_tasks(
+                {k: done[f"anchor-{k}"] for k in objectives}, objectives, n_points, name, common
+            )
+            done.update(
+                run_tasks(
+                    tasks,
+                    _front_task,
+                    store,
+                    workers,
+                    scheduler,
+                    True,
+                    label,
+                    key,
+                    on_record,
+                    pool=pool,
+                    known=done,
+                )
+            )
+    missing = [k for k in objectives if f"anchor-{k}" not in done]
+    if missing:
+        raise ProblemError(f"anchors {missing}: not computed")
+    for k in objectives:
+        _check_anchor(done[f"anchor-{k}"], k)
     pts = [_point(done[t["id"]], name) for t in sorted(tasks, key=lambda t: t["index"])]
+    anchor_ids = [t["id"] for t in first]
     info = {
-        "anchors": {k: v["objectives"] for k, v in anchors.items()},
+        "anchors": {k: done[f"anchor-{k}"]["objectives"] for k in objectives},
         "store": str(store),
-        "spacing": "explicit" if eps_values is not None and spacing != "uniform" else spacing,
+        "spacing": "explicit" if eps_values is not None else spacing,
         "n_solves": sum(done[t["id"]].get("n_solves", 0) for t in tasks)
-        + sum(r.get("n_solves", 0) for r in anchors.values()),
+        + sum(done[i].get("n_solves", 0) for i in anchor_ids),
         "n_retried": sum(1 for t in tasks if done[t["id"]].get("retried")),
     }
     return make_front(pts, objectives, name, time.perf_counter() - t0, info)
+
+
+def _three_objective_tasks(
+    anchors: Mapping[str, Mapping[str, Any]],
+    objectives: Sequence[str],
+    n_points: int,
+    name: str,
+    common: Mapping[str, Any],
+) -> list[dict[str, Any]]:
+    """Row tasks of a three-objective front ``[A, B, C]``.
+
+    Row r fixes A <= e1[r]. Its head (min B s.t. A <= e1, a chain along e1 from anchor A)
+    gives the smallest feasible e2 of the row, so that the row's grid e2 in [B_min(e1),
+    B_max] holds no infeasible corner; each row is then a warm-started chain of
+    min C s.t. A <= e1, B <= e2 from the tightest e2 up.
+    """
+    a, b, c = objectives
+    n_side = max(2, math.ceil(math.sqrt(n_points)))
+    lo_a = anchors[a]["objectives"][a] * (1 + ANCHOR_SLACK) + 1e-12
+    hi_a = max(r["objectives"][a] for r in anchors.values())
+    hi_b = max(r["objectives"][b] for r in anchors.values())
+    tasks: list[dict[str, Any]] = []
+    prev = f"anchor-{a}"
+    for r, v1 in enumerate(np.linspace(lo_a, hi_a, n_side)):
+        head = {
+            **common,
+            "id": f"{name}-{r:03d}-head",
+            "kind": "eps",
+            "target": b,
+            "eps": {a: float(v1), c: np.inf},
+            "warm": prev,
+            "after": [prev],
+            "index": r * (n_side + 1),
+            "head": True,
+        }
+        tasks.append(head)
+        prev, row_prev = head["id"], head["id"]
+        for k in range(n_side):
+            task = {
+                **common,
+                "id": f"{name}-{r:03d}-{k:03d}",
+                "kind": "eps",
+                "target": c,
+                "eps_row": {a: float(v1)},
+                "row_head": head["id"],
+                "b_name": b,
+                "b_hi": float(hi_b),
+                "frac": k / (n_side - 1),
+                "warm": row_prev,
+                "after": sorted({row_prev, head["id"]}),
+                "index": r * (n_side + 1) + k + 1,
+                "jump": None,  # grid steps are large: jumps are expected
+            }
+            tasks.append(task)
+            row_prev = task["id"]
+    return tasks
 
 
 def weighted_sum_front(
