@@ -50,8 +50,15 @@ def test_output_mapping_through_the_crank_slider():
     b = eb.budget(_sources(), MECH, phi)
     g = eb.gains(_sources(), MECH, phi)
     sd = [s.sd for s in _sources()]
-    assert float(b.rss) == pytest.approx(np.sqrt(sum((abs(gi) * si) ** 2 for gi, si, s in zip(
-        g, sd, _sources(), strict=True) if s.kind == "random")))
+    assert float(b.rss) == pytest.approx(
+        np.sqrt(
+            sum(
+                (abs(gi) * si) ** 2
+                for gi, si, s in zip(g, sd, _sources(), strict=True)
+                if s.kind == "random"
+            )
+        )
+    )
     with pytest.raises(InputError, match="acts_on"):
         eb.contribution(eb.random_source("r", 1.0, "rod_length"), 1.0)
 
@@ -75,7 +82,8 @@ def test_contribution_casadi_matches_numpy():
     src = eb.lead_error_source(1.0)
     f = ca.Function("c", [R, l], [eb.contribution(src, 0.003, sym_mech, 0.25)])
     assert float(f(90.0, 80.0)) == pytest.approx(
-        float(eb.contribution(src, 0.003, MECH, 0.25)), rel=1e-12)
+        float(eb.contribution(src, 0.003, MECH, 0.25)), rel=1e-12
+    )
 
 
 def test_monte_carlo_reproducible_and_statistically_stable():

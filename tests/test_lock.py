@@ -60,11 +60,16 @@ def test_bad_inputs_name_the_field():
 
 
 @settings(max_examples=60, deadline=None)
-@given(M=st.floats(1.0, 1e6), dM=st.floats(1e-3, 1e5), R=st.floats(5.0, 100.0),
-       mu=st.floats(0.05, 0.6))
+@given(
+    M=st.floats(1.0, 1e6), dM=st.floats(1e-3, 1e5), R=st.floats(5.0, 100.0), mu=st.floats(0.05, 0.6)
+)
 def test_lock_forces_increase_with_moment(M, dM, R, mu):
-    for design in (lock.FrictionPlateLock(0.5 * R, R, mu), lock.PinLock(R),
-                   lock.PinLock(R, bearing="guide"), lock.PinLock(R, bearing="tip")):
+    for design in (
+        lock.FrictionPlateLock(0.5 * R, R, mu),
+        lock.PinLock(R),
+        lock.PinLock(R, bearing="guide"),
+        lock.PinLock(R, bearing="tip"),
+    ):
         assert design.force(M + dM) > design.force(M) > 0
 
 
@@ -74,8 +79,9 @@ def test_motor_shaft_moment_follows_the_ratio():
     M_h, eta_b = 5e5, 0.96
     load = lock.motor_shaft_lock_load(mech, phi, M_h, eta_b, 1.0, lock.PinLock(40.0))
     # Virtual work: T = M_h eta' / i(phi) (i = motor radians per output radian).
-    assert np.asarray(load.moment) == pytest.approx(M_h * eta_b / np.asarray(mech.ratio(phi)),
-                                                   rel=1e-10)
+    assert np.asarray(load.moment) == pytest.approx(
+        M_h * eta_b / np.asarray(mech.ratio(phi)), rel=1e-10
+    )
     assert float(load.moment_max) == pytest.approx(M_h * eta_b / np.min(mech.ratio(phi)))
     assert float(load.force) == pytest.approx(0.35 * float(load.moment_max) / 40.0)
     # A self-locking screw passes nothing to the motor shaft.
@@ -89,12 +95,22 @@ def test_lock_force_casadi_matches_numpy():
     phi = np.radians(np.linspace(-30, 30, 61))
     eta_b = screw.efficiency_backdrive(screw.lead_angle(5.0, 20.0), screw.friction_angle(0.003))
     sym = lock.motor_shaft_lock_load(
-        CrankSlider(R=Rs, l=ls, n=50.0, p=5.0, i_a=2.0), ca.DM(phi), 5e5, eta_b, 1.0,
-        lock.PinLock(rs, bearing="guide"))
+        CrankSlider(R=Rs, l=ls, n=50.0, p=5.0, i_a=2.0),
+        ca.DM(phi),
+        5e5,
+        eta_b,
+        1.0,
+        lock.PinLock(rs, bearing="guide"),
+    )
     f = ca.Function("f", [Rs, ls, rs], [sym.force])
     num = lock.motor_shaft_lock_load(
-        CrankSlider(R=90.0, l=80.0, n=50.0, p=5.0, i_a=2.0), phi, 5e5, eta_b, 1.0,
-        lock.PinLock(40.0, bearing="guide"))
+        CrankSlider(R=90.0, l=80.0, n=50.0, p=5.0, i_a=2.0),
+        phi,
+        5e5,
+        eta_b,
+        1.0,
+        lock.PinLock(40.0, bearing="guide"),
+    )
     assert float(f(90.0, 80.0, 40.0)) == pytest.approx(float(num.force), rel=1e-12)
     # and the NumPy path agrees with loads.backdriven_motor_torque directly
     F_a = np.abs(CrankSlider(R=90.0, l=80.0, n=50.0, p=5.0, i_a=2.0).nut_force(phi, 5e5))

@@ -45,8 +45,7 @@ def test_casadi_matches_numpy():
 
 
 @settings(max_examples=80, deadline=None)
-@given(a=st.floats(3, 30), b=st.floats(20, 90), f_k=st.floats(0, 0.1),
-       f_r=st.floats(0, 0.05))
+@given(a=st.floats(3, 30), b=st.floats(20, 90), f_k=st.floats(0, 0.1), f_r=st.floats(0, 0.05))
 def test_efficiency_in_unit_interval(a, b, f_k, f_r):
     eta = rs.efficiency(np.radians(a), np.radians(b), 40.0, 10.0, f_k, f_r)
     assert 0.0 < eta <= 1.0 + 1e-12
@@ -59,7 +58,8 @@ def test_selector_ball_and_roller():
     assert ball.backdrive(lam) == pytest.approx(0.9621, abs=5e-5)
     roller = rs.ScrewEfficiency.roller(r_s=10.0)
     assert roller.forward(lam) == pytest.approx(
-        rs.efficiency(lam, np.radians(45.0), 10.0, 10.0, 0.055, 0.01))
+        rs.efficiency(lam, np.radians(45.0), 10.0, 10.0, 0.055, 0.01)
+    )
     with pytest.raises(InputError, match=r"efficiency\.kind"):
         roller.backdrive(lam)
     with pytest.raises(InputError, match=r"efficiency\.kind"):

@@ -13,7 +13,8 @@ from optdesign.models import screw, screw_sizing
 def test_buckling_catalogue_example():
     # d1 = 12.5, la = 820, fixed-supported -> 3630 N (10 x 12.5^4 / 820^2 x 1e4 = 3630.9)
     assert screw_sizing.buckling_load(12.5, 820.0, "fixed-supported") == pytest.approx(
-        3630.0, abs=1.0)
+        3630.0, abs=1.0
+    )
     # The exact Euler constant is 0.2 % lower (eta_2 = 10 rounds 9.98).
     euler = screw_sizing.buckling_load(12.5, 820.0, "fixed-supported", form="euler")
     assert euler == pytest.approx(3623.7, abs=0.1)
@@ -28,13 +29,15 @@ def test_life_catalogue_example():
     L = screw_sizing.rated_life_hours(4400.0, 250.0, 2118.0, 1.2)
     assert L == pytest.approx(24824.0, rel=2e-4)
     assert screw_sizing.rated_life_revolutions(4400.0, 250.0, 1.2) == pytest.approx(
-        (4400 / 300) ** 3 * 1e6)
+        (4400 / 300) ** 3 * 1e6
+    )
 
 
 def test_mean_load_of_a_duty_cycle():
     # Cubic mean: equal revolutions at 100, 200, 300 N -> (36e6/3)^(1/3) = 228.94 N
     assert screw_sizing.mean_load([100.0, 200.0, 300.0], [1.0, 1.0, 1.0]) == pytest.approx(
-        228.943, abs=1e-3)
+        228.943, abs=1e-3
+    )
     # A constant load is its own mean whatever the revolutions.
     assert screw_sizing.mean_load([250.0, 250.0], [3.0, 7.0]) == pytest.approx(250.0)
     with pytest.raises(InputError, match="revolutions"):
@@ -88,4 +91,5 @@ def test_margins_casadi_match_numpy():
 def test_buckling_falls_with_length(d1, la, k):
     for mounting in screw_sizing.BUCKLING_FACTOR:
         assert screw_sizing.buckling_load(d1, k * la, mounting) < screw_sizing.buckling_load(
-            d1, la, mounting)
+            d1, la, mounting
+        )

@@ -74,4 +74,3 @@ def test_anchor_multistart_stops_when_starts_agree(tmp_path):
     for m in ms:
         assert m["n_planned"] == 8 and m["agree"] == 3
         assert m["n_at_best"] >= 3 and m["n_starts"] == 3 and m["stopped_early"]
-

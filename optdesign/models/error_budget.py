@@ -201,8 +201,9 @@ def compliance_source(K: float, cv: float = 0.1) -> ErrorSource:
     """Deformation of the stiffness chain K (N/mm) under the nut force at each angle:
     random, compliance 1/K normal with coefficient of variation ``cv``. Needs ``M_h``
     (with a mechanism) or ``F`` (without) in :func:`contribution`."""
-    return ErrorSource("deformation", "random", "normal", abs(cv) / K, mean=1.0 / K,
-                       acts_on="compliance")
+    return ErrorSource(
+        "deformation", "random", "normal", abs(cv) / K, mean=1.0 / K, acts_on="compliance"
+    )
 
 
 def encoder_source(sigma_rad: float) -> ErrorSource:
@@ -210,8 +211,9 @@ def encoder_source(sigma_rad: float) -> ErrorSource:
     return ErrorSource("encoder", "random", "normal", sigma_rad, acts_on="motor_angle")
 
 
-def random_source(name: str, sigma: float, acts_on: str = "axial",
-                  distribution: str = "normal") -> ErrorSource:
+def random_source(
+    name: str, sigma: float, acts_on: str = "axial", distribution: str = "normal"
+) -> ErrorSource:
     """Any other random term (mounting, motor, bearings, measurement, environment)."""
     return ErrorSource(name, "random", distribution, sigma, acts_on=acts_on)
 
@@ -220,13 +222,23 @@ def random_source(name: str, sigma: float, acts_on: str = "axial",
 def screw_angle(mechanism, phi, phi_ref=0.0):
     """Screw rotation theta (rad) between the reference deflection and phi:
     2 pi (x(phi) - x(phi_ref)) / p."""
-    return 2.0 * m.pi * (mechanism.nut_position(phi) - mechanism.nut_position(phi_ref)) / (
-        mechanism.p
+    return (
+        2.0 * m.pi * (mechanism.nut_position(phi) - mechanism.nut_position(phi_ref)) / (mechanism.p)
     )
 
 
-def contribution(source: ErrorSource, value, mechanism=None, phi=0.0, *, p=None, i_a=1.0,
-                 theta=None, M_h=None, F=None):
+def contribution(
+    source: ErrorSource,
+    value,
+    mechanism=None,
+    phi=0.0,
+    *,
+    p=None,
+    i_a=1.0,
+    theta=None,
+    M_h=None,
+    F=None,
+):
     """Error at the output caused by ``value`` (native unit) of ``source``.
 
     With a mechanism: output angle (rad). Nut-side values pass through the axial

@@ -240,8 +240,14 @@ class PinLock:
         if self.bearing is None:
             return pin_lock_force(M, self.R, self.mu_h, self.lever_ratio, self.spring_fraction)
         return pin_lock_force_rolling(
-            M, self.R, self.mu_h, self.mu_g, self.misalignment, self.lever_ratio,
-            self.spring_fraction, self.bearing,
+            M,
+            self.R,
+            self.mu_h,
+            self.mu_g,
+            self.misalignment,
+            self.lever_ratio,
+            self.spring_fraction,
+            self.bearing,
         )
 
 

@@ -120,8 +120,7 @@ class ScrewEfficiency:
         return cls("ball", mu=mu)
 
     @classmethod
-    def roller(cls, r_s=40.0, beta=BETA_DEFAULT, r_RP=10.0, f_k=0.055, f_r=0.01
-               ) -> ScrewEfficiency:
+    def roller(cls, r_s=40.0, beta=BETA_DEFAULT, r_RP=10.0, f_k=0.055, f_r=0.01) -> ScrewEfficiency:
         """Planetary roller screw (eq. 14); defaults are the paper's (in mm)."""
         return cls("roller", beta=beta, r_s=r_s, r_RP=r_RP, f_k=f_k, f_r=f_r)
 

@@ -67,8 +67,9 @@ def root_area(d1):
     return m.pi * d1**2 / 4.0
 
 
-def buckling_load(d1, la, mounting: str = "fixed-supported", form: str = "catalogue",
-                  E=E_STEEL, safety=0.5):
+def buckling_load(
+    d1, la, mounting: str = "fixed-supported", form: str = "catalogue", E=E_STEEL, safety=0.5
+):
     """Permissible axial (buckling) load P1 (N) of the screw shaft.
 
     Parameters
@@ -138,9 +139,7 @@ def mean_load(forces, revolutions):
             raise InputError("revolutions", "must be >= 0 with a positive sum")
         F = np.abs(F)
         return (np.sum(F**3 * n, axis=-1) / np.sum(n, axis=-1)) ** (1.0 / 3.0)
-    return (m.grid_sum(m.fabs(forces) ** 3 * revolutions) / m.grid_sum(revolutions)) ** (
-        1.0 / 3.0
-    )
+    return (m.grid_sum(m.fabs(forces) ** 3 * revolutions) / m.grid_sum(revolutions)) ** (1.0 / 3.0)
 
 
 def mean_speed(speeds, times):

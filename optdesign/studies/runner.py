@@ -26,6 +26,7 @@ one.
 
 from __future__ import annotations
 
+import gc
 import json
 import multiprocessing
 import os
@@ -401,6 +402,10 @@ class WorkerPool:
         self.size = size
         self.conns: list[Any] = []
         self.procs: list[Any] = []
+        # Objects of this process that a forked worker inherits are frozen out of the
+        # garbage collector while forking: a collection in the worker would otherwise
+        # write to every inherited object and copy its memory page (copy-on-write).
+        gc.freeze()
         for _ in range(size):
             parent, child = ctx.Pipe()
             proc = ctx.Process(target=_worker_loop, args=(child,), daemon=True)
@@ -408,6 +413,7 @@ class WorkerPool:
             child.close()
             self.conns.append(parent)
             self.procs.append(proc)
+        gc.unfreeze()
         self.idle = list(range(size))[::-1]
         self.busy: set[int] = set()
 
