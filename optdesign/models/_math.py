@@ -13,7 +13,11 @@ in CasADi mode the grid is a column vector and designs are scalars. The aggregat
 
 from __future__ import annotations
 
-from typing import Any
+import contextvars
+import functools
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any, TypeVar
 
 import casadi as ca
 import numpy as np
@@ -24,6 +28,53 @@ pi = np.pi
 
 #: Smallest argument of a guarded square root on the CasADi path.
 SQRT_GUARD = 1e-12
+
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+#: The memo of the innermost :func:`shared_subexpressions` block (None outside one).
+_SHARED: contextvars.ContextVar[dict | None] = contextvars.ContextVar(
+    "optdesign_shared_subexpressions", default=None
+)
+
+
+@contextmanager
+def shared_subexpressions() -> Iterator[None]:
+    """Share the results of :func:`shareable` model functions within this block.
+
+    A design problem asks its mechanism for the same quantities many times (the nut
+    velocity for the ratio, the nut force and the motor torque; the rod force for the
+    pin pressure, the shear and every joint's clearance; ...), and each model function
+    rebuilds its own subexpressions. Inside this block a call with the very same argument
+    objects returns the first call's result object: on the CasADi path one node of the
+    expression graph instead of a copy per use (cs_min_backlash: formulation build
+    0.098 -> 0.048 s, the same constraints and, after CSE, the same 4182 instructions),
+    on the NumPy path one evaluation. Results are keyed by the identity of the arguments,
+    which the memo keeps alive; arrays must not be modified in place inside the block.
+    Per thread and per context (``contextvars``); blocks nest.
+    """
+    token = _SHARED.set({})
+    try:
+        yield
+    finally:
+        _SHARED.reset(token)
+
+
+def shareable(fn: _F) -> _F:
+    """Mark a pure model function whose results :func:`shared_subexpressions` may share."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        memo = _SHARED.get()
+        if memo is None:
+            return fn(*args, **kwargs)
+        key = (fn, *map(id, args), *((k, id(v)) for k, v in sorted(kwargs.items())))
+        hit = memo.get(key)
+        if hit is None:
+            hit = memo[key] = ((args, kwargs), fn(*args, **kwargs))
+        return hit[1]
+
+    return wrapper  # type: ignore[return-value]
 
 
 def is_symbolic(*xs: Any) -> bool:

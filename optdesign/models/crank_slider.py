@@ -27,17 +27,20 @@ def arm_angle(phi, phi0=0.0):
     return phi0 + phi
 
 
+@m.shareable
 def rod_rise(R, n, phi, phi0=0.0):
     """u = R cos a - n: the rod's extent perpendicular to the screw axis (mm)."""
     return R * m.cos(arm_angle(phi, phi0)) - n
 
 
+@m.shareable
 def assembly_margin(R, l, n, phi, phi0=0.0):
     """l^2 - u^2 (mm^2); the linkage assembles only where it is positive."""
     u = rod_rise(R, n, phi, phi0)
     return l**2 - u**2
 
 
+@m.shareable
 def rod_run(R, l, n, phi, phi0=0.0, floor=None):
     """s = sqrt(l^2 - u^2): the rod's extent along the screw axis (mm)."""
     margin = assembly_margin(R, l, n, phi, phi0)
@@ -46,12 +49,14 @@ def rod_run(R, l, n, phi, phi0=0.0, floor=None):
     return m.sqrt(margin)
 
 
+@m.shareable
 def nut_position(R, l, n, phi, phi0=0.0, floor=None):
     """Nut pin abscissa m(phi) = R sin a - sqrt(l^2 - u^2) (mm), eq. 2."""
     a = arm_angle(phi, phi0)
     return R * m.sin(a) - rod_run(R, l, n, phi, phi0, floor)
 
 
+@m.shareable
 def nut_velocity(R, l, n, phi, phi0=0.0, floor=None):
     """dm/dphi = R cos a - u R sin a / s (mm/rad): derivative of eq. 2."""
     a = arm_angle(phi, phi0)
@@ -60,17 +65,20 @@ def nut_velocity(R, l, n, phi, phi0=0.0, floor=None):
     return R * m.cos(a) - u * R * m.sin(a) / s
 
 
+@m.shareable
 def ratio(R, l, n, p, i_a, phi, phi0=0.0, floor=None):
     """Exact reduction ratio i(phi) = 2 pi i_a (dm/dphi) / p."""
     return ratio_from_nut_velocity(nut_velocity(R, l, n, phi, phi0, floor), p, i_a)
 
 
+@m.shareable
 def rod_length_rate(R, l, n, phi, phi0=0.0, floor=None):
     """d|BC|/dphi with the nut held (mm/rad) = (dm/dphi) s / l (physics.md 2.3)."""
     s = rod_run(R, l, n, phi, phi0, floor)
     return nut_velocity(R, l, n, phi, phi0, floor) * s / l
 
 
+@m.shareable
 def transmission_angle(R, l, n, phi, phi0=0.0, floor=None):
     """Angle at B between the arm (B->O) and the rod (B->C), in rad; 90 deg is ideal.
 
@@ -82,6 +90,7 @@ def transmission_angle(R, l, n, phi, phi0=0.0, floor=None):
     return m.arccos((s * m.sin(a) + u * m.cos(a)) / l)
 
 
+@m.shareable
 def transmission_angle_cos(R, l, n, phi, phi0=0.0, floor=None):
     """cos of the transmission angle (smooth; constraints use it instead of arccos)."""
     a = arm_angle(phi, phi0)
@@ -90,22 +99,26 @@ def transmission_angle_cos(R, l, n, phi, phi0=0.0, floor=None):
     return (s * m.sin(a) + u * m.cos(a)) / l
 
 
+@m.shareable
 def rod_inclination(R, l, n, phi, phi0=0.0, floor=None):
     """Signed inclination of the rod to the screw axis, atan2(u, s), in rad."""
     u = rod_rise(R, n, phi, phi0)
     return m.arctan2(u, rod_run(R, l, n, phi, phi0, floor))
 
 
+@m.shareable
 def sensitivity_rod_length(R, l, n, phi, phi0=0.0, floor=None):
     """Output rotation per unit change of the effective rod length (rad/mm)."""
     return 1.0 / rod_length_rate(R, l, n, phi, phi0, floor)
 
 
+@m.shareable
 def sensitivity_axial(R, l, n, phi, phi0=0.0, floor=None):
     """Output rotation per unit axial (nut-side) clearance (rad/mm) = 1/(dm/dphi)."""
     return 1.0 / nut_velocity(R, l, n, phi, phi0, floor)
 
 
+@m.shareable
 def sensitivity_lateral(R, l, n, phi, phi0=0.0, floor=None):
     """Output rotation per unit clearance of the nut slide across the screw axis (rad/mm).
 

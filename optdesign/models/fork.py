@@ -11,32 +11,38 @@ from optdesign.models import _math as m
 from optdesign.models.ratio import ratio_from_nut_velocity
 
 
+@m.shareable
 def nut_position(R, phi, phi0=0.0):
     """s = R tan(phi0 + phi) (mm), eq. 6."""
     return R * m.tan(phi0 + phi)
 
 
+@m.shareable
 def nut_velocity(R, phi, phi0=0.0):
     """ds/dphi = R / cos^2(phi0 + phi) (mm/rad)."""
     c = m.cos(phi0 + phi)
     return R / c**2
 
 
+@m.shareable
 def ratio(R, p, i_a, phi, phi0=0.0):
     """Exact reduction ratio 2 pi i_a R / (p cos^2 phi)."""
     return ratio_from_nut_velocity(nut_velocity(R, phi, phi0), p, i_a)
 
 
+@m.shareable
 def pin_distance(R, phi, phi0=0.0):
     """Distance from O to the pin, R / cos(phi0 + phi) (mm)."""
     return R / m.cos(phi0 + phi)
 
 
+@m.shareable
 def sensitivity_slot_normal(R, phi, phi0=0.0):
     """Output rotation per unit slot-normal clearance at the pin (rad/mm) = cos a / R."""
     return m.cos(phi0 + phi) / R
 
 
+@m.shareable
 def sensitivity_axial(R, phi, phi0=0.0):
     """Output rotation per unit axial (nut-side) clearance (rad/mm) = cos^2 a / R."""
     return 1.0 / nut_velocity(R, phi, phi0)

@@ -261,6 +261,14 @@ class DesignProblem:
         first_order
             Use first-order Hertz flattening (the GP form).
         """
+        # Every block below asks the mechanism for the same few quantities: share them
+        # (one expression node, or one NumPy evaluation, per quantity).
+        with m.shared_subexpressions():
+            return self._expressions(design, guarded, first_order)
+
+    def _expressions(
+        self, design: Mapping[str, Any], guarded: bool, first_order: bool
+    ) -> Expressions:
         req = self.spec.requirements
         phi = self.phi
         mech = self.mechanism(design, guarded)
