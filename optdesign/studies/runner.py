@@ -220,21 +220,28 @@ def run_tasks(
             add(expand(t, done[t["id"]], done))
 
     bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=0, desc=progress if isinstance(progress, str) else None, leave=False)
-    store = _Store(path, key, fresh=not (resume and path.exists()))
+    store: _Store | None = None
     try:
         add(tasks)
-        if bar is not None:
-            bar.update(sum(1 for i in by_id if i in done))
         expand_replayed()
 
         def ready(t: Mapping[str, Any]) -> bool:
             return all(a in done for a in t.get("after", []))
 
+        # The workers start (fork) before the store's fsync thread and the progress bar's
+        # monitor thread exist: a process forked while other threads run inherits only
+        # the forking one, and whatever locks the others held.
         with _executor(fn, workers, scheduler, pool) as ex:
+            store = _Store(path, key, fresh=not (resume and path.exists()))
+            if progress:
+                from tqdm.auto import tqdm
+
+                bar = tqdm(
+                    total=len(by_id),
+                    initial=sum(1 for i in by_id if i in done),
+                    desc=progress if isinstance(progress, str) else None,
+                    leave=False,
+                )
 
             def submit_ready() -> None:
                 while ex.has_room():
@@ -268,7 +275,8 @@ def run_tasks(
                     if on_record is not None:
                         on_record(record)
     finally:
-        store.close()
+        if store is not None:
+            store.close()
         if bar is not None:
             bar.close()
     return {i: done[i] for i in by_id if i in done}
