@@ -28,7 +28,8 @@ def design_sources(mech: CrankSlider):
     """Error sources of a crank-slider drive; the deformation is the stiffness chain's
     compliance under the nut force of the hinge moment at each sampled angle."""
     K = screw_sizing.axial_stiffness_chain(
-        screw_sizing.shaft_stiffness(16.0, 300.0, "fixed-free"), 4e5, 6e5, 1e6)
+        screw_sizing.shaft_stiffness(16.0, 300.0, "fixed-free"), 4e5, 6e5, 1e6
+    )
     return [
         eb.lead_error_source(0.003),
         eb.backlash_source(0.005),
@@ -61,8 +62,10 @@ def main() -> None:
             res = run_monte_carlo(sources, args.n, args.seed, mech, M_h=5e5, **kw)
             best = min(best, time.perf_counter() - t0)
         top = ", ".join(f"{k} {100 * v:.1f} %" for k, v in res.ranking()[:3])
-        print(f"{name}: {args.n / best:.3e} samples/s; output error mean "
-              f"{np.degrees(res.mean):.5f} deg, sd {np.degrees(res.std):.5f} deg; top: {top}")
+        print(
+            f"{name}: {args.n / best:.3e} samples/s; output error mean "
+            f"{np.degrees(res.mean):.5f} deg, sd {np.degrees(res.std):.5f} deg; top: {top}"
+        )
 
 
 if __name__ == "__main__":

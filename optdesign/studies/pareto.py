@@ -30,11 +30,13 @@ plus the epsilon bounds) to 1e-6 relative; a point that fails the check is kept 
 status ``infeasible`` and left out of the front, as are dominated points.
 
 Points are tasks of :func:`optdesign.studies.runner.run_tasks`: written to a JSONL store
-as they finish, resumable, on local processes or a Dask cluster. Parallel strategy: the
-anchors run in parallel; then the two-objective sweep is split into two chains, one from
-each anchor, that meet in the middle (more workers than chains only help the anchors and
-the rows of three-objective fronts); each worker builds its solvers once (per-process
-cache).
+as they finish, resumable, on local processes or a Dask cluster. Parallel strategy (two
+objectives): one task graph - the anchors' multistarts side by side, their tie-breaks,
+then two warm-started chains, one from each anchor, created as records come in
+(:class:`_TwoChains`) so that they meet wherever they meet and no worker waits for a
+fixed share; the formulation is built once before the workers are forked
+(:func:`prebuild_solvers`), each worker builds its solvers once (per-process cache).
+Three objectives: anchors first, then the rows side by side.
 """
 
 from __future__ import annotations
