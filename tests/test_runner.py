@@ -155,7 +155,8 @@ def test_expand_adds_tasks_as_records_come_in(tmp_path, workers):
     assert len(read_store(tmp_path / "m.jsonl")[1]) == 10
 
 
-def test_expand_replays_stored_records_on_resume(tmp_path):
+@pytest.mark.parametrize("workers", [1, 2])
+def test_expand_replays_stored_records_on_resume(tmp_path, workers):
     store = tmp_path / "m.jsonl"
     seen = []
 
@@ -169,6 +170,7 @@ def test_expand_replays_stored_records_on_resume(tmp_path):
             [{"id": "start", "index": -1, "dir": 0}],
             _step_fn,
             store,
+            workers=workers,
             expand=_Meet(9),
             on_record=stop,
         )
@@ -180,6 +182,7 @@ def test_expand_replays_stored_records_on_resume(tmp_path):
         _step_fn,
         store,
         resume=True,
+        workers=workers,
         expand=meet,
         on_record=lambda r: computed.append(r["id"]),
     )

@@ -457,17 +457,21 @@ class WorkerPool:
         return out
 
     def close(self) -> None:
-        for i, conn in enumerate(self.conns):
-            if i not in self.busy:
+        """Stop the workers: idle ones are asked to exit, busy ones (an interrupted run:
+        their results are not wanted any more) are terminated."""
+        for i, (conn, proc) in enumerate(zip(self.conns, self.procs, strict=True)):
+            if i in self.busy:
+                proc.terminate()
+            else:
                 try:
                     conn.send(None)
                 except OSError:
                     pass
         for proc in self.procs:
             proc.join(2.0)
-            if proc.is_alive():  # still running a task (interrupted run): stop it
-                proc.terminate()
-                proc.join(2.0)
+            if proc.is_alive():
+                proc.kill()
+                proc.join(1.0)
         for conn in self.conns:
             conn.close()
 
