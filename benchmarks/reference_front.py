@@ -44,6 +44,7 @@ def main() -> None:
         resume=args.resume,
         progress="reference",
         starts=args.anchor_starts,
+        agree=None,  # every anchor start runs (no early stop): a reference, not a race
         extra_starts=args.extra_starts,
         name="reference",
     )
