@@ -72,6 +72,11 @@ def main() -> None:
     ap.add_argument("--pop", type=int, default=100)
     ap.add_argument("--generations", type=int, default=500)
     ap.add_argument("--repeats", type=int, default=5, help="1-vs-2-worker pairs")
+    ap.add_argument(
+        "--deterministic",
+        action="store_true",
+        help="time the 1-vs-2-worker pairs with chains that meet in the middle",
+    )
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "data" / "bench_pareto.json")
     args = ap.parse_args()
     problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
@@ -124,14 +129,16 @@ def main() -> None:
 
     t1s, t2s = [], []
     for _ in range(args.repeats):
-        f1, t1 = timed_front(problem, args.points, 1, "w1")
-        f2, t2 = timed_front(problem, args.points, 2, "w2")
+        det = {"deterministic": args.deterministic}
+        f1, t1 = timed_front(problem, args.points, 1, "w1", **det)
+        f2, t2 = timed_front(problem, args.points, 2, "w2", **det)
         # The parallel front is the same computation: same points within the tolerance.
         assert len(f1.points) == len(f2.points), (len(f1.points), len(f2.points))
         t1s.append(t1)
         t2s.append(t2)
     t1, t2 = float(np.median(t1s)), float(np.median(t2s))
     results["workers"] = {
+        "deterministic": args.deterministic,
         "t1_s": t1,
         "t2_s": t2,
         "speedup": t1 / t2,

@@ -232,9 +232,10 @@ def test_cli_writes_front_files(fork, tmp_path):
             "--out",
             str(out),
             "--workers",
-            "1",
+            "2",
             "--starts",
             "2",
+            "--deterministic",
             "--no-progress",
         ]
     )
@@ -258,3 +259,33 @@ def test_cli_writes_front_files(fork, tmp_path):
         )
         == 2
     )
+
+
+def test_deterministic_front_is_the_same_for_any_workers_and_after_resume(fork, tmp_path):
+    objectives = ["size", "backlash"]
+    kw = dict(starts=2, deterministic=True)
+    one = epsilon_constraint_front(fork, objectives, 8, out=tmp_path / "1", **kw)
+    two = epsilon_constraint_front(fork, objectives, 8, out=tmp_path / "2", workers=2, **kw)
+    assert len(one.points) == len(two.points) == 8
+    assert two.F == pytest.approx(one.F, rel=1e-9)
+    seen = []
+
+    def interrupt(rec):
+        seen.append(rec["id"])
+        if len(seen) == 7:  # the 4 anchor records and 3 points
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        epsilon_constraint_front(
+            fork, objectives, 8, out=tmp_path / "r", workers=2, on_record=interrupt, **kw
+        )
+    resumed = epsilon_constraint_front(
+        fork, objectives, 8, out=tmp_path / "r", workers=2, resume=True, **kw
+    )
+    assert resumed.F == pytest.approx(one.F, rel=1e-9)
+    # The chains met in the middle: points 1-3 started from their left neighbour, 4-6
+    # from their right one (0 and 7 from the anchors).
+    _, recs = read_store(tmp_path / "r" / "epsilon.jsonl")
+    warm = [recs[f"epsilon-{i:04d}"]["warm"] for i in range(8)]
+    assert warm[0] == "anchor-size" and warm[7] == "anchor-backlash"
+    assert warm[1:7] == [f"epsilon-{i:04d}" for i in (0, 1, 2, 5, 6, 7)]

@@ -46,6 +46,13 @@ def _pareto(sub):
     p.add_argument("--seed", type=int, default=None, help="seed (default: file's)")
     p.add_argument("--pop", type=int, default=100, help="NSGA-II population (default 100)")
     p.add_argument("--generations", type=int, default=500, help="NSGA-II generations")
+    p.add_argument(
+        "--deterministic",
+        action="store_true",
+        help="epsilon fronts: the two chains meet in the middle, so the front is the same "
+        "for any --workers and a resumed run equals an uninterrupted one (slower with "
+        "several workers); by default they meet where timing makes them meet",
+    )
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run_pareto)
@@ -88,6 +95,12 @@ def run_pareto(args) -> int:
         if m == "nsga2":
             fronts.append(
                 pa.nsga2_front(problem, objectives, args.pop, args.generations, seed=seed)
+            )
+        elif m in ("epsilon", "uniform"):
+            fronts.append(
+                pa.METHODS[m](
+                    problem, objectives, args.points, deterministic=args.deterministic, **common
+                )
             )
         else:
             fronts.append(pa.METHODS[m](problem, objectives, args.points, **common))
