@@ -358,7 +358,7 @@ def _register_fronts() -> None:
             "front-epsilon",
             "front",
             eps,
-            "epsilon-constraint front (Ipopt)",
+            "epsilon-constraint front (SLSQP sweep, Ipopt tie-breaks)",
             dict(FRONT_OPTIONS),
             time_factor=10.0,
         )
