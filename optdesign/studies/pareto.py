@@ -477,10 +477,11 @@ def _json_vector(v) -> list | dict:
     a = np.asarray(v, dtype=float).ravel()
     nz = np.flatnonzero(a != 0.0)
     if 2 * len(nz) < len(a):
-        values = a[nz].tolist()
-        if not np.isfinite(a[nz]).all():
-            values = [x if math.isfinite(x) else None for x in values]
-        return {"size": len(a), "index": nz.tolist(), "value": values}
+        return {"size": len(a), "index": nz.tolist(), "value": _finite_list(a[nz])}
+    return _finite_list(a)
+
+
+def _finite_list(a: np.ndarray) -> list:
     out = a.tolist()
     if not np.isfinite(a).all():
         out = [x if math.isfinite(x) else None for x in out]
@@ -570,7 +571,7 @@ def _tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any
     method = task.get("solver", "slsqp")
     t0 = time.perf_counter()
     rec = dict(deps[task["multistart"]])
-    n_solves = 0
+    n_solves = rec["n_solves"]  # the anchor's record counts every solve behind it
     fixed: dict[str, float] = {}
     for k, name in enumerate(order[1:], start=1):
         if not _ok(rec):
@@ -592,7 +593,6 @@ def _tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any
         if _ok(cand) and cand["objectives"][name] <= start_value * (1 + 1e-9) + 1e-15:
             cand["multistart"] = rec["multistart"]
             rec = cand
-    rec.pop("id", None)
     rec["kind"] = "anchor"
     rec["order"] = order
     rec["n_solves"] = n_solves
@@ -1019,10 +1019,10 @@ class _TwoChains:
         tie_a, ms_b, tie_b = f"anchor-{a}", f"anchor-{b}-ms", f"anchor-{b}"
         new: list[dict[str, Any]] = []
         if self.frame is None and tie_a in done and ms_b in done:
-            need = (tie_a, ms_b) if self.spacing == "arc" and self.eps_values is None else None
-            if need is not None or tie_b in done:
+            arc = self.spacing == "arc" and self.eps_values is None
+            if arc or tie_b in done:  # uniform or explicit epsilon need B's tie-break
                 _check_anchor(done[tie_a], a)
-                far = done[ms_b] if need is not None else done[tie_b]
+                far = done[ms_b] if arc else done[tie_b]
                 _check_anchor(far, b)
                 self._make_frame(done[tie_a], far, done.get(tie_b))
                 new.append(self._point(0, +1, tie_a, done))
@@ -1203,7 +1203,6 @@ def epsilon_constraint_front(
         "extra_starts": extra_starts,
         "seed": seed,
     }
-    first = anchor_tasks(problem, objectives, starts, seed, solver, agree)
     if workers > 1 and scheduler is None:
         prebuild_solvers(problem, objectives, solver)
     label = f"{name}: points" if progress else False
@@ -1212,7 +1211,7 @@ def epsilon_constraint_front(
             split = n_points // 2 if deterministic else None
             sweep = _TwoChains(objectives, n_points, name, common, spacing, eps_values, split)
             done = run_tasks(
-                first,
+                anchor_tasks(problem, objectives, starts, seed, solver, agree),
                 _front_task,
                 store,
                 workers,
@@ -1225,54 +1224,49 @@ def epsilon_constraint_front(
                 expand=sweep,
             )
             tasks = sweep.tasks
+            # _TwoChains checked every anchor before starting a chain from it.
+            anchors = {k: done[f"anchor-{k}"] for k in objectives}
         else:
             # Three objectives: the rows need every anchor (the nadir of B), so the
             # anchors run first, then the rows in parallel.
-            done = run_tasks(
-                first,
-                _front_task,
+            anchors = compute_anchors(
+                problem,
+                objectives,
                 store,
                 workers,
                 scheduler,
                 resume,
                 f"{name}: anchors" if progress else False,
+                starts,
+                seed,
+                key,
+                on_record,
+                solver=solver,
+                agree=agree,
+                pool=pool,
+            )
+            tasks = _three_objective_tasks(anchors, objectives, n_points, name, common)
+            done = run_tasks(
+                tasks,
+                _front_task,
+                store,
+                workers,
+                scheduler,
+                True,  # the anchors are in the store already
+                label,
                 key,
                 on_record,
                 pool=pool,
+                known={f"anchor-{k}": rec for k, rec in anchors.items()},
             )
-            for k in objectives:
-                _check_anchor(done[f"anchor-{k}"], k)
-            tasks = _three_objective_tasks(
-                {k: done[f"anchor-{k}"] for k in objectives}, objectives, n_points, name, common
-            )
-            done.update(
-                run_tasks(
-                    tasks,
-                    _front_task,
-                    store,
-                    workers,
-                    scheduler,
-                    True,
-                    label,
-                    key,
-                    on_record,
-                    pool=pool,
-                    known=done,
-                )
-            )
-    missing = [k for k in objectives if f"anchor-{k}" not in done]
-    if missing:
-        raise ProblemError(f"anchors {missing}: not computed")
-    for k in objectives:
-        _check_anchor(done[f"anchor-{k}"], k)
     pts = [_point(done[t["id"]], name) for t in sorted(tasks, key=lambda t: t["index"])]
-    anchor_ids = [t["id"] for t in first]
     info = {
-        "anchors": {k: done[f"anchor-{k}"]["objectives"] for k in objectives},
+        "anchors": {k: rec["objectives"] for k, rec in anchors.items()},
         "store": str(store),
         "spacing": "explicit" if eps_values is not None else spacing,
+        # An anchor's record counts its multistart's solves too.
         "n_solves": sum(done[t["id"]].get("n_solves", 0) for t in tasks)
-        + sum(done[i].get("n_solves", 0) for i in anchor_ids),
+        + sum(rec.get("n_solves", 0) for rec in anchors.values()),
         "n_retried": sum(1 for t in tasks if done[t["id"]].get("retried")),
     }
     return make_front(pts, objectives, name, time.perf_counter() - t0, info)
