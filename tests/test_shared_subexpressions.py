@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from optdesign import math as m
 from optdesign.formulations.nlp import build_nlp
-from optdesign.models import _math as m
 from optdesign.models import crank_slider as cs
 from optdesign.problem import load_problem
 

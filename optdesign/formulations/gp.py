@@ -7,7 +7,7 @@ flattening taken to first order (b^2/D, a monomial) and the ISO 286 fit formulas
 (posynomials in D, :mod:`optdesign.models.fits`).
 
 **How the expressions are obtained.** The models are written once through
-:mod:`optdesign.models._math`, which dispatches CasADi symbols to CasADi and everything
+:mod:`optdesign.math`, which dispatches CasADi symbols to CasADi and everything
 else to NumPy. cvxpy expressions cannot go through it (NumPy ufuncs such as ``np.abs``
 raise on cvxpy objects) and cvxpy never merges like terms, so ``R tan(30) - R tan(-30)``
 (a monomial) would stay a non-DGP difference. Instead, :meth:`DesignProblem.expressions`

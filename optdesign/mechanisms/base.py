@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models import _math as m
 from optdesign.models._checks import require_positive
 from optdesign.models.clearance import pin_joint_clearance, root_sum_square, worst_case
 from optdesign.models.fits import Fit

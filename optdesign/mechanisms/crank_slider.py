@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.mechanisms.base import Joint, Mechanism, PinJoint
-from optdesign.models import _math as m
 from optdesign.models import crank_slider as cs
 from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import force_from_rate

@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.mechanisms.base import Joint, Mechanism, PinJoint
-from optdesign.models import _math as m
 from optdesign.models import fork
 from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import fork_pin_normal_force

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from optdesign.models import _math as m
+from optdesign import math as m
 from optdesign.models.fits import Fit, fit_clearance
 from optdesign.models.hertz_line import pin_flattening, pin_flattening_first_order
 

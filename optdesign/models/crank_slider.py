@@ -10,7 +10,7 @@ screw axis):
     dm/dphi    = R cos a - u R sin a / s
     d|BC|/dphi = (dm/dphi) s / l        (rate of the pin distance with the nut held)
 
-All functions accept floats, NumPy arrays or CasADi symbols (see models._math).
+All functions accept floats, NumPy arrays or CasADi symbols (see optdesign.math).
 ``floor`` guards the square root of the assembly margin for solvers: with ``floor=None``
 the NumPy path returns NaN where the linkage cannot assemble (the mechanism layer checks
 and names the angle); a solver passes a small positive floor so no NaN ever reaches it.
@@ -18,7 +18,7 @@ and names the angle); a solver passes a small positive floor so no NaN ever reac
 
 from __future__ import annotations
 
-from optdesign.models import _math as m
+from optdesign import math as m
 from optdesign.models.ratio import ratio_from_nut_velocity
 
 

@@ -112,7 +112,7 @@ class Surface:
     ----------
     builder
         ``builder(u, v, p) -> 3x1 SX`` building the surface point from SX symbols
-        (use CasADi or :mod:`optdesign.models._math` functions).
+        (use CasADi or :mod:`optdesign.math` functions).
     n_params
         Length of the parameter vector p (0 for none).
     name

@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models import _math as m
 
 #: Distributions of Table 1. ``periodic``: amplitude x sin(uniform phase).
 DISTRIBUTIONS = ("fixed", "uniform", "normal", "periodic")

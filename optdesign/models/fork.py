@@ -7,7 +7,7 @@ the paper) the nut sits at s = R tan a and the pin at R / cos a from O.
 
 from __future__ import annotations
 
-from optdesign.models import _math as m
+from optdesign import math as m
 from optdesign.models.ratio import ratio_from_nut_velocity
 
 

@@ -22,7 +22,7 @@ wide (physics.md 9). Where b approaches D/2 the formula has no real value.
 
 from __future__ import annotations
 
-from optdesign.models import _math as m
+from optdesign import math as m
 
 
 def contact_half_width(D, F, L, E, nu):

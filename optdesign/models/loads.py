@@ -7,7 +7,7 @@ radian is dx/dphi; the nut, the rod and the fork pin differ only in that rate.
 
 from __future__ import annotations
 
-from optdesign.models import _math as m
+from optdesign import math as m
 
 
 def force_from_rate(M_h, rate):

@@ -12,7 +12,7 @@ power on. The magnet of the lock must beat:
   the extracted text; reconstructed below, assumptions in :func:`pin_lock_force_rolling`).
 
 Units: M in N*mm, radii in mm, forces in N (the paper's SI inputs, metres, are converted
-at the boundary: 0.03 m -> 30 mm). Every formula goes through :mod:`._math`, so the lock
+at the boundary: 0.03 m -> 30 mm). Every formula goes through :mod:`optdesign.math`, so the lock
 force is a CasADi expression in a design problem and a NumPy array in a sweep.
 
 The coupling to a mechanism is :func:`motor_shaft_lock_load`: hinge moment -> nut force
@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models import _math as m
 from optdesign.models._checks import require_nonnegative, require_positive
 from optdesign.models.loads import backdriven_motor_torque
 

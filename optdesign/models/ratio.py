@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from optdesign.models import _math as m
+from optdesign import math as m
 
 
 def ratio_from_nut_velocity(v, p, i_a):

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models import _math as m
 from optdesign.models import screw
 
 

@@ -5,7 +5,7 @@ lambda: lead angle, tan(lambda) = p / (pi d_m); phi_f: friction angle, tan(phi_f
 
 from __future__ import annotations
 
-from optdesign.models import _math as m
+from optdesign import math as m
 
 
 def lead_angle(p, d_m):

@@ -1,7 +1,7 @@
 """Ball-screw sizing as the manufacturers publish it (THK, NSK, HIWIN, SKF; physics.md 8).
 
 Buckling, shaft yield, critical speed, rated life from a duty cycle and the axial
-stiffness chain. Pure functions through :mod:`._math`: a design problem passes CasADi
+stiffness chain. Pure functions through :mod:`optdesign.math`: a design problem passes CasADi
 symbols (d1, la, ...) and gets expressions, a sweep passes arrays. The ``*_margin``
 functions are constraints in the form g >= 0 (1 - demand / capacity).
 
@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models import _math as m
 from optdesign.models._checks import require_positive
 from optdesign.models.screw import series_stiffness
 

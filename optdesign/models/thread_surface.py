@@ -29,7 +29,7 @@ material of every tooth lies where ``xi (z - l theta/2pi - start p) < h/cos(lamb
 so the outward normal of a flank has ``sign(n_z) = xi`` (used to orient normals).
 
 The functions take CasADi symbols (for :class:`~optdesign.models.differential_geometry.Surface`)
-or floats/NumPy arrays, through :mod:`optdesign.models._math`.
+or floats/NumPy arrays, through :mod:`optdesign.math`.
 """
 
 from __future__ import annotations
@@ -37,8 +37,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models import _math as m
 
 PROFILES = ("screw", "roller", "nut")
 

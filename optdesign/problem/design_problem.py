@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.mechanisms import CrankSlider, Joint, PinJoint, ShiftingFork
-from optdesign.models import _math as m
 from optdesign.models import crank_slider as cs_model
 from optdesign.models.loads import pin_bearing_pressure, pin_shear_stress
 from optdesign.problem.spec import VARIABLE_DESCRIPTIONS, ProblemSpec

@@ -1,6 +1,8 @@
-"""One math namespace for two back-ends: CasADi symbols and NumPy arrays.
+"""One public math namespace for two back-ends: CasADi symbols and NumPy arrays.
 
-Every model formula in :mod:`optdesign.models` is written once with these functions.
+Every model formula in :mod:`optdesign.models` - and every mechanism, objective or
+constraint a user writes - is written once with these functions (``from optdesign import
+math as m``).
 Called with CasADi ``SX``/``MX``/``DM`` arguments they build CasADi expressions (exact
 derivatives for the solvers); called with floats or NumPy arrays they evaluate
 numerically with NumPy broadcasting (plots, sweeps, Monte Carlo, NSGA-II).
