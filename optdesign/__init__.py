@@ -1,19 +1,74 @@
-"""optdesign: design optimisation of ball-screw actuator transmissions.
+"""optdesign: design optimisation of screw-driven actuator linkages.
 
 Internal unit system (every number inside the package): millimetre (mm), newton (N),
 megapascal (MPa = N/mm^2), newton-millimetre (N*mm) for moments, radian (rad) for angles.
 Output backlash is *reported* in degrees. Quantities with units are accepted at the input
-boundary (problem files, CLI) and converted by :mod:`optdesign.units`.
+boundary (problem files, the API's bounds, the CLI) and converted by
+:mod:`optdesign.units`.
 
-Data flow, one package per stage::
+The public API (see :mod:`optdesign.api` and the README)::
 
-    models/       pure functions -> CasADi expressions or NumPy arrays (one definition each)
-    mechanisms/   crank-slider and shifting fork: geometry + loads + clearance chain
-    problem/      declared variables, objectives, constraints, from a problem file
-    formulations/ NLP (CasADi), convex (GP), discrete (catalogue)
-    solvers/      solver back-ends behind one Result type
-    studies/      solve, Pareto fronts, benchmarks
-    cli.py, plots/
+    import optdesign as od
+    problem = od.load("problems/cs_min_backlash.toml")
+    result = od.solve(problem)
+    front = od.pareto(problem, ["ripple", "backlash"], points=30)
+
+Data flow, one package per stage: ``models/`` (pure physics through :mod:`optdesign.math`)
+-> ``mechanisms/`` (plug-ins) -> ``problem/`` -> ``formulations/`` -> ``solvers/`` ->
+``studies/`` -> this API -> ``cli``, ``plots/``, ``reports/``. Names are imported lazily:
+``import optdesign`` costs little until a function is used.
 """
 
-__version__ = "0.1.0"
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__version__ = "0.2.0"
+
+#: public name -> "module:attribute" (or "module" for a module), imported on first use.
+_EXPORTS: dict[str, str] = {
+    "load": "optdesign.problem.load:load",
+    "solve": "optdesign.api:solve",
+    "pareto": "optdesign.api:pareto",
+    "bench": "optdesign.api:bench",
+    "DesignProblem": "optdesign.problem.design_problem:DesignProblem",
+    "Quantities": "optdesign.problem.quantities:Quantities",
+    "Result": "optdesign.solvers.result:Result",
+    "Front": "optdesign.studies.pareto:Front",
+    "Mechanism": "optdesign.mechanisms.base:Mechanism",
+    "VariableInfo": "optdesign.mechanisms.base:VariableInfo",
+    "RequirementInfo": "optdesign.mechanisms.base:RequirementInfo",
+    "Rows": "optdesign.mechanisms.base:Rows",
+    "Sketch": "optdesign.mechanisms.base:Sketch",
+    "Joint": "optdesign.mechanisms.joints:Joint",
+    "PinJoint": "optdesign.mechanisms.joints:PinJoint",
+    "register_mechanism": "optdesign.mechanisms.registry:register_mechanism",
+    "registered_mechanisms": "optdesign.mechanisms.registry:registered",
+    "register_solver": "optdesign.solvers.registry:register_solver",
+    "make_solver": "optdesign.solvers.registry:make_solver",
+    "solver_names": "optdesign.solvers.registry:solver_names",
+    "OptDesignError": "optdesign.errors:OptDesignError",
+    "InputError": "optdesign.errors:InputError",
+    "ProblemError": "optdesign.errors:ProblemError",
+    "math": "optdesign.math",
+    "units": "optdesign.units",
+}
+
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name: str) -> Any:
+    target = _EXPORTS.get(name)
+    if target is None:
+        raise AttributeError(f"module 'optdesign' has no attribute {name!r}")
+    module, _, attr = target.partition(":")
+    value = importlib.import_module(module)
+    if attr:
+        value = getattr(value, attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

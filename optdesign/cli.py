@@ -7,6 +7,7 @@ one line naming the field, with exit code 2 and no traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from collections.abc import Callable
@@ -67,7 +68,6 @@ def _load_plugins() -> None:
 #: Modules that register further subcommands with @command (solve, pareto, bench ...).
 PLUGIN_MODULES: list[str] = [
     "optdesign.commands.solve",
-    "optdesign.commands.gp_catalogue",
     "optdesign.commands.pareto",
     "optdesign.commands.bench",
 ]
@@ -88,6 +88,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``optdesign`` console script."""
+    # The command line writes figures to files: the Agg back-end, chosen here for this
+    # process only (the library itself never changes the user's back-end).
+    os.environ.setdefault("MPLBACKEND", "Agg")
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -163,3 +163,14 @@ def grid_mean(x):
 def grid_sum(x):
     """Sum over the deflection grid."""
     return ca.sum1(x) if is_symbolic(x) else np.sum(x, axis=-1)
+
+
+def spread(lo, hi):
+    """Relative spread (hi - lo)/(hi + lo) of a band [lo, hi]: half its width over its
+    mid-value (the papers' ratio ripple, seed 000). The one definition of the formula."""
+    return (hi - lo) / (hi + lo)
+
+
+def grid_spread(x):
+    """Spread of ``x`` over the deflection grid, :func:`spread` of its min and max."""
+    return spread(grid_min(x), grid_max(x))

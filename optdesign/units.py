@@ -83,3 +83,24 @@ def to_internal(value: object, dimension: str, field: str) -> float:
             f"{value!r} has dimension {q.dimensionality}, expected a {dimension} "
             f"(internal unit {unit})",
         ) from None
+
+
+def convert(value: object, unit: str, field: str) -> float:
+    """Convert a quantity string (or number, taken as already in ``unit``) to ``unit``.
+
+    For bounds of user-declared constraints: ``convert("3 kN", "N", "nut_force.upper")``.
+    """
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return float(value)
+    ureg = registry()
+    try:
+        target = ureg.Unit(unit or "dimensionless")
+    except Exception as exc:
+        raise InputError(field, f"unknown unit {unit!r} ({exc})") from None
+    try:
+        q = ureg.Quantity(str(value).strip())
+        return float(q.to(target).magnitude) if isinstance(q, pint.Quantity) else float(q)
+    except pint.DimensionalityError:
+        raise InputError(field, f"{value!r} cannot be expressed in {unit!r}") from None
+    except Exception as exc:
+        raise InputError(field, f"cannot parse quantity {value!r} ({exc})") from None

@@ -10,7 +10,13 @@ import numpy as np
 import pytest
 
 from optdesign.studies import bench
-from optdesign.studies.instances import SINGLE_FAMILIES, instance_dict, make_instance, suite
+from optdesign.studies.bench.instances import instance_dict, make_instance, single_families, suite
+from optdesign.studies.bench.metrics import (
+    best_config,
+    config_stats,
+    paired_time_ratio,
+    performance_profile,
+)
 
 
 def test_instances_are_reproducible_and_validated():
@@ -31,7 +37,7 @@ def test_instances_are_reproducible_and_validated():
             assert np.isclose(p.phi[0], -p.phi[-1])
         n_catalogue += any(v.discrete for v in p.free)
     assert 10 <= n_catalogue <= 60
-    assert {i.family for i in insts} == {"shipped", *SINGLE_FAMILIES}
+    assert {i.family for i in insts} == {"shipped", *single_families()}
 
 
 def test_performance_profile_hand_made_table():
@@ -45,13 +51,13 @@ def test_performance_profile_hand_made_table():
         ]
     )
     taus = np.array([1.0, 2.0, 4.0, 100.0])
-    rho = bench.performance_profile(T, taus)
+    rho = performance_profile(T, taus)
     np.testing.assert_allclose(rho[0], [2 / 3, 2 / 3, 2 / 3, 2 / 3])
     np.testing.assert_allclose(rho[1], [2 / 4, 3 / 4, 3 / 4, 3 / 4])
     np.testing.assert_allclose(rho[2], [0.0, 1 / 4, 2 / 4, 2 / 4])
     # gap profile: the best run has gap 0; gaps under the floor count as the floor
     G = np.array([[0.0, 1e-3], [2e-7, 0.0]])
-    rho_g = bench.performance_profile(G, np.array([1.0, 999.0, 1001.0]), floor=1e-6)
+    rho_g = performance_profile(G, np.array([1.0, 999.0, 1001.0]), floor=1e-6)
     np.testing.assert_allclose(rho_g[0], [1.0, 1.0, 1.0])
     np.testing.assert_allclose(rho_g[1], [0.5, 0.5, 1.0])
 
@@ -67,7 +73,7 @@ def test_scipy_back_ends_reach_the_fork_optimum():
         assert r.status == "optimal", r.message
         assert r.objectives["backlash"] == pytest.approx(0.0194989, rel=1e-5)
         assert r.max_violation == 0.0
-    r = bench.CONFIGS["de"].run(p, "backlash", 20.0)
+    r = bench.get_config("de").run(p, "backlash", 20.0)
     assert r.objective == pytest.approx(0.0194989, rel=1e-3)
     assert r.max_violation <= 0.0
 
@@ -84,7 +90,7 @@ def test_failures_are_recorded_and_the_run_goes_on(tmp_path):
         hard_timeout=2.0,
         instances=[inst],
     )
-    rows = {r["config"]: r for r in res["rows"]}
+    rows = {r["config"]: r for r in res.rows}
     assert set(rows) == {"debug-crash", "debug-hang", "debug-abort", "ipopt-exact"}
     assert rows["debug-crash"]["status"] == "error"
     assert "deliberate crash" in rows["debug-crash"]["reason"]
@@ -109,14 +115,14 @@ def test_failures_are_recorded_and_the_run_goes_on(tmp_path):
         resume=True,
     )
     assert (tmp_path / "bench_runs.jsonl").read_text().splitlines() == lines
-    assert [r["status"] for r in again["rows"]] == [r["status"] for r in res["rows"]]
+    assert [r["status"] for r in again.rows] == [r["status"] for r in res.rows]
 
 
 def test_quick_suite_every_configuration_and_consistent_metrics(tmp_path):
     res = bench.run_bench(
         "quick", None, tmp_path, workers=2, progress=False, time_limit=2.0, hard_timeout=4.0
     )
-    rows = res["rows"]
+    rows = res.rows
     configs = bench.default_configs()
     ran = {r["config"] for r in rows if r.get("applicable", True)}
     assert ran == set(configs), f"not run: {set(configs) - ran}"
@@ -168,10 +174,10 @@ def test_best_configuration_and_paired_time_ratio():
         row("a", "slow", 3.0), row("b", "slow", 10.0), row("c", "slow", 4.0),
         row("a", "subset", 0.1),  # applies to one instance only
     ]  # fmt: skip
-    stats = bench.config_stats(rows, ["fast", "slow", "subset"])
+    stats = config_stats(rows, ["fast", "slow", "subset"])
     assert stats["fast"]["success_rate"] == pytest.approx(2 / 3)
     assert stats["slow"]["median_time_s"] == 4.0
     # "slow" solves more instances; "subset" (1 run) is not crowned on its easy subset
-    assert bench.best_config(stats) == "slow"
-    ratio, n = bench.paired_time_ratio(rows, "fast", "slow")
+    assert best_config(stats) == "slow"
+    ratio, n = paired_time_ratio(rows, "fast", "slow")
     assert n == 2 and ratio == pytest.approx(np.median([1 / 3, 2 / 10]))

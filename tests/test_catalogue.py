@@ -59,17 +59,11 @@ def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
 
 
 def test_catalogue_problem_is_never_solved_as_continuous():
-    from optdesign.cli import _load_plugins
-    from optdesign.commands.solve import FORMULATIONS, choose_formulation
+    from optdesign.studies.solve import choose_formulation, solve
 
-    _load_plugins()
     problem = load_problem(CATALOGUE)
     assert choose_formulation(problem, "auto") == "catalogue"
-
-    class Args:
-        starts, seed, workers, solver, objective = 1, 0, 1, "ipopt", None
-
     with pytest.raises(ProblemError, match="catalogue values"):
-        FORMULATIONS["nlp"](problem, Args())
+        solve(problem, "nlp", starts=1)
     with pytest.raises(ProblemError, match=r"variable p: .*catalogue"):
-        FORMULATIONS["gp"](problem, Args())
+        solve(problem, "gp", starts=1)

@@ -24,27 +24,27 @@ def _output_angle(R, l, n, phi0, m_target, guess):
 def test_rod_length_sensitivity_by_reassembly(phi_deg):
     R, l, n, phi0 = 90.0, 80.0, 50.0, 0.0
     phi = np.radians(phi_deg)
-    mech = CrankSlider(R, l, n, 5, 2, phi0)
+    mech = CrankSlider(R=R, l=l, n=n, p=5, i_a=2, phi0=phi0)
     m0 = mech.nut_position(phi)
     delta = 1e-4
     phi_plus = _output_angle(R, l + delta, n, phi0, m0, phi)
     phi_minus = _output_angle(R, l - delta, n, phi0, m0, phi)
     fd = (phi_plus - phi_minus) / (2 * delta)
-    assert abs(fd) == pytest.approx(abs(mech.sensitivity("rod_length", phi)), rel=1e-6)
+    assert abs(fd) == pytest.approx(abs(mech.sensitivity_rod_length(phi)), rel=1e-6)
     # lateral clearance of the nut slide: move the nut line by dn
     fd_n = (
         _output_angle(R, l, n + delta, phi0, m0, phi)
         - _output_angle(R, l, n - delta, phi0, m0, phi)
     ) / (2 * delta)
-    assert abs(fd_n) == pytest.approx(mech.sensitivity("lateral", phi), rel=1e-6, abs=1e-12)
+    assert abs(fd_n) == pytest.approx(mech.sensitivity_lateral(phi), rel=1e-6, abs=1e-12)
 
 
 def test_backlash_chain_crank_slider():
-    mech = CrankSlider(90, 80, 50, 5, 2)
+    mech = CrankSlider(R=90, l=80, n=50, p=5, i_a=2)
     phi = np.radians(np.linspace(-30, 30, 61))
     pin = PinJoint(10, 15, "H7/g6")
-    joints = mech.default_joints(pin)
-    b = mech.backlash(phi, joints, 500e3)
+    joints = [j for j in mech.joints(phi, 500e3, pin) if j.pin is not None]
+    b = mech.backlash(phi, joints)
     # both rod pins carry the same force and the same clearance: equal shares
     np.testing.assert_allclose(b.per_joint["D rod pin (arm)"], b.per_joint["E rod pin (nut)"])
     np.testing.assert_allclose(b.worst_case, 2 * b.per_joint["D rod pin (arm)"])
@@ -55,15 +55,15 @@ def test_backlash_chain_crank_slider():
     expected = np.degrees(c / model.rod_length_rate(90, 80, 50, 0.0))
     assert b.per_joint["D rod pin (arm)"][30] == pytest.approx(expected, rel=1e-12)
     # an angular clearance at O adds directly
-    b2 = mech.backlash(phi, [Joint("O", "angular", clearance=np.radians(0.01))], 500e3)
+    b2 = mech.backlash(phi, [Joint("O", "O", angular=True, clearance=np.radians(0.01))])
     np.testing.assert_allclose(b2.worst_case, 0.01)
 
 
 def test_fork_slot_backlash():
-    fork = ShiftingFork(90, 5, 2)
+    fork = ShiftingFork(R=90, p=5, i_a=2)
     phi = np.radians(np.linspace(-30, 30, 61))
     pin = PinJoint(12, 18, "H7/g6")
-    b = fork.backlash(phi, [Joint("C", "slot_normal", pin=pin, load="pin_normal")], 500e3)
+    b = fork.backlash(phi, [j for j in fork.joints(phi, 500e3, pin) if j.pin is not None])
     F = 500e3 * np.cos(phi) / 90
     np.testing.assert_allclose(
         b.worst_case, np.degrees(pin.clearance(F) * np.cos(phi) / 90), rtol=1e-12
@@ -73,11 +73,11 @@ def test_fork_slot_backlash():
 
 
 def test_assembly_error_names_angle_and_margin():
-    mech = CrankSlider(90, 45, 10, 5, 2)  # rod too short near phi = 0 (u = 80 > l)
+    mech = CrankSlider(R=90, l=45, n=10, p=5, i_a=2)  # rod too short at -30 deg (u = 67.9 > l)
     with pytest.raises(AssemblyError, match=r"deflection -30\.000 deg.*margin") as exc:
         mech.check_assembly(np.radians(np.linspace(-30, 30, 61)))
     assert exc.value.margin < 0
-    CrankSlider(90, 80, 50, 5, 2).check_assembly(np.radians(np.linspace(-30, 30, 61)))
+    CrankSlider(R=90, l=80, n=50, p=5, i_a=2).check_assembly(np.radians(np.linspace(-30, 30, 61)))
 
 
 @pytest.mark.parametrize(
@@ -105,4 +105,4 @@ def test_poisson_ratio_out_of_range(nu):
 
 def test_fork_zero_lead_rejected():
     with pytest.raises(InputError, match=r"^p:"):
-        ShiftingFork(90, 0.0, 2)
+        ShiftingFork(R=90, p=0.0, i_a=2)

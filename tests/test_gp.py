@@ -79,9 +79,10 @@ def test_fork_gp_agrees_with_exact_nlp_and_is_certified():
     assert r.objective == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-3)
     # the exact model at the GP design is the exact optimum too (same active set)
     assert r.objectives["backlash"] == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-5)
-    cert = r.extra["certificate"]
-    assert cert["lower_bound"] <= r.objective * (1 + 1e-9)
-    assert cert["gap_rel"] < 1e-6
+    cert = r.certificate
+    assert cert.lower_bound <= r.objective * (1 + 1e-9)
+    assert r.bound == cert.lower_bound
+    assert cert.gap_rel < 1e-6
     # nut travel 2 R tan 30 <= 110 is what fixes R
     assert r.design["R"] == pytest.approx(110 / (2 * np.tan(np.radians(30))), rel=1e-6)
 
@@ -95,7 +96,7 @@ def test_fixed_linkage_crank_slider_is_a_gp():
     r = solve_gp_problem(problem, nlp_starts=2)
     assert r.status == "optimal"
     assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
-    assert r.extra["certificate"]["gap_rel"] < 1e-6
+    assert r.certificate.gap_rel < 1e-6
 
 
 def test_diagnosis_names_the_offending_term():
@@ -125,7 +126,7 @@ def test_cli_gp_on_a_non_gp_problem_names_the_variable(capsys):
 
 def test_auto_picks_gp_for_the_fork_and_nlp_for_the_crank_slider():
     from optdesign.cli import _load_plugins
-    from optdesign.commands.solve import choose_formulation
+    from optdesign.studies.solve import choose_formulation
 
     _load_plugins()
     assert choose_formulation(load_problem(FORK), "auto") == "gp"

@@ -19,7 +19,7 @@ def crank_designs(draw):
     n = draw(st.floats(0, 150))
     phi0 = draw(st.floats(-0.6, 0.6))
     p = draw(st.floats(2, 10))
-    mech = CrankSlider(R, l, n, p, 2.0, phi0)
+    mech = CrankSlider(R=R, l=l, n=n, p=p, i_a=2.0, phi0=phi0)
     phi = np.radians(np.linspace(-30, 30, 61))
     margin = mech.assembly_margin(phi)
     from hypothesis import assume
@@ -48,10 +48,10 @@ def test_casadi_derivative_matches_central_difference():
 def test_symbolic_and_numeric_paths_agree():
     x = ca.SX.sym("x", 4)  # R, l, n, phi0
     phi = np.radians(np.linspace(-30, 30, 7))
-    mech = CrankSlider(x[0], x[1], x[2], 5.0, 2.0, x[3])
+    mech = CrankSlider(R=x[0], l=x[1], n=x[2], p=5.0, i_a=2.0, phi0=x[3])
     f = ca.Function("i", [x], [mech.ratio(phi)])
     val = np.array(f([90, 80, 50, 0.2])).ravel()
-    ref = CrankSlider(90, 80, 50, 5.0, 2.0, 0.2).ratio(phi)
+    ref = CrankSlider(R=90, l=80, n=50, p=5.0, i_a=2.0, phi0=0.2).ratio(phi)
     np.testing.assert_allclose(val, ref, rtol=1e-13)
 
 
@@ -88,14 +88,14 @@ def test_transmission_angle_from_pin_positions(mech):
 
 def test_fork_symmetric_crank_slider_not():
     phi = np.radians(np.linspace(-30, 30, 61))
-    fork = ShiftingFork(90, 5, 2)
+    fork = ShiftingFork(R=90, p=5, i_a=2)
     np.testing.assert_allclose(fork.ratio(phi), fork.ratio(-phi), rtol=1e-14)
-    mech = CrankSlider(90, 80, 50, 5, 2)
+    mech = CrankSlider(R=90, l=80, n=50, p=5, i_a=2)
     assert np.max(np.abs(mech.ratio(phi) - mech.ratio(-phi))) > 10
 
 
 def test_fork_derivative_matches_finite_difference():
-    fork = ShiftingFork(75.0, 4.0, 2.0)
+    fork = ShiftingFork(R=75.0, p=4.0, i_a=2.0)
     phi = np.radians(np.linspace(-30, 30, 13))
     h = 1e-6
     fd = (fork.nut_position(phi + h) - fork.nut_position(phi - h)) / (2 * h)
@@ -106,7 +106,7 @@ def test_fork_derivative_matches_finite_difference():
 
 
 def test_finite_step_ratio_converges_to_derivative():
-    mech = CrankSlider(90, 80, 50, 5, 2)
+    mech = CrankSlider(R=90, l=80, n=50, p=5, i_a=2)
     phi = np.radians(np.linspace(-30, 30, 61))
     errs = [np.max(np.abs(mech.ratio_finite_step(phi, h) - mech.ratio(phi))) for h in (1e-2, 1e-3)]
     assert errs[1] < errs[0] / 8  # first-order forward difference: error ~ step
@@ -114,9 +114,9 @@ def test_finite_step_ratio_converges_to_derivative():
 
 def test_numpy_population_broadcasts():
     R = np.array([[80.0], [90.0], [100.0]])
-    mech = CrankSlider(R, 80.0, 50.0, 5.0, 2.0)
+    mech = CrankSlider(R=R, l=80.0, n=50.0, p=5.0, i_a=2.0)
     phi = np.radians(np.linspace(-30, 30, 61))
     i = mech.ratio(phi)
     assert i.shape == (3, 61)
-    np.testing.assert_allclose(i[1], CrankSlider(90, 80, 50, 5, 2).ratio(phi))
+    np.testing.assert_allclose(i[1], CrankSlider(R=90, l=80, n=50, p=5, i_a=2).ratio(phi))
     assert mech.ripple(phi).shape == (3,)

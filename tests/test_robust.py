@@ -77,8 +77,8 @@ def test_sampled_fit_spans_min_to_max_clearance(problem):
     data["requirements"] = dict(data["requirements"], fit_clearance="min")
     p_min = problem_from_dict(data)
     design = problem.design_dict(X_NOMINAL)
-    nominal_max = problem.evaluate(X_NOMINAL)["objectives"]["backlash"]
-    nominal_min = p_min.evaluate(X_NOMINAL)["objectives"]["backlash"]
+    nominal_max = problem.evaluate(X_NOMINAL).objectives["backlash"]
+    nominal_min = p_min.evaluate(X_NOMINAL).objectives["backlash"]
     hi, _ = sampled_objective(problem, design, "backlash", [1.0, 1.0])
     lo, _ = sampled_objective(problem, design, "backlash", [0.0, 0.0])
     assert np.max(hi.expr) == pytest.approx(nominal_max, rel=1e-12)
@@ -140,7 +140,7 @@ def test_monte_carlo_with_no_scatter_is_the_nominal_value(problem):
 
 def test_auto_picks_robust_for_a_file_with_tolerances():
     from optdesign.cli import build_parser
-    from optdesign.commands.solve import choose_formulation
+    from optdesign.studies.solve import choose_formulation
 
     build_parser()  # registers the formulations and their auto predicates
     from optdesign.problem import load_problem

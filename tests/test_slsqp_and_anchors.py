@@ -10,7 +10,7 @@ from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
-from optdesign.studies.pareto import epsilon_constraint_front
+from optdesign.studies.pareto import compute_front
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 
@@ -45,15 +45,17 @@ def test_slsqp_reaches_ipopt_optimum_with_consistent_multipliers(name):
             assert ls[rows[row]] == pytest.approx(li[rows[row]], rel=1e-4)
 
 
-def test_slsqp_reads_changed_bounds_between_solves():
+def test_bounds_are_passed_per_solve_and_the_nlp_is_never_changed():
     problem = load_problem(PROBLEMS / "fork_min_backlash.toml")
-    nlp = build_nlp(problem, epsilon={"size": np.inf})
+    nlp = build_nlp(problem, ["backlash", "size"])
+    ubg = nlp.ubg.copy()
     solver = ScipyNLPSolver(nlp, "SLSQP", "exact")
     free = solver.solve(problem.start())
-    row = nlp.g_names.index("size_max")
-    nlp.ubg = nlp.ubg.copy()
-    nlp.ubg[row] = 80.0 / nlp.g_scale[row]  # R <= 80 mm instead of the travel limit 95.3
-    tight = solver.solve(problem.start())
+    # R <= 80 mm instead of the travel limit 95.3, for this solve only
+    tight = solver.solve(problem.start(), bounds=nlp.bounds(eps={"size": 80.0}))
+    again = solver.solve(problem.start())
+    assert np.array_equal(nlp.ubg, ubg)
+    assert again.objective == pytest.approx(free.objective, rel=1e-9)
     assert tight.status == "optimal"
     assert tight.design["R"] == pytest.approx(80.0, rel=1e-7)
     assert tight.objective > free.objective * 1.05
@@ -61,8 +63,8 @@ def test_slsqp_reads_changed_bounds_between_solves():
 
 def test_anchor_multistart_stops_when_starts_agree(tmp_path):
     problem = load_problem(PROBLEMS / "cs_min_backlash.toml")
-    front = epsilon_constraint_front(
-        problem, ["ripple", "backlash"], n_points=6, out=tmp_path, starts=8, agree=3
+    front = compute_front(
+        problem, ["ripple", "backlash"], 6, "epsilon", out=tmp_path, starts=8, agree=3
     )
     assert len(front.points) >= 5 and all(p.verified for p in front.points)
     records = [json.loads(line) for line in (tmp_path / "epsilon.jsonl").read_text().splitlines()]

@@ -92,14 +92,17 @@ def test_no_nan_anywhere_inside_the_bounds(name):
     problem = load_problem(PROBLEMS / f"{name}.toml")
     nlp = build_nlp(problem)
     fg = ca.Function(
-        "fg", [nlp.z], [nlp.f, nlp.g, ca.gradient(nlp.f, nlp.z), ca.jacobian(nlp.g, nlp.z)]
+        "fg",
+        [nlp.z, nlp.p],
+        [nlp.f, nlp.g, ca.gradient(nlp.f, nlp.z), ca.jacobian(nlp.g, nlp.z)],
     )
+    p = nlp.params(nlp.target())
 
     @settings(max_examples=150, deadline=None)
     @given(st.lists(st.floats(0, 1), min_size=nlp.n_design, max_size=nlp.n_design))
     def check(zd):
         z = nlp.z_from_x(nlp.x_from_z(np.concatenate([zd, np.zeros(len(nlp.aux_names))])))
-        for out in fg(z):
+        for out in fg(z, p):
             assert np.all(np.isfinite(np.asarray(out.full() if hasattr(out, "full") else out)))
 
     check()
@@ -107,9 +110,12 @@ def test_no_nan_anywhere_inside_the_bounds(name):
 
 def test_warm_start_converges_fast():
     problem = load_problem(PROBLEMS / "cs_min_backlash.toml")
-    solver = CasadiNLPSolver(build_nlp(problem))
+    nlp = build_nlp(problem)
+    solver = CasadiNLPSolver(nlp)
     cold = solver.solve(problem.start())
-    warm = solver.solve(z0=cold.raw["z"], lam_x0=cold.raw["lam_x"], lam_g0=cold.raw["lam_g"])
+    warm = solver.solve(
+        nlp.start(z0=cold.raw["z"], lam_x0=cold.raw["lam_x"], lam_g0=cold.raw["lam_g"])
+    )
     assert warm.status == "optimal"
     assert warm.objective == pytest.approx(cold.objective, rel=1e-8)
     assert warm.iterations < cold.iterations / 2

@@ -2,9 +2,10 @@
 
 Runs every solver configuration (:data:`optdesign.studies.bench.CONFIGS`) on a suite of
 seeded instances, streams one JSON row per run to ``OUT/bench_runs.jsonl`` (``--resume``
-continues it), then writes ``bench_runs.csv``, ``bench_profiles.png`` (Dolan-More profiles of time
-and objective gap) and ``summary.md``; when ``OUT/../README.md`` has the generated-block
-markers, the summary is pasted between them.
+continues it), then writes ``bench_runs.csv``, ``bench_profiles.png`` (Dolan-More profiles of
+time and objective gap) and ``summary.md``, all under ``--out`` (default: a new folder).
+``--update-readme FILE`` pastes the summary between the generated-block markers of FILE
+(the maintainers' benchmarks/README.md); nothing else is ever written outside ``--out``.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ def _bench(sub):
         "--out",
         type=Path,
         default=None,
-        help="output folder (default: benchmarks/results if present, else a new one)",
+        help="output folder (default: a new one under ./optdesign-out)",
     )
     p.add_argument(
         "--resume", action="store_true", help="continue the run stored in OUT/bench_runs.jsonl"
@@ -53,7 +54,13 @@ def _bench(sub):
         help="kill a run after this many s (default time limit + 3)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--no-readme", action="store_true", help="do not update OUT/../README.md")
+    p.add_argument(
+        "--update-readme",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="paste the summary between the generated-block markers of FILE",
+    )
     p.set_defaults(func=run_bench_command)
 
 
@@ -63,7 +70,7 @@ def run_bench_command(args) -> int:
 
     if args.list:
         for name in bench.default_configs():
-            c = bench.CONFIGS[name]
+            c = bench.get_config(name)
             print(f"{name:20s} {c.kind:7s} {c.description}")
         return 0
     if args.workers < 1:
@@ -73,14 +80,8 @@ def run_bench_command(args) -> int:
     solvers = None
     if args.solvers:
         solvers = [s for item in args.solvers for s in item.split(",") if s]
-    out = args.out
-    if out is None:
-        out = (
-            Path("benchmarks/results")
-            if Path("benchmarks/README.md").exists()
-            else default_out("bench")
-        )
-    res = bench.run_bench(
+    out = args.out or default_out("bench")
+    report = bench.run_bench(
         args.suite,
         solvers,
         out,
@@ -91,13 +92,18 @@ def run_bench_command(args) -> int:
         time_limit=args.time_limit,
         hard_timeout=args.hard_timeout,
     )
-    print(res["summary"])
-    paths = res["paths"]
+    print(report.summary())
+    paths = report.paths
     print(
         f"wrote {out / 'bench_runs.jsonl'}, {paths['csv']}, {paths['profiles']}, {paths['summary']}"
     )
-    readme = Path(out).resolve().parent / "README.md"
-    if not args.no_readme and readme.exists():
-        if bench.update_readme(readme, res["summary"]):
-            print(f"updated the generated block of {readme}")
+    if args.update_readme is not None:
+        from optdesign.studies.bench.report import update_readme
+
+        if update_readme(args.update_readme, report.summary()):
+            print(f"updated the generated block of {args.update_readme}")
+        else:
+            raise InputError(
+                "--update-readme", f"{args.update_readme} has no generated-block markers"
+            )
     return 0

@@ -10,11 +10,8 @@ import os
 import time
 from pathlib import Path
 
-import numpy as np
-
 from optdesign.cli import command, default_out
 from optdesign.errors import InputError
-from optdesign.report import format_table
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
 
@@ -59,7 +56,6 @@ def _pareto(sub):
 
 
 def run_pareto(args) -> int:
-    from optdesign.plots.front import plot_fronts
     from optdesign.problem import load_problem
     from optdesign.studies import pareto as pa
 
@@ -79,40 +75,33 @@ def run_pareto(args) -> int:
         raise InputError("--resume", "give the --out folder of the run to resume")
     out = args.out or default_out(f"pareto-{problem.name}")
     out.mkdir(parents=True, exist_ok=True)
-    progress = not args.no_progress
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
-    fronts = []
-    common = dict(
+    run = dict(
         out=out,
         workers=args.workers,
         scheduler=args.scheduler,
         resume=args.resume,
-        progress=progress,
-        starts=args.starts,
-        seed=seed,
+        progress=not args.no_progress,
     )
+    fronts = []
     for m in methods:
         if m == "nsga2":
-            fronts.append(
-                pa.nsga2_front(problem, objectives, args.pop, args.generations, seed=seed)
-            )
-        elif m in ("epsilon", "uniform"):
-            fronts.append(
-                pa.METHODS[m](
-                    problem, objectives, args.points, deterministic=args.deterministic, **common
-                )
-            )
+            method = pa.NSGA2(pop_size=args.pop, generations=args.generations, seed=seed)
+        elif m == "weighted_sum":
+            method = pa.WeightedSum(points=args.points, starts=args.starts, seed=seed)
         else:
-            fronts.append(pa.METHODS[m](problem, objectives, args.points, **common))
+            method = pa.EpsilonConstraint(
+                points=args.points,
+                spacing="arc" if m == "epsilon" else "uniform",
+                name=m,
+                starts=args.starts,
+                seed=seed,
+                deterministic=args.deterministic,
+            )
+        fronts.append(pa.compute_front(problem, objectives, method=method, **run))
     if len(fronts) > 1:
         # Hypervolumes of different methods are comparable only with one reference point.
-        from optdesign.studies.front_metrics import hypervolume, reference_point
-
-        allF = np.vstack([f.F for f in fronts if len(f.F)])
-        ref = reference_point(allF)
-        for f in fronts:
-            f.metrics["hypervolume_common"] = hypervolume(f.F, ref)
-            f.metrics["common_reference_point"] = ref.tolist()
+        pa.common_hypervolumes(fronts)
     pa.write_front_csv(fronts, problem, out / "front.csv")
     pa.write_front_json(
         fronts,
@@ -123,66 +112,15 @@ def run_pareto(args) -> int:
         created=time.strftime("%Y-%m-%d %H:%M:%S"),
     )
     if not args.no_plot:
-        plot_fronts(problem, fronts, out / "front.png")
-    print(summary(problem, fronts))
+        from optdesign.plots import save_figure
+        from optdesign.plots.front import plot_fronts
+
+        save_figure(plot_fronts(problem, fronts), out / "front.png")
+    from optdesign.reports.front_text import front_summary
+
+    print(front_summary(fronts))
     print(
         f"\nwrote {out / 'front.csv'}, {out / 'front.json'}"
         + ("" if args.no_plot else f", {out / 'front.png'}")
     )
     return 0 if all(f.points for f in fronts) else 1
-
-
-def summary(problem, fronts) -> str:
-    """One line per method (points, failures, metrics, time) and the main front's points."""
-    rows = []
-    for f in fronts:
-        m = f.metrics
-        rows.append(
-            [
-                f.method,
-                str(len(f.points)),
-                str(m.get("n_failed", 0)),
-                f"{m.get('hypervolume', 0.0):.6g}",
-                f"{m['hypervolume_common']:.6g}" if "hypervolume_common" in m else "-",
-                f"{m.get('spacing', 0.0):.3g}",
-                f"{m.get('spread', 0.0):.3g}",
-                f"{f.wall_time_s:.2f}",
-            ]
-        )
-    lines = [f"problem   {problem.name}: objectives {', '.join(fronts[0].objectives)}", ""]
-    lines.append(
-        format_table(
-            [
-                "method",
-                "non-dominated",
-                "failed",
-                "HV own ref",
-                "HV common ref",
-                "spacing",
-                "spread",
-                "time s",
-            ],
-            rows,
-        )
-    )
-    lines.append(
-        "(reference points: nadir + 10 % of the range of the front itself (own) or of all "
-        "fronts together (common))"
-    )
-    main = fronts[0]
-    pts = main.points
-    step = max(1, len(pts) // 12)
-    shown = pts[::step] + ([pts[-1]] if pts and pts[-1] is not pts[::step][-1] else [])
-    rows = []
-    for p in shown:
-        rows.append(
-            [
-                *(f"{p.objectives[k]:.6g}" for k in main.objectives),
-                ", ".join(f"{v.name}={p.design[v.name]:.4g}" for v in problem.free),
-                p.status,
-                ", ".join(sorted({a.split("[")[0] for a in p.active}))[:60],
-            ]
-        )
-    lines += ["", f"{main.method} front ({len(pts)} points, every {step}th shown):"]
-    lines.append(format_table([*main.objectives, "design", "status", "active"], rows))
-    return "\n".join(lines)

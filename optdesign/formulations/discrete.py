@@ -2,21 +2,17 @@
 
 The loader turns ``values = [...]`` or ``catalogue = "ISO 3408"`` into
 :attr:`Variable.values` with the bounds set to the first and last item. Here: which
-variables are discrete, how many combinations they make, how to branch on one, and how
-to restrict an :class:`~optdesign.formulations.nlp.NLP` to a sub-box (fixing a variable
-is the sub-box of one value). The NLP is built once; a node only changes its bounds.
+variables are discrete, how many combinations they make, how to branch on one. A node is
+a sub-box of the catalogue variables (fixing a variable is the sub-box of one
+value), passed to the NLP solver per solve (:meth:`NLP.bounds`): the NLP is built once.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import replace
 
-import numpy as np
-
-from optdesign.formulations.nlp import NLP
-from optdesign.problem.design_problem import DesignProblem, Variable
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.variables import Variable
 
 #: A relaxed value within this relative distance of a catalogue item counts as that item.
 ON_ITEM_TOL = 1e-6
@@ -54,17 +50,3 @@ def branch(value: float, values: list[float]) -> tuple[list[float], list[float]]
     below = [v for v in values if v < value]
     above = [v for v in values if v > value]
     return below, above
-
-
-def restrict(nlp: NLP, bounds: Mapping[str, tuple[float, float]]) -> NLP:
-    """A copy of ``nlp`` whose design variables ``name`` lie in ``bounds[name]`` (mm, ...).
-
-    The scaling of z is kept (same x_lo, x_span), so starts and warm starts carry over.
-    """
-    lbz = np.array(nlp.lbz, dtype=float)
-    ubz = np.array(nlp.ubz, dtype=float)
-    for name, (lo, hi) in bounds.items():
-        k = nlp.design_names.index(name)
-        lbz[k] = (lo - nlp.x_lo[k]) / nlp.x_span[k]
-        ubz[k] = (hi - nlp.x_lo[k]) / nlp.x_span[k]
-    return replace(nlp, lbz=lbz, ubz=ubz)

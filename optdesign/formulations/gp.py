@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.problem.design_problem import DesignProblem
 
 #: Exponents are rounded to this many digits to merge like terms (1/3 from 1/3.0 etc.).
@@ -433,7 +434,7 @@ def trace(problem: DesignProblem):
         The traced expressions, or None and the reason when the model raised.
     """
     names = tuple(v.name for v in problem.free)
-    ref = problem.start()
+    ref = problem.midpoint()
     x = [Signomial.variable(names, k, ref) for k in range(len(names))]
     design = problem.design_dict(x)
     try:
@@ -700,14 +701,14 @@ def _constant_spread(expr) -> float | None:
         return None
     if not isinstance(expr, Signomial):
         v = np.asarray(expr, dtype=float)
-        return float((v.max() - v.min()) / (v.max() + v.min()))
+        return float(m.spread(v.min(), v.max()))
     if len(expr.terms) != 1:
         return None
     ((_, c),) = expr.terms.items()
     c = np.asarray(c, dtype=float)
     if np.any(c <= 0):
         return None
-    return float((c.max() - c.min()) / (c.max() + c.min()))
+    return float(m.spread(c.min(), c.max()))
 
 
 def _objective_rows(gp: GPData, name, kind, expr, problem, names, n_grid) -> DGPCheck:

@@ -1,52 +1,105 @@
-"""The NLP formulation of a design problem on CasADi.
+"""The NLP formulation of a design problem on CasADi, built once per objective set.
 
 Decision vector ``z`` = scaled free design variables (each mapped to [0, 1] by its
 bounds, so the bounds stay true bounds) followed by auxiliary epigraph variables.
 
 - ``"spread"`` objectives (ratio ripple) become lo <= i(phi_k) <= hi with the smooth
-  objective (hi - lo)/(hi + lo);
-- ``"max"`` objectives (worst-case backlash, peak torque) become theta(phi_k) <= t, min t;
-- every constraint block is divided by a typical magnitude so that one tolerance fits all.
+  value (hi - lo)/(hi + lo); ``"max"`` objectives (worst-case backlash, peak torque)
+  become theta(phi_k) <= t with value t;
+- every constraint block is divided by a typical magnitude so that one tolerance fits
+  all; the scales come from the middle of the bounds, never from a declared start;
+- the objective is a *parameter*: ``f = sum_k p_k v_k`` over the targets (every objective
+  of the set, then every design variable), so one solver serves a single-objective
+  solve, the ranges of the optimal set (min/max of a variable), the points of a Pareto
+  front and a weighted sum; each objective of the set also has an epsilon row
+  ``v_k <= eps_k`` whose limit is passed per solve (:meth:`NLP.bounds`).
 
 ``form="naive"`` hands mmax/mmin straight to the solver instead (non-smooth; kept to show
-why the epigraph form exists, see benchmarks). Multiple objectives combine by weights
-(weighted sum) and/or by epsilon-constraints on the others (Pareto fronts).
+why the epigraph form exists, see benchmarks).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import hashlib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
+
+#: Prefix of the targets that are design variables (``"var:R"``).
+VAR = "var:"
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Variable and constraint bounds of one solve (scaled, as the solver sees them)."""
+
+    lbz: np.ndarray
+    ubz: np.ndarray
+    lbg: np.ndarray
+    ubg: np.ndarray
+
+
+@dataclass(frozen=True)
+class Start:
+    """Where a solve starts: the scaled vector and, for a warm start, multipliers."""
+
+    z0: np.ndarray
+    lam_x0: np.ndarray | None = None
+    lam_g0: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Target:
+    """What a solve minimises: ``sum_k c_k v_k`` over named targets (objectives, or
+    ``"var:NAME"`` for a design variable)."""
+
+    coefficients: tuple[tuple[str, float], ...]
+
+    @property
+    def name(self) -> str:
+        if len(self.coefficients) == 1 and self.coefficients[0][1] == 1.0:
+            return self.coefficients[0][0]
+        return "weighted_sum"
 
 
 @dataclass
 class NLP:
-    """min f(z) s.t. lbg <= g(z) <= ubg, lbz <= z <= ubz, in scaled variables.
+    """min f(z; p) s.t. lbg <= g(z) <= ubg, lbz <= z <= ubz, in scaled variables.
 
     Attributes
     ----------
-    z, f, g
-        CasADi symbols/expressions.
+    z, f, g, p
+        CasADi symbols/expressions; ``p`` weights the targets.
+    lbz, ubz, lbg, ubg
+        Default bounds (epsilon rows at their requirement limits or +inf).
     g_names, g_units, g_scale
         Row names, units and the divisor applied to each row (raw = scaled * g_scale).
-    n_design
-        Number of design entries at the head of ``z``; ``x = x_lo + x_span * z``.
+    n_design, x_lo, x_span, design_names
+        ``x = x_lo + x_span * z[:n_design]``.
+    aux_names
+        Names of the auxiliary (epigraph) variables.
+    targets, target_scales
+        Names of the entries of ``p`` and the typical magnitude of each value.
     objective_values
-        Name -> expression of each objective's value (unscaled), for reports.
-    f_scale
-        The objective is ``value / f_scale``.
+        Objective name -> expression of its (unscaled) value, for reports.
+    eps_rows
+        Objective name -> row index of its epsilon row.
+    default_target
+        The objective minimised when a solve names none.
     """
 
     z: Any
     f: Any
     g: Any
+    p: Any
     lbz: np.ndarray
     ubz: np.ndarray
     lbg: np.ndarray
@@ -59,24 +112,90 @@ class NLP:
     x_span: np.ndarray
     design_names: list[str]
     aux_names: list[str]
+    targets: list[str]
+    target_scales: np.ndarray
     objective_values: dict[str, Any]
-    objective: str
-    f_scale: float
+    eps_rows: dict[str, int]
+    default_target: str
     form: str
-    aux_init: Any = None  # CasADi Function x -> aux start values
+    aux_init: Any = None  # CasADi Function zd -> aux start values
+    limits: dict[str, float] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
+
+    # --- targets -------------------------------------------------------------------------
+    def target(self, spec: str | Mapping[str, float] | Target | None = None) -> Target:
+        """A :class:`Target` from a name, a name -> coefficient mapping or None (default)."""
+        if isinstance(spec, Target):
+            return spec
+        coefs = (
+            {self.default_target: 1.0}
+            if spec is None
+            else ({spec: 1.0} if isinstance(spec, str) else dict(spec))
+        )
+        for name in coefs:
+            if name not in self.targets:
+                raise ProblemError(
+                    f"objective {name!r} is not in this formulation (available: "
+                    f"{', '.join(t for t in self.targets if not t.startswith(VAR))})"
+                )
+        return Target(tuple((k, float(v)) for k, v in coefs.items()))
+
+    def params(self, target: Target) -> np.ndarray:
+        """The parameter vector ``p`` of ``target`` (each value divided by its scale, so
+        that f is ~1 at the middle of the bounds)."""
+        p = np.zeros(len(self.targets))
+        for name, c in target.coefficients:
+            k = self.targets.index(name)
+            p[k] += c / self.target_scales[k]
+        return p
+
+    @cached_property
+    def values_fun(self) -> ca.Function:
+        """z -> every target's value (objectives, then design variables)."""
+        x = self.x_lo + self.x_span * self.z[: self.n_design]
+        exprs = [*self.objective_values.values(), *[x[k] for k in range(self.n_design)]]
+        return ca.Function("target_values", [self.z], [ca.vertcat(*exprs)])
+
+    @cached_property
+    def g_fun(self) -> ca.Function:
+        return ca.Function("g", [self.z], [self.g])
+
+    def objective_of(self, target: Target, values: np.ndarray) -> float:
+        """``sum c_k v_k`` from the vector of target values."""
+        return float(sum(c * values[self.targets.index(k)] for k, c in target.coefficients))
+
+    # --- bounds and starts -------------------------------------------------------------------
+    def bounds(
+        self,
+        eps: Mapping[str, float] | None = None,
+        box: Mapping[str, tuple[float, float]] | None = None,
+    ) -> Bounds:
+        """Bounds of a solve: epsilon limits ``eps`` (name -> upper limit of that
+        objective, tightened by the requirement's own limit) and a sub-box ``box`` of
+        design variables (name -> (lower, upper), internal units)."""
+        lbz, ubz, ubg = self.lbz, self.ubz, self.ubg
+        if eps:
+            ubg = ubg.copy()
+            for name, value in eps.items():
+                if name not in self.eps_rows:
+                    raise ProblemError(
+                        f"epsilon bound on {name!r}: not an objective of this formulation "
+                        f"({', '.join(self.eps_rows)})"
+                    )
+                row = self.eps_rows[name]
+                limit = min(float(value), self.limits.get(name, np.inf))
+                ubg[row] = limit / self.g_scale[row]
+        if box:
+            lbz, ubz = lbz.copy(), ubz.copy()
+            for name, (lo, hi) in box.items():
+                k = self.design_names.index(name)
+                lbz[k] = (lo - self.x_lo[k]) / self.x_span[k]
+                ubz[k] = (hi - self.x_lo[k]) / self.x_span[k]
+        return Bounds(lbz, ubz, self.lbg, ubg)
 
     def x_from_z(self, z) -> np.ndarray:
         z = np.asarray(z, dtype=float).ravel()
         return self.x_lo + self.x_span * z[: self.n_design]
-
-    def start(self, x0=None, z0=None) -> np.ndarray:
-        """The solver's start vector: ``z0`` as given, else built from the design ``x0``."""
-        if z0 is not None:
-            return np.asarray(z0, dtype=float).ravel()
-        if x0 is None:
-            raise ValueError("give x0 or z0")
-        return self.z_from_x(x0)
 
     def z_from_x(self, x) -> np.ndarray:
         """Full start vector from a design: aux variables set to their tightest values."""
@@ -87,14 +206,37 @@ class NLP:
         aux = np.asarray(self.aux_init(zd), dtype=float).ravel()
         return np.concatenate([zd, aux])
 
+    def start(self, x0=None, z0=None, lam_x0=None, lam_g0=None) -> Start:
+        """A :class:`Start` from the design ``x0`` or the scaled vector ``z0``."""
+        if z0 is None:
+            if x0 is None:
+                raise ValueError("give x0 or z0")
+            z0 = self.z_from_x(x0)
+        return Start(np.asarray(z0, dtype=float).ravel(), _vec(lam_x0), _vec(lam_g0))
+
+    @cached_property
+    def fingerprint(self) -> str:
+        """Content hash of the formulation (functions, bounds, names): the identity of
+        stores and caches, equal in every process that builds the same problem."""
+        fun = ca.Function("nlp", [self.z, self.p], [self.f, self.g])
+        h = hashlib.sha1(fun.serialize().encode())
+        for arr in (self.lbz, self.ubz, self.lbg, self.ubg, self.g_scale, self.target_scales):
+            h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
+        h.update("\0".join([*self.g_names, *self.targets, *self.aux_names]).encode())
+        return h.hexdigest()[:16]
+
+
+def _vec(v) -> np.ndarray | None:
+    return None if v is None else np.asarray(v, dtype=float).ravel()
+
 
 @dataclass
 class ConstraintRows:
-    """Constraint rows lower/scale <= expr/scale <= upper/scale, with their names and units.
+    """Constraint rows lower/scale <= expr/scale <= upper/scale, with names and units.
 
-    Every row is divided by a typical magnitude (its bound, or its size at the start
-    design) so that one solver tolerance fits all; ``scales`` keeps the divisors so that
-    reports give values in the constraint's own unit.
+    Every row is divided by a typical magnitude (its bound, or its size at the middle of
+    the bounds) so that one solver tolerance fits all; ``scales`` keeps the divisors so
+    that reports give values in the constraint's own unit.
     """
 
     exprs: list[Any] = field(default_factory=list)
@@ -121,38 +263,51 @@ class ConstraintRows:
         return ca.vertcat(*self.exprs) if self.exprs else ca.SX(0, 1)
 
 
+def typical(value) -> float:
+    """Largest finite magnitude of ``value`` (1 when none): a row's or value's scale."""
+    with np.errstate(invalid="ignore"):
+        v = np.nanmax(np.abs(np.asarray(value, dtype=float)))
+    return float(v) if np.isfinite(v) and v > 0 else 1.0
+
+
+def numeric_value(term) -> float:
+    """The value of an objective term of one design on the NumPy path."""
+    e = np.asarray(term.expr, dtype=float)
+    if term.kind == "spread":
+        return float(m.grid_spread(e.ravel()))
+    if term.kind == "max":
+        return float(np.max(e))
+    return float(e.ravel()[0])
+
+
 def build_nlp(
     problem: DesignProblem,
-    objective: str | Mapping[str, float] | None = None,
-    epsilon: Mapping[str, float] | None = None,
+    objectives: Sequence[str] | str | None = None,
     form: str = "epigraph",
     first_order: bool = False,
-    normalise: Mapping[str, tuple[float, float]] | None = None,
 ) -> NLP:
-    """Build the NLP of ``problem``.
+    """Build the NLP of ``problem`` for the objective set ``objectives``.
 
     Parameters
     ----------
-    objective
-        Objective name, or name -> weight for a weighted sum (default: the problem's
-        first objective).
-    epsilon
-        name -> upper limit of other objectives (epsilon-constraint method).
+    objectives
+        Objectives the formulation can minimise or bound (default: the problem's); the
+        first is the default target. Every design variable is a target too.
     form
         ``"epigraph"`` (smooth, default) or ``"naive"`` (max/min in the objective).
     first_order
         First-order Hertz flattening (to compare with the GP formulation).
-    normalise
-        name -> (ideal, nadir) used to scale the objectives of a weighted sum.
     """
     if form not in ("epigraph", "naive"):
         raise ProblemError(f"formulation form {form!r}: use 'epigraph' or 'naive'")
-    if objective is None:
-        objective = problem.objective_names[0]
-    weights = {objective: 1.0} if isinstance(objective, str) else dict(objective)
-    epsilon = dict(epsilon or {})
-    for name, limit in problem.objective_limits().items():
-        epsilon[name] = min(limit, epsilon.get(name, np.inf))
+    if objectives is None:
+        objectives = problem.objective_names
+    elif isinstance(objectives, str):
+        objectives = [objectives]
+    names: list[str] = []
+    for name in [*objectives, *problem.objective_limits()]:
+        if name not in names:
+            names.append(name)
 
     free = problem.free
     n = len(free)
@@ -160,53 +315,35 @@ def build_nlp(
     x_span = x_hi - x_lo
     zd = ca.SX.sym("z", n)
     x = x_lo + x_span * zd
-    design = problem.design_dict([x[k] for k in range(n)])
-    ex = problem.expressions(design, guarded=True, first_order=first_order)
-
-    # Typical magnitudes at the start design (NumPy path of the same expressions).
-    start_eval = problem.expressions(problem.design_dict(problem.start()), first_order=first_order)
-
-    aux: list[Any] = []
-    aux_names: list[str] = []
-    aux_lb: list[float] = []
-    aux_ub: list[float] = []
-    aux_start: list[Any] = []  # expressions of zd giving the tightest aux values
-    rows = ConstraintRows()
-    add_rows = rows.add
-
-    def typical(value) -> float:
-        v = np.nanmax(np.abs(np.asarray(value, dtype=float)))
-        return float(v) if np.isfinite(v) and v > 0 else 1.0
-
-    values: dict[str, Any] = {}
-    # An ordered list, not a set: the order of the aux variables and rows must be the same
-    # in every process, so that solutions and multipliers can warm-start other workers.
-    free_names = {v.name for v in free}
-    wanted = []
-    for name in [*weights, *epsilon]:
-        if name in free_names:
-            # a design variable as objective: ranges of non-unique optima (studies.solve)
-            values[name] = design[name]
-        elif name not in wanted:
-            wanted.append(name)
-    for name in wanted:
+    ex = problem.expressions(
+        problem.design_dict([x[k] for k in range(n)]), guarded=True, first_order=first_order
+    )
+    mid = problem.midpoint()
+    ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
+    for name in names:
         if name not in ex.objectives:
             raise ProblemError(
                 f"objective {name!r} is not available for this problem "
                 f"(available: {', '.join(ex.objectives)})"
             )
-    for name in wanted:
+
+    aux: list[tuple[Any, float]] = []  # (symbol, scale)
+    aux_names: list[str] = []
+    aux_lb: list[float] = []
+    aux_ub: list[float] = []
+    aux_start: list[Any] = []  # expressions of zd giving the tightest aux values
+    rows = ConstraintRows()
+    values: dict[str, Any] = {}
+    scales: dict[str, float] = {}
+    for name in names:
         term = ex.objectives[name]
         expr = term.expr
-        scale = typical(start_eval.objectives[name].expr)
+        scale = typical(ref.objectives[name].expr)
+        scales[name] = typical(numeric_value(ref.objectives[name]))
         if term.kind == "scalar":
             values[name] = expr
         elif form == "naive":
-            if term.kind == "spread":
-                hi, lo = ca.mmax(expr), ca.mmin(expr)
-                values[name] = (hi - lo) / (hi + lo)
-            else:
-                values[name] = ca.mmax(expr)
+            values[name] = m.grid_spread(ca.SX(expr)) if term.kind == "spread" else ca.mmax(expr)
         elif term.kind == "spread":
             lo, hi = ca.SX.sym(f"{name}_lo"), ca.SX.sym(f"{name}_hi")
             aux += [(lo, scale), (hi, scale)]
@@ -214,71 +351,78 @@ def build_nlp(
             aux_lb += [0.0, 1e-6]
             aux_ub += [np.inf, np.inf]
             aux_start += [ca.mmin(expr) / scale, ca.mmax(expr) / scale]
-            values[name] = (hi - lo) / (hi + lo)
-            add_rows(
+            values[name] = m.spread(lo, hi)
+            rows.add(
                 expr - lo, 0.0, None, scale, f"{name}_lower_envelope", problem.phi_labels, term.unit
             )
-            add_rows(
+            rows.add(
                 hi - expr, 0.0, None, scale, f"{name}_upper_envelope", problem.phi_labels, term.unit
             )
         else:  # max
             t = ca.SX.sym(f"{name}_max")
+            aux.append((t, scale))
             aux_names.append(f"{name}_max")
             aux_lb.append(-np.inf)
             aux_ub.append(np.inf)
             aux_start.append(ca.mmax(expr) / scale)
             values[name] = t
-            add_rows(t - expr, 0.0, None, scale, f"{name}_envelope", problem.phi_labels, term.unit)
-            aux.append((t, scale))
+            rows.add(t - expr, 0.0, None, scale, f"{name}_envelope", problem.phi_labels, term.unit)
 
     # Constraint blocks of the requirements.
-    start_blocks = {b.name: b for b in start_eval.constraints}
+    ref_blocks = {b.name: b for b in ref.constraints}
     for block in ex.constraints:
         if block.lower is None and block.upper is None:
             continue
         bound = max(abs(block.lower or 0.0), abs(block.upper or 0.0))
-        scale = bound if bound > 0 else typical(start_blocks[block.name].expr)
-        add_rows(block.expr, block.lower, block.upper, scale, block.name, block.labels, block.unit)
-    for name, limit in epsilon.items():
-        scale = typical(_numeric_value(start_eval.objectives[name])) or 1.0
-        add_rows(values[name], None, limit, scale, f"{name}_max", [""], ex.objectives[name].unit)
+        scale = bound if bound > 0 else typical(ref_blocks[block.name].expr)
+        rows.add(block.expr, block.lower, block.upper, scale, block.name, block.labels, block.unit)
+    limits = problem.objective_limits()
+    eps_rows = {}
+    for name in names:
+        eps_rows[name] = len(rows.names)
+        rows.add(
+            values[name],
+            None,
+            limits.get(name),
+            scales[name],
+            f"{name}_max",
+            [""],
+            ex.objectives[name].unit,
+        )
 
-    # Objective: weighted sum of (optionally normalised) values, scaled to ~1 at the start.
-    f_raw = 0
-    for name, w in weights.items():
-        v = values[name]
-        if normalise and name in normalise:
-            ideal, nadir = normalise[name]
-            v = (v - ideal) / max(nadir - ideal, 1e-12)
-        f_raw = f_raw + w * v
+    # Objective: the parameter-weighted sum of the target values.
+    targets = [*names, *(VAR + v.name for v in free)]
+    target_scales = np.array(
+        [scales[k] for k in names] + [abs(v) if abs(v) > 1e-12 else 1.0 for v in mid]
+    )
+    p = ca.SX.sym("p", len(targets))
+    f_raw = ca.SX(0)
+    for k, name in enumerate(names):
+        f_raw += p[k] * values[name]
+    for k in range(n):
+        f_raw += p[len(names) + k] * x[k]
 
     # Substitute the aux symbols by scaled decision variables za (aux = scale * za).
     za = ca.SX.sym("za", len(aux))
-    syms = [a for a, _ in aux]
-    scaled = [s * za[k] for k, (_, s) in enumerate(aux)]
     g_all = rows.g()
-    if syms:
-        sym_vec = ca.vertcat(*syms)
-        rep = ca.vertcat(*scaled)
+    if aux:
+        sym_vec = ca.vertcat(*[a for a, _ in aux])
+        rep = ca.vertcat(*[s * za[k] for k, (_, s) in enumerate(aux)])
         g_all = ca.substitute(g_all, sym_vec, rep)
         f_raw = ca.substitute(ca.SX(f_raw), sym_vec, rep)
         values = {k: ca.substitute(ca.SX(v), sym_vec, rep) for k, v in values.items()}
     z = ca.vertcat(zd, za)
-    f_start = _start_objective(f_raw, z, zd, aux_start, problem, x_lo, x_span)
-    f_scale = abs(f_start) if np.isfinite(f_start) and abs(f_start) > 1e-12 else 1.0
     aux_lb_s = [lb / s if np.isfinite(lb) else lb for lb, (_, s) in zip(aux_lb, aux, strict=True)]
     aux_ub_s = [ub / s if np.isfinite(ub) else ub for ub, (_, s) in zip(aux_ub, aux, strict=True)]
     aux_init = ca.Function("aux_init", [zd], [ca.vertcat(*aux_start)]) if aux_start else None
-    # Common subexpression elimination: the model builds each constraint block from its
-    # own copy of the mechanism's expressions, so the same subexpressions appear many
-    # times (cs_min_backlash: 15 900 SX instructions for g, 4 200 after). Same values, but
-    # ~3x faster evaluations and derivative generation (Ipopt set-up 0.36 -> 0.14 s).
-    f_out, g_all, *value_list = ca.cse([ca.SX(f_raw / f_scale), g_all, *values.values()])
-    values = dict(zip(values, value_list, strict=True))
+    # Common subexpression elimination: the blocks share the mechanism's subexpressions
+    # (model functions return shared nodes, but derived rows repeat arithmetic).
+    f_out, g_all, *value_list = ca.cse([ca.SX(f_raw), g_all, *(ca.SX(v) for v in values.values())])
     return NLP(
         z=z,
         f=f_out,
         g=g_all,
+        p=p,
         lbz=np.concatenate([np.zeros(n), aux_lb_s]),
         ubz=np.concatenate([np.ones(n), aux_ub_s]),
         lbg=np.array(rows.lbg),
@@ -291,29 +435,12 @@ def build_nlp(
         x_span=x_span,
         design_names=[v.name for v in free],
         aux_names=aux_names,
-        objective_values=values,
-        objective=objective if isinstance(objective, str) else "weighted_sum",
-        f_scale=f_scale,
+        targets=targets,
+        target_scales=target_scales,
+        objective_values=dict(zip(values, value_list, strict=True)),
+        eps_rows=eps_rows,
+        default_target=names[0] if names else "",
         form=form,
         aux_init=aux_init,
+        limits={k: float(v) for k, v in limits.items()},
     )
-
-
-def _numeric_value(term) -> float:
-    e = np.asarray(term.expr, dtype=float)
-    if term.kind == "spread":
-        return float((e.max() - e.min()) / (e.max() + e.min()))
-    return float(e.max())
-
-
-def _start_objective(f_raw, z, zd, aux_start, problem, x_lo, x_span) -> float:
-    zd0 = (problem.start() - x_lo) / x_span
-    if aux_start:
-        aux0 = ca.Function("a0", [zd], [ca.vertcat(*aux_start)])(zd0)
-        z0 = ca.vertcat(ca.DM(zd0), aux0)
-    else:
-        z0 = ca.DM(zd0)
-    try:
-        return float(ca.Function("f0", [z], [f_raw])(z0))
-    except RuntimeError:
-        return 1.0

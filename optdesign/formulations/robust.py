@@ -1,8 +1,8 @@
 """Robust design: a risk measure of an objective under manufacturing tolerances (SAA NLP).
 
-The tolerances of the problem file's ``[tolerances]`` section (R, l, n, p, d, phi0 as
-+-band, normal with sigma = band/3 or uniform; pin fits drawn uniformly between the
-fit's smallest and largest clearance) are sampled ONCE with a fixed seed, so the
+The tolerances of the problem file's ``[tolerances]`` section (any length or angle
+variable as +-band, normal with sigma = band/3 or uniform; pin fits drawn uniformly between
+the fit's smallest and largest clearance) are sampled ONCE with a fixed seed, so the
 sample-average approximation stays a smooth NLP:
 
 - sample s perturbs the design, ``design_s = design + delta_s`` (CasADi symbols plus
@@ -30,20 +30,18 @@ population of perturbed designs) for the independent Monte Carlo check
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import NLP, ConstraintRows, build_nlp
-from optdesign.models.fits import Fit
-from optdesign.problem.design_problem import DesignProblem, ObjectiveTerm
+from optdesign.formulations.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
+from optdesign.problem.catalogue import ObjectiveTerm
+from optdesign.problem.design_problem import DesignProblem, Expressions
 from optdesign.problem.spec import Tolerances
-
-#: Variables that a ``[tolerances]`` section may scatter.
-TOLERANCED = ("R", "l", "n", "p", "d", "phi0")
 
 #: Variance guard of the mean + k std measure (in scaled units, objective ~1).
 STD_EPS = 1e-12
@@ -84,17 +82,13 @@ def tolerances_of(problem: DesignProblem) -> Tolerances:
             'tolerances: robust design needs a [tolerances] section (e.g. R = "0.05 mm", '
             'phi0 = "0.1 deg", fit = "uniform")'
         )
-    for name in TOLERANCED:
-        if getattr(tol, name) is not None and not problem.has(name):
-            raise ProblemError(f"tolerances.{name}: {name} is not a variable of this problem")
     return tol
 
 
 def pin_count(problem: DesignProblem) -> int:
-    """Number of pin joints in the clearance chain (each gets its own fit draw)."""
-    design = problem.design_dict(problem.start())
-    ex = problem.expressions(design)
-    return sum(j.pin is not None for j in problem.joints(ex.mechanism, problem.pin(design)))
+    """Number of sized pin joints in the clearance chain (each gets its own fit draw)."""
+    q = problem.quantities(problem.design_dict(problem.midpoint()))
+    return sum(j.pin is not None for j in q.joints)
 
 
 def draw_samples(
@@ -110,10 +104,9 @@ def draw_samples(
     tol = tol if tol is not None else tolerances_of(problem)
     rng = np.random.default_rng(seed)
     deltas: dict[str, np.ndarray] = {}
-    for name in TOLERANCED:
-        t = getattr(tol, name)
-        if t is None:
-            continue
+    per_variable = tol.variables()
+    for name in _tolerance_order(problem, per_variable):
+        t = per_variable[name]
         if t.distribution == "normal":
             deltas[name] = (t.band / 3.0) * rng.standard_normal(n)
         else:
@@ -140,54 +133,32 @@ def perturb(design: Mapping[str, Any], samples: Samples, index) -> dict[str, Any
     return out
 
 
+def _tolerance_order(problem: DesignProblem, per_variable: Mapping[str, Any]) -> list[str]:
+    # The mechanism's variable table order (R, l, n, p, ...), then the pin's (d).
+    from optdesign.problem.variables import variable_table
+
+    return [k for k in variable_table(problem.mechanism) if k in per_variable]
+
+
 def sampled_objective(
     problem: DesignProblem,
     design: Mapping[str, Any],
     objective: str,
     fit_fraction=None,
     guarded: bool = False,
-):
+) -> tuple[ObjectiveTerm, Expressions]:
     """Objective term and expressions of ``design`` with the pin fits at ``fit_fraction``.
 
     ``fit_fraction``: one entry per pin joint (floats, or (k, 1) columns on the NumPy
-    path), or None for the nominal model. Only ``backlash`` and ``backlash_rss`` depend on
-    the fit; they are rebuilt from the same mechanism and clearance chain as
-    :meth:`DesignProblem.expressions`, with each pin's fit clearance
-    ``c_min + u (c_max - c_min)`` in place of the requirement's fixed one.
-
-    Returns
-    -------
-    (ObjectiveTerm, Expressions)
+    path), or None for the nominal model (the requirement's ``fit_clearance``).
     """
-    ex = problem.expressions(design, guarded=guarded)
+    ex = problem.expressions(design, guarded=guarded, fit_fractions=fit_fraction)
     if objective not in ex.objectives:
         raise ProblemError(
             f"objective {objective!r} is not available for this problem "
             f"(available: {', '.join(ex.objectives)})"
         )
-    term = ex.objectives[objective]
-    if fit_fraction is None or objective not in ("backlash", "backlash_rss"):
-        return term, ex
-    req = problem.spec.requirements
-    fit = Fit.parse(req.fit)
-    pin = problem.pin(design)
-    joints = []
-    k = 0
-    for joint in problem.joints(ex.mechanism, pin):
-        if joint.pin is not None:
-            lo, hi = fit.clearance(joint.pin.d, "min"), fit.clearance(joint.pin.d, "max")
-            joint = replace(
-                joint,
-                pin=replace(joint.pin, which="min"),
-                clearance=joint.clearance + fit_fraction[k] * (hi - lo),
-            )
-            k += 1
-        joints.append(joint)
-    backlash = ex.mechanism.backlash(problem.phi, joints, req.hinge_moment)
-    expr = backlash.worst_case if objective == "backlash" else backlash.rss
-    return ObjectiveTerm(
-        term.name, term.kind, expr, term.unit, term.description + " (sampled fit)"
-    ), ex
+    return ex.objectives[objective], ex
 
 
 def risk_label(risk: str, alpha: float, k: float, objective: str) -> str:
@@ -241,7 +212,7 @@ def build_robust_nlp(
         raise ProblemError("tolerances.samples: need at least one sample")
 
     # The nominal requirements (and objective limits) exactly as the nominal NLP has them.
-    base = build_nlp(problem, objective={})
+    base = build_nlp(problem, objectives=[])
     n = base.n_design
     zd = base.z[:n]
     x = base.x_lo + base.x_span * zd
@@ -249,15 +220,10 @@ def build_robust_nlp(
 
     # Magnitudes at the start design (NumPy path): rows are divided by the size of the
     # objective's grid expression, the per-sample values by the objective's value.
-    start_term, _ = sampled_objective(problem, problem.design_dict(problem.start()), objective)
-    start_val = np.asarray(start_term.expr, dtype=float)
-    scale = float(np.nanmax(np.abs(start_val)))
-    scale = scale if np.isfinite(scale) and scale > 0 else 1.0
-    v_scale = scale  # max/scalar: the value is in units of the expression
-    if start_term.kind == "spread":
-        hi0, lo0 = np.nanmax(start_val), np.nanmin(start_val)
-        spread0 = float((hi0 - lo0) / (hi0 + lo0))
-        v_scale = spread0 if np.isfinite(spread0) and spread0 > 0 else 1.0
+    start_term, _ = sampled_objective(problem, problem.design_dict(problem.midpoint()), objective)
+    scale = typical(start_term.expr)
+    # max/scalar: the value is in units of the expression; a spread is scale-free
+    v_scale = typical(numeric_value(start_term)) if start_term.kind == "spread" else scale
 
     aux, aux_lb, aux_ub, aux_init, aux_names = [], [], [], [], []
     rows = ConstraintRows()
@@ -291,7 +257,7 @@ def build_robust_nlp(
             add(raw - scale * lo, 0.0, None, scale, f"{objective}_lower[s{s}]", labels, term.unit)
             add(scale * hi - raw, 0.0, None, scale, f"{objective}_upper[s{s}]", labels, term.unit)
             # lo, hi are in units of scale; the spread is scale-free, bring it to ~1
-            values.append((hi - lo) / (hi + lo) / v_scale)
+            values.append(m.spread(lo, hi) / v_scale)
         else:
             values.append(expr)
         if constrain_samples:
@@ -341,7 +307,7 @@ def build_robust_nlp(
     if nominal_term.kind == "max":
         nominal_value = ca.mmax(nom)
     elif nominal_term.kind == "spread":
-        nominal_value = (ca.mmax(nom) - ca.mmin(nom)) / (ca.mmax(nom) + ca.mmin(nom))
+        nominal_value = m.grid_spread(nom)
     else:
         nominal_value = nom
 
@@ -355,10 +321,14 @@ def build_robust_nlp(
     aux_init_fun = ca.Function("robust_aux_init", [zd], [ca.vertcat(*init_parts)])
     label = risk_label(risk, alpha, k, objective)
     g = ca.vertcat(base.g, *rows.exprs)
+    nominal_name = f"{objective} (nominal)"
+    nominal_scale = typical(numeric_value(start_term))
+    p = ca.SX.sym("p", 2)
     return NLP(
         z=z,
-        f=f,
+        f=p[0] * f * v_scale + p[1] * nominal_value,
         g=g,
+        p=p,
         lbz=np.concatenate([base.lbz, aux_lb]),
         ubz=np.concatenate([base.ubz, aux_ub]),
         lbg=np.concatenate([base.lbg, rows.lbg]),
@@ -371,9 +341,11 @@ def build_robust_nlp(
         x_span=base.x_span,
         design_names=base.design_names,
         aux_names=base.aux_names + aux_names,
-        objective_values={label: f * v_scale, f"{objective} (nominal)": nominal_value},
-        objective=label,
-        f_scale=v_scale,
+        targets=[label, nominal_name],
+        target_scales=np.array([v_scale, nominal_scale]),
+        objective_values={label: f * v_scale, nominal_name: nominal_value},
+        eps_rows={},
+        default_target=label,
         form="robust-saa",
         aux_init=aux_init_fun,
         extra={

@@ -1,12 +1,40 @@
-"""Mechanisms: geometry + loads + clearance chain, built on the pure models.
+"""Mechanisms: plug-ins that own all mechanism knowledge.
 
-:class:`CrankSlider` and :class:`ShiftingFork` share one interface (:class:`Mechanism`),
-so problems and studies treat them alike. Their parameters may be floats, NumPy arrays
-(a population of designs, broadcast against the angle grid) or CasADi symbols.
+Each mechanism (:class:`Mechanism` subclass) declares its variables and computes its
+kinematics, loads and clearance chain from the pure models; the problem, formulations,
+solvers and studies see only what the contract exposes. Built-ins: the crank-slider and
+the shifting fork of seed 000, and the trunnion-mounted pivoting screw. Register your
+own with :func:`register_mechanism`.
 """
 
-from optdesign.mechanisms.base import Backlash, Joint, Mechanism, PinJoint
+from optdesign.mechanisms.base import (
+    DRIVE_VARIABLES,
+    Mechanism,
+    RequirementInfo,
+    Rows,
+    Sketch,
+    VariableInfo,
+)
+
+# Built-in plug-ins register themselves on import (after the registry exists).
 from optdesign.mechanisms.crank_slider import CrankSlider
 from optdesign.mechanisms.fork import ShiftingFork
+from optdesign.mechanisms.joints import Backlash, Joint, PinJoint
+from optdesign.mechanisms.registry import get_mechanism, register_mechanism, registered
 
-__all__ = ["Backlash", "CrankSlider", "Joint", "Mechanism", "PinJoint", "ShiftingFork"]
+__all__ = [
+    "DRIVE_VARIABLES",
+    "Backlash",
+    "CrankSlider",
+    "Joint",
+    "Mechanism",
+    "PinJoint",
+    "RequirementInfo",
+    "Rows",
+    "ShiftingFork",
+    "Sketch",
+    "VariableInfo",
+    "get_mechanism",
+    "register_mechanism",
+    "registered",
+]

@@ -1,211 +1,338 @@
-"""The interface shared by the mechanisms, and their clearance chain."""
+"""The mechanism contract: what a screw-driven linkage plug-in declares and computes.
+
+A mechanism turns the output deflection ``phi`` into the travel of the screw's nut (the
+*drive coordinate*). Everything else the framework derives from that, for any mechanism:
+the reduction ratio ``i = 2 pi i_a (dx/dphi) / p``, the nut force by virtual work
+``M_h / (dx/dphi)``, the motor torque, the nut travel, the ratio ripple. A plug-in
+subclasses :class:`Mechanism`, declares its own :attr:`~Mechanism.variables` and writes
+:meth:`~Mechanism.nut_position` with :mod:`optdesign.math`; the rest has defaults it may
+override with closed forms (the nut velocity, the clearance chain, the pin load, the size,
+assembly rows, mechanism-specific requirements, the sketch).
+
+An instance holds one design: every variable's value as a float, a NumPy array (a
+population, broadcast against the deflection grid on the last axis) or a CasADi symbol.
+``guarded`` asks for the solver's guards (square roots that never produce NaN at an
+iterate outside the domain). The screw lead ``p`` and gear ratio ``i_a`` are drive
+variables every mechanism has (:data:`DRIVE_VARIABLES`); the pin variables live in the
+problem, not here.
+"""
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any, ClassVar
 
+import casadi as ca
 import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import InputError
-from optdesign.models._checks import require_positive
-from optdesign.models.clearance import pin_joint_clearance, root_sum_square, worst_case
-from optdesign.models.fits import Fit
+from optdesign.errors import AssemblyError, InputError
+from optdesign.mechanisms.joints import Backlash, Joint, PinJoint, backlash_of
+from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import force_from_rate, motor_torque
-from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity, ratio_ripple
+from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity
 
-#: Joint kinds: how a clearance at the joint moves the output (see Mechanism.sensitivity).
-JOINT_KINDS = ("rod_length", "axial", "lateral", "slot_normal", "angular")
+#: Physical dimensions a variable may have (keys of optdesign.units.INTERNAL_UNITS).
+DIMENSIONS = ("length", "angle", "dimensionless")
 
 
 @dataclass(frozen=True)
-class PinJoint:
-    """A pin in a bore: ISO 286 fit plus Hertz flattening under the joint's load.
+class VariableInfo:
+    """A design variable a mechanism (or the framework) declares.
 
-    Parameters
+    Attributes
     ----------
-    d
-        Pin diameter (mm); may be symbolic.
-    L
-        Loaded pin length (mm); may be symbolic.
-    fit
-        ISO 286 fit, e.g. ``"H7/g6"``.
-    which
-        ``"max"`` (largest clearance, worst case) or ``"min"``.
-    E, nu
-        Modulus (MPa) and Poisson ratio of the pin material.
-    surfaces
-        How many flattened surfaces to count (2: pin and bore).
-    first_order
-        Use the first-order flattening b^2/D (the GP form).
+    dimension
+        ``"length"`` (mm), ``"angle"`` (rad) or ``"dimensionless"``.
+    description
+        What it is, for tables and error messages.
+    positive
+        Fixed values and lower bounds must be > 0 (lengths such as an arm).
+    default
+        Value used when a problem does not declare the variable (None: required).
     """
 
-    d: Any
-    L: Any
-    fit: str = "H7/g6"
-    which: str = "max"
-    E: float = 2.1e5
-    nu: float = 0.3
-    surfaces: int = 2
-    first_order: bool = False
+    dimension: str
+    description: str
+    positive: bool = True
+    default: float | None = None
 
     def __post_init__(self):
-        require_positive("pin.d", self.d)
-        require_positive("pin.L", self.L)
-        require_positive("pin.E", self.E)
-        if not m.is_symbolic(self.nu) and not 0.0 < float(self.nu) < 0.5:
-            raise InputError("pin.nu", f"Poisson ratio must lie in (0, 0.5), got {self.nu!r}")
-        Fit.parse(self.fit, "pin.fit")
+        if self.dimension not in DIMENSIONS:
+            raise ValueError(f"dimension {self.dimension!r} not in {DIMENSIONS}")
 
-    def clearance(self, F):
-        """Effective clearance (mm) under normal force F (N)."""
-        return pin_joint_clearance(
-            self.d,
-            F,
-            self.L,
-            self.E,
-            self.nu,
-            self.fit,
-            self.which,
-            self.surfaces,
-            self.first_order,
-        )
+
+def as_variable_info(value: VariableInfo | str | tuple) -> VariableInfo:
+    """Accept the short forms ``"length"`` or ``("length", "arm length")``."""
+    if isinstance(value, VariableInfo):
+        return value
+    if isinstance(value, str):
+        return VariableInfo(value, "")
+    return VariableInfo(*value)
+
+
+#: Drive variables of every mechanism: the screw lead and the gear pair.
+DRIVE_VARIABLES: dict[str, VariableInfo] = {
+    "p": VariableInfo("length", "screw lead"),
+    "i_a": VariableInfo("dimensionless", "gear ratio motor -> screw", default=1.0),
+}
 
 
 @dataclass(frozen=True)
-class Joint:
-    """One link of a clearance chain.
+class RequirementInfo:
+    """A requirement only some mechanisms have (e.g. the transmission angle).
 
-    Parameters
+    The problem-file schema of a mechanism gains one field per declared requirement;
+    :meth:`Mechanism.requirement_rows` turns its value into constraint rows.
+
+    Attributes
     ----------
-    name
-        Label, e.g. ``"D"`` (the paper's letters) or ``"rod pin B"``.
     kind
-        One of :data:`JOINT_KINDS`: what the clearance changes (``"rod_length"``: the
-        effective rod length; ``"axial"``: nut position along the screw; ``"lateral"``:
-        nut pin across the screw axis; ``"slot_normal"``: fork pin in its slot;
-        ``"angular"``: the output shaft itself, clearance in rad).
-    clearance
-        A fixed clearance (mm, or rad for ``"angular"``), added to the pin's if any.
-    pin
-        A loaded pin, whose clearance depends on the joint force.
-    load
-        Which force loads the pin: ``"rod"``, ``"pin_normal"`` or ``"nut_axial"``.
+        ``"band"`` (a table ``{min, max}``) or ``"value"`` (one quantity).
+    dimension
+        Dimension of the value(s): ``"length"``, ``"angle"``, ``"dimensionless"``.
+    description
+        What it limits.
+    default
+        Value imposed when the file omits it (None: not imposed).
     """
 
-    name: str
     kind: str
-    clearance: Any = 0.0
-    pin: PinJoint | None = None
-    load: str = "rod"
-
-    def __post_init__(self):
-        if self.kind not in JOINT_KINDS:
-            raise InputError(f"joint {self.name}.kind", f"{self.kind!r} not in {JOINT_KINDS}")
-        if not m.is_symbolic(self.clearance) and np.any(np.asarray(self.clearance) < 0):
-            raise InputError(f"joint {self.name}.clearance", "must be >= 0")
+    dimension: str
+    description: str
+    default: Any = None
 
 
 @dataclass
-class Backlash:
-    """Output backlash (degrees) at each grid angle: per joint, worst case and RSS."""
+class Rows:
+    """``lower <= expr <= upper`` over the deflection grid (or one value), as a mechanism
+    or a requirement states it; the problem turns these into named constraint blocks.
 
-    per_joint: dict[str, Any] = field(default_factory=dict)
-    worst_case: Any = None
-    rss: Any = None
+    ``display`` maps the row's values back to the quantity a user reads (e.g. ``arcsin``
+    of a sine, in the unit ``display_unit``) for reports; None shows the value as is.
+    """
+
+    name: str
+    expr: Any
+    lower: float | None = None
+    upper: float | None = None
+    unit: str = ""
+    description: str = ""
+    display: Callable[[Any], Any] | None = None
+    display_unit: str = ""
 
 
-class Mechanism(ABC):
-    """What every mechanism offers: kinematics, loads, clearance sensitivities."""
+@dataclass
+class Sketch:
+    """Points of a linkage at one deflection, for drawings (mm, output axis at the origin).
 
-    kind: str = ""
-    p: Any
-    i_a: Any
-    phi0: Any
+    ``links``: polylines drawn as bars; ``pivots``: fixed joints (ground); ``slider``: the
+    nut; ``axis``: the screw axis as two points.
+    """
 
-    # --- kinematics -------------------------------------------------------------
-    @abstractmethod
+    links: list[list[tuple[float, float]]] = field(default_factory=list)
+    pivots: list[tuple[float, float]] = field(default_factory=list)
+    slider: tuple[float, float] | None = None
+    axis: tuple[tuple[float, float], tuple[float, float]] | None = None
+
+
+class Mechanism:
+    """Base of every mechanism plug-in.
+
+    Subclass, set :attr:`name` and :attr:`variables`, write :meth:`nut_position`, then
+    register the class with :func:`optdesign.register_mechanism`. Example::
+
+        @register_mechanism
+        class Lever(Mechanism):
+            name = "lever"
+            variables = {"R": ("length", "lever arm")}
+
+            def nut_position(self, phi):
+                return self.R * m.sin(phi)
+
+    Class attributes
+    ----------------
+    name
+        Registry key, the ``mechanism`` field of problem files.
+    title
+        Human name for reports.
+    variables
+        Own design variables: name -> :class:`VariableInfo` (or a short form).
+    requirements
+        Mechanism-specific requirements: name -> :class:`RequirementInfo`.
+    fixed_clearances
+        Keys of the clearance chain's fixed clearances (``[clearances]`` of a problem
+        file): key -> (dimension, description).
+    pin_shear_planes
+        Shear planes of the sized pin (default of ``pin_shear_planes``).
+    size_description
+        What :meth:`size` measures.
+    """
+
+    name: ClassVar[str] = ""
+    title: ClassVar[str] = ""
+    variables: ClassVar[Mapping[str, Any]] = {}
+    requirements: ClassVar[Mapping[str, RequirementInfo]] = {}
+    fixed_clearances: ClassVar[Mapping[str, tuple[str, str]]] = {
+        "A": ("length", "screw bearings (axial)"),
+        "B": ("length", "screw/nut (axial)"),
+        "O": ("angle", "output shaft"),
+    }
+    pin_shear_planes: ClassVar[int] = 1
+    size_description: ClassVar[str] = "sum of the mechanism's lengths"
+
+    # --- construction ----------------------------------------------------------------
+    def __init__(self, design: Mapping[str, Any] | None = None, /, *, guarded=False, **values):
+        merged = {**(design or {}), **values}
+        table = self.variable_table()
+        unknown = sorted(k for k in merged if k not in table)
+        if unknown and design is None:
+            raise InputError(
+                unknown[0], f"not a variable of a {self.label()} (known: {', '.join(table)})"
+            )
+        v: dict[str, Any] = {}
+        for name, info in table.items():
+            if name in merged:
+                v[name] = merged[name]
+            elif info.default is not None:
+                v[name] = info.default
+            else:
+                raise InputError(name, f"required by a {self.label()} ({info.description})")
+            if info.positive:
+                require_positive(name, v[name])
+            else:
+                require_finite(name, v[name])
+        self.values = v
+        self.guarded = bool(guarded)
+
+    @classmethod
+    def variable_table(cls) -> dict[str, VariableInfo]:
+        """Every variable the mechanism needs: its own, then the drive's (p, i_a)."""
+        own = {k: as_variable_info(v) for k, v in cls.variables.items()}
+        return {**own, **{k: v for k, v in DRIVE_VARIABLES.items() if k not in own}}
+
+    @classmethod
+    def label(cls) -> str:
+        return cls.title or cls.name or cls.__name__
+
+    def __getattr__(self, item: str) -> Any:
+        # Design values read as attributes (self.R); only reached for missing attributes.
+        values = self.__dict__.get("values")
+        if values is not None and item in values:
+            return values[item]
+        raise AttributeError(f"{type(self).__name__} has no attribute {item!r}")
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.values.items())
+        return f"{type(self).__name__}({args})"
+
+    # --- kinematics (override nut_position; the rest follows) -------------------------
     def nut_position(self, phi):
-        """Nut position along the screw (mm)."""
+        """Drive coordinate x(phi): the nut's travel along the screw (mm), increasing
+        with phi. Every plug-in writes this (with :mod:`optdesign.math`)."""
+        raise NotImplementedError(f"{type(self).__name__} must define nut_position(phi)")
 
-    @abstractmethod
     def nut_velocity(self, phi):
-        """dx/dphi of the nut (mm/rad)."""
-
-    @abstractmethod
-    def sensitivity(self, kind: str, phi):
-        """Output rotation per unit clearance of a joint of ``kind`` (rad/mm)."""
-
-    @abstractmethod
-    def joint_force(self, load: str, phi, M_h):
-        """Force (N) on a joint loaded by ``load`` under hinge moment M_h (N*mm)."""
-
-    @abstractmethod
-    def assembly_margin(self, phi):
-        """Positive where the linkage assembles (mm^2)."""
-
-    @abstractmethod
-    def default_joints(self, pin: PinJoint | None = None) -> list[Joint]:
-        """The paper's clearance chain of this mechanism (seed 000, Fig. 8 and 9)."""
+        """dx/dphi (mm/rad). Default: exact derivative of :meth:`nut_position` by CasADi
+        algorithmic differentiation, on both paths (override with a closed form)."""
+        return _derivative(self, phi)
 
     def ratio(self, phi):
         """Exact reduction ratio i(phi) = 2 pi i_a (dx/dphi) / p."""
         return ratio_from_nut_velocity(self.nut_velocity(phi), self.p, self.i_a)
 
-    def ratio_finite_step(self, phi, step):
-        """The papers' finite-step ratio (eq. 5 / eq. 9) with step ``step`` (rad)."""
-        return ratio_finite_step(self.nut_position, phi, step, self.p, self.i_a)
-
     def ripple(self, phi):
         """Ratio ripple (i_max - i_min)/(i_max + i_min) over the grid ``phi``."""
-        return ratio_ripple(self.ratio(phi))
+        return m.grid_spread(self.ratio(phi))
+
+    def ratio_finite_step(self, phi, step):
+        """The papers' finite-step ratio (seed 000 eq. 5 / 9) with step ``step`` (rad)."""
+        return ratio_finite_step(self.nut_position, phi, step, self.p, self.i_a)
 
     def nut_travel(self, phi_lo, phi_hi):
-        """Nut travel |x(phi_hi) - x(phi_lo)| (mm)."""
-        return m.fabs(self.nut_position(phi_hi) - self.nut_position(phi_lo))
+        """Nut travel x(phi_hi) - x(phi_lo) (mm)."""
+        return self.nut_position(phi_hi) - self.nut_position(phi_lo)
 
-    # --- loads ------------------------------------------------------------------
+    # --- loads ---------------------------------------------------------------------------
     def nut_force(self, phi, M_h):
         """Nut axial force (N) carrying the hinge moment M_h (N*mm), by virtual work."""
         return force_from_rate(M_h, self.nut_velocity(phi))
 
     def motor_torque(self, phi, M_h, eta_screw=1.0, eta_gear=1.0):
-        """Motor torque (N*mm) to hold/drive the hinge moment M_h."""
+        """Motor torque (N*mm) that holds/drives the hinge moment M_h."""
         return motor_torque(self.nut_force(phi, M_h), self.p, self.i_a, eta_screw, eta_gear)
 
-    # --- clearance ----------------------------------------------------------------
-    def joint_clearance(self, joint: Joint, phi, M_h):
-        """Clearance (mm) of ``joint`` at each angle under the hinge moment M_h."""
-        c = joint.clearance
-        if joint.pin is not None:
-            F = m.fabs(self.joint_force(joint.load, phi, M_h))
-            c = c + joint.pin.clearance(F)
-        return c
+    # --- clearance chain -------------------------------------------------------------------
+    def sensitivity_axial(self, phi):
+        """Output rotation per unit nut-side axial clearance (rad/mm) = 1/(dx/dphi)."""
+        return 1.0 / self.nut_velocity(phi)
 
-    def backlash(self, phi, joints: list[Joint], M_h) -> Backlash:
-        """Output backlash in degrees at every angle of ``phi``: per joint, worst case, RSS."""
-        per_joint = {}
-        for joint in joints:
-            if joint.kind == "angular":
-                theta = joint.clearance + 0.0 * phi
-            else:
-                theta = m.fabs(self.sensitivity(joint.kind, phi)) * self.joint_clearance(
-                    joint, phi, M_h
-                )
-            per_joint[joint.name] = theta * (180.0 / np.pi)
-        contributions = list(per_joint.values())
-        return Backlash(per_joint, worst_case(contributions), root_sum_square(contributions))
+    def joints(self, phi, M_h, pin: PinJoint | None = None) -> list[Joint]:
+        """The clearance chain (joints whose clearance reaches the output).
 
-    # --- checks -----------------------------------------------------------------
+        Default: the screw's support bearings (A) and the screw/nut (B), axial; the
+        output shaft (O), angular; and, when the problem sizes a pin, one pin along the
+        screw's line of action loaded by the nut force (a screw pushing a pin).
+        """
+        s = self.sensitivity_axial(phi)
+        chain = [
+            Joint("A screw bearings", "A", sensitivity=s),
+            Joint("B screw/nut", "B", sensitivity=s),
+            Joint("O output shaft", "O", angular=True),
+        ]
+        if pin is not None:
+            chain.append(Joint("pin", "", sensitivity=s, force=self.nut_force(phi, M_h), pin=pin))
+        return chain
+
+    def pin_force(self, phi, M_h):
+        """Force on the sized pin(s) (N) for the bearing-pressure and shear requirements.
+        Default: the force of the first pin joint of :meth:`joints`."""
+        marker = PinJoint.placeholder()
+        for joint in self.joints(phi, M_h, marker):
+            if joint.pin is marker:
+                return joint.force
+        raise InputError("pin", f"a {self.label()} has no sized pin joint")
+
+    def backlash(self, phi, joints: Sequence[Joint]) -> Backlash:
+        """Output backlash (degrees) at each angle of ``phi``: per joint, worst case, RSS."""
+        return backlash_of(joints, phi)
+
+    # --- requirements ----------------------------------------------------------------------
+    def assembly_rows(self, phi) -> list[Rows]:
+        """Rows that keep the linkage assembled over the stroke (none by default)."""
+        return []
+
+    def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
+        """Rows of the mechanism-specific requirement ``name`` with its parsed ``value``."""
+        raise NotImplementedError(f"{type(self).__name__} declares {name!r} but builds no rows")
+
+    def size(self):
+        """A size measure to minimise (mm). Default: the sum of the length variables."""
+        total = 0.0
+        for k, info in type(self).variables.items():
+            if as_variable_info(info).dimension == "length":
+                total = total + self.values[k]
+        return total
+
+    # --- drawings and checks ---------------------------------------------------------------
+    def sketch(self, phi: float) -> Sketch | None:
+        """Points to draw the linkage at deflection ``phi`` (numeric designs); None when
+        the plug-in does not draw itself."""
+        return None
+
+    def assembly_margin(self, phi):
+        """Positive where the linkage assembles. Default: 1 where the nut position is
+        finite (NaN on the NumPy path marks angles where the geometry has no solution)."""
+        x = np.asarray(self.nut_position(np.asarray(phi, dtype=float)), dtype=float)
+        return np.where(np.isfinite(x), 1.0, -1.0)
+
     def check_assembly(self, phi) -> None:
         """Raise AssemblyError at the first angle of ``phi`` where the linkage cannot
         assemble (numeric designs only)."""
-        from optdesign.errors import AssemblyError
-
         phi = np.atleast_1d(np.asarray(phi, dtype=float))
-        margin = np.asarray(self.assembly_margin(phi), dtype=float)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            margin = np.asarray(self.assembly_margin(phi), dtype=float)
         margin = np.broadcast_to(margin, np.broadcast_shapes(margin.shape, phi.shape))
         bad = np.argwhere(~(margin > 0))
         if bad.size:
@@ -214,4 +341,66 @@ class Mechanism(ABC):
 
     def describe(self) -> str:
         """Short text of the design, for messages."""
-        return self.kind
+        shown = ", ".join(f"{k}={_short(v)}" for k, v in self.values.items())
+        return f"{self.label()} {shown}"
+
+    #: Benchmark instance families of this mechanism: family name -> objectives (see
+    #: optdesign.studies.bench.instances); empty: the benchmark has none of its own.
+    bench_families: ClassVar[Mapping[str, tuple[str, ...]]] = {}
+
+    @classmethod
+    def bench_template(cls) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The mechanism's own variables and requirements of a benchmark instance, as
+        problem-file tables (the benchmark adds the drive, pins and common requirements;
+        ``"p": None`` marks where the drawn screw lead goes in the variable order)."""
+        return {}, {}
+
+
+def _short(v: Any) -> str:
+    if m.is_symbolic(v):
+        return "<symbolic>"
+    a = np.asarray(v)
+    return f"{float(a):g}" if a.ndim == 0 else f"<array {a.shape}>"
+
+
+def replace_joint(joint: Joint, **changes) -> Joint:
+    """A copy of ``joint`` with ``changes`` (dataclasses.replace, re-exported for plug-ins)."""
+    return replace(joint, **changes)
+
+
+# --- automatic derivative of the nut position ------------------------------------------
+_DERIVATIVES: dict[tuple, ca.Function] = {}
+
+
+def _derivative(mech: Mechanism, phi):
+    """dx/dphi of ``mech.nut_position`` by CasADi AD, evaluated like the model itself.
+
+    One CasADi Function ``(phi, v_1..v_k) -> dx/dphi`` is built per mechanism class (on
+    scalar symbols) and cached; it is called element-wise with the design's values: CasADi
+    symbols give an expression per grid angle, NumPy arrays are broadcast.
+    """
+    cls = type(mech)
+    names = list(mech.values)
+    key = (cls, tuple(names), mech.guarded)
+    fun = _DERIVATIVES.get(key)
+    if fun is None:
+        phi_s = ca.SX.sym("phi")
+        syms = {k: ca.SX.sym(k) for k in names}
+        probe = cls.__new__(cls)
+        probe.values = dict(syms)
+        probe.guarded = mech.guarded
+        x = probe.nut_position(phi_s)
+        fun = ca.Function(f"dx_{cls.__name__}", [phi_s, *syms.values()], [ca.jacobian(x, phi_s)])
+        _DERIVATIVES[key] = fun
+    args = [mech.values[k] for k in names]
+    if m.is_symbolic(phi, *args):
+        phi_col = np.atleast_1d(np.asarray(phi, dtype=float)) if not m.is_symbolic(phi) else phi
+        if m.is_symbolic(phi):
+            return fun(phi, *args)
+        return ca.vertcat(*[fun(float(p), *args) for p in phi_col.ravel()])
+    arrays = np.broadcast_arrays(np.asarray(phi, dtype=float), *map(np.asarray, args))
+    shape = arrays[0].shape
+    flat = [a.astype(float).ravel() for a in arrays]
+    n = flat[0].size
+    out = fun.map(n)(*[a[None, :] for a in flat])
+    return np.asarray(out, dtype=float).reshape(shape)

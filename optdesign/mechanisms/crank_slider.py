@@ -2,58 +2,79 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
+
+import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import InputError
-from optdesign.mechanisms.base import Joint, Mechanism, PinJoint
+from optdesign.mechanisms.base import Mechanism, RequirementInfo, Rows, Sketch, VariableInfo
+from optdesign.mechanisms.joints import Joint, PinJoint
+from optdesign.mechanisms.registry import register_mechanism
 from optdesign.models import crank_slider as cs
-from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import force_from_rate
 
+#: sqrt guard of the assembly condition on the solver path (mm^2): keeps iterates that
+#: leave the assembly region finite; the assembly-margin requirement keeps solutions out.
+ASSEMBLY_FLOOR = 1e-6
 
-@dataclass
+
+@register_mechanism
 class CrankSlider(Mechanism):
     """Crank-slider linkage driven by a ball screw.
 
-    Parameters
-    ----------
-    R
-        Arm (rocker) length OB (mm).
-    l
-        Rod length BC (mm).
-    n
-        Offset: distance between the output-shaft axis and the screw axis (mm).
-    p
-        Screw lead (mm).
-    i_a
-        Gear ratio motor -> screw.
-    phi0
-        Neutral angle of the arm (rad); the arm sits at phi0 + phi.
-    floor
-        Guard for sqrt(l^2 - u^2) used by solvers (None: no guard, NaN where it
-        cannot assemble).
+    The arm OB (length R) turns with the output; the rod BC (length l) joins it to the
+    nut pin C, which slides on a line parallel to the screw axis at distance n from O.
+
+    Variables: R (arm), l (rod), n (offset), phi0 (neutral angle, the arm sits at
+    phi0 + phi) and the drive's p, i_a.
     """
 
-    R: Any
-    l: Any
-    n: Any
-    p: Any
-    i_a: Any = 1.0
-    phi0: Any = 0.0
-    floor: float | None = None
-    kind = "crank_slider"
+    name = "crank_slider"
+    title = "crank-slider"
+    variables: ClassVar = {
+        "R": VariableInfo("length", "arm length"),
+        "l": VariableInfo("length", "rod length"),
+        "n": VariableInfo("length", "offset of the screw axis", positive=False),
+        "phi0": VariableInfo("angle", "neutral angle", positive=False, default=0.0),
+    }
+    requirements: ClassVar = {
+        "transmission_angle": RequirementInfo(
+            "band", "angle", "angle between arm and rod at B (90 deg is ideal)"
+        ),
+        "rod_inclination_max": RequirementInfo(
+            "value", "angle", "largest inclination of the rod to the screw axis"
+        ),
+        "assembly_margin_min": RequirementInfo(
+            "value",
+            "dimensionless",
+            "smallest (l^2 - u^2)/l^2 over the stroke (distance from the toggle position)",
+            default=0.01,
+        ),
+    }
+    fixed_clearances: ClassVar = {
+        "A": ("length", "screw bearings (axial)"),
+        "B": ("length", "screw/nut (axial)"),
+        "C": ("length", "nut slide, across the screw axis"),
+        "O": ("angle", "output shaft"),
+    }
+    pin_shear_planes = 2
+    size_description = "linkage size R + l"
+    bench_families: ClassVar = {
+        "cs_ripple": ("ripple",),
+        "cs_backlash": ("backlash",),
+        "cs_size": ("size",),
+        "cs_torque": ("motor_torque",),
+        "cs_front": ("ripple", "backlash"),
+    }
 
-    def __post_init__(self):
-        for name in ("R", "l", "p", "i_a"):
-            require_positive(name, getattr(self, name))
-        require_finite("n", self.n)
-        require_finite("phi0", self.phi0)
+    @property
+    def floor(self) -> float | None:
+        return ASSEMBLY_FLOOR if self.guarded else None
 
     def _args(self):
         return self.R, self.l, self.n
 
+    # --- kinematics: closed forms (seed 000 eq. 2 and its derivative) -------------------
     def nut_position(self, phi):
         return cs.nut_position(*self._args(), phi, self.phi0, self.floor)
 
@@ -86,38 +107,121 @@ class CrankSlider(Mechanism):
         C = (self.nut_position(phi), self.n + 0.0 * phi)
         return B, C
 
+    # --- loads and clearance ---------------------------------------------------------------
     def rod_force(self, phi, M_h):
         """Axial force of the rod (N), M_h / (d|BC|/dphi)."""
         return force_from_rate(M_h, self.rod_length_rate(phi))
 
-    def joint_force(self, load, phi, M_h):
-        if load == "rod":
-            return self.rod_force(phi, M_h)
-        if load == "nut_axial":
-            return self.nut_force(phi, M_h)
-        raise InputError("joint.load", f"{load!r} is not a load of a crank-slider (rod, nut_axial)")
+    def sensitivity_rod_length(self, phi):
+        """Output rotation per unit change of the effective rod length (rad/mm)."""
+        return cs.sensitivity_rod_length(*self._args(), phi, self.phi0, self.floor)
 
-    def sensitivity(self, kind, phi):
-        args = (*self._args(), phi, self.phi0, self.floor)
-        if kind == "rod_length":
-            return cs.sensitivity_rod_length(*args)
-        if kind == "axial":
-            return cs.sensitivity_axial(*args)
-        if kind == "lateral":
-            return cs.sensitivity_lateral(*args)
-        raise InputError("joint.kind", f"{kind!r} has no meaning for a crank-slider")
+    def sensitivity_lateral(self, phi):
+        """Output rotation per unit clearance of the nut slide across the screw (rad/mm)."""
+        return cs.sensitivity_lateral(*self._args(), phi, self.phi0, self.floor)
 
-    def default_joints(self, pin: PinJoint | None = None) -> list[Joint]:
+    def joints(self, phi, M_h, pin: PinJoint | None = None) -> list[Joint]:
         """Seed 000 Fig. 8: A (screw bearings) and B (screw/nut) preloaded, C (nut slide)
         small, O (output shaft) ~0, D and E the two rod pins (the main source)."""
+        axial = self.sensitivity_axial(phi)
+        rod = self.sensitivity_rod_length(phi)
+        F_rod = self.rod_force(phi, M_h)
         return [
-            Joint("A screw bearings", "axial"),
-            Joint("B screw/nut", "axial"),
-            Joint("C nut slide", "lateral"),
-            Joint("O output shaft", "angular"),
-            Joint("D rod pin (arm)", "rod_length", pin=pin, load="rod"),
-            Joint("E rod pin (nut)", "rod_length", pin=pin, load="rod"),
+            Joint("A screw bearings", "A", sensitivity=axial),
+            Joint("B screw/nut", "B", sensitivity=axial),
+            Joint("C nut slide", "C", sensitivity=self.sensitivity_lateral(phi)),
+            Joint("O output shaft", "O", angular=True),
+            Joint("D rod pin (arm)", "", sensitivity=rod, force=F_rod, pin=pin),
+            Joint("E rod pin (nut)", "", sensitivity=rod, force=F_rod, pin=pin),
         ]
 
-    def describe(self) -> str:
-        return f"crank-slider R={self.R}, l={self.l}, n={self.n}, phi0={self.phi0}"
+    def pin_force(self, phi, M_h):
+        """Both rod pins carry the rod force."""
+        return self.rod_force(phi, M_h)
+
+    # --- requirements ----------------------------------------------------------------------
+    def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
+        R, l, n, phi0 = self.R, self.l, self.n, self.phi0
+        if name == "assembly_margin_min":
+            margin = cs.assembly_margin(R, l, n, phi, phi0) / l**2
+            return [
+                Rows(
+                    "assembly_margin",
+                    margin,
+                    float(value),
+                    None,
+                    "",
+                    "(l^2 - u^2)/l^2: the rod reaches the nut line",
+                )
+            ]
+        if name == "transmission_angle":
+            # cos is decreasing on [0, pi]: mu in [lo, hi] <=> cos mu in [cos hi, cos lo];
+            # the cosine is smooth where arccos is not (solvers see the cosine).
+            return [
+                Rows(
+                    "transmission_angle",
+                    cs.transmission_angle_cos(R, l, n, phi, phi0, self.floor),
+                    None if value.max is None else float(np.cos(value.max)),
+                    None if value.min is None else float(np.cos(value.min)),
+                    "",
+                    "transmission angle",
+                    display=_degrees_of_arccos,
+                    display_unit="deg",
+                )
+            ]
+        if name == "rod_inclination_max":
+            # |atan2(u, s)| <= theta  <=>  |u|/l <= sin(theta)  (s > 0 on the branch)
+            s_max = float(np.sin(value))
+            return [
+                Rows(
+                    "rod_inclination",
+                    cs.rod_rise(R, n, phi, phi0) / l,
+                    -s_max,
+                    s_max,
+                    "",
+                    "rod inclination to the screw axis",
+                    display=_degrees_of_arcsin,
+                    display_unit="deg",
+                )
+            ]
+        return super().requirement_rows(name, value, phi)
+
+    def size(self):
+        return self.R + self.l
+
+    # --- drawing ---------------------------------------------------------------------------
+    def sketch(self, phi: float) -> Sketch:
+        with np.errstate(invalid="ignore"):
+            (bx, by), (cx, cy) = self.pin_positions(np.asarray(phi, dtype=float))
+        B, C = (float(bx), float(by)), (float(cx), float(cy))
+        n = float(self.n)
+        return Sketch(
+            links=[[(0.0, 0.0), B], [B, C]],
+            pivots=[(0.0, 0.0)],
+            slider=C,
+            axis=((min(0.0, C[0]) - 0.5 * float(self.l), n), (max(0.0, C[0]) + 10.0, n)),
+        )
+
+    @classmethod
+    def bench_template(cls) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Variables and requirements of the benchmark's crank-slider instances."""
+        variables = {
+            "R": {"lower": "30 mm", "upper": "120 mm"},
+            "l": {"lower": "40 mm", "upper": "200 mm"},
+            "n": {"lower": "0 mm", "upper": "150 mm"},
+            "p": None,  # the screw lead, drawn by the benchmark, goes here
+            "phi0": {"lower": "-0.6 rad", "upper": "0.6 rad"},
+        }
+        requirements = {
+            "transmission_angle": {"min": "40 deg", "max": "140 deg"},
+            "rod_inclination_max": "30 deg",
+        }
+        return variables, requirements
+
+
+def _degrees_of_arccos(c):
+    return np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+
+
+def _degrees_of_arcsin(s):
+    return np.degrees(np.arcsin(np.clip(s, -1.0, 1.0)))

@@ -2,46 +2,46 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import InputError
-from optdesign.mechanisms.base import Joint, Mechanism, PinJoint
+from optdesign.mechanisms.base import Mechanism, Sketch, VariableInfo
+from optdesign.mechanisms.joints import Joint, PinJoint
+from optdesign.mechanisms.registry import register_mechanism
 from optdesign.models import fork
-from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import fork_pin_normal_force
 
 
-@dataclass
+@register_mechanism
 class ShiftingFork(Mechanism):
     """Shifting fork: the nut pin runs on a line at distance R from the output axis and
     slides in a slot of the output arm.
 
-    Parameters
-    ----------
-    R
-        Perpendicular distance from the output axis to the pin's line (mm).
-    p
-        Screw lead (mm).
-    i_a
-        Gear ratio motor -> screw.
-    phi0
-        Neutral angle (rad), 0 in the paper (then the ratio is symmetric).
+    Variables: R (perpendicular distance from the output axis to the pin's line), phi0
+    (neutral angle, 0 in the paper, where the ratio is symmetric) and the drive's p, i_a.
     """
 
-    R: Any
-    p: Any
-    i_a: Any = 1.0
-    phi0: Any = 0.0
-    kind = "fork"
+    name = "fork"
+    title = "shifting fork"
+    variables: ClassVar = {
+        "R": VariableInfo("length", "lever: distance from the output axis to the pin's line"),
+        "phi0": VariableInfo("angle", "neutral angle", positive=False, default=0.0),
+    }
+    pin_shear_planes = 1
+    size_description = "lever size R"
+    bench_families: ClassVar = {
+        "fork_backlash": ("backlash",),
+        "fork_size": ("size",),
+        "fork_torque": ("motor_torque",),
+        "fork_front": ("backlash", "size"),
+    }
 
-    def __post_init__(self):
-        for name in ("R", "p", "i_a"):
-            require_positive(name, getattr(self, name))
-        require_finite("phi0", self.phi0)
+    @classmethod
+    def bench_template(cls) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Variables of the benchmark's fork instances (it has no requirement of its own)."""
+        return {"R": {"lower": "30 mm", "upper": "120 mm"}, "p": None}, {}
 
     def nut_position(self, phi):
         return fork.nut_position(self.R, phi, self.phi0)
@@ -55,42 +55,48 @@ class ShiftingFork(Mechanism):
         return m.cos(self.phi0 + phi) * self.R**2
 
     def pin_normal_force(self, phi, M_h):
-        """Normal force of the pin on the slot (N), M_h cos(phi)/R."""
+        """Normal force of the pin on the slot (N), M_h cos(phi0 + phi)/R."""
         return fork_pin_normal_force(M_h, self.R, phi, self.phi0)
 
+    def sensitivity_slot_normal(self, phi):
+        """Output rotation per unit slot-normal clearance at the pin (rad/mm)."""
+        return fork.sensitivity_slot_normal(self.R, phi, self.phi0)
+
+    def joints(self, phi, M_h, pin: PinJoint | None = None) -> list[Joint]:
+        """Seed 000 Fig. 9: A, B, O as the crank-slider's, C the pin in the slot."""
+        axial = fork.sensitivity_axial(self.R, phi, self.phi0)
+        return [
+            Joint("A screw bearings", "A", sensitivity=axial),
+            Joint("B screw/nut", "B", sensitivity=axial),
+            Joint("O output shaft", "O", angular=True),
+            Joint(
+                "C pin in slot",
+                "",
+                sensitivity=self.sensitivity_slot_normal(phi),
+                force=self.pin_normal_force(phi, M_h),
+                pin=pin,
+            ),
+        ]
+
+    def pin_force(self, phi, M_h):
+        return self.pin_normal_force(phi, M_h)
+
+    def size(self):
+        return self.R
+
     def pin_positions(self, phi):
-        """(O->pin direction end, pin) as ((x, y), (x, y)) in mm."""
+        """(end of the arm's line at the pin, pin) as ((x, y), (x, y)) in mm."""
         a = self.phi0 + phi
         pin = (self.nut_position(phi), self.R + 0.0 * phi)
         return (self.R * m.tan(a), self.R + 0.0 * phi), pin
 
-    def joint_force(self, load, phi, M_h):
-        if load in ("pin_normal", "rod"):
-            return self.pin_normal_force(phi, M_h)
-        if load == "nut_axial":
-            return self.nut_force(phi, M_h)
-        raise InputError("joint.load", f"{load!r} is not a load of a fork (pin_normal, nut_axial)")
-
-    def sensitivity(self, kind, phi):
-        if kind == "slot_normal":
-            return fork.sensitivity_slot_normal(self.R, phi, self.phi0)
-        if kind == "axial":
-            return fork.sensitivity_axial(self.R, phi, self.phi0)
-        raise InputError("joint.kind", f"{kind!r} has no meaning for a shifting fork")
-
-    def default_joints(self, pin: PinJoint | None = None) -> list[Joint]:
-        """Seed 000 Fig. 9: A, B, O as the crank-slider's, C the pin in the slot."""
-        return [
-            Joint("A screw bearings", "axial"),
-            Joint("B screw/nut", "axial"),
-            Joint("O output shaft", "angular"),
-            Joint("C pin in slot", "slot_normal", pin=pin, load="pin_normal"),
-        ]
-
-    def check_assembly(self, phi) -> None:
-        phi = np.atleast_1d(np.asarray(phi, dtype=float))
-        if np.any(np.abs(np.asarray(self.phi0) + phi) >= np.pi / 2):
-            super().check_assembly(phi)
-
-    def describe(self) -> str:
-        return f"shifting fork R={self.R}"
+    def sketch(self, phi: float) -> Sketch:
+        with np.errstate(invalid="ignore"):
+            x = float(self.nut_position(np.asarray(phi, dtype=float)))
+        R = float(self.R)
+        return Sketch(
+            links=[[(0.0, 0.0), (x, R)]],
+            pivots=[(0.0, 0.0)],
+            slider=(x, R),
+            axis=((min(x, 0.0) - 0.3 * R, R), (max(x, 0.0) + 0.3 * R, R)),
+        )

@@ -273,7 +273,7 @@ def contribution(
     if a == "angular":
         return value
     if a == "rod_length":
-        return value * mechanism.sensitivity("rod_length", phi)
+        return value * mechanism.sensitivity_rod_length(phi)
     if a == "axial":
         nut = value
     elif a == "lead":
@@ -284,7 +284,7 @@ def contribution(
         nut = deformation_error(mechanism.nut_force(phi, M_h), 1.0 / value)
     else:
         nut = encoder_error(mechanism.p, value, mechanism.i_a)
-    return nut * mechanism.sensitivity("axial", phi)
+    return nut * mechanism.sensitivity_axial(phi)
 
 
 def gains(sources: Sequence[ErrorSource], mechanism=None, phi=0.0, **kwargs) -> list:

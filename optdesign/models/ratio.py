@@ -43,11 +43,9 @@ def ratio_ripple(i):
     This is the paper's "variation range": half the spread over the mean of the extremes.
     Non-smooth in the design; solvers use the epigraph form instead (see formulations).
     """
-    hi = m.grid_max(i)
-    lo = m.grid_min(i)
-    return (hi - lo) / (hi + lo)
+    return m.grid_spread(i)
 
 
 def ripple_from_bounds(i_lo, i_hi):
     """Ripple from an enclosing band [i_lo, i_hi] (the smooth epigraph objective)."""
-    return (i_hi - i_lo) / (i_hi + i_lo)
+    return m.spread(i_lo, i_hi)

@@ -1,19 +1,12 @@
-"""Plot of Pareto fronts: objective space (methods overlaid) and linkage sketches of a few
-picked designs (the two ends of the front and its knee), drawn from
-``mechanism.pin_positions``."""
+"""Plot of Pareto fronts: objective space (methods overlaid) and sketches of picked designs
+(the two ends of the front and its knee), drawn from each mechanism's :meth:`sketch`."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
-from optdesign.plots import save_figure
-from optdesign.problem.design_problem import DesignProblem
-
-_UNITS = {"backlash": "deg", "backlash_rss": "deg", "size": "mm", "nut_travel": "mm"}
 _STYLE = {
     "epsilon": dict(marker="o", ms=4, lw=1.0),
     "uniform": dict(marker="s", ms=3, lw=0.8),
@@ -40,59 +33,86 @@ def pick_points(F: np.ndarray) -> list[int]:
     return out
 
 
-def _label(name: str) -> str:
-    unit = _UNITS.get(name, "")
-    return f"{name} ({unit})" if unit else name
+def axis_label(problem, name: str) -> tuple[str, float]:
+    """(label with unit, scale to the displayed unit) of objective ``name``."""
+    from optdesign.reports.solve_text import objective_unit
+
+    unit, scale = objective_unit(problem, name)
+    return (f"{name} ({unit})" if unit else name), scale
 
 
-def draw_linkage(ax, problem: DesignProblem, design: dict, title: str = "") -> None:
-    """Sketch of a design at the stroke's ends and middle (pin positions, mm)."""
-    mech = problem.mechanism(design)
+def draw_linkage(ax, problem, design: dict, title: str = "") -> None:
+    """Sketch of a design at the stroke's ends and middle (mm), from the mechanism's
+    :meth:`~optdesign.mechanisms.Mechanism.sketch`."""
+    mech = problem.quantities(design).mechanism
     phis = [problem.phi[0], 0.5 * (problem.phi[0] + problem.phi[-1]), problem.phi[-1]]
+    drawn = False
     for j, phi in enumerate(phis):
+        sk = mech.sketch(float(phi))
+        if sk is None:
+            continue
+        drawn = True
         alpha = 0.35 + 0.3 * j
-        with np.errstate(invalid="ignore"):
-            P, Q = mech.pin_positions(np.array(phi))
-        P = (float(P[0]), float(P[1]))
-        Q = (float(Q[0]), float(Q[1]))
-        ax.plot([0, P[0]], [0, P[1]], "-", color="C0", lw=2, alpha=alpha)
-        ax.plot([P[0], Q[0]], [P[1], Q[1]], "-", color="C1", lw=2, alpha=alpha)
-        ax.plot(*Q, "s", color="C2", ms=6, alpha=alpha)
-        ax.plot(*P, "o", color="k", ms=3, alpha=alpha)
-    # The screw axis: the nut line (crank-slider) or the pin line (fork).
-    y_axis = float(design.get("n", design.get("R", 0.0)))
-    ax.axhline(y_axis, color="0.5", lw=0.8, ls="--")
-    ax.plot(0, 0, "k^", ms=7)
-    ax.set_aspect("equal", adjustable="datalim")
+        label = f"phi = {np.degrees(phi):+.0f} deg"
+        for k, link in enumerate(sk.links):
+            xs, ys = zip(*link, strict=True)
+            ax.plot(xs, ys, "-", color=f"C{k}", lw=2, alpha=alpha, label=label if k == 0 else None)
+        if sk.slider is not None:
+            ax.plot(*sk.slider, "s", color="C2", ms=6, alpha=alpha)
+        if j == 0:
+            for pv in sk.pivots:
+                ax.plot(*pv, "k^", ms=7)
+            if sk.axis is not None:
+                (x0, y0), (x1, y1) = sk.axis
+                ax.plot([x0, x1], [y0, y1], color="0.5", lw=0.8, ls="--", label="screw axis")
+    if not drawn:
+        ax.text(
+            0.5,
+            0.5,
+            "no sketch for this mechanism",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+            fontsize=8,
+        )
+        ax.set_axis_off()
+    else:
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x (mm)", fontsize=7)
+        ax.set_ylabel("y (mm)", fontsize=7)
+        ax.legend(fontsize=6, loc="best")
     ax.set_title(title, fontsize=8)
     ax.tick_params(labelsize=7)
 
 
-def plot_fronts(
-    problem: DesignProblem,
-    fronts: Sequence,
-    path: Path | str,
-    reference: np.ndarray | None = None,
-) -> Path:
+def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None = None):
     """Objective space with every front overlaid, plus sketches of picked points of the
-    first front. Two objectives: a 2-D plot; three: a 3-D scatter."""
+    first front (unless ``ax`` is given: then only the objective space, on ``ax``).
+    Returns the Figure. Two objectives: a 2-D plot; three: a 3-D scatter."""
+    import matplotlib.pyplot as plt
+
     main = fronts[0]
     objectives = main.objectives
     picks = pick_points(main.F)
-    n_sk = len(picks)
-    fig = plt.figure(figsize=(6 + 3.0 * max(n_sk, 1) / 1.5, 5), dpi=120)
-    gs = fig.add_gridspec(
-        2, 1 + max(1, (n_sk + 1) // 2), width_ratios=[2.2] + [1] * max(1, (n_sk + 1) // 2)
-    )
     three = len(objectives) == 3
-    ax = fig.add_subplot(gs[:, 0], projection="3d" if three else None)
+    labels = [axis_label(problem, k) for k in objectives]
+    scales = np.array([s for _, s in labels])
+    if ax is None:
+        n_sk = len(picks)
+        cols = max(1, (n_sk + 1) // 2)
+        fig = plt.figure(figsize=(6 + 3.0 * max(n_sk, 1) / 1.5, 5), dpi=120)
+        gs = fig.add_gridspec(2, 1 + cols, width_ratios=[2.2] + [1] * cols)
+        ax = fig.add_subplot(gs[:, 0], projection="3d" if three else None)
+        sketches = True
+    else:
+        fig, gs, sketches = ax.figure, None, False
     if reference is not None and len(reference) and not three:
-        R = reference[np.argsort(reference[:, 0])]
+        R = reference[np.argsort(reference[:, 0])] * scales
         ax.plot(
             R[:, 0], R[:, 1], color="0.3", label=f"reference ({len(R)} pts)", **_STYLE["reference"]
         )
     for f in fronts:
-        F = f.F
+        F = f.F * scales if len(f.F) else f.F
         if not len(F):
             continue
         style = _STYLE.get(f.method, dict(marker="o", ms=3, lw=0.0))
@@ -103,7 +123,7 @@ def plot_fronts(
             )
         else:
             ax.plot(F[:, 0], F[:, 1], label=label, **style)
-    F0 = main.F
+    F0 = main.F * scales if len(main.F) else main.F
     for k, i in enumerate(picks):
         pt = F0[i]
         if three:
@@ -112,17 +132,21 @@ def plot_fronts(
         else:
             ax.plot(*pt, "o", mfc="none", mec="r", ms=10)
             ax.annotate(chr(65 + k), pt, textcoords="offset points", xytext=(6, 6), color="r")
-    ax.set_xlabel(_label(objectives[0]))
-    ax.set_ylabel(_label(objectives[1]))
+    ax.set_xlabel(labels[0][0])
+    ax.set_ylabel(labels[1][0])
     if three:
-        ax.set_zlabel(_label(objectives[2]))
+        ax.set_zlabel(labels[2][0])
     else:
         ax.grid(True, alpha=0.3)
-    ax.set_title(f"{problem.name}: Pareto front", fontsize=10)
+    name = problem.name if problem is not None else ""
+    ax.set_title(f"{name}: Pareto front (A, B...: designs sketched)", fontsize=10)
     ax.legend(fontsize=7)
-    for k, i in enumerate(picks):
-        sub = fig.add_subplot(gs[k % 2, 1 + k // 2])
-        p = main.points[i]
-        text = ", ".join(f"{o}={p.objectives[o]:.4g}" for o in objectives)
-        draw_linkage(sub, problem, p.design, f"{chr(65 + k)}: {text}")
-    return save_figure(fig, path)
+    if sketches and problem is not None:
+        for k, i in enumerate(picks):
+            sub = fig.add_subplot(gs[k % 2, 1 + k // 2])
+            p = main.points[i]
+            text = ", ".join(
+                f"{o}={s * p.objectives[o]:.4g}" for o, s in zip(objectives, scales, strict=True)
+            )
+            draw_linkage(sub, problem, p.design, f"{chr(65 + k)}: {text}")
+    return fig

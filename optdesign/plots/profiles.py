@@ -3,21 +3,16 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
-
-from optdesign.plots import save_figure
 
 
 def plot_profiles(
     profiles: Mapping[str, tuple[np.ndarray, np.ndarray]],
     configs: Sequence[str],
-    path: Path,
     gap_floor: float = 1e-6,
-) -> Path:
-    """Plot the profiles side by side into a PNG at ``path``.
+):
+    """The profiles side by side; returns the Figure.
 
     Parameters
     ----------
@@ -29,6 +24,8 @@ def plot_profiles(
     gap_floor
         Floor used for the gap measure (the x axis of the gap panel is gap / floor).
     """
+    import matplotlib.pyplot as plt
+
     keys = [k for k in ("time", "gap") if k in profiles]
     fig, axes = plt.subplots(1, len(keys), figsize=(6.0 * len(keys), 5.4), dpi=110, squeeze=False)
     cmap = plt.get_cmap("tab20")
@@ -53,4 +50,4 @@ def plot_profiles(
     n_rows = -(-len(labels) // 6)
     fig.tight_layout(rect=(0.0, 0.04 * n_rows + 0.02, 1.0, 1.0))
     fig.legend(handles, labels, loc="lower center", ncol=6, fontsize=8, frameon=False)
-    return save_figure(fig, path, tight=False)
+    return fig

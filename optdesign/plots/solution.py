@@ -3,37 +3,54 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
-from optdesign.plots.curves import save_deflection_figure
 from optdesign.problem.design_problem import DesignProblem
 
 
-def plot_solution(
-    problem: DesignProblem, designs: Mapping[str, Mapping[str, float]], path: Path
-) -> Path:
-    """Ratio (and backlash, if the problem has pins) vs deflection for each named design."""
-    phi = problem.phi
-    phi_deg = np.degrees(phi)
+def plot_designs(problem: DesignProblem, designs: Mapping[str, Mapping[str, float]], ax=None):
+    """Ratio (and backlash, if the problem has pins) vs deflection for each named design.
+
+    Returns the Figure; with ``ax`` the ratio is drawn on that axes (and the backlash,
+    if any, on a twin axis) instead of a new figure.
+    """
+    import matplotlib.pyplot as plt
+
+    phi_deg = np.degrees(problem.phi)
     has_pin = problem.has("d")
-    fig, axes = plt.subplots(1, 2 if has_pin else 1, figsize=(11 if has_pin else 6, 4.2), dpi=120)
-    axes = np.atleast_1d(axes)
+    if ax is None:
+        fig, axes = plt.subplots(
+            1, 2 if has_pin else 1, figsize=(11 if has_pin else 6, 4.2), dpi=120, squeeze=False
+        )
+        axes = list(axes[0])
+    else:
+        fig = ax.figure
+        axes = [ax, ax.twinx()] if has_pin else [ax]
     for label, design in designs.items():
         with np.errstate(invalid="ignore", divide="ignore"):
-            ex = problem.expressions(design)
-            axes[0].plot(
-                phi_deg, np.asarray(ex.objectives["ripple"].expr, dtype=float), label=label
-            )
+            q = problem.quantities(design)
+            axes[0].plot(phi_deg, np.asarray(q.ratio, dtype=float), label=label)
             if has_pin:
                 axes[1].plot(
-                    phi_deg, np.asarray(ex.objectives["backlash"].expr, dtype=float), label=label
+                    phi_deg, np.asarray(q.backlash.worst_case, dtype=float), "--", label=label
                 )
-    axes[0].set_ylabel("reduction ratio i")
+    axes[0].set_ylabel("reduction ratio i (motor rad / output rad)")
     axes[0].set_title(f"{problem.name}: ratio over the stroke")
     if has_pin:
         axes[1].set_ylabel("worst-case backlash (deg)")
         axes[1].set_title("output backlash over the stroke")
-    return save_deflection_figure(fig, axes, path)
+    for a in axes:
+        a.set_xlabel("deflection phi (deg)")
+        a.grid(True, alpha=0.3)
+        a.legend(fontsize=8)
+    return fig
+
+
+def plot_result(result, ax=None):
+    """The optimum of ``result`` against the problem's initial design (a Figure)."""
+    problem = result.problem_object
+    if problem is None or not result.design:
+        raise ValueError("plot: the result carries no problem or no design to draw")
+    start = problem.design_dict(problem.start())
+    return plot_designs(problem, {"initial design": start, "optimum": result.design}, ax)

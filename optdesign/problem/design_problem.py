@@ -1,109 +1,72 @@
-"""A design problem as expressions: variables, objective terms, constraint blocks.
+"""A design problem: variables, objectives and constraints of a mechanism, as expressions.
 
-:meth:`DesignProblem.expressions` takes a design (a mapping of every variable name to a
-float, a NumPy array broadcast against the grid, or a CasADi symbol) and returns the
-objective terms and constraint blocks built from the mechanism models. The
-formulations (NLP, GP, NSGA-II) and the independent checks all go through it, so each
-requirement is written once. Nothing here knows a solver.
+:meth:`DesignProblem.expressions` takes a design (every variable name -> a float, a NumPy
+array broadcast against the grid, or a CasADi symbol) and returns the objective terms and
+constraint blocks computed from the design's quantities. The formulations (NLP, GP,
+robust, NSGA-II) and the independent checks all go through it, so each requirement is
+written once. Objectives come from the catalogue (:mod:`optdesign.problem.catalogue`) plus
+those a user adds; constraints from the requirements plus those a user adds. Nothing here
+knows a solver, nor names a mechanism.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+import uuid
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import ProblemError
-from optdesign.mechanisms import CrankSlider, Joint, PinJoint, ShiftingFork
-from optdesign.models import crank_slider as cs_model
-from optdesign.models.loads import pin_bearing_pressure, pin_shear_stress
-from optdesign.problem.spec import VARIABLE_DESCRIPTIONS, ProblemSpec
-
-#: sqrt guard of the assembly condition on the solver path (mm^2): keeps iterates that
-#: leave the assembly region finite; the assembly-margin constraint keeps solutions out.
-ASSEMBLY_FLOOR = 1e-6
-
-
-@dataclass(frozen=True)
-class Variable:
-    """A design variable, in internal units.
-
-    Attributes
-    ----------
-    name, description, unit
-        Identification (unit is the internal unit, for tables).
-    lower, upper
-        Bounds of a free variable (None for a fixed one).
-    value
-        Value of a fixed variable.
-    values
-        Catalogue values of a discrete variable (None when continuous).
-    start
-        Preferred initial value of a free variable.
-    """
-
-    name: str
-    description: str
-    unit: str
-    lower: float | None = None
-    upper: float | None = None
-    value: float | None = None
-    values: tuple[float, ...] | None = None
-    start: float | None = None
-
-    @property
-    def free(self) -> bool:
-        return self.value is None
-
-    @property
-    def discrete(self) -> bool:
-        return self.values is not None
-
-
-@dataclass
-class ObjectiveTerm:
-    """An objective.
-
-    kind ``"spread"``: (max - min)/(max + min) of ``expr`` over the grid (ripple);
-    ``"max"``: the maximum of ``expr`` over the grid; ``"scalar"``: ``expr`` itself.
-    """
-
-    name: str
-    kind: str
-    expr: Any
-    unit: str = ""
-    description: str = ""
-
-
-@dataclass
-class ConstraintBlock:
-    """lower <= expr <= upper, element-wise over the grid (or a scalar).
-
-    ``labels`` name the rows (e.g. the deflection angle), ``unit`` is the unit of expr.
-    """
-
-    name: str
-    expr: Any
-    lower: float | None = None
-    upper: float | None = None
-    labels: list[str] = field(default_factory=list)
-    unit: str = ""
-    description: str = ""
+from optdesign.errors import InputError, ProblemError
+from optdesign.problem.catalogue import (
+    BUILTIN_OBJECTIVES,
+    ConstraintBlock,
+    ConstraintInfo,
+    ObjectiveInfo,
+    ObjectiveTerm,
+)
+from optdesign.problem.quantities import Quantities
+from optdesign.problem.requirements import requirement_blocks
+from optdesign.problem.spec import ProblemSpec
+from optdesign.problem.variables import Variable
 
 
 @dataclass
 class Expressions:
-    """Objective terms and constraint blocks of one design."""
+    """Objective terms and constraint blocks of one design, and its quantities."""
 
     objectives: dict[str, ObjectiveTerm]
     constraints: list[ConstraintBlock]
-    mechanism: Any
+    quantities: Quantities
+
+    @property
+    def mechanism(self):
+        return self.quantities.mechanism
 
 
-UNITS = {"length": "mm", "angle": "rad", "dimensionless": ""}
+@dataclass
+class BlockValues:
+    """Values of one constraint block on the NumPy path (rows of a population)."""
+
+    values: np.ndarray
+    lower: float | None
+    upper: float | None
+
+
+@dataclass
+class Evaluation:
+    """Objectives and constraints of designs on the NumPy path.
+
+    ``objectives``: name -> value (array over the population, or a float for one
+    design); ``constraints``: block name -> :class:`BlockValues`; ``violation``: the
+    largest relative violation per design.
+    """
+
+    objectives: dict[str, Any]
+    constraints: dict[str, BlockValues]
+    violation: Any
 
 
 class DesignProblem:
@@ -112,32 +75,90 @@ class DesignProblem:
     Parameters
     ----------
     spec
-        The validated problem file.
+        The validated problem file (or dict).
     variables
         The declared variables (fixed and free), in internal units.
+    mechanism
+        The mechanism plug-in class.
     """
 
-    def __init__(self, spec: ProblemSpec, variables: list[Variable]):
+    def __init__(self, spec: ProblemSpec, variables: list[Variable], mechanism: type):
         self.spec = spec
+        self.mechanism = mechanism
         self.variables = variables
         self.by_name = {v.name: v for v in variables}
-        req = spec.requirements
-        self.phi = np.linspace(req.deflection.min, req.deflection.max, req.deflection.points)
-        self.phi_labels = [f"phi={np.degrees(p):+.1f}deg" for p in self.phi]
+        self._objectives: dict[str, ObjectiveInfo] = dict(BUILTIN_OBJECTIVES)
+        self._constraints: list[ConstraintInfo] = []
+        self._grid()
         self._check_consistency()
+        self._touch()
 
-    # --- declared things ---------------------------------------------------------
+    def _grid(self) -> None:
+        d = self.spec.requirements.deflection
+        self.phi = np.linspace(d.min, d.max, d.points)
+        self.phi_labels = [f"phi={np.degrees(p):+.1f}deg" for p in self.phi]
+
+    def _touch(self) -> None:
+        # A new token whenever the problem changes: in-process caches of formulations
+        # and solvers are keyed on it, so a changed problem never reuses a stale solver.
+        self.token = uuid.uuid4().hex
+        self._blob: bytes | None = None
+
+    # --- pickling (problems travel to worker processes) ---------------------------------
+    def __getstate__(self) -> dict[str, Any]:
+        # User functions (lambdas), a mechanism class defined in a notebook and the
+        # spec's model class (derived at run time) do not pickle by reference:
+        # cloudpickle carries the callables and the class by value (once per problem
+        # state), the spec travels as its validated data.
+        if self._blob is None:
+            import cloudpickle
+
+            self._blob = cloudpickle.dumps((self.mechanism, self._objectives, self._constraints))
+        return {
+            "spec": self.spec.model_dump(mode="python"),
+            "variables": self.variables,
+            "blob": self._blob,
+            "token": self.token,
+        }
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        import pickle
+
+        from optdesign.problem.load import validate_spec
+
+        mechanism, objectives, constraints = pickle.loads(state["blob"])
+        self.mechanism = mechanism
+        self.spec = validate_spec(state["spec"], mechanism, internal=True)
+        self.variables = state["variables"]
+        self.by_name = {v.name: v for v in self.variables}
+        self._objectives = objectives
+        self._constraints = constraints
+        self._grid()
+        self.token = state["token"]
+        self._blob = state["blob"]
+
+    # --- declared things ---------------------------------------------------------------
     @property
     def name(self) -> str:
         return self.spec.name
 
     @property
-    def mechanism_kind(self) -> str:
-        return self.spec.mechanism
+    def mechanism_name(self) -> str:
+        return self.mechanism.name
 
     @property
     def objective_names(self) -> list[str]:
+        """The objectives the problem minimises (first: the default)."""
         return list(self.spec.objective.minimize)
+
+    @property
+    def objectives(self) -> dict[str, ObjectiveInfo]:
+        """Every objective this problem can compute (built-in and added)."""
+        return dict(self._objectives)
+
+    @property
+    def user_constraints(self) -> list[ConstraintInfo]:
+        return list(self._constraints)
 
     @property
     def free(self) -> list[Variable]:
@@ -156,10 +177,16 @@ class DesignProblem:
     def upper(self) -> np.ndarray:
         return np.array([v.upper for v in self.free], dtype=float)
 
+    def midpoint(self) -> np.ndarray:
+        """The middle of the bounds: where formulations take their scales (a declared
+        start never changes the scaling, so it cannot steer the search)."""
+        return 0.5 * (self.lower() + self.upper())
+
     def start(self) -> np.ndarray:
         """Initial design: declared starts, else the middle of the bounds."""
+        mid = self.midpoint()
         return np.array(
-            [v.start if v.start is not None else 0.5 * (v.lower + v.upper) for v in self.free]
+            [v.start if v.start is not None else mid[k] for k, v in enumerate(self.free)]
         )
 
     def design_dict(self, x: np.ndarray | Any) -> dict[str, Any]:
@@ -177,14 +204,24 @@ class DesignProblem:
                 design[v.name] = x[k]
         return design
 
+    def describe_variable(self, name: str) -> str:
+        v = self.by_name.get(name)
+        return v.description if v is not None else name
+
     def _check_consistency(self) -> None:
-        spec = self.spec
+        table = self.mechanism.variable_table()
+        missing = [k for k, info in table.items() if info.default is None and not self.has(k)]
+        if missing:
+            raise ProblemError(
+                f"variables.{missing[0]}: required for a {self.mechanism.label()} "
+                f"({table[missing[0]].description})"
+            )
+        req = self.spec.requirements
         needs_pin = (
-            "backlash" in self.objective_names
-            or "backlash_rss" in self.objective_names
-            or spec.requirements.pin_bearing_pressure_max is not None
-            or spec.requirements.pin_shear_stress_max is not None
-            or spec.requirements.backlash_max is not None
+            any(o in ("backlash", "backlash_rss") for o in self.objective_names)
+            or req.pin_bearing_pressure_max is not None
+            or req.pin_shear_stress_max is not None
+            or req.backlash_max is not None
         )
         if needs_pin:
             if not self.has("d"):
@@ -196,59 +233,139 @@ class DesignProblem:
                 raise ProblemError(
                     "variables: declare exactly one of pin_length and pin_length_ratio"
                 )
-        for name in ("p",) + (("R", "l", "n") if spec.mechanism == "crank_slider" else ("R",)):
-            if not self.has(name):
-                raise ProblemError(f"variables.{name}: required for a {spec.mechanism}")
+        unknown = [o for o in self.objective_names if o not in self._objectives]
+        if unknown:
+            raise ProblemError(
+                f"objective.minimize: unknown objective {unknown[0]!r} "
+                f"(known: {', '.join(self._objectives)})"
+            )
+
+    # --- user additions ----------------------------------------------------------------
+    def add_objective(
+        self,
+        name: str,
+        fn: Callable[[Quantities], Any],
+        unit: str = "",
+        kind: str | None = None,
+        description: str = "",
+        formula: str = "",
+        display_unit: str | None = None,
+        display_scale: float = 1.0,
+    ) -> ObjectiveInfo:
+        """Declare an objective ``fn(q)`` (see :class:`~optdesign.problem.quantities.
+        Quantities` for ``q``), written with :mod:`optdesign.math`.
+
+        ``kind``: ``"max"`` (largest value over the stroke), ``"spread"`` ((max - min)/
+        (max + min) over the stroke) or ``"scalar"`` (one value per design); default:
+        ``"max"`` when ``fn`` returns a value per grid angle, else ``"scalar"``. ``unit``
+        is the internal unit of the value. The objective is then available to every
+        study (solve, Pareto, bench ...) by its name.
+        """
+        if not name or not isinstance(name, str):
+            raise InputError("add_objective.name", "give a non-empty name")
+        if kind is None:
+            value = fn(self.quantities(self.design_dict(self.midpoint())))
+            kind = "max" if self.quantities_on_grid(value) else "scalar"
+        info = ObjectiveInfo(
+            name, fn, kind, unit, description or name, formula, display_unit, display_scale
+        )
+        self._objectives[name] = info
+        self._touch()
+        return info
+
+    def add_constraint(
+        self,
+        name: str,
+        fn: Callable[[Quantities], Any],
+        lower: Any = None,
+        upper: Any = None,
+        unit: str = "",
+        over: str = "stroke",
+        description: str = "",
+    ) -> ConstraintInfo:
+        """Require ``lower <= fn(q) <= upper`` (at every grid angle for ``over="stroke"``,
+        once for ``over="design"``).
+
+        Bounds are numbers in ``unit`` or quantity strings (``"3 kN"``) converted to
+        ``unit``; ``unit`` is the internal unit of ``fn``'s value (e.g. ``"N"``).
+        """
+        if any(c.name == name for c in self._constraints):
+            raise InputError("add_constraint.name", f"a constraint {name!r} exists already")
+        info = ConstraintInfo(
+            name,
+            fn,
+            _bound(lower, unit, f"{name}.lower"),
+            _bound(upper, unit, f"{name}.upper"),
+            unit,
+            over,
+            description,
+        )
+        self._constraints.append(info)
+        self._touch()
+        return info
+
+    def remove_constraint(self, name: str) -> None:
+        """Drop the user constraint ``name``."""
+        before = len(self._constraints)
+        self._constraints = [c for c in self._constraints if c.name != name]
+        if len(self._constraints) == before:
+            raise InputError("remove_constraint", f"no user constraint {name!r}")
+        self._touch()
+
+    def set_requirement(self, name: str, value: Any) -> None:
+        """Change (or add; None removes) requirement ``name``, validated like a file."""
+        data = self.spec.model_dump(mode="python")
+        reqs = dict(data["requirements"])
+        if value is None:
+            reqs.pop(name, None)
+        else:
+            reqs[name] = value
+        self._revalidate({**data, "requirements": reqs})
+
+    def set_objective(self, *names: str) -> None:
+        """Change the objective(s) the problem minimises."""
+        data = self.spec.model_dump(mode="python")
+        self._revalidate({**data, "objective": {"minimize": list(names)}})
+
+    def _revalidate(self, data: dict[str, Any]) -> None:
+        from optdesign.problem.load import validate_spec
+
+        self.spec = validate_spec(data, self.mechanism, source=self.name)
+        self._grid()
+        self._check_consistency()
+        self._touch()
+
+    def quantities_on_grid(self, value) -> bool:
+        """True when ``value`` varies over the deflection grid."""
+        n = len(self.phi)
+        if m.is_symbolic(value):
+            return value.shape[0] == n and n > 1
+        shape = getattr(value, "shape", np.shape(value))
+        return bool(shape) and shape[-1] == n and n > 1
 
     # --- the model ---------------------------------------------------------------------
-    def mechanism(self, design: Mapping[str, Any], guarded: bool = False):
-        """The mechanism of ``design``; ``guarded`` adds the solver's sqrt guard."""
-        get = design.get
-        if self.spec.mechanism == "crank_slider":
-            return CrankSlider(
-                design["R"],
-                design["l"],
-                design["n"],
-                design["p"],
-                get("i_a", 1.0),
-                get("phi0", 0.0),
-                floor=ASSEMBLY_FLOOR if guarded else None,
-            )
-        return ShiftingFork(design["R"], design["p"], get("i_a", 1.0), get("phi0", 0.0))
-
-    def pin(self, design: Mapping[str, Any], first_order: bool = False) -> PinJoint | None:
-        """The pin joint of ``design`` (None if the problem has no pin)."""
-        if "d" not in design:
-            return None
-        d = design["d"]
-        L = design["pin_length"] if "pin_length" in design else design["pin_length_ratio"] * d
-        mat = self.spec.materials.pin
-        req = self.spec.requirements
-        return PinJoint(d, L, req.fit, req.fit_clearance, mat.E, mat.nu, 2, first_order)
-
-    def joints(self, mech, pin: PinJoint | None) -> list[Joint]:
-        """The clearance chain: the sized pin joint(s) plus the declared fixed clearances
-        (``[clearances]`` A, B, C, O, keyed by the paper's joint letters)."""
-        c = self.spec.clearances
-        fixed = {"A": c.A, "B": c.B, "C": c.C, "O": c.O}
-        joints = []
-        for joint in mech.default_joints(pin):
-            if joint.pin is not None:
-                joints.append(joint)
-            elif fixed.get(joint.name[0]):
-                joints.append(replace(joint, clearance=fixed[joint.name[0]]))
-        return joints
+    def quantities(
+        self,
+        design: Mapping[str, Any],
+        guarded: bool = False,
+        first_order: bool = False,
+        fit_fractions=None,
+    ) -> Quantities:
+        """The quantities of ``design`` (computed lazily)."""
+        return Quantities(self, design, guarded, first_order, fit_fractions)
 
     def objective_limits(self) -> dict[str, float]:
         """Upper limits that the requirements put on objective quantities."""
         req = self.spec.requirements
-        limits = {}
-        if req.ripple_max is not None:
-            limits["ripple"] = req.ripple_max
-        return limits
+        return {"ripple": req.ripple_max} if req.ripple_max is not None else {}
 
     def expressions(
-        self, design: Mapping[str, Any], guarded: bool = False, first_order: bool = False
+        self,
+        design: Mapping[str, Any],
+        guarded: bool = False,
+        first_order: bool = False,
+        fit_fractions=None,
+        share: bool = True,
     ) -> Expressions:
         """Objective terms and constraint blocks of ``design``.
 
@@ -260,286 +377,96 @@ class DesignProblem:
             Guard square roots for a solver (CasADi path).
         first_order
             Use first-order Hertz flattening (the GP form).
+        fit_fractions
+            One fit fraction per sized pin (robust design), None for the nominal fit.
+        share
+            Share the model functions' results within this call (False: each use
+            computes its own, to show that sharing changes no value).
         """
-        # Every block below asks the mechanism for the same few quantities: share them
-        # (one expression node, or one NumPy evaluation, per quantity).
+        if not share:
+            return self._build(design, guarded, first_order, fit_fractions)
+        # Every block asks for the same few quantities: share the model functions'
+        # results (one expression node, or one NumPy evaluation, per quantity).
         with m.shared_subexpressions():
-            return self._expressions(design, guarded, first_order)
+            return self._build(design, guarded, first_order, fit_fractions)
 
-    def _expressions(
-        self, design: Mapping[str, Any], guarded: bool, first_order: bool
-    ) -> Expressions:
-        req = self.spec.requirements
-        phi = self.phi
-        mech = self.mechanism(design, guarded)
-        pin = self.pin(design, first_order)
-        M_h = req.hinge_moment
-        ratio = mech.ratio(phi)
-        labels = self.phi_labels
-        obj: dict[str, ObjectiveTerm] = {}
-        con: list[ConstraintBlock] = []
-
-        obj["ripple"] = ObjectiveTerm(
-            "ripple", "spread", ratio, "", "ratio ripple (i_max - i_min)/(i_max + i_min)"
-        )
-        travel = mech.nut_position(phi[-1]) - mech.nut_position(phi[0])
-        obj["nut_travel"] = ObjectiveTerm("nut_travel", "scalar", travel, "mm", "nut travel")
-        if self.spec.mechanism == "crank_slider":
-            size = design["R"] + design["l"]
-            size_text = "linkage size R + l"
-        else:
-            size = design["R"]
-            size_text = "lever size R"
-        obj["size"] = ObjectiveTerm("size", "scalar", size, "mm", size_text)
-        torque = mech.motor_torque(phi, M_h, req.eta_screw, req.eta_gear)
-        obj["motor_torque"] = ObjectiveTerm(
-            "motor_torque", "max", torque, "N*mm", "largest motor torque over the stroke"
-        )
-        if pin is not None:
-            backlash = mech.backlash(phi, self.joints(mech, pin), M_h)
-            obj["backlash"] = ObjectiveTerm(
-                "backlash", "max", backlash.worst_case, "deg", "worst-case output backlash"
-            )
-            obj["backlash_rss"] = ObjectiveTerm(
-                "backlash_rss", "max", backlash.rss, "deg", "RSS output backlash"
-            )
-
-        # The linkage must not pass a dead point inside the stroke: positive ratio.
-        con.append(
-            ConstraintBlock("ratio_positive", ratio, 1.0, None, labels, "", "ratio i(phi) >= 1")
-        )
-        if self.spec.mechanism == "crank_slider":
-            l = design["l"]
-            margin = cs_model.assembly_margin(design["R"], l, design["n"], phi, mech.phi0) / l**2
-            con.append(
-                ConstraintBlock(
-                    "assembly_margin",
-                    margin,
-                    req.assembly_margin_min,
-                    None,
-                    labels,
-                    "",
-                    "(l^2 - u^2)/l^2: the rod reaches the nut line",
+    def _build(self, design, guarded, first_order, fit_fractions) -> Expressions:
+        q = self.quantities(design, guarded, first_order, fit_fractions)
+        objectives: dict[str, ObjectiveTerm] = {}
+        for info in self._objectives.values():
+            try:
+                expr = info.fn(q)
+            except Exception as exc:
+                if info.name in BUILTIN_OBJECTIVES:
+                    raise
+                raise ProblemError(
+                    f"objective {info.name!r}: its function raised {type(exc).__name__}: {exc}"
+                ) from exc
+            if expr is not None:
+                objectives[info.name] = ObjectiveTerm(
+                    info.name, info.kind, expr, info.unit, info.description
                 )
-            )
-            if req.transmission_angle is not None:
-                ta = req.transmission_angle
-                # cos is decreasing on [0, pi]: mu in [lo, hi] <=> cos mu in [cos hi, cos lo]
-                con.append(
-                    ConstraintBlock(
-                        "transmission_angle",
-                        cs_model.transmission_angle_cos(
-                            design["R"], l, design["n"], phi, mech.phi0, mech.floor
-                        ),
-                        None if ta.max is None else float(np.cos(ta.max)),
-                        None if ta.min is None else float(np.cos(ta.min)),
-                        labels,
-                        "",
-                        "cos of the transmission angle",
-                    )
-                )
-            if req.rod_inclination_max is not None:
-                # |atan2(u, s)| <= theta  <=>  |u|/l <= sin(theta)  (s > 0 on the branch)
-                s_max = float(np.sin(req.rod_inclination_max))
-                con.append(
-                    ConstraintBlock(
-                        "rod_inclination",
-                        cs_model.rod_rise(design["R"], design["n"], phi, mech.phi0) / l,
-                        -s_max,
-                        s_max,
-                        labels,
-                        "",
-                        "sin of the rod inclination to the screw axis",
-                    )
-                )
-        if req.mean_ratio is not None:
-            con.append(
-                ConstraintBlock(
-                    "mean_ratio",
-                    m.grid_mean(ratio),
-                    req.mean_ratio.min,
-                    req.mean_ratio.max,
-                    [""],
-                    "",
-                    "mean ratio over the grid",
-                )
-            )
-        if req.nut_travel_max is not None:
-            con.append(
-                ConstraintBlock(
-                    "nut_travel", travel, None, req.nut_travel_max, [""], "mm", "nut travel"
-                )
-            )
-        if pin is not None:
-            load = "rod" if self.spec.mechanism == "crank_slider" else "pin_normal"
-            F = mech.joint_force(load, phi, M_h)
-            if req.pin_bearing_pressure_max is not None:
-                con.append(
-                    ConstraintBlock(
-                        "pin_bearing_pressure",
-                        pin_bearing_pressure(F, pin.d, pin.L),
-                        None,
-                        req.pin_bearing_pressure_max,
-                        labels,
-                        "MPa",
-                        "pin bearing pressure F/(d L)",
-                    )
-                )
-            if req.pin_shear_stress_max is not None:
-                planes = req.pin_shear_planes or (2 if self.spec.mechanism == "crank_slider" else 1)
-                con.append(
-                    ConstraintBlock(
-                        "pin_shear_stress",
-                        pin_shear_stress(F, pin.d, planes),
-                        None,
-                        req.pin_shear_stress_max,
-                        labels,
-                        "MPa",
-                        f"pin shear stress ({'double' if planes == 2 else 'single'} shear)",
-                    )
-                )
-            if req.backlash_max is not None:
-                con.append(
-                    ConstraintBlock(
-                        "backlash",
-                        obj["backlash"].expr,
-                        None,
-                        float(np.degrees(req.backlash_max)),
-                        labels,
-                        "deg",
-                        "worst-case output backlash",
-                    )
-                )
-        if req.screw is not None:
-            self._screw_constraints(con, mech, phi, M_h, labels)
-        if req.lock is not None:
-            lock_force = self._lock_force(mech, phi, M_h)
-            obj["lock_force"] = ObjectiveTerm(
-                "lock_force", "max", lock_force, "N", "magnet force of the motor-shaft lock"
-            )
-            if req.lock.force_max is not None:
-                con.append(
-                    ConstraintBlock(
-                        "lock_force",
-                        lock_force,
-                        None,
-                        req.lock.force_max,
-                        labels,
-                        "N",
-                        "magnet force of the motor-shaft lock",
-                    )
-                )
-        if req.motor_torque_max is not None:
-            con.append(
-                ConstraintBlock(
-                    "motor_torque",
-                    torque,
-                    None,
-                    req.motor_torque_max,
-                    labels,
-                    "N*mm",
-                    "motor torque",
-                )
-            )
-        return Expressions(obj, con, mech)
-
-    def _screw_constraints(self, con, mech, phi, M_h, labels) -> None:
-        """Buckling and yield of the screw shaft under the nut force at every angle."""
-        from optdesign.models.screw_sizing import buckling_load, yield_load
-
-        sz = self.spec.requirements.screw
-        F_a = mech.nut_force(phi, M_h)
-        if sz.buckling_length is not None:
-            P1 = buckling_load(sz.root_diameter, sz.buckling_length, sz.mounting)
-            con.append(
-                ConstraintBlock(
-                    "screw_buckling",
-                    F_a,
-                    None,
-                    float(P1),
-                    labels,
-                    "N",
-                    f"nut force <= buckling load ({sz.mounting})",
-                )
-            )
-        if sz.check_yield:
-            con.append(
-                ConstraintBlock(
-                    "screw_yield",
-                    F_a,
-                    None,
-                    float(yield_load(sz.root_diameter)),
-                    labels,
-                    "N",
-                    "nut force <= permissible shaft load",
-                )
-            )
-
-    def _lock_force(self, mech, phi, M_h):
-        """Magnet force the lock needs at each angle (N), seed 002 coupled to the drive."""
-        from optdesign.models.lock import FrictionPlateLock, PinLock, motor_shaft_lock_load
-
-        lk = self.spec.requirements.lock
-        if lk.kind == "friction_plate":
-            lock = FrictionPlateLock(lk.r1, lk.r2, lk.mu)
-        else:
-            lock = PinLock(lk.radius, bearing="guide" if lk.kind == "pin_rolling" else None)
-        load = motor_shaft_lock_load(mech, phi, M_h, lk.eta_screw_back, lk.eta_gear_back)
-        return lock.force(load.moment)
+        backlash = objectives["backlash"].expr if "backlash" in objectives else None
+        blocks = requirement_blocks(q, self._constraints, backlash)
+        return Expressions(objectives, blocks, q)
 
     # --- numeric evaluation (NumPy path) ------------------------------------------------
-    def evaluate(self, x: np.ndarray) -> dict[str, Any]:
+    def evaluate(self, x: np.ndarray) -> Evaluation:
         """Objectives and constraint values of designs ``x`` on the NumPy path.
 
-        Parameters
-        ----------
-        x
-            Free-variable vector (1-D) or population (2-D, one design per row).
-
-        Returns
-        -------
-        dict
-            ``objectives``: name -> value (array over the population);
-            ``constraints``: block name -> (values, lower, upper);
-            ``violation``: largest relative violation per design.
+        ``x``: the free-variable vector (1-D) or a population (2-D, one design per row).
         """
         x = np.asarray(x, dtype=float)
         single = x.ndim == 1
         X = x[None, :] if single else x
-        with np.errstate(invalid="ignore", divide="ignore"):
+        pop = X.shape[0]
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             ex = self.expressions(self.design_dict(X))
-            pop = X.shape[0]
-            objectives = {}
-            for name, term in ex.objectives.items():
-                objectives[name] = term_values(term, pop, len(self.phi))
-            constraints = {}
+            objectives = {
+                name: term_values(term, pop, len(self.phi)) for name, term in ex.objectives.items()
+            }
+            constraints: dict[str, BlockValues] = {}
             worst = np.zeros(pop)
             for block in ex.constraints:
                 e = np.asarray(block.expr, dtype=float)
                 e = e.reshape(pop, -1) if e.size % pop == 0 and e.ndim > 0 else np.full((pop, 1), e)
                 viol = relative_violation(e, block.lower, block.upper)
                 worst = np.maximum(worst, np.nan_to_num(viol.max(axis=-1), nan=np.inf))
-                constraints[block.name] = (e, block.lower, block.upper)
+                constraints[block.name] = BlockValues(e, block.lower, block.upper)
             for name, limit in self.objective_limits().items():
                 val = objectives[name][:, None]
                 worst = np.maximum(worst, relative_violation(val, None, limit)[:, 0])
-                constraints[f"{name}_max"] = (val, None, limit)
+                constraints[f"{name}_max"] = BlockValues(val, None, limit)
         if single:
             objectives = {k: float(v[0]) for k, v in objectives.items()}
-            constraints = {k: (v[0][0], v[1], v[2]) for k, v in constraints.items()}
+            constraints = {
+                k: BlockValues(v.values[0], v.lower, v.upper) for k, v in constraints.items()
+            }
             worst = float(worst[0])
-        return {"objectives": objectives, "constraints": constraints, "violation": worst}
+        return Evaluation(objectives, constraints, worst)
 
-    def describe_variable(self, name: str) -> str:
-        return VARIABLE_DESCRIPTIONS.get(name, name)
+
+def _bound(value: Any, unit: str, field: str) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, str):
+        from optdesign.units import convert
+
+        return convert(value, unit, field)
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"expected a number or a quantity string, got {value!r}") from None
+    if not np.isfinite(v):
+        raise InputError(field, f"must be finite, got {value!r}")
+    return v
 
 
 def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
     """Value of an objective term for each of ``pop`` designs on the NumPy path."""
     e = np.broadcast_to(np.asarray(term.expr, dtype=float), (pop, n_phi))
     if term.kind == "spread":
-        hi, lo = e.max(axis=-1), e.min(axis=-1)
-        return (hi - lo) / (hi + lo)
+        return m.grid_spread(e)
     if term.kind == "max":
         return e.max(axis=-1)
     return e[:, 0]

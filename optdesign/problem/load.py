@@ -1,29 +1,24 @@
-"""Load and validate a problem file (TOML) into a :class:`DesignProblem`.
+"""Load and validate a problem (TOML file or dict) into a :class:`DesignProblem`.
 
 Errors name the field (``variables.R.lower: ...``) and never show a traceback in the CLI.
+The schema comes from the mechanism the problem names (:func:`optdesign.problem.spec.
+spec_model`), so a new mechanism plug-in brings its variables and requirements with it.
 """
 
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from pydantic import ValidationError
 
 from optdesign.errors import InputError, ProblemError
-from optdesign.problem.design_problem import UNITS, DesignProblem, Variable
-from optdesign.problem.spec import VARIABLE_DESCRIPTIONS, VARIABLE_DIMENSIONS, ProblemSpec
-from optdesign.units import to_internal
-
-#: Catalogues a discrete variable may name (physics.md 10).
-CATALOGUES: dict[str, tuple[float, ...]] = {
-    "ISO 3408": (1, 2, 2.5, 3, 4, 5, 6, 8, 10, 12, 16, 20, 25, 32, 40),
-    "ISO 2338": (3, 4, 5, 6, 8, 10, 12, 16, 20, 25),
-}
-
-#: Variables that must be positive when fixed or bounded.
-POSITIVE = {"R", "l", "p", "i_a", "d", "pin_length", "pin_length_ratio"}
+from optdesign.mechanisms.registry import get_mechanism, registered
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.spec import ProblemSpec, spec_model
+from optdesign.problem.variables import parse_variable, variable_table
 
 
 def load_problem(path: str | Path) -> DesignProblem:
@@ -33,6 +28,8 @@ def load_problem(path: str | Path) -> DesignProblem:
         text = path.read_text()
     except OSError as exc:
         raise ProblemError(f"{path}: cannot read problem file ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise ProblemError(f"{path}: not a text file (TOML must be UTF-8)") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -41,10 +38,24 @@ def load_problem(path: str | Path) -> DesignProblem:
     return problem_from_dict(data, source=str(path))
 
 
-def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignProblem:
-    """Validate a problem given as a dict (the parsed TOML)."""
+def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProblem:
+    """A problem from a file path, a dict (the parsed-TOML form) or a problem (returned)."""
+    if isinstance(problem, DesignProblem):
+        return problem
+    if isinstance(problem, Mapping):
+        return problem_from_dict(dict(problem))
+    return load_problem(problem)
+
+
+def validate_spec(
+    data: dict[str, Any], mechanism: type, source: str = "problem", internal: bool = False
+) -> ProblemSpec:
+    """Validate ``data`` against the schema of ``mechanism``; ProblemError naming fields.
+
+    ``internal``: ``data`` is a validated spec's own dump (numbers in internal units).
+    """
     try:
-        spec = ProblemSpec.model_validate(data)
+        return spec_model(mechanism).model_validate(data, context={"internal": internal})
     except ValidationError as exc:
         lines = []
         for err in exc.errors():
@@ -54,82 +65,37 @@ def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignPr
                 msg = "unknown field"
             lines.append(f"{loc}: {msg}")
         raise ProblemError(f"{source}: invalid problem file\n  " + "\n  ".join(lines)) from None
-    variables = [_variable(spec.mechanism, name, raw) for name, raw in spec.variables.items()]
-    return DesignProblem(spec, variables)
 
 
-def _variable(mechanism: str, name: str, raw: Any) -> Variable:
-    known = VARIABLE_DIMENSIONS[mechanism]
-    field = f"variables.{name}"
-    if name not in known:
+def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignProblem:
+    """Validate a problem given as a dict (the parsed TOML)."""
+    if not isinstance(data, dict):
+        raise ProblemError(f"{source}: a problem is a table of sections, got {type(data).__name__}")
+    name = data.get("mechanism")
+    if not isinstance(name, str):
         raise ProblemError(
-            f"{field}: unknown variable for a {mechanism} (known: {', '.join(known)})"
+            f"{source}: mechanism: give the mechanism's name "
+            f"(registered: {', '.join(registered())})"
         )
-    dim = known[name]
-    unit = UNITS[dim]
-    desc = VARIABLE_DESCRIPTIONS[name]
-
-    def q(value: Any, sub: str) -> float:
-        try:
-            return to_internal(value, dim, f"{field}.{sub}" if sub else field)
-        except InputError as exc:
-            raise ProblemError(str(exc)) from None
-
-    if not isinstance(raw, dict):
-        value = q(raw, "")
-        _check_sign(name, value, field)
-        return Variable(name, desc, unit, value=value)
-    allowed = {"value", "lower", "upper", "start", "values", "catalogue"}
-    extra = set(raw) - allowed
-    if extra:
-        raise ProblemError(
-            f"{field}.{sorted(extra)[0]}: unknown field (allowed: {sorted(allowed)})"
-        )
-    if "value" in raw:
-        if set(raw) - {"value"}:
-            raise ProblemError(f"{field}: a fixed value excludes bounds and catalogues")
-        value = q(raw["value"], "value")
-        _check_sign(name, value, field)
-        return Variable(name, desc, unit, value=value)
-    lower = q(raw["lower"], "lower") if "lower" in raw else None
-    upper = q(raw["upper"], "upper") if "upper" in raw else None
-    values = None
-    if "values" in raw or "catalogue" in raw:
-        if "values" in raw:
-            if not isinstance(raw["values"], list) or not raw["values"]:
-                raise ProblemError(f"{field}.values: must be a non-empty list")
-            values = [q(v, f"values[{k}]") for k, v in enumerate(raw["values"])]
-        else:
-            cat = raw["catalogue"]
-            if cat not in CATALOGUES:
+    try:
+        cls = get_mechanism(name)
+    except InputError as exc:
+        raise ProblemError(f"{source}: {exc}") from None
+    spec = validate_spec(data, cls, source)
+    table = variable_table(cls)
+    variables = []
+    for var_name, raw in spec.variables.items():
+        if var_name not in table:
+            raise ProblemError(
+                f"variables.{var_name}: unknown variable for a {cls.label()} "
+                f"(known: {', '.join(table)})"
+            )
+        variables.append(parse_variable(var_name, raw, table[var_name], cls.name))
+    declared = {v.name for v in variables}
+    if spec.tolerances is not None:
+        for var_name in spec.tolerances.variables():
+            if var_name not in declared:
                 raise ProblemError(
-                    f"{field}.catalogue: unknown catalogue {cat!r} (known: {', '.join(CATALOGUES)})"
+                    f"tolerances.{var_name}: {var_name} is not a variable of this problem"
                 )
-            values = list(CATALOGUES[cat])
-        if lower is not None:
-            values = [v for v in values if v >= lower - 1e-12]
-        if upper is not None:
-            values = [v for v in values if v <= upper + 1e-12]
-        if not values:
-            raise ProblemError(f"{field}: no catalogue value lies within the bounds")
-        values = sorted(set(values))
-        lower, upper = values[0], values[-1]
-    if lower is None or upper is None:
-        missing = "lower" if lower is None else "upper"
-        raise ProblemError(f"{field}.{missing}: a free variable needs both bounds")
-    if lower > upper:
-        raise ProblemError(
-            f"{field}: lower bound {lower:g} {unit} is above upper bound {upper:g} {unit}"
-        )
-    _check_sign(name, lower, f"{field}.lower")
-    start = q(raw["start"], "start") if "start" in raw else None
-    if start is not None and not lower <= start <= upper:
-        raise ProblemError(f"{field}.start: {start:g} lies outside [{lower:g}, {upper:g}]")
-    if lower == upper:
-        return Variable(name, desc, unit, value=lower)
-    return Variable(name, desc, unit, lower, upper, None, tuple(values) if values else None, start)
-
-
-def _check_sign(name: str, value: float, field: str) -> None:
-    if name in POSITIVE and not value > 0:
-        raise ProblemError(f"{field}: must be positive, got {value:g}")
+    return DesignProblem(spec, variables, cls)

@@ -1,11 +1,17 @@
 """Schema of a problem file, validated with pydantic; every quantity may carry a unit.
 
-Quantities are converted to the internal units (mm, N, MPa, N*mm, rad) on load by
-:func:`optdesign.units.to_internal`; a bare number is taken as already internal.
+The generic part (:class:`ProblemSpec`) holds what every mechanism shares: the stroke, the
+hinge moment, the drive and pin requirements, the objective, the solver settings. The
+mechanism-specific part is *derived from the mechanism plug-in* by :func:`spec_model`:
+its requirements (e.g. a crank-slider's transmission angle), the keys of its fixed
+clearances, the variables a tolerance or a reference design may name. Quantities are
+converted to the internal units (mm, N, MPa, N*mm, rad) on load by
+:func:`optdesign.units.to_internal`.
 """
 
 from __future__ import annotations
 
+from functools import cache
 from typing import Annotated, Any, Literal
 
 from pydantic import (
@@ -14,6 +20,7 @@ from pydantic import (
     ConfigDict,
     Field,
     ValidationInfo,
+    create_model,
     field_validator,
     model_validator,
 )
@@ -40,54 +47,19 @@ Pressure = Annotated[float, _quantity("pressure")]
 Force = Annotated[float, _quantity("force")]
 Dimensionless = Annotated[float, _quantity("dimensionless")]
 
+#: dimension name -> annotated type of a parsed quantity.
+QUANTITY_TYPES: dict[str, Any] = {
+    "length": Length,
+    "angle": Angle,
+    "moment": Moment,
+    "pressure": Pressure,
+    "force": Force,
+    "dimensionless": Dimensionless,
+}
+
 
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-#: Design variables of the crank-slider, and their dimension.
-_CRANK_SLIDER_VARIABLES: dict[str, str] = {
-    "R": "length",
-    "l": "length",
-    "n": "length",
-    "p": "length",
-    "phi0": "angle",
-    "i_a": "dimensionless",
-    "d": "length",
-    "pin_length": "length",
-    "pin_length_ratio": "dimensionless",
-}
-
-#: Design variables each mechanism knows. The fork has no rod and no offset: its lever
-#: R is the distance from the output axis to the pin's line.
-VARIABLE_DIMENSIONS: dict[str, dict[str, str]] = {
-    "crank_slider": _CRANK_SLIDER_VARIABLES,
-    "fork": {k: v for k, v in _CRANK_SLIDER_VARIABLES.items() if k not in ("l", "n")},
-}
-
-#: What each variable is, for tables and errors.
-VARIABLE_DESCRIPTIONS: dict[str, str] = {
-    "R": "arm length",
-    "l": "rod length",
-    "n": "offset of the screw axis",
-    "p": "screw lead",
-    "phi0": "neutral angle",
-    "i_a": "gear ratio",
-    "d": "pin diameter",
-    "pin_length": "pin length L",
-    "pin_length_ratio": "pin length ratio L/d",
-}
-
-#: Objective names a problem may minimise.
-OBJECTIVES = (
-    "ripple",
-    "backlash",
-    "backlash_rss",
-    "size",
-    "nut_travel",
-    "motor_torque",
-    "lock_force",
-)
 
 
 class Deflection(_Model):
@@ -129,6 +101,21 @@ class AngleBand(_OrderedBand):
     max: Angle | None = None
 
 
+class LengthBand(_OrderedBand):
+    """A length band [min, max] (mm once parsed)."""
+
+    min: Length | None = None
+    max: Length | None = None
+
+
+#: dimension -> band model of a ``kind="band"`` requirement.
+BAND_TYPES: dict[str, type[_OrderedBand]] = {
+    "angle": AngleBand,
+    "length": LengthBand,
+    "dimensionless": Band,
+}
+
+
 class Material(_Model):
     """Elastic constants of a pin material."""
 
@@ -148,21 +135,8 @@ class Materials(_Model):
     pin: Material = Material()
 
 
-class Clearances(_Model):
-    """Fixed clearances of the joints that are not sized by the problem (seed 000 Fig. 8-9).
-
-    A, B: axial (screw bearings, screw/nut), C: nut slide across the screw axis
-    (crank-slider), O: output shaft (angle).
-    """
-
-    A: Length = 0.0
-    B: Length = 0.0
-    C: Length = 0.0
-    O: Angle = 0.0
-
-
 class ScrewSizing(_Model):
-    """Catalogue sizing checks of the screw shaft under the nut force (physics.md 8)."""
+    """Catalogue sizing checks of the screw shaft under the nut force."""
 
     root_diameter: Length
     buckling_length: Length | None = None
@@ -205,17 +179,15 @@ class MotorLock(_Model):
 
 
 class Requirements(_Model):
-    """What a design must meet. Omitted requirements are not imposed."""
+    """What a design must meet, whatever the mechanism. Omitted ones are not imposed.
+
+    A mechanism adds its own requirements to this model (:func:`spec_model`).
+    """
 
     deflection: Deflection
     hinge_moment: Moment
     mean_ratio: Band | None = None
     nut_travel_max: Length | None = None
-    transmission_angle: AngleBand | None = None
-    rod_inclination_max: Angle | None = None
-    assembly_margin_min: float = Field(
-        0.01, ge=0.0, lt=1.0, description="smallest (l^2 - u^2)/l^2 over the grid"
-    )
     pin_bearing_pressure_max: Pressure | None = None
     pin_shear_stress_max: Pressure | None = None
     pin_shear_planes: int | None = Field(None, ge=1, le=2)
@@ -240,9 +212,10 @@ class Requirements(_Model):
 
 
 class Objective(_Model):
-    """Objective(s) to minimise; several for Pareto fronts."""
+    """Objective(s) to minimise; several for Pareto fronts. Names are checked against the
+    problem's objective catalogue (built-in and user-added) when the problem is built."""
 
-    minimize: list[Literal[OBJECTIVES]]  # type: ignore[valid-type]
+    minimize: list[str] = Field(min_length=1)
 
     @model_validator(mode="before")
     @classmethod
@@ -266,6 +239,8 @@ def _band_table(data: Any) -> Any:
 
 
 class _Tolerance(_Model):
+    distribution: Literal["normal", "uniform"] = "normal"
+
     @model_validator(mode="after")
     def _non_negative(self):
         if self.band < 0:  # type: ignore[attr-defined]
@@ -278,37 +253,31 @@ class LengthTolerance(_Tolerance):
     sigma = band/3 (a process capability Cp = 1)."""
 
     band: Length
-    distribution: Literal["normal", "uniform"] = "normal"
 
 
 class AngleTolerance(_Tolerance):
     """Manufacturing tolerance +-band of an angle (see :class:`LengthTolerance`)."""
 
     band: Angle
-    distribution: Literal["normal", "uniform"] = "normal"
 
 
-_LengthTol = Annotated[LengthTolerance, BeforeValidator(_band_table)]
-_AngleTol = Annotated[AngleTolerance, BeforeValidator(_band_table)]
+TOLERANCE_TYPES: dict[str, Any] = {
+    "length": Annotated[LengthTolerance, BeforeValidator(_band_table)],
+    "angle": Annotated[AngleTolerance, BeforeValidator(_band_table)],
+}
 
 
 class Tolerances(_Model):
     """Manufacturing scatter of a design, for robust design (formulations/robust.py).
 
-    R, l, n, p, d: length tolerances; phi0: angle tolerance. ``fit = "uniform"`` draws
-    each pin joint's fit clearance uniformly between the fit's smallest and largest
-    clearance (``"fixed"``: the requirement's ``fit_clearance``). ``samples`` and ``seed``
-    fix the sample-average approximation; ``risk`` is the minimised statistic of the
-    objective over the samples: ``"cvar"`` (mean of the worst 1 - alpha) or
-    ``"mean_std"`` (mean + k std).
+    Any length or angle variable may get a tolerance (fields derived per mechanism).
+    ``fit = "uniform"`` draws each pin joint's fit clearance uniformly between the fit's
+    smallest and largest clearance (``"fixed"``: the requirement's ``fit_clearance``).
+    ``samples`` and ``seed`` fix the sample-average approximation; ``risk`` is the
+    minimised statistic of the objective over the samples: ``"cvar"`` (mean of the worst
+    1 - alpha) or ``"mean_std"`` (mean + k std).
     """
 
-    R: _LengthTol | None = None
-    l: _LengthTol | None = None
-    n: _LengthTol | None = None
-    p: _LengthTol | None = None
-    d: _LengthTol | None = None
-    phi0: _AngleTol | None = None
     fit: Literal["fixed", "uniform"] = "fixed"
     samples: int = Field(32, ge=1, le=2000)
     seed: int = 0
@@ -316,19 +285,85 @@ class Tolerances(_Model):
     alpha: float = Field(0.9, ge=0.0, lt=1.0)
     k: float = Field(2.0, ge=0.0)
 
+    def variables(self) -> dict[str, Any]:
+        """Variable name -> tolerance, for the variables that have one."""
+        own = set(Tolerances.model_fields)
+        return {k: v for k, v in self if k not in own and v is not None}
+
+
+class Reference(_Model):
+    """A design to compare with (e.g. a paper's): a label and variable values (fields
+    derived per mechanism)."""
+
+    label: str = "reference"
+
+    def values(self) -> dict[str, float]:
+        """Variable name -> value (internal units) for the variables given."""
+        return {k: v for k, v in self if k != "label" and v is not None}
+
 
 class ProblemSpec(_Model):
-    """A whole problem file."""
+    """A whole problem file (generic part; :func:`spec_model` derives the one of a
+    mechanism)."""
 
     name: str
     description: str = ""
-    mechanism: Literal["crank_slider", "fork"]
+    mechanism: str
     variables: dict[str, Any]
     requirements: Requirements
     materials: Materials = Materials()
-    clearances: Clearances = Clearances()
+    clearances: _Model | None = None
     objective: Objective
     solver: SolverOptions = SolverOptions()
     tolerances: Tolerances | None = None
-    #: A design to compare with (e.g. a paper's); checked by optdesign.studies.reference.
-    reference: dict[str, Any] | None = None
+    reference: Reference | None = None
+
+
+def _requirement_field(info) -> tuple[Any, Any]:
+    """Pydantic field (type, default) of a mechanism-specific requirement."""
+    if info.kind == "band":
+        typ: Any = BAND_TYPES[info.dimension]
+    elif info.kind == "value":
+        typ = QUANTITY_TYPES[info.dimension]
+    else:
+        raise ValueError(f"requirement kind {info.kind!r}: use 'band' or 'value'")
+    if info.default is None:
+        return (typ | None, Field(None, description=info.description))
+    return (typ, Field(info.default, description=info.description))
+
+
+@cache
+def spec_model(mechanism_cls: type) -> type[ProblemSpec]:
+    """The problem-file model of one mechanism class (cached per class).
+
+    Its ``requirements`` gain the mechanism's :attr:`~Mechanism.requirements`;
+    ``clearances`` takes the keys of its fixed clearances; ``tolerances`` and
+    ``reference`` accept its variables and the framework's (drive, pin).
+    """
+    from optdesign.problem.variables import variable_table
+
+    name = mechanism_cls.__name__
+    req_fields = {k: _requirement_field(v) for k, v in mechanism_cls.requirements.items()}
+    Req = create_model(f"{name}Requirements", __base__=Requirements, **req_fields)
+    cl_fields: dict[str, Any] = {
+        key: (QUANTITY_TYPES[dim], Field(0.0, ge=0.0, description=desc))
+        for key, (dim, desc) in mechanism_cls.fixed_clearances.items()
+    }
+    Cl = create_model(f"{name}Clearances", __base__=_Model, **cl_fields)
+    table = variable_table(mechanism_cls)
+    tol_fields = {
+        k: (TOLERANCE_TYPES[v.dimension] | None, None)
+        for k, v in table.items()
+        if v.dimension in TOLERANCE_TYPES
+    }
+    Tol = create_model(f"{name}Tolerances", __base__=Tolerances, **tol_fields)
+    ref_fields = {k: (QUANTITY_TYPES[v.dimension] | None, None) for k, v in table.items()}
+    Ref = create_model(f"{name}Reference", __base__=Reference, **ref_fields)
+    return create_model(
+        f"{name}ProblemSpec",
+        __base__=ProblemSpec,
+        requirements=(Req, ...),
+        clearances=(Cl, Cl()),
+        tolerances=(Tol | None, None),
+        reference=(Ref | None, None),
+    )

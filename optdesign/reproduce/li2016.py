@@ -15,7 +15,7 @@ import numpy as np
 
 from optdesign.models import error_budget as eb
 from optdesign.models import roller_screw as rs
-from optdesign.report import Comparison, comparison_table, format_table
+from optdesign.reports.tables import Comparison, comparison_table, format_table
 from optdesign.studies.monte_carlo import plot_ranking, run_monte_carlo
 
 R_S, R_RP, F_K, F_R = 0.04e3, 0.01e3, 0.055, 1e-5 * 1e3
@@ -67,7 +67,9 @@ def run(out: Path) -> int:
     print(comparison_table(rows))
 
     # optdesign.plots selects the Agg back-end before pyplot loads
-    from optdesign.plots import plt, save_figure
+    import matplotlib.pyplot as plt
+
+    from optdesign.plots import save_figure
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
     for a in (2.0, 5.0, 10.0, 15.0, 20.0, 30.0):

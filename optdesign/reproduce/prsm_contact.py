@@ -32,7 +32,7 @@ from optdesign.models.hertz_point import (
     timoshenko_m_n,
 )
 from optdesign.models.prsm import STEEL_E, STEEL_NU, PRSMContact
-from optdesign.report import Comparison, comparison_table, format_table
+from optdesign.reports.tables import Comparison, comparison_table, format_table
 from optdesign.studies.prsm_contact import (
     SIDES,
     area_vs_load,
@@ -326,7 +326,9 @@ def run(out: Path) -> int:
 
 def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
     # optdesign.plots selects the Agg back-end before pyplot loads
-    from optdesign.plots import plt, save_figure
+    import matplotlib.pyplot as plt
+
+    from optdesign.plots import save_figure
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for s in SIDES:

@@ -16,7 +16,7 @@ import numpy as np
 
 from optdesign.mechanisms import CrankSlider
 from optdesign.models import lock, screw
-from optdesign.report import Comparison, comparison_table, format_table
+from optdesign.reports.tables import Comparison, comparison_table, format_table
 
 # Seed 002, converted at the boundary: r1 = 0.03 m, r2 = 0.04 m, R = 0.04 m (motor radius).
 R1_MM = 0.03 * 1e3
@@ -112,7 +112,9 @@ def run(out: Path) -> int:
     print(format_table(["lock", "max motor-shaft moment (N*m)", "magnet force (N)"], table))
 
     # optdesign.plots selects the Agg back-end before pyplot loads
-    from optdesign.plots import plt, save_figure
+    import matplotlib.pyplot as plt
+
+    from optdesign.plots import save_figure
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     ax.plot(np.degrees(phi), np.asarray(load.moment) / 1e3)

@@ -1,10 +1,13 @@
-"""Solver back-ends behind one :class:`~optdesign.solvers.result.Result` type.
+"""Solver back-ends behind one contract and one :class:`~optdesign.solvers.result.Result`.
 
-Solvers see generic problems (an NLP in scaled variables, a cvxpy problem, a vectorised
-objective); none of them knows a mechanism.
+Solvers see generic formulations (an NLP in scaled variables, a GP); none of them knows a
+mechanism. :func:`make_solver` builds any registered back-end; :func:`register_solver`
+adds one.
 """
 
+from optdesign.solvers.registry import make_solver, register_solver, solver_names
 from optdesign.solvers.result import (
+    Certificate,
     ConstraintReport,
     MultistartInfo,
     Result,
@@ -12,4 +15,14 @@ from optdesign.solvers.result import (
     TerminationCondition,
 )
 
-__all__ = ["ConstraintReport", "MultistartInfo", "Result", "SolutionStatus", "TerminationCondition"]
+__all__ = [
+    "Certificate",
+    "ConstraintReport",
+    "MultistartInfo",
+    "Result",
+    "SolutionStatus",
+    "TerminationCondition",
+    "make_solver",
+    "register_solver",
+    "solver_names",
+]

@@ -23,7 +23,13 @@ from scipy.optimize import minimize
 from scipy.special import logsumexp
 
 from optdesign.formulations.gp import GPData, GPRow, to_cvxpy
-from optdesign.solvers.result import ConstraintReport, Result, SolutionStatus, TerminationCondition
+from optdesign.solvers.result import (
+    Certificate,
+    ConstraintReport,
+    Result,
+    SolutionStatus,
+    TerminationCondition,
+)
 
 #: cvxpy status -> (termination, status word).
 _STATUS = {
@@ -161,11 +167,14 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
     timing["certificate_s"] = time.perf_counter() - t_cert
     log_p = float(np.log(objective))
     gap_log = log_p - g
-    certificate = {
-        "kind": "Lagrange dual bound from the GP multipliers (log space, box of the bounds)",
-        "lower_bound": float(np.exp(g)),
-        "objective": objective,
-        "gap_rel": float(1.0 - np.exp(-gap_log)),
+    lower = float(np.exp(g))
+    certificate = Certificate(
+        "gp-dual: Lagrange dual bound from the GP multipliers (log space, box of the bounds)",
+        lower,
+        objective,
+        float(1.0 - np.exp(-gap_log)),
+    )
+    dual_info = {
         "dual_bound_converged": conv,
         "multipliers": {
             f"{r.name}[{r.label}]" if r.label else r.name: d
@@ -193,6 +202,25 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
         iterations=int(stats.num_iters) if stats and stats.num_iters is not None else None,
         active=active,
         max_violation=0.0,
-        extra={"certificate": certificate, "gp_timing": timing},
+        bound=lower,
+        certificate=certificate,
+        extra={"gp_dual": dual_info, "gp_timing": timing},
         **common,
     )
+
+
+class GPSolver:
+    """The solver contract for a GP: built for one :class:`GPData`, ``solve()`` any
+    number of times (cvxpy builds its problem per call; the GP has no start)."""
+
+    def __init__(self, gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | None = None):
+        self.gp = gp
+        self.solver = solver.upper()
+        self.options = dict(options or {})
+
+    @property
+    def name(self) -> str:
+        return f"cvxpy-{self.solver.lower()}"
+
+    def solve(self, *_args, **_kwargs) -> Result:
+        return solve_gp(self.gp, self.solver, self.options)

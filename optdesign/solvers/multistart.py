@@ -1,26 +1,25 @@
 """Multistart: seeded Sobol starts inside the bounds, solved locally, best kept.
 
 Reports how many starts reached the best objective (evidence of a global optimum). Starts
-run in-process, or on local worker processes (each builds its own solver once) when
-``workers > 1``.
+run in-process, or on local worker processes that inherit the solver built once in this
+process (:mod:`optdesign.studies.runner`'s process engine).
 """
 
 from __future__ import annotations
 
 import math
-import os
 import time
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy.stats import qmc
 
 from optdesign.solvers.result import MultistartInfo, Result
 
 
 def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.ndarray:
     """``n`` scrambled-Sobol points in the box [lower, upper] (reproducible from ``seed``)."""
+    from scipy.stats import qmc
+
     d = len(lower)
     sampler = qmc.Sobol(d, scramble=True, seed=seed)
     m = max(0, math.ceil(math.log2(max(n, 1))))
@@ -28,7 +27,7 @@ def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.
     return lower + pts * (upper - lower)
 
 
-def best_of(results: list[Result], rel_tol: float = 1e-6) -> tuple[Result, int]:
+def best_of(results: Sequence[Result], rel_tol: float = 1e-6) -> tuple[Result, int]:
     """The best successful result and how many reached it within ``rel_tol``."""
     ok = [r for r in results if r.success and math.isfinite(r.objective)]
     if not ok:
@@ -43,50 +42,42 @@ def best_of(results: list[Result], rel_tol: float = 1e-6) -> tuple[Result, int]:
     return best, n_at_best
 
 
-# --- process pool plumbing: each worker builds its solver once --------------------------
-_WORKER_SOLVE: Callable | None = None
-
-
-def _init_worker(factory: Callable, args: tuple) -> None:
-    global _WORKER_SOLVE
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
-    _WORKER_SOLVE = factory(*args)
-
-
-def _solve_in_worker(x0: np.ndarray) -> Result:
-    assert _WORKER_SOLVE is not None
-    return _WORKER_SOLVE(x0)
-
-
 def multistart(
     solve: Callable[[np.ndarray], Result],
     starts: np.ndarray,
     workers: int = 1,
-    factory: Callable | None = None,
-    factory_args: tuple = (),
     rel_tol: float = 1e-6,
     seed: int = 0,
+    agree: int | None = None,
 ) -> Result:
     """Solve from every start and return the best result with its multistart record.
 
     Parameters
     ----------
     solve
-        x0 -> Result, used in-process.
+        x0 -> Result (a solver built once; local workers inherit it).
     starts
         One start per row.
     workers
-        Local processes; >1 needs ``factory(*factory_args)`` returning such a ``solve``
-        (picklable, built once per worker).
+        Local processes (the starts are split among them).
+    agree
+        Stop once this many successful starts agree on the best value (within
+        ``rel_tol``); None runs every start. With several workers the starts run in
+        rounds of ``workers``.
     """
     t0 = time.perf_counter()
-    if workers > 1 and factory is not None and len(starts) > 1:
-        with ProcessPoolExecutor(
-            max_workers=workers, initializer=_init_worker, initargs=(factory, factory_args)
-        ) as pool:
-            results = list(pool.map(_solve_in_worker, list(starts)))
+    starts = list(np.atleast_2d(starts))
+    results: list[Result] = []
+    if workers > 1 and len(starts) > 1:
+        from optdesign.studies.runner import map_inherited
+
+        results = map_inherited(solve, starts, workers, stop=_stop_rule(rel_tol, agree))
     else:
-        results = [solve(x0) for x0 in starts]
+        stop = _stop_rule(rel_tol, agree)
+        for x0 in starts:
+            results.append(solve(x0))
+            if stop(results):
+                break
     best, n_at_best = best_of(results, rel_tol)
     best.multistart = MultistartInfo(
         n_starts=len(results),
@@ -96,6 +87,15 @@ def multistart(
         objectives=[r.objective if r.success else math.nan for r in results],
         seed=seed,
         workers=workers,
+        n_planned=len(starts),
+        stopped_early=len(results) < len(starts),
     )
     best.wall_time_s = time.perf_counter() - t0
     return best
+
+
+def _stop_rule(rel_tol: float, agree: int | None) -> Callable[[list[Result]], bool]:
+    def stop(results: list[Result]) -> bool:
+        return bool(agree) and best_of(results, rel_tol)[1] >= agree
+
+    return stop

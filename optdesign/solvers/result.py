@@ -2,7 +2,8 @@
 
 ``termination`` says why the solver stopped, ``solution_status`` what the returned point
 is; ``status`` is the one word users and scripts read ("optimal", "feasible",
-"infeasible", "failed", "max_iterations", "time_limit").
+"infeasible", "failed", "max_iterations", "time_limit"). Bounds and certificates are
+typed fields, not dictionary entries.
 """
 
 from __future__ import annotations
@@ -77,11 +78,53 @@ class MultistartInfo:
     objectives: list[float] = field(default_factory=list)
     seed: int = 0
     workers: int = 1
+    n_planned: int | None = None
+    stopped_early: bool = False
+
+
+@dataclass
+class Certificate:
+    """A proof of optimality: a lower bound from duality (e.g. a GP's dual function).
+
+    ``gap_rel`` = (objective - lower_bound)/|objective|.
+    """
+
+    kind: str
+    lower_bound: float
+    objective: float
+    gap_rel: float
 
 
 @dataclass
 class Result:
-    """Outcome of one optimisation, whatever the solver."""
+    """Outcome of one optimisation, whatever the solver.
+
+    Attributes
+    ----------
+    status, objective, design, solver, formulation, wall_time_s
+        The answer: one status word, the objective's value, the full design.
+    termination, solution_status, message
+        Why the solver stopped and what the point is; the back-end's own message.
+    objective_name
+        What ``objective`` measures (an objective, a robust statistic, a weighted sum).
+    objectives
+        Every objective of the problem at the design (checked on the NumPy path).
+    violated, active, max_violation
+        Constraint rows at the point, by name and amount, in their units.
+    verified
+        The independent check on the NumPy path (None: not checked).
+    bound
+        A lower bound on the optimum when one is known (a relaxation's optimum, a dual
+        bound), for the gap.
+    certificate
+        A duality certificate of the optimum (GP).
+    multistart
+        How the starts went.
+    ranges
+        Range of each free variable over the (near-)optimal set, when computed.
+    notes
+        Plain-language remarks for the summary.
+    """
 
     status: str
     objective: float
@@ -92,6 +135,7 @@ class Result:
     termination: TerminationCondition = TerminationCondition.UNKNOWN
     solution_status: SolutionStatus = SolutionStatus.NO_SOLUTION
     message: str = ""
+    objective_name: str = ""
     objectives: dict[str, float] = field(default_factory=dict)
     iterations: int | None = None
     n_evals: dict[str, int] = field(default_factory=dict)
@@ -99,10 +143,18 @@ class Result:
     active: list[ConstraintReport] = field(default_factory=list)
     max_violation: float = math.nan
     verified: bool | None = None
+    bound: float | None = None
+    certificate: Certificate | None = None
     multistart: MultistartInfo | None = None
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    problem: str = ""
+    mechanism: str = ""
+    notes: list[str] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
     # solver internals kept for warm starts (not written to JSON)
     raw: dict[str, Any] = field(default_factory=dict, repr=False)
+    # the DesignProblem solved (for plots and tables; not written to JSON)
+    problem_object: Any = field(default=None, repr=False, compare=False)
 
     @property
     def success(self) -> bool:
@@ -111,25 +163,53 @@ class Result:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (enums as strings, NaN as None, no solver internals)."""
-        d = asdict(self)
+        problem, self.problem_object = self.problem_object, None
+        try:
+            d = asdict(self)
+        finally:
+            self.problem_object = problem
         d.pop("raw", None)
+        d.pop("problem_object", None)
         d["termination"] = self.termination.value
         d["solution_status"] = self.solution_status.value
-        return _clean(d)
+        return clean_json(d)
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), indent=kw.pop("indent", 2), **kw)
 
+    # Reading a result (tables, frames, figures) lives with the reports and plots; these
+    # methods only delegate, so that importing results costs neither pandas nor matplotlib.
+    def summary(self) -> str:
+        """The plain-text summary the CLI prints."""
+        from optdesign.reports.solve_text import result_summary
 
-def _clean(obj):
+        return result_summary(self)
+
+    def to_frame(self):
+        """A pandas DataFrame: one row per variable (value, bounds) and objective."""
+        from optdesign.reports.frames import result_frame
+
+        return result_frame(self)
+
+    def plot(self, ax=None):
+        """Ratio and backlash over the stroke, optimum against the initial design; returns
+        the matplotlib Figure (``ax``: draw the ratio on this axes instead)."""
+        from optdesign.plots.solution import plot_result
+
+        return plot_result(self, ax=ax)
+
+
+def clean_json(obj):
+    """A JSON-safe copy: enums as values, non-finite floats as None, NumPy scalars as
+    Python numbers."""
     if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
+        return {k: clean_json(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
+        return [clean_json(v) for v in obj]
     if isinstance(obj, Enum):
         return obj.value
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if hasattr(obj, "item") and callable(obj.item):  # numpy scalars
-        return _clean(obj.item())
+        return clean_json(obj.item())
     return obj

@@ -25,8 +25,8 @@ import casadi as ca
 import numpy as np
 import scipy.optimize as so
 
-from optdesign.formulations.nlp import NLP
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+from optdesign.formulations.nlp import NLP, Bounds, Start, Target
+from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
 
 
@@ -37,21 +37,13 @@ class _TimeUp(Exception):
 class ScipyNLPSolver:
     """SLSQP or trust-constr on an NLP in scaled variables (the one SciPy NLP back-end).
 
-    Same ``solve`` interface and :class:`Result` as
-    :class:`~optdesign.solvers.casadi_nlp.CasadiNLPSolver` (violated and active rows,
-    ``raw`` with ``z``, ``lam_x`` and ``lam_g``), so callers can swap them: the Pareto
-    sweeps use SLSQP with exact derivatives, the solver benchmark every combination.
-
-    - The constraint and variable bounds are read from ``nlp`` at every solve, so
-      changing ``nlp.ubg`` between solves (epsilon sweeps) works.
     - With exact derivatives, f, grad f, g and jac g come from one CasADi Function
       evaluated once per point (SciPy asks for them at the same point); the Hessians of
       trust-constr are separate Functions.
     - SLSQP's multipliers (SciPy >= 1.16 returns them) are mapped to CasADi's sign
       convention in ``raw["lam_g"]`` (``> 0`` at an active upper bound, ``< 0`` at an
       active lower bound); SciPy returns no bound multipliers, so ``raw["lam_x"]`` is
-      zero, and trust-constr's ``raw["lam_g"]`` is zero too. There is no dual warm start
-      (``lam_x0``/``lam_g0`` are accepted and ignored).
+      zero, and trust-constr's ``raw["lam_g"]`` is zero too. There is no dual warm start.
 
     Parameters
     ----------
@@ -97,19 +89,14 @@ class ScipyNLPSolver:
         self.derivatives = derivatives
         self.options = {**self.DEFAULTS[method], **(options or {})}
         self.time_limit = time_limit
-        z, f, g = nlp.z, nlp.f, nlp.g
-        self.f_fun = ca.Function("f", [z], [f])
+        z, p, f, g = nlp.z, nlp.p, nlp.f, nlp.g
+        self.f_fun = ca.Function("f", [z, p], [f])
         self.g_fun = ca.Function("g", [z], [g])
-        self.values_fun = ca.Function("values", [z], [ca.vertcat(*nlp.objective_values.values())])
         if derivatives == "exact":
-            self.fgj_fun = ca.Function("fgj", [z], [f, ca.gradient(f, z), g, ca.jacobian(g, z)])
+            self.fgj_fun = ca.Function("fgj", [z, p], [f, ca.gradient(f, z), g, ca.jacobian(g, z)])
             if method == "trust-constr":
-                lam = (
-                    ca.SX.sym("lam", g.shape[0])
-                    if isinstance(z, ca.SX)
-                    else ca.MX.sym("lam", g.shape[0])
-                )
-                self.hess_f_fun = ca.Function("hess_f", [z], [ca.hessian(f, z)[0]])
+                lam = ca.SX.sym("lam", g.shape[0])
+                self.hess_f_fun = ca.Function("hess_f", [z, p], [ca.hessian(f, z)[0]])
                 self.hess_g_fun = ca.Function(
                     "hess_g", [z, lam], [ca.hessian(ca.dot(lam, g), z)[0]]
                 )
@@ -117,6 +104,7 @@ class ScipyNLPSolver:
         # One-point caches: the exact (f, grad f, g, jac g) and, with finite differences,
         # g (SLSQP asks for its inequality and equality rows at the same point).
         self._cache: dict[str, tuple[bytes, Any]] = {}
+        self._p = np.zeros(nlp.p.shape[0])
 
     @property
     def name(self) -> str:
@@ -137,7 +125,7 @@ class ScipyNLPSolver:
         if hit is not None and hit[0] == key:
             return hit[1]
         if kind == "fgj":
-            f, gf, g, jg = self.fgj_fun(z)
+            f, gf, g, jg = self.fgj_fun(z, self._p)
             val: Any = (
                 float(f),
                 np.asarray(gf, dtype=float).ravel(),
@@ -154,7 +142,7 @@ class ScipyNLPSolver:
         self._tick("f", z)
         if self.derivatives == "exact":
             return self._cached("fgj", z)[0]
-        return float(self.f_fun(z))
+        return float(self.f_fun(z, self._p))
 
     # The cached arrays are handed out as copies: SciPy may keep or modify what it gets.
     def _grad(self, z):
@@ -173,7 +161,7 @@ class ScipyNLPSolver:
 
     def _hess_f(self, z):
         self._tick("hess_f", z)
-        return np.asarray(ca.densify(self.hess_f_fun(z)), dtype=float)
+        return np.asarray(ca.densify(self.hess_f_fun(z, self._p)), dtype=float)
 
     def _hess_g(self, z, v):
         self._tick("hess_g", z)
@@ -217,21 +205,10 @@ class ScipyNLPSolver:
         return cons
 
     def solve(
-        self,
-        x0: np.ndarray | None = None,
-        z0: np.ndarray | None = None,
-        lam_x0: np.ndarray | None = None,
-        lam_g0: np.ndarray | None = None,
+        self, start: Start | Any, target: Target | str | None = None, bounds: Bounds | None = None
     ) -> Result:
-        """Solve from design ``x0`` (or scaled ``z0``).
-
-        Parameters
-        ----------
-        x0, z0
-            Start: a design vector, or the scaled NLP vector (takes precedence).
-        lam_x0, lam_g0
-            Accepted for the :class:`CasadiNLPSolver` interface and ignored (SciPy takes
-            no dual warm start).
+        """Solve from ``start`` for ``target`` within ``bounds`` (multipliers of the start
+        are ignored: SciPy takes no dual warm start).
 
         Returns
         -------
@@ -240,15 +217,15 @@ class ScipyNLPSolver:
             ``failed``, or ``time_limit``), ``infeasible`` if an ``optimal`` point
             violates a row.
         """
-        del lam_x0, lam_g0
         nlp = self.nlp
-        z0 = nlp.start(x0, z0)
-        # Bounds read now, not at construction: epsilon sweeps change nlp.ubg between solves.
-        lbz, ubz = np.asarray(nlp.lbz, dtype=float), np.asarray(nlp.ubz, dtype=float)
-        lb, ub = np.asarray(nlp.lbg, dtype=float), np.asarray(nlp.ubg, dtype=float)
+        start, target, bounds = resolve(nlp, start, target, bounds)
+        self._p = nlp.params(target)
+        self._cache = {}
+        lbz, ubz = np.asarray(bounds.lbz, dtype=float), np.asarray(bounds.ubz, dtype=float)
+        lb, ub = np.asarray(bounds.lbg, dtype=float), np.asarray(bounds.ubg, dtype=float)
         rows = self._split_rows(lb, ub)
         # Aux variables may have infinite bounds: SciPy takes +-inf in Bounds.
-        z0 = np.clip(np.asarray(z0, dtype=float).ravel(), lbz, ubz)
+        z0 = np.clip(start.z0, lbz, ubz)
         self.n_evals = {}
         self._last = z0.copy()
         self._t0 = time.perf_counter()
@@ -280,20 +257,25 @@ class ScipyNLPSolver:
             status, term = "time_limit", TerminationCondition.MAX_TIME
         except (ValueError, np.linalg.LinAlgError, RuntimeError) as exc:
             wall = time.perf_counter() - self._t0
-            return Result(
-                "failed",
-                float("nan"),
-                {},
-                self.name,
-                f"nlp-{nlp.form}",
-                wall,
-                TerminationCondition.ERROR,
-                SolutionStatus.NO_SOLUTION,
-                message=f"{type(exc).__name__}: {exc}",
-                n_evals=dict(self.n_evals),
+            return failed_result(
+                self.name, nlp, target, f"{type(exc).__name__}: {exc}", wall, self.n_evals
             )
         wall = time.perf_counter() - self._t0
-        return self._result(z, lam_g, status, term, message, iters, wall)
+        return make_result(
+            self.name,
+            nlp,
+            target,
+            bounds,
+            z,
+            np.zeros(len(z)),
+            lam_g,
+            status,
+            term,
+            message,
+            iters,
+            dict(self.n_evals),
+            wall,
+        )
 
     @staticmethod
     def _lam_g(res, m: int, rows: tuple[np.ndarray, ...]) -> np.ndarray:
@@ -328,48 +310,6 @@ class ScipyNLPSolver:
         if res.status == 0:
             return "max_iterations", TerminationCondition.MAX_ITERATIONS
         return "failed", TerminationCondition.NUMERICAL_ERROR
-
-    def _result(self, z, lam_g, status, term, message, iters, wall) -> Result:
-        nlp = self.nlp
-        g = np.asarray(self.g_fun(z), dtype=float).ravel()
-        # Same row reports as the CasADi back-end (it only needs ``self.nlp``).
-        violated, active = CasadiNLPSolver.reports(self, g, lam_g)  # type: ignore[arg-type]
-        max_viol = max(
-            (
-                r.amount / max(1.0, abs(r.upper if r.upper is not None else r.lower))
-                for r in violated
-            ),
-            default=0.0,
-        )
-        if status == "optimal" and violated:
-            status, term = "infeasible", TerminationCondition.INFEASIBLE
-        if status == "optimal":
-            sol_status = SolutionStatus.OPTIMAL
-        elif not violated:
-            sol_status = SolutionStatus.FEASIBLE
-        else:
-            sol_status = SolutionStatus.INFEASIBLE
-        values = np.asarray(self.values_fun(z), dtype=float).ravel()
-        x = nlp.x_from_z(z)
-        z = np.asarray(z, dtype=float)
-        return Result(
-            status=status,
-            objective=float(self.f_fun(z)) * nlp.f_scale,
-            design=dict(zip(nlp.design_names, x.tolist(), strict=True)),
-            solver=self.name,
-            formulation=f"nlp-{nlp.form}",
-            wall_time_s=wall,
-            termination=term,
-            solution_status=sol_status,
-            message=message,
-            objectives=dict(zip(nlp.objective_values, values.tolist(), strict=True)),
-            iterations=iters,
-            n_evals=dict(self.n_evals),
-            violated=violated,
-            active=active,
-            max_violation=float(max_viol),
-            raw={"z": z, "lam_x": np.zeros(len(z)), "lam_g": lam_g},
-        )
 
 
 def differential_evolution(

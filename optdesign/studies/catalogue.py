@@ -15,7 +15,6 @@ on the shipped catalogue problem.
 
 from __future__ import annotations
 
-import copy
 import heapq
 import itertools
 import math
@@ -32,14 +31,11 @@ from optdesign.formulations.discrete import (
     items_within,
     n_combinations,
     nearest_item,
-    restrict,
 )
-from optdesign.formulations.nlp import build_nlp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.multistart import best_of, sobol_starts
 from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.studies.solve import finish
+from optdesign.studies.solve import _objective_set, finish, solver_for
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
@@ -47,8 +43,18 @@ ENUMERATE_MAX = 16
 PRUNE_TOL = 1e-6
 
 
+#: Sobol starts a node tries before it is called infeasible, when its own starts fail.
+RETRY_STARTS = 8
+
+
 class NodeSolver:
-    """Solve the problem's NLP on a sub-box of the catalogue variables (built once)."""
+    """Solve the problem's NLP on a sub-box of the catalogue variables.
+
+    One solver (:func:`optdesign.studies.solve.solver_for`) serves every node: a node
+    only passes its own variable bounds. A node whose starts all fail is tried again from
+    :data:`RETRY_STARTS` more Sobol starts before it counts as infeasible, so a poor
+    first start (e.g. a declared one) never makes a feasible problem look infeasible.
+    """
 
     def __init__(
         self,
@@ -60,10 +66,10 @@ class NodeSolver:
         options: Mapping[str, Any] | None = None,
     ):
         self.problem = problem
-        self.nlp = build_nlp(problem, objective=objective)
-        merged = dict(problem.spec.solver.ipopt) if plugin == "ipopt" else {}
-        merged.update(options or {})
-        self.solver = CasadiNLPSolver(self.nlp, plugin, merged)
+        self.objective = objective or problem.objective_names[0]
+        self.backend = solver_for(problem, plugin, options, _objective_set(problem, self.objective))
+        self.nlp = self.backend.nlp
+        self.target = self.nlp.target(self.objective)
         self.starts = max(1, starts)
         self.seed = seed
         self.names = [v.name for v in problem.free]
@@ -76,13 +82,15 @@ class NodeSolver:
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
             lo[k], hi[k] = a, b
+        box = self.nlp.bounds(box=bounds)
         first = self.problem.start() if x_hint is None else np.asarray(x_hint, dtype=float)
         pts = [np.clip(first, lo, hi)]
         if self.starts > 1:
             pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
-        node = copy.copy(self.solver)
-        node.nlp = restrict(self.nlp, bounds)
-        results = [node.solve(x0=p) for p in pts]
+        results = [self.backend.solve(p, self.target, box) for p in pts]
+        if not any(r.success for r in results):
+            retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
+            results += [self.backend.solve(p, self.target, box) for p in retry]
         self.n_solves += len(results)
         best, n_at_best = best_of(results)
         best.multistart = MultistartInfo(
@@ -240,14 +248,22 @@ def solve_catalogue(
     info["nlp_solves"] = ns.n_solves
     wall = time.perf_counter() - t0
     if best is None:
+        # Infeasible only when the continuous relaxation (every catalogue range at once)
+        # has no feasible point either; otherwise the search failed to find one.
+        relaxed_ok = root.success
         result = Result(
-            "infeasible",
+            "failed" if relaxed_ok else "infeasible",
             float("nan"),
             {},
             plugin,
             f"catalogue-{method}",
             wall,
-            message="no catalogue combination gave a feasible design",
+            message=(
+                "no catalogue combination gave a feasible design although the continuous "
+                "relaxation is feasible (more starts may find one)"
+                if relaxed_ok
+                else "the continuous relaxation has no feasible design"
+            ),
         )
         result.extra["catalogue"] = info
         return finish(problem, result, objective)
@@ -260,6 +276,7 @@ def solve_catalogue(
     if root.success:
         info["gap_to_relaxation_rel"] = (best.objective - root.objective) / abs(root.objective)
     best.extra["catalogue"] = info
+    best.bound = root.objective if root.success else None
     items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
     bound = (
         f"continuous relaxation bound {root.objective:.8g} (discrete optimum "
@@ -267,7 +284,7 @@ def solve_catalogue(
         if root.success
         else f"continuous relaxation: {root.status}"
     )
-    best.extra["note_catalogue"] = (
+    best.notes.append(
         f"catalogue items chosen: {items}; {bound}; {method}, {info['nlp_solves']} NLP solves"
     )
     return finish(problem, best, objective)
@@ -275,8 +292,24 @@ def solve_catalogue(
 
 def relaxation_bound(result: Result) -> float:
     """The continuous relaxation's optimum recorded in a catalogue result (NaN if none)."""
-    v = result.extra.get("catalogue", {}).get("relaxation_bound")
-    return float("nan") if v is None else float(v)
+    return float("nan") if result.bound is None else float(result.bound)
+
+
+def solve_catalogue_formulation(problem: DesignProblem, **options: Any) -> Result:
+    """``formulation="catalogue"``: the exact catalogue optimum and its relaxation bound."""
+    from optdesign.studies.reference import attach_reference, reference_design
+
+    reference_design(problem)
+    result = solve_catalogue(
+        problem,
+        method=options.get("method") or "auto",
+        starts=options.get("starts"),
+        seed=options.get("seed"),
+        objective=options.get("objective"),
+        plugin=options.get("solver") or "ipopt",
+        options=options.get("options"),
+    )
+    return attach_reference(problem, result)
 
 
 def is_on_catalogue(problem: DesignProblem, design: Mapping[str, float]) -> bool:

@@ -24,8 +24,8 @@ def penalised_objective(problem: DesignProblem, objective: str):
     def fun(X: np.ndarray) -> np.ndarray:
         pop = np.atleast_2d(X.T) if X.ndim == 2 else X[None, :]
         ev = problem.evaluate(pop)
-        val = np.asarray(ev["objectives"][objective], dtype=float)
-        viol = np.nan_to_num(np.asarray(ev["violation"], dtype=float), nan=1e3, posinf=1e3)
+        val = np.asarray(ev.objectives[objective], dtype=float)
+        viol = np.nan_to_num(np.asarray(ev.violation, dtype=float), nan=1e3, posinf=1e3)
         out = np.where(np.isfinite(val), val, 1e3) + PENALTY * np.minimum(viol, 1e3)
         return out if X.ndim == 2 else out[0]
 
@@ -69,8 +69,8 @@ def differential_evolution_optimum(
     ev = problem.evaluate(x)
     return {
         "x": x,
-        "objective": float(ev["objectives"][objective]),
-        "violation": float(ev["violation"]),
+        "objective": float(ev.objectives[objective]),
+        "violation": float(ev.violation),
         "nfev": int(nfev),
         "wall_time_s": time.perf_counter() - t0,
     }
@@ -80,7 +80,8 @@ def _slsqp_polish(problem, objective, x0, bounds):
     def cons(x):
         ev = problem.evaluate(x)
         rows = []
-        for values, lo, hi in ev["constraints"].values():
+        for b in ev.constraints.values():
+            values, lo, hi = b.values, b.lower, b.upper
             values = np.atleast_1d(values)
             if lo is not None:
                 rows.append((values - lo) / max(1.0, abs(lo)))
@@ -89,7 +90,7 @@ def _slsqp_polish(problem, objective, x0, bounds):
         return np.concatenate(rows)
 
     def fun(x):
-        return problem.evaluate(x)["objectives"][objective]
+        return problem.evaluate(x).objectives[objective]
 
     with np.errstate(invalid="ignore", divide="ignore"):
         res = minimize(
@@ -100,5 +101,5 @@ def _slsqp_polish(problem, objective, x0, bounds):
             constraints=[{"type": "ineq", "fun": cons}],
             options={"ftol": 1e-14, "maxiter": 500},
         )
-    ok = np.all(np.isfinite(res.x)) and problem.evaluate(res.x)["violation"] <= 1e-7
+    ok = np.all(np.isfinite(res.x)) and problem.evaluate(res.x).violation <= 1e-7
     return res.x if ok and fun(res.x) <= fun(x0) + 1e-12 else x0

@@ -8,13 +8,14 @@ the same problem (warm-started from the GP design), and the relative gap between
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.cvxpy_gp import solve_gp
+from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
 from optdesign.studies.solve import finish, solve_nlp
 
@@ -36,7 +37,7 @@ def solve_gp_problem(
     compare_nlp: bool = True,
     nlp_starts: int | None = None,
     seed: int | None = None,
-    solver: str = "CLARABEL",
+    solver: str = "clarabel",
 ) -> Result:
     """GP solve of ``problem`` with certificate, exact check and exact-NLP comparison.
 
@@ -50,45 +51,46 @@ def solve_gp_problem(
     nlp_starts, seed
         Multistart of that NLP (default: the problem file's).
     solver
-        cvxpy conic solver.
+        Registered GP back-end (``clarabel``, ``scs``).
     """
     objective = objective or problem.objective_names[0]
     t0 = time.perf_counter()
     gp = require_gp(problem, objective)
     t_trace = time.perf_counter() - t0
+    backend = make_solver(gp, solver.lower())
     if gp.infeasible:
         result = Result(
             "infeasible",
             float("nan"),
             {},
-            f"cvxpy-{solver.lower()}",
+            backend.name,
             "gp",
             t_trace,
             message="rows that no positive design can meet: " + "; ".join(gp.infeasible[:5]),
         )
         return finish(problem, result, objective)
-    result = solve_gp(gp, solver)
-    result.extra["gp_timing"]["trace_s"] = t_trace
+    result = backend.solve()
+    result.extra.setdefault("gp_timing", {})["trace_s"] = t_trace
     result.extra["gp_rows"] = {
         "objective": len(gp.objective_rows),
         "constraints": len(gp.rows),
         "before_pruning": gp.n_rows_before_pruning,
     }
-    result.extra["note_gp"] = (
+    result.notes.append(
         "GP model: first-order Hertz flattening b^2/D and ISO 286 formulas (posynomials); "
         "the independent check and 'objectives at this design' use the exact model"
     )
     gp_objective = result.objective
     result = finish(problem, result, objective)
-    if "certificate" in result.extra:
-        cert = result.extra["certificate"]
-        result.extra["note_certificate"] = (
-            f"GP certificate: dual bound {cert['lower_bound']:.8g} <= optimum <= "
-            f"{cert['objective']:.8g} (relative gap {cert['gap_rel']:.2e})"
+    cert = result.certificate
+    if cert is not None:
+        result.notes.append(
+            f"GP certificate: dual bound {cert.lower_bound:.8g} <= optimum <= "
+            f"{cert.objective:.8g} (relative gap {cert.gap_rel:.2e})"
         )
     if compare_nlp and result.design:
         x0 = np.array([result.design[v.name] for v in problem.free])
-        nlp = solve_nlp(problem, starts=nlp_starts, seed=seed, objective=objective, x0=x0)
+        nlp = solve_nlp(problem, objective=objective, starts=nlp_starts, seed=seed, x0=x0)
         gap = (gp_objective - nlp.objective) / abs(nlp.objective) if nlp.success else float("nan")
         result.extra["nlp_exact"] = {
             "status": nlp.status,
@@ -99,9 +101,25 @@ def solve_gp_problem(
         }
         result.extra["gap_gp_nlp_rel"] = gap
         exact_at_gp = result.objectives.get(objective, float("nan"))
-        result.extra["note_nlp"] = (
+        result.notes.append(
             f"exact NLP (exact Hertz) optimum {nlp.objective:.8g} ({nlp.status}, "
             f"{nlp.wall_time_s:.3f} s); GP optimum {gp_objective:.8g}: gap {100 * gap:+.4f} %; "
             f"exact model at the GP design {exact_at_gp:.8g}"
         )
     return result
+
+
+def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
+    """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
+    from optdesign.studies.reference import attach_reference, reference_design
+
+    reference_design(problem)  # validate [reference] before solving
+    gp_solver = options.get("solver")
+    result = solve_gp_problem(
+        problem,
+        objective=options.get("objective"),
+        nlp_starts=options.get("starts"),
+        seed=options.get("seed"),
+        solver=gp_solver if gp_solver in ("clarabel", "scs") else "clarabel",
+    )
+    return attach_reference(problem, result)

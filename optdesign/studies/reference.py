@@ -12,13 +12,11 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.errors import InputError, ProblemError
+from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.spec import VARIABLE_DIMENSIONS
-from optdesign.report import format_table
+from optdesign.reports.tables import format_table
 from optdesign.solvers.result import Result
 from optdesign.studies.verify import verify_design
-from optdesign.units import to_internal
 
 #: Quantities of the side-by-side table: (objective name, label, unit, scale).
 QUANTITIES = (
@@ -34,17 +32,14 @@ QUANTITIES = (
 def reference_design(problem: DesignProblem) -> tuple[str, dict[str, float]] | None:
     """(label, full design) of the file's ``[reference]``, or None when there is none.
 
-    Raises ProblemError naming ``reference.FIELD`` for an unknown, fixed or missing
-    variable or a value that is not a quantity of the right dimension.
+    Raises ProblemError naming ``reference.FIELD`` for a variable the problem does not
+    declare, a fixed one, or a free one left out (units were parsed with the file).
     """
-    raw = problem.spec.reference
-    if raw is None:
+    ref = problem.spec.reference
+    if ref is None:
         return None
-    raw = dict(raw)
-    label = str(raw.pop("label", "reference"))
-    dims = VARIABLE_DIMENSIONS[problem.mechanism_kind]
     design: dict[str, float] = dict(problem.fixed_values)
-    for name, value in raw.items():
+    for name, value in ref.values().items():
         field = f"reference.{name}"
         if name not in problem.by_name:
             raise ProblemError(
@@ -53,14 +48,11 @@ def reference_design(problem: DesignProblem) -> tuple[str, dict[str, float]] | N
             )
         if not problem.by_name[name].free:
             raise ProblemError(f"{field}: {name} is fixed by the problem; give free variables only")
-        try:
-            design[name] = to_internal(value, dims[name], field)
-        except InputError as exc:
-            raise ProblemError(str(exc)) from None
+        design[name] = value
     missing = [v.name for v in problem.free if v.name not in design]
     if missing:
         raise ProblemError(f"reference.{missing[0]}: missing (every free variable needs a value)")
-    return label, design
+    return ref.label, design
 
 
 def compare_reference(problem: DesignProblem, result: Result) -> dict[str, Any] | None:
@@ -81,24 +73,24 @@ def compare_reference(problem: DesignProblem, result: Result) -> dict[str, Any] 
     ev_ref, ev_opt = problem.evaluate(x_ref), problem.evaluate(x_opt)
     rows = {}
     for name, _text, _unit, scale in QUANTITIES:
-        if name in ev_ref["objectives"]:
+        if name in ev_ref.objectives:
             rows[name] = (
-                scale * float(ev_ref["objectives"][name]),
-                scale * float(ev_opt["objectives"][name]),
+                scale * float(ev_ref.objectives[name]),
+                scale * float(ev_opt.objectives[name]),
             )
-    ratio_ref = np.atleast_1d(ev_ref["constraints"]["ratio_positive"][0])
-    ratio_opt = np.atleast_1d(ev_opt["constraints"]["ratio_positive"][0])
+    ratio_ref = np.atleast_1d(ev_ref.constraints["ratio_positive"].values)
+    ratio_opt = np.atleast_1d(ev_opt.constraints["ratio_positive"].values)
     rows["ratio_min"] = (float(ratio_ref.min()), float(ratio_opt.min()))
     rows["ratio_max"] = (float(ratio_ref.max()), float(ratio_opt.max()))
     return {
         "label": label,
         "design": {v.name: design[v.name] for v in problem.free},
         "quantities": rows,
-        "reference_violation": float(ev_ref["violation"]),
+        "reference_violation": float(ev_ref.violation),
         "reference_violated": sorted(
             {r.name.split("[")[0] for r in verify_design(problem, x_ref)[1]}
         ),
-        "optimum_violation": float(ev_opt["violation"]),
+        "optimum_violation": float(ev_opt.violation),
     }
 
 
@@ -141,5 +133,5 @@ def attach_reference(problem: DesignProblem, result: Result) -> Result:
         return result
     comparison["optimum_design"] = {v.name: result.design[v.name] for v in problem.free}
     result.extra["reference"] = comparison
-    result.extra["note_reference"] = comparison_text(problem, comparison)
+    result.notes.append(comparison_text(problem, comparison))
     return result

@@ -34,11 +34,11 @@ from optdesign.formulations.robust import (
     tolerances_of,
 )
 from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
-from optdesign.report import format_table
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver
-from optdesign.solvers.multistart import multistart, sobol_starts
+from optdesign.reports.tables import format_table
+from optdesign.solvers.multistart import multistart
+from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
-from optdesign.studies.solve import finish, solve_nlp
+from optdesign.studies.solve import finish, solve_nlp, solver_options, start_points
 
 #: Default independent Monte Carlo: sample count and seed (different from the SAA seed).
 MC_SAMPLES = 20_000
@@ -179,9 +179,8 @@ def make_robust_solve(
 ):
     """Build the robust NLP and its solver once; return x0 -> Result."""
     nlp = build_robust_nlp(problem, objective, samples, risk, alpha, k, constrain_samples)
-    merged = dict(problem.spec.solver.ipopt) if plugin == "ipopt" else {}
-    merged.update(options or {})
-    return CasadiNLPSolver(nlp, plugin, merged).solve
+    merged = {**solver_options(problem, plugin), **(options or {})}
+    return make_solver(nlp, plugin, merged).solve
 
 
 def solve_robust(
@@ -223,22 +222,13 @@ def solve_robust(
     alpha = tol.alpha if alpha is None else alpha
     k = tol.k if k is None else k
     samples = samples if samples is not None else draw_samples(problem, tol.samples, tol.seed, tol)
-    first = problem.start() if x0 is None else np.asarray(x0, dtype=float)
-    pts = [first]
-    if starts > 1:
-        pts += list(sobol_starts(problem.lower(), problem.upper(), starts - 1, seed))
-    args = (problem, objective, samples, plugin, options, risk, alpha, k, constrain_samples)
+    pts = start_points(problem, starts, seed, x0)
     t0 = time.perf_counter()
-    solve = make_robust_solve(*args)
-    build_s = time.perf_counter() - t0
-    result = multistart(
-        solve,
-        np.array(pts),
-        workers=workers,
-        factory=make_robust_solve,
-        factory_args=args,
-        seed=seed,
+    solve = make_robust_solve(
+        problem, objective, samples, plugin, options, risk, alpha, k, constrain_samples
     )
+    build_s = time.perf_counter() - t0
+    result = multistart(solve, pts, workers=workers, seed=seed)
     label = risk_label(risk, alpha, k, objective)
     result.formulation = "robust-saa"
     # Per-sample rows are the formulation's own; report the nominal requirements only.
@@ -250,12 +240,12 @@ def solve_robust(
         saa_seed=samples.seed,
         build_time_s=build_s,
         constrain_samples=constrain_samples,
-        note_robust=(
-            f"objective = {label} over {samples.n} fixed samples (seed {samples.seed}); "
-            f"'objectives' below are the nominal design's"
-        ),
     )
-    result.extra["objective_name"] = label
+    result.notes.append(
+        f"objective = {label} over {samples.n} fixed samples (seed {samples.seed}); "
+        "'objectives' below are the nominal design's"
+    )
+    result.objective_name = label
     if result.design:
         free = {v.name: result.design[v.name] for v in problem.free}
         values, _ = sample_values(problem, free, samples, objective)
@@ -263,20 +253,24 @@ def solve_robust(
     return result
 
 
-def solve_robust_cli(problem: DesignProblem, args) -> Result:
-    """``optdesign solve FILE --formulation robust``: nominal optimum (multistart, the
-    CLI's ``--starts``/``--seed``), then the robust optimum started from it."""
-    objective = args.objective or problem.objective_names[0]
+def solve_robust_formulation(problem: DesignProblem, **options: Any) -> Result:
+    """``formulation="robust"``: the nominal optimum (multistart), then the robust optimum
+    started from it."""
+    objective = options.get("objective") or problem.objective_names[0]
+    plugin = options.get("solver") or "ipopt"
     nominal = solve_nlp(
         problem,
-        starts=args.starts,
-        seed=args.seed,
-        workers=args.workers,
-        plugin=args.solver,
         objective=objective,
+        starts=options.get("starts"),
+        seed=options.get("seed"),
+        workers=options.get("workers") or 1,
+        solver=plugin,
+        options=options.get("options"),
     )
     x0 = np.array([nominal.design[v.name] for v in problem.free]) if nominal.design else None
-    result = solve_robust(problem, x0=x0, objective=objective, plugin=args.solver)
+    result = solve_robust(
+        problem, x0=x0, objective=objective, plugin=plugin, options=options.get("options")
+    )
     result.extra["nominal_optimum"] = {
         "status": nominal.status,
         objective: nominal.objectives.get(objective, nominal.objective),

@@ -581,3 +581,56 @@ def cached(key: tuple, build: Callable[[], Any]) -> Any:
     with _CACHE_LOCK:
         _CACHE[full] = value
     return value
+
+
+#: Callables handed to forked workers by inheritance (see :func:`map_inherited`).
+_INHERITED: dict[int, Callable[[Any], Any]] = {}
+
+
+def _call_inherited(key: int, item: Any) -> Any:
+    return _INHERITED[key](item)
+
+
+def map_inherited(
+    fn: Callable[[Any], Any],
+    items: list[Any],
+    workers: int,
+    stop: Callable[[list[Any]], bool] | None = None,
+) -> list[Any]:
+    """``[fn(item) for item in items]`` on ``workers`` forked processes that inherit
+    ``fn`` (e.g. a solver's bound ``solve``: built once here, never pickled).
+
+    Results come back in the order of ``items``; with ``stop``, no new item is started
+    once ``stop(results so far, in order)`` holds. Off Linux (no fork) it runs here.
+    """
+    if workers <= 1 or not forks_workers() or len(items) <= 1:
+        out: list[Any] = []
+        for item in items:
+            out.append(fn(item))
+            if stop is not None and stop(out):
+                break
+        return out
+    key = id(fn)
+    _INHERITED[key] = fn
+    try:
+        pool = WorkerPool(min(workers, len(items)))
+        try:
+            results: dict[int, Any] = {}
+            running: dict[int, int] = {}  # worker -> item index
+            nxt = 0
+            stopped = False
+            while nxt < len(items) or running:
+                while not stopped and nxt < len(items) and pool.idle:
+                    running[pool.submit(_call_inherited, (key, items[nxt]))] = nxt
+                    nxt += 1
+                for worker, value in pool.wait():
+                    results[running.pop(worker)] = value
+                done = [results[k] for k in sorted(results)]
+                if stop is not None and stop(done):
+                    stopped = True
+                    nxt = len(items)
+            return [results[k] for k in sorted(results)]
+        finally:
+            pool.close()
+    finally:
+        _INHERITED.pop(key, None)

@@ -23,8 +23,9 @@ def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = VERIFY_TOL
     """
     ev = problem.evaluate(np.asarray(x, dtype=float))
     violated = []
-    for name, (values, lo, hi) in ev["constraints"].items():
-        values = np.atleast_1d(np.asarray(values, dtype=float))
+    for name, block in ev.constraints.items():
+        values = np.atleast_1d(np.asarray(block.values, dtype=float))
+        lo, hi = block.lower, block.upper
         rel = relative_violation(values, lo, hi)
         labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
         for k in np.flatnonzero(rel > tol):
@@ -32,4 +33,4 @@ def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = VERIFY_TOL
             amount = max((lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0)
             label = f"{name}[{labels[k]}]" if labels[k] else name
             violated.append(ConstraintReport(label, v, lo, hi, float(amount)))
-    return not violated, violated, ev["objectives"]
+    return not violated, violated, ev.objectives

@@ -1,9 +1,12 @@
-"""Benchmark instance families: random requirements generated from (family, seed).
+"""Benchmark instances: random problems generated from (family, seed), user problems, and
+the shipped problem files.
 
-Each family draws the requirements of a crank-slider or shifting-fork problem
-(deflection range 20-40 deg, hinge moment, mean-ratio band, nut-travel limit, fit class,
-catalogue or continuous screw lead) and states them as a *problem dict*, the parsed form of
-a problem file, so that every instance goes through
+Each mechanism plug-in names its families (:attr:`Mechanism.bench_families`: family ->
+objectives) and its own variables and requirements (:meth:`Mechanism.bench_template`);
+here every family draws the requirements common to all mechanisms (deflection range
+20-40 deg, hinge moment, mean-ratio band, nut-travel limit, fit class, catalogue or
+continuous screw lead, sized pins) and states the instance as a *problem dict*, the
+parsed form of a problem file, so that every instance goes through
 :func:`optdesign.problem.problem_from_dict` and its validation exactly like a TOML file.
 
 An instance is reproducible from ``(family, seed)`` alone: the generator is
@@ -36,23 +39,27 @@ P_CATALOGUE = 0.3
 #: Shipped problem files (family ``shipped``, seed = index).
 SHIPPED = ("cs_min_ripple", "cs_min_backlash", "fork_min_backlash")
 
-#: family -> (mechanism, objectives). A two-objective family is a Pareto-front instance.
-FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
-    "cs_ripple": ("crank_slider", ("ripple",)),
-    "cs_backlash": ("crank_slider", ("backlash",)),
-    "cs_size": ("crank_slider", ("size",)),
-    "cs_torque": ("crank_slider", ("motor_torque",)),
-    "fork_backlash": ("fork", ("backlash",)),
-    "fork_size": ("fork", ("size",)),
-    "fork_torque": ("fork", ("motor_torque",)),
-    "cs_front": ("crank_slider", ("ripple", "backlash")),
-    "fork_front": ("fork", ("backlash", "size")),
-}
 
-#: Families of single-objective instances (the fork's ripple depends on the deflection
-#: range alone, so a fork ripple family would be a constant: left out).
-SINGLE_FAMILIES = tuple(f for f, (_, obj) in FAMILIES.items() if len(obj) == 1)
-FRONT_FAMILIES = tuple(f for f, (_, obj) in FAMILIES.items() if len(obj) > 1)
+def families() -> dict[str, tuple[str, tuple[str, ...]]]:
+    """family -> (mechanism, objectives), from every registered mechanism. A
+    two-objective family is a Pareto-front instance."""
+    from optdesign.mechanisms.registry import get_mechanism, registered
+
+    out: dict[str, tuple[str, tuple[str, ...]]] = {}
+    for name in registered():
+        for family, objectives in get_mechanism(name).bench_families.items():
+            out[family] = (name, tuple(objectives))
+    return out
+
+
+def single_families() -> tuple[str, ...]:
+    """Families of single-objective instances."""
+    return tuple(f for f, (_, obj) in families().items() if len(obj) == 1)
+
+
+def front_families() -> tuple[str, ...]:
+    """Families of Pareto-front instances."""
+    return tuple(f for f, (_, obj) in families().items() if len(obj) > 1)
 
 
 @dataclass(frozen=True)
@@ -62,21 +69,29 @@ class Instance:
     Attributes
     ----------
     family, seed
-        Identity; :func:`make_instance` rebuilds the same ``data`` from them.
+        Identity; :func:`make_instance` rebuilds the same ``data`` from them (family
+        ``"user"``: a problem given by the caller, carried in ``given``).
     data
-        The problem dict (parsed-TOML form).
+        The problem dict (parsed-TOML form); empty for a user problem.
+    given
+        The user's problem (family ``"user"``).
     """
 
     family: str
     seed: int
     data: dict[str, Any]
+    given: DesignProblem | None = None
 
     @property
     def id(self) -> str:
+        if self.given is not None:
+            return f"user-{self.seed:03d}-{self.given.name}"
         return f"{self.family}-{self.seed:03d}"
 
     @property
     def objectives(self) -> list[str]:
+        if self.given is not None:
+            return self.given.objective_names
         obj = self.data["objective"]["minimize"]
         return [obj] if isinstance(obj, str) else list(obj)
 
@@ -86,11 +101,18 @@ class Instance:
 
     @property
     def mechanism(self) -> str:
-        return self.data["mechanism"]
+        return self.given.mechanism_name if self.given is not None else self.data["mechanism"]
 
     def problem(self) -> DesignProblem:
         """The validated problem (same validation as a problem file)."""
+        if self.given is not None:
+            return self.given
         return problem_from_dict(copy.deepcopy(self.data), source=self.id)
+
+
+def user_instances(problems) -> list[Instance]:
+    """Instances of the caller's own problems (family ``"user"``)."""
+    return [Instance("user", k, {}, p) for k, p in enumerate(problems)]
 
 
 def _rng(family: str, seed: int) -> np.random.Generator:
@@ -107,11 +129,13 @@ def instance_dict(family: str, seed: int) -> dict[str, Any]:
     """
     if family == "shipped":
         return _shipped(seed)
-    if family not in FAMILIES:
-        raise KeyError(
-            f"unknown instance family {family!r} (known: shipped, {', '.join(FAMILIES)})"
-        )
-    mechanism, objectives = FAMILIES[family]
+    fams = families()
+    if family not in fams:
+        raise KeyError(f"unknown instance family {family!r} (known: shipped, {', '.join(fams)})")
+    mechanism, objectives = fams[family]
+    from optdesign.mechanisms.registry import get_mechanism
+
+    mech = get_mechanism(mechanism)
     rng = _rng(family, seed)
     phi_max = float(rng.uniform(20.0, 40.0))
     points = int(rng.choice([31, 41, 61]))
@@ -125,13 +149,11 @@ def instance_dict(family: str, seed: int) -> dict[str, Any]:
         lead: dict[str, Any] = {"catalogue": "ISO 3408", "lower": f"{lo} mm", "upper": f"{hi} mm"}
     else:
         lead = {"lower": "2 mm", "upper": "10 mm"}
-    variables: dict[str, Any] = {"R": {"lower": "30 mm", "upper": "120 mm"}}
-    if mechanism == "crank_slider":
-        variables["l"] = {"lower": "40 mm", "upper": "200 mm"}
-        variables["n"] = {"lower": "0 mm", "upper": "150 mm"}
-    variables["p"] = lead
-    if mechanism == "crank_slider":
-        variables["phi0"] = {"lower": "-0.6 rad", "upper": "0.6 rad"}
+    own_vars, own_reqs = mech.bench_template()
+    # The template says where the lead goes (``"p": None``), so the variable order - and
+    # with it every instance - is the same as when the families were written by hand.
+    variables: dict[str, Any] = {k: (lead if k == "p" else v) for k, v in own_vars.items()}
+    variables.setdefault("p", lead)
     variables["i_a"] = 2
     requirements: dict[str, Any] = {
         "deflection": {"min": f"{-phi_max} deg", "max": f"{phi_max} deg", "points": points},
@@ -140,17 +162,15 @@ def instance_dict(family: str, seed: int) -> dict[str, Any]:
         "nut_travel_max": f"{travel} mm",
         "fit": fit,
         "fit_clearance": "max",
+        **own_reqs,
     }
-    if mechanism == "crank_slider":
-        requirements["transmission_angle"] = {"min": "40 deg", "max": "140 deg"}
-        requirements["rod_inclination_max"] = "30 deg"
     needs_pin = any(o.startswith("backlash") for o in objectives) or rng.random() < 0.5
     if needs_pin:
         variables["d"] = {"lower": "4 mm", "upper": "30 mm"}
         variables["pin_length_ratio"] = float(rng.choice([1.0, 1.5, 2.0]))
         requirements["pin_bearing_pressure_max"] = f"{float(rng.uniform(60.0, 120.0))} MPa"
         requirements["pin_shear_stress_max"] = "200 MPa"
-        requirements["pin_shear_planes"] = 2 if mechanism == "crank_slider" else 1
+        requirements["pin_shear_planes"] = mech.pin_shear_planes
     return {
         "name": f"{family}-{seed:03d}",
         "description": f"benchmark instance {family} seed {seed}",
@@ -174,8 +194,10 @@ def _shipped(seed: int) -> dict[str, Any]:
 
 
 def problems_dir() -> Path:
-    """The shipped ``problems/`` folder of the source tree."""
-    return Path(__file__).resolve().parents[2] / "problems"
+    """The shipped ``problems/`` folder (package data, see :mod:`optdesign.data`)."""
+    from optdesign.data import problems_dir as shipped
+
+    return shipped()
 
 
 def make_instance(family: str, seed: int) -> Instance:
@@ -193,9 +215,9 @@ def suite(name: str, fronts: bool = True) -> list[Instance]:
     """
     if name == "default":
         out = [make_instance("shipped", k) for k in range(len(SHIPPED))]
-        out += [make_instance(f, s) for f in SINGLE_FAMILIES for s in range(14)]
+        out += [make_instance(f, s) for f in single_families() for s in range(14)]
         if fronts:
-            out += [make_instance(f, s) for f in FRONT_FAMILIES for s in range(3)]
+            out += [make_instance(f, s) for f in front_families() for s in range(3)]
         return out
     if name == "quick":
         out = [

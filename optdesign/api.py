@@ -1,0 +1,146 @@
+"""The public API: what ``import optdesign`` offers a script or a notebook.
+
+::
+
+    import optdesign as od
+
+    problem = od.load("problems/cs_min_backlash.toml")   # a file, a dict, or a problem
+    result = od.solve(problem)                             # formulation="auto"
+    print(result.summary()); result.to_frame(); result.plot()
+    front = od.pareto(problem, ["ripple", "backlash"], points=30)
+    report = od.bench(problems=[problem], solvers=["ipopt", "slsqp"])
+
+Every function takes keyword arguments and returns typed results; none prints, none
+changes the matplotlib back-end.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.load import load
+from optdesign.solvers.result import Result
+
+__all__ = ["bench", "load", "pareto", "solve"]
+
+
+def solve(
+    problem: DesignProblem | str | Path | Mapping[str, Any],
+    formulation: str = "auto",
+    *,
+    objective: str | None = None,
+    starts: int | None = None,
+    seed: int | None = None,
+    workers: int = 1,
+    solver: str = "ipopt",
+    options: Mapping[str, Any] | None = None,
+    ranges: bool = True,
+) -> Result:
+    """The optimal design of ``problem``, with its evidence.
+
+    Parameters
+    ----------
+    problem
+        A :class:`DesignProblem`, a problem-file path or a problem dict.
+    formulation
+        ``"auto"`` (catalogue when a variable takes catalogue values, robust when the
+        problem has tolerances, GP when it is a geometric program, else NLP), or one of
+        ``"nlp"``, ``"gp"``, ``"catalogue"``, ``"robust"``.
+    objective
+        Objective to minimise (default: the problem's first).
+    starts, seed
+        Multistart size and Sobol seed (default: the problem's ``[solver]``).
+    workers
+        Local processes for the starts.
+    solver, options
+        Registered solver back-end (:func:`optdesign.solvers.solver_names`) and options.
+    ranges
+        Also compute the range of each variable over the optimal set (NLP optima).
+
+    Returns
+    -------
+    Result
+        Status, objective, design, every objective at the design, active and violated
+        constraints, the independent check, the multistart record, bounds/certificates.
+    """
+    from optdesign.studies.solve import solve as run
+
+    return run(
+        load(problem),
+        formulation,
+        objective=objective,
+        starts=starts,
+        seed=seed,
+        workers=workers,
+        solver=solver,
+        options=options,
+        ranges=ranges,
+    )
+
+
+def pareto(
+    problem: DesignProblem | str | Path | Mapping[str, Any],
+    objectives: Sequence[str],
+    points: int = 50,
+    method: str = "epsilon",
+    **options: Any,
+):
+    """The Pareto front of two or three objectives of ``problem``.
+
+    ``method``: ``"epsilon"`` (epsilon-constraint between exact anchors, evenly spread
+    along the front; default), ``"uniform"`` (epsilon evenly spaced), ``"weighted_sum"``
+    or ``"nsga2"``. Options (all keywords): ``out`` (folder of the resumable store),
+    ``workers``, ``scheduler`` (Dask), ``resume``, ``starts``, ``seed``, ``solver``,
+    ``deterministic``, NSGA-II's ``pop_size`` and ``generations``.
+
+    Returns
+    -------
+    Front
+        The non-dominated points with their designs, the rejected points, the metrics
+        (hypervolume, spacing, spread); ``.summary()``, ``.to_frame()``, ``.plot()``.
+    """
+    from optdesign.studies.pareto import compute_front
+
+    return compute_front(load(problem), list(objectives), points, method, **options)
+
+
+def bench(
+    problems: Sequence[DesignProblem | str | Path | Mapping[str, Any]] | None = None,
+    *,
+    suite: str | None = None,
+    solvers: Sequence[str] | None = None,
+    out: str | Path | None = None,
+    workers: int = 1,
+    resume: bool = False,
+    time_limit: float = 1.0,
+    progress: bool = False,
+):
+    """Benchmark solver configurations on problems (yours) or on a seeded suite.
+
+    ``problems``: problems to run every configuration on; ``suite``: ``"quick"`` or
+    ``"default"`` (instance families of the registered mechanisms). ``solvers``: names of
+    configurations (default: all). Runs stream to ``out`` (a new temporary folder by
+    default) and can be resumed.
+
+    Returns
+    -------
+    BenchReport
+        Every run's row, per-configuration statistics, performance profiles, the summary
+        table; ``.summary()``, ``.to_frame()``, ``.plot()``.
+    """
+    from optdesign.studies.bench import run_bench
+
+    loaded = None if problems is None else [load(p) for p in problems]
+    return run_bench(
+        suite=suite,
+        problems=loaded,
+        configs=solvers,
+        out=out,
+        workers=workers,
+        resume=resume,
+        time_limit=time_limit,
+        progress=progress,
+    )

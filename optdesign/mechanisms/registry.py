@@ -1,0 +1,119 @@
+"""The mechanism registry: name -> plug-in class.
+
+Built-in mechanisms register on import of :mod:`optdesign.mechanisms`; a notebook or
+script registers its own with :func:`register_mechanism`; a separate package adds one
+through the entry-point group ``optdesign.mechanisms`` (``name = "pkg.module:Class"`` in
+its ``pyproject.toml`` under ``[project.entry-points."optdesign.mechanisms"]``), loaded
+the first time a name is not found. Problem files name a mechanism by its key; the
+problem schema (variables, requirements, clearances) is derived from the class.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from importlib.metadata import entry_points
+from typing import TYPE_CHECKING, TypeVar, overload
+
+from optdesign.errors import InputError
+
+if TYPE_CHECKING:
+    from optdesign.mechanisms.base import Mechanism
+
+ENTRY_POINT_GROUP = "optdesign.mechanisms"
+
+_REGISTRY: dict[str, type[Mechanism]] = {}
+_ENTRY_POINTS_LOADED = False
+
+M = TypeVar("M", bound="type[Mechanism]")
+
+
+@overload
+def register_mechanism(cls: M, /) -> M: ...
+@overload
+def register_mechanism(
+    name: str | None = None, /, *, replace: bool = False
+) -> Callable[[M], M]: ...
+
+
+def register_mechanism(arg=None, /, *, replace: bool = False):
+    """Register a :class:`~optdesign.mechanisms.Mechanism` subclass under its ``name``.
+
+    Use as ``@register_mechanism`` (the key is the class's ``name``), as
+    ``@register_mechanism("key")``, or call ``register_mechanism(Cls)``. Registering a
+    name twice replaces the first class only with ``replace=True`` (or when it is the
+    same class, e.g. a module reloaded in a notebook).
+    """
+
+    def add(cls, key: str | None):
+        from optdesign.mechanisms.base import Mechanism
+
+        if not (isinstance(cls, type) and issubclass(cls, Mechanism)):
+            raise TypeError(f"register_mechanism: {cls!r} is not a Mechanism subclass")
+        key = key or cls.name
+        if not key:
+            raise InputError("mechanism", f"{cls.__name__} has no name; set name = '...'")
+        if key != cls.name:
+            cls.name = key
+        old = _REGISTRY.get(key)
+        if (
+            old is not None
+            and old is not cls
+            and not replace
+            and old.__qualname__ != cls.__qualname__
+        ):
+            raise InputError(
+                "mechanism",
+                f"{key!r} is registered already ({old.__module__}.{old.__qualname__}); "
+                "pass replace=True to replace it",
+            )
+        cls.variable_table()  # validates the declared variables now, not at first use
+        _REGISTRY[key] = cls
+        return cls
+
+    if isinstance(arg, type):
+        return add(arg, None)
+
+    def deco(cls):
+        return add(cls, arg)
+
+    return deco
+
+
+def _load_entry_points() -> None:
+    global _ENTRY_POINTS_LOADED
+    if _ENTRY_POINTS_LOADED:
+        return
+    _ENTRY_POINTS_LOADED = True
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name in _REGISTRY:
+            continue
+        try:
+            cls = ep.load()
+        except Exception as exc:  # a broken plug-in must not break the others
+            raise InputError(
+                "mechanism", f"plug-in {ep.name!r} ({ep.value}) failed to load: {exc}"
+            ) from None
+        register_mechanism(ep.name)(cls)
+
+
+def get_mechanism(name: str) -> type[Mechanism]:
+    """The class registered as ``name``; InputError listing the registered ones if none."""
+    import optdesign.mechanisms  # noqa: F401  (registers the built-ins)
+
+    cls = _REGISTRY.get(name)
+    if cls is None:
+        _load_entry_points()
+        cls = _REGISTRY.get(name)
+    if cls is None:
+        raise InputError(
+            "mechanism", f"unknown mechanism {name!r} (registered: {', '.join(registered())})"
+        )
+    return cls
+
+
+def registered() -> list[str]:
+    """Names of the registered mechanisms (entry points included)."""
+    import optdesign.mechanisms  # noqa: F401
+
+    _load_entry_points()
+    return list(_REGISTRY)

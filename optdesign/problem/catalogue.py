@@ -1,0 +1,196 @@
+"""Objectives and constraints as declarations: name, unit, description, formula, and the
+function of the design's :class:`~optdesign.problem.quantities.Quantities` that computes
+them. The built-in objectives are declared once here; a user adds more with
+:meth:`DesignProblem.add_objective` / :meth:`DesignProblem.add_constraint`, and every
+formulation, check, report and plot reads names and units from these records.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from optdesign.errors import InputError
+
+#: Objective kinds: how a grid quantity becomes one number.
+#: ``spread``: (max - min)/(max + min) over the grid (the ratio ripple);
+#: ``max``: the largest value over the grid; ``scalar``: one value per design.
+KINDS = ("spread", "max", "scalar")
+
+
+@dataclass(frozen=True)
+class ObjectiveInfo:
+    """A minimisable quantity.
+
+    Attributes
+    ----------
+    name
+        Key (``[objective] minimize = [...]``, ``--objectives``).
+    fn
+        ``fn(q) -> expression`` (over the grid for ``spread``/``max``, one value for
+        ``scalar``), or None when the problem lacks what it needs (e.g. no pin).
+    kind
+        One of :data:`KINDS`.
+    unit
+        Internal unit of the value ("" for dimensionless).
+    description, formula
+        What it is and how it is computed, for reports and docs.
+    display_unit, display_scale
+        How users read it: value * display_scale in display_unit (e.g. ripple in %).
+    """
+
+    name: str
+    fn: Callable[[Any], Any]
+    kind: str
+    unit: str = ""
+    description: str = ""
+    formula: str = ""
+    display_unit: str | None = None
+    display_scale: float = 1.0
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise InputError(f"objective {self.name}.kind", f"{self.kind!r} not in {KINDS}")
+        if not callable(self.fn):
+            raise InputError(f"objective {self.name}.fn", "must be a function of the quantities")
+
+    @property
+    def shown_unit(self) -> str:
+        return self.unit if self.display_unit is None else self.display_unit
+
+
+@dataclass(frozen=True)
+class ConstraintInfo:
+    """A user-declared requirement ``lower <= fn(q) <= upper``.
+
+    ``over="stroke"``: ``fn`` returns a value per grid angle, each must hold;
+    ``over="design"``: one value. Bounds are in ``unit`` (internal units of the value).
+    """
+
+    name: str
+    fn: Callable[[Any], Any]
+    lower: float | None = None
+    upper: float | None = None
+    unit: str = ""
+    over: str = "stroke"
+    description: str = ""
+
+    def __post_init__(self):
+        if self.over not in ("stroke", "design"):
+            raise InputError(f"constraint {self.name}.over", "use 'stroke' or 'design'")
+        if self.lower is None and self.upper is None:
+            raise InputError(f"constraint {self.name}", "give a lower or an upper bound")
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise InputError(
+                f"constraint {self.name}", f"lower {self.lower:g} is above upper {self.upper:g}"
+            )
+        if not callable(self.fn):
+            raise InputError(f"constraint {self.name}.fn", "must be a function of the quantities")
+
+
+@dataclass
+class ObjectiveTerm:
+    """An objective of one design: its declaration's name and kind, and the expression."""
+
+    name: str
+    kind: str
+    expr: Any
+    unit: str = ""
+    description: str = ""
+
+
+@dataclass
+class ConstraintBlock:
+    """``lower <= expr <= upper``, element-wise over the grid (or one value).
+
+    ``labels`` name the rows (the deflection angle), ``unit`` is the unit of ``expr``;
+    ``display``/``display_unit`` map a row value to what a user reads (e.g. degrees of an
+    angle whose cosine is constrained).
+    """
+
+    name: str
+    expr: Any
+    lower: float | None = None
+    upper: float | None = None
+    labels: list[str] = field(default_factory=list)
+    unit: str = ""
+    description: str = ""
+    display: Callable[[Any], Any] | None = None
+    display_unit: str = ""
+
+
+def _backlash(q):
+    return None if q.pin is None else q.backlash.worst_case
+
+
+def _backlash_rss(q):
+    return None if q.pin is None else q.backlash.rss
+
+
+#: The built-in objectives, declared once.
+BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
+    o.name: o
+    for o in (
+        ObjectiveInfo(
+            "ripple",
+            lambda q: q.ratio,
+            "spread",
+            "",
+            "ratio ripple",
+            "(i_max - i_min)/(i_max + i_min) of the ratio over the stroke",
+            display_unit="%",
+            display_scale=100.0,
+        ),
+        ObjectiveInfo(
+            "backlash",
+            _backlash,
+            "max",
+            "deg",
+            "worst-case output backlash",
+            "max over the stroke of the sum of each joint's clearance times its sensitivity",
+        ),
+        ObjectiveInfo(
+            "backlash_rss",
+            _backlash_rss,
+            "max",
+            "deg",
+            "RSS output backlash",
+            "max over the stroke of the root-sum-square of the joints' contributions",
+        ),
+        ObjectiveInfo(
+            "size",
+            lambda q: q.size,
+            "scalar",
+            "mm",
+            "size of the mechanism",
+            "the mechanism's size measure (crank-slider R + l, fork R, ...)",
+        ),
+        ObjectiveInfo(
+            "nut_travel",
+            lambda q: q.nut_travel,
+            "scalar",
+            "mm",
+            "nut travel",
+            "x(phi_max) - x(phi_min)",
+        ),
+        ObjectiveInfo(
+            "motor_torque",
+            lambda q: q.motor_torque,
+            "max",
+            "N*mm",
+            "largest motor torque over the stroke",
+            "max of F_nut p / (2 pi i_a eta_screw eta_gear)",
+            display_unit="N*m",
+            display_scale=1e-3,
+        ),
+        ObjectiveInfo(
+            "lock_force",
+            lambda q: q.lock_force,
+            "max",
+            "N",
+            "magnet force of the motor-shaft lock",
+            "lock force holding the hinge moment reflected to the motor shaft",
+        ),
+    )
+}

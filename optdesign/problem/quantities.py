@@ -1,0 +1,183 @@
+"""The quantities of one design over the deflection grid: what objectives and constraints
+(built-in and user-written) are functions of.
+
+``q = problem.quantities(design)`` gives, computed once each on first use, the
+mechanism's drive coordinate and its derivative, the ratio, the nut force, the motor
+torque, the nut travel, the clearance chain and backlash, the sized pin and its load,
+the size, the lock force; ``q.mechanism`` is the mechanism instance itself (for its own
+quantities, e.g. ``q.mechanism.transmission_angle(q.phi)``) and ``q.R`` any design
+variable. The values are CasADi expressions on the solver path, NumPy arrays (a design,
+or a population broadcast on the last axis) on the checking path, and signomial tracers
+in the GP diagnosis: write functions of ``q`` with :mod:`optdesign.math`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from optdesign.mechanisms.joints import (
+    Backlash,
+    Joint,
+    PinJoint,
+    with_fixed_clearances,
+    with_sampled_fits,
+)
+
+if TYPE_CHECKING:
+    from optdesign.problem.design_problem import DesignProblem
+
+
+class Quantities:
+    """Lazily computed quantities of ``design`` (see the module docstring).
+
+    Parameters
+    ----------
+    problem
+        The design problem (grid, requirements, materials).
+    design
+        Every variable name -> value.
+    guarded
+        Solver path: guarded square roots.
+    first_order
+        First-order Hertz flattening (the GP form).
+    fit_fractions
+        One fit fraction per sized pin joint (robust design), or None for the
+        requirement's ``fit_clearance``.
+    """
+
+    def __init__(
+        self,
+        problem: DesignProblem,
+        design: Mapping[str, Any],
+        guarded: bool = False,
+        first_order: bool = False,
+        fit_fractions: Sequence[Any] | None = None,
+    ):
+        self.problem = problem
+        self.design = dict(design)
+        self.guarded = guarded
+        self.first_order = first_order
+        self.fit_fractions = fit_fractions
+        self.phi = problem.phi
+        self.labels = problem.phi_labels
+        self.requirements = problem.spec.requirements
+        self.hinge_moment = self.requirements.hinge_moment
+
+    def __getattr__(self, item: str) -> Any:
+        design = self.__dict__.get("design")
+        if design is not None and item in design:
+            return design[item]
+        raise AttributeError(
+            f"no quantity or variable {item!r} (variables: {', '.join(design or {})}; "
+            "quantities: see optdesign.problem.quantities.Quantities)"
+        )
+
+    # --- mechanism ---------------------------------------------------------------------
+    @cached_property
+    def mechanism(self):
+        """The mechanism instance of this design."""
+        cls = self.problem.mechanism
+        names = cls.variable_table()
+        values = {k: v for k, v in self.design.items() if k in names}
+        return cls(values, guarded=self.guarded)
+
+    @cached_property
+    def nut_position(self):
+        """Drive coordinate x(phi) over the grid (mm)."""
+        return self.mechanism.nut_position(self.phi)
+
+    @cached_property
+    def nut_velocity(self):
+        """dx/dphi over the grid (mm/rad)."""
+        return self.mechanism.nut_velocity(self.phi)
+
+    @cached_property
+    def ratio(self):
+        """Reduction ratio i(phi) = 2 pi i_a (dx/dphi)/p over the grid."""
+        return self.mechanism.ratio(self.phi)
+
+    @cached_property
+    def nut_travel(self):
+        """x(phi_max) - x(phi_min) (mm)."""
+        return self.mechanism.nut_travel(self.phi[0], self.phi[-1])
+
+    @cached_property
+    def nut_force(self):
+        """Nut axial force over the grid (N), by virtual work."""
+        return self.mechanism.nut_force(self.phi, self.hinge_moment)
+
+    @cached_property
+    def motor_torque(self):
+        """Motor torque over the grid (N*mm), with the requirements' efficiencies."""
+        req = self.requirements
+        return self.mechanism.motor_torque(self.phi, self.hinge_moment, req.eta_screw, req.eta_gear)
+
+    @cached_property
+    def size(self):
+        """The mechanism's size measure (mm)."""
+        return self.mechanism.size()
+
+    # --- pins and clearance --------------------------------------------------------------
+    @cached_property
+    def pin(self) -> PinJoint | None:
+        """The sized pin (None when the problem declares no pin diameter)."""
+        d = self.design
+        if "d" not in d:
+            return None
+        L = d["pin_length"] if "pin_length" in d else d["pin_length_ratio"] * d["d"]
+        mat = self.problem.spec.materials.pin
+        req = self.requirements
+        return PinJoint(d["d"], L, req.fit, req.fit_clearance, mat.E, mat.nu, 2, self.first_order)
+
+    @cached_property
+    def pin_force(self):
+        """Force on the sized pin(s) over the grid (N)."""
+        return self.mechanism.pin_force(self.phi, self.hinge_moment)
+
+    @cached_property
+    def joints(self) -> list[Joint]:
+        """The clearance chain: sized pins and the declared fixed clearances."""
+        chain = self.mechanism.joints(self.phi, self.hinge_moment, self.pin)
+        clearances = self.problem.spec.clearances
+        fixed = dict(clearances) if clearances is not None else {}
+        chain = with_fixed_clearances(chain, fixed)
+        if self.fit_fractions is not None:
+            chain = with_sampled_fits(chain, self.fit_fractions)
+        return chain
+
+    @cached_property
+    def backlash(self) -> Backlash:
+        """Output backlash over the grid (deg): per joint, worst case, RSS."""
+        return self.mechanism.backlash(self.phi, self.joints)
+
+    # --- drive extras ----------------------------------------------------------------------
+    @cached_property
+    def lock_force(self):
+        """Magnet force of the motor-shaft lock over the grid (N), seed 002 coupled to the
+        drive (None without a ``lock`` requirement)."""
+        from optdesign.models.lock import FrictionPlateLock, PinLock, motor_shaft_lock_load
+
+        lk = self.requirements.lock
+        if lk is None:
+            return None
+        if lk.kind == "friction_plate":
+            lock = FrictionPlateLock(lk.r1, lk.r2, lk.mu)
+        else:
+            lock = PinLock(lk.radius, bearing="guide" if lk.kind == "pin_rolling" else None)
+        load = motor_shaft_lock_load(
+            self.mechanism, self.phi, self.hinge_moment, lk.eta_screw_back, lk.eta_gear_back
+        )
+        return lock.force(load.moment)
+
+    def on_grid(self, value) -> bool:
+        """True when ``value`` varies over the deflection grid (a stroke quantity)."""
+        from optdesign import math as m
+
+        if m.is_symbolic(value):
+            return value.shape[0] == len(self.phi) and len(self.phi) > 1
+        shape = np.shape(value)
+        return bool(shape) and shape[-1] == len(self.phi) and len(self.phi) > 1

@@ -1,0 +1,238 @@
+"""Benchmark outputs: the runs as CSV, the profiles as PNG, the Markdown summary, and the
+:class:`BenchReport` a caller reads (summary, frame, figure)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from optdesign.studies.bench.configs import get_config
+from optdesign.studies.bench.metrics import (
+    GAP_FLOOR,
+    SOLVED_GAP,
+    best_config,
+    config_stats,
+    measure_table,
+    paired_time_ratio,
+    performance_profile,
+)
+from optdesign.studies.verify import VERIFY_TOL
+
+
+def stats_table(
+    stats: Mapping[str, Mapping[str, Any]],
+    descriptions: Mapping[str, str],
+    rows: Sequence[Mapping[str, Any]],
+) -> str:
+    """Markdown table of :func:`config_stats`, best configuration first, with the median
+    per-instance ratio of each configuration's time to the best one's."""
+    best = best_config(stats)
+    order = sorted(
+        stats,
+        key=lambda c: (
+            c != best,
+            -(stats[c]["solved_rate"] or 0),
+            stats[c]["median_time_s"] if math.isfinite(stats[c]["median_time_s"]) else 1e9,
+        ),
+    )
+    lines = [
+        "| configuration | what | runs | success | solved (gap <= 1e-4) | median time (s) "
+        "| time / best (median, paired) | median gap | failures |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for c in order:
+        s = stats[c]
+        if not s["runs"]:
+            continue
+        ratio, n_pairs = paired_time_ratio(rows, c, best) if best else (float("nan"), 0)
+        fails = ", ".join(f"{k} {v}" for k, v in sorted(s["failures"].items())) or "-"
+        lines.append(
+            f"| {'**' + c + '**' if c == best else c} | {descriptions.get(c, '')} | {s['runs']} | "
+            f"{100 * s['success_rate']:.0f} % | {100 * s['solved_rate']:.0f} % | "
+            f"{_fmt(s['median_time_s'], '.3g')} | {_fmt(ratio, '.2f')} ({n_pairs}) | "
+            f"{_fmt(s['median_gap'], '.1e')} | {fails} |"
+        )
+    return "\n".join(lines)
+
+
+def _fmt(v: float, spec: str) -> str:
+    return "-" if v is None or not math.isfinite(v) else format(v, spec)
+
+
+CSV_FIELDS = [
+    "instance",
+    "family",
+    "seed",
+    "mechanism",
+    "objective_name",
+    "catalogue",
+    "config",
+    "kind",
+    "status",
+    "success",
+    "objective",
+    "best_known",
+    "gap",
+    "violation",
+    "time_s",
+    "iterations",
+    "n_fun",
+    "n_grad",
+    "n_hess",
+    "n_subproblems",
+    "reason",
+]
+
+
+def eval_counts(n_evals: Mapping[str, int]) -> tuple[int | None, int | None, int | None]:
+    """(function, first-derivative, Hessian) evaluation counts from a back-end's counters.
+
+    Ipopt: nlp_f / nlp_grad_f / nlp_hess_l; sqpmethod: nlp_fg / nlp_jac_fg / nlp_hess_l;
+    scipy: f / grad_f / hess_f; DE: designs evaluated. ``None`` when not reported.
+    """
+    if not n_evals:
+        return None, None, None
+    f = n_evals.get("nlp_f", n_evals.get("nlp_fg", n_evals.get("f")))
+    g = n_evals.get("nlp_grad_f", n_evals.get("nlp_jac_fg", n_evals.get("grad_f")))
+    h = n_evals.get("nlp_hess_l", n_evals.get("hess_f"))
+    return f, g, h
+
+
+def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) -> dict[str, Any]:
+    """bench_runs.csv, bench_profiles.png, summary.md, bench_stats.json in ``out``."""
+
+    out = Path(out)
+    with (out / "bench_runs.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, CSV_FIELDS, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            f, g, h = eval_counts(r.get("n_evals") or {})
+            w.writerow(
+                {
+                    **r,
+                    "n_fun": f,
+                    "n_grad": g,
+                    "n_hess": h,
+                    "reason": str(r.get("reason", ""))[:200],
+                }
+            )
+    single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
+    fronts = [c for c in configs if get_config(c).kind == "front"]
+    if single:
+        from optdesign.plots import save_figure
+
+        save_figure(profiles_figure(rows, configs), out / "bench_profiles.png", tight=False)
+    desc = {c: get_config(c).description for c in configs}
+    stats_all = config_stats([r for r in rows if r["config"] in single], single)
+    shipped = [r for r in rows if r["family"] == "shipped"]
+    n_inst = len({r["instance"] for r in rows})
+    lines = [
+        f"Suite `{suite_name}`: {n_inst} instances, {len(rows)} runs, wall time {wall:.0f} s "
+        f"(soft time limit {time_limit:g} s per run, hard timeout {hard:g} s). "
+        "Time = wall time of one run from the problem to the answer (formulation, solver "
+        "set-up and solve; catalogue combinations summed), median over successful runs. "
+        "Success = the solver reports success and the independent NumPy check passes "
+        f"(violation <= {VERIFY_TOL:g}); solved = success with gap <= {SOLVED_GAP:g} to the "
+        "best value any configuration found. Best configuration (bold) = among those run "
+        "on every instance of the table, the highest solved rate, then the lowest median "
+        "time; 'time / best' = median over the instances both solved of the per-instance "
+        "time ratio (number of such instances in brackets).",
+        "",
+        "### All single-objective instances",
+        "",
+        stats_table(stats_all, desc, rows),
+    ]
+    if shipped:
+        lines += [
+            "",
+            "### Shipped problems (problems/*.toml)",
+            "",
+            stats_table(
+                config_stats([r for r in shipped if r["config"] in single], single), desc, shipped
+            ),
+        ]
+        lines += ["", _shipped_table(shipped, single)]
+    if fronts:
+        st = config_stats([r for r in rows if r["config"] in fronts], fronts)
+        lines += [
+            "",
+            "### Pareto-front instances (gap = 1 - hypervolume / best hypervolume)",
+            "",
+            stats_table(st, desc, rows),
+        ]
+    text = "\n".join(lines) + "\n"
+    (out / "summary.md").write_text(text)
+    (out / "bench_stats.json").write_text(
+        json.dumps(
+            {"all": stats_all, "wall_time_s": wall, "suite": suite_name}, indent=1, default=str
+        )
+    )
+    return {
+        "csv": out / "bench_runs.csv",
+        "profiles": out / "bench_profiles.png",
+        "summary": out / "summary.md",
+        "summary_text": text,
+    }
+
+
+def _shipped_table(rows, configs) -> str:
+    insts = sorted({r["instance"] for r in rows})
+    head = "| configuration | " + " | ".join(f"{i}: time (s) / gap" for i in insts) + " |"
+    lines = [head, "|---|" + "---|" * len(insts)]
+    by = {(r["instance"], r["config"]): r for r in rows}
+    for c in configs:
+        cells = []
+        for i in insts:
+            r = by.get((i, c))
+            if r is None or not r.get("applicable", True):
+                cells.append("n/a")
+            elif not r.get("success"):
+                cells.append(f"{r['status']}")
+            else:
+                cells.append(f"{r['time_s']:.3g} / {r['gap']:.1e}")
+        lines.append(f"| {c} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+#: Markers of the generated block in benchmarks/README.md.
+README_BEGIN = "<!-- bench-summary:begin (generated by optdesign bench) -->"
+README_END = "<!-- bench-summary:end -->"
+
+
+def update_readme(readme: Path, summary: str) -> bool:
+    """Replace the text between the markers of ``readme`` by ``summary``; False if the
+    markers are absent."""
+    text = readme.read_text()
+    a, b = text.find(README_BEGIN), text.find(README_END)
+    if a < 0 or b < a:
+        return False
+    readme.write_text(text[: a + len(README_BEGIN)] + "\n" + summary + text[b:])
+    return True
+
+
+def profiles(rows, configs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Time and gap performance profiles of the single-objective configurations."""
+    single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
+    chosen = [r for r in rows if r["config"] in single]
+    taus_t = np.logspace(0, 3, 200)
+    taus_g = np.logspace(0, 6, 200)
+    _, Tt = measure_table(chosen, single, "time")
+    _, Tg = measure_table(chosen, single, "gap")
+    return {
+        "time": (taus_t, performance_profile(Tt, taus_t)),
+        "gap": (taus_g, performance_profile(Tg, taus_g, floor=GAP_FLOOR)),
+    }
+
+
+def profiles_figure(rows, configs):
+    """The profiles as a matplotlib Figure."""
+    from optdesign.plots.profiles import plot_profiles
+
+    single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
+    return plot_profiles(profiles(rows, configs), single, gap_floor=GAP_FLOOR)

@@ -1,0 +1,199 @@
+"""The whole benchmark: tasks of (instance, configuration), streamed through the runner's
+checkpointed store, then gaps, statistics, profiles and the summary."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from optdesign.errors import InputError, OptDesignError
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.bench.configs import default_configs, get_config
+from optdesign.studies.bench.instances import Instance, user_instances
+from optdesign.studies.bench.instances import suite as build_suite
+from optdesign.studies.bench.metrics import add_gaps, config_stats
+from optdesign.studies.bench.sandbox import run_task
+
+
+@dataclass
+class BenchReport:
+    """What a benchmark run produced.
+
+    Attributes
+    ----------
+    rows
+        One dict per (instance, configuration) run, with its gap to the best known value.
+    configs
+        The configurations run.
+    stats
+        Per configuration: runs, success and solved rates, median time and gap, failures.
+    summary_markdown
+        The summary tables (Markdown).
+    paths
+        Files written (CSV, profiles PNG, summary).
+    wall_time_s
+        Wall time of the whole benchmark (resumed runs included).
+    """
+
+    rows: list[dict[str, Any]]
+    configs: list[str]
+    stats: dict[str, dict[str, Any]] = field(default_factory=dict)
+    summary_markdown: str = ""
+    paths: dict[str, Any] = field(default_factory=dict)
+    wall_time_s: float = 0.0
+
+    def summary(self) -> str:
+        return self.summary_markdown
+
+    def to_frame(self):
+        """A pandas DataFrame of the runs (one row per instance and configuration)."""
+        import pandas as pd
+
+        keep = (
+            "instance",
+            "config",
+            "kind",
+            "status",
+            "success",
+            "objective",
+            "gap",
+            "time_s",
+            "iterations",
+            "reason",
+        )
+        return pd.DataFrame([{k: r.get(k) for k in keep} for r in self.rows])
+
+    def plot(self, ax=None):
+        """Dolan-More profiles (time and gap) of the single-objective configurations."""
+        from optdesign.studies.bench.report import profiles_figure
+
+        return profiles_figure(self.rows, self.configs)
+
+
+def make_tasks(
+    instances: Sequence[Instance], configs: Sequence[str], time_limit: float, hard_timeout: float
+) -> list[dict[str, Any]]:
+    """One task per (instance, configuration); fronts only with front configurations."""
+    tasks = []
+    for inst in instances:
+        problem = None
+        for name in configs:
+            c = get_config(name)
+            if (c.kind == "front") != inst.is_front and c.kind != "debug":
+                continue
+            if c.applies is not None:
+                problem = problem or inst.problem()
+                if not c.applies(problem):
+                    continue
+            task = {
+                "id": f"{inst.id}|{name}",
+                "family": inst.family,
+                "seed": inst.seed,
+                "config": name,
+                "time_limit": time_limit * c.time_factor,
+                "hard_timeout": hard_timeout * c.time_factor,
+            }
+            if inst.given is not None:
+                task["problem"] = inst.given
+            tasks.append(task)
+    return tasks
+
+
+def run_bench(
+    suite: str | None = "default",
+    configs: Sequence[str] | None = None,
+    out: Path | str | None = None,
+    workers: int = 1,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    time_limit: float = 1.0,
+    hard_timeout: float | None = None,
+    instances: Sequence[Instance] | None = None,
+    problems: Sequence[DesignProblem] | None = None,
+) -> BenchReport:
+    """Run the benchmark, stream rows to ``out/bench_runs.jsonl``, write CSV, profiles and
+    the summary into ``out`` (a new temporary folder by default: never over committed
+    files).
+
+    ``problems`` (the caller's own) or ``instances`` replace the suite's instances.
+    """
+    from optdesign.studies.bench.report import write_outputs
+    from optdesign.studies.runner import read_store, run_tasks
+
+    names = list(configs) if configs else default_configs()
+    for c in names:
+        get_config(c)  # InputError naming the unknown one
+    if workers < 1:
+        raise InputError("workers", f"need at least 1 worker, got {workers}")
+    hard = hard_timeout if hard_timeout is not None else time_limit + 3.0
+    if problems is not None:
+        instances = user_instances(problems)
+        suite_name = "user"
+    elif instances is None:
+        suite_name = suite or "default"
+        wants_fronts = any(get_config(c).kind == "front" for c in names)
+        try:
+            instances = build_suite(suite_name, fronts=wants_fronts)
+        except KeyError as exc:
+            raise InputError("suite", str(exc).strip("'\"")) from None
+    else:
+        suite_name = suite or "custom"
+    tasks = make_tasks(instances, names, time_limit, hard)
+    out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-bench-"))
+    out.mkdir(parents=True, exist_ok=True)
+    store = out / "bench_runs.jsonl"
+    identity = {
+        "suite": suite_name,
+        "ids": [t["id"] for t in tasks],
+        "tl": time_limit,
+        "hard": hard,
+    }
+    if problems is not None:
+        from optdesign.studies.solve import formulation_for
+
+        identity["formulations"] = [formulation_for(p).fingerprint for p in problems]
+    key = hashlib.sha256(json.dumps(identity).encode()).hexdigest()[:16]
+    t0 = time.perf_counter()
+    if resume and store.exists():
+        prev_key, _ = read_store(store)
+        if prev_key is not None and prev_key != key:
+            raise OptDesignError(
+                f"--resume: {store} holds another run (other suite, configurations or time "
+                "limit); use the same settings or a new --out"
+            )
+    records = run_tasks(
+        tasks,
+        run_task,
+        store,
+        workers=workers,
+        scheduler=scheduler,
+        resume=resume,
+        progress="bench" if progress else False,
+        key=key,
+    )
+    wall = time.perf_counter() - t0
+    # Wall time over all invocations of this run (a resumed run adds to the stored one).
+    meta_path = out / "bench_meta.json"
+    if resume and meta_path.exists():
+        meta = json.loads(meta_path.read_text())
+        if meta.get("key") == key:
+            wall += float(meta.get("wall_time_s", 0.0))
+    meta_path.write_text(json.dumps({"key": key, "wall_time_s": wall}))
+    rows = add_gaps([dict(records[t["id"]]) for t in tasks if t["id"] in records])
+    paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard)
+    single = [c for c in names if get_config(c).kind not in ("front", "debug")]
+    return BenchReport(
+        rows=rows,
+        configs=names,
+        stats=config_stats([r for r in rows if r["config"] in single], single),
+        summary_markdown=paths["summary_text"],
+        paths=paths,
+        wall_time_s=wall,
+    )

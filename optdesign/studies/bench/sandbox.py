@@ -1,0 +1,341 @@
+"""One benchmark run, sandboxed: an (instance, configuration) pair solved in a forked child
+with a hard timeout (a hung or crashed solver becomes a failure row with its reason), its
+design verified on the NumPy path, and a JSON row returned.
+
+Catalogue variables: configurations on a continuous formulation (NLP, GP) enumerate the
+catalogue (one continuous solve per combination, best kept; time and evaluations
+summed); differential evolution searches catalogue indices directly.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import os
+import pickle
+import select
+import signal
+import time
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from optdesign.problem import DesignProblem, problem_from_dict
+from optdesign.solvers.result import Result
+from optdesign.studies.bench.configs import Config, NotApplicable, get_config
+from optdesign.studies.bench.instances import Instance, make_instance
+from optdesign.studies.verify import VERIFY_TOL, verify_design
+
+#: After this many hard timeouts of one configuration on one mechanism in one worker
+#: process, its further runs on that mechanism are recorded as failures without running
+#: (sqpmethod+qrqp hangs inside a QP on every crank-slider; without this the default
+#: suite would spend most of its time waiting for it).
+TIMEOUT_STRIKES = 2
+
+
+def task_instance(task: Mapping[str, Any]) -> Instance:
+    """The instance of a task: generated from (family, seed), or the user's problem."""
+    if task.get("problem") is not None:
+        return Instance("user", int(task["seed"]), {}, task["problem"])
+    return make_instance(task["family"], task["seed"])
+
+
+def _catalogue_combos(problem: DesignProblem) -> list[dict[str, float]]:
+    disc = [v for v in problem.free if v.discrete]
+    if not disc:
+        return [{}]
+    return [
+        dict(zip([v.name for v in disc], c, strict=True))
+        for c in itertools.product(*(v.values for v in disc))
+    ]
+
+
+def _solve_single(
+    config: Config, inst: Instance, objective: str, time_limit: float
+) -> dict[str, Any]:
+    """Run a single-objective configuration; catalogues enumerated for nlp/gp kinds."""
+    problem = inst.problem()
+    combos = _catalogue_combos(problem) if config.kind in ("nlp", "gp") else [{}]
+    t0 = time.perf_counter()
+    best: tuple[float, Result, dict] | None = None
+    last: tuple[Result, dict] | None = None
+    iters, evals, statuses, n_na = 0, {}, [], 0
+    for combo in combos:
+        remaining = time_limit - (time.perf_counter() - t0)
+        if remaining <= 0:
+            statuses.append("time_limit")
+            break
+        sub = _fix(inst, problem, combo) if combo else problem
+        try:
+            r = config.run(sub, objective, remaining)
+        except NotApplicable:
+            n_na += 1
+            continue
+        statuses.append(r.status)
+        iters += r.iterations or 0
+        for k, v in (r.n_evals or {}).items():
+            evals[k] = evals.get(k, 0) + int(v)
+        if not r.design:
+            continue
+        x = np.array([{**r.design, **combo}[v.name] for v in problem.free], dtype=float)
+        last = (r, combo)
+        outside = _outside_bounds(problem, x)
+        if outside:
+            # The models reject such a design (e.g. a negative length): not a design.
+            r.status, r.message = "failed", f"returned a design outside the bounds: {outside}"
+            statuses[-1] = "failed"
+            continue
+        ok, _viol, objs = verify_design(problem, x)
+        if r.success and ok and math.isfinite(objs[objective]):
+            if best is None or objs[objective] < best[0]:
+                best = (float(objs[objective]), r, combo)
+    elapsed = time.perf_counter() - t0
+    if n_na == len(combos):
+        raise NotApplicable("not applicable to any catalogue combination")
+    chosen = (best[1], best[2]) if best is not None else last
+    row: dict[str, Any] = {
+        "time_s": elapsed,
+        "iterations": iters,
+        "n_evals": evals,
+        "n_subproblems": len(combos),
+    }
+    if chosen is None:
+        row.update(
+            status=statuses[-1] if statuses else "failed", reason="no design returned", design=None
+        )
+        return row
+    r, combo = chosen
+    design = {**r.design, **combo}
+    if best is None:
+        status = next(
+            (s for s in statuses if s != "optimal"), statuses[-1] if statuses else "failed"
+        )
+    else:
+        status = r.status
+    row.update(
+        status=status,
+        reason=r.message,
+        design={k: float(v) for k, v in design.items()},
+        solver_objective=float(r.objective) if math.isfinite(r.objective) else None,
+    )
+    return row
+
+
+def _outside_bounds(problem: DesignProblem, x: np.ndarray) -> str:
+    """'' if ``x`` lies in the bounds (to 1e-9 of the span), else the first offender."""
+    lo, hi = problem.lower(), problem.upper()
+    tol = 1e-9 * np.maximum(hi - lo, 1.0)
+    for k, v in enumerate(problem.free):
+        if not lo[k] - tol[k] <= x[k] <= hi[k] + tol[k]:
+            return f"{v.name} = {x[k]:.6g} {v.unit} not in [{lo[k]:g}, {hi[k]:g}]".replace(
+                " ]", "]"
+            )
+    return ""
+
+
+def _solve_front(config: Config, inst: Instance, time_limit: float) -> dict[str, Any]:
+    problem = inst.problem()
+    t0 = time.perf_counter()
+    out = config.run(problem, inst.objectives, time_limit)
+    elapsed = time.perf_counter() - t0
+    worst = 0.0
+    F = []
+    for d in out["designs"]:
+        x = np.array([d[v.name] for v in problem.free], dtype=float)
+        ev = problem.evaluate(x)
+        worst = max(worst, float(ev.violation))
+        F.append([float(ev.objectives[k]) for k in inst.objectives])
+    ok = len(F) >= 2 and worst <= VERIFY_TOL
+    return {
+        "time_s": elapsed,
+        "status": "optimal" if ok else "failed",
+        "reason": f"{len(F)} front points" + ("" if ok else " (fewer than 2 or infeasible)"),
+        "front": F,
+        "violation": worst if F else None,
+        "success": ok,
+        "iterations": out.get("iterations"),
+        "n_evals": {},
+    }
+
+
+def _execute(task: Mapping[str, Any]) -> dict[str, Any]:
+    """The run itself (in the forked child)."""
+    config = get_config(task["config"])
+    inst = task_instance(task)
+    tl = float(task["time_limit"])
+    if config.kind == "front":
+        return _solve_front(config, inst, tl)
+    objective = inst.objectives[0]
+    row = _solve_single(config, inst, objective, tl)
+    problem = inst.problem()
+    x = None
+    if row.get("design"):
+        x = np.array([row["design"][v.name] for v in problem.free], dtype=float)
+        if _outside_bounds(problem, x):
+            x = None
+    if x is not None:
+        ok, violated, objs = verify_design(problem, x)
+        ev = problem.evaluate(x)
+        row["objective"] = float(objs[objective])
+        row["violation"] = float(ev.violation)
+        row["verified"] = bool(ok)
+        row["success"] = bool(row["status"] in ("optimal", "feasible") and ok)
+        if row["status"] in ("optimal", "feasible") and not ok:
+            row["reason"] = f"independent check failed: {violated[0].describe()}"
+    else:
+        row.update(objective=None, violation=None, verified=False, success=False)
+    return row
+
+
+_STRIKES: dict[tuple[str, str], int] = {}
+_BLAS_LIMITED = False
+
+
+def _single_thread_blas() -> None:
+    """One BLAS thread per process: threaded OpenBLAS on a loaded 2-core machine made a
+    trust-constr QR 100x slower in a trial."""
+    global _BLAS_LIMITED
+    if not _BLAS_LIMITED:
+        from optdesign.studies.runner import limit_blas_threads
+
+        limit_blas_threads(1)
+        _BLAS_LIMITED = True
+
+
+def _fork_call(fn: Callable[[], dict], timeout: float) -> tuple[str, Any]:
+    """Run ``fn()`` in a forked child; ("ok", value), ("error", text), ("timeout", text)
+    or ("crash", text). os.fork (not multiprocessing) also works in daemonic workers."""
+    rfd, wfd = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # child
+        os.close(rfd)
+        # Solver chatter (qpOASES banner, HiGHS logs) would garble the progress bar.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        try:
+            payload = pickle.dumps(("ok", fn()))
+        except BaseException as exc:  # every failure becomes a row
+            payload = pickle.dumps(("error", f"{type(exc).__name__}: {exc}"))
+        with os.fdopen(wfd, "wb") as fh:
+            fh.write(payload)
+        os._exit(0)
+    os.close(wfd)
+    chunks = []
+    deadline = time.monotonic() + timeout
+    timed_out = False
+    with os.fdopen(rfd, "rb") as fh:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                timed_out = True
+                break
+            ready, _, _ = select.select([fh], [], [], left)
+            if not ready:
+                continue
+            chunk = os.read(fh.fileno(), 1 << 16)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    if timed_out:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        return "timeout", f"no result within the hard timeout of {timeout:g} s (killed)"
+    _, status = os.waitpid(pid, 0)
+    data = b"".join(chunks)
+    if not data:
+        return "crash", f"worker process died (wait status {status})"
+    return pickle.loads(data)
+
+
+def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """One (instance, configuration) run -> JSON row (never raises for solver trouble).
+
+    ``task``: ``id``, ``family``, ``seed``, ``config``, ``time_limit`` (soft, s),
+    ``hard_timeout`` (s).
+    """
+    _single_thread_blas()
+    config = get_config(task["config"])
+    inst = task_instance(task)
+    base = {
+        "instance": inst.id,
+        "family": inst.family,
+        "seed": inst.seed,
+        "mechanism": inst.mechanism,
+        "objective_name": "+".join(inst.objectives),
+        "catalogue": any(
+            isinstance(v, dict) and "catalogue" in v for v in inst.data["variables"].values()
+        ),
+        "config": config.name,
+        "kind": config.kind,
+        "applicable": True,
+    }
+    strike_key = (config.name, inst.mechanism)
+    if _STRIKES.get(strike_key, 0) >= TIMEOUT_STRIKES:
+        return {
+            **base,
+            **_failure(
+                "skipped",
+                f"not run: hit the hard timeout on {TIMEOUT_STRIKES} earlier {inst.mechanism} instances in this worker",
+                0.0,
+            ),
+        }
+    t0 = time.perf_counter()
+    kind, value = _fork_call(lambda: _execute_or_na(task), float(task["hard_timeout"]))
+    wall = time.perf_counter() - t0
+    if kind == "ok":
+        return {**base, **value}
+    if kind == "timeout":
+        _STRIKES[strike_key] = _STRIKES.get(strike_key, 0) + 1
+    return {**base, **_failure(kind, value, wall)}
+
+
+def _execute_or_na(task):
+    try:
+        return _execute(task)
+    except NotApplicable as exc:
+        return {
+            "applicable": False,
+            "status": "n/a",
+            "reason": str(exc),
+            "success": False,
+            "time_s": 0.0,
+        }
+
+
+def _failure(kind: str, reason: str, wall: float) -> dict[str, Any]:
+    return {
+        "status": kind,
+        "reason": reason,
+        "success": False,
+        "time_s": wall,
+        "objective": None,
+        "violation": None,
+        "iterations": None,
+        "n_evals": {},
+    }
+
+
+def _fix(inst: Instance, problem: DesignProblem, combo: Mapping[str, float]) -> DesignProblem:
+    """The problem with the catalogue variables of ``combo`` fixed."""
+    if inst.given is None:
+        data = copy.deepcopy(inst.data)
+        data["variables"].update(combo)
+        return problem_from_dict(data, source=inst.id)
+    data = problem.spec.model_dump(mode="python")
+    data["variables"] = {**data["variables"], **{k: float(v) for k, v in combo.items()}}
+    from optdesign.problem.load import validate_spec
+    from optdesign.problem.variables import parse_variable, variable_table
+
+    spec = validate_spec(data, problem.mechanism, inst.id, internal=True)
+    table = variable_table(problem.mechanism)
+    variables = [
+        parse_variable(k, v, table[k], problem.mechanism_name) for k, v in spec.variables.items()
+    ]
+    sub = DesignProblem(spec, variables, problem.mechanism)
+    for info in problem.objectives.values():
+        sub._objectives.setdefault(info.name, info)
+    sub._constraints = list(problem.user_constraints)
+    return sub

@@ -1,0 +1,209 @@
+"""A Pareto front: its points, the rejected ones, its metrics, and how to read it."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from optdesign.solvers.result import clean_json
+from optdesign.studies.pareto.metrics import front_metrics, non_dominated
+from optdesign.studies.pareto.records import PointRecord
+
+
+@dataclass
+class FrontPoint:
+    """One point of a front.
+
+    Attributes
+    ----------
+    objectives
+        Every objective of the problem at the design (NumPy path).
+    design
+        The full design (fixed and free variables).
+    status
+        Solver status after the independent check.
+    active
+        Names of the active constraint rows (requirements and epsilon bounds).
+    method
+        The front method that produced it.
+    verified
+        Result of the independent NumPy check (None if not checked).
+    eps
+        The epsilon bounds (or weights) that defined the point.
+    id
+        Task id in the store.
+    rejected
+        Why the point is not on the front ("" when it is).
+    """
+
+    objectives: dict[str, float]
+    design: dict[str, float]
+    status: str
+    active: list[str]
+    method: str
+    verified: bool | None = None
+    eps: dict[str, float] = field(default_factory=dict)
+    id: str = ""
+    rejected: str = ""
+    n_solves: int = 0
+    wall_time_s: float = 0.0
+    message: str = ""
+
+    @property
+    def success(self) -> bool:
+        return self.status in ("optimal", "feasible") and self.verified is not False
+
+    @classmethod
+    def from_record(cls, rec: PointRecord, method: str) -> FrontPoint:
+        return cls(
+            objectives=dict(rec.objectives),
+            design=dict(rec.design),
+            status=rec.status,
+            active=list(rec.active),
+            method=method,
+            verified=rec.verified,
+            eps=dict(rec.eps or rec.weights),
+            id=rec.id,
+            n_solves=rec.n_solves,
+            wall_time_s=rec.wall_time_s,
+            message=rec.message,
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return clean_json(dict(self.__dict__))
+
+
+@dataclass
+class Front:
+    """A Pareto front: its non-dominated successful points, the rest, and its metrics.
+
+    Attributes
+    ----------
+    objectives
+        The front's objective names.
+    method
+        The method that computed it.
+    points
+        Successful, verified, non-dominated points (sorted by the first objective).
+    rejected
+        Failed, infeasible or dominated points, each with its reason.
+    metrics
+        Hypervolume, spacing, spread (see :mod:`optdesign.studies.pareto.metrics`).
+    wall_time_s
+        Wall time of the whole method (anchors included).
+    anchors
+        Objective values at each anchor (epsilon method).
+    store
+        The resumable store of the run, if any.
+    n_solves
+        NLP solves behind the front.
+    """
+
+    objectives: list[str]
+    method: str
+    points: list[FrontPoint]
+    rejected: list[FrontPoint] = field(default_factory=list)
+    metrics: dict[str, Any] = field(default_factory=dict)
+    wall_time_s: float = 0.0
+    anchors: dict[str, dict[str, float]] = field(default_factory=dict)
+    store: str = ""
+    n_solves: int = 0
+    settings: dict[str, Any] = field(default_factory=dict)
+    problem_object: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def F(self) -> np.ndarray:
+        """Objective values, one row per point."""
+        return np.array(
+            [[p.objectives[k] for k in self.objectives] for p in self.points], dtype=float
+        ).reshape(-1, len(self.objectives))
+
+    def to_dict(self) -> dict[str, Any]:
+        return clean_json(
+            {
+                "method": self.method,
+                "objectives": self.objectives,
+                "metrics": self.metrics,
+                "wall_time_s": self.wall_time_s,
+                "anchors": self.anchors,
+                "store": self.store,
+                "n_solves": self.n_solves,
+                "settings": self.settings,
+                "points": [p.to_dict() for p in self.points],
+                "rejected": [p.to_dict() for p in self.rejected],
+            }
+        )
+
+    def summary(self) -> str:
+        """Metrics and a table of (a selection of) the points, with units."""
+        from optdesign.reports.front_text import front_summary
+
+        return front_summary([self])
+
+    def to_frame(self, rejected: bool = False):
+        """A pandas DataFrame: one row per point (objectives, free variables, status)."""
+        from optdesign.reports.frames import front_frame
+
+        return front_frame(self, rejected)
+
+    def plot(self, ax=None):
+        """The front in objective space with sketches of its ends and knee; returns the
+        matplotlib Figure (``ax``: only the objective-space plot, on that axes)."""
+        from optdesign.plots.front import plot_fronts
+
+        return plot_fronts(self.problem_object, [self], ax=ax)
+
+
+def make_front(
+    points: Sequence[FrontPoint],
+    objectives: Sequence[str],
+    method: str,
+    wall_time_s: float = 0.0,
+    problem=None,
+    **info: Any,
+) -> Front:
+    """Filter failed and dominated points, sort by the first objective, compute metrics."""
+    objectives = list(objectives)
+    good = [p for p in points if p.success and all(k in p.objectives for k in objectives)]
+    rejected = []
+    for p in points:
+        if p not in good:
+            p.rejected = "failed" if not p.success else "missing objective"
+            rejected.append(p)
+    F = np.array([[p.objectives[k] for k in objectives] for p in good], dtype=float)
+    F = F.reshape(-1, len(objectives))
+    mask = non_dominated(F) if len(F) else np.zeros(0, dtype=bool)
+    kept = []
+    for p, keep in zip(good, mask, strict=True):
+        if keep:
+            kept.append(p)
+        else:
+            p.rejected = "dominated or duplicate"
+            rejected.append(p)
+    kept.sort(key=lambda p: tuple(p.objectives[k] for k in objectives))
+    front = Front(objectives, method, kept, rejected, wall_time_s=wall_time_s, **info)
+    front.problem_object = problem
+    front.metrics = front_metrics(front.F)
+    front.metrics["n_failed"] = sum(1 for p in points if not p.success)
+    return front
+
+
+def common_hypervolumes(fronts: Sequence[Front]) -> None:
+    """Hypervolumes of several fronts against one reference point (comparable), stored in
+    each front's metrics as ``hypervolume_common`` and ``common_reference_point``."""
+    from optdesign.studies.pareto.metrics import hypervolume, reference_point
+
+    sets = [f.F for f in fronts if len(f.F)]
+    if not sets:
+        return
+    ref = reference_point(np.vstack(sets))
+    for f in fronts:
+        f.metrics["hypervolume_common"] = hypervolume(f.F, ref)
+        f.metrics["common_reference_point"] = ref.tolist()
+
+
+def anchors_of(records: Mapping[str, PointRecord]) -> dict[str, dict[str, float]]:
+    return {k: dict(r.objectives) for k, r in records.items()}

@@ -1,0 +1,471 @@
+"""Front methods as objects holding their settings, behind one :func:`compute_front`.
+
+- :class:`EpsilonConstraint`: exact anchors (multistart, lexicographic tie-break), then
+  warm-started chains of ``min B s.t. A <= eps``, evenly spread along the front (arc
+  spacing) or in epsilon (``spacing="uniform"``); three objectives on a grid of rows.
+- :class:`WeightedSum`: normalised weighted sums (finds only the convex hull).
+- :class:`NSGA2`: pymoo's NSGA-II on the NumPy path of the same problem (the baseline).
+
+Every run of the first two goes through :func:`optdesign.studies.runner.run_tasks`: each
+record is written to a JSONL store as it finishes (resumable), on local processes or a
+Dask cluster. The store's identity is the formulation's fingerprint plus the settings,
+so a resumed run never mixes records of another problem or setting.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from optdesign.errors import InputError, ProblemError
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.pareto.chains import (
+    TwoChains,
+    anchor_tasks,
+    check_anchor,
+    three_objective_tasks,
+)
+from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
+from optdesign.studies.pareto.records import PointRecord
+from optdesign.studies.pareto.tasks import ANCHOR_SLACK, front_task
+from optdesign.studies.runner import forks_workers, process_pool, run_tasks
+from optdesign.studies.solve import formulation_for
+from optdesign.studies.verify import VERIFY_TOL
+
+
+@dataclass
+class RunOptions:
+    """Where and how a front's tasks run (not what they compute)."""
+
+    out: Path | str | None = None
+    workers: int = 1
+    scheduler: str | Any | None = None
+    resume: bool = False
+    progress: bool = False
+    on_record: Callable | None = None
+
+
+def check_objectives(problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
+    """Two or three distinct objectives the problem can compute."""
+    objectives = list(objectives)
+    if len(objectives) not in (2, 3):
+        raise InputError("objectives", f"give two or three objectives, got {objectives}")
+    if len(set(objectives)) != len(objectives):
+        raise InputError("objectives", f"repeated objective in {objectives}")
+    ex = problem.expressions(problem.design_dict(problem.midpoint()))
+    for k in objectives:
+        if k not in ex.objectives:
+            raise InputError(
+                "objectives",
+                f"{k!r} is not an objective of {problem.name} (available: {', '.join(ex.objectives)})",
+            )
+    return objectives
+
+
+def _store(out: Path | str | None, name: str) -> Path:
+    base = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-pareto-"))
+    base.mkdir(parents=True, exist_ok=True)
+    return base / f"{name}.jsonl"
+
+
+def run_key(problem: DesignProblem, objectives: Sequence[str], **settings: Any) -> str:
+    """Identity of a front's run: the formulation's content and the settings."""
+    nlp = formulation_for(problem, tuple(sorted(objectives)))
+    text = json.dumps(
+        {"formulation": nlp.fingerprint, "objectives": list(objectives), **settings},
+        sort_keys=True,
+        default=str,
+    )
+    return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+
+def _common(
+    problem: DesignProblem, objectives: Sequence[str], solver: str, **more
+) -> dict[str, Any]:
+    return {"problem": problem, "objectives": sorted(objectives), "solver": solver, **more}
+
+
+@dataclass
+class EpsilonConstraint:
+    """Epsilon-constraint fronts of two or three objectives.
+
+    Attributes
+    ----------
+    points
+        Points of the sweep (2 objectives), or about that many grid points (3).
+    spacing
+        ``"arc"`` (default): evenly along the front (L1 arc length in normalised
+        objectives, predicted from the neighbour's multiplier); ``"uniform"``: epsilon
+        evenly spaced (sparse where the front is steep).
+    eps_values
+        Explicit epsilon values of the first objective (overrides ``points``, ``spacing``).
+    starts, seed
+        Multistart of the anchors (default: the problem file's).
+    agree
+        An anchor's multistart stops once this many starts agree (None: all starts).
+    solver
+        ``"slsqp"`` (SLSQP sweep, Ipopt fallback and tie-breaks) or ``"ipopt"``.
+    retry_starts, extra_starts
+        Sobol starts for a point that fails, worsens or jumps; at every point.
+    deterministic
+        Chains meet in the middle whatever the timing (same front for any workers).
+    name
+        Name of the method and of its store (``{name}.jsonl``).
+    """
+
+    points: int = 50
+    spacing: str = "arc"
+    eps_values: Sequence[float] | None = None
+    starts: int | None = None
+    seed: int | None = None
+    agree: int | None = 3
+    solver: str = "slsqp"
+    retry_starts: int = 4
+    extra_starts: int = 0
+    deterministic: bool = False
+    name: str = "epsilon"
+
+    def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
+        objectives = check_objectives(problem, objectives)
+        if self.spacing not in ("arc", "uniform"):
+            raise InputError("spacing", f"{self.spacing!r}: use 'arc' or 'uniform'")
+        n_points = len(self.eps_values) if self.eps_values is not None else self.points
+        if n_points < 2:
+            raise InputError("points", f"a front needs at least 2 points, got {n_points}")
+        t0 = time.perf_counter()
+        store = _store(run.out, self.name)
+        starts = self.starts if self.starts is not None else problem.spec.solver.starts
+        seed = self.seed if self.seed is not None else problem.spec.solver.seed
+        settings = {k: v for k, v in asdict(self).items() if k != "name"}
+        key = run_key(
+            problem, objectives, method="epsilon", **{**settings, "starts": starts, "seed": seed}
+        )
+        common = _common(
+            problem,
+            objectives,
+            self.solver,
+            retry_starts=self.retry_starts,
+            extra_starts=self.extra_starts,
+            seed=seed,
+        )
+        if run.workers > 1 and run.scheduler is None and forks_workers():
+            # Forked workers inherit the formulation built here (~0.03 s) instead of each
+            # building its own; their solvers they build side by side on first use.
+            formulation_for(problem, tuple(sorted(objectives)))
+        label = f"{self.name}: points" if run.progress else False
+        with process_pool(run.workers if run.scheduler is None else 1) as pool:
+            anchor_list = anchor_tasks(common, objectives, starts, seed, self.agree)
+            if len(objectives) == 2:
+                split = n_points // 2 if self.deterministic else None
+                sweep = TwoChains(
+                    objectives, n_points, self.name, common, self.spacing, self.eps_values, split
+                )
+                done = run_tasks(
+                    anchor_list,
+                    front_task,
+                    store,
+                    run.workers,
+                    run.scheduler,
+                    run.resume,
+                    label,
+                    key,
+                    run.on_record,
+                    pool=pool,
+                    expand=sweep,
+                )
+                tasks = sweep.tasks
+            else:
+                # Three objectives: the rows need every anchor (the nadir of B), so the
+                # anchors run first, then the rows in parallel.
+                done = run_tasks(
+                    anchor_list,
+                    front_task,
+                    store,
+                    run.workers,
+                    run.scheduler,
+                    run.resume,
+                    label,
+                    key,
+                    run.on_record,
+                    pool=pool,
+                )
+                anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+                for k, rec in anchors.items():
+                    check_anchor(rec, k)
+                tasks = three_objective_tasks(anchors, objectives, n_points, self.name, common)
+                done = run_tasks(
+                    tasks,
+                    front_task,
+                    store,
+                    run.workers,
+                    run.scheduler,
+                    True,
+                    label,
+                    key,
+                    run.on_record,
+                    pool=pool,
+                    known={f"anchor-{k}": done[f"anchor-{k}"] for k in objectives},
+                )
+        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+        for k, rec in anchors.items():
+            check_anchor(rec, k)
+        recs = [
+            PointRecord.from_dict(done[t["id"]]) for t in sorted(tasks, key=lambda t: t["index"])
+        ]
+        pts = [FrontPoint.from_record(r, self.name) for r in recs]
+        return make_front(
+            pts,
+            objectives,
+            self.name,
+            time.perf_counter() - t0,
+            problem,
+            anchors=anchors_of(anchors),
+            store=str(store),
+            n_solves=sum(r.n_solves for r in recs) + sum(r.n_solves for r in anchors.values()),
+            settings={**settings, "starts": starts, "seed": seed},
+        )
+
+
+@dataclass
+class WeightedSum:
+    """Weighted sum of the normalised objectives (ideal 0, nadir 1), weights evenly
+    spaced. It finds only the convex hull of the front: points in non-convex parts are
+    missed whatever the weights."""
+
+    points: int = 50
+    starts: int | None = None
+    seed: int | None = None
+    name: str = "weighted_sum"
+
+    def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
+        objectives = check_objectives(problem, objectives)
+        t0 = time.perf_counter()
+        store = _store(run.out, self.name)
+        starts = self.starts if self.starts is not None else problem.spec.solver.starts
+        seed = self.seed if self.seed is not None else problem.spec.solver.seed
+        key = run_key(
+            problem, objectives, method="weighted_sum", n=self.points, starts=starts, seed=seed
+        )
+        common = _common(problem, objectives, "ipopt")
+        done = run_tasks(
+            anchor_tasks(common, objectives, starts, seed, 3),
+            front_task,
+            store,
+            run.workers,
+            run.scheduler,
+            run.resume,
+            False,
+            key,
+            run.on_record,
+        )
+        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+        for k, rec in anchors.items():
+            check_anchor(rec, k)
+        F = np.array([[r.objectives[k] for k in objectives] for r in anchors.values()])
+        ideal, nadir = F.min(axis=0), F.max(axis=0)
+        normalise = {k: (float(ideal[j]), float(nadir[j])) for j, k in enumerate(objectives)}
+        tasks, prev = [], f"anchor-{objectives[-1]}"
+        for i, w in enumerate(_weight_grid(len(objectives), self.points)):
+            # Zero weights make ties (the anchors' non-uniqueness); a tiny floor breaks them.
+            weights = {k: float(max(wk, 1e-4)) for k, wk in zip(objectives, w, strict=True)}
+            tasks.append(
+                {
+                    **common,
+                    "id": f"ws-{i:04d}",
+                    "kind": "weighted_sum",
+                    "weights": weights,
+                    "normalise": normalise,
+                    "warm": prev,
+                    "after": [prev],
+                    "x0": anchors[objectives[-1]].x,
+                }
+            )
+            prev = tasks[-1]["id"]
+        done = run_tasks(
+            tasks,
+            front_task,
+            store,
+            1,
+            None,
+            True,
+            "weighted sum" if run.progress else False,
+            key,
+            run.on_record,
+            known={f"anchor-{objectives[-1]}": done[f"anchor-{objectives[-1]}"]},
+        )
+        recs = [PointRecord.from_dict(done[t["id"]]) for t in tasks]
+        pts = [FrontPoint.from_record(r, self.name) for r in recs]
+        return make_front(
+            pts,
+            objectives,
+            self.name,
+            time.perf_counter() - t0,
+            problem,
+            anchors=anchors_of(anchors),
+            store=str(store),
+            n_solves=len(recs) + sum(r.n_solves for r in anchors.values()),
+        )
+
+
+def _weight_grid(m: int, n_points: int) -> list[tuple[float, ...]]:
+    if m == 2:
+        return [(w, 1 - w) for w in np.linspace(0.0, 1.0, n_points)]
+    side = max(2, math.ceil((math.sqrt(8 * n_points + 1) - 1) / 2))
+    return [
+        (i / (side - 1), j / (side - 1), 1 - (i + j) / (side - 1))
+        for i in range(side)
+        for j in range(side - i)
+    ]
+
+
+@dataclass
+class NSGA2:
+    """NSGA-II (pymoo) on the NumPy path of the same problem: its final non-dominated
+    feasible population, each point checked with the same independent check."""
+
+    pop_size: int = 100
+    generations: int = 500
+    seed: int = 0
+    name: str = "nsga2"
+
+    def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
+        from pymoo.algorithms.moo.nsga2 import NSGA2 as PymooNSGA2
+        from pymoo.optimize import minimize
+
+        objectives = check_objectives(problem, objectives)
+        t0 = time.perf_counter()
+        res = minimize(
+            pymoo_problem(problem, objectives),
+            PymooNSGA2(pop_size=self.pop_size),
+            ("n_gen", self.generations),
+            seed=self.seed,
+            verbose=False,
+        )
+        wall = time.perf_counter() - t0
+        pts = []
+        X = np.atleast_2d(res.X) if res.X is not None else np.zeros((0, len(problem.free)))
+        if len(X):
+            ev = problem.evaluate(X)
+            for j, x in enumerate(X):
+                ok = bool(ev.violation[j] <= VERIFY_TOL)
+                design = {**problem.fixed_values, **problem.design_dict(x)}
+                pts.append(
+                    FrontPoint(
+                        objectives={k: float(v[j]) for k, v in ev.objectives.items()},
+                        design={k: float(v) for k, v in design.items()},
+                        status="feasible" if ok else "infeasible",
+                        active=[],
+                        method=self.name,
+                        verified=ok,
+                        id=f"nsga2-{j:04d}",
+                    )
+                )
+        return make_front(
+            pts,
+            objectives,
+            self.name,
+            wall,
+            problem,
+            settings={
+                "pop_size": self.pop_size,
+                "generations": self.generations,
+                "seed": self.seed,
+            },
+        )
+
+
+def pymoo_problem(problem: DesignProblem, objectives: Sequence[str]):
+    """The problem as a vectorised pymoo ``Problem`` (NumPy path, relative violations)."""
+    from pymoo.core.problem import Problem
+
+    n_con = len(problem.evaluate(problem.start()[None, :]).constraints)
+
+    class _Vectorised(Problem):
+        def __init__(self):
+            super().__init__(
+                n_var=len(problem.free),
+                n_obj=len(objectives),
+                n_ieq_constr=n_con,
+                xl=problem.lower(),
+                xu=problem.upper(),
+            )
+
+        def _evaluate(self, X, out, *args, **kwargs):
+            ev = problem.evaluate(X)
+            out["F"] = np.column_stack(
+                [np.nan_to_num(ev.objectives[k], nan=1e6, posinf=1e6) for k in objectives]
+            )
+            G = []
+            for block in ev.constraints.values():
+                # G <= 0 feasible: the largest signed relative violation of the block.
+                v = np.asarray(block.values, dtype=float).reshape(len(X), -1)
+                g = np.full(v.shape, -np.inf)
+                if block.lower is not None:
+                    g = np.maximum(g, (block.lower - v) / max(1.0, abs(block.lower)))
+                if block.upper is not None:
+                    g = np.maximum(g, (v - block.upper) / max(1.0, abs(block.upper)))
+                G.append(np.nan_to_num(g.max(axis=1), nan=1e6))
+            out["G"] = np.column_stack(G)
+
+    return _Vectorised()
+
+
+#: method name -> settings class; ``"uniform"`` is epsilon with uniform spacing.
+METHODS: dict[str, Callable[..., Any]] = {
+    "epsilon": EpsilonConstraint,
+    "uniform": lambda **kw: EpsilonConstraint(spacing="uniform", name="uniform", **kw),
+    "weighted_sum": WeightedSum,
+    "nsga2": NSGA2,
+}
+
+_RUN_FIELDS = ("out", "workers", "scheduler", "resume", "progress", "on_record")
+
+
+def compute_front(
+    problem: DesignProblem,
+    objectives: Sequence[str],
+    points: int = 50,
+    method: str | Any = "epsilon",
+    **options: Any,
+) -> Front:
+    """The front of ``objectives`` by ``method`` (a name of :data:`METHODS` or a method
+    object with ``run(problem, objectives, RunOptions)``). ``options`` holds the run's
+    options (``out``, ``workers``, ``scheduler``, ``resume``, ``progress``,
+    ``on_record``) and the method's settings (see the method classes)."""
+    run = RunOptions(**{k: options.pop(k) for k in _RUN_FIELDS if k in options})
+    if run.workers < 1:
+        raise InputError("workers", f"need at least 1 worker, got {run.workers}")
+    if isinstance(method, str):
+        if method not in METHODS:
+            raise InputError("method", f"unknown method {method!r} (known: {', '.join(METHODS)})")
+        if method in ("nsga2",):
+            options.pop("solver", None)
+        else:
+            options.setdefault("points", points)
+        try:
+            method = METHODS[method](**options)
+        except TypeError as exc:
+            raise InputError("pareto", f"option not understood by {method!r}: {exc}") from None
+    elif options:
+        raise ProblemError(f"options {sorted(options)} go into the method object, not pareto()")
+    return method.run(problem, objectives, run)
+
+
+__all__ = [
+    "ANCHOR_SLACK",
+    "METHODS",
+    "NSGA2",
+    "EpsilonConstraint",
+    "RunOptions",
+    "WeightedSum",
+    "compute_front",
+]
