@@ -71,7 +71,7 @@ def test_fit_is_differentiable_in_casadi():
     assert float(dc(12.0)) > 0
 
 
-@pytest.mark.parametrize("bad", ["H7", "h7/g6", "H7/z6", "H4/g6", "K7/g6"])
+@pytest.mark.parametrize("bad", ["H7", "h7/g6", "H7/z6", "H4/g6", "Q7/g6", "H7/s6"])
 def test_fit_parse_errors_name_the_field(bad):
     with pytest.raises(InputError, match=r"^fit"):
         Fit.parse(bad)
