@@ -60,8 +60,11 @@ def test_selector_ball_and_roller():
     assert roller.forward(lam) == pytest.approx(
         rs.efficiency(lam, np.radians(45.0), 10.0, 10.0, 0.055, 0.01)
     )
-    with pytest.raises(InputError, match=r"efficiency\.kind"):
-        roller.backdrive(lam)
+    # roller back-driving: friction terms of eq. 11-13 reversed (roller_screw docstring)
+    assert roller.backdrive(lam) == pytest.approx(
+        rs.efficiency_backdrive(lam, np.radians(45.0), 10.0, 10.0, 0.055, 0.01)
+    )
+    assert roller.backdrive(lam) < roller.forward(lam)
     with pytest.raises(InputError, match=r"efficiency\.kind"):
         rs.ScrewEfficiency("acme")
     # In the drive: the motor torque scales with 1/eta.

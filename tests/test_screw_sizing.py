@@ -93,3 +93,101 @@ def test_buckling_falls_with_length(d1, la, k):
         assert screw_sizing.buckling_load(d1, k * la, mounting) < screw_sizing.buckling_load(
             d1, la, mounting
         )
+
+
+def test_life_default_is_the_iso_nominal_life():
+    # ISO 3408-5 has no load factor: f_w = 1.0 by default, 1.2 only when asked for
+    assert screw_sizing.rated_life_revolutions(4400.0, 250.0) == pytest.approx(
+        (4400 / 250) ** 3 * 1e6
+    )
+    ratio = screw_sizing.rated_life_hours(4400.0, 250.0, 2118.0) / screw_sizing.rated_life_hours(
+        4400.0, 250.0, 2118.0, f_w=1.2
+    )
+    assert ratio == pytest.approx(1.728)
+
+
+def test_buckling_fixed_free_factor_is_on_the_unsafe_side():
+    # Euler with safety 0.5 and E = 2.06e5: eta_2 = 0.5 x 0.25 x pi^3 E / 64 x 1e-4 = 1.2475
+    euler = screw_sizing.buckling_load(20.0, 1000.0, "fixed-free", form="euler")
+    assert euler * 1000.0**2 / 20.0**4 / 1e4 == pytest.approx(1.24752, abs=1e-5)
+    cat = screw_sizing.buckling_load(20.0, 1000.0, "fixed-free")
+    assert cat / euler == pytest.approx(1.0421, abs=1e-4)  # the catalogue's 1.3: +4.2 %
+    # HIWIN's constant 4.072e5 is pi^3 E / 16 with E = 2.1e5 MPa (to 0.06 %)
+    assert 4.072e5 == pytest.approx(np.pi**3 * 2.1e5 / 16, rel=1e-3)
+
+
+def test_duty_cycle_life_against_miners_rule():
+    # Three steps (N, min^-1, s). Independent check: Miner's rule, each step's share of
+    # the revolutions used up against its own constant-load life.
+    F, n, t = (
+        np.array([1500.0, 4000.0, 800.0]),
+        np.array([1000.0, 200.0, 3000.0]),
+        np.array([30.0, 50.0, 20.0]),
+    )
+    Ca = 12_520.0  # HIWIN R25-5T4-FSI, BS-08-2-EN-1704-K Table 6.6
+    L_h = screw_sizing.duty_cycle_life_hours(Ca, F, n, t, f_w=1.1)
+    life_rev = (Ca / (1.1 * F)) ** 3 * 1e6
+    rev_per_hour = 60.0 * n * t / t.sum()
+    assert 1.0 / np.sum(rev_per_hour / life_rev) == pytest.approx(L_h, rel=1e-12)
+    # one step: the constant-load life at that step's speed
+    assert screw_sizing.duty_cycle_life_hours(Ca, [1500.0], [1000.0], [1.0]) == pytest.approx(
+        (Ca / 1500.0) ** 3 * 1e6 / 60_000.0
+    )
+    with pytest.raises(InputError, match="times"):
+        screw_sizing.duty_cycle_life_hours(Ca, F, n, t[:2])
+
+
+def test_static_safety_and_dn():
+    # R20-5T3-FSI: C0 = 17 670 N (HIWIN Table 6.6); 5 kN peak -> f_s = 3.534
+    assert screw_sizing.static_safety_factor(17_670.0, -5000.0) == pytest.approx(3.534)
+    assert screw_sizing.static_safety_margin(5000.0, 17_670.0, 3.0) == pytest.approx(
+        1 - 15_000 / 17_670
+    )
+    # DN: 20 mm at 3000 min^-1 = 60 000 < 70 000 (rolled), margin 1/7
+    assert screw_sizing.dn_value(20.0, 3000.0) == 60_000.0
+    assert screw_sizing.dn_margin(20.0, 3000.0) == pytest.approx(1 / 7)
+    assert screw_sizing.dn_margin(20.0, 4000.0, screw_sizing.DN_LIMIT["ground"]) == pytest.approx(
+        1 - 80 / 90
+    )
+
+
+def test_shaft_mass_inertia_and_reflected_inertia_against_si_forms():
+    # 20 mm x 1 m steel: rho pi d^2 L / 4 in SI = 7850 x pi x 0.02^2 / 4 = 2.4662 kg
+    mass = screw_sizing.shaft_mass(20.0, 1000.0)
+    assert mass == pytest.approx(7850 * np.pi * 0.02**2 / 4, rel=1e-12)
+    assert mass == pytest.approx(2.4662, abs=1e-4)
+    J = screw_sizing.shaft_inertia(20.0, 1000.0)  # kg*mm^2
+    assert J * 1e-6 == pytest.approx(mass * (20.0 / 2000) ** 2 / 2, rel=1e-12)  # HIWIN F 3.19
+    # reflected to the motor, HIWIN F 3.19 in SI with N1/N2 = 1/i_a:
+    JM, JG1, JG2, m_l, P, i_a = 2e-5, 1e-5, 4e-5, 12.0, 5.0, 2.5
+    si = JG1 + JG2 / i_a**2 + J * 1e-6 / i_a**2 + m_l * (P / (2000 * np.pi)) ** 2 / i_a**2
+    mine = screw_sizing.reflected_inertia(J, m_l, P, i_a, J_driven=JG2 * 1e6, J_driving=JG1 * 1e6)
+    assert (mine * 1e-6 + JM) == pytest.approx(si + JM, rel=1e-12)
+
+
+def test_shaft_stiffness_by_mounting_and_nut_position():
+    AE = np.pi * 12.5**2 / 4 * 2.06e5
+    L = 800.0
+    for x in (100.0, 400.0, 650.0):
+        # fixed-fixed: the two shaft parts x and L - x act in parallel
+        ff = screw_sizing.shaft_stiffness(12.5, L, "fixed-fixed", x=x)
+        assert ff == pytest.approx(AE / x + AE / (L - x), rel=1e-12)
+        # one axial bearing (fixed-free, fixed-supported): only the part x carries load
+        assert screw_sizing.shaft_stiffness(12.5, L, "fixed-supported", x=x) == pytest.approx(
+            AE / x
+        )
+    assert screw_sizing.shaft_stiffness(12.5, L, "fixed-fixed") == pytest.approx(4 * AE / L)
+    assert screw_sizing.shaft_stiffness(12.5, L, "fixed-supported") == pytest.approx(AE / L)
+    with pytest.raises(InputError, match=r"^x"):
+        screw_sizing.shaft_stiffness(12.5, L, "fixed-fixed", x=L)
+    with pytest.raises(InputError, match="mounting"):
+        screw_sizing.shaft_stiffness(12.5, L, "supported-supported")
+
+
+@settings(max_examples=60, deadline=None)
+@given(x=st.floats(0.02, 0.98))
+def test_fixed_fixed_stiffness_is_least_at_mid_span(x):
+    L = 1000.0
+    k = screw_sizing.shaft_stiffness(16.0, L, "fixed-fixed", x=x * L)
+    assert k >= screw_sizing.shaft_stiffness(16.0, L, "fixed-fixed") * (1 - 1e-12)
+    assert k > screw_sizing.shaft_stiffness(16.0, L, "fixed-supported", x=x * L)

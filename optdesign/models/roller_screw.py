@@ -34,6 +34,17 @@ def rolling_friction_angle(f_r, r_RP, beta):
     return m.arctan(f_r / (r_RP * m.sin(beta)))
 
 
+def _check(beta, r_s, r_RP, f_k, f_r) -> None:
+    for field, value in (("r_s", r_s), ("r_RP", r_RP)):
+        if not m.is_symbolic(value) and np.any(~(np.asarray(value, dtype=float) > 0)):
+            raise InputError(field, f"must be > 0, got {value!r}")
+    for field, value in (("f_k", f_k), ("f_r", f_r)):
+        if not m.is_symbolic(value) and np.any(~(np.asarray(value, dtype=float) >= 0)):
+            raise InputError(field, f"must be >= 0, got {value!r}")
+    if not m.is_symbolic(beta) and np.any(np.sin(np.asarray(beta, dtype=float)) <= 0):
+        raise InputError("beta", f"contact angle must lie in (0, pi), got {beta!r}")
+
+
 def efficiency(alpha_s, beta, r_s, r_RP, f_k, f_r):
     """Forward efficiency of a planetary roller screw, eq. 14 (physics.md 6 reading).
 
@@ -57,14 +68,7 @@ def efficiency(alpha_s, beta, r_s, r_RP, f_k, f_r):
     eta
         Efficiency (can fall to <= 0 for tiny helix angles: the drive then jams).
     """
-    for field, value in (("r_s", r_s), ("r_RP", r_RP)):
-        if not m.is_symbolic(value) and np.any(~(np.asarray(value, dtype=float) > 0)):
-            raise InputError(field, f"must be > 0, got {value!r}")
-    for field, value in (("f_k", f_k), ("f_r", f_r)):
-        if not m.is_symbolic(value) and np.any(~(np.asarray(value, dtype=float) >= 0)):
-            raise InputError(field, f"must be >= 0, got {value!r}")
-    if not m.is_symbolic(beta) and np.any(np.sin(np.asarray(beta, dtype=float)) <= 0):
-        raise InputError("beta", f"contact angle must lie in (0, pi), got {beta!r}")
+    _check(beta, r_s, r_RP, f_k, f_r)
     a, b = alpha_s, beta
     rho = rolling_friction_angle(f_r, r_RP, b)
     sa, ca_, sb, cb = m.sin(a), m.cos(a), m.sin(b), m.cos(b)
@@ -72,6 +76,39 @@ def efficiency(alpha_s, beta, r_s, r_RP, f_k, f_r):
     num = r_s * m.tan(a) * (ca_ * cr * sb - sa * sr - f_k * (sa * cr + ca_ * sr * sb))
     den = r_s * (cr * sa * sb + sr * ca_) + r_RP * (1.0 - cr) * (sr + cr) * ca_ * cb
     return num / den
+
+
+def efficiency_backdrive(alpha_s, beta, r_s, r_RP, f_k, f_r):
+    """Back-driving efficiency (the axial load drives the screw), derived from eq. 11-14.
+
+    Seed 003 derives only the forward efficiency. Its eq. 11 turns the contact normal by
+    the rolling-friction angle rho against the motion and eq. 12 adds sliding friction
+    f_k along the tangent; when the load drives, the motion reverses, so both friction
+    terms change sign (rho -> -rho, f_k -> -f_k), and the efficiency is output over input
+    power, eta' = 2 pi M / (P_s F_a) = M / (r_s tan(a) F_a):
+
+        F_a / N = cos a cos rho sin b + sin a sin rho + f_k (sin a cos rho - cos a sin rho sin b)
+        M / N   = r_s (cos rho sin a sin b - sin rho cos a)
+                  - r_RP (1 - cos rho)(cos rho - sin rho) cos a cos b
+
+    The last (rolling-resistance) term of eq. 14's denominator is a loss in either
+    direction, so it is subtracted from the output torque here (the reading of this
+    project; it is O(rho^2), 1e-6 of the first term at the paper's numbers). Checks (see
+    the tests): eta' = 1 without friction; eta' = tan(a - rho)/tan(a), the ball-screw
+    back-driving form, at beta = 90 deg with f_k = 0. Eq. 12 models sliding friction as a
+    force f_k N along the tangent, not as a friction angle; that term alone gives
+    eta = 1 - x forward and 1/(1 + x) back, so eta' can exceed eta at second order in the
+    loss (0.975016 vs 0.974796 at the paper's 10/45 deg). eta' <= 0 means the screw
+    self-locks under axial load. Arguments and units as :func:`efficiency`.
+    """
+    _check(beta, r_s, r_RP, f_k, f_r)
+    a, b = alpha_s, beta
+    rho = rolling_friction_angle(f_r, r_RP, b)
+    sa, ca_, sb, cb = m.sin(a), m.cos(a), m.sin(b), m.cos(b)
+    sr, cr = m.sin(rho), m.cos(rho)
+    force = ca_ * cr * sb + sa * sr + f_k * (sa * cr - ca_ * sr * sb)
+    torque = r_s * (cr * sa * sb - sr * ca_) - r_RP * (1.0 - cr) * (cr - sr) * ca_ * cb
+    return torque / (r_s * m.tan(a) * force)
 
 
 def helix_angle(P_s, r_s):
@@ -131,13 +168,12 @@ class ScrewEfficiency:
         return efficiency(lam, self.beta, self.r_s, self.r_RP, self.f_k, self.f_r)
 
     def backdrive(self, lam):
-        """Back-driving efficiency (load drives screw).
+        """Back-driving efficiency (load drives screw) at lead/helix angle ``lam`` (rad).
 
-        Only the ball screw has one here (models.screw.efficiency_backdrive); seed 003
-        gives no back-driving efficiency of the roller screw, and none is invented.
+        Ball screw: models.screw.efficiency_backdrive. Roller screw: seed 003 gives only
+        the forward efficiency; :func:`efficiency_backdrive` derives the counterpart by
+        reversing the friction terms of eq. 11-13 (stated there).
         """
         if self.kind == "ball":
             return screw.efficiency_backdrive(lam, screw.friction_angle(self.mu))
-        raise InputError(
-            "efficiency.kind", "seed 003 gives no back-driving efficiency for a roller screw"
-        )
+        return efficiency_backdrive(lam, self.beta, self.r_s, self.r_RP, self.f_k, self.f_r)

@@ -6,7 +6,10 @@ symbols (d1, la, ...) and gets expressions, a sweep passes arrays. The ``*_margi
 functions are constraints in the form g >= 0 (1 - demand / capacity).
 
 Units: d1, lengths in mm; E in MPa; forces in N; speeds in min^-1 (rev/min); life in
-revolutions or hours. Efficiency of the screw: :mod:`optdesign.models.screw`.
+revolutions or hours; mass in kg; inertia in kg*mm^2 (x 1e-3 gives N*mm*s^2, the unit
+that pairs with N*mm torques). Efficiency of the screw:
+:mod:`optdesign.models.screw_efficiency`; catalogue data:
+:mod:`optdesign.models.screw_catalogue`.
 """
 
 from __future__ import annotations
@@ -49,6 +52,14 @@ CRITICAL_SPEED_FACTOR = {
 #: Permissible tensile/compressive stress of the screw shaft in the catalogues (MPa).
 SIGMA_ALLOWABLE = 147.0
 
+#: Density of steel (kg/mm^3).
+STEEL_DENSITY = 7.85e-6
+
+#: DN = d0 x n_max limits (mm x min^-1), HIWIN *Ballscrews & Accessories*
+#: BS-08-2-EN-1704-K, section 3.7.6 (p. 29): rolled 70 000, peeled and ground 90 000,
+#: high-speed series 180 000. Other makers print their own limits.
+DN_LIMIT = {"rolled": 70_000.0, "peeled": 90_000.0, "ground": 90_000.0, "high-speed": 180_000.0}
+
 
 def _factor(table: dict[str, float], mounting: str) -> float:
     try:
@@ -83,9 +94,14 @@ def buckling_load(
         ``"fixed-fixed"``.
     form
         ``"catalogue"``: P1 = eta_2 d1^4 / la^2 x 1e4 with the published, rounded eta_2
-        (the form the catalogues' examples use); ``"euler"``: P1 = safety eta_m pi^2 E I /
-        la^2 with the exact constant (0.2 % below the catalogue's at fixed-supported,
-        because eta_2 = 10 rounds 9.98).
+        of :data:`BUCKLING_FACTOR` (the form the catalogues' examples use);
+        ``"euler"``: P1 = safety eta_m pi^2 E I / la^2 with the end factor eta_m of
+        :data:`EULER_END_FACTOR` and the exact constant. With E = 2.06e5 MPa and safety
+        0.5 the Euler form is eta_2 = 0.5 eta_m pi^3 E / 64 x 1e-4 = 1.2475, 4.99, 9.98,
+        19.96; the catalogue's 10 and 20 round these up by 0.2 %, but its fixed-free
+        1.3 lies 4.2 % above the Euler value 1.2475, on the unsafe side. HIWIN
+        (BS-08-2-EN-1704-K, F 3.25-3.26) writes the same Euler load as
+        0.5 x 4.072e5 f_k dk^4 / ls^2 with f_k = 1, 0.5, 0.25, 0.0625 (E = 2.1e5 MPa).
     E
         Young's modulus (MPa), Euler form only.
     safety
@@ -147,7 +163,7 @@ def mean_speed(speeds, times):
     return m.grid_sum(speeds * times) / m.grid_sum(times)
 
 
-def rated_life_revolutions(Ca, Fa, f_w=1.2):
+def rated_life_revolutions(Ca, Fa, f_w=1.0):
     """Rated life L = (Ca / (f_w Fa))^3 x 1e6 (revolutions).
 
     Parameters
@@ -157,7 +173,10 @@ def rated_life_revolutions(Ca, Fa, f_w=1.2):
     Fa
         (Mean) axial load (N), e.g. :func:`mean_load`.
     f_w
-        Load factor: 1.0-1.2 smooth, 1.2-1.5 normal, 1.5-2 with impact.
+        Load factor. ISO 3408-5 (7.2.1) defines the nominal life with none, f_w = 1.0, the
+        default here; the catalogues multiply the load by an operating factor: 1.0-1.2
+        smooth, 1.2-1.5 normal, 1.5-2 with impact (physics.md 8), HIWIN's f_p 1.1-1.2
+        without impact (BS-08-2-EN-1704-K, F 3.8). Pass the factor you assume.
     """
     require_positive("Ca", Ca)
     require_positive("Fa", Fa)
@@ -165,26 +184,133 @@ def rated_life_revolutions(Ca, Fa, f_w=1.2):
     return (Ca / (f_w * Fa)) ** 3 * 1e6
 
 
-def rated_life_hours(Ca, Fa, speed, f_w=1.2):
-    """Rated life in hours, L / (60 N) with the mean speed N (min^-1)."""
+def rated_life_hours(Ca, Fa, speed, f_w=1.0):
+    """Rated life in hours, L / (60 N) with the mean speed N (min^-1); f_w as
+    :func:`rated_life_revolutions` (default 1.0, ISO 3408-5)."""
     require_positive("speed", speed)
     return rated_life_revolutions(Ca, Fa, f_w) / (60.0 * speed)
 
 
-def shaft_stiffness(d1, L, mounting: str = "fixed-free", E=E_STEEL):
-    """Axial stiffness of the screw shaft (N/mm).
+def duty_cycle_life_hours(Ca, forces, speeds, times, f_w=1.0):
+    """Rated life (h) over a duty cycle of steps (axial force, speed, time).
 
-    ``"fixed-free"`` (one axial bearing, load at distance L): A E / L.
-    ``"fixed-fixed"`` (both ends axially fixed): 4 A E / L, its minimum, with the nut at
-    mid-span L/2.
+    The steps count by the revolutions they take, n_i t_i: mean speed
+    N_m = sum n_i t_i / sum t_i, cubic mean load Fm over n_i t_i (:func:`mean_load`), and
+    L_h = (Ca / (f_w Fm))^3 1e6 / (60 N_m) (ISO 3408-5 7.1-7.2; HIWIN F 3.4, F 3.8-3.12).
+
+    Parameters
+    ----------
+    Ca
+        Basic dynamic load rating (N).
+    forces, speeds, times
+        Per step: axial force (N, sign ignored), speed (min^-1, >= 0) and time (any unit,
+        only the shares matter).
+    f_w
+        Load factor applied to every step (stated by the caller; ISO default 1.0).
+    """
+    if not m.is_symbolic(forces, speeds, times):
+        n = np.asarray(speeds, dtype=float)
+        t = np.asarray(times, dtype=float)
+        if n.shape != t.shape or np.asarray(forces).shape[-1:] != n.shape[-1:]:
+            raise InputError("times", "needs one force, speed and time per step")
+        if np.any(n < 0) or np.any(t < 0):
+            raise InputError("speeds", "speeds and times must be >= 0")
+        speeds, times = n, t
+    revs = speeds * times
+    Fm = mean_load(forces, revs)
+    return rated_life_hours(Ca, Fm, mean_speed(speeds, times), f_w)
+
+
+def static_safety_factor(C0a, Fa_max):
+    """Static safety factor f_s = C0a / |Fa_max| (ISO 3408-4; HIWIN F 3.3: S0 Fa_max < C0).
+
+    The minimum to ask for is the designer's (service conditions); none is assumed here.
+    """
+    require_positive("C0a", C0a)
+    return C0a / m.fabs(Fa_max)
+
+
+def dn_value(d0, n_max):
+    """DN = d0 x n_max (mm x min^-1), nominal diameter times the highest speed; compare
+    with :data:`DN_LIMIT` (HIWIN: rolled 70 000, ground 90 000)."""
+    require_positive("d0", d0)
+    return d0 * n_max
+
+
+def shaft_mass(d0, length, density=STEEL_DENSITY):
+    """Mass of the screw shaft as a solid cylinder of the nominal diameter, rho pi d0^2 L / 4 (kg).
+
+    The thread grooves remove a few per cent; catalogues compute the same way (HIWIN
+    F 3.19 takes m_r with the nominal diameter).
+    """
+    require_positive("d0", d0)
+    require_positive("length", length)
+    return density * m.pi * d0**2 * length / 4.0
+
+
+def shaft_inertia(d0, length, density=STEEL_DENSITY):
+    """Polar moment of inertia of the shaft about its axis, m d0^2 / 8 (kg*mm^2)."""
+    return shaft_mass(d0, length, density) * d0**2 / 8.0
+
+
+def reflected_inertia(J_screw, m_load, p, i_a=1.0, J_driven=0.0, J_driving=0.0):
+    """Inertia at the motor shaft (kg*mm^2) of the screw, the translating mass and the gears.
+
+    J = J_driving + (J_driven + J_screw) / i_a^2 + m_load (p / (2 pi i_a))^2, with i_a the
+    gear ratio (motor turns per screw turn) and p the lead (mm); HIWIN F 3.19 in mm units.
+    The linkage behind the nut adds its own reflected inertia through the nut rate
+    (dm/dphi); that is the mechanism's to add.
+    """
+    require_positive("i_a", i_a)
+    return J_driving + (J_driven + J_screw) / i_a**2 + m_load * (p / (2.0 * m.pi * i_a)) ** 2
+
+
+#: Mountings :func:`shaft_stiffness` knows.
+STIFFNESS_MOUNTINGS = ("fixed-free", "fixed-supported", "fixed-fixed")
+
+
+def shaft_stiffness(d1, L, mounting: str = "fixed-free", E=E_STEEL, x=None):
+    """Axial stiffness of the screw shaft between its axial bearing(s) and the nut (N/mm).
+
+    Parameters
+    ----------
+    d1
+        Root diameter (mm); HIWIN (F 3.31-3.33) uses the load diameter
+        dc = PCD - D_ball cos(alpha), slightly larger: the root is the conservative choice.
+    L
+        ``"fixed-free"``: distance from the axial bearing to the nut (as before);
+        ``"fixed-supported"`` and ``"fixed-fixed"``: distance between the bearings.
+    mounting
+        ``"fixed-free"`` / ``"fixed-supported"``: one axial bearing (a floating support
+        takes no axial load), K = A E / x. ``"fixed-fixed"``: both ends axially fixed, the
+        two shaft parts act in parallel, K = A E L / (x (L - x)) (HIWIN F 3.32).
+    E
+        Young's modulus (MPa).
+    x
+        Nut position measured from the (first) axial bearing (mm). Default: the worst
+        case, x = L (one axial bearing) or x = L/2 (fixed-fixed, K = 4 A E / L).
     """
     require_positive("d1", d1)
     require_positive("L", L)
-    if mounting == "fixed-free":
-        return root_area(d1) * E / L
+    if mounting not in STIFFNESS_MOUNTINGS:
+        raise InputError("mounting", f"{mounting!r} not in {STIFFNESS_MOUNTINGS}")
+    AE = root_area(d1) * E
     if mounting == "fixed-fixed":
-        return 4.0 * root_area(d1) * E / L
-    raise InputError("mounting", f"{mounting!r} not in ('fixed-free', 'fixed-fixed')")
+        x = 0.5 * L if x is None else x
+        _check_nut_position(x, L)
+        return AE * L / (x * (L - x))
+    x = L if x is None else x
+    _check_nut_position(x, L, closed=True)
+    return AE / x
+
+
+def _check_nut_position(x, L, closed: bool = False) -> None:
+    if m.is_symbolic(x, L):
+        return
+    xa, La = np.asarray(x, dtype=float), np.asarray(L, dtype=float)
+    inside = (xa > 0) & ((xa <= La) if closed else (xa < La))
+    if not np.all(inside):
+        raise InputError("x", f"nut position must lie in (0, L{']' if closed else ')'}, got {x!r}")
 
 
 def axial_stiffness_chain(K_shaft, K_nut, K_bearing, K_housing=None):
@@ -212,6 +338,16 @@ def critical_speed_margin(speed_max, d1, lb, mounting: str = "fixed-supported"):
     return 1.0 - speed_max / critical_speed(d1, lb, mounting)
 
 
-def life_margin(L_required_h, Ca, Fa, speed, f_w=1.2):
+def static_safety_margin(Fa_max, C0a, f_s_min):
+    """1 - f_s_min |Fa_max| / C0a (>= 0 where the static safety factor reaches f_s_min)."""
+    return 1.0 - f_s_min * m.fabs(Fa_max) / C0a
+
+
+def dn_margin(d0, n_max, limit=DN_LIMIT["rolled"]):
+    """1 - d0 n_max / DN_limit (>= 0 below the DN limit; default HIWIN rolled, 70 000)."""
+    return 1.0 - dn_value(d0, n_max) / limit
+
+
+def life_margin(L_required_h, Ca, Fa, speed, f_w=1.0):
     """1 - L_required / L_h (>= 0 where the rated life covers the requirement)."""
     return 1.0 - L_required_h / rated_life_hours(Ca, Fa, speed, f_w)
