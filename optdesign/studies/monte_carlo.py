@@ -145,7 +145,9 @@ def run_monte_carlo(
 def plot_ranking(result: MonteCarloResult, path: Path, title: str = "") -> Path:
     """Bar plot of the sensitivity ranking in percent (like seed 003 Fig. 6b)."""
     # optdesign.plots selects the Agg back-end before pyplot loads
-    from optdesign.plots import plt, save_figure
+    import matplotlib.pyplot as plt
+
+    from optdesign.plots import save_figure
 
     ranked = result.ranking()
     fig, ax = plt.subplots(figsize=(7, 3.5))
