@@ -1,13 +1,18 @@
 """Command line: ``optdesign reproduce|solve|pareto|bench ...``.
 
 Errors that a user can act on (:class:`optdesign.errors.OptDesignError`) are printed as
-one line naming the field, with exit code 2 and no traceback.
+one line naming the field, with exit code 2 and no traceback. SIGINT (Ctrl-C) and
+SIGTERM end a run cleanly - workers stopped, finished records saved - with one line and
+exit code 130 or 143 (128 + the signal number, as a shell reports a killed command).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -86,16 +91,92 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``optdesign`` console script."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM received: raised in the main thread so that every ``finally``
+    and context manager on the way out runs (workers stopped, store closed).
+
+    A :class:`KeyboardInterrupt` so that ``except Exception`` clauses let it through.
+    """
+
+    def __init__(self, signum: int):
+        self.signum = signum
+        super().__init__(signal.Signals(signum).name)
+
+
+def _signal_name(exc: KeyboardInterrupt) -> tuple[str, int]:
+    signum = getattr(exc, "signum", signal.SIGINT)
+    return signal.Signals(signum).name, 128 + int(signum)
+
+
+@contextlib.contextmanager
+def interrupts_as_exceptions():
+    """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread meanwhile.
+
+    Only the first signal raises: the cleanup it starts (bounded: workers get 2 s) is not
+    cut short by a second Ctrl-C, which would leave a store half closed. Outside the main
+    thread nothing is installed (Python allows signal handlers only there).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    fired = False
+
+    def handler(signum, frame):
+        nonlocal fired
+        if not fired:
+            fired = True
+            raise Interrupted(signum)
+
+    previous = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        code = args.func(args)
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+def run_guarded(func: Callable[[], int | None]) -> int:
+    """Run ``func`` as a command: user errors and interrupts become one line and an exit code.
+
+    Returns
+    -------
+    int
+        ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
+        (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143).
+    """
+    try:
+        with interrupts_as_exceptions():
+            code = func()
     except OptDesignError as exc:
         print(f"optdesign: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # e.g. no space left while writing the results
+        print(f"optdesign: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        name, code = _signal_name(exc)
+        store = getattr(exc, "run_store", None)
+        if store:
+            print(
+                f"optdesign: interrupted ({name}); {store['records']} records saved in "
+                f"{store['path']}, --resume continues",
+                file=sys.stderr,
+            )
+        else:
+            print(f"optdesign: interrupted ({name})", file=sys.stderr)
+        return code
     return int(code or 0)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``optdesign`` console script."""
+
+    def run() -> int | None:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        return args.func(args)
+
+    return run_guarded(run)
 
 
 if __name__ == "__main__":

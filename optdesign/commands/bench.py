@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from optdesign import storage
 from optdesign.cli import command, default_out
 
 
@@ -39,6 +40,12 @@ def _bench(sub):
     )
     p.add_argument(
         "--resume", action="store_true", help="continue the run stored in OUT/bench_runs.jsonl"
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="start over: replace the store of an earlier run in OUT (without it, a folder "
+        "holding one is refused unless --resume)",
     )
     p.add_argument(
         "--time-limit",
@@ -80,6 +87,16 @@ def run_bench_command(args) -> int:
             if Path("benchmarks/README.md").exists()
             else default_out("bench")
         )
+    if args.resume and args.overwrite:
+        raise InputError("--overwrite", "excludes --resume (start over, or continue)")
+    with storage.lock_folder(out):
+        storage.ensure_writable(out)
+        if args.overwrite:
+            storage.discard_store(Path(out) / "bench_runs.jsonl")
+        return _run_locked(args, bench, solvers, out)
+
+
+def _run_locked(args, bench, solvers, out) -> int:
     res = bench.run_bench(
         args.suite,
         solvers,

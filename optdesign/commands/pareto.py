@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from optdesign import storage
 from optdesign.cli import command, default_out
 from optdesign.errors import InputError
 from optdesign.report import format_table
@@ -36,6 +37,12 @@ def _pareto(sub):
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
     p.add_argument("--resume", action="store_true", help="continue the run stored in --out")
     p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="start over: replace the stores of an earlier run in --out (without it, a "
+        "folder holding one is refused unless --resume)",
+    )
+    p.add_argument(
         "--workers",
         type=int,
         default=os.cpu_count() or 1,
@@ -59,9 +66,7 @@ def _pareto(sub):
 
 
 def run_pareto(args) -> int:
-    from optdesign.plots.front import plot_fronts
     from optdesign.problem import load_problem
-    from optdesign.studies import pareto as pa
 
     problem = load_problem(args.file)
     objectives = [s.strip() for s in args.objectives.split(",") if s.strip()]
@@ -77,8 +82,26 @@ def run_pareto(args) -> int:
         raise InputError("--points", "need at least 2 points")
     if args.resume and args.out is None:
         raise InputError("--resume", "give the --out folder of the run to resume")
+    if args.resume and args.overwrite:
+        raise InputError("--overwrite", "excludes --resume (start over, or continue)")
     out = args.out or default_out(f"pareto-{problem.name}")
-    out.mkdir(parents=True, exist_ok=True)
+    # One run per folder for the whole command (the runner re-enters the lock per store),
+    # checked before any solving.
+    with storage.lock_folder(out):
+        storage.ensure_writable(out)
+        stores = [out / f"{m}.jsonl" for m in methods if m != "nsga2"]
+        for store in stores:
+            if args.overwrite:
+                storage.discard_store(store)
+            elif not args.resume:
+                storage.check_new_store(store)
+        return _run_locked(args, problem, objectives, methods, out)
+
+
+def _run_locked(args, problem, objectives, methods, out) -> int:
+    from optdesign.plots.front import plot_fronts
+    from optdesign.studies import pareto as pa
+
     progress = not args.no_progress
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
     fronts = []
@@ -123,7 +146,8 @@ def run_pareto(args) -> int:
         created=time.strftime("%Y-%m-%d %H:%M:%S"),
     )
     if not args.no_plot:
-        plot_fronts(problem, fronts, out / "front.png")
+        with storage.atomic_output(out / "front.png") as tmp:
+            plot_fronts(problem, fronts, tmp)
     print(summary(problem, fronts))
     print(
         f"\nwrote {out / 'front.csv'}, {out / 'front.json'}"

@@ -118,15 +118,15 @@ def run_solve(args) -> int:
     write_files = args.out is not None or not args.json
     out = args.out or default_out(f"solve-{problem.name}")
     if write_files:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "result.json").write_text(result.to_json())
+        from optdesign.storage import atomic_output, atomic_write_text
+
+        atomic_write_text(out / "result.json", result.to_json())
         if not args.no_plot and result.design:
             from optdesign.plots.solution import plot_solution
 
             start = problem.design_dict(problem.start())
-            plot_solution(
-                problem, {"initial design": start, "optimum": result.design}, out / "solution.png"
-            )
+            with atomic_output(out / "solution.png") as tmp:
+                plot_solution(problem, {"initial design": start, "optimum": result.design}, tmp)
     if args.json:
         print(result.to_json())
     else:

@@ -5,8 +5,9 @@ metrics, Dolan-More performance profiles and the Markdown summary.
   :class:`DesignProblem` (or trace a front) and return the common
   :class:`~optdesign.solvers.result.Result`. Configurations whose back-end is missing
   (the GP and front modules) are simply not registered.
-- :func:`run_task` does one (instance, configuration) run in a forked child with a hard
-  timeout (a hung or crashed solver becomes a failure row with its reason), verifies the
+- :func:`run_task` does one (instance, configuration) run - in a forked child with a
+  hard timeout, through the runner's :class:`~optdesign.studies.runner.Isolation` (a
+  hung or crashed solver becomes a failure row with its reason) -, verifies the
   design on the NumPy path (:func:`optdesign.studies.verify.verify_design`) and returns a
   JSON row. :func:`run_bench` streams the rows through
   :func:`optdesign.studies.runner.run_tasks` (JSONL store, ``resume``, local processes or
@@ -22,12 +23,11 @@ import copy
 import csv
 import ctypes
 import hashlib
+import io
 import itertools
 import json
 import math
 import os
-import pickle
-import select
 import signal
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -39,6 +39,7 @@ import numpy as np
 
 from optdesign.problem import DesignProblem, problem_from_dict
 from optdesign.solvers.result import Result
+from optdesign.storage import atomic_output, atomic_write_text
 from optdesign.studies.instances import Instance, make_instance, suite
 from optdesign.studies.verify import VERIFY_TOL, verify_design
 
@@ -572,62 +573,10 @@ def _single_thread_blas() -> None:
                 break
 
 
-def _fork_call(fn: Callable[[], dict], timeout: float) -> tuple[str, Any]:
-    """Run ``fn()`` in a forked child; ("ok", value), ("error", text), ("timeout", text)
-    or ("crash", text). os.fork (not multiprocessing) also works in daemonic workers."""
-    rfd, wfd = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # child
-        os.close(rfd)
-        # Solver chatter (qpOASES banner, HiGHS logs) would garble the progress bar.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 1)
-        os.dup2(devnull, 2)
-        try:
-            payload = pickle.dumps(("ok", fn()))
-        except BaseException as exc:  # every failure becomes a row
-            payload = pickle.dumps(("error", f"{type(exc).__name__}: {exc}"))
-        with os.fdopen(wfd, "wb") as fh:
-            fh.write(payload)
-        os._exit(0)
-    os.close(wfd)
-    chunks = []
-    deadline = time.monotonic() + timeout
-    timed_out = False
-    with os.fdopen(rfd, "rb") as fh:
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                timed_out = True
-                break
-            ready, _, _ = select.select([fh], [], [], left)
-            if not ready:
-                continue
-            chunk = os.read(fh.fileno(), 1 << 16)
-            if not chunk:
-                break
-            chunks.append(chunk)
-    if timed_out:
-        os.kill(pid, signal.SIGKILL)
-        os.waitpid(pid, 0)
-        return "timeout", f"no result within the hard timeout of {timeout:g} s (killed)"
-    _, status = os.waitpid(pid, 0)
-    data = b"".join(chunks)
-    if not data:
-        return "crash", f"worker process died (wait status {status})"
-    return pickle.loads(data)
-
-
-def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """One (instance, configuration) run -> JSON row (never raises for solver trouble).
-
-    ``task``: ``id``, ``family``, ``seed``, ``config``, ``time_limit`` (soft, s),
-    ``hard_timeout`` (s).
-    """
-    _single_thread_blas()
+def _row_base(task: Mapping[str, Any]) -> dict[str, Any]:
     config = CONFIGS[task["config"]]
     inst = make_instance(task["family"], task["seed"])
-    base = {
+    return {
         "instance": inst.id,
         "family": inst.family,
         "seed": inst.seed,
@@ -640,24 +589,38 @@ def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> 
         "kind": config.kind,
         "applicable": True,
     }
-    strike_key = (config.name, inst.mechanism)
-    if _STRIKES.get(strike_key, 0) >= TIMEOUT_STRIKES:
+
+
+def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """One (instance, configuration) run -> JSON row.
+
+    ``task``: ``id``, ``family``, ``seed``, ``config``, ``time_limit`` (soft, s),
+    ``hard_timeout`` (s). :func:`run_bench` runs it isolated (a forked child per run,
+    killed after ``hard_timeout``; a crash, hang or exception becomes the failure row
+    made by :func:`failed_run`); called directly it runs in this process.
+    """
+    _single_thread_blas()
+    base = _row_base(task)
+    # The strikes are counted by failed_run in the worker; this (forked) run sees them.
+    if _STRIKES.get((base["config"], base["mechanism"]), 0) >= TIMEOUT_STRIKES:
         return {
             **base,
             **_failure(
                 "skipped",
-                f"not run: hit the hard timeout on {TIMEOUT_STRIKES} earlier {inst.mechanism} instances in this worker",
+                f"not run: hit the hard timeout on {TIMEOUT_STRIKES} earlier {base['mechanism']} instances in this worker",
                 0.0,
             ),
         }
-    t0 = time.perf_counter()
-    kind, value = _fork_call(lambda: _execute_or_na(task), float(task["hard_timeout"]))
-    wall = time.perf_counter() - t0
-    if kind == "ok":
-        return {**base, **value}
+    return {**base, **_execute_or_na(task)}
+
+
+def failed_run(task: Mapping[str, Any], kind: str, reason: str, wall_s: float) -> dict[str, Any]:
+    """The row of a run that timed out, crashed or raised (in the worker, not the child)."""
+    base = _row_base(task)
     if kind == "timeout":
-        _STRIKES[strike_key] = _STRIKES.get(strike_key, 0) + 1
-    return {**base, **_failure(kind, value, wall)}
+        key = (base["config"], base["mechanism"])
+        _STRIKES[key] = _STRIKES.get(key, 0) + 1
+    return {**base, **_failure(kind, reason, wall_s)}
 
 
 def _execute_or_na(task):
@@ -740,7 +703,7 @@ def run_bench(
     dict
         ``rows`` (with gaps), ``summary`` (Markdown), ``paths``, ``wall_time_s``.
     """
-    from optdesign.studies.runner import read_store, run_tasks
+    from optdesign.studies.runner import Isolation, read_store, run_tasks
 
     all_names = default_configs(include_hidden=True)
     configs = list(configs) if configs else default_configs()
@@ -783,6 +746,7 @@ def run_bench(
         resume=resume,
         progress="bench" if progress else False,
         key=key,
+        isolate=Isolation(timeout="hard_timeout", failure=failed_run, quiet=True),
     )
     wall = time.perf_counter() - t0
     # Wall time over all invocations of this run (a resumed run adds to the stored one).
@@ -791,7 +755,7 @@ def run_bench(
         meta = json.loads(meta_path.read_text())
         if meta.get("key") == key:
             wall += float(meta.get("wall_time_s", 0.0))
-    meta_path.write_text(json.dumps({"key": key, "wall_time_s": wall}))
+    atomic_write_text(meta_path, json.dumps({"key": key, "wall_time_s": wall}))
     rows = [dict(records[t["id"]]) for t in tasks if t["id"] in records]
     rows = add_gaps(rows)
     paths = write_outputs(rows, out, configs, suite_name, wall, time_limit, hard)
@@ -1045,7 +1009,7 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
     from optdesign.plots.profiles import plot_profiles
 
     out = Path(out)
-    with (out / "bench_runs.csv").open("w", newline="") as fh:
+    with io.StringIO() as fh:
         w = csv.DictWriter(fh, CSV_FIELDS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
@@ -1059,6 +1023,7 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
                     "reason": str(r.get("reason", ""))[:200],
                 }
             )
+        atomic_write_text(out / "bench_runs.csv", fh.getvalue())
     single = [c for c in configs if CONFIGS[c].kind not in ("front", "debug")]
     fronts = [c for c in configs if CONFIGS[c].kind == "front"]
     taus_t = np.logspace(0, 3, 200)
@@ -1069,7 +1034,8 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
         _, Tg = measure_table([r for r in rows if r["config"] in single], single, "gap")
         profiles["time"] = (taus_t, performance_profile(Tt, taus_t))
         profiles["gap"] = (taus_g, performance_profile(Tg, taus_g, floor=GAP_FLOOR))
-        plot_profiles(profiles, single, out / "bench_profiles.png", gap_floor=GAP_FLOOR)
+        with atomic_output(out / "bench_profiles.png") as tmp:
+            plot_profiles(profiles, single, tmp, gap_floor=GAP_FLOOR)
     desc = {c: CONFIGS[c].description for c in configs}
     stats_all = config_stats([r for r in rows if r["config"] in single], single)
     shipped = [r for r in rows if r["family"] == "shipped"]
@@ -1109,11 +1075,12 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
             stats_table(st, desc, rows),
         ]
     text = "\n".join(lines) + "\n"
-    (out / "summary.md").write_text(text)
-    (out / "bench_stats.json").write_text(
+    atomic_write_text(out / "summary.md", text)
+    atomic_write_text(
+        out / "bench_stats.json",
         json.dumps(
             {"all": stats_all, "wall_time_s": wall, "suite": suite_name}, indent=1, default=str
-        )
+        ),
     )
     return {
         "csv": out / "bench_runs.csv",
@@ -1154,7 +1121,7 @@ def update_readme(readme: Path, summary: str) -> bool:
     a, b = text.find(README_BEGIN), text.find(README_END)
     if a < 0 or b < a:
         return False
-    readme.write_text(text[: a + len(README_BEGIN)] + "\n" + summary + text[b:])
+    atomic_write_text(readme, text[: a + len(README_BEGIN)] + "\n" + summary + text[b:])
     return True
 
 

@@ -1507,18 +1507,21 @@ def write_front_csv(
 ) -> Path:
     """``front.csv``: one row a point (objectives, design variables, status, ...)."""
     import csv
+    import io
+
+    from optdesign.storage import atomic_write_text
 
     fronts = [front] if isinstance(front, Front) else list(front)
     rows = [r for f in fronts for r in front_rows(f, problem, rejected=True)]
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fields = list(rows[0]) if rows else ["method"]
-    with path.open("w", newline="") as fh:
+    with io.StringIO() as fh:
         w = csv.DictWriter(fh, fieldnames=fields)
         w.writeheader()
         for r in rows:
             w.writerow({k: (f"{v:.12g}" if isinstance(v, float) else v) for k, v in r.items()})
-    return path
+        return atomic_write_text(path, fh.getvalue())
 
 
 def read_front_csv(path: Path | str, objectives: Sequence[str]) -> np.ndarray:
@@ -1532,7 +1535,9 @@ def read_front_csv(path: Path | str, objectives: Sequence[str]) -> np.ndarray:
 
 def write_front_json(fronts: Sequence[Front], path: Path | str, **meta) -> Path:
     """``front.json``: every front with its points, rejected points and metrics."""
+    from optdesign.storage import atomic_write_text
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_clean({**meta, "fronts": [f.to_dict() for f in fronts]}), indent=1))
-    return path
+    text = json.dumps(_clean({**meta, "fronts": [f.to_dict() for f in fronts]}), indent=1)
+    return atomic_write_text(path, text)
