@@ -9,15 +9,15 @@ exit code 130 or 143 (128 + the signal number, as a shell reports a killed comma
 from __future__ import annotations
 
 import argparse
-import contextlib
-import signal
 import sys
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 from optdesign.errors import OptDesignError
+from optdesign.interrupts import Interrupted, exit_code, interrupts_as_exceptions
+
+__all__ = ["COMMANDS", "Interrupted", "build_parser", "command", "main", "run_guarded"]
 
 #: subcommand name -> function(subparsers) that registers it. Add one line per command.
 COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {}
@@ -91,50 +91,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM received: raised in the main thread so that every ``finally``
-    and context manager on the way out runs (workers stopped, store closed).
-
-    A :class:`KeyboardInterrupt` so that ``except Exception`` clauses let it through.
-    """
-
-    def __init__(self, signum: int):
-        self.signum = signum
-        super().__init__(signal.Signals(signum).name)
-
-
-def _signal_name(exc: KeyboardInterrupt) -> tuple[str, int]:
-    signum = getattr(exc, "signum", signal.SIGINT)
-    return signal.Signals(signum).name, 128 + int(signum)
-
-
-@contextlib.contextmanager
-def interrupts_as_exceptions():
-    """SIGINT and SIGTERM raise :class:`Interrupted` in the main thread meanwhile.
-
-    Only the first signal raises: the cleanup it starts (bounded: workers get 2 s) is not
-    cut short by a second Ctrl-C, which would leave a store half closed. Outside the main
-    thread nothing is installed (Python allows signal handlers only there).
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    fired = False
-
-    def handler(signum, frame):
-        nonlocal fired
-        if not fired:
-            fired = True
-            raise Interrupted(signum)
-
-    previous = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for s, h in previous.items():
-            signal.signal(s, h)
-
-
 def run_guarded(func: Callable[[], int | None]) -> int:
     """Run ``func`` as a command: user errors and interrupts become one line and an exit code.
 
@@ -154,12 +110,13 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         print(f"optdesign: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
-        name, code = _signal_name(exc)
+        name, code = exit_code(exc)
         store = getattr(exc, "run_store", None)
         if store:
+            n = store["records"]
             print(
-                f"optdesign: interrupted ({name}); {store['records']} records saved in "
-                f"{store['path']}, --resume continues",
+                f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved "
+                f"in {store['path']}, --resume continues",
                 file=sys.stderr,
             )
         else:

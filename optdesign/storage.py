@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from optdesign.errors import OptDesignError
+from optdesign.interrupts import deferred
 
 try:  # POSIX; elsewhere folders are not locked
     import fcntl
@@ -495,11 +496,11 @@ class StoreWriter:
     def write(self, obj: Mapping[str, Any]) -> None:
         """Append one record (a JSON-able mapping with an ``id``)."""
         data = (json.dumps(obj, allow_nan=True) + "\n").encode()
-        view = memoryview(data)
-        while view:
-            n = os.write(self.fd, view)
-            view = view[n:]
-        self.count += 1
+        with deferred():  # the whole line, and counted (the CLI reports the count)
+            view = memoryview(data)
+            while view:
+                view = view[os.write(self.fd, view) :]
+            self.count += 1
         self._dirty.set()
 
     def _sync_loop(self) -> None:
@@ -517,6 +518,10 @@ class StoreWriter:
         """Stop the fsync thread, fsync and close (idempotent)."""
         if self.fd < 0:
             return
+        with deferred():
+            self._close()
+
+    def _close(self) -> None:
         self._closing = True
         self._dirty.set()
         self._syncer.join()

@@ -137,9 +137,10 @@ def _interrupt_and_resume(tmp_path: Path, sig: int, seed: int, isolated: bool = 
     else:
         assert proc.returncode == 128 + sig, (proc.returncode, err)
         name = signal.Signals(sig).name
+        n = len(before)
         assert err.strip() == (
-            f"optdesign: interrupted ({name}); {len(before)} records saved in {store}, "
-            "--resume continues"
+            f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved in "
+            f"{store}, --resume continues"
         )
         # an interrupt leaves no torn line
         assert store.read_bytes().endswith(b"\n")

@@ -21,6 +21,7 @@ from contextlib import contextmanager
 from typing import Any
 
 from optdesign.errors import OptDesignError
+from optdesign.interrupts import deferred
 
 
 @contextmanager
@@ -84,7 +85,8 @@ class WorkerPool:
                 inherited = [*self.conns, parent] if ctx.get_start_method() == "fork" else []
                 proc = ctx.Process(target=_worker_loop, args=(child, me, inherited), daemon=True)
                 self.conns.append(parent)
-                proc.start()
+                with deferred():  # not inside the fork's callbacks, where it would be lost
+                    proc.start()
                 child.close()
                 self.procs.append(proc)
         except BaseException:  # interrupted while starting: stop the ones started
@@ -131,6 +133,10 @@ class WorkerPool:
     def close(self) -> None:
         """Stop the workers: idle ones are asked to exit, busy ones (an interrupted run:
         their results are not wanted any more) are terminated."""
+        with deferred():  # a second Ctrl-C waits for this (2 s at most)
+            self._close()
+
+    def _close(self) -> None:
         for i, (conn, proc) in enumerate(zip(self.conns, self.procs, strict=True)):
             if i in self.busy:
                 proc.terminate()
@@ -239,9 +245,10 @@ def fork_call(
         with contextlib.suppress(Exception):
             stream.flush()
     rfd, wfd = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child (coverage does not follow it)
-        _fork_child(fn, rfd, wfd, me, quiet)
+    with deferred():  # not inside the fork's callbacks, where it would be lost
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child (coverage does not follow it)
+            _fork_child(fn, rfd, wfd, me, quiet)
     os.close(wfd)
     chunks: list[bytes] = []
     status: int | None = None

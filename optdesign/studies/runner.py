@@ -44,6 +44,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from optdesign.interrupts import deferred
 from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
 from optdesign.studies.processes import (
     WorkerPool,
@@ -311,10 +312,9 @@ def _run(
                 # killed in between just recomputes the unstored records on resume.
                 submit_ready()
                 while pending:
-                    # popleft before the write: an interrupt in between loses the record
-                    # (it runs again on resume) but can never write it twice.
-                    record = pending.popleft()
-                    store.write(record)
+                    with deferred():  # written and off the list, or neither
+                        record = pending.popleft()
+                        store.write(record)
                     if bar is not None:
                         bar.update(1)
                     if on_record is not None:
@@ -324,14 +324,15 @@ def _run(
                             stopped_by_callback = True
                             raise
     except BaseException as exc:
-        if store is not None and not stopped_by_callback:
-            while pending:
-                store.write(pending.popleft())
-        if isinstance(exc, KeyboardInterrupt):
-            exc.run_store = {  # type: ignore[attr-defined]
-                "path": str(path),
-                "records": store.count if store is not None else n_stored,
-            }
+        with deferred(drop=True):  # the run is ending already: a second Ctrl-C waits
+            if store is not None and not stopped_by_callback:
+                while pending:
+                    store.write(pending.popleft())
+            if isinstance(exc, KeyboardInterrupt):
+                exc.run_store = {  # type: ignore[attr-defined]
+                    "path": str(path),
+                    "records": store.count if store is not None else n_stored,
+                }
         raise
     finally:
         if store is not None:
