@@ -139,6 +139,9 @@ def _parse(text: str) -> tuple[float, Any]:
     rest = text[m.end() :]
     if not rest.strip():
         return number, None
+    star = re.match(r"\s*[*·⋅×](?!\*)", rest)  # "2*mm", as pint allowed
+    if star is not None:
+        rest = rest[star.end() :]
     parser = _UnitParser(rest, text)
     unit = parser.expression(0)
     parser.expect_end()

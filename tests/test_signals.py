@@ -195,3 +195,41 @@ def test_isolated_task_is_killed_when_this_process_is_interrupted(tmp_path):
     assert _alive([int(pidfile.read_text())], wait=1.0) == []
     assert info.value.run_store == {"path": str(store), "records": 1}
     assert list(read_store(store)[1]) == ["t0"]
+
+
+def test_a_signal_inside_a_critical_section_is_raised_at_its_end_not_lost():
+    from optdesign.interrupts import Interrupted, deferred, interrupts_as_exceptions
+
+    with interrupts_as_exceptions():
+        reached = []
+        with pytest.raises(Interrupted) as info:
+            with deferred():
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.05)  # the handler has run by now: it only took note
+                reached.append("end of section")
+        assert reached == ["end of section"] and info.value.signum == signal.SIGTERM
+        with deferred(drop=True):  # the cleanup of a run being interrupted already
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)
+        with pytest.raises(Interrupted):  # outside a section: at once
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+
+
+def test_run_guarded_exit_codes_and_one_line(capsys):
+    from optdesign.cli import run_guarded
+    from optdesign.errors import InputError
+
+    def terminated():
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)
+
+    def bad_input():
+        raise InputError("--points", "need at least 2 points")
+
+    assert run_guarded(terminated) == 143
+    assert capsys.readouterr().err == "optdesign: interrupted (SIGTERM)\n"
+    assert run_guarded(bad_input) == 2
+    assert capsys.readouterr().err == "optdesign: error: --points: need at least 2 points\n"
+    assert run_guarded(lambda: 1) == 1

@@ -38,6 +38,7 @@ def _registry_built():
         ("12 µm", "length", 0.012),  # micro sign
         ("12 μm", "length", 0.012),  # Greek mu
         ("90 mm", "length", 90.0),
+        ("90*mm", "length", 90.0),
         ("-1.5e1 mm", "length", -15.0),
         (".5 m", "length", 500.0),
         ("30 °", "angle", math.radians(30)),
@@ -106,7 +107,7 @@ def test_non_finite_numbers_are_refused(value):
 @pytest.mark.parametrize(
     "text",
     ["", "mm", "90 furlongs_of_cheese", "90 mm2", "90 mm^99", "90 (((((mm)))))", "90 mm)", "90 (mm",
-     "90 mm; rm -rf", "__import__('os')", "90 mm**x", "1,5 mm", "90 mm * ", "0x10 mm", "True"],
+     "90 mm; rm -rf", "__import__('os')", "90 mm**x", "1,5 mm", "90 mm * ", "0x10 mm", "True", "2**mm", "2 * * mm"],
 )  # fmt: skip
 def test_malformed_strings_are_refused_with_the_field(text):
     with pytest.raises(InputError, match=r"^variables\.R: "):
