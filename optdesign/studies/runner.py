@@ -186,6 +186,11 @@ def run_tasks(
 
     Raises
     ------
+    optdesign.storage.FolderInUseError
+        Another process writes into the store's folder.
+    optdesign.storage.StoreError
+        The store cannot be resumed (no identity, another key, damaged), or holds records
+        and neither ``resume`` nor ``overwrite`` is given.
     KeyboardInterrupt
         Re-raised after the cleanup when the run is interrupted (Ctrl-C, or SIGTERM turned
         into one by the CLI): workers stopped, every finished record written, the store
