@@ -1,7 +1,9 @@
 """Command line: ``optdesign reproduce|solve|pareto|bench ...``.
 
 Errors that a user can act on (:class:`optdesign.errors.OptDesignError`) are printed as
-one line naming the field, with exit code 2 and no traceback.
+one line naming the field, with exit code 2 and no traceback. SIGINT (Ctrl-C) and
+SIGTERM end a run cleanly - workers stopped, finished records saved - with one line and
+exit code 130 or 143 (128 + the signal number, as a shell reports a killed command).
 """
 
 from __future__ import annotations
@@ -14,6 +16,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 from optdesign.errors import OptDesignError
+from optdesign.interrupts import Interrupted, exit_code, interrupts_as_exceptions
+
+__all__ = ["COMMANDS", "Interrupted", "build_parser", "command", "main", "run_guarded"]
 
 #: subcommand name -> function(subparsers) that registers it. Add one line per command.
 COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {}
@@ -86,19 +91,52 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def run_guarded(func: Callable[[], int | None]) -> int:
+    """Run ``func`` as a command: user errors and interrupts become one line and an exit code.
+
+    Returns
+    -------
+    int
+        ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
+        (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143).
+    """
+    try:
+        with interrupts_as_exceptions():
+            code = func()
+    except OptDesignError as exc:
+        print(f"optdesign: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # e.g. no space left while writing the results
+        print(f"optdesign: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        name, code = exit_code(exc)
+        store = getattr(exc, "run_store", None)
+        if store:
+            n = store["records"]
+            print(
+                f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved "
+                f"in {store['path']}, --resume continues",
+                file=sys.stderr,
+            )
+        else:
+            print(f"optdesign: interrupted ({name})", file=sys.stderr)
+        return code
+    return int(code or 0)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``optdesign`` console script."""
     # The command line writes figures to files: the Agg back-end, chosen here for this
     # process only (the library itself never changes the user's back-end).
     os.environ.setdefault("MPLBACKEND", "Agg")
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        code = args.func(args)
-    except OptDesignError as exc:
-        print(f"optdesign: error: {exc}", file=sys.stderr)
-        return 2
-    return int(code or 0)
+
+    def run() -> int | None:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        return args.func(args)
+
+    return run_guarded(run)
 
 
 if __name__ == "__main__":

@@ -1,24 +1,531 @@
-"""Safe output files (placeholder until the storage module lands): atomic writes."""
+"""Safe output: atomic result files, one writer per output folder, the JSONL task store.
+
+Long runs write into an output folder that a user may reuse, interrupt, or (by mistake)
+share between two runs. This module makes each of those safe:
+
+- :func:`atomic_write_text` / :func:`atomic_write_bytes` / :func:`atomic_output`: a
+  result file is either the old one or the complete new one, never a partial file (a
+  temporary file in the same folder, fsynced, then ``os.replace``);
+- :func:`lock_folder`: an advisory lock (``flock`` on ``.optdesign.lock`` in the folder),
+  non-blocking, so a second run into the same folder is refused at once with the pid of
+  the first. The kernel drops the lock with the process, whatever ends it: no stale
+  locks. The lock is re-entrant within a process (a command holds it for the whole run,
+  the task runner takes it again for each store);
+- :func:`open_store` / :class:`StoreWriter` / :func:`read_store`: the append-only JSON
+  Lines store of :func:`optdesign.studies.runner.run_tasks`. Its first line is the run's
+  identity ``{"__store__": 1, "key": ...}``, written with the file's creation (the file
+  appears complete with it, atomically), so a store without its identity is never ours.
+  Resuming checks the identity, refuses damaged or foreign stores, and cuts a torn last
+  line (a run killed while writing) before appending.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import json
 import os
 import tempfile
+import threading
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
+
+from optdesign.errors import OptDesignError
+from optdesign.interrupts import deferred
+
+try:  # POSIX; elsewhere folders are not locked
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None  # type: ignore[assignment]
+
+Record = dict[str, Any]
+
+#: Name of the lock file in a locked output folder.
+LOCK_NAME = ".optdesign.lock"
+
+#: Identity line version.
+STORE_VERSION = 1
+
+_EMPTY = "it is empty (no identity line)"
 
 
-def atomic_write_text(path: Path | str, text: str) -> Path:
-    """Write ``text`` to ``path`` atomically (temp file in the same folder, fsync, rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+class StoreError(OptDesignError):
+    """An output folder or store that cannot be used safely (damaged, foreign, busy)."""
+
+
+class FolderInUseError(StoreError):
+    """Another process holds the lock of an output folder."""
+
+
+# --- atomic files ------------------------------------------------------------------------
+def _umask() -> int:
+    # os.umask can only be read by setting it; do it once (at first use, not at import).
+    global _UMASK
+    if _UMASK is None:
+        old = os.umask(0o022)
+        os.umask(old)
+        _UMASK = old
+    return _UMASK
+
+
+_UMASK: int | None = None
+
+
+def _fsync_dir(folder: Path) -> None:
+    # The rename itself is durable only once the directory entry is on disk.
     try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _temp_name(path: Path) -> Path:
+    # Hidden, in the same folder (os.replace must not cross file systems), keeping the
+    # suffix so that writers choosing the format by extension (matplotlib) still work.
+    try:
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent
+        )
+    except OSError as exc:
+        raise StoreError(f"cannot write {path}: {exc.strerror}") from None
+    os.close(fd)
+    return Path(tmp)
+
+
+@contextlib.contextmanager
+def atomic_output(path: Path | str) -> Iterator[Path]:
+    """A temporary path to write ``path``'s new content to; it replaces ``path`` on exit.
+
+    For writers that want a file name (``savefig``). On an exception (an interrupt too)
+    the temporary file is removed and ``path`` is unchanged.
+
+    Examples
+    --------
+    >>> with atomic_output(out / "front.png") as tmp:  # doctest: +SKIP
+    ...     fig.savefig(tmp)
+    """
+    path = Path(path)
+    _make_folder(path.parent)
+    tmp = _temp_name(path)
+    try:
+        yield tmp
+        fd = os.open(tmp, os.O_RDWR)
+        try:
+            os.fchmod(fd, 0o666 & ~_umask())  # mkstemp made it 0600
+            os.fsync(fd)
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
         raise
+    _fsync_dir(path.parent)
+
+
+def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically: readers see the old file or the whole new one.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    path = Path(path)
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
     return path
+
+
+def atomic_write_text(path: Path | str, text: str, encoding: str = "utf-8") -> Path:
+    """Write ``text`` to ``path`` atomically (see :func:`atomic_write_bytes`)."""
+    return atomic_write_bytes(path, text.encode(encoding))
+
+
+def _make_folder(folder: Path) -> None:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise StoreError(f"cannot create the output folder {folder}: {exc.strerror}") from None
+
+
+def ensure_writable(folder: Path | str) -> Path:
+    """Create ``folder`` if needed and check that files can be created in it.
+
+    Done before a long computation, so that a read-only or full output folder is
+    reported at once rather than after an hour of solving.
+
+    Raises
+    ------
+    StoreError
+        Naming the folder and the reason.
+    """
+    folder = Path(folder)
+    _make_folder(folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".optdesign-write-test.", dir=folder)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise StoreError(f"cannot write to the output folder {folder}: {exc.strerror}") from None
+    return folder
+
+
+# --- one writer per folder ------------------------------------------------------------------
+#: realpath of a folder -> [lock file descriptor, depth] for the locks this process holds.
+_HELD: dict[str, list[int]] = {}
+_HELD_LOCK = threading.Lock()
+
+
+def _forget_locks_in_child() -> None:
+    # A forked child (worker, isolated task) inherits the lock's file descriptor; it
+    # must not keep the lock alive after the parent is gone, nor believe it holds it.
+    # Closing the inherited descriptor leaves the parent's lock in place (flock locks
+    # belong to the open file, which the parent still has open).
+    global _HELD_LOCK
+    _HELD_LOCK = threading.Lock()
+    for fd, _ in _HELD.values():
+        with contextlib.suppress(OSError):
+            os.close(fd)
+    _HELD.clear()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_locks_in_child)
+
+
+def _lock_holder(path: Path) -> str:
+    try:
+        pid = path.read_text().strip()
+    except OSError:
+        pid = ""
+    return f"pid {pid}" if pid.isdigit() else "pid unknown"
+
+
+def _acquire(folder: Path) -> int:
+    path = folder / LOCK_NAME
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+    except OSError as exc:
+        raise StoreError(f"cannot write to the output folder {folder}: {exc.strerror}") from None
+    if fcntl is None:  # pragma: no cover - no advisory locks on this platform
+        return fd
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        raise FolderInUseError(
+            f"folder {folder} is in use by another optdesign run ({_lock_holder(path)}); "
+            "wait for it to finish or use another output folder"
+        ) from None
+    # The pid is for the message of a run refused by this one.
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    return fd
+
+
+@contextlib.contextmanager
+def lock_folder(folder: Path | str) -> Iterator[Path]:
+    """Hold the output folder ``folder`` (created if needed) for this process.
+
+    Non-blocking: if another process holds it, :class:`FolderInUseError` says so with
+    its pid. Re-entrant within a process. The lock is released on exit, or by the kernel
+    when the process ends, however it ends.
+    """
+    folder = Path(folder)
+    _make_folder(folder)
+    key = os.path.realpath(folder)
+    with _HELD_LOCK:
+        entry = _HELD.get(key)
+        if entry is not None:
+            entry[1] += 1
+        else:
+            _HELD[key] = [_acquire(folder), 1]
+    try:
+        yield folder
+    finally:
+        with _HELD_LOCK:
+            entry = _HELD.get(key)
+            if entry is not None:  # absent in a forked child: nothing to release
+                entry[1] -= 1
+                if entry[1] == 0:
+                    del _HELD[key]
+                    with contextlib.suppress(OSError):
+                        os.close(entry[0])  # closing releases the flock
+
+
+def holds_lock(folder: Path | str) -> bool:
+    """Whether this process holds the lock of ``folder``."""
+    return os.path.realpath(folder) in _HELD
+
+
+# --- the JSONL store --------------------------------------------------------------------
+@dataclass
+class StoreScan:
+    """What a store file holds (see :func:`scan_store`)."""
+
+    path: Path
+    exists: bool = False
+    key: str | None = None
+    has_identity: bool = False
+    records: dict[str, Record] = field(default_factory=dict)
+    #: Length of the part made of complete lines (a torn tail starts there).
+    good_bytes: int = 0
+    #: The file's bytes after the last newline (a record being written when killed).
+    torn: bytes = b""
+    #: The torn tail is a complete record that only lacks its newline.
+    torn_record: Record | None = None
+    #: Why the file cannot be used as a store (None: it can).
+    problem: str | None = None
+
+
+def scan_store(path: Path | str) -> StoreScan:
+    """Read a store without trusting it: the identity, the records, a torn tail, damage.
+
+    Never raises for content (an unreadable file gives ``problem``); only for a file that
+    cannot be opened.
+    """
+    path = Path(path)
+    scan = StoreScan(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return scan
+    except OSError as exc:
+        raise StoreError(f"cannot read the store {path}: {exc.strerror}") from None
+    scan.exists = True
+    end = data.rfind(b"\n") + 1
+    scan.good_bytes, scan.torn = end, data[end:]
+    if not data:
+        scan.problem = _EMPTY
+        return scan
+    lines = data[:end].split(b"\n")[:-1]
+    for n, raw in enumerate(lines, start=1):
+        obj, why = _parse_line(raw)
+        if why is not None:
+            scan.problem = f"line {n} {why}"
+            return scan
+        if obj is None:
+            continue  # blank line
+        if "__store__" in obj:
+            if n != 1:
+                scan.problem = f"line {n} is a second identity line (two runs wrote into it)"
+                return scan
+            scan.has_identity, scan.key = True, obj.get("key")
+            continue
+        if n == 1:
+            scan.problem = "its first line is not the identity of an optdesign run"
+            return scan
+        rid = obj.get("id")
+        if not isinstance(rid, str):
+            scan.problem = f"line {n} is not a record (no string 'id')"
+            return scan
+        if rid in scan.records:
+            scan.problem = f"record {rid!r} appears twice (line {n}): two runs wrote into it"
+            return scan
+        scan.records[rid] = obj
+    if not scan.has_identity:
+        scan.problem = "it has no identity line"
+    elif scan.torn:
+        obj, why = _parse_line(scan.torn)
+        if why is None and obj is not None and isinstance(obj.get("id"), str):
+            if obj["id"] not in scan.records and "__store__" not in obj:
+                scan.torn_record = obj
+    return scan
+
+
+def _parse_line(raw: bytes) -> tuple[dict | None, str | None]:
+    """(object, None), (None, None) for a blank line, or (None, why it is unreadable)."""
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return None, "is not text (binary data)"
+    if not text.strip():
+        return None, None
+    try:
+        obj = json.loads(text)
+    except (json.JSONDecodeError, RecursionError):
+        return None, "is not JSON"
+    if not isinstance(obj, dict):
+        return None, "is not a JSON object"
+    return obj, None
+
+
+def read_store(store_path: Path | str) -> tuple[str | None, dict[str, Record]]:
+    """The key and the records (id -> record) of a JSONL store.
+
+    A torn last line (a run killed while writing it) is ignored - that task runs again on
+    resume - unless it is a whole record that only lacks its newline. A missing file
+    gives ``(None, {})``.
+
+    Raises
+    ------
+    StoreError
+        If the file is not a readable store (damaged, binary, two runs interleaved).
+    """
+    scan = scan_store(store_path)
+    if scan.problem not in (None, _EMPTY):
+        raise StoreError(f"{scan.path} is not a usable optdesign store: {scan.problem}")
+    if scan.torn_record is not None:
+        scan.records[scan.torn_record["id"]] = scan.torn_record
+    return scan.key, scan.records
+
+
+def open_store(
+    path: Path | str, key: str | None, resume: bool, overwrite: bool = False
+) -> dict[str, Record]:
+    """Make ``path`` ready for appending the records of run ``key``; return its records.
+
+    - ``resume`` and the store exists: its identity must be present and carry ``key``,
+      every line must be readable; a torn last line is completed (a whole record that
+      only lacks its newline) or cut. Returns the stored records.
+    - otherwise a new store holding only the identity replaces ``path``, atomically.
+      An existing store with records (or unreadable content) is not replaced unless
+      ``overwrite``: a run without ``resume`` must not silently empty an earlier one.
+
+    The caller holds the folder's lock (:func:`lock_folder`).
+
+    Raises
+    ------
+    StoreError
+        Naming the file and the reason, and what to do.
+    """
+    path = Path(path)
+    scan = scan_store(path)
+    if resume and scan.exists:
+        if scan.problem is not None:
+            raise StoreError(
+                f"--resume: {path} cannot be resumed: {scan.problem}; "
+                "start over with --overwrite or use a new output folder"
+            )
+        if scan.key != key:
+            raise StoreError(
+                f"--resume: the store {path} belongs to another run (key {scan.key!r}, "
+                f"this run {key!r}); use a new output folder or the same settings"
+            )
+        if scan.torn:
+            _repair_tail(path, scan)
+            if scan.torn_record is not None:
+                scan.records[scan.torn_record["id"]] = scan.torn_record
+        return scan.records
+    if not overwrite:
+        _refuse_replacing(scan)
+    identity = {"__store__": STORE_VERSION, "key": key}
+    atomic_write_text(path, json.dumps(identity) + "\n")
+    return {}
+
+
+def _refuse_replacing(scan: StoreScan) -> None:
+    if scan.exists and (scan.records or scan.problem not in (None, _EMPTY)):
+        what = (
+            f"holds {len(scan.records)} records of an earlier run"
+            if scan.problem is None
+            else f"holds data that is not a usable store ({scan.problem})"
+        )
+        raise StoreError(
+            f"{scan.path} {what}; continue it with --resume, start over with --overwrite, "
+            "or use another output folder"
+        )
+
+
+def check_new_store(path: Path | str) -> None:
+    """Refuse, before any work, to start a new run over ``path`` if it holds records.
+
+    The check :func:`open_store` makes without ``resume`` and ``overwrite``, for a
+    command to make it for all its stores up front.
+    """
+    _refuse_replacing(scan_store(path))
+
+
+def _repair_tail(path: Path, scan: StoreScan) -> None:
+    # The next record must start on a line of its own: appended onto the partial line,
+    # it would make that line unreadable and be lost with it.
+    fd = os.open(path, os.O_RDWR)
+    try:
+        if scan.torn_record is not None:
+            os.lseek(fd, 0, os.SEEK_END)
+            os.write(fd, b"\n")
+        else:
+            os.ftruncate(fd, scan.good_bytes)
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def discard_store(path: Path | str) -> None:
+    """Remove a store (``--overwrite``); the caller holds the folder's lock."""
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(path)
+
+
+class StoreWriter:
+    """Append records to a store made ready by :func:`open_store`.
+
+    One ``os.write`` of the whole line per record (``O_APPEND``): a record is on disk
+    complete or, if the process is killed inside that one system call, as a torn tail
+    that the next resume cuts. No user-space buffer, so an interrupt between two records
+    loses nothing already handed to :meth:`write`. A background thread fsyncs, so a
+    crash of the machine loses at most the last few milliseconds; the fsync (~1 ms) used
+    to delay the next task of every chain when it ran in the scheduling loop.
+
+    Parameters
+    ----------
+    path
+        The store.
+    count
+        Records already in it (for :attr:`count`).
+    """
+
+    def __init__(self, path: Path | str, count: int = 0):
+        self.path = Path(path)
+        self.count = count
+        flags = os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0)
+        self.fd = os.open(self.path, flags)
+        self._dirty = threading.Event()
+        self._closing = False
+        self._syncer = threading.Thread(target=self._sync_loop, daemon=True)
+        self._syncer.start()
+
+    def write(self, obj: Mapping[str, Any]) -> None:
+        """Append one record (a JSON-able mapping with an ``id``)."""
+        data = (json.dumps(obj, allow_nan=True) + "\n").encode()
+        with deferred():  # the whole line, and counted (the CLI reports the count)
+            view = memoryview(data)
+            while view:
+                view = view[os.write(self.fd, view) :]
+            self.count += 1
+        self._dirty.set()
+
+    def _sync_loop(self) -> None:
+        while True:
+            self._dirty.wait()
+            self._dirty.clear()
+            if self._closing:
+                return
+            try:
+                os.fsync(self.fd)
+            except (OSError, ValueError):
+                return  # closed underneath us: close() syncs itself
+
+    def close(self) -> None:
+        """Stop the fsync thread, fsync and close (idempotent)."""
+        if self.fd < 0:
+            return
+        with deferred():
+            self._close()
+
+    def _close(self) -> None:
+        self._closing = True
+        self._dirty.set()
+        self._syncer.join()
+        with contextlib.suppress(OSError):
+            os.fsync(self.fd)
+        os.close(self.fd)
+        self.fd = -1

@@ -1,6 +1,7 @@
 """The generic task runner: JSONL store, dependencies, resume, local processes, Dask."""
 
 import json
+import os
 
 import pytest
 
@@ -209,3 +210,70 @@ def test_worker_errors_reach_the_caller(tmp_path):
             tmp_path / "d.jsonl",
             workers=2,
         )
+
+
+def _misbehave(task, deps):
+    import signal
+    import time
+
+    if task["do"] == "hang":
+        time.sleep(60)
+    elif task["do"] == "segfault":  # what a crashing solver library does
+        os.kill(os.getpid(), signal.SIGSEGV)
+    elif task["do"] == "exit":
+        os._exit(7)
+    elif task["do"] == "raise":
+        raise RuntimeError("deliberate failure")
+    return {"status": "ok", "pid": os.getpid()}
+
+
+def _my_failure(task, kind, reason, wall_s):
+    return {"status": f"failed:{kind}", "why": reason, "t": wall_s}
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_isolated_tasks_hard_timeout_and_crashes_become_failure_records(tmp_path, workers):
+    import time
+
+    from optdesign.studies.runner import Isolation
+
+    kinds = ["ok", "hang", "segfault", "exit", "raise", "ok"]
+    tasks = [{"id": f"t{i}", "do": d, "limit": 0.5} for i, d in enumerate(kinds)]
+    store = tmp_path / "i.jsonl"
+    t0 = time.monotonic()
+    done = run_tasks(
+        tasks, _misbehave, store, workers=workers, isolate=Isolation(timeout="limit", quiet=True)
+    )
+    assert time.monotonic() - t0 < 10  # the hang was killed after its 0.5 s
+    status = {k: r["status"] for k, r in done.items()}
+    assert status == {
+        "t0": "ok", "t1": "timeout", "t2": "crash", "t3": "crash", "t4": "error", "t5": "ok"
+    }  # fmt: skip
+    assert "hard timeout of 0.5 s" in done["t1"]["reason"]
+    assert 0.5 <= done["t1"]["time_s"] < 5
+    assert "wait status" in done["t2"]["reason"]
+    assert done["t4"]["reason"] == "RuntimeError: deliberate failure"
+    assert not any(done[k]["success"] for k in ("t1", "t2", "t3", "t4"))
+    assert done["t0"]["pid"] != os.getpid()  # ran in a child
+    assert len(read_store(store)[1]) == 6  # failures are records like any other
+    # a custom failure record (e.g. the benchmark's row), with a fixed timeout
+    done = run_tasks(
+        tasks[1:3],
+        _misbehave,
+        tmp_path / "j.jsonl",
+        workers=workers,
+        isolate=Isolation(timeout=0.3, failure=_my_failure, quiet=True),
+    )
+    assert done["t1"]["status"] == "failed:timeout" and done["t1"]["id"] == "t1"
+    assert done["t2"]["status"] == "failed:crash"
+
+
+def test_fork_call_returns_values_and_kinds():
+    from optdesign.studies.runner import fork_call
+
+    assert fork_call(lambda: {"a": [1.5]}) == ("ok", {"a": [1.5]})
+    assert fork_call(lambda: 1 / 0)[0] == "error"
+    kind, reason = fork_call(lambda: __import__("time").sleep(5), timeout=0.2)
+    assert kind == "timeout" and "0.2 s" in reason
+    assert fork_call(lambda: os._exit(0))[0] == "crash"
+    assert fork_call(lambda: b"x" * 3_000_000) == ("ok", b"x" * 3_000_000)  # > a pipe buffer

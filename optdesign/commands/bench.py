@@ -42,6 +42,11 @@ def _bench(sub):
         "--resume", action="store_true", help="continue the run stored in OUT/bench_runs.jsonl"
     )
     p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="start afresh in an --out folder that holds a previous run's store",
+    )
+    p.add_argument(
         "--time-limit",
         type=float,
         default=1.0,
@@ -65,6 +70,7 @@ def _bench(sub):
 
 
 def run_bench_command(args) -> int:
+    from optdesign import storage
     from optdesign.errors import InputError
     from optdesign.studies import bench
 
@@ -80,7 +86,19 @@ def run_bench_command(args) -> int:
     solvers = None
     if args.solvers:
         solvers = [s for item in args.solvers for s in item.split(",") if s]
+    if args.resume and args.overwrite:
+        raise InputError("--overwrite", "excludes --resume (start over, or continue)")
+    if args.resume and args.out is None:
+        raise InputError("--resume", "give the --out folder of the run to resume")
     out = args.out or default_out("bench")
+    with storage.lock_folder(out):
+        storage.ensure_writable(out)
+        return _run_locked(args, bench, solvers, out)
+
+
+def _run_locked(args, bench, solvers, out: Path) -> int:
+    from optdesign.errors import InputError
+
     report = bench.run_bench(
         args.suite,
         solvers,
@@ -91,6 +109,7 @@ def run_bench_command(args) -> int:
         progress=not args.no_progress,
         time_limit=args.time_limit,
         hard_timeout=args.hard_timeout,
+        overwrite=args.overwrite,
     )
     print(report.summary())
     paths = report.paths

@@ -33,6 +33,11 @@ def _pareto(sub):
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
     p.add_argument("--resume", action="store_true", help="continue the run stored in --out")
     p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="start afresh in an --out folder that holds a previous run's stores",
+    )
+    p.add_argument(
         "--workers",
         type=int,
         default=os.cpu_count() or 1,
@@ -56,8 +61,8 @@ def _pareto(sub):
 
 
 def run_pareto(args) -> int:
+    from optdesign import storage
     from optdesign.problem import load_problem
-    from optdesign.studies import pareto as pa
 
     problem = load_problem(args.file)
     objectives = [s.strip() for s in args.objectives.split(",") if s.strip()]
@@ -73,8 +78,27 @@ def run_pareto(args) -> int:
         raise InputError("--points", "need at least 2 points")
     if args.resume and args.out is None:
         raise InputError("--resume", "give the --out folder of the run to resume")
+    if args.resume and args.overwrite:
+        raise InputError("--overwrite", "excludes --resume (start over, or continue)")
     out = args.out or default_out(f"pareto-{problem.name}")
-    out.mkdir(parents=True, exist_ok=True)
+    # One run per folder for the whole command (the runner re-enters the lock per store),
+    # checked before any solving.
+    with storage.lock_folder(out):
+        storage.ensure_writable(out)
+        for m in methods:
+            if m == "nsga2":
+                continue
+            store = out / f"{m}.jsonl"
+            if args.overwrite:
+                storage.discard_store(store)
+            elif not args.resume:
+                storage.check_new_store(store)
+        return _run_locked(args, problem, objectives, methods, out)
+
+
+def _run_locked(args, problem, objectives, methods, out: Path) -> int:
+    from optdesign.studies import pareto as pa
+
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
     run = dict(
         out=out,
@@ -114,8 +138,11 @@ def run_pareto(args) -> int:
     if not args.no_plot:
         from optdesign.plots import save_figure
         from optdesign.plots.front import plot_fronts
+        from optdesign.storage import atomic_output
 
-        save_figure(plot_fronts(problem, fronts), out / "front.png")
+        fig = plot_fronts(problem, fronts)
+        with atomic_output(out / "front.png") as tmp:
+            save_figure(fig, tmp)
     from optdesign.reports.front_text import front_summary
 
     print(front_summary(fronts))

@@ -31,10 +31,23 @@ def _solve(sub):
 
 
 def run_solve(args) -> int:
-    from optdesign.api import solve
+    from optdesign import storage
     from optdesign.problem import load_problem
 
     problem = load_problem(args.file)
+    write_files = args.out is not None or not args.json
+    if not write_files:
+        return _solve_and_report(args, problem, None)
+    out = args.out or default_out(f"solve-{problem.name}")
+    # One writer per folder, and a folder we cannot write to is refused before solving.
+    with storage.lock_folder(out):
+        storage.ensure_writable(out)
+        return _solve_and_report(args, problem, out)
+
+
+def _solve_and_report(args, problem, out: Path | None) -> int:
+    from optdesign.api import solve
+
     result = solve(
         problem,
         formulation=args.formulation,
@@ -45,20 +58,20 @@ def run_solve(args) -> int:
         solver=args.solver,
         ranges=not args.no_ranges,
     )
-    write_files = args.out is not None or not args.json
-    out = args.out or default_out(f"solve-{problem.name}")
-    if write_files:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "result.json").write_text(result.to_json())
-        if not args.no_plot and result.design:
-            from optdesign.plots import save_figure
+    if out is not None:
+        from optdesign.plots import save_figure
+        from optdesign.storage import atomic_output, atomic_write_text
 
-            save_figure(result.plot(), out / "solution.png")
+        atomic_write_text(out / "result.json", result.to_json())
+        if not args.no_plot and result.design:
+            fig = result.plot()
+            with atomic_output(out / "solution.png") as tmp:
+                save_figure(fig, tmp)
     if args.json:
         print(result.to_json())
     else:
         print(result.summary())
-        if write_files:
+        if out is not None:
             print(
                 f"\nwrote {out / 'result.json'}"
                 + ("" if args.no_plot else f" and {out / 'solution.png'}")

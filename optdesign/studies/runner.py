@@ -10,14 +10,22 @@ benchmark command can reuse it):
   record. ``fn`` must be a picklable module-level function; per-process state (a solver
   built once per worker) belongs in a module-level cache inside ``fn``'s module;
 - every finished record is appended to ``store_path`` (JSON Lines, one record a line,
-  flushed at once), so a killed run loses at most the tasks in flight;
+  one ``write`` each), so a killed run loses at most the tasks in flight; an interrupted
+  run (Ctrl-C, SIGTERM through the CLI) writes every record it received before it
+  stops its workers. The store and the folder lock live in :mod:`optdesign.storage`;
+  the worker processes (which die with this process, whatever kills it) in
+  :mod:`optdesign.studies.processes`;
 - ``expand(task, record, done)`` may add tasks as records come in (a computation that
   decides its next steps from results, e.g. two chains of a sweep meeting wherever they
   meet); on resume it sees the stored records too, so the same tasks are generated;
 - ``resume=True`` reads the store first, skips every task with a record and hands the
   stored records to dependants as if just computed. The first line of the store holds a
-  ``key`` (e.g. a hash of the run's settings); resuming with another key is an error, so
-  a resumed run cannot silently mix two configurations.
+  ``key`` (e.g. a hash of the run's settings); resuming with another key, or from a
+  store without that identity line, is an error, so a resumed run cannot silently mix
+  two configurations. Without ``resume``, a store holding records is not replaced
+  unless ``overwrite=True``. The store's folder has one writer at a time;
+- ``isolate=Isolation(timeout=...)`` runs each task in a forked child: a hang past the
+  timeout is killed, a crash or exception becomes a failure record (the benchmark).
 
 Records must be JSON-able. Floats survive the round trip exactly (``json`` writes
 ``repr``), so a resumed chain of warm starts is the same computation as an uninterrupted
@@ -26,101 +34,84 @@ one.
 
 from __future__ import annotations
 
-import gc
-import json
-import multiprocessing
-import os
-import sys
+import functools
 import threading
+import time
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from optdesign.errors import OptDesignError
+from optdesign.interrupts import deferred
+from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
+from optdesign.studies.processes import (
+    WorkerPool,
+    die_with_parent,
+    fork_call,
+    forks_workers,
+    limit_blas_threads,
+    process_pool,
+)
+
+__all__ = [
+    "Isolation",
+    "WorkerPool",
+    "cached",
+    "die_with_parent",
+    "failure_record",
+    "fork_call",
+    "forks_workers",
+    "limit_blas_threads",
+    "process_pool",
+    "read_store",
+    "run_tasks",
+]
 
 Record = dict[str, Any]
 TaskFn = Callable[[Mapping[str, Any], Mapping[str, Record]], Record]
 ExpandFn = Callable[[Mapping[str, Any], Record, Mapping[str, Record]], Iterable[Mapping[str, Any]]]
+FailureFn = Callable[[Mapping[str, Any], str, str, float], Record]
 
 
-def read_store(store_path: Path | str) -> tuple[str | None, dict[str, Record]]:
-    """The key and the records (id -> record) of a JSONL store; a torn last line is ignored.
+@dataclass(frozen=True)
+class Isolation:
+    """Run each task in a forked child of its worker: a hard timeout and crash isolation.
 
-    A run killed while writing can leave a partial last line; it is dropped (that task
-    simply runs again on resume).
-    """
-    path = Path(store_path)
-    key: str | None = None
-    records: dict[str, Record] = {}
-    if not path.exists():
-        return key, records
-    with path.open() as fh:
-        for line in fh:
-            line = line.strip()
-            if not line:
-                continue
-            try:
-                obj = json.loads(line)
-            except json.JSONDecodeError:
-                continue
-            if "__store__" in obj:
-                key = obj.get("key")
-            elif "id" in obj:
-                records[obj["id"]] = obj
-    return key, records
+    A task that outlives ``timeout`` is killed, one that crashes its process (a segfault
+    in a solver library, ``os._exit``) or raises becomes a *failure record* instead of
+    stopping the run: ``failure(task, kind, reason, wall_s)`` with ``kind`` one of
+    ``"timeout"``, ``"crash"``, ``"error"``. ``failure`` runs in the worker (the child's
+    parent), so it may keep per-worker state (e.g. stop trying a solver that timed out
+    repeatedly); the child inherits that state at its fork. POSIX only (``os.fork``).
 
-
-class _Store:
-    """Append-only JSONL writer: one line per record, flushed at once (a killed run keeps
-    every record written so far) and fsynced by a background thread (so that a crash of
-    the machine loses at most the records of the last few milliseconds).
-
-    The fsync (~1 ms here) used to run in the scheduling loop, where it delayed the next
-    task of every chain; in a thread it releases the GIL and overlaps the solves.
+    Parameters
+    ----------
+    timeout
+        Seconds, or the name of a task field giving them; None: no time limit.
+    failure
+        Picklable module-level function making the failure record (default
+        :func:`failure_record`).
+    quiet
+        Send the child's stdout and stderr to /dev/null (solver chatter would garble a
+        progress bar).
     """
 
-    def __init__(self, path: Path, key: str | None, fresh: bool):
-        self.path = path
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self.fh = path.open("w" if fresh else "a")
-        self._dirty = threading.Event()
-        self._closing = False
-        self._syncer = threading.Thread(target=self._sync_loop, daemon=True)
-        self._syncer.start()
-        if fresh:
-            self.write({"__store__": 1, "key": key})
+    timeout: float | str | None = None
+    failure: FailureFn | None = None
+    quiet: bool = False
 
-    def write(self, obj: Mapping[str, Any]) -> None:
-        self.fh.write(json.dumps(obj, allow_nan=True) + "\n")
-        self.fh.flush()
-        self._dirty.set()
-
-    def _sync_loop(self) -> None:
-        while True:
-            self._dirty.wait()
-            self._dirty.clear()
-            if self._closing:
-                return
-            try:
-                os.fsync(self.fh.fileno())
-            except (OSError, ValueError):
-                return  # closed underneath us: close() syncs itself
-
-    def close(self) -> None:
-        self._closing = True
-        self._dirty.set()
-        self._syncer.join()
-        self.fh.flush()
-        os.fsync(self.fh.fileno())
-        self.fh.close()
+    def timeout_for(self, task: Mapping[str, Any]) -> float | None:
+        """The hard timeout of ``task`` in seconds (None: none)."""
+        if self.timeout is None:
+            return None
+        return float(task[self.timeout] if isinstance(self.timeout, str) else self.timeout)
 
 
-def _call(fn: TaskFn, task: Mapping[str, Any], deps: Mapping[str, Record]) -> Record:
-    record = dict(fn(task, deps))
-    record["id"] = task["id"]
-    return record
+def failure_record(task: Mapping[str, Any], kind: str, reason: str, wall_s: float) -> Record:
+    """Default record of an isolated task that failed: ``status``, ``reason``, ``time_s``."""
+    return {"status": kind, "reason": reason, "success": False, "time_s": wall_s}
 
 
 def run_tasks(
@@ -136,6 +127,9 @@ def run_tasks(
     known: Mapping[str, Record] | None = None,
     pool: WorkerPool | None = None,
     expand: ExpandFn | None = None,
+    *,
+    overwrite: bool = False,
+    isolate: Isolation | None = None,
 ) -> dict[str, Record]:
     """Run ``tasks`` through ``fn``, storing each record as it finishes.
 
@@ -146,14 +140,17 @@ def run_tasks(
     fn
         ``fn(task, deps) -> record``, picklable (module-level).
     store_path
-        JSONL file; created (or truncated unless ``resume``).
+        JSONL store. Its folder is locked for the run (one writer per folder, see
+        :func:`optdesign.storage.lock_folder`).
     workers
         Local processes (1: in this process, no pool).
     scheduler
         Address of a Dask distributed scheduler (or a ``distributed.Client``); when given,
         tasks go to that cluster instead of local processes.
     resume
-        Keep the store's records and run only the missing tasks.
+        Keep the store's records and run only the missing tasks. A store whose identity
+        line is missing or carries another ``key``, or that is damaged, is refused
+        (:class:`optdesign.storage.StoreError`); a torn last line is cut first.
     progress
         Show a tqdm bar (a string is used as its description).
     key
@@ -174,22 +171,68 @@ def run_tasks(
         resuming); the tasks it returns join the run. A computation can so decide its
         next tasks from results - e.g. two chains of a sweep that meet wherever they
         meet. ``done`` maps every id finished so far to its record.
+    overwrite
+        Without ``resume``, replace a store that holds records of an earlier run (by
+        default that is refused rather than silently emptying it).
+    isolate
+        Run every task in a forked child with a hard timeout; a timeout, crash or
+        exception becomes a failure record (see :class:`Isolation`) instead of an error.
 
     Returns
     -------
     dict
         id -> record for every task (stored ones included when resuming), in the order
         the tasks joined the run.
+
+    Raises
+    ------
+    optdesign.storage.FolderInUseError
+        Another process writes into the store's folder.
+    optdesign.storage.StoreError
+        The store cannot be resumed (no identity, another key, damaged), or holds records
+        and neither ``resume`` nor ``overwrite`` is given.
+    KeyboardInterrupt
+        Re-raised after the cleanup when the run is interrupted (Ctrl-C, or SIGTERM turned
+        into one by the CLI): workers stopped, every finished record written, the store
+        closed. Its attribute ``run_store = {"path": ..., "records": n}`` tells the CLI
+        what was saved.
     """
     path = Path(store_path)
-    done: dict[str, Record] = {}
-    if resume and path.exists():
-        stored_key, done = read_store(path)
-        if key is not None and stored_key is not None and stored_key != key:
-            raise OptDesignError(
-                f"--resume: the store {path} belongs to another run (key {stored_key!r}, "
-                f"this run {key!r}); use a new output folder or the same settings"
-            )
+    with lock_folder(path.parent):
+        stored = open_store(path, key, resume, overwrite)
+        return _run(
+            tasks,
+            fn,
+            path,
+            len(stored),
+            dict(stored),
+            workers,
+            scheduler,
+            progress,
+            on_record,
+            known,
+            pool,
+            expand,
+            isolate,
+        )
+
+
+def _run(
+    tasks,
+    fn,
+    path,
+    n_stored,
+    done,
+    workers,
+    scheduler,
+    progress,
+    on_record,
+    known,
+    pool,
+    expand,
+    isolate,
+) -> dict[str, Record]:
+    # run_tasks once the store is open: the scheduling loop.
     for k, rec in (known or {}).items():
         done.setdefault(k, rec)
     by_id: dict[str, dict[str, Any]] = {}
@@ -220,7 +263,11 @@ def run_tasks(
             add(expand(t, done[t["id"]], done))
 
     bar = None
-    store: _Store | None = None
+    store: StoreWriter | None = None
+    # Records computed but not yet written; written on the way out of an interrupted run
+    # too (they are finished work), unless on_record itself stopped the run.
+    pending: deque[Record] = deque()
+    stopped_by_callback = False
     try:
         add(tasks)
         expand_replayed()
@@ -231,8 +278,8 @@ def run_tasks(
         # The workers start (fork) before the store's fsync thread and the progress bar's
         # monitor thread exist: a process forked while other threads run inherits only
         # the forking one, and whatever locks the others held.
-        with _executor(fn, workers, scheduler, pool) as ex:
-            store = _Store(path, key, fresh=not (resume and path.exists()))
+        with _executor(fn, workers, scheduler, pool, isolate) as ex:
+            store = StoreWriter(path, n_stored)
             if progress:
                 from tqdm.auto import tqdm
 
@@ -260,6 +307,7 @@ def run_tasks(
                 results = ex.wait()
                 for _, record in results:
                     done[record["id"]] = record
+                    pending.append(record)
                 for t, record in results:
                     if expand is not None:
                         add(expand(t, record, done))
@@ -268,12 +316,29 @@ def run_tasks(
                 # each, ~1 ms, was serial latency on every step of every chain); a run
                 # killed in between just recomputes the unstored records on resume.
                 submit_ready()
-                for _, record in results:
-                    store.write(record)
+                while pending:
+                    with deferred():  # written and off the list, or neither
+                        record = pending.popleft()
+                        store.write(record)
                     if bar is not None:
                         bar.update(1)
                     if on_record is not None:
-                        on_record(record)
+                        try:
+                            on_record(record)
+                        except BaseException:
+                            stopped_by_callback = True
+                            raise
+    except BaseException as exc:
+        with deferred(drop=True):  # the run is ending already: a second Ctrl-C waits
+            if store is not None and not stopped_by_callback:
+                while pending:
+                    store.write(pending.popleft())
+            if isinstance(exc, KeyboardInterrupt):
+                exc.run_store = {  # type: ignore[attr-defined]
+                    "path": str(path),
+                    "records": store.count if store is not None else n_stored,
+                }
+        raise
     finally:
         if store is not None:
             store.close()
@@ -282,11 +347,33 @@ def run_tasks(
     return {i: done[i] for i in by_id if i in done}
 
 
+def _call(
+    fn: TaskFn,
+    task: Mapping[str, Any],
+    deps: Mapping[str, Record],
+    isolate: Isolation | None = None,
+) -> Record:
+    if isolate is None:
+        record = dict(fn(task, deps))
+    else:
+        t0 = time.perf_counter()
+        kind, value = fork_call(
+            functools.partial(fn, task, deps), isolate.timeout_for(task), isolate.quiet
+        )
+        if kind == "ok":
+            record = dict(value)
+        else:
+            failure = isolate.failure or failure_record
+            record = dict(failure(task, kind, value, time.perf_counter() - t0))
+    record["id"] = task["id"]
+    return record
+
+
 class _Serial:
     """Runs each task in this process when asked for a result (one at a time)."""
 
-    def __init__(self, fn: TaskFn):
-        self.fn = fn
+    def __init__(self, fn: TaskFn, isolate: Isolation | None):
+        self.fn, self.isolate = fn, isolate
         self.next: tuple[dict, dict] | None = None
 
     def has_room(self) -> bool:
@@ -302,15 +389,15 @@ class _Serial:
         assert self.next is not None
         task, deps = self.next
         self.next = None
-        return [(task, _call(self.fn, task, deps))]
+        return [(task, _call(self.fn, task, deps, self.isolate))]
 
 
 class _Pool:
     """Local worker processes: never more tasks in flight than workers, so that a chain's
     next point goes to a free worker as soon as its neighbour is done."""
 
-    def __init__(self, fn: TaskFn, pool: WorkerPool):
-        self.fn, self.pool = fn, pool
+    def __init__(self, fn: TaskFn, pool: WorkerPool, isolate: Isolation | None):
+        self.fn, self.pool, self.isolate = fn, pool, isolate
         self.tasks: dict[int, dict] = {}
 
     def has_room(self) -> bool:
@@ -320,7 +407,7 @@ class _Pool:
         return bool(self.tasks)
 
     def submit(self, task: dict, deps: dict) -> None:
-        self.tasks[self.pool.submit(_call, (self.fn, task, deps))] = task
+        self.tasks[self.pool.submit(_call, (self.fn, task, deps, self.isolate))] = task
 
     def wait(self) -> list[tuple[dict, Record]]:
         return [(self.tasks.pop(i), record) for i, record in self.pool.wait()]
@@ -329,10 +416,10 @@ class _Pool:
 class _Dask:
     """A Dask distributed cluster: every ready task is submitted at once."""
 
-    def __init__(self, fn: TaskFn, client: Any):
+    def __init__(self, fn: TaskFn, client: Any, isolate: Isolation | None):
         from distributed import as_completed
 
-        self.fn, self.client = fn, client
+        self.fn, self.client, self.isolate = fn, client, isolate
         self.ac = as_completed(with_results=False)
         self.tasks: dict[str, dict] = {}
 
@@ -343,7 +430,7 @@ class _Dask:
         return bool(self.tasks)
 
     def submit(self, task: dict, deps: dict) -> None:
-        fut = self.client.submit(_call, self.fn, task, deps, pure=False)
+        fut = self.client.submit(_call, self.fn, task, deps, self.isolate, pure=False)
         self.tasks[fut.key] = task
         self.ac.add(fut)
 
@@ -353,208 +440,26 @@ class _Dask:
 
 
 @contextmanager
-def _executor(fn: TaskFn, workers: int, scheduler: Any, pool: WorkerPool | None):
+def _executor(
+    fn: TaskFn, workers: int, scheduler: Any, pool: WorkerPool | None, isolate: Isolation | None
+):
     if scheduler is not None:
         from distributed import Client
 
         own = not hasattr(scheduler, "submit")
         client = Client(scheduler) if own else scheduler
         try:
-            yield _Dask(fn, client)
+            yield _Dask(fn, client, isolate)
         finally:
             if own:
                 client.close()
     elif workers > 1 and pool is not None:
-        yield _Pool(fn, pool)
+        yield _Pool(fn, pool, isolate)
     elif workers > 1:
         with process_pool(workers) as own_pool:
-            yield _Pool(fn, own_pool)
+            yield _Pool(fn, own_pool, isolate)
     else:
-        yield _Serial(fn)
-
-
-@contextmanager
-def process_pool(workers: int) -> Iterator[WorkerPool | None]:
-    """A pool of ``workers`` local processes (None for ``workers <= 1``).
-
-    Pass it to several :func:`run_tasks` calls (``pool=``) to keep the same worker
-    processes, and so their caches, across phases; it is shut down on exit.
-    """
-    if workers <= 1:
-        yield None
-        return
-    pool = WorkerPool(workers)
-    try:
-        yield pool
-    finally:
-        pool.close()
-
-
-class WorkerPool:
-    """Local worker processes, each fed through its own pipe.
-
-    Why not :class:`concurrent.futures.ProcessPoolExecutor`: a task there passes through
-    two helper threads on its way to a worker; for the ~10 ms points of a Pareto chain
-    that cost 1.6 ms median (3.5 ms at the 90th percentile) between submitting a point
-    and its worker starting it, and 0.7 ms back - a fifth of a 2-worker front's chain
-    time. One pipe per worker, written from the scheduling thread, costs ~0.3 ms for
-    the round trip (measured with the same ~29 kB task).
-
-    A task that raises re-raises in :meth:`wait` (the same exception when it pickles, a
-    :class:`OptDesignError` with the worker's traceback otherwise); a worker that dies is
-    reported with its exit code.
-    """
-
-    def __init__(self, size: int):
-        ctx = multiprocessing.get_context("fork" if forks_workers() else "spawn")
-        self.size = size
-        self.conns: list[Any] = []
-        self.procs: list[Any] = []
-        # Objects of this process that a forked worker inherits are frozen out of the
-        # garbage collector while forking: a collection in the worker would otherwise
-        # write to every inherited object and copy its memory page (copy-on-write).
-        gc.freeze()
-        for _ in range(size):
-            parent, child = ctx.Pipe()
-            proc = ctx.Process(target=_worker_loop, args=(child,), daemon=True)
-            proc.start()
-            child.close()
-            self.conns.append(parent)
-            self.procs.append(proc)
-        gc.unfreeze()
-        self.idle = list(range(size))[::-1]
-        self.busy: set[int] = set()
-
-    def submit(self, fn: Callable, args: tuple) -> int:
-        """Send ``fn(*args)`` to an idle worker; returns the worker's index."""
-        i = self.idle.pop()
-        self.conns[i].send((fn, args))
-        self.busy.add(i)
-        return i
-
-    def wait(self) -> list[tuple[int, Any]]:
-        """Block until at least one busy worker answers; ``(worker index, result)`` each."""
-        from multiprocessing.connection import wait as wait_any
-
-        ready = wait_any([self.conns[i] for i in self.busy])
-        out = []
-        for i in sorted(self.busy):
-            if self.conns[i] not in ready:
-                continue
-            try:
-                ok, value = self.conns[i].recv()
-            except EOFError:
-                self.procs[i].join(1.0)
-                raise OptDesignError(
-                    f"worker process {self.procs[i].pid} died "
-                    f"(exit code {self.procs[i].exitcode}) while running a task"
-                ) from None
-            self.busy.discard(i)
-            self.idle.append(i)
-            if not ok:
-                raise value
-            out.append((i, value))
-        return out
-
-    def close(self) -> None:
-        """Stop the workers: idle ones are asked to exit, busy ones (an interrupted run:
-        their results are not wanted any more) are terminated."""
-        for i, (conn, proc) in enumerate(zip(self.conns, self.procs, strict=True)):
-            if i in self.busy:
-                proc.terminate()
-            else:
-                try:
-                    conn.send(None)
-                except OSError:
-                    pass
-        for proc in self.procs:
-            proc.join(2.0)
-            if proc.is_alive():
-                proc.kill()
-                proc.join(1.0)
-        for conn in self.conns:
-            conn.close()
-
-
-def _worker_loop(conn) -> None:
-    _init_process()
-    while True:
-        try:
-            msg = conn.recv()
-        except (EOFError, KeyboardInterrupt):
-            return
-        if msg is None:
-            return
-        fn, args = msg
-        try:
-            reply = (True, fn(*args))
-        except BaseException as exc:  # every failure goes back to the parent
-            reply = (False, _portable(exc))
-        try:
-            conn.send(reply)
-        except Exception as exc:  # e.g. a result that does not pickle
-            conn.send((False, _portable(exc)))
-
-
-def _portable(exc: BaseException) -> BaseException:
-    """``exc`` if it survives pickling, else an OptDesignError carrying its traceback."""
-    import pickle
-    import traceback
-
-    try:
-        pickle.loads(pickle.dumps(exc))
-        return exc
-    except Exception:
-        text = "".join(traceback.format_exception(exc))
-        return OptDesignError(f"a worker process failed:\n{text}")
-
-
-def forks_workers() -> bool:
-    """Whether local workers are forked from this process (Linux), and so inherit what it
-    built before starting them. Elsewhere the platform's default (spawn) is used."""
-    return sys.platform.startswith("linux")
-
-
-def _init_process() -> None:
-    # One solver thread per process: the processes are the parallelism.
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
-    # The environment variable is read when a BLAS library loads; forked workers inherit
-    # NumPy's and SciPy's OpenBLAS already loaded with one thread per core. Two workers
-    # each running two BLAS threads (SLSQP's QP) on 2 cores ran ~3x slower per point.
-    limit_blas_threads(1)
-
-
-def limit_blas_threads(n: int = 1) -> int:
-    """Set the thread count of every OpenBLAS already loaded in this process.
-
-    Returns how many libraries were limited (0 where there is no OpenBLAS or no
-    ``/proc``; nothing else changes then).
-    """
-    import ctypes
-
-    try:
-        with open("/proc/self/maps") as fh:
-            libs = {line.split()[-1] for line in fh if "openblas" in line.lower()}
-    except OSError:
-        return 0
-    count = 0
-    for lib in sorted(libs):
-        try:
-            handle = ctypes.CDLL(lib)
-        except OSError:
-            continue
-        for symbol in (
-            "openblas_set_num_threads",
-            "openblas_set_num_threads64_",
-            "scipy_openblas_set_num_threads",
-            "scipy_openblas_set_num_threads64_",
-        ):
-            fn = getattr(handle, symbol, None)
-            if fn is not None:
-                fn(ctypes.c_int(n))
-                count += 1
-                break
-    return count
+        yield _Serial(fn, isolate)
 
 
 #: Per-process (and per-thread, for threaded Dask workers) cache of expensive objects.

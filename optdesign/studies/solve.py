@@ -45,7 +45,9 @@ _BUILD_LOCK = threading.RLock()
 
 
 def _remember(cache: OrderedDict, key: tuple, build: Callable[[], Any]) -> Any:
-    owner = "main" if threading.current_thread() is threading.main_thread() else threading.get_ident()
+    owner = (
+        "main" if threading.current_thread() is threading.main_thread() else threading.get_ident()
+    )
     key = (owner, *key)
     with _BUILD_LOCK:
         if key in cache:

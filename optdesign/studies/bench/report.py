@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -12,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.storage import atomic_output, atomic_write_text
 from optdesign.studies.bench.configs import get_config
 from optdesign.studies.bench.metrics import (
     GAP_FLOOR,
@@ -108,7 +110,7 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
     """bench_runs.csv, bench_profiles.png, summary.md, bench_stats.json in ``out``."""
 
     out = Path(out)
-    with (out / "bench_runs.csv").open("w", newline="") as fh:
+    with io.StringIO() as fh:
         w = csv.DictWriter(fh, CSV_FIELDS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
@@ -122,12 +124,15 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
                     "reason": str(r.get("reason", ""))[:200],
                 }
             )
+        atomic_write_text(out / "bench_runs.csv", fh.getvalue())
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
     fronts = [c for c in configs if get_config(c).kind == "front"]
     if single:
         from optdesign.plots import save_figure
 
-        save_figure(profiles_figure(rows, configs), out / "bench_profiles.png", tight=False)
+        fig = profiles_figure(rows, configs)
+        with atomic_output(out / "bench_profiles.png") as tmp:
+            save_figure(fig, tmp, tight=False)
     desc = {c: get_config(c).description for c in configs}
     stats_all = config_stats([r for r in rows if r["config"] in single], single)
     shipped = [r for r in rows if r["family"] == "shipped"]
@@ -167,11 +172,12 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
             stats_table(st, desc, rows),
         ]
     text = "\n".join(lines) + "\n"
-    (out / "summary.md").write_text(text)
-    (out / "bench_stats.json").write_text(
+    atomic_write_text(out / "summary.md", text)
+    atomic_write_text(
+        out / "bench_stats.json",
         json.dumps(
             {"all": stats_all, "wall_time_s": wall, "suite": suite_name}, indent=1, default=str
-        )
+        ),
     )
     return {
         "csv": out / "bench_runs.csv",
@@ -212,7 +218,7 @@ def update_readme(readme: Path, summary: str) -> bool:
     a, b = text.find(README_BEGIN), text.find(README_END)
     if a < 0 or b < a:
         return False
-    readme.write_text(text[: a + len(README_BEGIN)] + "\n" + summary + text[b:])
+    atomic_write_text(readme, text[: a + len(README_BEGIN)] + "\n" + summary + text[b:])
     return True
 
 

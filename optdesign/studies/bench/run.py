@@ -14,6 +14,7 @@ from typing import Any
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.storage import atomic_write_text
 from optdesign.studies.bench.configs import default_configs, get_config
 from optdesign.studies.bench.instances import Instance, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
@@ -117,15 +118,19 @@ def run_bench(
     hard_timeout: float | None = None,
     instances: Sequence[Instance] | None = None,
     problems: Sequence[DesignProblem] | None = None,
+    overwrite: bool = False,
 ) -> BenchReport:
     """Run the benchmark, stream rows to ``out/bench_runs.jsonl``, write CSV, profiles and
     the summary into ``out`` (a new temporary folder by default: never over committed
     files).
 
     ``problems`` (the caller's own) or ``instances`` replace the suite's instances.
+    ``overwrite`` starts afresh in a folder that holds a previous run's store (otherwise
+    refused unless ``resume``).
     """
     from optdesign.studies.bench.report import write_outputs
-    from optdesign.studies.runner import read_store, run_tasks
+    from optdesign.studies.bench.sandbox import failed_run
+    from optdesign.studies.runner import Isolation, read_store, run_tasks
 
     names = list(configs) if configs else default_configs()
     for c in names:
@@ -177,6 +182,8 @@ def run_bench(
         resume=resume,
         progress="bench" if progress else False,
         key=key,
+        overwrite=overwrite,
+        isolate=Isolation(timeout="hard_timeout", failure=failed_run, quiet=True),
     )
     wall = time.perf_counter() - t0
     # Wall time over all invocations of this run (a resumed run adds to the stored one).
@@ -185,7 +192,7 @@ def run_bench(
         meta = json.loads(meta_path.read_text())
         if meta.get("key") == key:
             wall += float(meta.get("wall_time_s", 0.0))
-    meta_path.write_text(json.dumps({"key": key, "wall_time_s": wall}))
+    atomic_write_text(meta_path, json.dumps({"key": key, "wall_time_s": wall}))
     rows = add_gaps([dict(records[t["id"]]) for t in tasks if t["id"] in records])
     paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard)
     single = [c for c in names if get_config(c).kind not in ("front", "debug")]

@@ -1,6 +1,6 @@
 """One benchmark run, sandboxed: an (instance, configuration) pair solved in a forked child
-with a hard timeout (a hung or crashed solver becomes a failure row with its reason), its
-design verified on the NumPy path, and a JSON row returned.
+with a hard timeout (the runner's isolation: a hung or crashed solver becomes a failure
+row with its reason), its design verified on the NumPy path, and a JSON row returned.
 
 Catalogue variables: configurations on a continuous formulation (NLP, GP) enumerate the
 catalogue (one continuous solve per combination, best kept; time and evaluations
@@ -12,12 +12,8 @@ from __future__ import annotations
 import copy
 import itertools
 import math
-import os
-import pickle
-import select
-import signal
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -204,92 +200,50 @@ def _single_thread_blas() -> None:
         _BLAS_LIMITED = True
 
 
-def _fork_call(fn: Callable[[], dict], timeout: float) -> tuple[str, Any]:
-    """Run ``fn()`` in a forked child; ("ok", value), ("error", text), ("timeout", text)
-    or ("crash", text). os.fork (not multiprocessing) also works in daemonic workers."""
-    rfd, wfd = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # child
-        os.close(rfd)
-        # Solver chatter (qpOASES banner, HiGHS logs) would garble the progress bar.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 1)
-        os.dup2(devnull, 2)
-        try:
-            payload = pickle.dumps(("ok", fn()))
-        except BaseException as exc:  # every failure becomes a row
-            payload = pickle.dumps(("error", f"{type(exc).__name__}: {exc}"))
-        with os.fdopen(wfd, "wb") as fh:
-            fh.write(payload)
-        os._exit(0)
-    os.close(wfd)
-    chunks = []
-    deadline = time.monotonic() + timeout
-    timed_out = False
-    with os.fdopen(rfd, "rb") as fh:
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                timed_out = True
-                break
-            ready, _, _ = select.select([fh], [], [], left)
-            if not ready:
-                continue
-            chunk = os.read(fh.fileno(), 1 << 16)
-            if not chunk:
-                break
-            chunks.append(chunk)
-    if timed_out:
-        os.kill(pid, signal.SIGKILL)
-        os.waitpid(pid, 0)
-        return "timeout", f"no result within the hard timeout of {timeout:g} s (killed)"
-    _, status = os.waitpid(pid, 0)
-    data = b"".join(chunks)
-    if not data:
-        return "crash", f"worker process died (wait status {status})"
-    return pickle.loads(data)
-
-
-def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """One (instance, configuration) run -> JSON row (never raises for solver trouble).
-
-    ``task``: ``id``, ``family``, ``seed``, ``config``, ``time_limit`` (soft, s),
-    ``hard_timeout`` (s).
-    """
-    _single_thread_blas()
+def _row_base(task: Mapping[str, Any]) -> dict[str, Any]:
     config = get_config(task["config"])
     inst = task_instance(task)
-    base = {
+    return {
         "instance": inst.id,
         "family": inst.family,
         "seed": inst.seed,
         "mechanism": inst.mechanism,
         "objective_name": "+".join(inst.objectives),
-        "catalogue": any(
-            isinstance(v, dict) and "catalogue" in v for v in inst.data["variables"].values()
-        ),
+        "catalogue": any(v.discrete for v in inst.problem().free),
         "config": config.name,
         "kind": config.kind,
         "applicable": True,
     }
-    strike_key = (config.name, inst.mechanism)
-    if _STRIKES.get(strike_key, 0) >= TIMEOUT_STRIKES:
-        return {
-            **base,
-            **_failure(
-                "skipped",
-                f"not run: hit the hard timeout on {TIMEOUT_STRIKES} earlier {inst.mechanism} instances in this worker",
-                0.0,
-            ),
-        }
-    t0 = time.perf_counter()
-    kind, value = _fork_call(lambda: _execute_or_na(task), float(task["hard_timeout"]))
-    wall = time.perf_counter() - t0
-    if kind == "ok":
-        return {**base, **value}
+
+
+def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """One (instance, configuration) run -> JSON row.
+
+    ``task``: ``id``, ``family``, ``seed`` (or ``problem``), ``config``, ``time_limit``
+    (soft, s), ``hard_timeout`` (s). :func:`~optdesign.studies.bench.run_bench` runs it
+    isolated (:data:`ISOLATION`: a forked child per run, killed after ``hard_timeout``; a
+    crash, hang or exception becomes the row of :func:`failed_run`); called directly it
+    runs in this process.
+    """
+    _single_thread_blas()
+    base = _row_base(task)
+    # The strikes are counted by failed_run in the worker; this (forked) run sees them.
+    if _STRIKES.get((base["config"], base["mechanism"]), 0) >= TIMEOUT_STRIKES:
+        reason = (
+            f"not run: hit the hard timeout on {TIMEOUT_STRIKES} earlier "
+            f"{base['mechanism']} instances in this worker"
+        )
+        return {**base, **_failure("skipped", reason, 0.0)}
+    return {**base, **_execute_or_na(task)}
+
+
+def failed_run(task: Mapping[str, Any], kind: str, reason: str, wall_s: float) -> dict[str, Any]:
+    """The row of a run that timed out, crashed or raised (in the worker, not the child)."""
+    base = _row_base(task)
     if kind == "timeout":
-        _STRIKES[strike_key] = _STRIKES.get(strike_key, 0) + 1
-    return {**base, **_failure(kind, value, wall)}
+        key = (base["config"], base["mechanism"])
+        _STRIKES[key] = _STRIKES.get(key, 0) + 1
+    return {**base, **_failure(kind, reason, wall_s)}
 
 
 def _execute_or_na(task):
