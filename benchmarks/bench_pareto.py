@@ -32,9 +32,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 
 from optdesign.problem import load_problem
-from optdesign.studies import runner
-from optdesign.studies.front_metrics import hypervolume, non_dominated, reference_point
-from optdesign.studies.pareto import epsilon_constraint_front, nsga2_front, read_front_csv
+from optdesign.studies import solve as solve_study
+from optdesign.studies.pareto import NSGA2, EpsilonConstraint, compute_front, read_front_csv
+from optdesign.studies.pareto.metrics import hypervolume, non_dominated, reference_point
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "benchmarks" / "data" / "cs_min_backlash_reference_front.csv"
@@ -42,10 +42,13 @@ OBJECTIVES = ["ripple", "backlash"]
 
 
 def timed_front(problem, points, workers, tag, **kw):
-    runner._CACHE.clear()  # include the solver builds in every timed run
+    # include the formulation and solver builds in every timed run
+    solve_study._NLPS.clear()
+    solve_study._SOLVERS.clear()
     out = Path(tempfile.mkdtemp(prefix=f"bench-pareto-{tag}-"))
     t0 = time.perf_counter()
-    front = epsilon_constraint_front(problem, OBJECTIVES, points, out=out, workers=workers, **kw)
+    method = EpsilonConstraint(points=points, **kw)
+    front = compute_front(problem, OBJECTIVES, method=method, out=out, workers=workers)
     return front, time.perf_counter() - t0
 
 
@@ -54,7 +57,7 @@ def _solver_counts(front) -> dict:
     record, Ipopt fallbacks, and the anchors' multistart evidence."""
     from optdesign.studies.runner import read_store
 
-    _, recs = read_store(front.info["store"])
+    _, recs = read_store(front.store)
     solvers: dict[str, int] = {}
     for r in recs.values():
         solvers[r.get("solver", "?")] = solvers.get(r.get("solver", "?"), 0) + 1
@@ -94,14 +97,14 @@ def main() -> None:
         "failed": eps.metrics["n_failed"],
         "hv_ratio": hv / hv_ref,
         "time_s": t_eps,
-        "n_solves": eps.info["n_solves"],
-        "n_retried": eps.info["n_retried"],
+        "n_solves": eps.n_solves,
+        "n_retried": eps.n_retried,
         "spacing": eps.metrics["spacing"],
         "solvers": _solver_counts(eps),
     }
     print(
         f"epsilon ({args.points} pts, 1 worker): HV {100 * hv / hv_ref:.3f} % of reference, "
-        f"{t_eps:.2f} s, {eps.info['n_solves']} solves, {eps.metrics['n_failed']} failed; "
+        f"{t_eps:.2f} s, {eps.n_solves} solves, {eps.metrics['n_failed']} failed; "
         f"{results['epsilon']['solvers']}"
     )
 
@@ -115,7 +118,8 @@ def main() -> None:
     ns = []
     for seed in args.seeds:
         t0 = time.perf_counter()
-        f = nsga2_front(problem, OBJECTIVES, args.pop, args.generations, seed=seed)
+        method = NSGA2(args.pop, args.generations, seed=seed)
+        f = compute_front(problem, OBJECTIVES, method=method)
         t = time.perf_counter() - t0
         ns.append({"seed": seed, "hv_ratio": hypervolume(f.F, ref) / hv_ref, "time_s": t})
         print(

@@ -25,7 +25,7 @@ from optdesign.problem import load_problem
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.global_check import penalised_objective
-from optdesign.studies.pareto import SLSQP_OPTIONS
+from optdesign.studies.pareto.eps_solver import SLSQP_OPTIONS
 from optdesign.studies.solve import solve_nlp
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,8 +36,8 @@ def _target_callback(problem, objective, target, t_start, reached):
 
     def callback(intermediate_result):
         ev = problem.evaluate(intermediate_result.x)
-        f = ev["objectives"][objective]
-        if ev["violation"] <= 1e-6 and f <= target * (1 + 1e-4):
+        f = ev.objectives[objective]
+        if ev.violation <= 1e-6 and f <= target * (1 + 1e-4):
             reached["t"] = time.perf_counter() - t_start
             reached["f"] = f
             return True

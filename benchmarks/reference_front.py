@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from optdesign.problem import load_problem
-from optdesign.studies.pareto import epsilon_constraint_front, write_front_csv
+from optdesign.studies.pareto import EpsilonConstraint, compute_front, write_front_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 CSV = ROOT / "benchmarks" / "data" / "cs_min_backlash_reference_front.csv"
@@ -35,18 +35,21 @@ def main() -> None:
     args = ap.parse_args()
     problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
     t0 = time.perf_counter()
-    front = epsilon_constraint_front(
-        problem,
-        ["ripple", "backlash"],
-        args.points,
-        out=args.out,
-        workers=args.workers,
-        resume=args.resume,
-        progress="reference",
+    method = EpsilonConstraint(
+        points=args.points,
         starts=args.anchor_starts,
         agree=None,  # every anchor start runs (no early stop): a reference, not a race
         extra_starts=args.extra_starts,
         name="reference",
+    )
+    front = compute_front(
+        problem,
+        ["ripple", "backlash"],
+        method=method,
+        out=args.out,
+        workers=args.workers,
+        resume=args.resume,
+        progress=True,
     )
     write_front_csv(front, problem, CSV)
     print(
@@ -54,7 +57,7 @@ def main() -> None:
         f"({front.metrics['n_failed']} failed) in {time.perf_counter() - t0:.1f} s "
         f"-> {CSV.relative_to(ROOT)}"
     )
-    print(f"anchors: {front.info['anchors']}")
+    print(f"anchors: {front.anchors}")
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ from optdesign.studies.solve import solve_nlp
 from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
-SHIPPED = ["cs_min_ripple", "cs_min_backlash", "fork_min_backlash"]
+SHIPPED = ["cs_min_ripple", "cs_min_backlash", "fork_min_backlash", "pivot_min_backlash"]
 
 
 @pytest.fixture(scope="module")

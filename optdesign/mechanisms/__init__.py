@@ -16,10 +16,11 @@ from optdesign.mechanisms.base import (
     VariableInfo,
 )
 
-# Built-in plug-ins register themselves on import (after the registry exists).
+# The built-in plug-ins register themselves on import.
 from optdesign.mechanisms.crank_slider import CrankSlider
 from optdesign.mechanisms.fork import ShiftingFork
 from optdesign.mechanisms.joints import Backlash, Joint, PinJoint
+from optdesign.mechanisms.pivoting_screw import PivotingScrew
 from optdesign.mechanisms.registry import get_mechanism, register_mechanism, registered
 
 __all__ = [
@@ -29,6 +30,7 @@ __all__ = [
     "Joint",
     "Mechanism",
     "PinJoint",
+    "PivotingScrew",
     "RequirementInfo",
     "Rows",
     "ShiftingFork",

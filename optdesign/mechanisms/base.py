@@ -398,7 +398,16 @@ def _derivative(mech: Mechanism, phi):
         if m.is_symbolic(phi):
             return fun(phi, *args)
         return ca.vertcat(*[fun(float(p), *args) for p in phi_col.ravel()])
-    arrays = np.broadcast_arrays(np.asarray(phi, dtype=float), *map(np.asarray, args))
+    values = [np.asarray(a) for a in (phi, *args)]
+    if any(v.dtype.kind not in "fiub" for v in values):
+        # e.g. the GP diagnosis's tracers: AD cannot see through them, and a numeric
+        # stand-in would give a wrong model, so say why instead.
+        raise TypeError(
+            f"{cls.__name__}.nut_velocity is the automatic derivative of nut_position, "
+            "which needs CasADi or NumPy values; write nut_velocity in closed form to "
+            "trace it (GP diagnosis)"
+        )
+    arrays = np.broadcast_arrays(*[v.astype(float) for v in values])
     shape = arrays[0].shape
     flat = [a.astype(float).ravel() for a in arrays]
     n = flat[0].size

@@ -51,6 +51,7 @@ class FrontPoint:
     n_solves: int = 0
     wall_time_s: float = 0.0
     message: str = ""
+    retried: str = ""
 
     @property
     def success(self) -> bool:
@@ -70,6 +71,7 @@ class FrontPoint:
             n_solves=rec.n_solves,
             wall_time_s=rec.wall_time_s,
             message=rec.message,
+            retried=rec.retried,
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -113,6 +115,11 @@ class Front:
     n_solves: int = 0
     settings: dict[str, Any] = field(default_factory=dict)
     problem_object: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def n_retried(self) -> int:
+        """Points re-solved from Sobol starts (failed, worse than a neighbour, jumped)."""
+        return sum(1 for p in self.points + self.rejected if p.retried)
 
     @property
     def F(self) -> np.ndarray:

@@ -1,0 +1,45 @@
+"""The examples run as users run them, with public names only."""
+
+from __future__ import annotations
+
+import ast
+import runpy
+from pathlib import Path
+
+import pytest
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "custom_mechanism.py"
+
+
+def test_example_imports_only_public_names():
+    tree = ast.parse(EXAMPLE.read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            assert not (node.module or "").split(".")[-1].startswith("_")
+            assert all(not a.name.startswith("_") for a in node.names)
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            if node.value.id in ("od", "m"):
+                assert not node.attr.startswith("_"), node.attr
+    assert len(EXAMPLE.read_text().splitlines()) <= 60
+
+
+def test_custom_mechanism_solves_fronts_and_benches(tmp_path):
+    module = runpy.run_path(str(EXAMPLE), run_name="example")
+    result, front, report = module["main"](tmp_path)
+    assert result.status == "optimal" and result.verified
+    assert result.mechanism == "scotch_yoke"
+    # a Scotch yoke under the fork's requirements is pinned by the same two limits: nut
+    # travel 2 R sin 30 deg <= 110 mm and the pin pressure at the stroke's ends
+    assert result.design["R"] == pytest.approx(110.0, rel=1e-7)
+    assert {r.name.split("[")[0] for r in result.active} >= {"nut_travel", "pin_bearing_pressure"}
+    # the front's ends are the anchors' optima: the smallest yoke, and the backlash optimum
+    F = front.F
+    assert len(F) == 8
+    # (to the anchors' slack of 1e-7 relative, which keeps a tie-break feasible)
+    assert F[0, 0] == pytest.approx(front.anchors["size"]["size"], rel=2e-7)
+    assert F[-1, 1] == pytest.approx(result.objective, rel=2e-7)
+    # the user's constraint reached the front too
+    assert all(p.design["R"] >= F[0, 0] * (1 - 1e-9) for p in front.points)
+    rows = {r["config"]: r for r in report.rows}
+    assert rows["ipopt-exact"]["success"] and rows["slsqp-exact"]["success"]
+    assert rows["ipopt-exact"]["objective"] == pytest.approx(result.objective, rel=1e-6)

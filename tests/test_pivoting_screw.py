@@ -1,0 +1,110 @@
+"""The pivoting (trunnion-mounted) screw, checked against computations that do not use its
+formulas: finite differences, a loop closure solved numerically, statics by cross
+products, and property tests."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import brentq
+
+from optdesign.mechanisms import Mechanism, PinJoint, PivotingScrew
+
+DESIGN = {"R": 90.0, "a_T": -220.0, "b_T": 40.0, "phi0": 0.1, "p": 5.0, "i_a": 2.0}
+PHI = np.radians(np.linspace(-30.0, 30.0, 13))
+
+
+def _length(R, a_T, b_T, phi0, phi):
+    """Actuator length by plain vector geometry (not the model)."""
+    B = np.array([R * np.sin(phi0 + phi), R * np.cos(phi0 + phi)])
+    return float(np.hypot(*(B - np.array([a_T, b_T]))))
+
+
+def _angle_at_length(d, L, guess):
+    """Output angle where the actuator has length L (loop closure solved numerically)."""
+    return brentq(
+        lambda phi: _length(d["R"], d["a_T"], d["b_T"], d["phi0"], phi) - L,
+        guess - 0.2,
+        guess + 0.2,
+        xtol=1e-15,
+    )
+
+
+def test_nut_velocity_three_ways():
+    mech = PivotingScrew(**DESIGN)
+    h = 1e-6
+    fd = (mech.nut_position(PHI + h) - mech.nut_position(PHI - h)) / (2 * h)
+    np.testing.assert_allclose(mech.nut_velocity(PHI), fd, rtol=1e-7)
+    # the framework's automatic derivative (CasADi AD of nut_position) agrees
+    np.testing.assert_allclose(
+        Mechanism.nut_velocity(mech, PHI), mech.nut_velocity(PHI), rtol=1e-12
+    )
+    # the length itself is the distance pivot-pin
+    assert mech.nut_position(PHI[3]) == pytest.approx(_length(90, -220, 40, 0.1, PHI[3]), rel=1e-14)
+
+
+@pytest.mark.parametrize("k", [0, 4, 8, 12])
+def test_loop_closure_gives_the_inverse_rate(k):
+    # dphi/dL of the assembled linkage (lengthen the actuator, re-solve for phi) is the
+    # output rotation per unit clearance along the actuator, 1/(dL/dphi)
+    mech = PivotingScrew(**DESIGN)
+    phi = PHI[k]
+    L = mech.nut_position(phi)
+    delta = 1e-5
+    fd = (_angle_at_length(DESIGN, L + delta, phi) - _angle_at_length(DESIGN, L - delta, phi)) / (
+        2 * delta
+    )
+    assert fd == pytest.approx(float(mech.sensitivity_axial(phi)), rel=1e-7)
+    joints = mech.joints(np.array([phi]), 500e3, PinJoint(8.0, 12.0))
+    pins = [j for j in joints if j.pin is not None]
+    assert [j.name for j in pins] == ["horn pin", "trunnion"]
+    for j in pins:
+        assert float(np.asarray(j.sensitivity).ravel()[0]) == pytest.approx(fd, rel=1e-7)
+
+
+def test_statics_by_cross_product():
+    # the actuator force F along T->B produces the hinge moment about O: |B x F| = M_h
+    mech = PivotingScrew(**DESIGN)
+    M_h = 500e3
+    F = mech.nut_force(PHI, M_h)
+    for k, phi in enumerate(PHI):
+        B = np.array([90 * np.sin(0.1 + phi), 90 * np.cos(0.1 + phi)])
+        u = (B - np.array([-220.0, 40.0])) / _length(90, -220, 40, 0.1, phi)
+        moment = abs(B[0] * u[1] - B[1] * u[0]) * F[k]
+        assert moment == pytest.approx(M_h, rel=1e-12)
+
+
+def test_transmission_angle_from_the_pin_positions():
+    mech = PivotingScrew(**DESIGN)
+    c = mech.transmission_angle_cos(PHI)
+    for k, phi in enumerate(PHI):
+        B = np.array([90 * np.sin(0.1 + phi), 90 * np.cos(0.1 + phi)])
+        v1, v2 = -B, np.array([-220.0, 40.0]) - B
+        expected = v1 @ v2 / (np.linalg.norm(v1) * np.linalg.norm(v2))
+        assert c[k] == pytest.approx(expected, rel=1e-12)
+
+
+def test_ratio_by_finite_step_tends_to_the_exact_ratio():
+    mech = PivotingScrew(**DESIGN)
+    errs = [np.max(np.abs(mech.ratio_finite_step(PHI, s) - mech.ratio(PHI))) for s in (1e-2, 1e-3)]
+    assert errs[1] < errs[0] / 8  # first order in the step
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    R=st.floats(30, 120),
+    a_T=st.floats(-300, -40),
+    b_T=st.floats(-100, 150),
+    phi0=st.floats(-0.6, 0.6),
+)
+def test_casadi_and_numpy_paths_agree(R, a_T, b_T, phi0):
+    x = ca.SX.sym("x", 4)
+    sym = PivotingScrew(R=x[0], a_T=x[1], b_T=x[2], phi0=x[3], p=5.0, i_a=2.0)
+    f = ca.Function("f", [x], [sym.ratio(PHI), sym.nut_force(PHI, 5e5)])
+    num = PivotingScrew(R=R, a_T=a_T, b_T=b_T, phi0=phi0, p=5.0, i_a=2.0)
+    ratio, force = f([R, a_T, b_T, phi0])
+    np.testing.assert_allclose(np.asarray(ratio).ravel(), num.ratio(PHI), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(force).ravel(), num.nut_force(PHI, 5e5), rtol=1e-10)
