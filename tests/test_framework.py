@@ -149,7 +149,7 @@ def test_a_solver_back_end_registered_from_outside_the_package():
     assert result.solver == "cobyqa" and result.verified
     assert result.objective == pytest.approx(0.0194989, rel=1e-4)
     # and the benchmark takes it by its name
-    report = od.bench(problems=[problem], solvers=["cobyqa", "ipopt-exact"])
+    report = od.bench(problems=[problem], solvers=["cobyqa", "ipopt-exact"], time_limit=20.0)
     rows = {r["config"]: r for r in report.rows}
     assert rows["cobyqa"]["success"] and rows["cobyqa"]["gap"] < 1e-4
 
