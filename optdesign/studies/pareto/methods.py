@@ -14,6 +14,7 @@ so a resumed run never mixes records of another problem or setting.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -163,59 +164,38 @@ class EpsilonConstraint:
             formulation_for(problem, tuple(sorted(objectives)))
         label = f"{self.name}: points" if run.progress else False
         with process_pool(run.workers if run.scheduler is None else 1) as pool:
+            # Every phase of the front shares the store, the identity and the workers.
+            phase = functools.partial(
+                run_tasks,
+                fn=front_task,
+                store_path=store,
+                workers=run.workers,
+                scheduler=run.scheduler,
+                progress=label,
+                key=key,
+                on_record=run.on_record,
+                pool=pool,
+            )
             anchor_list = anchor_tasks(common, objectives, starts, seed, self.agree)
             if len(objectives) == 2:
                 split = n_points // 2 if self.deterministic else None
                 sweep = TwoChains(
                     objectives, n_points, self.name, common, self.spacing, self.eps_values, split
                 )
-                done = run_tasks(
-                    anchor_list,
-                    front_task,
-                    store,
-                    run.workers,
-                    run.scheduler,
-                    run.resume,
-                    label,
-                    key,
-                    run.on_record,
-                    pool=pool,
-                    expand=sweep,
-                )
+                done = phase(anchor_list, resume=run.resume, expand=sweep)
+                anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
                 tasks = sweep.tasks
             else:
                 # Three objectives: the rows need every anchor (the nadir of B), so the
                 # anchors run first, then the rows in parallel.
-                done = run_tasks(
-                    anchor_list,
-                    front_task,
-                    store,
-                    run.workers,
-                    run.scheduler,
-                    run.resume,
-                    label,
-                    key,
-                    run.on_record,
-                    pool=pool,
-                )
+                done = phase(anchor_list, resume=run.resume)
                 anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
                 for k, rec in anchors.items():
                     check_anchor(rec, k)
                 tasks = three_objective_tasks(anchors, objectives, n_points, self.name, common)
-                done = run_tasks(
-                    tasks,
-                    front_task,
-                    store,
-                    run.workers,
-                    run.scheduler,
-                    True,
-                    label,
-                    key,
-                    run.on_record,
-                    pool=pool,
-                    known={f"anchor-{k}": done[f"anchor-{k}"] for k in objectives},
-                )
-        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+                known = {f"anchor-{k}": done[f"anchor-{k}"] for k in objectives}
+                # the anchors are in the store already: resume over them
+                done = phase(tasks, resume=True, known=known)
         for k, rec in anchors.items():
             check_anchor(rec, k)
         recs = [
