@@ -40,6 +40,8 @@ INTERNAL_UNITS: dict[str, str] = {
     "stiffness": "N/mm",
     "speed": "1/min",
     "time": "h",
+    "angular_speed": "rad/s",
+    "rotational_stiffness": "N*mm/rad",
 }
 
 #: The unit suggested to a user for each dimension (error messages, ``bare="refuse"``).
@@ -53,6 +55,8 @@ SUGGESTED_UNITS: dict[str, str] = {
     "stiffness": "N/mm",
     "speed": "1/min",
     "time": "h",
+    "angular_speed": "deg/s",
+    "rotational_stiffness": "N*m/rad",
 }
 
 #: How a dimension is named in messages ("expected a moment").
@@ -66,6 +70,8 @@ _DIMENSION_NAMES: dict[str, str] = {
     "stiffness": "a stiffness",
     "speed": "a speed",
     "time": "a time",
+    "angular_speed": "an angular speed",
+    "rotational_stiffness": "a rotational stiffness",
 }
 
 #: Spellings pint does not read as meant ("Nm" is pint's "number * metre" per gram!).

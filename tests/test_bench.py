@@ -170,10 +170,14 @@ def test_best_configuration_and_paired_time_ratio():
         return {"instance": inst, "config": cfg, "time_s": t, "success": ok, "gap": 0.0}
 
     rows = [
-        row("a", "fast", 1.0), row("b", "fast", 2.0), row("c", "fast", 9.0, ok=False),
-        row("a", "slow", 3.0), row("b", "slow", 10.0), row("c", "slow", 4.0),
+        row("a", "fast", 1.0),
+        row("b", "fast", 2.0),
+        row("c", "fast", 9.0, ok=False),
+        row("a", "slow", 3.0),
+        row("b", "slow", 10.0),
+        row("c", "slow", 4.0),
         row("a", "subset", 0.1),  # applies to one instance only
-    ]  # fmt: skip
+    ]
     stats = config_stats(rows, ["fast", "slow", "subset"])
     assert stats["fast"]["success_rate"] == pytest.approx(2 / 3)
     assert stats["slow"]["median_time_s"] == 4.0

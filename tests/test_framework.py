@@ -133,14 +133,27 @@ def test_a_solver_back_end_registered_from_outside_the_package():
             t0 = time.perf_counter()
             box = so.Bounds(bounds.lbz, bounds.ubz)
             z0 = np.clip(start.z0, bounds.lbz, bounds.ubz)
-            res = so.minimize(f, z0, method="COBYQA", bounds=box, constraints=[con],
-                              options={"maxiter": 3000})  # fmt: skip
+            res = so.minimize(
+                f, z0, method="COBYQA", bounds=box, constraints=[con], options={"maxiter": 3000}
+            )
             status = "optimal" if res.success else "failed"
             term = TerminationCondition.CONVERGED if res.success else TerminationCondition.ERROR
             zero = np.zeros(len(res.x))
-            return make_result(self.name, self.nlp, target, bounds, res.x, zero,
-                               np.zeros(len(bounds.lbg)), status, term, str(res.message),
-                               res.nit, {}, time.perf_counter() - t0)  # fmt: skip
+            return make_result(
+                self.name,
+                self.nlp,
+                target,
+                bounds,
+                res.x,
+                zero,
+                np.zeros(len(bounds.lbg)),
+                status,
+                term,
+                str(res.message),
+                res.nit,
+                {},
+                time.perf_counter() - t0,
+            )
 
     od.register_solver("cobyqa", TrustRegionCobyqa, replace=True)
     assert "cobyqa" in od.solver_names("nlp")

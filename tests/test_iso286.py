@@ -241,10 +241,34 @@ def test_formula_at_geometric_mean_reproduces_most_of_the_print():
 # Properties
 # --------------------------------------------------------------------------------------
 TABLE_FITS = [
-    "H7/g6", "H8/f7", "H7/h6", "H11/c11", "H9/d9", "H8/e8", "H7/js6", "H7/k6", "H7/m6",
-    "H7/n6", "H7/p6", "H7/r6", "H7/s6", "H7/u6", "G7/h6", "F8/h7", "K7/h6", "M7/h6",
-    "N7/h6", "P7/h6", "R7/h6", "S7/h6", "U7/h6", "JS7/h6", "C11/h11", "D9/h9", "E8/h8",
-]  # fmt: skip
+    "H7/g6",
+    "H8/f7",
+    "H7/h6",
+    "H11/c11",
+    "H9/d9",
+    "H8/e8",
+    "H7/js6",
+    "H7/k6",
+    "H7/m6",
+    "H7/n6",
+    "H7/p6",
+    "H7/r6",
+    "H7/s6",
+    "H7/u6",
+    "G7/h6",
+    "F8/h7",
+    "K7/h6",
+    "M7/h6",
+    "N7/h6",
+    "P7/h6",
+    "R7/h6",
+    "S7/h6",
+    "U7/h6",
+    "JS7/h6",
+    "C11/h11",
+    "D9/h9",
+    "E8/h8",
+]
 sizes = st.floats(min_value=0.01, max_value=500.0, allow_nan=False)
 
 

@@ -247,8 +247,13 @@ def test_isolated_tasks_hard_timeout_and_crashes_become_failure_records(tmp_path
     assert time.monotonic() - t0 < 10  # the hang was killed after its 0.5 s
     status = {k: r["status"] for k, r in done.items()}
     assert status == {
-        "t0": "ok", "t1": "timeout", "t2": "crash", "t3": "crash", "t4": "error", "t5": "ok"
-    }  # fmt: skip
+        "t0": "ok",
+        "t1": "timeout",
+        "t2": "crash",
+        "t3": "crash",
+        "t4": "error",
+        "t5": "ok",
+    }
     assert "hard timeout of 0.5 s" in done["t1"]["reason"]
     assert 0.5 <= done["t1"]["time_s"] < 5
     assert "wait status" in done["t2"]["reason"]

@@ -113,10 +113,21 @@ def test_cli_refuses_resume_from_an_empty_store_with_one_line_and_exit_2(tmp_pat
     problem = ROOT / "problems" / "fork_min_backlash.toml"
     code = main(
         [
-            "pareto", str(problem), "--objectives", "size,backlash", "--points", "3",
-            "--out", str(out), "--resume", "--workers", "1", "--no-progress", "--no-plot",
+            "pareto",
+            str(problem),
+            "--objectives",
+            "size,backlash",
+            "--points",
+            "3",
+            "--out",
+            str(out),
+            "--resume",
+            "--workers",
+            "1",
+            "--no-progress",
+            "--no-plot",
         ]
-    )  # fmt: skip
+    )
     err = capsys.readouterr().err
     assert code == 2
     assert err.count("\n") == 1 and "optdesign: error:" in err and "empty" in err
@@ -225,12 +236,23 @@ def test_two_concurrent_cli_runs_into_one_folder(tmp_path):
     try:
         res = subprocess.run(
             [
-                sys.executable, "-m", "optdesign", "bench", "--suite", "quick", "--solvers",
-                "debug-crash", "--out", str(tmp_path), "--no-progress",
+                sys.executable,
+                "-m",
+                "optdesign",
+                "bench",
+                "--suite",
+                "quick",
+                "--solvers",
+                "debug-crash",
+                "--out",
+                str(tmp_path),
+                "--no-progress",
             ],
-            capture_output=True, text=True, timeout=60,
+            capture_output=True,
+            text=True,
+            timeout=60,
             env={**os.environ, "PYTHONPATH": str(ROOT)},
-        )  # fmt: skip
+        )
     finally:
         proc.kill()
         proc.wait()

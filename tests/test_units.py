@@ -106,9 +106,26 @@ def test_non_finite_numbers_are_refused(value):
 
 @pytest.mark.parametrize(
     "text",
-    ["", "mm", "90 furlongs_of_cheese", "90 mm2", "90 mm^99", "90 (((((mm)))))", "90 mm)", "90 (mm",
-     "90 mm; rm -rf", "__import__('os')", "90 mm**x", "1,5 mm", "90 mm * ", "0x10 mm", "True", "2**mm", "2 * * mm"],
-)  # fmt: skip
+    [
+        "",
+        "mm",
+        "90 furlongs_of_cheese",
+        "90 mm2",
+        "90 mm^99",
+        "90 (((((mm)))))",
+        "90 mm)",
+        "90 (mm",
+        "90 mm; rm -rf",
+        "__import__('os')",
+        "90 mm**x",
+        "1,5 mm",
+        "90 mm * ",
+        "0x10 mm",
+        "True",
+        "2**mm",
+        "2 * * mm",
+    ],
+)
 def test_malformed_strings_are_refused_with_the_field(text):
     with pytest.raises(InputError, match=r"^variables\.R: "):
         to_internal(text, "length", "variables.R")

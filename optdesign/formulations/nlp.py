@@ -39,12 +39,14 @@ VAR = "var:"
 
 @dataclass(frozen=True)
 class Bounds:
-    """Variable and constraint bounds of one solve (scaled, as the solver sees them)."""
+    """What one solve fixes: variable and constraint bounds (scaled, as the solver sees
+    them) and the values of the problem's parameters (None: their defaults)."""
 
     lbz: np.ndarray
     ubz: np.ndarray
     lbg: np.ndarray
     ubg: np.ndarray
+    parameters: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -87,7 +89,10 @@ class NLP:
     aux_names
         Names of the auxiliary (epigraph) variables.
     targets, target_scales
-        Names of the entries of ``p`` and the typical magnitude of each value.
+        Names of the weights at the head of ``p`` and the typical magnitude of each value.
+    param_names, param_defaults
+        The problem's parameters (values fixed per solve, e.g. a catalogue item's load
+        rating) at the tail of ``p``, and their default values.
     objective_values
         Objective name -> expression of its (unscaled) value, for reports.
     eps_rows
@@ -119,6 +124,8 @@ class NLP:
     default_target: str
     form: str
     aux_init: Any = None  # CasADi Function zd -> aux start values
+    param_names: list[str] = field(default_factory=list)
+    param_defaults: np.ndarray = field(default_factory=lambda: np.zeros(0))
     limits: dict[str, float] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
 
@@ -140,25 +147,45 @@ class NLP:
                 )
         return Target(tuple((k, float(v)) for k, v in coefs.items()))
 
-    def params(self, target: Target) -> np.ndarray:
-        """The parameter vector ``p`` of ``target`` (each value divided by its scale, so
-        that f is ~1 at the middle of the bounds)."""
-        p = np.zeros(len(self.targets))
+    def params(self, target: Target, parameters: np.ndarray | None = None) -> np.ndarray:
+        """The vector ``p`` of a solve: the weights of ``target`` (each value divided by its
+        scale, so that f is ~1 at the middle of the bounds), then the problem's
+        parameters (``parameters``, default: their defaults)."""
+        w = np.zeros(len(self.targets))
         for name, c in target.coefficients:
             k = self.targets.index(name)
-            p[k] += c / self.target_scales[k]
-        return p
+            w[k] += c / self.target_scales[k]
+        values = self.param_defaults if parameters is None else np.asarray(parameters, float)
+        return np.concatenate([w, values])
+
+    def parameter_vector(self, values: Mapping[str, float] | None) -> np.ndarray | None:
+        """The parameters' vector from name -> value (the rest at their defaults)."""
+        if not values:
+            return None
+        out = self.param_defaults.copy()
+        for name, v in values.items():
+            out[self.param_names.index(name)] = float(v)
+        return out
+
+    @property
+    def theta(self):
+        """The parameters' symbols (the tail of ``p``)."""
+        return self.p[len(self.targets) :]
+
+    def parameter_values(self, parameters: np.ndarray | None) -> np.ndarray:
+        return self.param_defaults if parameters is None else np.asarray(parameters, float)
 
     @cached_property
     def values_fun(self) -> ca.Function:
-        """z -> every target's value (objectives, then design variables)."""
+        """(z, theta) -> every target's value (objectives, then design variables)."""
         x = self.x_lo + self.x_span * self.z[: self.n_design]
         exprs = [*self.objective_values.values(), *[x[k] for k in range(self.n_design)]]
-        return ca.Function("target_values", [self.z], [ca.vertcat(*exprs)])
+        return ca.Function("target_values", [self.z, self.theta], [ca.vertcat(*exprs)])
 
     @cached_property
     def g_fun(self) -> ca.Function:
-        return ca.Function("g", [self.z], [self.g])
+        """(z, theta) -> the constraint rows."""
+        return ca.Function("g", [self.z, self.theta], [self.g])
 
     def objective_of(self, target: Target, values: np.ndarray) -> float:
         """``sum c_k v_k`` from the vector of target values."""
@@ -169,10 +196,12 @@ class NLP:
         self,
         eps: Mapping[str, float] | None = None,
         box: Mapping[str, tuple[float, float]] | None = None,
+        parameters: Mapping[str, float] | None = None,
     ) -> Bounds:
         """Bounds of a solve: epsilon limits ``eps`` (name -> upper limit of that
-        objective, tightened by the requirement's own limit) and a sub-box ``box`` of
-        design variables (name -> (lower, upper), internal units)."""
+        objective, tightened by the requirement's own limit), a sub-box ``box`` of
+        design variables (name -> (lower, upper), internal units) and values of the
+        problem's parameters (name -> value)."""
         lbz, ubz, ubg = self.lbz, self.ubz, self.ubg
         if eps:
             ubg = ubg.copy()
@@ -191,27 +220,28 @@ class NLP:
                 k = self.design_names.index(name)
                 lbz[k] = (lo - self.x_lo[k]) / self.x_span[k]
                 ubz[k] = (hi - self.x_lo[k]) / self.x_span[k]
-        return Bounds(lbz, ubz, self.lbg, ubg)
+        return Bounds(lbz, ubz, self.lbg, ubg, self.parameter_vector(parameters))
 
     def x_from_z(self, z) -> np.ndarray:
         z = np.asarray(z, dtype=float).ravel()
         return self.x_lo + self.x_span * z[: self.n_design]
 
-    def z_from_x(self, x) -> np.ndarray:
-        """Full start vector from a design: aux variables set to their tightest values."""
+    def z_from_x(self, x, parameters: np.ndarray | None = None) -> np.ndarray:
+        """Full start vector from a design: aux variables set to their tightest values
+        (with the parameters' values of the solve, default: their defaults)."""
         x = np.asarray(x, dtype=float).ravel()
         zd = (x - self.x_lo) / self.x_span
         if not self.aux_names:
             return zd
-        aux = np.asarray(self.aux_init(zd), dtype=float).ravel()
-        return np.concatenate([zd, aux])
+        aux = np.asarray(self.aux_init(zd, self.parameter_values(parameters)), dtype=float)
+        return np.concatenate([zd, aux.ravel()])
 
-    def start(self, x0=None, z0=None, lam_x0=None, lam_g0=None) -> Start:
+    def start(self, x0=None, z0=None, lam_x0=None, lam_g0=None, parameters=None) -> Start:
         """A :class:`Start` from the design ``x0`` or the scaled vector ``z0``."""
         if z0 is None:
             if x0 is None:
                 raise ValueError("give x0 or z0")
-            z0 = self.z_from_x(x0)
+            z0 = self.z_from_x(x0, parameters)
         return Start(np.asarray(z0, dtype=float).ravel(), _vec(lam_x0), _vec(lam_g0))
 
     @cached_property
@@ -315,9 +345,11 @@ def build_nlp(
     x_span = x_hi - x_lo
     zd = ca.SX.sym("z", n)
     x = x_lo + x_span * zd
-    ex = problem.expressions(
-        problem.design_dict([x[k] for k in range(n)]), guarded=True, first_order=first_order
-    )
+    defaults = problem.parameters()
+    theta = ca.SX.sym("theta", len(defaults))
+    design = problem.design_dict([x[k] for k in range(n)])
+    design.update(problem.parameter_design(dict(zip(defaults, ca.vertsplit(theta), strict=True))))
+    ex = problem.expressions(design, guarded=True, first_order=first_order)
     mid = problem.midpoint()
     ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
     for name in names:
@@ -395,12 +427,12 @@ def build_nlp(
     target_scales = np.array(
         [scales[k] for k in names] + [abs(v) if abs(v) > 1e-12 else 1.0 for v in mid]
     )
-    p = ca.SX.sym("p", len(targets))
+    w = ca.SX.sym("w", len(targets))
     f_raw = ca.SX(0)
     for k, name in enumerate(names):
-        f_raw += p[k] * values[name]
+        f_raw += w[k] * values[name]
     for k in range(n):
-        f_raw += p[len(names) + k] * x[k]
+        f_raw += w[len(names) + k] * x[k]
 
     # Substitute the aux symbols by scaled decision variables za (aux = scale * za).
     za = ca.SX.sym("za", len(aux))
@@ -414,7 +446,7 @@ def build_nlp(
     z = ca.vertcat(zd, za)
     aux_lb_s = [lb / s if np.isfinite(lb) else lb for lb, (_, s) in zip(aux_lb, aux, strict=True)]
     aux_ub_s = [ub / s if np.isfinite(ub) else ub for ub, (_, s) in zip(aux_ub, aux, strict=True)]
-    aux_init = ca.Function("aux_init", [zd], [ca.vertcat(*aux_start)]) if aux_start else None
+    aux_init = ca.Function("aux_init", [zd, theta], [ca.vertcat(*aux_start)]) if aux_start else None
     # Common subexpression elimination: the blocks share the mechanism's subexpressions
     # (model functions return shared nodes, but derived rows repeat arithmetic).
     f_out, g_all, *value_list = ca.cse([ca.SX(f_raw), g_all, *(ca.SX(v) for v in values.values())])
@@ -422,7 +454,7 @@ def build_nlp(
         z=z,
         f=f_out,
         g=g_all,
-        p=p,
+        p=ca.vertcat(w, theta),
         lbz=np.concatenate([np.zeros(n), aux_lb_s]),
         ubz=np.concatenate([np.ones(n), aux_ub_s]),
         lbg=np.array(rows.lbg),
@@ -443,4 +475,6 @@ def build_nlp(
         form=form,
         aux_init=aux_init,
         limits={k: float(v) for k, v in limits.items()},
+        param_names=list(defaults),
+        param_defaults=np.array(list(defaults.values()), dtype=float),
     )

@@ -217,6 +217,10 @@ def build_robust_nlp(
     zd = base.z[:n]
     x = base.x_lo + base.x_span * zd
     design = problem.design_dict([x[j] for j in range(n)])
+    theta = base.theta
+    design.update(
+        problem.parameter_design(dict(zip(base.param_names, ca.vertsplit(theta), strict=True)))
+    )
 
     # Magnitudes at the start design (NumPy path): rows are divided by the size of the
     # objective's grid expression, the per-sample values by the objective's value.
@@ -316,19 +320,19 @@ def build_robust_nlp(
     z = ca.vertcat(base.z, z_aux)
     init_parts = []
     if n_base_aux:
-        init_parts.append(base.aux_init(zd))
+        init_parts.append(base.aux_init(zd, theta))
     init_parts.append(ca.vertcat(*aux_init))
-    aux_init_fun = ca.Function("robust_aux_init", [zd], [ca.vertcat(*init_parts)])
+    aux_init_fun = ca.Function("robust_aux_init", [zd, theta], [ca.vertcat(*init_parts)])
     label = risk_label(risk, alpha, k, objective)
     g = ca.vertcat(base.g, *rows.exprs)
     nominal_name = f"{objective} (nominal)"
     nominal_scale = typical(numeric_value(start_term))
-    p = ca.SX.sym("p", 2)
+    w = ca.SX.sym("w", 2)
     return NLP(
         z=z,
-        f=p[0] * f * v_scale + p[1] * nominal_value,
+        f=w[0] * f * v_scale + w[1] * nominal_value,
         g=g,
-        p=p,
+        p=ca.vertcat(w, theta),
         lbz=np.concatenate([base.lbz, aux_lb]),
         ubz=np.concatenate([base.ubz, aux_ub]),
         lbg=np.concatenate([base.lbg, rows.lbg]),
@@ -348,6 +352,8 @@ def build_robust_nlp(
         default_target=label,
         form="robust-saa",
         aux_init=aux_init_fun,
+        param_names=base.param_names,
+        param_defaults=base.param_defaults,
         extra={
             "objective": objective,
             "risk": risk,

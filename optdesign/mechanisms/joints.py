@@ -18,9 +18,20 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import InputError
+from optdesign.models import pin_contact
 from optdesign.models._checks import require_positive
-from optdesign.models.clearance import pin_joint_clearance, root_sum_square, worst_case
+from optdesign.models.clearance import root_sum_square, worst_case
 from optdesign.models.fits import Fit
+from optdesign.models.hertz_line import (
+    contact_half_width,
+    pin_flattening,
+    pin_flattening_first_order,
+)
+
+
+def _numeric(value) -> bool:
+    """A plain number or NumPy array (not a CasADi symbol nor a GP tracer)."""
+    return not m.is_symbolic(value) and np.asarray(value).dtype.kind in "fiu"
 
 
 @dataclass(frozen=True)
@@ -45,6 +56,14 @@ class PinJoint:
         Use the first-order flattening b^2/D (the GP form).
     extra
         Clearance added to the fit's (mm), e.g. a sampled share of the fit's band.
+    contact
+        ``"duan2017"``: seed 000 eq. 10-11, a cylinder on a flat (``surfaces`` x Delta);
+        ``"conforming"``: the pin in its bore with the fit's clearance
+        (:mod:`optdesign.models.pin_contact`), the elastic approach of the pair.
+    values
+        ISO 286 values: ``"smooth"`` (the formulas at D) or ``"table"`` (as ISO 286-2
+        prints them; a symbolic D takes the smooth value times ``ratio_max`` /
+        ``ratio_min``, the table's ratio that the catalogue search sets per solve).
     """
 
     d: Any
@@ -56,6 +75,10 @@ class PinJoint:
     surfaces: int = 2
     first_order: bool = False
     extra: Any = 0.0
+    contact: str = "duan2017"
+    values: str = "smooth"
+    ratio_max: Any = 1.0
+    ratio_min: Any = 1.0
 
     def __post_init__(self):
         require_positive("pin.d", self.d)
@@ -64,6 +87,8 @@ class PinJoint:
         if not m.is_symbolic(self.nu) and not 0.0 < float(self.nu) < 0.5:
             raise InputError("pin.nu", f"Poisson ratio must lie in (0, 0.5), got {self.nu!r}")
         Fit.parse(self.fit, "pin.fit")
+        if self.contact not in ("duan2017", "conforming"):
+            raise InputError("pin.contact", f"{self.contact!r}: use 'duan2017' or 'conforming'")
 
     @staticmethod
     @cache
@@ -71,24 +96,48 @@ class PinJoint:
         """A pin that marks which joints a mechanism sizes (its values are never used)."""
         return PinJoint(1.0, 1.0)
 
+    def fit_clearance(self, which: str | None = None):
+        """Diametral clearance of the fit (mm), ``which`` = "max" or "min"."""
+        which = which or self.which
+        if self.values == "table" and _numeric(self.d):
+            from optdesign.fits import clearance
+
+            return clearance(self.fit, self.d, which, values="table")
+        ratio = self.ratio_max if which == "max" else self.ratio_min
+        return Fit.parse(self.fit).clearance(self.d, which) * ratio
+
     def clearance(self, F):
-        """Effective clearance (mm) under normal force F (N)."""
-        return self.extra + pin_joint_clearance(
-            self.d,
-            F,
-            self.L,
-            self.E,
-            self.nu,
-            self.fit,
-            self.which,
-            self.surfaces,
-            self.first_order,
-        )
+        """Effective clearance (mm) under normal force F (N): the fit's, plus the contact
+        deformation of the chosen model."""
+        c = self.fit_clearance()
+        if self.contact == "conforming":
+            approach = pin_contact.approach(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
+            return self.extra + c + approach
+        flat = pin_flattening_first_order if self.first_order else pin_flattening
+        return self.extra + c + self.surfaces * flat(self.d, F, self.L, self.E, self.nu)
+
+    def contact_stiffness(self, F):
+        """dF/d(clearance) of the loaded pin (N/mm): how the joint yields under its load."""
+        if self.contact == "conforming":
+            c = self.fit_clearance()
+            return pin_contact.contact_stiffness(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
+        # Delta = D/2 - sqrt(D^2/4 - k F) (eq. 11): dDelta/dF = k / (2 sqrt(D^2/4 - k F))
+        k = 4.0 * self.d * (1.0 - self.nu**2) / (np.pi * self.E * self.L)
+        root = m.sqrt_domain(0.25 * self.d**2 - k * F)
+        return 2.0 * root / (self.surfaces * k)
+
+    def contact_pressure(self, F):
+        """Largest contact pressure (MPa) under F: Hertz line contact (eq. 10) or the
+        conforming solution."""
+        if self.contact == "conforming":
+            c = self.fit_clearance()
+            return pin_contact.max_pressure(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
+        b = contact_half_width(self.d, F, self.L, self.E, self.nu)
+        return 2.0 * F / (np.pi * b * self.L)
 
     def fit_band(self):
         """(smallest, largest) fit clearance (mm) of this pin's diameter."""
-        f = Fit.parse(self.fit)
-        return f.clearance(self.d, "min"), f.clearance(self.d, "max")
+        return self.fit_clearance("min"), self.fit_clearance("max")
 
 
 @dataclass(frozen=True)

@@ -53,9 +53,21 @@ from optdesign.models import iso286
 
 #: IT grade -> multiple of the tolerance unit i.
 IT_FACTORS: dict[int, float] = {
-    5: 7.0, 6: 10.0, 7: 16.0, 8: 25.0, 9: 40.0, 10: 64.0, 11: 100.0,
-    12: 160.0, 13: 250.0, 14: 400.0, 15: 640.0, 16: 1000.0, 17: 1600.0, 18: 2500.0,
-}  # fmt: skip
+    5: 7.0,
+    6: 10.0,
+    7: 16.0,
+    8: 25.0,
+    9: 40.0,
+    10: 64.0,
+    11: 100.0,
+    12: 160.0,
+    13: 250.0,
+    14: 400.0,
+    15: 640.0,
+    16: 1000.0,
+    17: 1600.0,
+    18: 2500.0,
+}
 
 #: Shaft letter -> (coefficient, exponent) of the upper deviation es = coef * D^exp (um).
 SHAFT_DEVIATIONS: dict[str, tuple[float, float]] = {

@@ -87,8 +87,33 @@ from optdesign.errors import InputError
 MAX_SIZE = 500.0
 
 #: Upper limits (mm) of the 25 size steps of the fundamental-deviation tables.
-STEPS = (3, 6, 10, 14, 18, 24, 30, 40, 50, 65, 80, 100, 120,
-         140, 160, 180, 200, 225, 250, 280, 315, 355, 400, 450, 500)  # fmt: skip
+STEPS = (
+    3,
+    6,
+    10,
+    14,
+    18,
+    24,
+    30,
+    40,
+    50,
+    65,
+    80,
+    100,
+    120,
+    140,
+    160,
+    180,
+    200,
+    225,
+    250,
+    280,
+    315,
+    355,
+    400,
+    450,
+    500,
+)
 
 #: Upper limits (mm) of the 13 main size steps of the IT table.
 MAIN_STEPS = (3, 6, 10, 18, 30, 50, 80, 120, 180, 250, 315, 400, 500)

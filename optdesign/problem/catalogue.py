@@ -120,6 +120,38 @@ class ConstraintBlock:
     display_unit: str = ""
 
 
+def _drive_loss(q):
+    return 1.0 - q.drive_efficiency
+
+
+def _screw_mass(q):
+    """Screw shaft mass (solid steel of d0 over the support length), kg. The nut is left
+    out: the catalogue prints the masses of some nuts only."""
+    from optdesign.models.screw_sizing import shaft_mass
+
+    screw, data = q.problem.spec.screw, q.screw
+    if screw is None or screw.length is None or data is None or data.d0 is None:
+        return None
+    return shaft_mass(data.d0, screw.length)
+
+
+def _motor_inertia(q):
+    """Screw shaft inertia reflected to the motor shaft through the gear, kg*mm^2."""
+    from optdesign.models.screw_sizing import reflected_inertia, shaft_inertia
+
+    screw, data = q.problem.spec.screw, q.screw
+    if screw is None or screw.length is None or data is None or data.d0 is None:
+        return None
+    return reflected_inertia(shaft_inertia(data.d0, screw.length), 0.0, data.p, q.mechanism.i_a)
+
+
+def _hinge_compliance(q):
+    screw = q.problem.spec.screw
+    if screw is None or (screw.bearing_stiffness is None and screw.nut_offset is None):
+        return None
+    return q.output_compliance
+
+
 def _backlash(q):
     return None if q.pin is None else q.backlash.worst_case
 
@@ -183,6 +215,44 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "max of F_nut p / (2 pi i_a eta_screw eta_gear)",
             display_unit="N*m",
             display_scale=1e-3,
+        ),
+        ObjectiveInfo(
+            "drive_loss",
+            _drive_loss,
+            "scalar",
+            "",
+            "power lost in the drive",
+            "1 - forward efficiency of screw x gear",
+            display_unit="%",
+            display_scale=100.0,
+        ),
+        ObjectiveInfo(
+            "screw_mass",
+            _screw_mass,
+            "scalar",
+            "kg",
+            "mass of the screw shaft",
+            "solid steel shaft of d0 over the support length",
+        ),
+        ObjectiveInfo(
+            "motor_inertia",
+            _motor_inertia,
+            "scalar",
+            "kg*mm^2",
+            "screw inertia at the motor shaft",
+            "J_screw / i_a^2, J_screw of a solid steel shaft of d0 over the support length",
+            display_unit="kg*cm^2",
+            display_scale=1e-2,
+        ),
+        ObjectiveInfo(
+            "hinge_compliance",
+            _hinge_compliance,
+            "max",
+            "rad/(N*mm)",
+            "largest compliance at the output over the stroke (1/stiffness)",
+            "sum over the chain of (sensitivity^2 / member stiffness)",
+            display_unit="urad/(N*m)",
+            display_scale=1e9,
         ),
         ObjectiveInfo(
             "lock_force",

@@ -20,6 +20,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
+from optdesign.problem import drive
 from optdesign.problem.catalogue import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
@@ -353,6 +354,20 @@ class DesignProblem:
     ) -> Quantities:
         """The quantities of ``design`` (computed lazily)."""
         return Quantities(self, design, guarded, first_order, fit_fractions)
+
+    def parameters(self) -> dict[str, float]:
+        """The problem's parameters (values fixed per solve on the solver path: catalogue
+        item data, table-fit ratios) and their defaults; see :mod:`optdesign.problem.drive`."""
+        return drive.parameter_defaults(self)
+
+    def parameter_values(self, box: Mapping[str, tuple[float, float]]) -> dict[str, float]:
+        """Parameter values of a solve whose discrete variables lie in ``box``."""
+        return drive.parameter_values(self, dict(box))
+
+    @staticmethod
+    def parameter_design(values: Mapping[str, Any]) -> dict[str, Any]:
+        """Design-dict entries that carry parameter values (symbols on the solver path)."""
+        return {drive.PARAM + k: v for k, v in values.items()}
 
     def objective_limits(self) -> dict[str, float]:
         """Upper limits that the requirements put on objective quantities."""

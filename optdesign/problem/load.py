@@ -90,7 +90,7 @@ def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignPr
                 f"variables.{var_name}: unknown variable for a {cls.label()} "
                 f"(known: {', '.join(table)})"
             )
-        variables.append(parse_variable(var_name, raw, table[var_name], cls.name))
+        variables.append(parse_variable(var_name, raw, table[var_name], cls.name, spec.screw))
     declared = {v.name for v in variables}
     if spec.tolerances is not None:
         for var_name in spec.tolerances.variables():

@@ -26,6 +26,7 @@ from optdesign.mechanisms.joints import (
     with_fixed_clearances,
     with_sampled_fits,
 )
+from optdesign.problem import drive
 
 if TYPE_CHECKING:
     from optdesign.problem.design_problem import DesignProblem
@@ -69,7 +70,7 @@ class Quantities:
 
     def __getattr__(self, item: str) -> Any:
         design = self.__dict__.get("design")
-        if design is not None and item in design:
+        if design is not None and item in design and not item.startswith(drive.PARAM):
             return design[item]
         raise AttributeError(
             f"no quantity or variable {item!r} (variables: {', '.join(design or {})}; "
@@ -112,9 +113,56 @@ class Quantities:
 
     @cached_property
     def motor_torque(self):
-        """Motor torque over the grid (N*mm), with the requirements' efficiencies."""
-        req = self.requirements
-        return self.mechanism.motor_torque(self.phi, self.hinge_moment, req.eta_screw, req.eta_gear)
+        """Motor torque over the grid (N*mm) through the forward efficiencies of the screw
+        and the gear."""
+        gear, _ = drive.gear_efficiencies(self.problem.spec)
+        return self.mechanism.motor_torque(self.phi, self.hinge_moment, self.efficiency, gear)
+
+    # --- the drive (screw, efficiency, speed, life, stiffness) ---------------------------
+    @cached_property
+    def screw(self) -> drive.ScrewData | None:
+        """The screw: lead, mean and root diameters, catalogue ratings (or None)."""
+        return drive.screw_data(self)
+
+    @cached_property
+    def efficiencies(self):
+        return drive.efficiencies(self)
+
+    @property
+    def efficiency(self):
+        """Forward efficiency of the screw (the model of ``[screw]``, else eta_screw)."""
+        return self.efficiencies[0]
+
+    @property
+    def efficiency_back(self):
+        """Back-driving efficiency of the screw (<= 0: self-locking)."""
+        return self.efficiencies[1]
+
+    @cached_property
+    def drive_efficiency(self):
+        """Forward efficiency of screw and gear together."""
+        gear, _ = drive.gear_efficiencies(self.problem.spec)
+        return self.efficiency * gear
+
+    @cached_property
+    def screw_speed(self):
+        """Screw speed (1/min) over the grid at the required deflection rate."""
+        return drive.screw_speed(self)
+
+    @cached_property
+    def life_hours(self):
+        """Rated life (h) of the screw over the duty cycle (ISO 3408-5 L10)."""
+        return drive.life_hours(self)
+
+    @cached_property
+    def output_compliance(self):
+        """Compliance at the output over the grid (rad/(N*mm))."""
+        return drive.output_compliance(self)
+
+    @cached_property
+    def output_stiffness(self):
+        """Stiffness at the output over the grid (N*mm/rad)."""
+        return 1.0 / self.output_compliance
 
     @cached_property
     def size(self):
@@ -131,7 +179,26 @@ class Quantities:
         L = d["pin_length"] if "pin_length" in d else d["pin_length_ratio"] * d["d"]
         mat = self.problem.spec.materials.pin
         req = self.requirements
-        return PinJoint(d["d"], L, req.fit, req.fit_clearance, mat.E, mat.nu, 2, self.first_order)
+        values = drive.fit_values(self.problem)
+        ratios = {}
+        if values == "table" and drive.PARAM + "fit_ratio_max" in d:
+            ratios = {
+                "ratio_max": d[drive.PARAM + "fit_ratio_max"],
+                "ratio_min": d[drive.PARAM + "fit_ratio_min"],
+            }
+        return PinJoint(
+            d["d"],
+            L,
+            req.fit,
+            req.fit_clearance,
+            mat.E,
+            mat.nu,
+            2,
+            self.first_order,
+            contact=req.pin_contact,
+            values=values,
+            **ratios,
+        )
 
     @cached_property
     def pin_force(self):
@@ -168,8 +235,13 @@ class Quantities:
             lock = FrictionPlateLock(lk.r1, lk.r2, lk.mu)
         else:
             lock = PinLock(lk.radius, bearing="guide" if lk.kind == "pin_rolling" else None)
+        if self.problem.spec.screw is not None:
+            _, gear_back = drive.gear_efficiencies(self.problem.spec)
+            eta_back = self.efficiency_back
+        else:
+            eta_back, gear_back = lk.eta_screw_back, lk.eta_gear_back
         load = motor_shaft_lock_load(
-            self.mechanism, self.phi, self.hinge_moment, lk.eta_screw_back, lk.eta_gear_back
+            self.mechanism, self.phi, self.hinge_moment, eta_back, gear_back
         )
         return lock.force(load.moment)
 

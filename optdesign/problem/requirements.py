@@ -18,6 +18,7 @@ from optdesign.errors import ProblemError
 from optdesign.mechanisms.base import Rows
 from optdesign.models.loads import pin_bearing_pressure, pin_shear_stress
 from optdesign.problem.catalogue import ConstraintBlock, ConstraintInfo
+from optdesign.problem.drive_requirements import drive_blocks
 
 
 def _block(rows: Rows, labels: list[str]) -> ConstraintBlock:
@@ -77,6 +78,7 @@ def requirement_blocks(
         blocks += _pin_blocks(q, labels, backlash)
     if req.screw is not None:
         blocks += _screw_blocks(q, labels)
+    blocks += drive_blocks(q, labels)
     if req.lock is not None and req.lock.force_max is not None:
         blocks.append(
             ConstraintBlock(
@@ -137,6 +139,18 @@ def _pin_blocks(q, labels, backlash) -> list[ConstraintBlock]:
                     f"pin shear stress ({'double' if planes == 2 else 'single'} shear)",
                 )
             )
+    if req.pin_contact_pressure_max is not None:
+        out.append(
+            ConstraintBlock(
+                "pin_contact_pressure",
+                pin.contact_pressure(m.fabs(q.pin_force)),
+                None,
+                req.pin_contact_pressure_max,
+                labels,
+                "MPa",
+                f"largest contact pressure of the pin ({req.pin_contact} model)",
+            )
+        )
     if req.backlash_max is not None:
         out.append(
             ConstraintBlock(

@@ -46,6 +46,10 @@ Moment = Annotated[float, _quantity("moment")]
 Pressure = Annotated[float, _quantity("pressure")]
 Force = Annotated[float, _quantity("force")]
 Dimensionless = Annotated[float, _quantity("dimensionless")]
+Stiffness = Annotated[float, _quantity("stiffness")]
+RotationalStiffness = Annotated[float, _quantity("rotational_stiffness")]
+AngularSpeed = Annotated[float, _quantity("angular_speed")]
+Time = Annotated[float, _quantity("time")]
 
 #: dimension name -> annotated type of a parsed quantity.
 QUANTITY_TYPES: dict[str, Any] = {
@@ -154,6 +158,54 @@ class ScrewSizing(_Model):
         return self
 
 
+class Screw(_Model):
+    """The drive's screw: its type and friction (efficiency), where its size comes from,
+    its mounting, and the stiffness of the parts a model cannot size.
+
+    ``catalogue``: the screw is a catalogue item - declare ``d0`` and ``p`` with
+    ``catalogue = "HIWIN"`` (their values are the catalogue's diameters and leads, and only
+    the pairs it lists exist); the item gives root diameter, load ratings and nut
+    stiffness. Without it, a declared ``d0`` is a continuous nominal (mean) diameter with a
+    root diameter ``root_ratio * d0``.
+    """
+
+    kind: Literal["ball", "roller", "sliding", "trapezoidal", "acme"] = "ball"
+    friction: float | None = Field(None, ge=0.0, lt=1.0)
+    catalogue: Literal["HIWIN"] | None = None
+    nut: Literal["FSI", "FSC"] | None = None
+    root_ratio: float = Field(0.83, gt=0.0, lt=1.0)
+    mounting: Literal["fixed-free", "supported-supported", "fixed-supported", "fixed-fixed"] = (
+        "fixed-supported"
+    )
+    length: Length | None = None
+    nut_offset: Length | None = None
+    nut_stiffness: Stiffness | None = None
+    bearing_stiffness: Stiffness | None = None
+    gear_efficiency: float = Field(1.0, gt=0.0, le=1.0)
+    gear_back_efficiency: float = Field(1.0, gt=0.0, le=1.0)
+    check_buckling: bool = True
+    check_yield: bool = True
+
+    @model_validator(mode="after")
+    def _positive(self):
+        for name in ("length", "nut_offset", "nut_stiffness", "bearing_stiffness"):
+            value = getattr(self, name)
+            if value is not None and not value > 0:
+                raise ValueError(f"{name} must be positive, got {value:g}")
+        if self.nut is not None and self.catalogue is None:
+            raise ValueError("nut selects a catalogue nut type: give catalogue too")
+        return self
+
+
+class DutyStep(_Model):
+    """One step of a duty cycle: a deflection held under a hinge moment for a share of
+    the time (the speed comes from ``deflection_rate``)."""
+
+    deflection: Angle
+    hinge_moment: Moment
+    time: float = Field(gt=0.0)
+
+
 class MotorLock(_Model):
     """Power-off lock on the motor shaft (seed 002): what it must hold and its force."""
 
@@ -200,6 +252,32 @@ class Requirements(_Model):
     fit_clearance: Literal["min", "max"] = "max"
     screw: ScrewSizing | None = None
     lock: MotorLock | None = None
+    fit_values: Literal["table", "smooth"] | None = None
+    pin_contact: Literal["duan2017", "conforming"] = "duan2017"
+    pin_contact_pressure_max: Pressure | None = None
+    efficiency_min: float | None = Field(None, gt=0.0, le=1.0)
+    back_drive: Literal["required", "forbidden"] | None = None
+    deflection_rate: AngularSpeed | None = None
+    critical_speed: bool = False
+    dn_max: float | Literal["rolled", "peeled", "ground", "high-speed"] | None = None
+    static_safety_min: float | None = Field(None, ge=1.0)
+    life_min: Time | None = None
+    duty_cycle: list[DutyStep] | None = None
+    f_w: float = Field(1.0, ge=1.0, le=3.0)
+    stiffness_min: RotationalStiffness | None = None
+
+    @model_validator(mode="after")
+    def _drive_rules(self):
+        if self.life_min is not None and not self.duty_cycle:
+            raise ValueError("life_min needs a duty_cycle (deflection, hinge_moment, time)")
+        if (self.life_min is not None or self.critical_speed or self.dn_max is not None) and (
+            self.deflection_rate is None
+        ):
+            raise ValueError(
+                "life_min, critical_speed and dn_max need the screw's speed: give "
+                'deflection_rate (e.g. "60 deg/s")'
+            )
+        return self
 
     @field_validator("fit")
     @classmethod
@@ -317,6 +395,7 @@ class ProblemSpec(_Model):
     solver: SolverOptions = SolverOptions()
     tolerances: Tolerances | None = None
     reference: Reference | None = None
+    screw: Screw | None = None
 
 
 def _requirement_field(info) -> tuple[Any, Any]:

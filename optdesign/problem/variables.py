@@ -18,11 +18,12 @@ from optdesign.errors import InputError, ProblemError
 from optdesign.mechanisms.base import VariableInfo
 from optdesign.units import to_internal
 
-#: Variables of the sized pin joints, the same for every mechanism.
+#: Variables of the sized pin joints and of the screw's size, the same for every mechanism.
 PIN_VARIABLES: dict[str, VariableInfo] = {
     "d": VariableInfo("length", "pin diameter"),
     "pin_length": VariableInfo("length", "pin length L"),
     "pin_length_ratio": VariableInfo("dimensionless", "pin length ratio L/d"),
+    "d0": VariableInfo("length", "screw nominal (mean) diameter"),
 }
 
 #: Internal unit of each variable dimension (for tables).
@@ -82,7 +83,24 @@ class Variable:
         return self.values is not None
 
 
-def parse_variable(name: str, raw: Any, info: VariableInfo, mechanism: str) -> Variable:
+def catalogue_items(catalogue: str, variable: str, field: str, screw=None) -> list[float]:
+    """The values catalogue ``catalogue`` gives ``variable``."""
+    if catalogue in CATALOGUES:
+        return list(CATALOGUES[catalogue])
+    if catalogue == "HIWIN":
+        from optdesign.problem.drive import catalogue_values
+
+        if screw is None or screw.catalogue != "HIWIN":
+            raise ProblemError(
+                f'{field}: a catalogue screw needs [screw] catalogue = "HIWIN" (its d0 and p '
+                "are pairs of one catalogue item)"
+            )
+        return list(catalogue_values(catalogue, variable, screw.nut))
+    known = ", ".join([*CATALOGUES, "HIWIN"])
+    raise ProblemError(f"{field}: unknown catalogue {catalogue!r} (known: {known})")
+
+
+def parse_variable(name: str, raw: Any, info: VariableInfo, mechanism: str, screw=None) -> Variable:
     """Validate the ``[variables]`` entry ``name`` of a problem of ``mechanism``."""
     field = f"variables.{name}"
     unit = UNITS[info.dimension]
@@ -127,12 +145,7 @@ def parse_variable(name: str, raw: Any, info: VariableInfo, mechanism: str) -> V
                 raise ProblemError(f"{field}.values: must be a non-empty list")
             values = [q(v, f"values[{k}]") for k, v in enumerate(raw["values"])]
         else:
-            cat = raw["catalogue"]
-            if cat not in CATALOGUES:
-                raise ProblemError(
-                    f"{field}.catalogue: unknown catalogue {cat!r} (known: {', '.join(CATALOGUES)})"
-                )
-            values = list(CATALOGUES[cat])
+            values = catalogue_items(raw["catalogue"], name, f"{field}.catalogue", screw)
         if lower is not None:
             values = [v for v in values if v >= lower - 1e-12]
         if upper is not None:

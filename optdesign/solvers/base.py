@@ -99,7 +99,8 @@ def make_result(
     of a stopped solve (iterations, time) that violates nothing is a feasible solution.
     """
     z = np.asarray(z, dtype=float).ravel()
-    g = np.asarray(nlp.g_fun(z), dtype=float).ravel()
+    theta = nlp.parameter_values(bounds.parameters)
+    g = np.asarray(nlp.g_fun(z, theta), dtype=float).ravel()
     violated, active = constraint_reports(nlp, g, bounds)
     max_viol = max(
         (r.amount / max(1.0, abs(r.upper if r.upper is not None else r.lower)) for r in violated),
@@ -115,7 +116,7 @@ def make_result(
         sol_status = SolutionStatus.FEASIBLE
     else:
         sol_status = SolutionStatus.INFEASIBLE if violated else SolutionStatus.NO_SOLUTION
-    values = np.asarray(nlp.values_fun(z), dtype=float).ravel()
+    values = np.asarray(nlp.values_fun(z, theta), dtype=float).ravel()
     n_obj = len(nlp.objective_values)
     x = nlp.x_from_z(z)
     return Result(
@@ -167,6 +168,7 @@ def resolve(
     nlp: NLP, start: Start | Any, target, bounds: Bounds | None
 ) -> tuple[Start, Target, Bounds]:
     """Normalise the arguments of a solve (a design vector is accepted as the start)."""
+    bounds = bounds if bounds is not None else nlp.bounds()
     if not isinstance(start, Start):
-        start = nlp.start(x0=start)
-    return start, nlp.target(target), bounds if bounds is not None else nlp.bounds()
+        start = nlp.start(x0=start, parameters=bounds.parameters)
+    return start, nlp.target(target), bounds

@@ -87,7 +87,7 @@ class CasadiNLPSolver:
         start, target, bounds = resolve(nlp, start, target, bounds)
         args: dict[str, Any] = {
             "x0": start.z0,
-            "p": nlp.params(target),
+            "p": nlp.params(target, bounds.parameters),
             "lbx": bounds.lbz,
             "ubx": bounds.ubz,
             "lbg": bounds.lbg,

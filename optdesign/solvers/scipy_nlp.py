@@ -91,14 +91,14 @@ class ScipyNLPSolver:
         self.time_limit = time_limit
         z, p, f, g = nlp.z, nlp.p, nlp.f, nlp.g
         self.f_fun = ca.Function("f", [z, p], [f])
-        self.g_fun = ca.Function("g", [z], [g])
+        self.g_fun = ca.Function("g", [z, p], [g])
         if derivatives == "exact":
             self.fgj_fun = ca.Function("fgj", [z, p], [f, ca.gradient(f, z), g, ca.jacobian(g, z)])
             if method == "trust-constr":
                 lam = ca.SX.sym("lam", g.shape[0])
                 self.hess_f_fun = ca.Function("hess_f", [z, p], [ca.hessian(f, z)[0]])
                 self.hess_g_fun = ca.Function(
-                    "hess_g", [z, lam], [ca.hessian(ca.dot(lam, g), z)[0]]
+                    "hess_g", [z, p, lam], [ca.hessian(ca.dot(lam, g), z)[0]]
                 )
         self.n_evals: dict[str, int] = {}
         # One-point caches: the exact (f, grad f, g, jac g) and, with finite differences,
@@ -134,7 +134,7 @@ class ScipyNLPSolver:
             )
             self.n_evals["fgj"] = self.n_evals.get("fgj", 0) + 1
         else:
-            val = np.asarray(self.g_fun(z), dtype=float).ravel()
+            val = np.asarray(self.g_fun(z, self._p), dtype=float).ravel()
         self._cache[kind] = (key, val)
         return val
 
@@ -165,7 +165,7 @@ class ScipyNLPSolver:
 
     def _hess_g(self, z, v):
         self._tick("hess_g", z)
-        return np.asarray(ca.densify(self.hess_g_fun(z, v)), dtype=float)
+        return np.asarray(ca.densify(self.hess_g_fun(z, self._p, v)), dtype=float)
 
     @staticmethod
     def _split_rows(lb: np.ndarray, ub: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -219,7 +219,7 @@ class ScipyNLPSolver:
         """
         nlp = self.nlp
         start, target, bounds = resolve(nlp, start, target, bounds)
-        self._p = nlp.params(target)
+        self._p = nlp.params(target, bounds.parameters)
         self._cache = {}
         lbz, ubz = np.asarray(bounds.lbz, dtype=float), np.asarray(bounds.ubz, dtype=float)
         lb, ub = np.asarray(bounds.lbg, dtype=float), np.asarray(bounds.ubg, dtype=float)

@@ -20,6 +20,7 @@ import itertools
 import math
 import time
 from collections.abc import Mapping
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -33,6 +34,7 @@ from optdesign.formulations.discrete import (
     nearest_item,
 )
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.drive import box_has_item
 from optdesign.solvers.multistart import best_of, sobol_starts
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.solve import _objective_set, finish, solver_for
@@ -44,7 +46,7 @@ PRUNE_TOL = 1e-6
 
 
 #: Sobol starts a node tries before it is called infeasible, when its own starts fail.
-RETRY_STARTS = 8
+RETRY_STARTS = 4
 
 
 class NodeSolver:
@@ -64,10 +66,14 @@ class NodeSolver:
         seed: int = 0,
         plugin: str = "ipopt",
         options: Mapping[str, Any] | None = None,
+        eps: Mapping[str, float] | None = None,
     ):
         self.problem = problem
         self.objective = objective or problem.objective_names[0]
-        self.backend = solver_for(problem, plugin, options, _objective_set(problem, self.objective))
+        self.eps = dict(eps or {})
+        names = _objective_set(problem, self.objective)
+        names = tuple(dict.fromkeys([*names, *sorted(self.eps)]))
+        self.backend = solver_for(problem, plugin, options, names)
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
         self.starts = max(1, starts)
@@ -82,15 +88,31 @@ class NodeSolver:
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
             lo[k], hi[k] = a, b
-        box = self.nlp.bounds(box=bounds)
+        node = {
+            v.name: bounds.get(v.name, (v.lower, v.upper)) for v in discrete_variables(self.problem)
+        }
+        if not box_has_item(self.problem, node):
+            # e.g. a (d0, p) box that holds no screw of the catalogue: nothing to solve
+            return Result(
+                "infeasible",
+                float("nan"),
+                {},
+                self.backend.name,
+                "catalogue",
+                0.0,
+                message="no catalogue item in this box",
+            )
+        params = self.problem.parameter_values(node)
+        box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
         first = self.problem.start() if x_hint is None else np.asarray(x_hint, dtype=float)
         pts = [np.clip(first, lo, hi)]
         if self.starts > 1:
             pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
-        results = [self.backend.solve(p, self.target, box) for p in pts]
+        start = partial(self.nlp.start, parameters=box.parameters)
+        results = [self.backend.solve(start(x0=p), self.target, box) for p in pts]
         if not any(r.success for r in results):
             retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
-            results += [self.backend.solve(p, self.target, box) for p in retry]
+            results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
         self.n_solves += len(results)
         best, n_at_best = best_of(results)
         best.multistart = MultistartInfo(
@@ -195,6 +217,7 @@ def solve_catalogue(
     objective: str | None = None,
     plugin: str = "ipopt",
     options: Mapping[str, Any] | None = None,
+    eps: Mapping[str, float] | None = None,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -206,6 +229,9 @@ def solve_catalogue(
     starts, seed
         Multistart of each node NLP (default: the problem file's ``solver``; ``starts``
         at most 4 per node, the first start being the parent's optimum).
+    eps
+        Upper limits on other objectives (name -> limit): a point of an
+        epsilon-constraint front over catalogue designs.
 
     Returns
     -------
@@ -228,7 +254,7 @@ def solve_catalogue(
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate or bnb")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
-    ns = NodeSolver(problem, objective, n_starts, seed, plugin, options)
+    ns = NodeSolver(problem, objective, n_starts, seed, plugin, options, eps)
     root = ns.solve({})
     info: dict[str, Any] = {
         "method": method,

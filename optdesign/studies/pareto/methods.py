@@ -29,6 +29,7 @@ import numpy as np
 
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, has_catalogue
 from optdesign.studies.pareto.chains import (
     TwoChains,
     anchor_tasks,
@@ -137,6 +138,12 @@ class EpsilonConstraint:
 
     def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
         objectives = check_objectives(problem, objectives)
+        if has_catalogue(problem):
+            raise InputError(
+                "method",
+                "continuous sweeps would leave the catalogue: use CatalogueEpsilon (or "
+                "method='epsilon', which picks it)",
+            )
         if self.spacing not in ("arc", "uniform"):
             raise InputError("spacing", f"{self.spacing!r}: use 'arc' or 'uniform'")
         n_points = len(self.eps_values) if self.eps_values is not None else self.points
@@ -424,6 +431,16 @@ def compute_front(
     run = RunOptions(**{k: options.pop(k) for k in _RUN_FIELDS if k in options})
     if run.workers < 1:
         raise InputError("workers", f"need at least 1 worker, got {run.workers}")
+    if isinstance(method, str) and has_catalogue(problem):
+        # every point a catalogue design: each one solved by the catalogue search
+        if method not in ("epsilon", "uniform"):
+            raise InputError(
+                "method",
+                f"{method!r} would leave the catalogue: with catalogue variables use 'epsilon'",
+            )
+        keep = {k: options[k] for k in ("starts", "seed") if k in options}
+        method = CatalogueEpsilon(points=options.get("points", points), **keep)
+        options = {}
     if isinstance(method, str):
         if method not in METHODS:
             raise InputError("method", f"unknown method {method!r} (known: {', '.join(METHODS)})")
@@ -444,6 +461,7 @@ __all__ = [
     "ANCHOR_SLACK",
     "METHODS",
     "NSGA2",
+    "CatalogueEpsilon",
     "EpsilonConstraint",
     "RunOptions",
     "WeightedSum",

@@ -1,0 +1,352 @@
+"""The drive of a design: the screw (catalogue item or continuous size), its efficiency
+forward and back, its speed, life, static safety, and the output stiffness of the chain.
+
+Mechanism-free: everything here reads the design's quantities (the nut velocity and force
+over the grid, the clearance chain's sensitivities) and the problem's ``[screw]`` section.
+
+**Screw data.** A catalogue screw (``[screw] catalogue = "HIWIN"``, ``d0`` and ``p`` declared
+with ``catalogue = "HIWIN"``) is the catalogue's (d0, p) pair with its strongest nut of the
+allowed type (highest dynamic rating, then static rating, then stiffness): root diameter
+d1, ratings Ca and C0a and the nut stiffness come from that row. On the NumPy path they
+are looked up from the design's d0 and p (a pair the catalogue lacks gives NaN: not a
+design); on the solver path they are the problem's *parameters*, set per solve by the
+catalogue search - the item's own values at a leaf, and at a relaxation node the most
+favourable values of the items in the node's box (largest d1, Ca, C0a, nut stiffness),
+which keeps the relaxation a valid bound. Without a catalogue, a
+declared ``d0`` is a continuous mean diameter with d1 = root_ratio d0; without ``d0`` the
+legacy ``requirements.screw.root_diameter`` gives d1.
+
+**Pins with ISO 286 table fits** use a parameter the same way: the table's clearance over
+the smooth formula's at the pin diameter (exact at a catalogue leaf, the smallest ratio of
+the node's items in a relaxation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+import numpy as np
+
+from optdesign import math as m
+from optdesign.errors import ProblemError
+from optdesign.models import screw_sizing as sizing
+from optdesign.models.screw_catalogue import BallScrew, load_ball_screws
+from optdesign.models.screw_efficiency import MU_BALL_DEFAULT, MU_SLIDING_DEFAULT, screw_efficiency
+from optdesign.models.stiffness import shaft_torsional_stiffness, torsion_to_axial
+
+#: Prefix of the design-dict keys that carry parameters on the solver path.
+PARAM = "param:"
+
+#: Screw item fields that are parameters, with the direction that is favourable for a
+#: relaxation (+1: the largest value of the node's items, -1: the smallest).
+SCREW_FIELDS = {"d1": +1, "Ca": +1, "C0a": +1, "K_nut": +1}
+
+
+@dataclass(frozen=True)
+class ScrewData:
+    """The screw of one design (values or expressions, mm, N, N/mm, kg).
+
+    ``on_catalogue``: 1 where the design's (d0, p) is a catalogue item, 0 where not
+    (NumPy path; None on the solver path, where the search solves items only).
+    """
+
+    d0: Any
+    p: Any
+    d_m: Any
+    d1: Any
+    Ca: Any = None
+    C0a: Any = None
+    K_nut: Any = None
+    on_catalogue: Any = None
+
+
+# --- catalogue ------------------------------------------------------------------------------
+@cache
+def catalogue_items(name: str, nut: str | None) -> dict[tuple[float, float], BallScrew]:
+    """(d0, p) -> the strongest nut of the allowed type, for catalogue ``name``."""
+    if name != "HIWIN":
+        raise ProblemError(f"screw.catalogue: unknown catalogue {name!r} (known: HIWIN)")
+    best: dict[tuple[float, float], BallScrew] = {}
+    for row in load_ball_screws():
+        if nut is not None and row.nut != nut:
+            continue
+        key = (row.d0, row.p)
+        old = best.get(key)
+        if old is None or (row.Ca, row.C0a, row.K_nut) > (old.Ca, old.C0a, old.K_nut):
+            best[key] = row
+    return best
+
+
+def catalogue_values(name: str, variable: str, nut: str | None = None) -> tuple[float, ...]:
+    """The values a catalogue gives variable ``d0`` or ``p``."""
+    items = catalogue_items(name, nut)
+    if variable == "d0":
+        return tuple(sorted({k[0] for k in items}))
+    if variable == "p":
+        return tuple(sorted({k[1] for k in items}))
+    raise ProblemError(f"variables.{variable}: the {name} screw catalogue gives d0 and p only")
+
+
+def _row_value(row: BallScrew | None, field: str) -> float:
+    if row is None:
+        return np.nan
+    value = getattr(row, field)
+    return np.nan if value is None else float(value)
+
+
+def _nearest(items, d0: float, p: float) -> tuple[BallScrew, bool]:
+    """The item (d0, p), or the nearest one and False when the catalogue lacks the pair."""
+    key = (float(np.round(d0, 9)), float(np.round(p, 9)))
+    if key in items:
+        return items[key], True
+    near = min(items, key=lambda k: abs(np.log(k[0] / d0)) + abs(np.log(k[1] / p)))
+    return items[near], False
+
+
+def _lookup(items, d0, p, fields) -> tuple[dict[str, Any], Any]:
+    """The items' ``fields`` on the NumPy path, element-wise, and where the design is an
+    item (1.0) or not (0.0): off the catalogue the nearest item's values stand in, so
+    that the other quantities stay finite, and the ``screw_catalogue`` block fails."""
+    d0, p = np.broadcast_arrays(np.asarray(d0, dtype=float), np.asarray(p, dtype=float))
+    out = {f: np.full(d0.shape, np.nan) for f in fields}
+    on = np.zeros(d0.shape)
+    for idx in np.ndindex(d0.shape):
+        if not (np.isfinite(d0[idx]) and np.isfinite(p[idx]) and d0[idx] > 0 and p[idx] > 0):
+            continue
+        row, exact = _nearest(items, float(d0[idx]), float(p[idx]))
+        on[idx] = float(exact)
+        for f in fields:
+            out[f][idx] = _row_value(row, f)
+    if not d0.ndim:
+        return {f: float(v) for f, v in out.items()}, float(on)
+    return out, on
+
+
+# --- parameters -----------------------------------------------------------------------------
+def fit_values(problem) -> str:
+    """``"table"`` or ``"smooth"``: the file's choice, else table for a catalogue pin."""
+    req = problem.spec.requirements
+    if req.fit_values is not None:
+        return req.fit_values
+    d = problem.by_name.get("d")
+    return "table" if d is not None and d.discrete else "smooth"
+
+
+def parameter_defaults(problem) -> dict[str, float]:
+    """The problem's parameters and their defaults (at the middle of the catalogues)."""
+    out: dict[str, float] = {}
+    if "d" in problem.by_name and fit_values(problem) == "table":
+        d = problem.by_name["d"]
+        if d.free and not d.discrete:
+            raise ProblemError(
+                "requirements.fit_values: table values need pin diameters from a catalogue "
+                '(d = { catalogue = "ISO 2338", ... }); use "smooth" for a continuous d'
+            )
+        out["fit_ratio_max"] = 1.0
+        out["fit_ratio_min"] = 1.0
+    screw = problem.spec.screw
+    if screw is not None and screw.catalogue is not None:
+        for field in SCREW_FIELDS:
+            out[f"screw_{field}"] = 1.0
+    return out
+
+
+def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, float]:
+    """Parameter values of a solve whose discrete variables lie in ``box`` (name ->
+    (lo, hi); fixed variables as (v, v)): exact for a single item, favourable over the
+    items of a wider box (a valid relaxation). Empty when the box holds no catalogue item."""
+    defaults = parameter_defaults(problem)
+    values: dict[str, float] = {}
+    if "fit_ratio_max" in defaults:
+        values.update(_fit_ratios(problem, box))
+    if "screw_d1" in defaults:
+        values.update(_screw_values(problem, box))
+    return values
+
+
+def _range(problem, name: str, box) -> tuple[float, float]:
+    v = problem.by_name[name]
+    if name in box:
+        return box[name]
+    return (v.value, v.value) if not v.free else (v.lower, v.upper)
+
+
+def _items_in(values, lo, hi) -> list[float]:
+    tol = 1e-9 * max(1.0, abs(hi))
+    return [v for v in values if lo - tol <= v <= hi + tol]
+
+
+def _fit_ratios(problem, box) -> dict[str, float]:
+    from optdesign.fits import clearance
+
+    d = problem.by_name["d"]
+    lo, hi = _range(problem, "d", box)
+    items = _items_in(d.values if d.discrete else (d.value,), lo, hi)
+    fit = problem.spec.requirements.fit
+    out = {}
+    for which in ("max", "min"):
+        ratios = []
+        for D in items:
+            smooth = float(clearance(fit, D, which, values="smooth"))
+            table = float(clearance(fit, D, which, values="table"))
+            ratios.append(table / smooth if smooth > 0 else 1.0)
+        out[f"fit_ratio_{which}"] = min(ratios) if ratios else 1.0
+    return out
+
+
+def _screw_values(problem, box) -> dict[str, float]:
+    screw = problem.spec.screw
+    items = catalogue_items(screw.catalogue, screw.nut)
+    d_lo, d_hi = _range(problem, "d0", box)
+    p_lo, p_hi = _range(problem, "p", box)
+    rows = [
+        r
+        for (d0, p), r in items.items()
+        if d_lo - 1e-9 <= d0 <= d_hi + 1e-9 and p_lo - 1e-9 <= p <= p_hi + 1e-9
+    ]
+    if not rows:
+        return {}
+    out = {}
+    for field, sign in SCREW_FIELDS.items():
+        vals = [_row_value(r, field) for r in rows]
+        vals = [v for v in vals if np.isfinite(v)] or [0.0]
+        out[f"screw_{field}"] = max(vals) if sign > 0 else min(vals)
+    return out
+
+
+def box_has_item(problem, box) -> bool:
+    """Whether a box of the discrete variables holds a catalogue screw (always True when
+    the screw is not a catalogue item)."""
+    screw = problem.spec.screw
+    if screw is None or screw.catalogue is None:
+        return True
+    return bool(_screw_values(problem, box))
+
+
+# --- screw data and efficiency ------------------------------------------------------------
+def screw_data(q) -> ScrewData | None:
+    """The screw of design ``q`` (None when the problem says nothing of the screw)."""
+    spec = q.problem.spec
+    screw, legacy = spec.screw, spec.requirements.screw
+    design = q.design
+    p = design["p"]
+    if screw is not None and screw.catalogue is not None:
+        d0 = design["d0"]
+        if PARAM + "screw_d1" in design:
+            vals = {f: design[PARAM + f"screw_{f}"] for f in SCREW_FIELDS}
+            return ScrewData(d0, p, d0, **vals)
+        items = catalogue_items(screw.catalogue, screw.nut)
+        vals, on = _lookup(items, d0, p, SCREW_FIELDS)
+        return ScrewData(d0, p, d0, **vals, on_catalogue=on)
+    if "d0" in design:
+        d0 = design["d0"]
+        ratio = screw.root_ratio if screw is not None else 0.83
+        K = screw.nut_stiffness if screw is not None else None
+        return ScrewData(d0, p, d0, ratio * d0, K_nut=K)
+    if legacy is not None:
+        d1 = legacy.root_diameter
+        return ScrewData(None, p, None, d1)
+    return None
+
+
+def friction(spec) -> float:
+    screw = spec.screw
+    if screw.friction is not None:
+        return screw.friction
+    return MU_BALL_DEFAULT if screw.kind == "ball" else MU_SLIDING_DEFAULT
+
+
+def efficiencies(q) -> tuple[Any, Any]:
+    """(forward, back-driving) efficiency of the screw alone: the model of ``[screw]``
+    (lead, mean diameter, friction), else the requirements' constants."""
+    spec = q.problem.spec
+    req = spec.requirements
+    if spec.screw is None:
+        back = req.lock.eta_screw_back if req.lock is not None else 1.0
+        return req.eta_screw, back
+    data = q.screw
+    if data is None or data.d_m is None:
+        raise ProblemError(
+            "variables.d0: the screw's efficiency needs its mean diameter: declare d0 "
+            "(or a catalogue screw)"
+        )
+    kind, mu = spec.screw.kind, friction(spec)
+    fwd = screw_efficiency(kind, data.p, data.d_m, mu, "forward")
+    back = screw_efficiency(kind, data.p, data.d_m, mu, "back")
+    return fwd, back
+
+
+def gear_efficiencies(spec) -> tuple[float, float]:
+    if spec.screw is not None:
+        return spec.screw.gear_efficiency, spec.screw.gear_back_efficiency
+    req = spec.requirements
+    back = req.lock.eta_gear_back if req.lock is not None else 1.0
+    return req.eta_gear, back
+
+
+# --- speed, life, static safety ---------------------------------------------------------------
+def screw_speed(q, phi=None):
+    """Screw speed (1/min) at the required deflection rate, over the grid (or at ``phi``)."""
+    rate = q.requirements.deflection_rate
+    v = q.nut_velocity if phi is None else q.mechanism.nut_velocity(phi)
+    return m.fabs(v) * rate / q.screw.p * 60.0
+
+
+def life_hours(q):
+    """Rated life (h) over the duty cycle, ISO 3408-5 L10 with the stated f_w."""
+    req = q.requirements
+    steps = req.duty_cycle
+    phis = np.array([s.deflection for s in steps])
+    v = q.mechanism.nut_velocity(phis)
+    v = [_at(v, k) for k in range(len(steps))]
+    forces = [m.fabs(s.hinge_moment / v[k]) for k, s in enumerate(steps)]
+    speeds = [m.fabs(v[k]) * req.deflection_rate / q.screw.p * 60.0 for k in range(len(steps))]
+    times = [s.time for s in steps]
+    # The cubic mean load and mean speed of the cycle (written out so it holds on CasADi).
+    work = sum(F**3 * n * t for F, n, t in zip(forces, speeds, times, strict=True))
+    revs = sum(n * t for n, t in zip(speeds, times, strict=True))
+    F_m = (work / revs) ** (1.0 / 3.0)
+    n_m = revs / sum(times)
+    return (q.screw.Ca / (req.f_w * F_m)) ** 3 * 1e6 / (60.0 * n_m)
+
+
+def _at(v, k):
+    # the k-th angle: a CasADi column's row, a NumPy array's last axis (a population)
+    return v[k] if m.is_symbolic(v) else np.asarray(v)[..., k]
+
+
+# --- stiffness --------------------------------------------------------------------------------
+def axial_compliance(q):
+    """Axial compliance of the screw side (mm/N) over the grid: the support bearings, the
+    nut and the shaft (tension/compression to the nut, and torsion from the motor end,
+    turned into an axial compliance through the lead)."""
+    spec = q.problem.spec
+    screw = spec.screw
+    data = q.screw
+    total = 0.0
+    if screw.bearing_stiffness is not None:
+        total = total + 1.0 / screw.bearing_stiffness
+    if data.K_nut is not None:
+        total = total + 1.0 / data.K_nut
+    if screw.nut_offset is not None:
+        x = screw.nut_offset + m.fabs(q.nut_position - q.nut_position[0])
+        area = np.pi * data.d1**2 / 4.0
+        total = total + x / (area * sizing.E_STEEL)
+        # motor held: the torsion of the shaft between the drive end and the nut
+        total = total + 1.0 / torsion_to_axial(shaft_torsional_stiffness(data.d1, x), data.p)
+    return total
+
+
+def output_compliance(q):
+    """Compliance at the output (rad/(N*mm)) over the grid: every member in series,
+    reflected through its own rate - the screw side through dx/dphi, each sized pin
+    through its joint's sensitivity (its contact stiffness under the joint's force)."""
+    s_axial = m.fabs(q.mechanism.sensitivity_axial(q.phi))
+    total = axial_compliance(q) * s_axial**2
+    for joint in q.joints:
+        if joint.pin is not None:
+            K = joint.pin.contact_stiffness(m.fabs(joint.force))
+            total = total + joint.sensitivity**2 / K
+    return total

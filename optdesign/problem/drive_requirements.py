@@ -1,0 +1,167 @@
+"""Requirements on the drive as constraint blocks: efficiency and back-drivability, the
+screw's buckling, yield, critical speed, DN, static safety and life, and the output
+stiffness. Each names what it needs from the problem file when that is missing."""
+
+from __future__ import annotations
+
+from optdesign import math as m
+from optdesign.errors import ProblemError
+from optdesign.models import screw_sizing as sizing
+from optdesign.problem.catalogue import ConstraintBlock
+
+
+def _need(value, what: str, field: str):
+    if value is None:
+        raise ProblemError(f"{field}: needs {what}")
+    return value
+
+
+def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
+    """Blocks of the drive requirements of ``q``'s problem (none when it asks for none)."""
+    spec = q.problem.spec
+    req, screw = spec.requirements, spec.screw
+    out: list[ConstraintBlock] = []
+    if req.efficiency_min is not None:
+        out.append(
+            ConstraintBlock(
+                "efficiency",
+                q.drive_efficiency,
+                req.efficiency_min,
+                None,
+                [""],
+                "",
+                "forward efficiency of screw and gear",
+            )
+        )
+    if req.back_drive is not None:
+        _need(screw, "a [screw] section (its type, friction and size)", "requirements.back_drive")
+        lo, hi = (0.0, None) if req.back_drive == "required" else (None, 0.0)
+        text = "back-drivable" if req.back_drive == "required" else "self-locking"
+        out.append(
+            ConstraintBlock(
+                "back_drive",
+                q.efficiency_back,
+                lo,
+                hi,
+                [""],
+                "",
+                f"back-driving efficiency ({text})",
+            )
+        )
+    if screw is None:
+        return out
+    data = q.screw
+    F = m.fabs(q.nut_force)
+    if data is not None and data.on_catalogue is not None:
+        # the NumPy check of a design: a (d0, p) pair the catalogue lacks is not a screw
+        out.append(
+            ConstraintBlock(
+                "screw_catalogue",
+                data.on_catalogue,
+                1.0,
+                None,
+                [""],
+                "",
+                "(d0, p) is a screw of the catalogue",
+            )
+        )
+    if screw.length is not None and screw.check_buckling:
+        P1 = sizing.buckling_load(data.d1, screw.length, screw.mounting)
+        out.append(
+            ConstraintBlock(
+                "screw_buckling",
+                F / P1,
+                None,
+                1.0,
+                labels,
+                "",
+                f"nut force / buckling load ({screw.mounting})",
+            )
+        )
+    if screw.check_yield and data.d1 is not None:
+        out.append(
+            ConstraintBlock(
+                "screw_yield",
+                F / sizing.yield_load(data.d1),
+                None,
+                1.0,
+                labels,
+                "",
+                "nut force / permissible shaft load",
+            )
+        )
+    if req.critical_speed:
+        length = _need(
+            screw.length,
+            "screw.length (the distance between the supports)",
+            "requirements.critical_speed",
+        )
+        N1 = sizing.critical_speed(data.d1, length, screw.mounting)
+        out.append(
+            ConstraintBlock(
+                "critical_speed",
+                q.screw_speed / N1,
+                None,
+                1.0,
+                labels,
+                "",
+                "screw speed / critical speed",
+            )
+        )
+    if req.dn_max is not None:
+        d0 = _need(data.d0, "the screw's diameter d0 (a variable)", "requirements.dn_max")
+        limit = sizing.DN_LIMIT[req.dn_max] if isinstance(req.dn_max, str) else float(req.dn_max)
+        out.append(
+            ConstraintBlock(
+                "dn",
+                d0 * q.screw_speed,
+                None,
+                limit,
+                labels,
+                "mm/min",
+                "d0 x screw speed (DN value)",
+            )
+        )
+    if req.static_safety_min is not None:
+        C0a = _need(
+            data.C0a,
+            'a catalogue screw ([screw] catalogue = "HIWIN")',
+            "requirements.static_safety_min",
+        )
+        out.append(
+            ConstraintBlock(
+                "static_safety",
+                F * req.static_safety_min / C0a,
+                None,
+                1.0,
+                labels,
+                "",
+                "f_s x nut force / static rating C0a",
+            )
+        )
+    if req.life_min is not None:
+        _need(data.Ca, 'a catalogue screw ([screw] catalogue = "HIWIN")', "requirements.life_min")
+        out.append(
+            ConstraintBlock(
+                "life",
+                q.life_hours,
+                req.life_min,
+                None,
+                [""],
+                "h",
+                f"rated life L10 over the duty cycle (f_w = {req.f_w:g})",
+            )
+        )
+    if req.stiffness_min is not None:
+        out.append(
+            ConstraintBlock(
+                "stiffness",
+                q.output_compliance * req.stiffness_min,
+                None,
+                1.0,
+                labels,
+                "",
+                "required stiffness / stiffness at the output",
+            )
+        )
+    return out

@@ -1,0 +1,158 @@
+"""Pareto fronts over catalogue designs (variables that take catalogue values).
+
+A front of continuous NLPs would pass through designs no catalogue sells; here every point
+- the anchors too - is solved by the catalogue search (branch and bound over NLP
+relaxations, :func:`optdesign.studies.catalogue.solve_catalogue`) with the epsilon limit
+on the other objective, so every point is a catalogue design with its relaxation bound.
+The points are independent once the anchors are in: they run side by side as tasks of the
+checkpointed runner (resumable, local processes or Dask).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from optdesign.errors import InputError
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.pareto.chains import check_anchor
+from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
+from optdesign.studies.pareto.records import PointRecord, record_from_result
+from optdesign.studies.pareto.tasks import ANCHOR_SLACK
+from optdesign.studies.runner import run_tasks
+
+
+def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """One catalogue solve: ``min target s.t. eps`` (an anchor, its tie-break, a point)."""
+    from optdesign.studies.catalogue import solve_catalogue
+
+    problem: DesignProblem = task["problem"]
+    t0 = time.perf_counter()
+    eps = dict(task.get("eps") or {})
+    if "tie_of" in task:  # lexicographic tie-break: the first objective held at its optimum
+        first = PointRecord.from_dict(deps[task["tie_of"]])
+        if not first.ok:
+            first.id, first.kind = task["id"], "anchor"
+            return first.to_dict()
+        name = task["fixed"]
+        eps = {name: first.objectives[name] * (1 + ANCHOR_SLACK) + 1e-12}
+    if "eps_frac" in task:
+        a, b = task["eps_name"], task["target"]
+        lo_rec = PointRecord.from_dict(deps[f"anchor-{a}"])
+        hi_rec = PointRecord.from_dict(deps[f"anchor-{b}"])
+        lo = lo_rec.objectives[a] * (1 + ANCHOR_SLACK) + 1e-12
+        hi = max(hi_rec.objectives[a], lo)
+        eps = {a: float(lo + task["eps_frac"] * (hi - lo))}
+    result = solve_catalogue(
+        problem, starts=task["starts"], seed=task["seed"], objective=task["target"], eps=eps
+    )
+    rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
+    rec.n_solves = int(result.extra.get("catalogue", {}).get("nlp_solves", 0))
+    rec.wall_time_s = time.perf_counter() - t0
+    return rec.to_dict()
+
+
+@dataclass
+class CatalogueEpsilon:
+    """Epsilon-constraint front of two objectives over catalogue designs.
+
+    Attributes
+    ----------
+    points
+        Points between the two anchors (epsilon evenly spaced in the first objective).
+    starts, seed
+        Multistart of each node NLP of every catalogue search (default: the file's,
+        at most 4).
+    """
+
+    points: int = 12
+    starts: int | None = None
+    seed: int | None = None
+    name: str = "epsilon-catalogue"
+
+    def run(self, problem: DesignProblem, objectives: Sequence[str], run) -> Front:
+        from optdesign.studies.pareto.methods import _store, check_objectives, run_key
+
+        objectives = check_objectives(problem, objectives)
+        if len(objectives) != 2:
+            raise InputError("objectives", "a catalogue front takes two objectives")
+        if self.points < 2:
+            raise InputError("points", f"a front needs at least 2 points, got {self.points}")
+        t0 = time.perf_counter()
+        a, b = objectives
+        starts = self.starts if self.starts is not None else min(problem.spec.solver.starts, 4)
+        seed = self.seed if self.seed is not None else problem.spec.solver.seed
+        common = {"problem": problem, "starts": starts, "seed": seed}
+        tasks = []
+        for first, second in ((a, b), (b, a)):
+            tasks.append(
+                {**common, "id": f"anchor-{first}-ms", "kind": "anchor-multistart", "target": first}
+            )
+            tasks.append(
+                {
+                    **common,
+                    "id": f"anchor-{first}",
+                    "kind": "anchor",
+                    "target": second,
+                    "tie_of": f"anchor-{first}-ms",
+                    "fixed": first,
+                    "after": [f"anchor-{first}-ms"],
+                }
+            )
+        points = []
+        for i in range(self.points):
+            points.append(
+                {
+                    **common,
+                    "id": f"{self.name}-{i:04d}",
+                    "kind": "eps",
+                    "target": b,
+                    "eps_name": a,
+                    "eps_frac": i / (self.points - 1),
+                    "index": i,
+                    "after": [f"anchor-{a}", f"anchor-{b}"],
+                }
+            )
+        key = run_key(
+            problem, objectives, method=self.name, points=self.points, starts=starts, seed=seed
+        )
+        store = _store(run.out, self.name)
+        done = run_tasks(
+            tasks + points,
+            catalogue_task,
+            store,
+            run.workers,
+            run.scheduler,
+            run.resume,
+            f"{self.name}: points" if run.progress else False,
+            key,
+            run.on_record,
+        )
+        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+        for k, rec in anchors.items():
+            check_anchor(rec, k)
+        recs = [PointRecord.from_dict(done[t["id"]]) for t in points]
+        pts = [FrontPoint.from_record(r, self.name) for r in recs]
+        n_solves = sum(PointRecord.from_dict(r).n_solves for r in done.values())
+        return make_front(
+            pts,
+            objectives,
+            self.name,
+            time.perf_counter() - t0,
+            problem,
+            anchors=anchors_of(anchors),
+            store=str(store),
+            n_solves=n_solves,
+            settings={
+                "points": self.points,
+                "starts": starts,
+                "seed": seed,
+                "spacing": "uniform in " + a,
+            },
+        )
+
+
+def has_catalogue(problem: DesignProblem) -> bool:
+    return any(v.discrete for v in problem.free)
