@@ -34,7 +34,7 @@ from optdesign.errors import ProblemError
 from optdesign.models import screw_sizing as sizing
 from optdesign.models.screw_catalogue import BallScrew, load_ball_screws
 from optdesign.models.screw_efficiency import MU_BALL_DEFAULT, MU_SLIDING_DEFAULT, screw_efficiency
-from optdesign.models.stiffness import shaft_torsional_stiffness, torsion_to_axial
+from optdesign.models.stiffness import G_STEEL, polar_moment
 
 #: Prefix of the design-dict keys that carry parameters on the solver path.
 PARAM = "param:"
@@ -313,8 +313,9 @@ def life_hours(q):
 
 
 def _at(v, k):
-    # the k-th angle: a CasADi column's row, a NumPy array's last axis (a population)
-    return v[k] if m.is_symbolic(v) else np.asarray(v)[..., k]
+    # the k-th angle: a CasADi column's row; on NumPy the last axis, kept as an axis so
+    # that a population's (pop, 1) columns broadcast with the catalogue data (pop, 1)
+    return v[k] if m.is_symbolic(v) else np.asarray(v)[..., k : k + 1]
 
 
 # --- stiffness --------------------------------------------------------------------------------
@@ -331,11 +332,14 @@ def axial_compliance(q):
     if data.K_nut is not None:
         total = total + 1.0 / data.K_nut
     if screw.nut_offset is not None:
-        x = screw.nut_offset + m.fabs(q.nut_position - q.nut_position[0])
+        x = screw.nut_offset + m.fabs(q.nut_position - _at(q.nut_position, 0))
         area = np.pi * data.d1**2 / 4.0
         total = total + x / (area * sizing.E_STEEL)
-        # motor held: the torsion of the shaft between the drive end and the nut
-        total = total + 1.0 / torsion_to_axial(shaft_torsional_stiffness(data.d1, x), data.p)
+        # motor held: the torsion of the shaft between the drive end and the nut, as a
+        # compliance x (p / 2 pi)^2 / (G J) - the inverse of torsion_to_axial(G J / x, p),
+        # written out so that a population's non-assembling designs (NaN x) stay NaN
+        # instead of failing the models' input checks
+        total = total + x * (data.p / (2.0 * m.pi)) ** 2 / (G_STEEL * polar_moment(data.d1))
     return total
 
 

@@ -32,6 +32,30 @@ def penalised_objective(problem: DesignProblem, objective: str):
     return fun
 
 
+class _CatalogueMap:
+    """DE coordinates of a problem with catalogue variables: a catalogue variable is
+    searched as the integer index of its value (scipy's ``integrality``), so that the
+    search visits catalogue items only, as the catalogue formulation does."""
+
+    def __init__(self, problem: DesignProblem):
+        self.free = problem.free
+        self.discrete = [k for k, v in enumerate(self.free) if v.discrete]
+        self.values = {k: np.asarray(self.free[k].values, dtype=float) for k in self.discrete}
+        lo, hi = problem.lower().astype(float), problem.upper().astype(float)
+        for k in self.discrete:
+            lo[k], hi[k] = 0.0, float(len(self.values[k]) - 1)
+        self.bounds = list(zip(lo, hi, strict=True))
+        self.integrality = np.array([k in self.values for k in range(len(self.free))])
+
+    def to_design(self, Z: np.ndarray) -> np.ndarray:
+        """Design vectors (rows, or one vector) from DE coordinates."""
+        X = np.array(Z, dtype=float, copy=True)
+        for k, vals in self.values.items():
+            idx = np.clip(np.rint(X[..., k]), 0, len(vals) - 1).astype(int)
+            X[..., k] = vals[idx]
+        return X
+
+
 def differential_evolution_optimum(
     problem: DesignProblem,
     objective: str | None = None,
@@ -43,17 +67,26 @@ def differential_evolution_optimum(
     """Global optimum by differential evolution (penalty), polished by SLSQP with finite
     differences on the NumPy path.
 
+    Catalogue variables are searched over their values (integer indices with scipy's
+    ``integrality``) and held at the item found while the continuous ones are polished.
+
     Returns
     -------
     dict
         ``x``, ``objective``, ``violation`` (relative, at x), ``nfev``, ``wall_time_s``.
     """
     objective = objective or problem.objective_names[0]
-    bounds = list(zip(problem.lower(), problem.upper(), strict=True))
+    coords = _CatalogueMap(problem)
+    penalised = penalised_objective(problem, objective)
+
+    def fun(Z: np.ndarray) -> np.ndarray:
+        # scipy passes a population column-wise: (n, pop)
+        return penalised(coords.to_design(Z.T).T if Z.ndim == 2 else coords.to_design(Z))
+
     t0 = time.perf_counter()
     res = differential_evolution(
-        penalised_objective(problem, objective),
-        bounds,
+        fun,
+        coords.bounds,
         seed=seed,
         popsize=popsize,
         maxiter=maxiter,
@@ -62,9 +95,13 @@ def differential_evolution_optimum(
         vectorized=True,
         updating="deferred",
         polish=False,
+        integrality=coords.integrality if coords.discrete else None,
     )
-    x, nfev = res.x, res.nfev
+    x, nfev = coords.to_design(res.x), res.nfev
     if polish:
+        bounds = list(zip(problem.lower(), problem.upper(), strict=True))
+        for k in coords.discrete:  # the item found stays; the continuous variables move
+            bounds[k] = (x[k], x[k])
         x = _slsqp_polish(problem, objective, x, bounds)
     ev = problem.evaluate(x)
     return {

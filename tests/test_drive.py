@@ -1,0 +1,330 @@
+"""The drive inside problems (issue 14): efficiency from the lead, back-drivability, the
+lock's load, screw speed, DN, critical speed, static safety, life and output stiffness.
+
+Expected values come from hand formulas written out here (lead angle, virtual work with
+the crank-slider's position equation differentiated by central differences, the HIWIN
+catalogue file read with the csv module, Miner's cubic mean) or from physics.md's printed
+check - never from the function under test.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from optdesign.problem import load_problem, problem_from_dict
+from optdesign.studies.solve import solve_nlp
+
+ROOT = Path(__file__).resolve().parents[1]
+FIN = ROOT / "problems" / "fin_actuator.toml"
+CATALOGUE_CSV = ROOT / "optdesign" / "data" / "ball_screws.csv"
+HINGE = 500e3  # N*mm
+
+
+def _x(R, l, n, phi0, phi):
+    """Crank-slider nut abscissa, seed 000 eq. 2, written out (mm)."""
+    a = phi + phi0
+    return R * np.sin(a) - np.sqrt(l**2 - (R * np.cos(a) - n) ** 2)
+
+
+def _dx(R, l, n, phi0, phi, h=1e-6):
+    return (_x(R, l, n, phi0, phi + h) - _x(R, l, n, phi0, phi - h)) / (2 * h)
+
+
+def _data(screw=None, variables=None, objective="ripple", **req):
+    data = {
+        "name": "drive",
+        "mechanism": "crank_slider",
+        "variables": {
+            "R": {"lower": "30 mm", "upper": "120 mm"},
+            "l": {"lower": "40 mm", "upper": "200 mm"},
+            "n": {"lower": "0 mm", "upper": "150 mm"},
+            "p": {"lower": "2 mm", "upper": "10 mm"},
+            "phi0": {"lower": "-0.6 rad", "upper": "0.6 rad"},
+            "i_a": 2,
+            **(variables or {}),
+        },
+        "requirements": {
+            "deflection": {"min": "-30 deg", "max": "30 deg", "points": 31},
+            "hinge_moment": "500 N*m",
+            "mean_ratio": {"min": 200, "max": 260},
+            "nut_travel_max": "110 mm",
+            "transmission_angle": {"min": "40 deg", "max": "140 deg"},
+            "rod_inclination_max": "30 deg",
+            **req,
+        },
+        "objective": {"minimize": objective},
+    }
+    if screw is not None:
+        data["screw"] = screw
+    return data
+
+
+def _quantities(problem, **design):
+    x = np.array([design[v.name] for v in problem.free])
+    return problem.quantities(problem.design_dict(x))
+
+
+DESIGN = dict(R=80.0, l=120.0, n=60.0, phi0=0.1, p=5.0)
+
+
+def test_efficiency_from_the_lead_reaches_motor_torque():
+    """physics.md's check p = 5, d_m = 20, mu = 0.003: eta = 0.9634, eta' = 0.9621."""
+    screw = {"kind": "ball", "friction": 0.003, "gear_efficiency": 0.95}
+    problem = problem_from_dict(_data(screw, {"d0": "20 mm"}))
+    q = _quantities(problem, **DESIGN)
+    assert float(q.efficiency) == pytest.approx(0.9634, abs=5e-5)
+    assert float(q.efficiency_back) == pytest.approx(0.9621, abs=5e-5)
+    # lead angle by hand: tan(lam) / tan(lam + atan(mu))
+    lam = math.atan(5.0 / (math.pi * 20.0))
+    eta = math.tan(lam) / math.tan(lam + math.atan(0.003))
+    assert float(q.drive_efficiency) == pytest.approx(eta * 0.95, rel=1e-12)
+    # motor torque by virtual work: F = M / (dx/dphi), T = F p / (2 pi i_a eta eta_g)
+    phi = np.radians(np.linspace(-30, 30, 31))
+    F = HINGE / _dx(80.0, 120.0, 60.0, 0.1, phi)
+    T = F * 5.0 / (2 * math.pi * 2 * eta * 0.95)
+    assert np.asarray(q.motor_torque, dtype=float).ravel() == pytest.approx(T, rel=1e-7)
+    # the same problem without [screw] uses eta_screw = 1: 1/(eta eta_g) times less torque
+    plain = problem_from_dict(_data())
+    T1 = np.asarray(_quantities(plain, **DESIGN).motor_torque, dtype=float).ravel()
+    assert T1 == pytest.approx(T * eta * 0.95, rel=1e-7)
+
+
+def _self_locking_lead(d_m: float, mu: float) -> float:
+    """Largest lead of a self-locking Tr thread (alpha = 15 deg): lam = phi', where
+    tan(phi') = mu / cos(alpha_n) and tan(alpha_n) = tan(alpha) cos(lam)."""
+
+    def gap(lam):
+        alpha_n = math.atan(math.tan(math.radians(15.0)) * math.cos(lam))
+        return lam - math.atan(mu / math.cos(alpha_n))
+
+    lam = brentq(gap, 1e-6, 0.5, xtol=1e-15)
+    return math.pi * d_m * math.tan(lam)
+
+
+@pytest.mark.parametrize("rule", ["forbidden", "required"])
+def test_back_drive_requirement_on_a_sliding_screw(rule):
+    # the least motor torque wants the longest lead (efficiency grows with it up to
+    # ~45 deg): with back-driving forbidden the lead stops where the thread self-locks
+    screw = {"kind": "trapezoidal", "friction": 0.1}
+    # a long stroke allowed, so that only the efficiency limits the lead
+    variables = {"d0": "20 mm", "R": {"lower": "30 mm", "upper": "300 mm"}}
+    variables["l"] = {"lower": "40 mm", "upper": "500 mm"}
+    data = _data(
+        screw, variables, "motor_torque", back_drive=rule, nut_travel_max="400 mm"
+    )
+    problem = problem_from_dict(data)
+    res = solve_nlp(problem, starts=4, seed=2)
+    assert res.status == "optimal" and res.verified
+    p_lock = _self_locking_lead(20.0, 0.1)  # 6.55 mm
+    assert 6.4 < p_lock < 6.7
+    if rule == "forbidden":
+        assert res.design["p"] == pytest.approx(p_lock, rel=1e-6)
+        assert "back_drive" in {r.name.split("[")[0] for r in res.active}
+    else:
+        assert res.design["p"] > p_lock + 1.0
+    q = _quantities(problem, **{v.name: res.design[v.name] for v in problem.free})
+    assert (float(q.efficiency_back) <= 1e-9) == (rule == "forbidden")
+
+
+def test_lock_load_uses_the_model_back_efficiency():
+    from optdesign.mechanisms import CrankSlider
+    from optdesign.models.lock import PinLock, motor_shaft_lock_load
+
+    screw = {"kind": "ball", "friction": 0.005, "gear_back_efficiency": 0.9}
+    lock = {"kind": "pin", "radius": "20 mm"}
+    problem = problem_from_dict(_data(screw, {"d0": "16 mm"}, lock=lock))
+    q = _quantities(problem, **DESIGN)
+    lam = math.atan(5.0 / (math.pi * 16.0))
+    eta_back = math.tan(lam - math.atan(0.005)) / math.tan(lam)
+    mech = CrankSlider(R=80.0, l=120.0, n=60.0, p=5.0, i_a=2, phi0=0.1)
+    load = motor_shaft_lock_load(mech, problem.phi, HINGE, eta_back, 0.9)
+    expected = PinLock(20.0).force(load.moment)
+    assert np.asarray(q.lock_force, dtype=float).ravel() == pytest.approx(
+        np.asarray(expected, dtype=float).ravel(), rel=1e-9
+    )
+    # by hand at the stroke's largest moment: T_back = F p eta' eta_g' / (2 pi i_a),
+    # pin lock f_a = 0.35 T / r
+    phi = np.radians(np.linspace(-30, 30, 31))
+    T = HINGE / np.abs(_dx(80.0, 120.0, 60.0, 0.1, phi)) * 5.0 * eta_back * 0.9 / (4 * math.pi)
+    assert float(np.max(q.lock_force)) == pytest.approx(0.35 * T.max() / 20.0, rel=1e-7)
+
+
+def _catalogue_row(d0: float, p: float) -> dict[str, float]:
+    """The strongest nut of HIWIN (d0, p), read from the shipped CSV with the csv module."""
+    with CATALOGUE_CSV.open() as f:
+        lines = [line for line in f if not line.startswith("#")]
+        rows = [r for r in csv.DictReader(lines) if float(r["d0"]) == d0 and float(r["p"]) == p]
+    best = max(rows, key=lambda r: (float(r["Ca"]), float(r["C0a"])))
+    return {k: float(v) for k, v in best.items() if k in ("d1", "Ca", "C0a")}
+
+
+FIN_DESIGN = dict(R=100.0, l=150.0, n=90.0, phi0=0.2, d0=25.0, p=5.0, d=6.0)
+
+
+@pytest.fixture(scope="module")
+def fin():
+    problem = load_problem(FIN)
+    return problem, _quantities(problem, **FIN_DESIGN)
+
+
+def test_screw_speed_dn_critical_speed_and_static_safety_by_hand(fin):
+    problem, q = fin
+    phi = np.radians(np.linspace(-30, 30, 61))
+    v = np.abs(_dx(100.0, 150.0, 90.0, 0.2, phi))  # mm/rad
+    rate = math.radians(120.0)  # rad/s
+    n = v * rate / 5.0 * 60.0  # 1/min
+    assert np.asarray(q.screw_speed, dtype=float).ravel() == pytest.approx(n, rel=1e-7)
+    ev = problem.evaluate(np.array([FIN_DESIGN[v.name] for v in problem.free]))
+    c = ev.constraints
+    assert np.max(c["dn"].values) == pytest.approx(25.0 * n.max(), rel=1e-7)
+    assert c["dn"].upper == 90_000.0  # HIWIN, ground screws
+    row = _catalogue_row(25.0, 5.0)
+    # HIWIN critical speed N = f d1 / L^2 x 1e7, fixed-supported f = 15.1
+    N1 = 15.1 * row["d1"] / 300.0**2 * 1e7
+    assert np.max(c["critical_speed"].values) == pytest.approx(n.max() / N1, rel=1e-7)
+    F = HINGE / v
+    assert np.max(c["static_safety"].values) == pytest.approx(1.5 * F.max() / row["C0a"], rel=1e-7)
+
+
+def test_life_over_the_duty_cycle_by_miners_rule(fin):
+    problem, q = fin
+    row = _catalogue_row(25.0, 5.0)
+    steps = [(0.0, 150e3, 0.6), (15.0, 300e3, 0.3), (-25.0, 450e3, 0.1)]
+    rate = math.radians(120.0)
+    loads, speeds, times = [], [], []
+    for deg, M, t in steps:
+        v = abs(_dx(100.0, 150.0, 90.0, 0.2, math.radians(deg)))
+        loads.append(M / v)
+        speeds.append(v * rate / 5.0 * 60.0)
+        times.append(t)
+    # ISO 3408-5: cubic mean load weighted by revolutions, mean speed by time; f_w = 1.2
+    revs = sum(n * t for n, t in zip(speeds, times, strict=True))
+    F_m = (sum(F**3 * n * t for F, n, t in zip(loads, speeds, times, strict=True)) / revs) ** (
+        1 / 3
+    )
+    n_m = revs / sum(times)
+    hours = (row["Ca"] / (1.2 * F_m)) ** 3 * 1e6 / (60 * n_m)
+    assert float(np.asarray(q.life_hours).ravel()[0]) == pytest.approx(hours, rel=1e-7)
+
+
+def test_population_evaluation_equals_one_design_at_a_time(fin):
+    """The NumPy path on a population (global searches) gives each design's own values,
+    the catalogue lookups and duty-cycle terms included."""
+    problem, _ = fin
+    rng = np.random.default_rng(5)
+    X = np.array([[FIN_DESIGN[v.name] for v in problem.free]] * 4, dtype=float)
+    X[:, 0] += rng.uniform(-10, 10, 4)  # R
+    X[:, 4] = [16.0, 20.0, 25.0, 25.0]  # d0
+    X[:, 5] = [5.0, 5.0, 5.0, 10.0]  # p
+    pop = problem.evaluate(X)
+    for k in range(4):
+        one = problem.evaluate(X[k])
+        assert pop.violation[k] == pytest.approx(one.violation, rel=1e-12)
+        for name in ("life", "stiffness", "static_safety"):
+            assert np.ravel(pop.constraints[name].values[k]) == pytest.approx(
+                np.ravel(one.constraints[name].values), rel=1e-12
+            )
+
+
+def _hinge_rotation(q, M, phi, K_ax):
+    """Output rotation under an extra hinge moment M with the nut on an axial spring K_ax:
+    the nut moves F/K_ax with F = M/(dx/dphi) at the loaded angle, and the angle follows
+    from the position equation solved for that nut position (no rates used)."""
+    R, l, n, phi0 = 100.0, 150.0, 90.0, 0.2
+
+    def rotation(sign):
+        def residual(dphi):
+            dx = _x(R, l, n, phi0, phi + dphi) - _x(R, l, n, phi0, phi)
+            return K_ax * dx * _dx(R, l, n, phi0, phi + dphi) - sign * M
+
+        return brentq(residual, -1e-2, 1e-2, xtol=1e-16)
+
+    return (rotation(+1) - rotation(-1)) / 2
+
+
+def test_output_stiffness_of_the_screw_side_against_the_assembled_linkage(fin):
+    """Without pins, the output compliance is the screw side's through (dx/dphi)^2: check
+    it against the equilibrium of the linkage with the nut on a spring."""
+    problem, q = fin
+    data = _data(
+        {"kind": "ball", "bearing_stiffness": "400 N/um", "nut_stiffness": "270 N/um"},
+        {"d0": "25 mm"},
+        "hinge_compliance",
+    )
+    plain = problem_from_dict(data)
+    qq = _quantities(plain, R=100.0, l=150.0, n=90.0, phi0=0.2, p=5.0)
+    K_ax = 1 / (1 / 400e3 + 1 / 270e3)
+    phi = np.radians(np.linspace(-30, 30, 31))
+    for k in (0, 12, 30):
+        M = 2000.0  # N*mm: a small moment, the response stays linear
+        rot = _hinge_rotation(qq, M, phi[k], K_ax)
+        K_out = float(np.asarray(qq.output_stiffness, dtype=float).ravel()[k])
+        assert M / rot == pytest.approx(K_out, rel=1e-5)
+
+
+def test_fin_actuator_stiffness_chain_includes_every_member(fin):
+    problem, q = fin
+    # removing the pins' contact leaves a stiffer output; removing the screw side too
+    # leaves the pins alone: the chain is a series sum
+    total = np.asarray(q.output_compliance, dtype=float).ravel()
+    from optdesign.problem import drive
+
+    screw_side = np.asarray(drive.axial_compliance(q), dtype=float).ravel()
+    s = np.abs(np.asarray(q.mechanism.sensitivity_axial(q.phi), dtype=float).ravel())
+    pins = total - screw_side * s**2
+    assert np.all(pins > 0) and np.all(screw_side * s**2 > 0)
+    # the requirement 600 kN*m/rad is compared with 1/compliance in N*mm/rad
+    ev = problem.evaluate(np.array([FIN_DESIGN[v.name] for v in problem.free]))
+    assert np.ravel(ev.constraints["stiffness"].values) == pytest.approx(total * 600e6, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_fin_actuator_optimum_confirmed_by_a_global_search():
+    """The shipped whole-actuator problem: catalogue search (branch and bound over Ipopt
+    relaxations) against differential evolution over the catalogue indices and the
+    continuous variables on the NumPy path (no CasADi, no Ipopt)."""
+    import optdesign as od
+    from optdesign.studies.global_check import differential_evolution_optimum
+
+    problem = load_problem(FIN)
+    res = od.solve(problem)
+    assert res.status == "optimal" and res.verified
+    assert res.objective == pytest.approx(0.0348393, rel=1e-5)
+    assert {k: res.design[k] for k in ("d0", "p", "d")} == {"d0": 25.0, "p": 5.0, "d": 6.0}
+    names = {r.name.split("[")[0] for r in res.active}
+    assert {"mean_ratio", "lock_force"} <= names
+    for seed in (11, 12):
+        de = differential_evolution_optimum(problem, seed=seed, popsize=20, maxiter=600)
+        assert de["violation"] <= 1e-6
+        assert de["objective"] >= res.objective * (1 - 1e-6)
+        assert de["objective"] == pytest.approx(res.objective, rel=1e-4)
+
+
+@pytest.mark.slow
+def test_catalogue_front_backlash_against_motor_torque():
+    """A front over catalogue designs (every point a catalogue item with its fit from the
+    ISO 286-2 table): the backlash end is the catalogue optimum, the points trade."""
+    import tomllib
+
+    import optdesign as od
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["5 mm", "6 mm", "8 mm"]}
+    problem = problem_from_dict(data)
+    front = od.pareto(problem, ["backlash", "motor_torque"], points=3, starts=2)
+    frame = front.to_frame()
+    assert len(frame) == 3
+    backlash = frame["backlash"].to_numpy()
+    torque = frame["motor_torque"].to_numpy()
+    assert backlash.min() == pytest.approx(0.0340646, rel=1e-5)  # test_catalogue's optimum
+    order = np.argsort(backlash)
+    assert np.all(np.diff(torque[order]) < 0)  # more backlash buys less torque
+    for _, row in frame.iterrows():
+        assert row["p"] in (5.0, 6.0) and row["d"] in (5.0, 6.0, 8.0)
