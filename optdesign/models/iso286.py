@@ -54,7 +54,7 @@ P7/h6     n/a (-1.0..+0.8)                -9.9..+26.0 % (-5.9..+6.2)
 
 Most extremes sit in the first step (1..3 mm, where the standard departs most from its
 own formulas) or at a step's ends (the formula at D against the value of the step's
-geometric mean); at the low end of a step the smooth model overstates the clearance (the
+geometric mean); at the low end of a step the smooth model understates the clearance (the
 unsafe side for backlash), so the table is the one to use for a design at a fixed size.
 """
 
