@@ -365,3 +365,21 @@ def test_conforming_pin_contact_in_a_problem():
     # the conforming approach (contact part, net-force mode excluded) is below the two
     # flattened surfaces of eq. 11 here: the optimum is lower than duan2017's 0.0362197
     assert res.objective < 0.0362197
+
+
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("critical_speed", True),
+        ("dn_max", "ground"),
+        ("static_safety_min", 2.0),
+        ("stiffness_min", "100 kN*m/rad"),
+    ],
+)
+def test_screw_requirements_without_a_screw_are_refused(field, value):
+    from optdesign.errors import ProblemError
+
+    data = _data(None, None, **{field: value, "deflection_rate": "60 deg/s"})
+    with pytest.raises(ProblemError, match=rf"requirements\.{field}: needs a \[screw\]"):
+        problem = problem_from_dict(data)
+        problem.evaluate(np.array([80.0, 120.0, 60.0, 5.0, 0.1]))

@@ -222,7 +222,7 @@ def duty_cycle_life_hours(Ca, forces, speeds, times, f_w=1.0):
 
 
 def static_safety_factor(C0a, Fa_max):
-    """Static safety factor f_s = C0a / |Fa_max| (ISO 3408-4; HIWIN F 3.3: S0 Fa_max < C0).
+    """Static safety factor f_s = C0a / |Fa_max| (ISO 3408-5; HIWIN F 3.3: S0 Fa_max < C0).
 
     The minimum to ask for is the designer's (service conditions); none is assumed here.
     """

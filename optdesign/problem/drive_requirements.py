@@ -49,6 +49,19 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
             )
         )
     if screw is None:
+        needs_screw = {
+            "critical_speed": req.critical_speed,
+            "dn_max": req.dn_max is not None,
+            "static_safety_min": req.static_safety_min is not None,
+            "life_min": req.life_min is not None,
+            "stiffness_min": req.stiffness_min is not None,
+        }
+        for name, asked in needs_screw.items():
+            if asked:
+                raise ProblemError(
+                    f"requirements.{name}: needs a [screw] section (its size, catalogue "
+                    "and mounting)"
+                )
         return out
     data = q.screw
     F = m.fabs(q.nut_force)
