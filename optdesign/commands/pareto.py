@@ -98,6 +98,7 @@ def run_pareto(args) -> int:
 
 def _run_locked(args, problem, objectives, methods, out: Path) -> int:
     from optdesign.studies import pareto as pa
+    from optdesign.studies.pareto.catalogue_front import has_catalogue
 
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
     run = dict(
@@ -113,6 +114,10 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
             method = pa.NSGA2(pop_size=args.pop, generations=args.generations, seed=seed)
         elif m == "weighted_sum":
             method = pa.WeightedSum(points=args.points, starts=args.starts, seed=seed)
+        elif has_catalogue(problem):
+            # the name: compute_front turns it into the catalogue front (every point a
+            # catalogue design)
+            method = m
         else:
             method = pa.EpsilonConstraint(
                 points=args.points,
@@ -122,7 +127,9 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
                 seed=seed,
                 deterministic=args.deterministic,
             )
-        fronts.append(pa.compute_front(problem, objectives, method=method, **run))
+        named = {"points": args.points, "starts": args.starts, "seed": seed}
+        extra = named if isinstance(method, str) else {}
+        fronts.append(pa.compute_front(problem, objectives, method=method, **extra, **run))
     if len(fronts) > 1:
         # Hypervolumes of different methods are comparable only with one reference point.
         pa.common_hypervolumes(fronts)

@@ -17,7 +17,8 @@ import numpy as np
 
 
 def non_dominated(F: np.ndarray) -> np.ndarray:
-    """Boolean mask of the non-dominated rows of ``F`` (duplicates: the first is kept)."""
+    """Boolean mask of the non-dominated rows of ``F`` (duplicates, equal to 1e-9
+    relative: the first is kept)."""
     F = np.asarray(F, dtype=float)
     n = len(F)
     keep = np.isfinite(F).all(axis=1)
@@ -30,7 +31,9 @@ def non_dominated(F: np.ndarray) -> np.ndarray:
         if dominated_by.any():
             keep[i] = False
             continue
-        same = (F == F[i]).all(axis=1)
+        # two solves that reach the same design (a catalogue front's epsilon limit that
+        # does not bind) differ by rounding only: one point
+        same = np.isclose(F, F[i], rtol=1e-9, atol=0.0).all(axis=1)
         same[: i + 1] = False
         keep &= ~same
     return keep
