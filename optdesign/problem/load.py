@@ -98,4 +98,9 @@ def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignPr
                 raise ProblemError(
                     f"tolerances.{var_name}: {var_name} is not a variable of this problem"
                 )
-    return DesignProblem(spec, variables, cls)
+    problem = DesignProblem(spec, variables, cls)
+    # Reports show numbers in the units the file wrote (degrees in, degrees out).
+    from optdesign.reports.units import written_units
+
+    problem.written_units = written_units(data)
+    return problem

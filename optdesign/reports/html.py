@@ -1,0 +1,2 @@
+def solve_report(result):
+    return "<html></html>"
