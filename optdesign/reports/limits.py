@@ -256,3 +256,33 @@ def relaxation_text(lim: Limit) -> str:
 def _decreasing(f: Callable[[Any], Any], x: float) -> bool:
     step = 1e-7 * max(1.0, abs(x))
     return float(f(x + step)) < float(f(x))
+
+
+def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5):
+    """(active, violated) constraint reports of any design on the NumPy path: a row is
+    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond."""
+    from optdesign.problem.design_problem import relative_violation
+    from optdesign.solvers.result import ConstraintReport
+
+    x = np.array([design[v.name] for v in problem.free], dtype=float)
+    ev = problem.evaluate(x)
+    active, violated = [], []
+    for name, block in ev.constraints.items():
+        values = np.atleast_1d(np.asarray(block.values, dtype=float))
+        lo, hi = block.lower, block.upper
+        labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
+        viol = relative_violation(values, lo, hi)
+        for k, v in enumerate(values):
+            label = f"{name}[{labels[k]}]" if labels[k] else name
+            gap = min(
+                abs(v - lo) / max(1.0, abs(lo)) if lo is not None else math.inf,
+                abs(v - hi) / max(1.0, abs(hi)) if hi is not None else math.inf,
+            )
+            if viol[k] > rel:
+                amount = max(
+                    (lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0
+                )
+                violated.append(ConstraintReport(label, float(v), lo, hi, float(amount)))
+            elif gap <= rel:
+                active.append(ConstraintReport(label, float(v), lo, hi, 0.0))
+    return active, violated
