@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.reports.facts import design_facts, objective_facts
-from optdesign.reports.limits import bound_limits, limits_of, rows_at
+from optdesign.reports.limits import binding_angles, bound_limits, limits_of, rows_at
 from optdesign.reports.units import (
     angle_unit,
     objective_shown,
@@ -55,20 +55,10 @@ def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str,
             lim.text() for lim in limits_of(problem, active) + bound_limits(problem, design)
         ],
         "violated": [lim.text() for lim in limits_of(problem, violated)],
-        "active_angles": _angles(active),
+        "active_angles": binding_angles(active),
         "sketch": _sketch(problem, design),
         "curves": _curves(problem, design),
     }
-
-
-def _angles(rows: Sequence[Any]) -> dict[str, list[float]]:
-    """Requirement name -> deflection angles (deg) where it binds."""
-    out: dict[str, list[float]] = {}
-    for r in rows:
-        if "[phi=" in r.name and "_envelope" not in r.name:
-            base, label = r.name.split("[", 1)
-            out.setdefault(base, []).append(float(label[4:].rstrip("]").removesuffix("deg")))
-    return out
 
 
 def _sketch(problem: Any, design: dict[str, float]) -> list[dict[str, Any]]:

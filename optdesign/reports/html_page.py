@@ -100,6 +100,8 @@ _SCRIPT = r"""
     el('objectives').innerHTML = list(d.objectives.map((o) => o.text).concat(d.facts.map((f) => f.text)));
     el('limits').innerHTML = list(d.limits);
     el('violated').innerHTML = list(d.violated, 'violated');
+    el('reference').innerHTML = ref && ref !== d
+      ? '<h3>' + esc(ref.label) + ': violated requirements</h3>' + list(ref.violated, 'violated') : '';
     let sk = sketchTraces(d, false);
     if (ref && ref !== d) sk = sketchTraces(ref, true).concat(sk);
     if (sk.length) {
@@ -165,7 +167,7 @@ moments in N*m, ripple in %.</p>
 <div class="grid">
 <div><div id="design"></div><h3>at this design</h3><div id="objectives"></div></div>
 <div><h3>what limits it (binding requirements and bounds)</h3><div id="limits"></div>
-<h3>violated requirements</h3><div id="violated"></div></div>
+<h3>violated requirements</h3><div id="violated"></div><div id="reference"></div></div>
 <div id="sketch" class="plot"></div>
 <div id="curves" class="plot"></div>
 </div>

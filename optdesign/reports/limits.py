@@ -286,3 +286,14 @@ def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5):
             elif gap <= rel:
                 active.append(ConstraintReport(label, float(v), lo, hi, 0.0))
     return active, violated
+
+
+def binding_angles(rows: Iterable[Any]) -> dict[str, list[float]]:
+    """Requirement name -> deflection angles (deg) where its rows bind (internal rows
+    left out)."""
+    out: dict[str, list[float]] = {}
+    for r in rows:
+        if "[phi=" in r.name and not is_internal(r.name):
+            base, label = r.name.split("[", 1)
+            out.setdefault(base, []).append(float(label[4:].rstrip("]").removesuffix("deg")))
+    return out
