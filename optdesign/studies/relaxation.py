@@ -1,6 +1,6 @@
-"""Why a problem is infeasible, as a change the engineer can make: for each violated
-requirement, the smallest relaxation of that requirement alone (the others kept) that
-makes the problem feasible.
+"""Why a problem is infeasible, as a change the engineer can make: for each requirement
+in the conflict (violated, or binding, at the best infeasible point), the smallest
+relaxation of that requirement alone (the others kept) that makes the problem feasible.
 
 Each requirement's rows are relaxed by an amount ``t`` in its own unit (through the
 solve's :class:`~optdesign.formulations.nlp.Bounds`, so the formulation and the solver
@@ -74,8 +74,10 @@ def relaxations(
     """
     from optdesign.studies.solve import _objective_set, solver_for
 
+    # The conflict is between the violated requirements and the ones binding at the best
+    # infeasible point: each is a candidate.
     names: dict[str, Any] = {}
-    for r in sorted(result.violated, key=lambda r: -r.amount):
+    for r in [*sorted(result.violated, key=lambda r: -r.amount), *result.active]:
         base = r.name.split("[", 1)[0]
         if "_envelope" not in base and base not in names:  # not the objective's rows
             names[base] = r
@@ -112,7 +114,9 @@ def relaxations(
                     return r
             return None
 
-        hi_side = row.upper is not None and (row.lower is None or row.value > row.upper)
+        hi_side = row.upper is not None and (
+            row.lower is None or abs(row.value - row.upper) <= abs(row.value - row.lower)
+        )
         ok = feasible(np.inf)
         if ok is None:
             out.append(_record(row, hi_side, None, count))
