@@ -203,3 +203,44 @@ def test_infeasible_report_shows_physical_objective_and_smallest_relaxation():
     # and the relaxed problem is feasible
     spec["requirements"]["nut_travel_max"] = f"{needed} mm"
     assert od.solve(od.load(spec), starts=2, ranges=False).success
+
+
+def _legend_labels(fig) -> list[str]:
+    return [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().texts]
+
+
+def test_solution_plot_draws_the_band_and_the_limits(user_result):
+    import matplotlib.pyplot as plt
+
+    _, result = user_result
+    fig = result.plot()
+    labels = _legend_labels(fig)
+    assert "required mean ratio" in labels and "rod_inclination binds" in labels
+    assert "initial design" in labels  # the midpoint design meets every requirement
+    ratio_ax = fig.axes[0]
+    band = next(p for p in ratio_ax.patches if p.get_label() == "required mean ratio")
+    xy = band.get_xy()
+    ys = [xy[1], xy[1] + band.get_height()] if isinstance(xy, tuple) else np.asarray(xy)[:, 1]
+    assert min(ys) == pytest.approx(150) and max(ys) == pytest.approx(200)
+    assert "rod inclination" in fig._supxlabel.get_text()
+    plt.close(fig)
+
+
+def test_initial_design_labelled_when_it_violates():
+    import matplotlib.pyplot as plt
+
+    problem = od.load(PROBLEMS / "cs_min_backlash.toml")
+    # the midpoint design (R 75, l 120, n 75, p 6 mm) travels 75 mm at a mean ratio of 150
+    problem.set_requirement("nut_travel_max", "50 mm")
+    result = od.solve(problem, starts=1, ranges=False)
+    fig = result.plot()
+    assert "initial design (violates 2 requirements)" in _legend_labels(fig)
+    plt.close(fig)
+
+
+def test_no_progress_bar_outside_a_terminal(capfd):
+    problem = od.load(PROBLEMS / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], points=3, workers=1, starts=1, progress=True)
+    assert len(front.points) >= 2
+    err = capfd.readouterr().err
+    assert "it/s" not in err and "%|" not in err
