@@ -180,7 +180,7 @@ def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> l
     out = []
     for var in problem.free:
         value = design.get(var.name)
-        if value is None or var.discrete:
+        if value is None:
             continue
         tol = rel * max(1.0, abs(var.upper - var.lower))
         for side, bound in (("lower", var.lower), ("upper", var.upper)):

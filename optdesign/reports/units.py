@@ -16,6 +16,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from optdesign.units import INTERNAL_UNITS
+
 #: Unit texts that mean degrees or radians in a problem file.
 DEGREES = ("deg", "degree", "degrees", "°")
 RADIANS = ("rad", "radian", "radians")
@@ -166,17 +168,8 @@ def json_value(value: Any) -> Any:
     return value
 
 
-_DIMENSION_UNITS = {
-    "length": "mm",
-    "angle": "rad",
-    "moment": "N*mm",
-    "pressure": "MPa",
-    "force": "N",
-    "stiffness": "N/mm",
-    "rotational_stiffness": "N*mm/rad",
-    "angular_speed": "rad/s",
-    "time": "s",
-}
+#: Dimension -> internal unit (the package's one table).
+_DIMENSION_UNITS = {k: v for k, v in INTERNAL_UNITS.items() if k != "dimensionless"}
 
 
 def _dimension(field: Any) -> str | None:
@@ -208,8 +201,26 @@ def _value(problem: Any, path: str, value: Any, dim: str | None) -> Any:
     if isinstance(value, list):
         return f"[{len(value)} items]"
     if isinstance(value, float) and dim is not None:
+        written = _in_written_unit(problem, path, value, dim)
+        if written is not None:
+            return written
         if dim == "angular_speed":
             return Shown(math.degrees(value), "deg/s")
         angle = angle_unit(problem, path) if dim == "angle" else "deg"
         return shown(value, _DIMENSION_UNITS[dim], angle)
     return value
+
+
+def _in_written_unit(problem: Any, path: str, value: float, dim: str) -> Shown | None:
+    """``value`` (internal unit of ``dim``) in the unit the file wrote at ``path``; None
+    when the file gave a bare number there (or a unit pint cannot convert to)."""
+    unit = (getattr(problem, "written_units", None) or {}).get(path)
+    if not unit:
+        return None
+    from optdesign.units import registry
+
+    try:
+        q = registry().Quantity(value, _DIMENSION_UNITS[dim]).to(unit)
+    except Exception:  # a display nicety: fall back to the package's own unit
+        return None
+    return Shown(float(q.magnitude), unit)
