@@ -244,3 +244,18 @@ def test_no_progress_bar_outside_a_terminal(capfd):
     assert len(front.points) >= 2
     err = capfd.readouterr().err
     assert "it/s" not in err and "%|" not in err
+
+
+def test_cli_flags_skip_the_diagnosis_and_the_report(tmp_path, capsys):
+    from optdesign.cli import main
+
+    src = (PROBLEMS / "cs_min_backlash.toml").read_text()
+    path = tmp_path / "tight.toml"
+    path.write_text(src.replace('nut_travel_max = "110 mm"', 'nut_travel_max = "25 mm"'))
+    out = tmp_path / "out"
+    args = ["solve", str(path), "--starts", "1", "--no-plot", "--out", str(out)]
+    code = main([*args, "--no-diagnosis", "--no-report"])
+    text = capsys.readouterr().out
+    assert code == 1 and "smallest change" not in text
+    assert not (out / "report.html").exists()
+    assert "relaxations" not in json.loads((out / "result.json").read_text())

@@ -188,6 +188,10 @@ def test_requirements_no_design_can_meet(tmp_path, capsys):
     names = [v["name"] for v in out["violated"]]
     assert any(n.startswith("mean_ratio") for n in names)
     assert all(v["violation"]["value"] > 0 for v in out["violated"])
+    # the diagnosis: the mean ratio's lower limit must fall to what a 2 mm lead allows
+    relax = {r["name"]: r for r in out["relaxations"]}
+    assert relax["mean_ratio"]["side"] == "min"
+    assert 200 < relax["mean_ratio"]["needed"]["value"] < 2000
 
 
 def test_units_are_parsed_not_guessed():
