@@ -81,7 +81,8 @@ def result_summary(result: Result) -> str:
     limits = limits_of(problem, result.active) if problem is not None else []
     bounds = bound_limits(problem, result.design) if problem is not None and result.design else []
     if limits or bounds:
-        lines += ["", "what limits the optimum (active requirements and bounds):"]
+        head = "what limits the optimum" if result.success else "binding at the best point found"
+        lines += ["", f"{head} (active requirements and bounds):"]
         lines += [f"  {lim.text()}" for lim in (limits + bounds)[:30]]
     violated = limits_of(problem, result.violated) if problem is not None else []
     if violated:
