@@ -5,14 +5,13 @@ The package computes in mm, N, N*mm, rad (:mod:`optdesign.units`); reports conve
 the last moment: moments in N*m, ratios of a whole in %, and angles in the unit the file
 wrote them in (degrees in, degrees out). Which unit a file wrote where is read once, when
 the file is loaded (:func:`written_units`), and kept on the problem as
-``problem.written_units`` (path -> unit text, e.g. ``"variables.phi0.lower": "deg"``).
+``problem.written_units`` (path -> unit text, e.g. ``"variables.phi0.lower": "deg"``; see
+:func:`optdesign.problem.load.written_units`).
 """
 
 from __future__ import annotations
 
 import math
-import re
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,26 +26,6 @@ SHOWN: dict[str, tuple[str, float]] = {
     "N*mm": ("N*m", 1e-3),
     "rad": ("deg", 180.0 / math.pi),
 }
-
-_UNIT_TEXT = re.compile(r"^\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*(.*?)\s*$")
-
-
-def written_units(data: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
-    """The unit text of every quantity string in the parsed problem file ``data``.
-
-    Returns path -> unit, e.g. ``{"variables.phi0.lower": "deg", "requirements.
-    hinge_moment": "N*m"}``; bare numbers and non-quantity strings are left out.
-    """
-    out: dict[str, str] = {}
-    for key, value in data.items():
-        path = f"{prefix}{key}"
-        if isinstance(value, Mapping):
-            out.update(written_units(value, path + "."))
-        elif isinstance(value, str):
-            match = _UNIT_TEXT.match(value)
-            if match and match.group(1):
-                out[path] = match.group(1)
-    return out
 
 
 def _angle_kind(unit: str) -> str | None:
