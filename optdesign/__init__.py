@@ -17,6 +17,10 @@ Data flow, one package per stage: ``models/`` (pure physics through :mod:`optdes
 -> ``mechanisms/`` (plug-ins) -> ``problem/`` -> ``formulations/`` -> ``solvers/`` ->
 ``studies/`` -> this API -> ``cli``, ``plots/``, ``reports/``. Names are imported lazily:
 ``import optdesign`` costs little until a function is used.
+
+The physics (every model's equations, assumptions, validity and checks) is documented in
+the repository's ``docs/`` (``docs/README.md``); bracketed keys such as [D17] in the
+docstrings are the papers of ``docs/references.md``.
 """
 
 from __future__ import annotations

@@ -167,7 +167,7 @@ def grid_sum(x):
 
 def spread(lo, hi):
     """Relative spread (hi - lo)/(hi + lo) of a band [lo, hi]: half its width over its
-    mid-value (the papers' ratio ripple, seed 000). The one definition of the formula."""
+    mid-value (the papers' ratio ripple, [D17]). The one definition of the formula."""
     return (hi - lo) / (hi + lo)
 
 

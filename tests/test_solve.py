@@ -187,7 +187,11 @@ def test_requirements_no_design_can_meet(tmp_path, capsys):
     assert out["status"] == "infeasible"
     names = [v["name"] for v in out["violated"]]
     assert any(n.startswith("mean_ratio") for n in names)
-    assert all(v["amount"] > 0 for v in out["violated"])
+    assert all(v["violation"]["value"] > 0 for v in out["violated"])
+    # the diagnosis: the mean ratio's lower limit must fall to what a 2 mm lead allows
+    relax = {r["name"]: r for r in out["relaxations"]}
+    assert relax["mean_ratio"]["side"] == "min"
+    assert 200 < relax["mean_ratio"]["needed"]["value"] < 2000
 
 
 def test_units_are_parsed_not_guessed():
@@ -224,12 +228,12 @@ def test_solve_cli_json_and_files(tmp_path, capsys):
     )
     out = json.loads(capsys.readouterr().out)
     assert code == 0
-    for key in ("status", "objective", "design", "solver", "wall_time_s"):
+    for key in ("schema", "status", "objective", "design", "solver", "wall_time"):
         assert key in out
     assert out["status"] == "optimal" and out["solver"] == "ipopt"
     assert set(out["design"]) >= {"R", "p", "d"}
-    assert json.loads((tmp_path / "result.json").read_text())["objective"] == pytest.approx(
-        out["objective"]
+    assert json.loads((tmp_path / "result.json").read_text())["objective"]["value"] == (
+        pytest.approx(out["objective"]["value"])
     )
     assert (tmp_path / "solution.png").stat().st_size > 10_000
 
@@ -241,7 +245,7 @@ def test_solve_cli_summary(tmp_path, capsys):
     text = capsys.readouterr().out
     assert code == 0
     assert "status    optimal" in text and "arm length" in text and "multistart" in text
-    assert "active constraints" in text
+    assert "what limits the optimum" in text
 
 
 def test_multistart_on_two_processes_matches_in_process():

@@ -1,6 +1,6 @@
 """``optdesign pareto FILE --objectives A,B[,C]``: the Pareto front of a problem file.
 
-Writes ``front.csv``, ``front.json``, ``front.png`` and one JSONL store per method (the
+Writes ``front.csv``, ``front.json``, ``front.png``, ``report.html`` and one JSONL store per method (the
 points as they finish; ``--resume`` continues from them) to the output folder.
 """
 
@@ -57,6 +57,7 @@ def _pareto(sub):
     )
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--no-report", action="store_true", help="skip the interactive report.html")
     p.set_defaults(func=run_pareto)
 
 
@@ -150,11 +151,15 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         fig = plot_fronts(problem, fronts)
         with atomic_output(out / "front.png") as tmp:
             save_figure(fig, tmp)
+    wrote = [out / "front.csv", out / "front.json"] + ([] if args.no_plot else [out / "front.png"])
+    if not args.no_report and any(f.points for f in fronts):
+        from optdesign.reports.html import front_report
+        from optdesign.storage import atomic_write_text
+
+        atomic_write_text(out / "report.html", front_report(problem, fronts))
+        wrote.append(out / "report.html")
     from optdesign.reports.front_text import front_summary
 
     print(front_summary(fronts))
-    print(
-        f"\nwrote {out / 'front.csv'}, {out / 'front.json'}"
-        + ("" if args.no_plot else f", {out / 'front.png'}")
-    )
+    print("\nwrote " + ", ".join(str(w) for w in wrote))
     return 0 if all(f.points for f in fronts) else 1

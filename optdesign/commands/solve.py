@@ -22,6 +22,12 @@ def _solve(sub):
     p.add_argument("--seed", type=int, default=None, help="multistart seed (default: file's)")
     p.add_argument("--workers", type=int, default=1, help="local processes for the starts")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
+    p.add_argument("--no-report", action="store_true", help="skip the interactive report.html")
+    p.add_argument(
+        "--no-diagnosis",
+        action="store_true",
+        help="on an infeasible problem, skip the smallest relaxation of each requirement",
+    )
     p.add_argument(
         "--no-ranges",
         action="store_true",
@@ -58,22 +64,44 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
         solver=args.solver,
         ranges=not args.no_ranges,
     )
+    if not result.success and result.design and not args.no_diagnosis:
+        _diagnose(problem, result, args.solver)
+    from optdesign.reports.result_json import result_json
+
+    text = result_json(result)
+    wrote = []
     if out is not None:
         from optdesign.plots import save_figure
         from optdesign.storage import atomic_output, atomic_write_text
 
-        atomic_write_text(out / "result.json", result.to_json())
+        atomic_write_text(out / "result.json", text)
+        wrote.append(out / "result.json")
         if not args.no_plot and result.design:
             fig = result.plot()
             with atomic_output(out / "solution.png") as tmp:
                 save_figure(fig, tmp)
+            wrote.append(out / "solution.png")
+        if not args.no_report:
+            from optdesign.reports.html import solve_report
+
+            atomic_write_text(out / "report.html", solve_report(result))
+            wrote.append(out / "report.html")
     if args.json:
-        print(result.to_json())
+        print(text)
     else:
         print(result.summary())
-        if out is not None:
-            print(
-                f"\nwrote {out / 'result.json'}"
-                + ("" if args.no_plot else f" and {out / 'solution.png'}")
-            )
+        if wrote:
+            print("\nwrote " + ", ".join(str(w) for w in wrote))
     return 0 if result.success else 1
+
+
+def _diagnose(problem, result, solver: str) -> None:
+    """The smallest relaxation of each violated requirement (NLP results only)."""
+    if not result.formulation.startswith("nlp") or any(v.discrete for v in problem.free):
+        return
+    from optdesign.studies.relaxation import relaxations
+
+    try:
+        result.extra["relaxations"] = relaxations(problem, result, solver=solver)
+    except Exception as exc:  # a diagnosis, not the result: never lose the report
+        result.notes.append(f"relaxations not computed: {exc}")

@@ -3,7 +3,7 @@
 Each mechanism (:class:`Mechanism` subclass) declares its variables and computes its
 kinematics, loads and clearance chain from the pure models; the problem, formulations,
 solvers and studies see only what the contract exposes. Built-ins: the crank-slider and
-the shifting fork of seed 000, and the trunnion-mounted pivoting screw. Register your
+the shifting fork of [D17], and the trunnion-mounted pivoting screw. Register your
 own with :func:`register_mechanism`.
 """
 

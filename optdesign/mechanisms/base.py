@@ -247,7 +247,7 @@ class Mechanism:
         return m.grid_spread(self.ratio(phi))
 
     def ratio_finite_step(self, phi, step):
-        """The papers' finite-step ratio (seed 000 eq. 5 / 9) with step ``step`` (rad)."""
+        """The papers' finite-step ratio ([D17] eq. 5 / 9) with step ``step`` (rad)."""
         return ratio_finite_step(self.nut_position, phi, step, self.p, self.i_a)
 
     def nut_travel(self, phi_lo, phi_hi):

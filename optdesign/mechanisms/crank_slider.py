@@ -1,4 +1,4 @@
-"""Crank-slider mechanism: arm R, rod l, offset n, neutral angle phi0 (seed 000 Fig. 2)."""
+"""Crank-slider mechanism: arm R, rod l, offset n, neutral angle phi0 ([D17] Fig. 2)."""
 
 from __future__ import annotations
 
@@ -74,7 +74,7 @@ class CrankSlider(Mechanism):
     def _args(self):
         return self.R, self.l, self.n
 
-    # --- kinematics: closed forms (seed 000 eq. 2 and its derivative) -------------------
+    # --- kinematics: closed forms ([D17] eq. 2 and its derivative) -------------------
     def nut_position(self, phi):
         return cs.nut_position(*self._args(), phi, self.phi0, self.floor)
 

@@ -1,4 +1,4 @@
-"""Shifting-fork (pin-in-slot) mechanism: lever R (seed 000 Fig. 5)."""
+"""Shifting-fork (pin-in-slot) mechanism: lever R ([D17] Fig. 5)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Joints of a clearance chain and how their clearance reaches the output (seed 000
+"""Joints of a clearance chain and how their clearance reaches the output ([D17]
 section 2; the Jacobian mapping of docs/clearance_and_backlash.md).
 
 A joint contributes an output rotation ``theta = |S(phi)| * delta`` where ``delta`` is its
@@ -57,7 +57,7 @@ class PinJoint:
     extra
         Clearance added to the fit's (mm), e.g. a sampled share of the fit's band.
     contact
-        ``"duan2017"``: seed 000 eq. 10-11, a cylinder on a flat (``surfaces`` x Delta);
+        ``"duan2017"``: [D17] eq. 10-11, a cylinder on a flat (``surfaces`` x Delta);
         ``"conforming"``: the pin in its bore with the fit's clearance
         (:mod:`optdesign.models.pin_contact`), the elastic approach of the pair.
     values

@@ -1,4 +1,4 @@
-"""Joint clearance and its sum at the output (seed 000 section 2; physics.md 2.2-2.4).
+"""Joint clearance and its sum at the output ([D17] section 2; docs/clearance_and_backlash.md-2.4).
 
 A joint contributes an output rotation theta_k = S_k(phi) * delta_k where delta_k is its
 clearance (mm, or rad for an angular joint) and S_k the kinematic sensitivity of the

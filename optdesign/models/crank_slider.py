@@ -1,4 +1,4 @@
-"""Crank-slider kinematics (seed 000 eq. 1-5, Fig. 2; physics.md 1.1 and 2.3).
+"""Crank-slider kinematics ([D17] eq. 1-5, Fig. 2; docs/kinematics.md and 2.3).
 
 Output shaft axis O at the origin; the arm of length R carries pin B at
 (R sin a, R cos a) with a = phi0 + phi (phi the deflection, phi0 the neutral angle);
@@ -73,7 +73,7 @@ def ratio(R, l, n, p, i_a, phi, phi0=0.0, floor=None):
 
 @m.shareable
 def rod_length_rate(R, l, n, phi, phi0=0.0, floor=None):
-    """d|BC|/dphi with the nut held (mm/rad) = (dm/dphi) s / l (physics.md 2.3)."""
+    """d|BC|/dphi with the nut held (mm/rad) = (dm/dphi) s / l (docs/clearance_and_backlash.md)."""
     s = rod_run(R, l, n, phi, phi0, floor)
     return nut_velocity(R, l, n, phi, phi0, floor) * s / l
 

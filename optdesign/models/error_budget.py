@@ -1,5 +1,5 @@
-"""Transmission-error budget of a screw drive (seed 003, Li et al. 2016, eq. 1-6, Table 1),
-carried to the output angle of a linkage through its kinematics (physics.md 2.3).
+"""Transmission-error budget of a screw drive ([L16], Li et al. 2016, eq. 1-6, Table 1),
+carried to the output angle of a linkage through its kinematics (docs/clearance_and_backlash.md).
 
 Seed 003 writes the transmission error as the sum of systematic terms plus or minus the
 root-sum-square of the random ones (eq. 6):
@@ -45,7 +45,7 @@ ACTS_ON = ("axial", "lead", "motor_angle", "compliance", "rod_length", "angular"
 KINDS = ("systematic", "random")
 
 
-# --- the paper's terms (seed 003 eq. 2-5), pure functions ------------------------------------
+# --- the paper's terms ([L16] eq. 2-5), pure functions ------------------------------------
 def lead_error(dP, theta):
     """Nut displacement error from a lead deviation dP (mm/rev) after a screw turn theta
     (rad): dP theta / 2 pi (mm), eq. 2."""
@@ -248,7 +248,7 @@ def contribution(
     force of the hinge moment ``M_h`` (N*mm) at phi; a rod-length change through the rod
     sensitivity.
 
-    Without a mechanism (a screw on its own, seed 003): nut displacement (mm), using the
+    Without a mechanism (a screw on its own, [L16]): nut displacement (mm), using the
     lead ``p``, gear ratio ``i_a``, screw angle ``theta`` and axial load ``F`` given here.
 
     ``value`` and ``phi`` may be arrays (one entry per Monte Carlo sample).

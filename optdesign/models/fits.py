@@ -1,4 +1,4 @@
-"""ISO 286-1 fits as smooth functions of the nominal diameter (physics.md 2.4).
+"""ISO 286-1 fits as smooth functions of the nominal diameter (docs/clearance_and_backlash.md).
 
 The standard's tables are these formulas evaluated at the geometric mean of each
 diameter step and rounded. An optimiser needs them continuous in D, so optdesign

@@ -1,4 +1,4 @@
-"""Shifting-fork (pin-in-slot) kinematics (seed 000 eq. 6-9, Fig. 5; physics.md 1.2, 2.3).
+"""Shifting-fork (pin-in-slot) kinematics ([D17] eq. 6-9, Fig. 5; docs/kinematics.md, 2.3).
 
 The nut pin C moves on a line at perpendicular distance R from the output axis O and
 slides in a slot of the output arm; at deflection phi (arm at a = phi0 + phi, phi0 = 0 in

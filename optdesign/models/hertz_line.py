@@ -1,4 +1,4 @@
-"""Hertz line contact of a pin: contact half-width and flattening (seed 000 eq. 10-11).
+"""Hertz line contact of a pin: contact half-width and flattening ([D17] eq. 10-11).
 
 The paper treats a pin of diameter D, length L, under a normal force F as a cylinder on
 a flat of the same material:
@@ -17,7 +17,7 @@ which does not lose digits to cancellation when b << D. First-order form: b^2 / 
 
 Limits: eq. 10 is a cylinder on a flat; a pin in a bore with small clearance is a
 conforming contact where the half-width grows and Hertz stops holding once the arc is
-wide (physics.md 9). Where b approaches D/2 the formula has no real value.
+wide (docs/clearance_and_backlash.md). Where b approaches D/2 the formula has no real value.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Hertz point contact of two bodies whose principal planes make an angle omega (seed 004).
+"""Hertz point contact of two bodies whose principal planes make an angle omega ([C-PRSM]).
 
 Geometry. Body i has principal curvatures rho_i1, rho_i2 (1/mm) in its principal planes
 1 and 2, counted **positive where the body is convex** towards the other body (a concave
@@ -27,7 +27,7 @@ normal load Q (Johnson eq. 3.64-3.67, rearranged)
     a = (3 kappa^2 E(e) Q / (pi E* sum_rho))^(1/3),   b = k a,
     p_max = 3 Q / (2 pi a b),   approach delta = p_max b K(e) / E*.
 
-These reduce to the sphere-on-flat closed forms for F(rho) = 0 (physics.md section 9).
+These reduce to the sphere-on-flat closed forms for F(rho) = 0 (docs/thread_contact.md).
 Hamrock & Brewe's curve fits (kappa, E, K as power/log laws in Ry/Rx) are in
 :func:`hamrock_brewe` for comparison; they are approximations, not used by the solver.
 

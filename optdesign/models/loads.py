@@ -1,4 +1,4 @@
-"""Loads by virtual work (physics.md 3): the hinge moment M_h at the output carried back
+"""Loads by virtual work (docs/loads.md): the hinge moment M_h at the output carried back
 through the linkage and the screw to the motor.
 
 With no losses in the linkage, F dx = M_h dphi for any member whose travel per output

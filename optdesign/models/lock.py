@@ -1,4 +1,4 @@
-"""Power-off lock on the motor shaft (seed 002, Yang & Chen 2016; physics.md 5).
+"""Power-off lock on the motor shaft ([Y16], Yang & Chen 2016; docs/lock.md).
 
 A disturbance moment M at the motor shaft (the hinge moment reflected back through the
 linkage, the screw and the gears) must be held with the power off and released with the
@@ -52,7 +52,7 @@ def friction_radius(r1, r2, law: str = "uniform_pressure"):
     r1, r2
         Inner and outer radius of the friction annulus (mm), 0 <= r1 < r2.
     law
-        ``"uniform_pressure"``: r_f = (2/3)(r2^3 - r1^3)/(r2^2 - r1^2) (seed 002 eq. 1);
+        ``"uniform_pressure"``: r_f = (2/3)(r2^3 - r1^3)/(r2^2 - r1^2) ([Y16] eq. 1);
         ``"uniform_wear"``: r_f = (r1 + r2)/2 (p r constant, a worn-in lining; the smaller
         of the two, so the conservative choice for the spring force).
     """

@@ -1,4 +1,4 @@
-"""Conforming pin-in-bore contact (beside seed 000 eq. 11) and Palmgren's line-contact approach.
+"""Conforming pin-in-bore contact (beside [D17] eq. 11) and Palmgren's line-contact approach.
 
 Problem (Persson 1964; Ciavarella & Decuzzi 2001, part I): a pin of radius R in a bore of
 radius R + dR (dR the radial clearance) in a large plate, same material (E, nu), plane
@@ -40,7 +40,7 @@ The contact stiffness dF/d(delta) = L E* / d'(P*) follows from d.
 (:func:`in_hertz_range`). The explicit form holds for P* <= 100, eps <= 84 deg
 (:func:`in_fit_range`); beyond it the arc is too wide for the fit, and in any case the
 model assumes a frictionless, elastically similar, plane-strain pair with clearance
-(dR > 0, no interference). Example: seed 000's pin, D = 10 mm, L = 20 mm, 20 kN, with an
+(dR > 0, no interference). Example: [D17]'s pin, D = 10 mm, L = 20 mm, 20 kN, with an
 H7/g6 fit's largest clearance (30.9 um on the diameter, dR = 15.5 um), has P* = 0.56 and
 eps = 41 deg: far outside Hertz's range.
 

@@ -1,6 +1,6 @@
 """Planetary roller screw (PRSM): geometry, thread-contact matching, principal-plane angle.
 
-Standard PRSM relations (seed 004; Jones & Velinsky 2013):
+Standard PRSM relations ([C-PRSM]; Jones & Velinsky 2013):
 
 * nut nominal diameter ``d_n = d_s + 2 d_r``;
 * equal pitch p on all parts; the screw and the nut have the same number of starts n and
@@ -53,7 +53,7 @@ from optdesign.models.hertz_point import (
 )
 from optdesign.models.thread_surface import flank_builder, thread_flank
 
-#: Steel (physics.md section 8): E (MPa), Poisson's ratio.
+#: Steel (docs/thread_contact.md): E (MPa), Poisson's ratio.
 STEEL_E = 2.06e5
 STEEL_NU = 0.3
 

@@ -1,4 +1,4 @@
-"""Reduction ratio of a screw drive and its ripple over a deflection range (seed 000).
+"""Reduction ratio of a screw drive and its ripple over a deflection range ([D17]).
 
 The ratio is motor angle per output angle, i = d(theta_motor)/d(phi). The nut moves
 p/(2 pi) per screw radian and the gear pair divides by i_a, so for a nut velocity
@@ -28,7 +28,7 @@ def ratio_from_nut_velocity(v, p, i_a):
 
 
 def ratio_finite_step(position: Callable, phi, step, p, i_a):
-    """The papers' finite-step ratio (seed 000 eq. 5 and 9).
+    """The papers' finite-step ratio ([D17] eq. 5 and 9).
 
     i = 2 pi i_a [x(phi + step) - x(phi)] / (p step), a forward difference of the nut
     position ``position(phi)``; it tends to the exact ratio as ``step`` -> 0 and lags it
@@ -38,7 +38,7 @@ def ratio_finite_step(position: Callable, phi, step, p, i_a):
 
 
 def ratio_ripple(i):
-    """Ripple (i_max - i_min) / (i_max + i_min) of ratios over the grid (seed 000, 1.3).
+    """Ripple (i_max - i_min) / (i_max + i_min) of ratios over the grid ([D17], 1.3).
 
     This is the paper's "variation range": half the spread over the mean of the extremes.
     Non-smooth in the design; solvers use the epigraph form instead (see formulations).

@@ -1,7 +1,7 @@
-"""Planetary roller screw efficiency (seed 003, Li et al. 2016, eq. 7-14; physics.md 6),
+"""Planetary roller screw efficiency ([L16], Li et al. 2016, eq. 7-14; docs/roller_screw.md),
 and a selector between it and the ball-screw efficiency of models.screw.
 
-Eq. 14 as read in physics.md 6 (a = alpha_s helix angle, b = beta contact angle,
+Eq. 14 as read in docs/roller_screw.md (a = alpha_s helix angle, b = beta contact angle,
 tan rho = f_r / (r_RP sin b), rho the equivalent rolling-friction angle):
 
     eta = r_s tan(a) [cos a cos rho sin b - sin a sin rho
@@ -46,7 +46,7 @@ def _check(beta, r_s, r_RP, f_k, f_r) -> None:
 
 
 def efficiency(alpha_s, beta, r_s, r_RP, f_k, f_r):
-    """Forward efficiency of a planetary roller screw, eq. 14 (physics.md 6 reading).
+    """Forward efficiency of a planetary roller screw, eq. 14 (docs/roller_screw.md reading).
 
     Parameters
     ----------
@@ -170,7 +170,7 @@ class ScrewEfficiency:
     def backdrive(self, lam):
         """Back-driving efficiency (load drives screw) at lead/helix angle ``lam`` (rad).
 
-        Ball screw: models.screw.efficiency_backdrive. Roller screw: seed 003 gives only
+        Ball screw: models.screw.efficiency_backdrive. Roller screw: [L16] gives only
         the forward efficiency; :func:`efficiency_backdrive` derives the counterpart by
         reversing the friction terms of eq. 11-13 (stated there).
         """

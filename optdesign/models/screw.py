@@ -1,4 +1,4 @@
-"""Lead screw relations (seed 001; physics.md 4 and 8).
+"""Lead screw relations ([Z00]; docs/screw.md and 8).
 
 lambda: lead angle, tan(lambda) = p / (pi d_m); phi_f: friction angle, tan(phi_f) = mu.
 """
@@ -39,13 +39,13 @@ def drive_torque(P, d_m, lam, phi_f):
 def torsional_stiffness(K_axial, d_m, h, lam, phi_f):
     """Torsional stiffness at the screw (N*mm/rad) equivalent to an axial stiffness (N/mm).
 
-    K_theta = (d_m/2) K (h/2 pi) tan(lambda + phi_f), seed 001 eq. 5; h is the lead (mm).
+    K_theta = (d_m/2) K (h/2 pi) tan(lambda + phi_f), [Z00] eq. 5; h is the lead (mm).
     """
     return 0.5 * d_m * K_axial * h / (2.0 * m.pi) * m.tan(lam + phi_f)
 
 
 def axial_stiffness(K_theta, d_m, h, lam, phi_f):
-    """Axial stiffness (N/mm) equivalent to a torsional stiffness, seed 001 eq. 7.
+    """Axial stiffness (N/mm) equivalent to a torsional stiffness, [Z00] eq. 7.
 
     K = 4 pi K_theta / (d_m h tan(lambda + phi_f)), the inverse of
     :func:`torsional_stiffness`.

@@ -1,4 +1,4 @@
-"""Screw efficiency by kind of screw, forward and back-driving (physics.md 4, 6, 8).
+"""Screw efficiency by kind of screw, forward and back-driving (docs/screw.md, 6, 8).
 
 One entry point, :func:`screw_efficiency`, for the three screws an actuator can use:
 
@@ -16,7 +16,7 @@ One entry point, :func:`screw_efficiency`, for the three screws an actuator can 
     cos(lam). The textbooks take alpha_n = alpha (``normal_section=False``); the
     difference is cos(lam), 0.1 % in mu' at lam = 3 deg.
 ``"roller"``
-    Planetary roller screw, seed 003 eq. 14 (:func:`roller_screw.efficiency`) forward and
+    Planetary roller screw, [L16] eq. 14 (:func:`roller_screw.efficiency`) forward and
     :func:`roller_screw.efficiency_backdrive` back (friction terms of eq. 11-13 reversed;
     derivation in its docstring). The screw radius is r_s = d_m / 2.
 
@@ -55,7 +55,7 @@ TR_FLANK_HALF_ANGLE = float(np.radians(15.0))
 #: Flank half-angle of the Acme thread (29 deg included), rad.
 ACME_FLANK_HALF_ANGLE = float(np.radians(14.5))
 
-#: Default friction coefficients: ball screw 0.003 (physics.md 8); sliding screw 0.1, a
+#: Default friction coefficients: ball screw 0.003 (docs/screw.md); sliding screw 0.1, a
 #: lubricated steel-on-bronze value (Bhandari's worked examples use 0.12-0.15): pass your own.
 MU_BALL_DEFAULT = 0.003
 MU_SLIDING_DEFAULT = 0.1
@@ -159,7 +159,7 @@ def screw_efficiency(
         Sliding screws: flank half-angle (rad) and normal-section reading.
     beta, r_RP, f_k, f_r
         Roller screw: contact angle (rad), roller thread curvature radius (mm), sliding
-        friction, rolling friction length (mm); defaults are seed 003's.
+        friction, rolling friction length (mm); defaults are [L16]'s.
 
     Returns
     -------

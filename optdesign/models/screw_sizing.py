@@ -1,4 +1,4 @@
-"""Ball-screw sizing as the manufacturers publish it (THK, NSK, HIWIN, SKF; physics.md 8).
+"""Ball-screw sizing as the manufacturers publish it (THK, NSK, HIWIN, SKF; docs/screw.md).
 
 Buckling, shaft yield, critical speed, rated life from a duty cycle and the axial
 stiffness chain. Pure functions through :mod:`optdesign.math`: a design problem passes CasADi
@@ -175,7 +175,7 @@ def rated_life_revolutions(Ca, Fa, f_w=1.0):
     f_w
         Load factor. ISO 3408-5 (7.2.1) defines the nominal life with none, f_w = 1.0, the
         default here; the catalogues multiply the load by an operating factor: 1.0-1.2
-        smooth, 1.2-1.5 normal, 1.5-2 with impact (physics.md 8), HIWIN's f_p 1.1-1.2
+        smooth, 1.2-1.5 normal, 1.5-2 with impact (docs/screw.md), HIWIN's f_p 1.1-1.2
         without impact (BS-08-2-EN-1704-K, F 3.8). Pass the factor you assume.
     """
     require_positive("Ca", Ca)

@@ -1,4 +1,4 @@
-"""Stiffness chain from the motor to the output shaft (seed 001; physics.md 4 and 8).
+"""Stiffness chain from the motor to the output shaft ([Z00]; docs/screw.md and 8).
 
 Members and their stiffness (all through :mod:`optdesign.math`, CasADi or NumPy):
 
@@ -6,7 +6,7 @@ Members and their stiffness (all through :mod:`optdesign.math`, CasADi or NumPy)
   and nut position);
 - screw shaft, torsional: :func:`shaft_torsional_stiffness` G J / L, seen at the nut as an
   axial stiffness through the lead, :func:`torsion_to_axial` K_theta (2 pi / p)^2
-  (seed 001 eq. 7, :func:`optdesign.models.screw.axial_stiffness`, carries a friction
+  ([Z00] eq. 7, :func:`optdesign.models.screw.axial_stiffness`, carries a friction
   factor eta in addition; for an elastic member the lossless form is the energy-consistent
   one; the two differ by the factor eta, 3.7 % at eta = 0.963);
 - nut, support bearings, housing: numbers from the catalogue (e.g.

@@ -1,4 +1,4 @@
-"""Helicoid thread flanks of the planetary roller screw (seed 004, "unified equation").
+"""Helicoid thread flanks of the planetary roller screw ([C-PRSM], "unified equation").
 
 Each part i (screw s, roller r, nut n) has its own frame: z along its axis, x through
 the start of the thread. A flank point is given by the surface parameters (rho, theta):
@@ -11,7 +11,7 @@ with xi = +1 the upper flank (facing +z) and xi = -1 the lower flank, h_i the th
 profile in the **normal section** (half tooth thickness as a function of radius), l_i the
 lead, lambda_i the helix angle at the nominal (pitch) radius and p the pitch. Dividing by
 cos(lambda_i) turns normal-section thickness into axial thickness; this is the unified
-equation of Qiao et al. (seed 004 ref. [8]) as far as the extracted text lets it be read
+equation of Qiao et al. ([C-PRSM] ref. [8]) as far as the extracted text lets it be read
 (the equation itself was lost). It is an approximation of the exact normal-to-axial
 section conversion that is good to O(lambda^2) in the profile shape.
 

@@ -58,10 +58,10 @@ def draw_linkage(ax, problem, design: dict, title: str = "") -> None:
             xs, ys = zip(*link, strict=True)
             ax.plot(xs, ys, "-", color=f"C{k}", lw=2, alpha=alpha, label=label if k == 0 else None)
         if sk.slider is not None:
-            ax.plot(*sk.slider, "s", color="C2", ms=6, alpha=alpha)
+            ax.plot(*sk.slider, "s", color="C2", ms=6, alpha=alpha, label="nut" if j == 0 else None)
         if j == 0:
-            for pv in sk.pivots:
-                ax.plot(*pv, "k^", ms=7)
+            for k, pv in enumerate(sk.pivots):
+                ax.plot(*pv, "k^", ms=7, label="ground pivot" if k == 0 else None)
             if sk.axis is not None:
                 (x0, y0), (x1, y1) = sk.axis
                 ax.plot([x0, x1], [y0, y1], color="0.5", lw=0.8, ls="--", label="screw axis")
@@ -145,8 +145,13 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
         for k, i in enumerate(picks):
             sub = fig.add_subplot(gs[k % 2, 1 + k // 2])
             p = main.points[i]
-            text = ", ".join(
-                f"{o}={s * p.objectives[o]:.4g}" for o, s in zip(objectives, scales, strict=True)
-            )
+            text = ", ".join(_value_text(problem, o, p.objectives[o]) for o in objectives)
             draw_linkage(sub, problem, p.design, f"{chr(65 + k)}: {text}")
     return fig
+
+
+def _value_text(problem, name: str, value: float) -> str:
+    """``ripple=0.843 %``: an objective's value with its unit, for titles."""
+    from optdesign.reports.units import objective_shown
+
+    return f"{name}=" + objective_shown(problem, name, value).text(4)

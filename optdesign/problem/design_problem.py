@@ -14,6 +14,7 @@ from __future__ import annotations
 import uuid
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -82,6 +83,10 @@ class DesignProblem:
     mechanism
         The mechanism plug-in class.
     """
+
+    #: Unit text of each quantity the problem file wrote (path -> unit, set by the loader),
+    #: so that reports answer in the file's units; empty for a problem built in code.
+    written_units: Mapping[str, str] = MappingProxyType({})
 
     def __init__(self, spec: ProblemSpec, variables: list[Variable], mechanism: type):
         self.spec = spec

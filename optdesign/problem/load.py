@@ -7,6 +7,7 @@ spec_model`), so a new mechanism plug-in brings its variables and requirements w
 
 from __future__ import annotations
 
+import re
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -98,4 +99,28 @@ def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignPr
                 raise ProblemError(
                     f"tolerances.{var_name}: {var_name} is not a variable of this problem"
                 )
-    return DesignProblem(spec, variables, cls)
+    problem = DesignProblem(spec, variables, cls)
+    # Reports show numbers in the units the file wrote (degrees in, degrees out).
+    problem.written_units = written_units(data)
+    return problem
+
+
+_UNIT_TEXT = re.compile(r"^\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*(.*?)\s*$")
+
+
+def written_units(data: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
+    """The unit text of every quantity string in the parsed problem file ``data``.
+
+    Returns path -> unit, e.g. ``{"variables.phi0.lower": "deg", "requirements.
+    hinge_moment": "N*m"}``; bare numbers and non-quantity strings are left out.
+    """
+    out: dict[str, str] = {}
+    for key, value in data.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            out.update(written_units(value, path + "."))
+        elif isinstance(value, str):
+            match = _UNIT_TEXT.match(value)
+            if match and match.group(1):
+                out[path] = match.group(1)
+    return out

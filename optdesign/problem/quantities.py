@@ -224,7 +224,7 @@ class Quantities:
     # --- drive extras ----------------------------------------------------------------------
     @cached_property
     def lock_force(self):
-        """Magnet force of the motor-shaft lock over the grid (N), seed 002 coupled to the
+        """Magnet force of the motor-shaft lock over the grid (N), [Y16] coupled to the
         drive (None without a ``lock`` requirement)."""
         from optdesign.models.lock import FrictionPlateLock, PinLock, motor_shaft_lock_load
 

@@ -4,14 +4,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from optdesign.reports.limits import bound_limits, is_internal
 from optdesign.reports.solve_text import objective_unit
 from optdesign.reports.tables import format_table
+from optdesign.reports.units import variable_shown
 
 
 def front_summary(fronts: Sequence) -> str:
     """One line per method (points, failures, metrics, time) and the first front's points."""
     main = fronts[0]
     problem = main.problem_object
+    hv_scale, hv_unit = hypervolume_unit(problem, main.objectives)
     rows = []
     for f in fronts:
         m = f.metrics
@@ -20,8 +23,8 @@ def front_summary(fronts: Sequence) -> str:
                 f.method,
                 str(len(f.points)),
                 str(m.get("n_failed", 0)),
-                f"{m.get('hypervolume', 0.0):.6g}",
-                f"{m['hypervolume_common']:.6g}" if "hypervolume_common" in m else "-",
+                f"{hv_scale * m.get('hypervolume', 0.0):.6g}",
+                f"{hv_scale * m['hypervolume_common']:.6g}" if "hypervolume_common" in m else "-",
                 f"{m.get('spacing', 0.0):.3g}",
                 f"{m.get('spread', 0.0):.3g}",
                 f"{f.wall_time_s:.2f}",
@@ -45,7 +48,7 @@ def front_summary(fronts: Sequence) -> str:
         )
     )
     lines.append(
-        "(hypervolume in internal units; reference points: nadir + 10 % of the range of the "
+        f"(hypervolume in {hv_unit}; reference points: nadir + 10 % of the range of the "
         "front itself (own) or of all fronts together (common))"
     )
     pts = main.points
@@ -57,17 +60,42 @@ def front_summary(fronts: Sequence) -> str:
     for k in main.objectives:
         unit, _ = objective_unit(problem, k)
         heads.append(f"{k} ({unit})" if unit else k)
-    free = [v.name for v in problem.free] if problem is not None else []
+    free = list(problem.free) if problem is not None else []
     table = []
     for p in shown:
         cells = []
         for k in main.objectives:
             _, scale = objective_unit(problem, k)
             cells.append(f"{scale * p.objectives[k]:.6g}")
-        cells.append(", ".join(f"{n}={p.design[n]:.4g}" for n in free))
+        cells.append(", ".join(_design_cell(problem, v, p.design[v.name]) for v in free))
         cells.append(p.status)
-        cells.append(", ".join(sorted({a.split("[")[0] for a in p.active}))[:60])
+        cells.append(", ".join(point_limits(problem, main.objectives, p))[:70])
         table.append(cells)
     lines += ["", f"{main.method} front ({len(pts)} points, every {step}th shown):"]
-    lines.append(format_table([*heads, "design", "status", "active"], table))
+    lines.append(format_table([*heads, "design", "status", "what limits it"], table))
     return "\n".join(lines)
+
+
+def _design_cell(problem, var, value: float) -> str:
+    v = variable_shown(problem, var, value)
+    return f"{var.name}={v.value:.4g}" + (f" {v.unit}" if v.unit else "")
+
+
+def point_limits(problem, objectives: Sequence[str], point) -> list[str]:
+    """What limits a front point: its active requirements (not the front's own epsilon
+    rows nor internal rows), then its variables at a bound."""
+    own = {f"{o}_max" for o in objectives}
+    names = sorted({a.split("[")[0] for a in point.active if not is_internal(a)} - own)
+    if problem is not None:
+        names += [f"{b.name} at {b.side} bound" for b in bound_limits(problem, point.design)]
+    return names
+
+
+def hypervolume_unit(problem, objectives: Sequence[str]) -> tuple[float, str]:
+    """(scale, unit) of a hypervolume of ``objectives`` in the units users read them."""
+    scale, units = 1.0, []
+    for k in objectives:
+        unit, s = objective_unit(problem, k)
+        scale *= s
+        units.append(unit or "1")
+    return scale, " x ".join(units)

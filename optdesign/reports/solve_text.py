@@ -1,38 +1,57 @@
-"""The plain-text summary of a solve: status, objective, design table, what limits the
-optimum, and the ranges of a non-unique optimum."""
+"""The plain-text summary of a solve: status, objective, the requirements as read, the
+design table, what the design achieves, what limits the optimum, and for an infeasible
+problem the smallest change of each conflicting requirement that makes it feasible.
+
+Every number carries its unit, in the units the problem file wrote where that is
+unambiguous (:mod:`optdesign.reports.units`); the formulation's internal rows are never
+shown (:mod:`optdesign.reports.limits`).
+"""
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
+from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.limits import (
+    bound_limits,
+    limits_of,
+    objective_where,
+    relaxation_limits,
+    relaxation_text,
+)
 from optdesign.reports.tables import format_table
+from optdesign.reports.units import objective_shown, requirement_echo, variable_shown
 from optdesign.solvers.result import Result
 
 
 def objective_unit(problem, name: str) -> tuple[str, float]:
     """(unit shown, scale) of objective ``name``; a robust statistic such as
     ``CVaR_0.9(backlash)`` has the unit of what it is taken of."""
-    if problem is None:
-        return "", 1.0
-    infos = problem.objectives
-    info = infos.get(name) or next((i for k, i in infos.items() if f"({k})" in name), None)
-    if info is None:
-        return "", 1.0
-    return info.shown_unit, info.display_scale
+    s = objective_shown(problem, name, 1.0)
+    return s.unit, s.value
+
+
+def objective_value(result: Result) -> float:
+    """The objective's physical value at the design (the independent check's), not the
+    formulation's bound variable (which is not tight at an infeasible point)."""
+    phys = result.objectives.get(result.objective_name)
+    return float(phys) if phys is not None and math.isfinite(phys) else result.objective
 
 
 def result_summary(result: Result) -> str:
-    """Readable summary: status, objective, design table, active and violated constraints."""
+    """Readable summary: status, objective, requirements, design, limits, diagnosis."""
     problem = result.problem_object
-    lines = [f"problem   {result.problem} ({result.mechanism})"]
+    label = problem.mechanism.label() if problem is not None else result.mechanism
+    lines = [f"problem   {result.problem} ({label})"]
     check = {True: "passed", False: "FAILED", None: "n/a"}[result.verified]
     lines.append(
         f"status    {result.status} (solver {result.solver}, {result.formulation}, "
         f"{result.message or result.termination.value}); independent check: {check}"
     )
     name = result.objective_name
-    unit, scale = objective_unit(problem, name)
-    lines.append(f"objective {name} = {scale * result.objective:.8g} {unit}".rstrip())
+    value = objective_shown(problem, name, objective_value(result)).text(8)
+    where = "" if result.success else " at the best point found (requirements not met)"
+    lines.append(f"objective {name} = {value}{where}")
     lines.append(f"time      {result.wall_time_s:.3f} s")
     if result.multistart:
         ms = result.multistart
@@ -43,39 +62,52 @@ def result_summary(result: Result) -> str:
     for note in result.notes:
         lines.append(f"note      {note}")
     if problem is not None:
+        echo = requirement_echo(problem)
+        lines += ["", "requirements (as read from the file, in its units):"]
+        lines += [f"  {k} = {v}" for k, v in echo]
         lines += ["", _design_table(problem, result)]
         if any(_moves(result, v.name) for v in problem.free):
             lines.append(
                 "(the optimum is not unique: the variables marked above can move within their "
                 "range, together, without changing the objective by more than 1e-6 relative)"
             )
-    if result.objectives:
-        shown = []
-        for k, v in result.objectives.items():
-            u, s = objective_unit(problem, k)
-            shown.append(f"{k} = {s * v:.6g} {u}".rstrip())
-        lines += ["", "objectives at this design: " + ", ".join(shown)]
-    envelope = [r for r in result.active if "_envelope[" in r.name]
-    limits = [r for r in result.active if "_envelope[" not in r.name]
-    if envelope:
-        where = sorted({r.name.split("[", 1)[1].rstrip("]") for r in envelope})
-        lines += ["", f"objective attained at: {', '.join(where)}"]
-    if limits:
-        lines += ["", "active constraints (what limits the optimum):"]
-        lines += [f"  {r.describe()}" for r in limits[:25]]
-        if len(limits) > 25:
-            lines.append(f"  ... and {len(limits) - 25} more")
-    if result.violated:
+    facts = design_facts(problem, result.design) + objective_facts(problem, result.objectives)
+    if facts:
+        lines += ["", "at this design:"]
+        lines += [f"  {f.text()}" for f in facts]
+    attained = objective_where(result.active)
+    if attained:
+        lines += ["", f"objective attained at: {', '.join(attained)}"]
+    limits = limits_of(problem, result.active) if problem is not None else []
+    bounds = bound_limits(problem, result.design) if problem is not None and result.design else []
+    if limits or bounds:
+        head = "what limits the optimum" if result.success else "binding at the best point found"
+        lines += ["", f"{head} (active requirements and bounds):"]
+        lines += [f"  {lim.text()}" for lim in (limits + bounds)[:30]]
+    violated = limits_of(problem, result.violated) if problem is not None else []
+    if violated:
+        lines += ["", "violated requirements:"]
+        lines += [f"  {lim.text()}" for lim in violated[:30]]
+    elif result.violated and problem is None:
         lines += ["", "violated constraints:"]
         lines += [f"  {r.describe()}" for r in result.violated[:25]]
-        if len(result.violated) > 25:
-            lines.append(f"  ... and {len(result.violated) - 25} more")
+    relax = result.extra.get("relaxations")
+    if relax:
+        lines += ["", "smallest change of one requirement that makes the problem feasible:"]
+        lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, relax)]
     if not result.success:
         lines += [
             "",
             "no feasible design found"
             + (": the requirements above conflict within the bounds" if result.violated else ""),
         ]
+        if not relax:
+            lines.append(
+                "next: relax one of the violated requirements, or widen a bound at its limit"
+            )
+    elif bounds:
+        names = ", ".join(sorted({b.name for b in bounds}))
+        lines += ["", f"next: widening the bounds of {names} may improve the objective"]
     return "\n".join(lines)
 
 
@@ -88,6 +120,8 @@ def _design_table(problem, result: Result) -> str:
     rows = []
     for var in problem.variables:
         val = result.design.get(var.name, float("nan"))
+        v = variable_shown(problem, var, val)
+        unit = v.unit
         if var.free:
             at = ""
             tol = 1e-6 * max(1.0, abs(var.upper - var.lower))
@@ -95,15 +129,16 @@ def _design_table(problem, result: Result) -> str:
                 at = "at lower bound"
             elif abs(val - var.upper) < tol:
                 at = "at upper bound"
-            bounds = f"[{var.lower:g}, {var.upper:g}]"
+            lo = variable_shown(problem, var, var.lower).value
+            hi = variable_shown(problem, var, var.upper).value
+            bounds = f"[{lo:.6g}, {hi:.6g}]"
         else:
             bounds, at = "fixed", ""
-        shown = f"{val:.6g}" if var.unit != "rad" else f"{val:.6g} ({np.degrees(val):.3f} deg)"
         lo_hi = result.ranges.get(var.name)
-        moves = (
-            f"optimal for any value in [{lo_hi[0]:.6g}, {lo_hi[1]:.6g}]"
-            if _moves(result, var.name)
-            else ""
-        )
-        rows.append([var.name, var.description, shown, var.unit, bounds, at, moves])
+        moves = ""
+        if _moves(result, var.name):
+            a = variable_shown(problem, var, lo_hi[0]).value
+            b = variable_shown(problem, var, lo_hi[1]).value
+            moves = f"optimal for any value in [{a:.6g}, {b:.6g}]"
+        rows.append([var.name, var.description, f"{v.value:.6g}", unit, bounds, at, moves])
     return format_table(["variable", "what", "value", "unit", "bounds", "", "optimal set"], rows)

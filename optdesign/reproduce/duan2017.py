@@ -1,5 +1,5 @@
 """Reproduction of Duan, Huang, Liu (2017), *Study on transmission mechanism of ball screw
-actuator* (seed 000): ratio ranges and ripple of the crank-slider and the shifting fork,
+actuator* ([D17]): ratio ranges and ripple of the crank-slider and the shifting fork,
 the position of the ratio maximum, the Hertz pin example and the backlash of D + E.
 """
 

@@ -1,4 +1,4 @@
-"""Reproduction of seed 003 (Li et al. 2016): planetary roller screw efficiency (eq. 14) and
+"""Reproduction of [L16] (Li et al. 2016): planetary roller screw efficiency (eq. 14) and
 the transmission-error budget with Monte Carlo sensitivity ranking (eq. 6, Fig. 6b).
 
 The paper's inputs are in SI (m); converted here: r_s = 0.04 m = 40 mm, r_RP = 0.01 m =
@@ -127,7 +127,9 @@ def run(out: Path) -> int:
     ]
     print("Seed 003 (Li et al. 2016): planetary roller screw efficiency, eq. 14")
     print("Inputs (SI -> mm): r_s = 0.04 m = 40 mm, r_RP = 0.01 m = 10 mm,")
-    print("f_r = 1e-5 m = 0.01 mm, f_k = 0.055. eq. 14 read with tan(alpha_s) (physics.md 6).")
+    print(
+        "f_r = 1e-5 m = 0.01 mm, f_k = 0.055. eq. 14 read with tan(alpha_s) (docs/roller_screw.md)."
+    )
     print("The paper's text swaps the ranges (beta 0-15, alpha 30-60 deg); its Fig. 7 and")
     print("conclusions use beta up to 90 deg and alpha around 5-15 deg, as plotted here.\n")
     print(comparison_table(rows))

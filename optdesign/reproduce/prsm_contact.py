@@ -1,8 +1,8 @@
-"""Reproduction of seed 004: PRSM thread contact with the principal-plane angle omega.
+"""Reproduction of [C-PRSM]: PRSM thread contact with the principal-plane angle omega.
 
 ``optdesign reproduce prsm-contact`` prints
 
-1. the Hertz solver checks (physics.md section 9: sphere on flat, crossed cylinders,
+1. the Hertz solver checks (docs/thread_contact.md: sphere on flat, crossed cylinders,
    Timoshenko's m and n, Hamrock-Brewe's fits);
 2. omega along the contact position (the paper's Fig. 7: constant);
 3. omega and the eccentricity with and without omega against the pitch and the flank
@@ -140,7 +140,7 @@ def run(out: Path) -> int:
     print("  omega: angle between the planes of larger curvature of the two bodies (0-90 deg).")
     print()
 
-    print("1. Hertz point-contact solver against closed forms (physics.md 9)")
+    print("1. Hertz point-contact solver against closed forms (docs/thread_contact.md)")
     print(comparison_table(_hertz_checks()))
     print("Hamrock-Brewe curve fits against the exact elliptic-integral solution:")
     print(

@@ -1,4 +1,4 @@
-"""Reproduction of seed 002 (Yang & Chen 2016): magnet force of motor-shaft locks.
+"""Reproduction of [Y16] (Yang & Chen 2016): magnet force of motor-shaft locks.
 
 Prints the paper's 9.25 % (pin lock / friction plate) and 6.32 % (pin lock with a rolling
 bearing / friction plate) beside the computed values, states the reconstruction of the

@@ -1,4 +1,4 @@
-"""Monte Carlo of the transmission error and its sensitivity ranking (seed 003, Fig. 5-6).
+"""Monte Carlo of the transmission error and its sensitivity ranking ([L16], Fig. 5-6).
 
 Draws every :class:`~optdesign.models.error_budget.ErrorSource` from its distribution with a
 ``numpy.random.Generator`` seeded by the caller, maps each draw to the output through
@@ -143,7 +143,7 @@ def run_monte_carlo(
 
 
 def plot_ranking(result: MonteCarloResult, path: Path, title: str = "") -> Path:
-    """Bar plot of the sensitivity ranking in percent (like seed 003 Fig. 6b)."""
+    """Bar plot of the sensitivity ranking in percent (like [L16] Fig. 6b)."""
     # optdesign.plots selects the Agg back-end before pyplot loads
     import matplotlib.pyplot as plt
 

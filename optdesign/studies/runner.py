@@ -288,6 +288,7 @@ def _run(
                     initial=sum(1 for i in by_id if i in done),
                     desc=progress if isinstance(progress, str) else None,
                     leave=False,
+                    disable=None,  # no bar outside a terminal: its redraws would fill logs
                 )
 
             def submit_ready() -> None:

@@ -1,0 +1,71 @@
+"""What a design achieves, as a user reads it: the mean ratio and its range over the
+stroke, the drive efficiency used, every objective with its unit (and what "size"
+measures for this mechanism)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from optdesign import math as m
+from optdesign.reports.units import Shown, objective_shown
+
+
+@dataclass(frozen=True)
+class Fact:
+    """One number of a design: name, value with unit, and what it is."""
+
+    name: str
+    value: Shown
+    description: str = ""
+
+    def text(self) -> str:
+        extra = f" ({self.description})" if self.description else ""
+        return f"{self.name} = {self.value.text()}{extra}"
+
+    def to_json(self) -> dict[str, Any]:
+        return {**self.value.to_json(), "description": self.description}
+
+
+def design_facts(problem: Any, design: dict[str, float]) -> list[Fact]:
+    """Mean ratio, ratio range, drive efficiency of ``design`` (NumPy path)."""
+    if problem is None or not design:
+        return []
+    with np.errstate(all="ignore"):
+        q = problem.quantities(design)
+        ratio = np.asarray(q.ratio, dtype=float).ravel()
+        eta = np.asarray(q.drive_efficiency, dtype=float).ravel()
+    out = [
+        Fact(
+            "mean_ratio",
+            Shown(float(m.grid_mean(ratio)), ""),
+            "mean reduction ratio over the stroke",
+        ),
+        Fact("ratio_min", Shown(float(np.min(ratio)), ""), "smallest ratio over the stroke"),
+        Fact("ratio_max", Shown(float(np.max(ratio)), ""), "largest ratio over the stroke"),
+    ]
+    req = problem.spec.requirements
+    source = (
+        "screw x gear, from the file"
+        if problem.spec.screw is None
+        else "screw x gear, screw from its lead and friction"
+    )
+    if req.eta_screw == 1.0 and req.eta_gear == 1.0 and problem.spec.screw is None:
+        source = "lossless: the file gives no eta_screw, eta_gear or [screw]"
+    out.append(Fact("drive_efficiency", Shown(100.0 * float(np.min(eta)), "%"), source))
+    return out
+
+
+def objective_facts(problem: Any, objectives: dict[str, float]) -> list[Fact]:
+    """Every objective's value with its unit and description; ``size`` says what it
+    measures for this mechanism."""
+    out = []
+    for name, value in objectives.items():
+        info = problem.objectives.get(name) if problem is not None else None
+        desc = info.description if info is not None else ""
+        if name == "size" and problem is not None:
+            desc = f"{desc}: {problem.mechanism.size_description}"
+        out.append(Fact(name, objective_shown(problem, name, value), desc))
+    return out

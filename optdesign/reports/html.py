@@ -1,0 +1,197 @@
+"""``report.html``: an interactive, self-contained report of a solve or a front.
+
+The page needs no network: plotly's JavaScript is inlined, and the data of every design
+shown (its values with units, its linkage sketch, its ratio and backlash over the
+stroke, what limits it) is computed here and embedded as JSON; the page only draws it
+(:mod:`optdesign.reports.html_page`). For a front, hovering or clicking a point shows
+that design; for a solve, the optimum is shown against the initial design.
+
+The sketch comes from the mechanism's public :meth:`~optdesign.mechanisms.Mechanism.
+sketch`: no mechanism is named here.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.limits import binding_angles, bound_limits, limits_of, rows_at
+from optdesign.reports.units import (
+    angle_unit,
+    objective_shown,
+    requirement_echo,
+    variable_shown,
+)
+
+
+def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str, Any]:
+    """Everything the page shows of one design (JSON-ready)."""
+    active, violated = rows_at(problem, design)
+    with np.errstate(all="ignore"):
+        facts = design_facts(problem, design)
+        objectives = problem.evaluate(np.array([design[v.name] for v in problem.free])).objectives
+    rows = []
+    for var in problem.variables:
+        v = variable_shown(problem, var, design[var.name])
+        row = {"name": var.name, "description": var.description, "value": v.value, "unit": v.unit}
+        if var.free:
+            row["lower"] = variable_shown(problem, var, var.lower).value
+            row["upper"] = variable_shown(problem, var, var.upper).value
+        rows.append(row)
+    return {
+        "label": label,
+        "design": rows,
+        "facts": [{"text": f.text(), **f.to_json(), "name": f.name} for f in facts],
+        "objectives": [
+            {"name": f.name, "text": f.text(), **f.value.to_json()}
+            for f in objective_facts(problem, {k: float(v) for k, v in objectives.items()})
+        ],
+        "limits": [
+            lim.text() for lim in limits_of(problem, active) + bound_limits(problem, design)
+        ],
+        "violated": [lim.text() for lim in limits_of(problem, violated)],
+        "active_angles": binding_angles(active),
+        "sketch": _sketch(problem, design),
+        "curves": _curves(problem, design),
+    }
+
+
+def _sketch(problem: Any, design: dict[str, float]) -> list[dict[str, Any]]:
+    mech = problem.quantities(design).mechanism
+    phis = [problem.phi[0], 0.5 * (problem.phi[0] + problem.phi[-1]), problem.phi[-1]]
+    out = []
+    for phi in phis:
+        with np.errstate(all="ignore"):
+            sk = mech.sketch(float(phi))
+        if sk is None:
+            return []
+        out.append(
+            {
+                "phi": math.degrees(float(phi)),
+                "links": [[[float(x), float(y)] for x, y in link] for link in sk.links],
+                "pivots": [[float(x), float(y)] for x, y in sk.pivots],
+                "slider": None if sk.slider is None else [float(c) for c in sk.slider],
+                "axis": None if sk.axis is None else [[float(c) for c in p] for p in sk.axis],
+            }
+        )
+    return out
+
+
+def _curves(problem: Any, design: dict[str, float]) -> dict[str, Any]:
+    with np.errstate(all="ignore"):
+        q = problem.quantities(design)
+        ratio = np.asarray(q.ratio, dtype=float).ravel()
+        backlash = (
+            np.asarray(q.backlash.worst_case, dtype=float).ravel() if problem.has("d") else None
+        )
+    return {
+        "phi": np.degrees(problem.phi).tolist(),
+        "ratio": _finite(ratio),
+        "backlash": None if backlash is None else _finite(backlash),
+    }
+
+
+def _finite(a: np.ndarray) -> list[float | None]:
+    return [float(v) if math.isfinite(v) else None for v in a]
+
+
+def _bands(problem: Any) -> dict[str, Any]:
+    """Requirement limits drawn over the curves: the mean-ratio band, the backlash limit."""
+    req = problem.spec.requirements
+    out: dict[str, Any] = {}
+    if req.mean_ratio is not None:
+        out["mean_ratio"] = [req.mean_ratio.min, req.mean_ratio.max]
+    if req.backlash_max is not None:
+        out["backlash_max"] = math.degrees(req.backlash_max)
+    return out
+
+
+def _header(problem: Any) -> dict[str, Any]:
+    return {
+        "problem": problem.name,
+        "mechanism": problem.mechanism.label(),
+        "size": problem.mechanism.size_description,
+        "requirements": [f"{k} = {v}" for k, v in requirement_echo(problem)],
+        "angle_unit": angle_unit(problem),
+        "bands": _bands(problem),
+    }
+
+
+def solve_report(result: Any) -> str:
+    """The report of a solve: the optimum against the initial design."""
+    from optdesign.reports.html_page import render
+    from optdesign.reports.solve_text import objective_value
+
+    problem = result.problem_object
+    if problem is None or not result.design:
+        raise ValueError("report: the result carries no problem or no design")
+    start = problem.design_dict(problem.start())
+    initial = design_view(problem, start, "initial design")
+    if initial["violated"]:
+        initial["label"] = "initial design (violates the requirements)"
+    best = design_view(problem, result.design, "optimum" if result.success else "best point found")
+    name = result.objective_name
+    data = {
+        **_header(problem),
+        "kind": "solve",
+        "status": result.status,
+        "objective": f"{name} = {objective_shown(problem, name, objective_value(result)).text(8)}",
+        "designs": [initial, best],
+        "reference": 0,
+        "selected": 1,
+        "front": None,
+    }
+    return render(data, title=f"optdesign: {problem.name}")
+
+
+def front_report(problem: Any, fronts: Sequence[Any]) -> str:
+    """The report of fronts: the objective space; hover or click a point for its design."""
+    from optdesign.plots.front import pick_points
+    from optdesign.reports.html_page import render
+
+    main = fronts[0]
+    objectives = list(main.objectives)
+    designs: list[dict[str, Any]] = []
+    traces = []
+    for f in fronts:
+        idx = []
+        coords: list[list[float]] = [[] for _ in objectives]
+        for k, p in enumerate(f.points):
+            label = f"{f.method} point {k + 1}"
+            designs.append(design_view(problem, p.design, label))
+            idx.append(len(designs) - 1)
+            for j, o in enumerate(objectives):
+                coords[j].append(objective_shown(problem, o, p.objectives[o]).value)
+        traces.append({"method": f.method, "coords": coords, "index": idx})
+    axes = []
+    for o in objectives:
+        unit = objective_shown(problem, o, 1.0).unit
+        axes.append(f"{o} ({unit})" if unit else o)
+    picks = pick_points(main.F) if len(main.points) else []
+    data = {
+        **_header(problem),
+        "kind": "front",
+        "status": f"{sum(len(f.points) for f in fronts)} points on {len(fronts)} front(s)",
+        "objective": ", ".join(objectives),
+        "designs": designs,
+        "reference": None,
+        "selected": picks[-1] if picks else (0 if designs else None),
+        "front": {"axes": axes, "traces": traces},
+    }
+    return render(data, title=f"optdesign: {problem.name} front")
+
+
+def to_json(data: Any) -> str:
+    """JSON for embedding in a <script> element (no ``</`` inside)."""
+    return json.dumps(data, allow_nan=False, default=_default).replace("</", "<\\/")
+
+
+def _default(obj: Any) -> Any:
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"not JSON: {type(obj).__name__}")

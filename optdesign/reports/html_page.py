@@ -1,0 +1,177 @@
+"""The page of ``report.html``: HTML, CSS and the script that draws the embedded data
+with plotly (inlined: the page opens without a network)."""
+
+from __future__ import annotations
+
+import html
+from typing import Any
+
+_CSS = """
+body { font-family: system-ui, sans-serif; margin: 1em 2em; color: #222; }
+h1 { font-size: 1.3em; margin-bottom: 0.2em; }
+.meta { color: #555; margin: 0.2em 0; }
+.grid { display: grid; grid-template-columns: minmax(420px, 1fr) minmax(420px, 1fr); gap: 1em; }
+.plot { width: 100%; height: 480px; }
+table { border-collapse: collapse; font-size: 0.9em; }
+td, th { padding: 2px 8px; border-bottom: 1px solid #ddd; text-align: left; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+ul { margin: 0.2em 0 0.8em 0; }
+.violated { color: #b00; }
+details { margin: 0.5em 0; }
+"""
+
+_SCRIPT = r"""
+(function () {
+  const DATA = JSON.parse(document.getElementById('report-data').textContent);
+  const fmt = (v) => (v === null || v === undefined) ? '-' : Number(v).toPrecision(6).replace(/\.?0+(e|$)/, '$1');
+  const el = (id) => document.getElementById(id);
+  function esc(s) { const d = document.createElement('div'); d.textContent = String(s); return d.innerHTML; }
+  function list(items, cls) {
+    if (!items.length) return '<p class="meta">none</p>';
+    return '<ul' + (cls ? ' class="' + cls + '"' : '') + '>' + items.map((t) => '<li>' + esc(t) + '</li>').join('') + '</ul>';
+  }
+  function table(sel, ref) {
+    let h = '<table><tr><th>variable</th><th>what</th><th>' + esc(sel.label) + '</th>';
+    if (ref) h += '<th>' + esc(ref.label) + '</th>';
+    h += '<th>unit</th><th>bounds</th></tr>';
+    sel.design.forEach((row, k) => {
+      h += '<tr><td>' + esc(row.name) + '</td><td>' + esc(row.description) + '</td>';
+      h += '<td class="num" data-var="' + esc(row.name) + '">' + fmt(row.value) + '</td>';
+      if (ref) h += '<td class="num">' + fmt(ref.design[k].value) + '</td>';
+      const b = row.lower === undefined ? 'fixed' : '[' + fmt(row.lower) + ', ' + fmt(row.upper) + ']';
+      h += '<td>' + esc(row.unit) + '</td><td>' + b + '</td></tr>';
+    });
+    return h + '</table>';
+  }
+  function sketchTraces(d, grey) {
+    const out = [];
+    const n = d.sketch.length;
+    d.sketch.forEach((pose, j) => {
+      const op = 0.35 + 0.65 * j / Math.max(1, n - 1);
+      const name = (grey ? d.label + ', ' : '') + 'phi = ' + pose.phi.toFixed(0) + ' deg';
+      pose.links.forEach((link, k) => out.push({
+        x: link.map((p) => p[0]), y: link.map((p) => p[1]), mode: 'lines+markers', type: 'scatter',
+        line: { width: 3, color: grey ? '#999' : ['#1f77b4', '#ff7f0e', '#2ca02c', '#9467bd'][k % 4], dash: grey ? 'dot' : 'solid' },
+        marker: { size: 5 }, opacity: op, name: name, legendgroup: name, showlegend: k === 0,
+        hovertemplate: 'x %{x:.1f} mm, y %{y:.1f} mm<extra>' + esc(name) + '</extra>' }));
+      if (pose.slider) out.push({ x: [pose.slider[0]], y: [pose.slider[1]], type: 'scatter', mode: 'markers',
+        marker: { symbol: 'square', size: 10, color: grey ? '#999' : '#2ca02c' }, opacity: op,
+        name: 'nut', legendgroup: 'nut' + grey, showlegend: j === 0 && !grey });
+      if (j === 0) {
+        if (pose.pivots.length) out.push({ x: pose.pivots.map((p) => p[0]), y: pose.pivots.map((p) => p[1]),
+          type: 'scatter', mode: 'markers', marker: { symbol: 'triangle-up', size: 11, color: '#000' },
+          name: 'ground pivot', showlegend: !grey });
+        if (pose.axis) out.push({ x: [pose.axis[0][0], pose.axis[1][0]], y: [pose.axis[0][1], pose.axis[1][1]],
+          type: 'scatter', mode: 'lines', line: { color: '#888', width: 1, dash: 'dash' }, name: 'screw axis', showlegend: !grey });
+      }
+    });
+    return out;
+  }
+  function curveTraces(d, grey) {
+    const c = d.curves, out = [];
+    const lab = (s) => grey ? s + ' (' + d.label + ')' : s + ' (' + d.label + ')';
+    out.push({ x: c.phi, y: c.ratio, type: 'scatter', mode: 'lines', name: lab('ratio'),
+      line: { color: grey ? '#999' : '#1f77b4', dash: grey ? 'dot' : 'solid' } });
+    if (c.backlash) out.push({ x: c.phi, y: c.backlash, type: 'scatter', mode: 'lines', name: lab('backlash'),
+      yaxis: 'y2', line: { color: grey ? '#bbb' : '#d62728', dash: grey ? 'dot' : 'dash' } });
+    return out;
+  }
+  function bandTraces(d) {
+    const out = [], phi = d.curves.phi, lo = phi[0], hi = phi[phi.length - 1];
+    const b = DATA.bands;
+    if (b.mean_ratio) b.mean_ratio.forEach((v, k) => { if (v !== null) out.push({ x: [lo, hi], y: [v, v], type: 'scatter', mode: 'lines',
+      line: { color: '#1f77b4', width: 1, dash: 'dashdot' }, name: 'mean ratio ' + (k ? 'max' : 'min') + ' ' + fmt(v) }); });
+    if (b.backlash_max !== undefined) out.push({ x: [lo, hi], y: [b.backlash_max, b.backlash_max], yaxis: 'y2', type: 'scatter',
+      mode: 'lines', line: { color: '#d62728', width: 1, dash: 'dashdot' }, name: 'backlash max ' + fmt(b.backlash_max) + ' deg' });
+    Object.entries(d.active_angles).forEach(([name, angles]) => {
+      const ys = angles.map((a) => d.curves.ratio[phi.findIndex((p) => Math.abs(p - a) < 0.051)]);
+      out.push({ x: angles, y: ys, type: 'scatter', mode: 'markers', marker: { symbol: 'x', size: 9 },
+        name: name + ' binds' });
+    });
+    return out;
+  }
+  const config = { responsive: true, displaylogo: false };
+  function show(i) {
+    const d = DATA.designs[i];
+    const ref = DATA.reference === null ? null : DATA.designs[DATA.reference];
+    el('selected-label').textContent = d.label;
+    document.body.dataset.selected = String(i);
+    el('design').innerHTML = table(d, ref && ref !== d ? ref : null);
+    el('objectives').innerHTML = list(d.objectives.map((o) => o.text).concat(d.facts.map((f) => f.text)));
+    el('limits').innerHTML = list(d.limits);
+    el('violated').innerHTML = list(d.violated, 'violated');
+    el('reference').innerHTML = ref && ref !== d
+      ? '<h3>' + esc(ref.label) + ': violated requirements</h3>' + list(ref.violated, 'violated') : '';
+    let sk = sketchTraces(d, false);
+    if (ref && ref !== d) sk = sketchTraces(ref, true).concat(sk);
+    if (sk.length) {
+      Plotly.react('sketch', sk, { title: { text: 'linkage at the stroke ends and middle' },
+        xaxis: { title: { text: 'x (mm)' }, scaleanchor: 'y' }, yaxis: { title: { text: 'y (mm)' } },
+        margin: { t: 40 }, legend: { font: { size: 10 }, orientation: 'h', y: -0.25 } }, config);
+    } else {
+      el('sketch').textContent = 'no sketch for this mechanism';
+    }
+    let cu = bandTraces(d).concat(curveTraces(d, false));
+    if (ref && ref !== d) cu = curveTraces(ref, true).concat(cu);
+    Plotly.react('curves', cu, { title: { text: 'ratio and backlash over the stroke' },
+      xaxis: { title: { text: 'deflection phi (deg)' } },
+      yaxis: { title: { text: 'reduction ratio i (motor rad / output rad)' } },
+      yaxis2: { title: { text: 'worst-case backlash (deg)' }, overlaying: 'y', side: 'right', showgrid: false },
+      margin: { t: 40 }, legend: { font: { size: 10 }, orientation: 'h', y: -0.25 } }, config);
+  }
+  function drawFront() {
+    const f = DATA.front, three = f.axes.length === 3;
+    const traces = f.traces.map((t) => ({
+      x: t.coords[0], y: t.coords[1], z: three ? t.coords[2] : undefined,
+      customdata: t.index, type: three ? 'scatter3d' : 'scatter', mode: 'markers' + (three ? '' : '+lines'),
+      marker: { size: three ? 4 : 8 }, name: t.method + ' (' + t.index.length + ' points)',
+      hovertemplate: f.axes[0] + ' %{x}<br>' + f.axes[1] + ' %{y}' + (three ? '<br>' + f.axes[2] + ' %{z}' : '') + '<extra>%{fullData.name}</extra>' }));
+    const layout = { title: { text: 'Pareto front: hover or click a point' }, hovermode: 'closest', margin: { t: 40 },
+      legend: { font: { size: 10 } } };
+    if (three) layout.scene = { xaxis: { title: { text: f.axes[0] } }, yaxis: { title: { text: f.axes[1] } }, zaxis: { title: { text: f.axes[2] } } };
+    else { layout.xaxis = { title: { text: f.axes[0] } }; layout.yaxis = { title: { text: f.axes[1] } }; }
+    return Plotly.newPlot('front', traces, layout, config).then((gd) => {
+      const pick = (ev) => { if (ev && ev.points && ev.points.length) show(ev.points[0].customdata); };
+      gd.on('plotly_click', pick);
+      gd.on('plotly_hover', pick);
+    });
+  }
+  const ready = DATA.front ? drawFront() : Promise.resolve();
+  ready.then(() => { if (DATA.selected !== null) show(DATA.selected); document.body.dataset.ready = '1'; });
+})();
+"""
+
+
+def render(data: dict[str, Any], title: str) -> str:
+    """The whole page for ``data`` (see :mod:`optdesign.reports.html`)."""
+    from plotly.offline import get_plotlyjs
+
+    from optdesign.reports.html import to_json
+
+    e = html.escape
+    reqs = "".join(f"<li>{e(r)}</li>" for r in data["requirements"])
+    front = '<div id="front" class="plot"></div>' if data.get("front") else ""
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<title>{e(title)}</title>
+<style>{_CSS}</style>
+<script>{get_plotlyjs()}</script>
+</head><body>
+<h1>{e(data["problem"])} ({e(data["mechanism"])})</h1>
+<p class="meta">status {e(data["status"])}; objective {e(data["objective"])}</p>
+<p class="meta">size, where shown, is the {e(data["size"])}; angles in {e(data["angle_unit"])},
+moments in N*m, ripple in %.</p>
+<details><summary>requirements (as read from the file)</summary><ul>{reqs}</ul></details>
+{front}
+<h2>design: <span id="selected-label"></span></h2>
+<div class="grid">
+<div><div id="design"></div><h3>at this design</h3><div id="objectives"></div></div>
+<div><h3>what limits it (binding requirements and bounds)</h3><div id="limits"></div>
+<h3>violated requirements</h3><div id="violated"></div><div id="reference"></div></div>
+<div id="sketch" class="plot"></div>
+<div id="curves" class="plot"></div>
+</div>
+<script type="application/json" id="report-data">{to_json(data)}</script>
+<script>{_SCRIPT}</script>
+</body></html>
+"""

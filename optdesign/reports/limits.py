@@ -1,0 +1,299 @@
+"""What limits a design, in the quantities the user wrote.
+
+The solver reports constraint rows as it sees them: one row per deflection angle, some
+rows on a transformed quantity (the sine of a rod inclination, the cosine of a
+transmission angle), some internal (the epigraph rows ``backlash_envelope[...]`` that
+carry the objective). Here rows become :class:`Limit` records, one per requirement,
+shown through the block's own ``display`` map (an inclination in degrees, not its sine)
+and in the units a user reads; active variable bounds are limits too.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from optdesign.reports.units import Shown, angle_unit, shown
+
+#: Row names that carry the objective in the epigraph form: never shown to users.
+INTERNAL_MARKERS = ("_envelope",)
+
+
+def is_internal(row_name: str) -> bool:
+    """True for a formulation's own rows (the objective's epigraph rows)."""
+    base = row_name.split("[", 1)[0]
+    return any(m in base for m in INTERNAL_MARKERS)
+
+
+@dataclass
+class Limit:
+    """One requirement or variable bound at a design, as a user reads it.
+
+    Attributes
+    ----------
+    name, description
+        Requirement (or variable) name and what it is.
+    kind
+        ``"requirement"`` or ``"bound"`` (a design variable at its bound).
+    side
+        ``"max"`` or ``"min"``: which side of the requirement binds.
+    value, limit
+        The worst value over the binding angles, and the limit, in ``value.unit``.
+    where
+        Deflection angles where it binds (empty for one-value requirements).
+    violation
+        Amount by which it is exceeded (0 when it holds), same unit.
+    """
+
+    name: str
+    description: str
+    kind: str
+    side: str
+    value: Shown
+    limit: Shown
+    where: list[str] = field(default_factory=list)
+    violation: float = 0.0
+
+    def text(self) -> str:
+        """One line: ``rod inclination (rod_inclination) = 25 deg, max 25 deg at phi=...``."""
+        what = f"{self.description} ({self.name})" if self.description else self.name
+        if self.kind == "bound":
+            return f"{what} = {self.value.text()}, at its {self.side} bound"
+        line = f"{what} = {self.value.text()}, {self.side} {self.limit.text()}"
+        if self.where:
+            shown_where = ", ".join(self.where[:4]) + (" ..." if len(self.where) > 4 else "")
+            line += f" at {shown_where}"
+        if self.violation > 0:
+            unit = "" if self.value.unit in ("", "%") else " " + self.value.unit
+            pct = " %" if self.value.unit == "%" else ""
+            word = "short by" if self.side == "min" else "exceeded by"
+            line += f": {word} {self.violation:.3g}{pct}{unit}"
+        return line
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "description": self.description,
+            "kind": self.kind,
+            "side": self.side,
+            "value": self.value.to_json(),
+            "limit": self.limit.to_json(),
+            "where": list(self.where),
+            "violation": {"value": float(self.violation), "unit": self.value.unit},
+        }
+
+
+@dataclass(frozen=True)
+class BlockInfo:
+    """How one constraint block is shown: its map to the user's quantity and unit."""
+
+    description: str
+    unit: str
+    display: Callable[[Any], Any] | None
+    display_unit: str
+
+
+def block_infos(problem: Any) -> dict[str, BlockInfo]:
+    """Name -> :class:`BlockInfo` of every constraint block of ``problem`` (NumPy path,
+    at its start design: only the declarations are read)."""
+    design = problem.design_dict(problem.start()[None, :])
+    with np.errstate(all="ignore"):
+        ex = problem.expressions(design)
+    infos = {
+        b.name: BlockInfo(b.description, b.unit, b.display, b.display_unit) for b in ex.constraints
+    }
+    for name in problem.objective_limits():
+        info = problem.objectives[name]
+        infos[f"{name}_max"] = BlockInfo(
+            f"{info.description} (limit)", info.unit, _scaled(info.display_scale), info.shown_unit
+        )
+    return infos
+
+
+def _scaled(scale: float) -> Callable[[Any], Any] | None:
+    return None if scale == 1.0 else (lambda v: v * scale)
+
+
+def _label(row_name: str) -> str:
+    return row_name.split("[", 1)[1].rstrip("]") if "[" in row_name else ""
+
+
+def limits_of(problem: Any, rows: Sequence[Any], infos: dict[str, BlockInfo] | None = None):
+    """:class:`Limit` records of constraint reports ``rows`` (one per requirement, the
+    worst row first), internal rows left out."""
+    if problem is None:
+        return []
+    infos = infos if infos is not None else block_infos(problem)
+    groups: dict[str, list[Any]] = {}
+    for r in rows:
+        if not is_internal(r.name):
+            groups.setdefault(r.name.split("[", 1)[0], []).append(r)
+    return [_limit(problem, name, group, infos.get(name)) for name, group in groups.items()]
+
+
+def _limit(problem: Any, name: str, group: list[Any], info: BlockInfo | None) -> Limit:
+    worst = max(group, key=lambda r: r.amount)
+    bound_hi = worst.upper is not None and (
+        worst.lower is None or abs(worst.value - worst.upper) <= abs(worst.value - worst.lower)
+    )
+    raw_limit = worst.upper if bound_hi else worst.lower
+    side = "max" if bound_hi else "min"
+    unit = info.unit if info is not None else worst.unit
+    where = [_label(r.name) for r in group if _label(r.name)]
+    if info is not None and info.display is not None:
+        f = info.display
+        worst_value = worst.value
+        if symmetric(f, worst.lower, worst.upper):
+            # |x| <= a written as -a <= x <= a: the user wrote the magnitude's limit
+            worst_value, raw_limit, side = abs(worst_value), worst.upper, "max"
+        value = Shown(float(f(worst_value)), info.display_unit)
+        limit = Shown(float(f(raw_limit)), info.display_unit)
+        # a decreasing map (an angle from its cosine) turns an upper row bound into a min
+        probe = raw_limit if np.isfinite(raw_limit) else worst.value
+        if _decreasing(f, probe):
+            side = "min" if side == "max" else "max"
+        violation = abs(value.value - limit.value) if worst.amount > 0 else 0.0
+        return Limit(name, info.description, "requirement", side, value, limit, where, violation)
+    angle = angle_unit(problem)
+    value = shown(worst.value, unit, angle)
+    limit = shown(raw_limit, unit, angle)
+    violation = abs(shown(worst.amount, unit, angle).value) if worst.amount > 0 else 0.0
+    description = info.description if info is not None else ""
+    return Limit(name, description, "requirement", side, value, limit, where, violation)
+
+
+def symmetric(f: Callable[[Any], Any], lower: float | None, upper: float | None) -> bool:
+    """A band -a <= x <= a whose display map is odd (shows as |f(x)| <= f(a))."""
+    if lower is None or upper is None or upper <= 0 or abs(lower + upper) > 1e-12 * upper:
+        return False
+    return abs(float(f(lower)) + float(f(upper))) <= 1e-9 * max(1.0, abs(float(f(upper))))
+
+
+def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> list[Limit]:
+    """Free variables of ``design`` at a bound (within ``rel`` of the bound range)."""
+    from optdesign.reports.units import variable_shown
+
+    out = []
+    for var in problem.free:
+        value = design.get(var.name)
+        if value is None:
+            continue
+        tol = rel * max(1.0, abs(var.upper - var.lower))
+        for side, bound in (("lower", var.lower), ("upper", var.upper)):
+            if abs(value - bound) < tol:
+                v = variable_shown(problem, var, value)
+                out.append(
+                    Limit(
+                        var.name,
+                        var.description,
+                        "bound",
+                        side,
+                        v,
+                        variable_shown(problem, var, bound),
+                    )
+                )
+    return out
+
+
+def what_limits(result: Any) -> list[Limit]:
+    """Everything that limits the optimum of ``result``: active requirements, then the
+    variables at a bound."""
+    problem = result.problem_object
+    if problem is None:
+        return []
+    out = limits_of(problem, result.active)
+    if result.design:
+        out += bound_limits(problem, result.design)
+    return out
+
+
+def objective_where(rows: Iterable[Any]) -> list[str]:
+    """Angles where the objective is attained (from its internal epigraph rows)."""
+    return sorted({_label(r.name) for r in rows if is_internal(r.name) and _label(r.name)})
+
+
+def relaxation_limits(problem: Any, items: Sequence[Any]) -> list[Limit]:
+    """:class:`~optdesign.studies.relaxation.Relaxation` records as limits a user reads:
+    ``limit`` as written, ``value`` the limit that makes the problem feasible (None:
+    relaxing it alone is not enough)."""
+    infos = block_infos(problem)
+    out = []
+    for r in items:
+        info = infos.get(r.name)
+        side = "max" if r.upper else "min"
+        written, needed = r.written, r.needed
+        unit = info.unit if info is not None else ""
+        f = info.display if info is not None else None
+        if f is not None:
+            if symmetric(f, r.lower_row, r.upper_row):
+                side, written = "max", r.upper_row
+                needed = None if needed is None else r.upper_row + abs(r.needed - r.written)
+            elif _decreasing(f, written):
+                side = "min" if side == "max" else "max"
+            lim = Shown(float(f(written)), info.display_unit)
+            need = None if needed is None else Shown(float(f(needed)), info.display_unit)
+        else:
+            angle = angle_unit(problem)
+            lim = shown(written, unit, angle)
+            need = None if needed is None else shown(needed, unit, angle)
+        description = info.description if info is not None else ""
+        out.append(Limit(r.name, description, "relaxation", side, need or Shown(math.nan), lim))
+    return out
+
+
+def relaxation_text(lim: Limit) -> str:
+    """``nut travel (nut_travel): max 25 mm -> 33.4 mm`` (or why there is no answer)."""
+    what = f"{lim.description} ({lim.name})" if lim.description else lim.name
+    if math.isnan(lim.value.value):
+        return f"{what}: relaxing it alone gave no feasible design (it conflicts with others too)"
+    return f"{what}: {lim.side} {lim.limit.text()} -> {lim.value.text()}"
+
+
+def _decreasing(f: Callable[[Any], Any], x: float) -> bool:
+    step = 1e-7 * max(1.0, abs(x))
+    return float(f(x + step)) < float(f(x))
+
+
+def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5):
+    """(active, violated) constraint reports of any design on the NumPy path: a row is
+    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond."""
+    from optdesign.problem.design_problem import relative_violation
+    from optdesign.solvers.result import ConstraintReport
+
+    x = np.array([design[v.name] for v in problem.free], dtype=float)
+    ev = problem.evaluate(x)
+    active, violated = [], []
+    for name, block in ev.constraints.items():
+        values = np.atleast_1d(np.asarray(block.values, dtype=float))
+        lo, hi = block.lower, block.upper
+        labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
+        viol = relative_violation(values, lo, hi)
+        for k, v in enumerate(values):
+            label = f"{name}[{labels[k]}]" if labels[k] else name
+            gap = min(
+                abs(v - lo) / max(1.0, abs(lo)) if lo is not None else math.inf,
+                abs(v - hi) / max(1.0, abs(hi)) if hi is not None else math.inf,
+            )
+            if viol[k] > rel:
+                amount = max(
+                    (lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0
+                )
+                violated.append(ConstraintReport(label, float(v), lo, hi, float(amount)))
+            elif gap <= rel:
+                active.append(ConstraintReport(label, float(v), lo, hi, 0.0))
+    return active, violated
+
+
+def binding_angles(rows: Iterable[Any]) -> dict[str, list[float]]:
+    """Requirement name -> deflection angles (deg) where its rows bind (internal rows
+    left out)."""
+    out: dict[str, list[float]] = {}
+    for r in rows:
+        if "[phi=" in r.name and not is_internal(r.name):
+            base, label = r.name.split("[", 1)
+            out.setdefault(base, []).append(float(label[4:].rstrip("]").removesuffix("deg")))
+    return out

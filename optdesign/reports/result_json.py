@@ -1,0 +1,123 @@
+"""``result.json``: the result of a solve as a user's program reads it.
+
+Every number is ``{"value": ..., "unit": ...}`` in the unit a user reads (the file's
+angle unit, moments in N*m, ripple in %); internal rows are left out; the document
+carries its schema version (:data:`SCHEMA`), described in ``docs/reports.md``.
+:meth:`Result.to_dict` stays the complete internal record (internal units, every row),
+which the stores of fronts and benchmarks keep.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from typing import Any
+
+from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.limits import (
+    bound_limits,
+    limits_of,
+    objective_where,
+    relaxation_limits,
+)
+from optdesign.reports.solve_text import objective_value
+from optdesign.reports.units import (
+    Shown,
+    json_value,
+    objective_shown,
+    requirement_values,
+    variable_shown,
+)
+from optdesign.solvers.result import Result, clean_json
+
+#: Name and version of the document's layout; bumped when a key changes meaning.
+SCHEMA = "optdesign.result/2"
+
+
+def result_document(result: Result) -> dict[str, Any]:
+    """The ``result.json`` document of ``result`` (see ``docs/reports.md``)."""
+    problem = result.problem_object
+    doc: dict[str, Any] = {
+        "schema": SCHEMA,
+        "problem": result.problem,
+        "mechanism": result.mechanism,
+        "status": result.status,
+        "success": result.success,
+        "solver": result.solver,
+        "formulation": result.formulation,
+        "termination": result.termination.value,
+        "message": result.message,
+        "verified": result.verified,
+        "wall_time": {"value": result.wall_time_s, "unit": "s"},
+    }
+    name = result.objective_name
+    doc["objective"] = {
+        "name": name,
+        **objective_shown(problem, name, objective_value(result)).to_json(),
+        "attained_at": objective_where(result.active),
+    }
+    if problem is None:
+        doc["design"] = {k: {"value": v, "unit": ""} for k, v in result.design.items()}
+        doc["objectives"] = {k: {"value": v, "unit": ""} for k, v in result.objectives.items()}
+        return clean_json(doc)
+    doc["requirements"] = {k: json_value(v) for k, v in requirement_values(problem).items()}
+    doc["design"] = _design(problem, result)
+    doc["achieved"] = {f.name: f.to_json() for f in design_facts(problem, result.design)}
+    doc["objectives"] = {f.name: f.to_json() for f in objective_facts(problem, result.objectives)}
+    limits = limits_of(problem, result.active)
+    if result.design:
+        limits += bound_limits(problem, result.design)
+    doc["limits"] = [lim.to_json() for lim in limits]
+    doc["violated"] = [lim.to_json() for lim in limits_of(problem, result.violated)]
+    relax = result.extra.get("relaxations")
+    if relax:
+        doc["relaxations"] = [
+            {
+                "name": lim.name,
+                "description": lim.description,
+                "side": lim.side,
+                "limit": lim.limit.to_json(),
+                "needed": lim.value.to_json(),
+            }
+            for lim in relaxation_limits(problem, relax)
+        ]
+    if result.bound is not None:
+        doc["bound"] = objective_shown(problem, name, result.bound).to_json()
+    if result.certificate is not None:
+        cert = result.certificate
+        doc["certificate"] = {
+            "kind": cert.kind,
+            "lower_bound": objective_shown(problem, name, cert.lower_bound).to_json(),
+            "gap": Shown(100.0 * cert.gap_rel, "%").to_json(),
+        }
+    if result.multistart is not None:
+        doc["multistart"] = asdict(result.multistart)
+    doc["notes"] = list(result.notes)
+    return clean_json(doc)
+
+
+def _design(problem: Any, result: Result) -> dict[str, Any]:
+    out = {}
+    for var in problem.variables:
+        if var.name not in result.design:
+            continue
+        v = variable_shown(problem, var, result.design[var.name])
+        entry: dict[str, Any] = {**v.to_json(), "description": var.description}
+        if var.free:
+            entry["lower"] = variable_shown(problem, var, var.lower).value
+            entry["upper"] = variable_shown(problem, var, var.upper).value
+        else:
+            entry["fixed"] = True
+        if var.name in result.ranges:
+            lo, hi = result.ranges[var.name]
+            entry["optimal_range"] = [
+                variable_shown(problem, var, lo).value,
+                variable_shown(problem, var, hi).value,
+            ]
+        out[var.name] = entry
+    return out
+
+
+def result_json(result: Result) -> str:
+    """``result.json`` as text."""
+    return json.dumps(result_document(result), indent=2)
