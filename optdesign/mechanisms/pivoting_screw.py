@@ -49,7 +49,10 @@ class PivotingScrew(Mechanism):
     }
     requirements: ClassVar = {
         "transmission_angle": RequirementInfo(
-            "band", "angle", "angle between horn and actuator at the horn pin"
+            "band",
+            "angle",
+            "angle between horn and actuator at the horn pin",
+            valid=(0.0, np.pi),
         ),
         "dead_length": RequirementInfo(
             "value",

@@ -11,10 +11,12 @@ converted to the internal units (mm, N, MPa, N*mm, rad) on load by
 
 from __future__ import annotations
 
+import math
 from functools import cache
 from typing import Annotated, Any, Literal
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -32,8 +34,11 @@ from optdesign.units import to_internal
 
 def _quantity(dimension: str):
     def convert(value: Any, info: ValidationInfo) -> float:
+        # A problem file (context bare="refuse") must give a dimensioned value its unit;
+        # a dict from Python and a validated spec's own dump hold internal units.
+        bare = (info.context or {}).get("bare", "internal")
         try:
-            return to_internal(value, dimension, info.field_name or dimension)
+            return to_internal(value, dimension, info.field_name or dimension, bare=bare)
         except InputError as exc:
             raise ValueError(exc.reason) from None
 
@@ -205,6 +210,12 @@ class DutyStep(_Model):
     hinge_moment: Moment
     time: float = Field(gt=0.0)
 
+    @model_validator(mode="after")
+    def _positive(self):
+        if not self.hinge_moment > 0:
+            raise ValueError(f"hinge_moment: must be positive, got {self.hinge_moment:g} N*mm")
+        return self
+
 
 class MotorLock(_Model):
     """Power-off lock on the motor shaft (seed 002): what it must hold and its force."""
@@ -214,7 +225,7 @@ class MotorLock(_Model):
     r1: Length | None = None
     r2: Length | None = None
     mu: float = Field(0.3, gt=0.0)
-    eta_screw_back: float = Field(1.0, le=1.0)
+    eta_screw_back: float = Field(1.0, gt=0.0, le=1.0)
     eta_gear_back: float = Field(1.0, gt=0.0, le=1.0)
     force_max: Force | None = None
 
@@ -227,6 +238,8 @@ class MotorLock(_Model):
                 raise ValueError(f"need 0 <= r1 < r2, got r1={self.r1}, r2={self.r2}")
         elif self.radius is None or self.radius <= 0:
             raise ValueError(f"a {self.kind} lock needs a positive radius")
+        if self.force_max is not None and not self.force_max > 0:
+            raise ValueError(f"force_max: must be positive, got {self.force_max:g} N")
         return self
 
 
@@ -267,6 +280,26 @@ class Requirements(_Model):
     stiffness_min: RotationalStiffness | None = None
 
     @model_validator(mode="after")
+    def _physical(self):
+        # Limits and loads are magnitudes: a negative or zero one is a sign error that a
+        # solver would otherwise turn into a constraint that never binds.
+        for name in POSITIVE_REQUIREMENTS:
+            value = getattr(self, name)
+            if isinstance(value, int | float) and not value > 0:
+                raise ValueError(f"{name}: must be positive, got {value:g} {_unit_of(name)}")
+        span = self.deflection.max - self.deflection.min
+        if span > 2 * math.pi + 1e-12:
+            raise ValueError(
+                f"deflection: the stroke spans {math.degrees(span):g} deg, more than a turn"
+            )
+        band = self.mean_ratio
+        if band is not None and any(v is not None and not v > 0 for v in (band.min, band.max)):
+            raise ValueError(
+                f"mean_ratio: min and max must be positive, got {band.min}, {band.max}"
+            )
+        return self
+
+    @model_validator(mode="after")
     def _drive_rules(self):
         if self.life_min is not None and not self.duty_cycle:
             raise ValueError("life_min needs a duty_cycle (deflection, hinge_moment, time)")
@@ -287,6 +320,26 @@ class Requirements(_Model):
         except InputError as exc:
             raise ValueError(exc.reason) from None
         return value
+
+
+#: Requirements that are magnitudes (checked > 0), with the internal unit for messages.
+POSITIVE_REQUIREMENTS: dict[str, str] = {
+    "hinge_moment": "N*mm",
+    "nut_travel_max": "mm",
+    "pin_bearing_pressure_max": "MPa",
+    "pin_shear_stress_max": "MPa",
+    "motor_torque_max": "N*mm",
+    "backlash_max": "rad",
+    "pin_contact_pressure_max": "MPa",
+    "deflection_rate": "rad/s",
+    "life_min": "h",
+    "stiffness_min": "N*mm/rad",
+    "dn_max": "mm/min",
+}
+
+
+def _unit_of(name: str) -> str:
+    return POSITIVE_REQUIREMENTS.get(name, "")
 
 
 class Objective(_Model):
@@ -406,9 +459,29 @@ def _requirement_field(info) -> tuple[Any, Any]:
         typ = QUANTITY_TYPES[info.dimension]
     else:
         raise ValueError(f"requirement kind {info.kind!r}: use 'band' or 'value'")
+    if getattr(info, "valid", None) is not None:
+        typ = Annotated[typ, AfterValidator(_in_range(info.valid, info.dimension))]
     if info.default is None:
         return (typ | None, Field(None, description=info.description))
     return (typ, Field(info.default, description=info.description))
+
+
+def _in_range(valid: tuple[float, float], dimension: str):
+    """Validator: a value (or a band's min and max) within ``valid`` (inclusive)."""
+    lo, hi = valid
+    deg = dimension == "angle"
+
+    def shown(v: float) -> str:
+        return f"{math.degrees(v):g} deg" if deg else f"{v:g}"
+
+    def check(value: Any) -> Any:
+        values = [value] if isinstance(value, int | float) else [value.min, value.max]
+        for v in values:
+            if v is not None and not lo <= v <= hi:
+                raise ValueError(f"{shown(v)} is outside [{shown(lo)}, {shown(hi)}]")
+        return value
+
+    return check
 
 
 @cache
