@@ -142,6 +142,8 @@ def validate_spec(
             parts = [str(p) for p in err["loc"] if not str(p).startswith("function-")]
             loc = ".".join(parts)
             msg = err["msg"].removeprefix("Value error, ")
+            if err["type"] == "missing":
+                msg = "missing (a required field)"
             if err["type"] == "extra_forbidden":
                 msg = "unknown field" + _did_you_mean(model, parts)
             head = re.match(r"(\w+): ", msg)  # a table's check naming its own field
@@ -191,9 +193,13 @@ def problem_from_dict(
         raise ProblemError(f"{source}: a problem is a table of sections, got {type(data).__name__}")
     name = data.get("mechanism")
     if not isinstance(name, str):
+        misspelt = [k for k in data if difflib.get_close_matches(str(k), ["mechanism"], 1, 0.6)]
+        hint = (
+            f"; is {misspelt[0]!r} a misspelling?" if "mechanism" not in data and misspelt else ""
+        )
         raise ProblemError(
             f"{source}: mechanism: give the mechanism's name "
-            f"(registered: {', '.join(registered())})"
+            f"(registered: {', '.join(registered())}){hint}"
         )
     try:
         cls = get_mechanism(name)
@@ -210,7 +216,12 @@ def problem_from_dict(
                 f"variables.{var_name}: unknown variable for a {cls.label()} "
                 f"({hint}known: {', '.join(table)})"
             )
-        variables.append(parse_variable(var_name, raw, table[var_name], cls.name, spec.screw, bare))
+        try:
+            variables.append(
+                parse_variable(var_name, raw, table[var_name], cls.name, spec.screw, bare)
+            )
+        except ProblemError as exc:
+            raise ProblemError(f"{source}: {exc}" if source != "problem" else str(exc)) from None
     declared = {v.name for v in variables}
     if spec.tolerances is not None:
         for var_name in spec.tolerances.variables():

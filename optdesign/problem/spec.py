@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from functools import cache
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 from pydantic import (
     AfterValidator,
@@ -68,7 +68,29 @@ QUANTITY_TYPES: dict[str, Any] = {
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # NaN and inf are refused in every plain number (quantities check their own).
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_boolean_numbers(cls, data: Any) -> Any:
+        # pydantic reads true as 1 in a number field (`pin_shear_planes = true`): refused.
+        if isinstance(data, dict):
+            for key, value in data.items():
+                info = cls.model_fields.get(key)
+                if (
+                    isinstance(value, bool)
+                    and info is not None
+                    and not _takes_bool(info.annotation)
+                ):
+                    raise ValueError(f"{key}: expected a number or a string, got {value}")
+        return data
+
+
+def _takes_bool(annotation: Any) -> bool:
+    return (
+        annotation is bool or annotation is Any or any(_takes_bool(a) for a in get_args(annotation))
+    )
 
 
 class Deflection(_Model):
