@@ -15,8 +15,8 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from hostile_corpus import PROBLEMS, all_cases, handwritten_cases, run_case
+
 from optdesign.errors import OptDesignError
 from optdesign.problem import load_problem
 from optdesign.units import to_internal
