@@ -64,6 +64,17 @@ def read_problem_text(path: Path) -> str:
         ) from None
 
 
+def _shipped_or(path: Path) -> Path:
+    """``path``, or the shipped problem of that name (``cs_min_backlash``) when no such
+    file exists and the name has no folder: the shipped files work from any folder."""
+    if path.exists() or path.parent != Path("."):
+        return path
+    from optdesign.data import problems_dir
+
+    shipped = problems_dir() / (path.name if path.suffix == ".toml" else f"{path.name}.toml")
+    return shipped if shipped.is_file() else path
+
+
 def _nesting(text: str) -> int:
     # Deepest bracket nesting outside strings, checked before tomllib (recursive) sees it.
     depth = deepest = 0
@@ -95,7 +106,7 @@ def load_problem(path: str | Path) -> DesignProblem:
     A problem file gives every dimensioned value its unit: a bare number there is refused
     with the unit to write (``hinge_moment: 300 has no unit; write "300 N*m"``).
     """
-    path = Path(path)
+    path = _shipped_or(Path(path))
     text = read_problem_text(path)
     if _nesting(text) > MAX_NESTING:
         raise ProblemError(f"{path}: arrays or tables nested too deeply (at most {MAX_NESTING})")
