@@ -422,6 +422,23 @@ def command_line_cases() -> list[Case]:
         ('reproduce nosuch', ['reproduce', 'nosuch'], ('nosuch',), ''),
     ]
     # fmt: on
+    resume = [
+        "pareto",
+        two,
+        "--objectives",
+        "ripple,size",
+        "--points",
+        "5",
+        "--resume",
+        "--out",
+        "{tmp}/p",
+        "--workers",
+        "1",
+    ]
+    lines += [
+        (f"pareto resume {kind}", resume, ("epsilon.jsonl",), f"store-{kind}")
+        for kind in ("binary", "empty", "foreign")
+    ]
     if os.geteuid() == 0:  # root writes into a read-only folder: the case tests nothing
         lines = [line for line in lines if line[3] != "readonly"]
     return [Case(f"argv:{n}", a, None, names=k, setup=st) for n, a, k, st in lines]
@@ -448,6 +465,14 @@ def _prepare(case: Case, tmp: Path) -> list[str]:
         (tmp / "problem.toml").write_bytes(data)
     if case.setup == "outfile":
         (tmp / "f").write_text("not a folder\n")
+    if case.setup.startswith("store-"):
+        (tmp / "p").mkdir(exist_ok=True)
+        store = {
+            "store-binary": bytes(range(256)) * 8,
+            "store-empty": b"",
+            "store-foreign": b'{"kind": "something else", "id": 1}\n{"x": 1}\n',
+        }[case.setup]
+        (tmp / "p" / "epsilon.jsonl").write_bytes(store)
     if case.setup == "readonly":
         (tmp / "ro").mkdir(exist_ok=True)
         (tmp / "ro").chmod(0o555)

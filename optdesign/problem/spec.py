@@ -297,7 +297,7 @@ class Requirements(_Model):
     dn_max: float | Literal["rolled", "peeled", "ground", "high-speed"] | None = None
     static_safety_min: float | None = Field(None, ge=1.0)
     life_min: Time | None = None
-    duty_cycle: list[DutyStep] | None = None
+    duty_cycle: list[DutyStep] | None = Field(None, max_length=1000)
     f_w: float = Field(1.0, ge=1.0, le=3.0)
     stiffness_min: RotationalStiffness | None = None
 
@@ -368,7 +368,7 @@ class Objective(_Model):
     """Objective(s) to minimise; several for Pareto fronts. Names are checked against the
     problem's objective catalogue (built-in and user-added) when the problem is built."""
 
-    minimize: list[str] = Field(min_length=1)
+    minimize: list[str] = Field(min_length=1, max_length=10)
 
     @model_validator(mode="before")
     @classmethod
