@@ -371,6 +371,12 @@ def handwritten_cases() -> list[Case]:
         ('infeasible travel', _sub('"110 mm"', '"1 mm"'), ('nut_travel',), (1,)),
     ]
     # fmt: on
+    pivot = (PROBLEMS / "pivot_min_backlash.toml").read_text()
+    assert 'dead_length = "60 mm"' in pivot
+    files += [
+        ("dead length negative", pivot.replace('dead_length = "60 mm"', 'dead_length = "-60 mm"'), ("dead_length",), (2,)),
+        ("assembly margin 2", _sub(_MOMENT, _MOMENT + "\nassembly_margin_min = 2"), ("assembly_margin_min",), (2,)),
+    ]  # fmt: skip
     cases = [Case(f"file:{n}", s, t, codes=c, names=k) for n, t, k, c in files]
     return cases
 

@@ -186,7 +186,7 @@ def test_hyphen_only_joins_unit_names():
         (
             'hinge_moment = "500 N*m"',
             'hinge_moment = "-500 N*m"',
-            "requirements.hinge_moment: must be positive, got -500000 N*mm",
+            "requirements.hinge_moment: must be positive, got -500 N*m",
         ),
         (
             "nut_travel_max",

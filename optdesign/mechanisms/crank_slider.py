@@ -55,6 +55,7 @@ class CrankSlider(Mechanism):
             "dimensionless",
             "smallest (l^2 - u^2)/l^2 over the stroke (distance from the toggle position)",
             default=0.01,
+            valid=(0.0, 1.0),
         ),
     }
     fixed_clearances: ClassVar = {

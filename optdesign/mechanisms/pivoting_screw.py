@@ -58,6 +58,7 @@ class PivotingScrew(Mechanism):
             "value",
             "length",
             "shortest actuator length minus its stroke (body, bearings, nut)",
+            valid=(0.0, np.inf),
         ),
     }
     pin_shear_planes = 2

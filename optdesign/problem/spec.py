@@ -235,7 +235,8 @@ class DutyStep(_Model):
     @model_validator(mode="after")
     def _positive(self):
         if not self.hinge_moment > 0:
-            raise ValueError(f"hinge_moment: must be positive, got {self.hinge_moment:g} N*mm")
+            shown = _shown("hinge_moment", self.hinge_moment)
+            raise ValueError(f"hinge_moment: must be positive, got {shown}")
         return self
 
 
@@ -308,7 +309,7 @@ class Requirements(_Model):
         for name in POSITIVE_REQUIREMENTS:
             value = getattr(self, name)
             if isinstance(value, int | float) and not value > 0:
-                raise ValueError(f"{name}: must be positive, got {value:g} {_unit_of(name)}")
+                raise ValueError(f"{name}: must be positive, got {_shown(name, value)}")
         span = self.deflection.max - self.deflection.min
         if span > 2 * math.pi + 1e-12:
             raise ValueError(
@@ -344,24 +345,26 @@ class Requirements(_Model):
         return value
 
 
-#: Requirements that are magnitudes (checked > 0), with the internal unit for messages.
-POSITIVE_REQUIREMENTS: dict[str, str] = {
-    "hinge_moment": "N*mm",
-    "nut_travel_max": "mm",
-    "pin_bearing_pressure_max": "MPa",
-    "pin_shear_stress_max": "MPa",
-    "motor_torque_max": "N*mm",
-    "backlash_max": "rad",
-    "pin_contact_pressure_max": "MPa",
-    "deflection_rate": "rad/s",
-    "life_min": "h",
-    "stiffness_min": "N*mm/rad",
-    "dn_max": "mm/min",
+#: Requirements that are magnitudes (checked > 0), with the unit a message shows them in
+#: and its factor from the internal unit.
+POSITIVE_REQUIREMENTS: dict[str, tuple[str, float]] = {
+    "hinge_moment": ("N*m", 1e-3),
+    "nut_travel_max": ("mm", 1.0),
+    "pin_bearing_pressure_max": ("MPa", 1.0),
+    "pin_shear_stress_max": ("MPa", 1.0),
+    "motor_torque_max": ("N*m", 1e-3),
+    "backlash_max": ("deg", 180.0 / math.pi),
+    "pin_contact_pressure_max": ("MPa", 1.0),
+    "deflection_rate": ("deg/s", 180.0 / math.pi),
+    "life_min": ("h", 1.0),
+    "stiffness_min": ("N*m/rad", 1e-3),
+    "dn_max": ("mm/min", 1.0),
 }
 
 
-def _unit_of(name: str) -> str:
-    return POSITIVE_REQUIREMENTS.get(name, "")
+def _shown(name: str, value: float) -> str:
+    unit, factor = POSITIVE_REQUIREMENTS.get(name, ("", 1.0))
+    return f"{value * factor:g} {unit}".rstrip()
 
 
 class Objective(_Model):
