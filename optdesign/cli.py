@@ -55,9 +55,11 @@ def _reproduce(sub):
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
 
     def run(args):
+        from optdesign import storage
         from optdesign.reproduce import run as run_reproduction
 
         out = args.out or default_out(args.paper)
+        storage.ensure_writable(out)  # an --out that is a file: one line, before any work
         return run_reproduction(args.paper, out)
 
     p.set_defaults(func=run)

@@ -375,6 +375,8 @@ def handwritten_cases() -> list[Case]:
     assert 'dead_length = "60 mm"' in pivot
     files += [
         ("dead length negative", pivot.replace('dead_length = "60 mm"', 'dead_length = "-60 mm"'), ("dead_length",), (2,)),
+        ("infeasible ratio band", _sub("min = 200, max = 260", "min = 2000, max = 2100"), ("mean_ratio",), (1,)),
+        ("infeasible pin pressure", _sub('"100 MPa"', '"0.01 MPa"'), ("pin_bearing_pressure",), (1,)),
         ("assembly margin 2", _sub(_MOMENT, _MOMENT + "\nassembly_margin_min = 2"), ("assembly_margin_min",), (2,)),
     ]  # fmt: skip
     cases = [Case(f"file:{n}", s, t, codes=c, names=k) for n, t, k, c in files]
@@ -425,6 +427,8 @@ def command_line_cases() -> list[Case]:
         ('bench suite nosuch', ['bench', '--suite', 'nosuch'], ('--suite',), ''),
         ('bench solvers nosuch', ['bench', '--solvers', 'nosuch', '--out', '{tmp}/b'], ('nosuch',), ''),
         ('bench out is a file', ['bench', '--suite', 'quick', '--out', '{tmp}/f'], ('f',), 'outfile'),
+        ('out under a file', ['solve', ok, '--out', '{tmp}/f/sub', '--starts', '1'], ('f',), 'outfile'),
+        ('reproduce out is a file', ['reproduce', 'duan2017', '--out', '{tmp}/f'], ('f',), 'outfile'),
         ('reproduce nosuch', ['reproduce', 'nosuch'], ('nosuch',), ''),
     ]
     # fmt: on
