@@ -213,3 +213,17 @@ def test_messages_name_the_field(tmp_path, old, new, message):
 def test_reference_keys_are_checked(tmp_path):
     with pytest.raises(OptDesignError, match=r"reference.RR: unknown field; did you mean 'R'"):
         _load(tmp_path, "[objective]", '[reference]\nRR = "50 mm"\n\n[objective]')
+
+
+def test_nesting_counts_only_toml_structure(tmp_path):
+    """Brackets in comments and strings are text: a valid file with many of them loads."""
+    from optdesign.problem.load import MAX_NESTING, _nesting
+
+    assert _nesting("a = [[1], [2]]\n[t]\nb = { c = [1] }\n") == 2
+    deep = "[" * (MAX_NESTING + 5)
+    assert _nesting(f"# {deep}\ns = \"{deep}\"\nt = '{deep}'\n") == 0
+    text = BASE.replace("[objective]", f"# {deep}\n[objective]", 1)
+    text = text.replace('name = "cs_min_backlash"', f'name = "cs_min_backlash"  # {deep}', 1)
+    f = tmp_path / "p.toml"
+    f.write_text(text)
+    assert load_problem(f).name == "cs_min_backlash"

@@ -80,8 +80,11 @@ def _nesting(text: str) -> int:
     depth = deepest = 0
     quote = ""
     escaped = False
+    comment = False
     for ch in text:
-        if quote:
+        if comment:
+            comment = ch != "\n"
+        elif quote:
             if escaped:
                 escaped = False
             elif ch == "\\" and quote == '"':
@@ -90,6 +93,8 @@ def _nesting(text: str) -> int:
                 quote = ""
         elif ch in "\"'":
             quote = ch
+        elif ch == "#":
+            comment = True
         elif ch in "[{":
             depth += 1
             deepest = max(deepest, depth)
