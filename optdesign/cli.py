@@ -146,13 +146,13 @@ def stdout_to_stderr():
     (``solve --json``). Restores stdout on exit."""
     saved_fd = None
     try:
-        fd = sys.stdout.fileno()
+        fd, err_fd = sys.stdout.fileno(), sys.stderr.fileno()
     except (AttributeError, OSError, ValueError):  # a StringIO (tests): Python level only
-        fd = None
-    if fd is not None:
+        fd = err_fd = None
+    if fd is not None and err_fd is not None and fd != err_fd:
         sys.stdout.flush()
         saved_fd = os.dup(fd)
-        os.dup2(sys.stderr.fileno(), fd)  # C libraries and child processes write to fd 1
+        os.dup2(err_fd, fd)  # C libraries and child processes write to fd 1
     try:
         with contextlib.redirect_stdout(sys.stderr):
             yield
