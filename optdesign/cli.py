@@ -9,6 +9,7 @@ exit code 130 or 143 (128 + the signal number, as a shell reports a killed comma
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -54,9 +55,11 @@ def _reproduce(sub):
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
 
     def run(args):
+        from optdesign import storage
         from optdesign.reproduce import run as run_reproduction
 
         out = args.out or default_out(args.paper)
+        storage.ensure_writable(out)  # an --out that is a file: one line, before any work
         return run_reproduction(args.paper, out)
 
     p.set_defaults(func=run)
@@ -78,6 +81,50 @@ PLUGIN_MODULES: list[str] = [
 ]
 
 
+def bounded_int(lo: int, hi: int) -> Callable[[str], int]:
+    """An argparse type: an integer from ``lo`` to ``hi`` (sizes are capped, so that a
+    typo cannot start unbounded work)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{value} is outside {lo}..{hi}")
+        return value
+
+    return parse
+
+
+def bounded_float(lo: float, hi: float) -> Callable[[str], float]:
+    """An argparse type: a finite number with ``lo < value <= hi``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not lo < value <= hi:  # also refuses nan
+            raise argparse.ArgumentTypeError(f"{text} is outside ({lo:g}, {hi:g}]")
+        return value
+
+    return parse
+
+
+#: Caps of the command-line sizes (a front of 10^7 points is a typo, not a study).
+MAX_WORKERS = 256
+MAX_STARTS = 10_000
+MAX_POINTS = 10_000
+MAX_SEED = 2**32 - 1
+
+
+def _version() -> str:
+    from optdesign import __version__
+
+    return __version__
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every registered subcommand."""
     _load_plugins()
@@ -85,10 +132,35 @@ def build_parser() -> argparse.ArgumentParser:
         prog="optdesign",
         description="Design optimisation of ball-screw actuator transmissions.",
     )
+    parser.add_argument("--version", action="version", version=f"optdesign {_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     for builder in COMMANDS.values():
         builder(sub)
     return parser
+
+
+@contextlib.contextmanager
+def stdout_to_stderr():
+    """Send everything printed while it is open - a solver's log, from this process or
+    from its workers - to stderr, so that stdout carries only a command's own output
+    (``solve --json``). Restores stdout on exit."""
+    saved_fd = None
+    try:
+        fd, err_fd = sys.stdout.fileno(), sys.stderr.fileno()
+    except (AttributeError, OSError, ValueError):  # a StringIO (tests): Python level only
+        fd = err_fd = None
+    if fd is not None and err_fd is not None and fd != err_fd:
+        sys.stdout.flush()
+        saved_fd = os.dup(fd)
+        os.dup2(err_fd, fd)  # C libraries and child processes write to fd 1
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        if saved_fd is not None:
+            sys.stderr.flush()
+            os.dup2(saved_fd, fd)
+            os.close(saved_fd)
 
 
 def run_guarded(func: Callable[[], int | None]) -> int:
@@ -98,7 +170,8 @@ def run_guarded(func: Callable[[], int | None]) -> int:
     -------
     int
         ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
-        (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143).
+        (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143);
+        1 for any other exception (one line; ``OPTDESIGN_DEBUG=1`` re-raises it).
     """
     try:
         with interrupts_as_exceptions():
@@ -109,6 +182,18 @@ def run_guarded(func: Callable[[], int | None]) -> int:
     except OSError as exc:  # e.g. no space left while writing the results
         print(f"optdesign: error: {exc}", file=sys.stderr)
         return 2
+    except Exception as exc:
+        # Last resort: a bug (or an input no check foresaw) is one line, not a traceback;
+        # OPTDESIGN_DEBUG=1 shows the traceback for a report.
+        if os.environ.get("OPTDESIGN_DEBUG"):
+            raise
+        text = " ".join(str(exc).split())[:300]
+        print(
+            f"optdesign: internal error: {type(exc).__name__}: {text} "
+            "(set OPTDESIGN_DEBUG=1 for the traceback, and please report it)",
+            file=sys.stderr,
+        )
+        return 1
     except KeyboardInterrupt as exc:
         name, code = exit_code(exc)
         store = getattr(exc, "run_store", None)

@@ -78,6 +78,7 @@ _DIMENSION_NAMES: dict[str, str] = {
 ALIASES: dict[str, str] = {
     "Nm": "N*m",
     "kNm": "kN*m",
+    "MNm": "MN*m",
     "mNm": "mN*m",
     "Nmm": "N*mm",
     "Ncm": "N*cm",
@@ -94,6 +95,9 @@ MAX_LENGTH = 100
 MAX_POWER = 9
 #: Deepest nesting of parentheses.
 MAX_DEPTH = 4
+#: Largest magnitude accepted in internal units: 1e15 mm is a billion kilometres; beyond
+#: it a bound only breaks the solver's scaling (1e308 overflows to inf in the first sum).
+MAX_MAGNITUDE = 1e15
 
 Bare = Literal["internal", "refuse"]
 
@@ -148,6 +152,8 @@ def _parse(text: str) -> tuple[float, Any]:
     star = re.match(r"\s*[*·⋅×](?!\*)", rest)  # "2*mm", as pint allowed
     if star is not None:
         rest = rest[star.end() :]
+    # "N-m", "lbf-ft": a hyphen between two unit names multiplies (engineering usage).
+    rest = re.sub(r"(?<=[^\W\d_])-(?=[^\W\d_])", "*", rest)
     parser = _UnitParser(rest, text)
     unit = parser.expression(0)
     parser.expect_end()
@@ -330,6 +336,7 @@ def _is_quantity(value: object) -> bool:
 def _bare(number: float, text: str, dimension: str, field: str, bare: Bare) -> float:
     if not math.isfinite(number):
         raise InputError(field, f"{text!r} is not a finite number")
+    _check_magnitude(number, text, field)
     if bare == "refuse" and number != 0.0 and dimension != "dimensionless":
         raise InputError(field, f"{text} has no unit; write {_suggest(text, dimension)}")
     return number
@@ -362,7 +369,16 @@ def _convert(q: Any, shown: object, dimension: str, field: str) -> float:
         ) from None
     if not math.isfinite(result):
         raise InputError(field, f"{shown!r} is out of range")
+    _check_magnitude(result, str(shown), field, INTERNAL_UNITS[dimension])
     return result
+
+
+def _check_magnitude(value: float, shown: str, field: str, unit: str = "") -> None:
+    if abs(value) > MAX_MAGNITUDE:
+        internal = f" {unit}" if unit and unit != "dimensionless" else ""
+        raise InputError(
+            field, f"{shown} is out of range (magnitude above {MAX_MAGNITUDE:g}{internal})"
+        )
 
 
 def convert(value: object, unit: str, field: str) -> float:

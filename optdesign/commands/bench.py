@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from optdesign.cli import command, default_out
+from optdesign.cli import MAX_WORKERS, bounded_float, bounded_int, command, default_out
 
 
 @command("bench")
@@ -28,7 +28,12 @@ def _bench(sub):
         help="configurations to run (default: all registered; see --list)",
     )
     p.add_argument("--list", action="store_true", help="list the configurations and exit")
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="local processes")
+    p.add_argument(
+        "--workers",
+        type=bounded_int(1, MAX_WORKERS),
+        default=os.cpu_count() or 1,
+        help="local processes",
+    )
     p.add_argument(
         "--scheduler", default=None, help="Dask scheduler address (instead of local processes)"
     )
@@ -48,13 +53,13 @@ def _bench(sub):
     )
     p.add_argument(
         "--time-limit",
-        type=float,
+        type=bounded_float(0.0, 86_400.0),
         default=1.0,
         help="soft wall-time limit of each solver call, s (default 1; set-up not included)",
     )
     p.add_argument(
         "--hard-timeout",
-        type=float,
+        type=bounded_float(0.0, 86_400.0),
         default=None,
         help="kill a run after this many s (default time limit + 3)",
     )

@@ -10,7 +10,15 @@ import os
 import time
 from pathlib import Path
 
-from optdesign.cli import command, default_out
+from optdesign.cli import (
+    MAX_POINTS,
+    MAX_SEED,
+    MAX_STARTS,
+    MAX_WORKERS,
+    bounded_int,
+    command,
+    default_out,
+)
 from optdesign.errors import InputError
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
@@ -23,7 +31,12 @@ def _pareto(sub):
     p.add_argument(
         "--objectives", required=True, help="two or three objectives, e.g. ripple,backlash"
     )
-    p.add_argument("--points", type=int, default=50, help="points of the front (default 50)")
+    p.add_argument(
+        "--points",
+        type=bounded_int(2, MAX_POINTS),
+        default=50,
+        help="points of the front (default 50)",
+    )
     p.add_argument(
         "--method",
         default="epsilon",
@@ -39,15 +52,26 @@ def _pareto(sub):
     )
     p.add_argument(
         "--workers",
-        type=int,
+        type=bounded_int(1, MAX_WORKERS),
         default=os.cpu_count() or 1,
         help="local processes (default: the CPU count)",
     )
     p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
-    p.add_argument("--starts", type=int, default=None, help="anchor multistarts (default: file's)")
-    p.add_argument("--seed", type=int, default=None, help="seed (default: file's)")
-    p.add_argument("--pop", type=int, default=100, help="NSGA-II population (default 100)")
-    p.add_argument("--generations", type=int, default=500, help="NSGA-II generations")
+    p.add_argument(
+        "--starts",
+        type=bounded_int(1, MAX_STARTS),
+        default=None,
+        help="anchor multistarts (default: file's)",
+    )
+    p.add_argument(
+        "--seed", type=bounded_int(0, MAX_SEED), default=None, help="seed (default: file's)"
+    )
+    p.add_argument(
+        "--pop", type=bounded_int(4, 100_000), default=100, help="NSGA-II population (default 100)"
+    )
+    p.add_argument(
+        "--generations", type=bounded_int(1, 100_000), default=500, help="NSGA-II generations"
+    )
     p.add_argument(
         "--deterministic",
         action="store_true",

@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
-from optdesign.cli import command, default_out
+from optdesign.cli import (
+    MAX_SEED,
+    MAX_STARTS,
+    MAX_WORKERS,
+    bounded_int,
+    command,
+    default_out,
+)
 
 
 @command("solve")
@@ -18,9 +26,24 @@ def _solve(sub):
     )
     p.add_argument("--solver", default="ipopt", help="solver back-end (default ipopt)")
     p.add_argument("--objective", default=None, help="objective to minimise (default: file's)")
-    p.add_argument("--starts", type=int, default=None, help="multistart count (default: file's)")
-    p.add_argument("--seed", type=int, default=None, help="multistart seed (default: file's)")
-    p.add_argument("--workers", type=int, default=1, help="local processes for the starts")
+    p.add_argument(
+        "--starts",
+        type=bounded_int(1, MAX_STARTS),
+        default=None,
+        help="multistart count (default: file's)",
+    )
+    p.add_argument(
+        "--seed",
+        type=bounded_int(0, MAX_SEED),
+        default=None,
+        help="multistart seed (default: file's)",
+    )
+    p.add_argument(
+        "--workers",
+        type=bounded_int(1, MAX_WORKERS),
+        default=1,
+        help="local processes for the starts",
+    )
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.add_argument("--no-report", action="store_true", help="skip the interactive report.html")
     p.add_argument(
@@ -53,19 +76,23 @@ def run_solve(args) -> int:
 
 def _solve_and_report(args, problem, out: Path | None) -> int:
     from optdesign.api import solve
+    from optdesign.cli import stdout_to_stderr
 
-    result = solve(
-        problem,
-        formulation=args.formulation,
-        objective=args.objective,
-        starts=args.starts,
-        seed=args.seed,
-        workers=args.workers,
-        solver=args.solver,
-        ranges=not args.no_ranges,
-    )
-    if not result.success and result.design and not args.no_diagnosis:
-        _diagnose(problem, result, args.solver)
+    # With --json, stdout carries the JSON only: a solver's log goes to stderr.
+    quiet = stdout_to_stderr() if args.json else contextlib.nullcontext()
+    with quiet:
+        result = solve(
+            problem,
+            formulation=args.formulation,
+            objective=args.objective,
+            starts=args.starts,
+            seed=args.seed,
+            workers=args.workers,
+            solver=args.solver,
+            ranges=not args.no_ranges,
+        )
+        if not result.success and result.design and not args.no_diagnosis:
+            _diagnose(problem, result, args.solver)
     from optdesign.reports.result_json import result_json
 
     text = result_json(result)

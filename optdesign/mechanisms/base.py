@@ -96,12 +96,16 @@ class RequirementInfo:
         What it limits.
     default
         Value imposed when the file omits it (None: not imposed).
+    valid
+        Physical range (inclusive, internal units) of the value or of a band's ends,
+        checked when the file is read (None: any finite value).
     """
 
     kind: str
     dimension: str
     description: str
     default: Any = None
+    valid: tuple[float, float] | None = None
 
 
 @dataclass

@@ -39,16 +39,23 @@ class CrankSlider(Mechanism):
     }
     requirements: ClassVar = {
         "transmission_angle": RequirementInfo(
-            "band", "angle", "angle between arm and rod at B (90 deg is ideal)"
+            "band",
+            "angle",
+            "angle between arm and rod at B (90 deg is ideal)",
+            valid=(0.0, np.pi),
         ),
         "rod_inclination_max": RequirementInfo(
-            "value", "angle", "largest inclination of the rod to the screw axis"
+            "value",
+            "angle",
+            "largest inclination of the rod to the screw axis",
+            valid=(0.0, np.pi / 2),
         ),
         "assembly_margin_min": RequirementInfo(
             "value",
             "dimensionless",
             "smallest (l^2 - u^2)/l^2 over the stroke (distance from the toggle position)",
             default=0.01,
+            valid=(0.0, 1.0),
         ),
     }
     fixed_clearances: ClassVar = {

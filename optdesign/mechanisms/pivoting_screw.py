@@ -49,12 +49,16 @@ class PivotingScrew(Mechanism):
     }
     requirements: ClassVar = {
         "transmission_angle": RequirementInfo(
-            "band", "angle", "angle between horn and actuator at the horn pin"
+            "band",
+            "angle",
+            "angle between horn and actuator at the horn pin",
+            valid=(0.0, np.pi),
         ),
         "dead_length": RequirementInfo(
             "value",
             "length",
             "shortest actuator length minus its stroke (body, bearings, nut)",
+            valid=(0.0, np.inf),
         ),
     }
     pin_shear_planes = 2

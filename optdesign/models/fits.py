@@ -254,7 +254,12 @@ class Fit:
         _check_values(values)
         match = _FIT_RE.match(str(text))
         if not match:
-            raise InputError(field, f"{text!r} is not a fit like 'H7/g6'")
+            holes, shafts, grades = _supported(values)
+            raise InputError(
+                field,
+                f"{text!r} is not a fit like 'H7/g6' (hole letters {', '.join(holes)}; "
+                f"shaft letters {', '.join(shafts)}; grades {grades[0]}..{grades[-1]})",
+            )
         hole, hg, shaft, sg = (
             match.group(1),
             int(match.group(2)),

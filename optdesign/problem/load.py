@@ -7,11 +7,13 @@ spec_model`), so a new mechanism plug-in brings its variables and requirements w
 
 from __future__ import annotations
 
+import difflib
 import re
+import stat
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, get_args
 
 from pydantic import ValidationError
 
@@ -20,23 +22,107 @@ from optdesign.mechanisms.registry import get_mechanism, registered
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.spec import ProblemSpec, spec_model
 from optdesign.problem.variables import parse_variable, variable_table
+from optdesign.units import Bare
+
+#: Largest problem file read (a real one is a few kB).
+MAX_FILE_BYTES = 1_000_000
+#: Deepest nesting of tables and arrays in a problem file (a real one needs 4).
+MAX_NESTING = 12
+
+
+def read_problem_text(path: Path) -> str:
+    """The text of a problem file: a regular, UTF-8 file of at most MAX_FILE_BYTES.
+
+    A named pipe, a device (``/dev/zero``) or a folder is refused before it is opened,
+    so that reading can neither block nor grow without bound.
+    """
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise ProblemError(f"{path}: cannot read problem file ({exc.strerror})") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = "a folder" if stat.S_ISDIR(st.st_mode) else "not a regular file"
+        raise ProblemError(f"{path}: cannot read problem file ({kind})")
+    if st.st_size > MAX_FILE_BYTES:
+        raise ProblemError(
+            f"{path}: problem file too large ({st.st_size} bytes, at most {MAX_FILE_BYTES})"
+        )
+    try:
+        with path.open("rb") as fh:
+            raw = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ProblemError(f"{path}: cannot read problem file ({exc.strerror})") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ProblemError(f"{path}: problem file too large (at most {MAX_FILE_BYTES} bytes)")
+    if b"\x00" in raw:
+        raise ProblemError(f"{path}: not a text file (a binary file; TOML is UTF-8 text)")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ProblemError(
+            f"{path}: not a text file (byte {exc.start} is not UTF-8; TOML must be UTF-8)"
+        ) from None
+
+
+def _shipped_or(path: Path) -> Path:
+    """``path``, or the shipped problem of that name (``cs_min_backlash``) when no such
+    file exists and the name has no folder: the shipped files work from any folder."""
+    if path.exists() or path.parent != Path("."):
+        return path
+    from optdesign.data import problems_dir
+
+    shipped = problems_dir() / (path.name if path.suffix == ".toml" else f"{path.name}.toml")
+    return shipped if shipped.is_file() else path
+
+
+def _nesting(text: str) -> int:
+    # Deepest bracket nesting outside strings, checked before tomllib (recursive) sees it.
+    depth = deepest = 0
+    quote = ""
+    escaped = False
+    comment = False
+    for ch in text:
+        if comment:
+            comment = ch != "\n"
+        elif quote:
+            if escaped:
+                escaped = False
+            elif ch == "\\" and quote == '"':
+                escaped = True
+            elif ch == quote:
+                quote = ""
+        elif ch in "\"'":
+            quote = ch
+        elif ch == "#":
+            comment = True
+        elif ch in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in "]}":
+            depth -= 1
+        elif ch == "\n":
+            depth = max(depth, 0)
+    return deepest
 
 
 def load_problem(path: str | Path) -> DesignProblem:
-    """Read, validate and build the problem in the TOML file ``path``."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ProblemError(f"{path}: cannot read problem file ({exc.strerror})") from None
-    except UnicodeDecodeError:
-        raise ProblemError(f"{path}: not a text file (TOML must be UTF-8)") from None
+    """Read, validate and build the problem in the TOML file ``path``.
+
+    A problem file gives every dimensioned value its unit: a bare number there is refused
+    with the unit to write (``hinge_moment: 300 has no unit; write "300 N*m"``).
+    """
+    path = _shipped_or(Path(path))
+    text = read_problem_text(path)
+    if _nesting(text) > MAX_NESTING:
+        raise ProblemError(f"{path}: arrays or tables nested too deeply (at most {MAX_NESTING})")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ProblemError(f"{path}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise ProblemError(f"{path}: arrays or tables nested too deeply") from None
     data.setdefault("name", path.stem)
-    return problem_from_dict(data, source=str(path))
+    return problem_from_dict(data, source=str(path), bare="refuse")
 
 
 def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProblem:
@@ -49,49 +135,109 @@ def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProbl
 
 
 def validate_spec(
-    data: dict[str, Any], mechanism: type, source: str = "problem", internal: bool = False
+    data: dict[str, Any],
+    mechanism: type,
+    source: str = "problem",
+    internal: bool = False,
+    bare: Bare = "internal",
 ) -> ProblemSpec:
     """Validate ``data`` against the schema of ``mechanism``; ProblemError naming fields.
 
     ``internal``: ``data`` is a validated spec's own dump (numbers in internal units).
+    ``bare``: a bare number for a dimensioned field is internal, or refused (files).
+    The error is one line: every invalid field with its reason, an unknown field with the
+    nearest valid name.
     """
+    model = spec_model(mechanism)
+    context = {"internal": internal, "bare": "internal" if internal else bare}
     try:
-        return spec_model(mechanism).model_validate(data, context={"internal": internal})
+        return model.model_validate(data, context=context)
     except ValidationError as exc:
         lines = []
         for err in exc.errors():
-            loc = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-"))
+            parts = [str(p) for p in err["loc"] if not str(p).startswith("function-")]
+            loc = ".".join(parts)
             msg = err["msg"].removeprefix("Value error, ")
+            if err["type"] == "missing":
+                msg = "missing (a required field)"
             if err["type"] == "extra_forbidden":
-                msg = "unknown field"
+                msg = "unknown field" + _did_you_mean(model, parts)
+            head = re.match(r"(\w+): ", msg)  # a table's check naming its own field
+            if head is not None:
+                loc, msg = f"{loc}.{head.group(1)}" if loc else head.group(1), msg[head.end() :]
             lines.append(f"{loc}: {msg}")
-        raise ProblemError(f"{source}: invalid problem file\n  " + "\n  ".join(lines)) from None
+        more = f" (and {len(lines) - 3} more)" if len(lines) > 3 else ""
+        raise ProblemError(f"{source}: {'; '.join(lines[:3])}{more}") from None
 
 
-def problem_from_dict(data: dict[str, Any], source: str = "problem") -> DesignProblem:
-    """Validate a problem given as a dict (the parsed TOML)."""
+def _did_you_mean(model: type, parts: list[str]) -> str:
+    """`` (did you mean 'x'?; valid: ...)`` for the unknown last key of ``parts``."""
+    # Walk the schema to the table that holds the key.
+    for key in parts[:-1]:
+        field = getattr(model, "model_fields", {}).get(key)
+        if field is None:
+            return ""
+        model = _model_of(field.annotation)
+        if model is None:
+            return ""
+    names = list(getattr(model, "model_fields", {}))
+    close = difflib.get_close_matches(parts[-1], names, n=1, cutoff=0.6)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return f"{hint} (valid: {', '.join(names)})" if len(names) <= 40 else hint
+
+
+def _model_of(annotation: Any) -> type | None:
+    """The pydantic model inside ``annotation`` (``X``, ``X | None``, ``Annotated[X, ...]``)."""
+    if isinstance(annotation, type) and hasattr(annotation, "model_fields"):
+        return annotation
+    for arg in get_args(annotation):
+        found = _model_of(arg)
+        if found is not None:
+            return found
+    return None
+
+
+def problem_from_dict(
+    data: dict[str, Any], source: str = "problem", bare: Bare = "internal"
+) -> DesignProblem:
+    """Validate a problem given as a dict (the parsed TOML).
+
+    ``bare``: a number without a unit for a dimensioned field is taken in internal units
+    (``"internal"``, a dict from Python) or refused (``"refuse"``, a problem file).
+    """
     if not isinstance(data, dict):
         raise ProblemError(f"{source}: a problem is a table of sections, got {type(data).__name__}")
     name = data.get("mechanism")
     if not isinstance(name, str):
+        misspelt = [k for k in data if difflib.get_close_matches(str(k), ["mechanism"], 1, 0.6)]
+        hint = (
+            f"; is {misspelt[0]!r} a misspelling?" if "mechanism" not in data and misspelt else ""
+        )
         raise ProblemError(
             f"{source}: mechanism: give the mechanism's name "
-            f"(registered: {', '.join(registered())})"
+            f"(registered: {', '.join(registered())}){hint}"
         )
     try:
         cls = get_mechanism(name)
     except InputError as exc:
         raise ProblemError(f"{source}: {exc}") from None
-    spec = validate_spec(data, cls, source)
+    spec = validate_spec(data, cls, source, bare=bare)
     table = variable_table(cls)
     variables = []
     for var_name, raw in spec.variables.items():
         if var_name not in table:
+            close = difflib.get_close_matches(var_name, list(table), n=1, cutoff=0.6)
+            hint = f"did you mean {close[0]!r}? " if close else ""
             raise ProblemError(
                 f"variables.{var_name}: unknown variable for a {cls.label()} "
-                f"(known: {', '.join(table)})"
+                f"({hint}known: {', '.join(table)})"
             )
-        variables.append(parse_variable(var_name, raw, table[var_name], cls.name, spec.screw))
+        try:
+            variables.append(
+                parse_variable(var_name, raw, table[var_name], cls.name, spec.screw, bare)
+            )
+        except ProblemError as exc:
+            raise ProblemError(f"{source}: {exc}" if source != "problem" else str(exc)) from None
     declared = {v.name for v in variables}
     if spec.tolerances is not None:
         for var_name in spec.tolerances.variables():

@@ -11,10 +11,12 @@ converted to the internal units (mm, N, MPa, N*mm, rad) on load by
 
 from __future__ import annotations
 
+import math
 from functools import cache
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -32,8 +34,11 @@ from optdesign.units import to_internal
 
 def _quantity(dimension: str):
     def convert(value: Any, info: ValidationInfo) -> float:
+        # A problem file (context bare="refuse") must give a dimensioned value its unit;
+        # a dict from Python and a validated spec's own dump hold internal units.
+        bare = (info.context or {}).get("bare", "internal")
         try:
-            return to_internal(value, dimension, info.field_name or dimension)
+            return to_internal(value, dimension, info.field_name or dimension, bare=bare)
         except InputError as exc:
             raise ValueError(exc.reason) from None
 
@@ -63,7 +68,29 @@ QUANTITY_TYPES: dict[str, Any] = {
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # NaN and inf are refused in every plain number (quantities check their own).
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_boolean_numbers(cls, data: Any) -> Any:
+        # pydantic reads true as 1 in a number field (`pin_shear_planes = true`): refused.
+        if isinstance(data, dict):
+            for key, value in data.items():
+                info = cls.model_fields.get(key)
+                if (
+                    isinstance(value, bool)
+                    and info is not None
+                    and not _takes_bool(info.annotation)
+                ):
+                    raise ValueError(f"{key}: expected a number or a string, got {value}")
+        return data
+
+
+def _takes_bool(annotation: Any) -> bool:
+    return (
+        annotation is bool or annotation is Any or any(_takes_bool(a) for a in get_args(annotation))
+    )
 
 
 class Deflection(_Model):
@@ -205,6 +232,13 @@ class DutyStep(_Model):
     hinge_moment: Moment
     time: float = Field(gt=0.0)
 
+    @model_validator(mode="after")
+    def _positive(self):
+        if not self.hinge_moment > 0:
+            shown = _shown("hinge_moment", self.hinge_moment)
+            raise ValueError(f"hinge_moment: must be positive, got {shown}")
+        return self
+
 
 class MotorLock(_Model):
     """Power-off lock on the motor shaft (seed 002): what it must hold and its force."""
@@ -214,7 +248,7 @@ class MotorLock(_Model):
     r1: Length | None = None
     r2: Length | None = None
     mu: float = Field(0.3, gt=0.0)
-    eta_screw_back: float = Field(1.0, le=1.0)
+    eta_screw_back: float = Field(1.0, gt=0.0, le=1.0)
     eta_gear_back: float = Field(1.0, gt=0.0, le=1.0)
     force_max: Force | None = None
 
@@ -227,6 +261,8 @@ class MotorLock(_Model):
                 raise ValueError(f"need 0 <= r1 < r2, got r1={self.r1}, r2={self.r2}")
         elif self.radius is None or self.radius <= 0:
             raise ValueError(f"a {self.kind} lock needs a positive radius")
+        if self.force_max is not None and not self.force_max > 0:
+            raise ValueError(f"force_max: must be positive, got {self.force_max:g} N")
         return self
 
 
@@ -262,9 +298,29 @@ class Requirements(_Model):
     dn_max: float | Literal["rolled", "peeled", "ground", "high-speed"] | None = None
     static_safety_min: float | None = Field(None, ge=1.0)
     life_min: Time | None = None
-    duty_cycle: list[DutyStep] | None = None
+    duty_cycle: list[DutyStep] | None = Field(None, max_length=1000)
     f_w: float = Field(1.0, ge=1.0, le=3.0)
     stiffness_min: RotationalStiffness | None = None
+
+    @model_validator(mode="after")
+    def _physical(self):
+        # Limits and loads are magnitudes: a negative or zero one is a sign error that a
+        # solver would otherwise turn into a constraint that never binds.
+        for name in POSITIVE_REQUIREMENTS:
+            value = getattr(self, name)
+            if isinstance(value, int | float) and not value > 0:
+                raise ValueError(f"{name}: must be positive, got {_shown(name, value)}")
+        span = self.deflection.max - self.deflection.min
+        if span > 2 * math.pi + 1e-12:
+            raise ValueError(
+                f"deflection: the stroke spans {math.degrees(span):g} deg, more than a turn"
+            )
+        band = self.mean_ratio
+        if band is not None and any(v is not None and not v > 0 for v in (band.min, band.max)):
+            raise ValueError(
+                f"mean_ratio: min and max must be positive, got {band.min}, {band.max}"
+            )
+        return self
 
     @model_validator(mode="after")
     def _drive_rules(self):
@@ -289,11 +345,33 @@ class Requirements(_Model):
         return value
 
 
+#: Requirements that are magnitudes (checked > 0), with the unit a message shows them in
+#: and its factor from the internal unit.
+POSITIVE_REQUIREMENTS: dict[str, tuple[str, float]] = {
+    "hinge_moment": ("N*m", 1e-3),
+    "nut_travel_max": ("mm", 1.0),
+    "pin_bearing_pressure_max": ("MPa", 1.0),
+    "pin_shear_stress_max": ("MPa", 1.0),
+    "motor_torque_max": ("N*m", 1e-3),
+    "backlash_max": ("deg", 180.0 / math.pi),
+    "pin_contact_pressure_max": ("MPa", 1.0),
+    "deflection_rate": ("deg/s", 180.0 / math.pi),
+    "life_min": ("h", 1.0),
+    "stiffness_min": ("N*m/rad", 1e-3),
+    "dn_max": ("mm/min", 1.0),
+}
+
+
+def _shown(name: str, value: float) -> str:
+    unit, factor = POSITIVE_REQUIREMENTS.get(name, ("", 1.0))
+    return f"{value * factor:g} {unit}".rstrip()
+
+
 class Objective(_Model):
     """Objective(s) to minimise; several for Pareto fronts. Names are checked against the
     problem's objective catalogue (built-in and user-added) when the problem is built."""
 
-    minimize: list[str] = Field(min_length=1)
+    minimize: list[str] = Field(min_length=1, max_length=10)
 
     @model_validator(mode="before")
     @classmethod
@@ -406,9 +484,29 @@ def _requirement_field(info) -> tuple[Any, Any]:
         typ = QUANTITY_TYPES[info.dimension]
     else:
         raise ValueError(f"requirement kind {info.kind!r}: use 'band' or 'value'")
+    if getattr(info, "valid", None) is not None:
+        typ = Annotated[typ, AfterValidator(_in_range(info.valid, info.dimension))]
     if info.default is None:
         return (typ | None, Field(None, description=info.description))
     return (typ, Field(info.default, description=info.description))
+
+
+def _in_range(valid: tuple[float, float], dimension: str):
+    """Validator: a value (or a band's min and max) within ``valid`` (inclusive)."""
+    lo, hi = valid
+    deg = dimension == "angle"
+
+    def shown(v: float) -> str:
+        return f"{math.degrees(v):g} deg" if deg else f"{v:g}"
+
+    def check(value: Any) -> Any:
+        values = [value] if isinstance(value, int | float) else [value.min, value.max]
+        for v in values:
+            if v is not None and not lo <= v <= hi:
+                raise ValueError(f"{shown(v)} is outside [{shown(lo)}, {shown(hi)}]")
+        return value
+
+    return check
 
 
 @cache

@@ -16,7 +16,7 @@ from typing import Any
 
 from optdesign.errors import InputError, ProblemError
 from optdesign.mechanisms.base import VariableInfo
-from optdesign.units import to_internal
+from optdesign.units import Bare, to_internal
 
 #: Variables of the sized pin joints and of the screw's size, the same for every mechanism.
 PIN_VARIABLES: dict[str, VariableInfo] = {
@@ -28,6 +28,9 @@ PIN_VARIABLES: dict[str, VariableInfo] = {
 
 #: Internal unit of each variable dimension (for tables).
 UNITS = {"length": "mm", "angle": "rad", "dimensionless": ""}
+
+#: Most values a discrete variable may list (branch and bound grows with them).
+MAX_CATALOGUE = 1000
 
 #: Catalogues a discrete variable may name (ISO 3408 preferred leads, ISO 2338 pins).
 CATALOGUES: dict[str, tuple[float, ...]] = {
@@ -100,8 +103,19 @@ def catalogue_items(catalogue: str, variable: str, field: str, screw=None) -> li
     raise ProblemError(f"{field}: unknown catalogue {catalogue!r} (known: {known})")
 
 
-def parse_variable(name: str, raw: Any, info: VariableInfo, mechanism: str, screw=None) -> Variable:
-    """Validate the ``[variables]`` entry ``name`` of a problem of ``mechanism``."""
+def parse_variable(
+    name: str,
+    raw: Any,
+    info: VariableInfo,
+    mechanism: str,
+    screw=None,
+    bare: Bare = "internal",
+) -> Variable:
+    """Validate the ``[variables]`` entry ``name`` of a problem of ``mechanism``.
+
+    ``bare``: a number without a unit is taken in internal units (``"internal"``, dicts
+    from Python) or refused with the unit to write (``"refuse"``, problem files).
+    """
     field = f"variables.{name}"
     unit = UNITS[info.dimension]
     make = dict(name=name, description=info.description, unit=unit, dimension=info.dimension)
@@ -109,7 +123,7 @@ def parse_variable(name: str, raw: Any, info: VariableInfo, mechanism: str, scre
     def q(value: Any, sub: str) -> float:
         where = f"{field}.{sub}" if sub else field
         try:
-            v = to_internal(value, info.dimension, where)
+            v = to_internal(value, info.dimension, where, bare=bare)
         except InputError as exc:
             raise ProblemError(str(exc)) from None
         if not math.isfinite(v):
@@ -143,8 +157,14 @@ def parse_variable(name: str, raw: Any, info: VariableInfo, mechanism: str, scre
         if "values" in raw:
             if not isinstance(raw["values"], list) or not raw["values"]:
                 raise ProblemError(f"{field}.values: must be a non-empty list")
+            if len(raw["values"]) > MAX_CATALOGUE:
+                raise ProblemError(
+                    f"{field}.values: {len(raw['values'])} values, at most {MAX_CATALOGUE}"
+                )
             values = [q(v, f"values[{k}]") for k, v in enumerate(raw["values"])]
         else:
+            if not isinstance(raw["catalogue"], str):
+                raise ProblemError(f"{field}.catalogue: give a catalogue's name (a string)")
             values = catalogue_items(raw["catalogue"], name, f"{field}.catalogue", screw)
         if lower is not None:
             values = [v for v in values if v >= lower - 1e-12]

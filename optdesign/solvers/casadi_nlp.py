@@ -7,13 +7,19 @@ dual values warm-start it.
 
 from __future__ import annotations
 
+import contextlib
+import difflib
+import io
+import re
 import time
 from collections.abc import Mapping
+from functools import lru_cache
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
+from optdesign.errors import InputError
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.result import Result, TerminationCondition
@@ -48,6 +54,68 @@ _IPOPT_STATUS = {
 }
 
 
+@lru_cache(maxsize=1)
+def ipopt_option_names() -> frozenset[str]:
+    """Every option this Ipopt build knows, read from Ipopt's own documentation output."""
+    x = ca.MX.sym("x")
+    buf = io.StringIO()
+    opts = {
+        "print_options_documentation": "yes",
+        "print_advanced_options": "yes",
+        "print_options_mode": "text",
+        "max_iter": 0,
+    }
+    with contextlib.redirect_stdout(buf):  # CasADi prints through Python's sys.stdout
+        solver = ca.nlpsol(
+            "options", "ipopt", {"x": x, "f": x**2}, {"ipopt": opts, "print_time": False}
+        )
+        solver(x0=1.0)
+    names = frozenset(re.findall(r"^([a-z]\w*)\s{2,}", buf.getvalue(), re.MULTILINE))
+    return names | {"sb"}  # "sb" (suppress the banner) is undocumented
+
+
+def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt") -> None:
+    """Refuse an option Ipopt does not know (with the nearest name) or a value it refuses.
+
+    Each option is tried on a one-variable problem, so the check is Ipopt's own.
+
+    Raises
+    ------
+    InputError
+        Naming ``field.<option>`` and the reason.
+    """
+    known = ipopt_option_names()
+    for key, value in options.items():
+        where = f"{field}.{key}"
+        if key not in known:
+            close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise InputError(where, f"unknown Ipopt option{hint}")
+        if isinstance(value, bool) or not isinstance(value, str | int | float):
+            raise InputError(where, f"expected a number or a string, got {value!r}")
+        _try_ipopt_option(key, value, where)
+
+
+@lru_cache(maxsize=256)
+def _try_ipopt_option(key: str, value: Any, where: str) -> None:
+    x = ca.MX.sym("x")
+    buf = io.StringIO()
+    opts = {"print_level": 0, "sb": "yes", "max_iter": 0, key: value}
+    if key in ("output_file", "print_options_documentation"):
+        return  # side effects (a file, the whole manual); the solve itself checks them
+    try:
+        with contextlib.redirect_stdout(buf):
+            solver = ca.nlpsol(
+                "check", "ipopt", {"x": x, "f": x**2}, {"ipopt": opts, "print_time": False}
+            )
+            solver(x0=1.0)
+    except RuntimeError as exc:
+        reason = str(exc).strip().splitlines()[-1].split(": ")[-1]
+        raise InputError(where, f"Ipopt refuses {value!r} ({reason})") from None
+    if solver.stats().get("return_status") == "Invalid_Option":
+        raise InputError(where, f"Ipopt refuses {value!r} (out of the option's range)")
+
+
 class CasadiNLPSolver:
     """A reusable CasADi NLP solver for one :class:`NLP`.
 
@@ -67,6 +135,7 @@ class CasadiNLPSolver:
         self.plugin = plugin
         opts: dict[str, Any] = {"print_time": False}
         if plugin == "ipopt":
+            check_ipopt_options(options or {})
             opts["ipopt"] = {**IPOPT_DEFAULTS, **(options or {})}
         else:
             opts.update(options or {})

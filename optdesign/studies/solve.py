@@ -91,7 +91,12 @@ def solver_for(
 
 def solver_options(problem: DesignProblem, name: str) -> dict[str, Any]:
     """The problem file's own options of back-end ``name`` (``[solver] ipopt = {...}``)."""
-    return dict(problem.spec.solver.ipopt) if name == "ipopt" else {}
+    if name != "ipopt":
+        return {}
+    from optdesign.solvers.casadi_nlp import check_ipopt_options
+
+    check_ipopt_options(problem.spec.solver.ipopt)  # before any work, naming the option
+    return dict(problem.spec.solver.ipopt)
 
 
 # --- the NLP path -----------------------------------------------------------------------
