@@ -108,7 +108,7 @@ def _nearest(items, d0: float, p: float) -> tuple[BallScrew, bool]:
 def _lookup(items, d0, p, fields) -> tuple[dict[str, Any], Any]:
     """The items' ``fields`` on the NumPy path, element-wise, and where the design is an
     item (1.0) or not (0.0): off the catalogue the nearest item's values stand in, so
-    that the other quantities stay finite, and the ``screw_catalogue`` block fails."""
+    that the other quantities stay finite, and the ``screw_catalogue_membership`` block fails."""
     d0, p = np.broadcast_arrays(np.asarray(d0, dtype=float), np.asarray(p, dtype=float))
     out = {f: np.full(d0.shape, np.nan) for f in fields}
     on = np.zeros(d0.shape)

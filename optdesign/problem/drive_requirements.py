@@ -69,7 +69,7 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
         # the NumPy check of a design: a (d0, p) pair the catalogue lacks is not a screw
         out.append(
             ConstraintBlock(
-                "screw_catalogue",
+                "screw_catalogue_membership",
                 data.on_catalogue,
                 1.0,
                 None,

@@ -19,12 +19,13 @@ import numpy as np
 
 from optdesign.reports.units import Shown, angle_unit, shown
 
-#: Row names that carry the objective in the epigraph form: never shown to users.
-INTERNAL_MARKERS = ("_envelope",)
+#: Row names never shown as limits: the objective's epigraph rows, and membership checks
+#: (a design is a catalogue item: met with equality by every catalogue design).
+INTERNAL_MARKERS = ("_envelope", "_membership")
 
 
 def is_internal(row_name: str) -> bool:
-    """True for a formulation's own rows (the objective's epigraph rows)."""
+    """True for a formulation's own rows (the objective's epigraph rows, membership checks)."""
     base = row_name.split("[", 1)[0]
     return any(m in base for m in INTERNAL_MARKERS)
 
