@@ -309,6 +309,9 @@ def to_internal(value: object, dimension: str, field: str, bare: Bare = "interna
         return _bare(float(value), _number_text(float(value)), dimension, field, bare)
     if isinstance(value, str):
         text = value.strip()
+        fast = _fast_internal(text, dimension)
+        if fast is not None:
+            return fast
         try:
             number, unit = _parse(text)
         except _Refused as exc:
@@ -326,6 +329,42 @@ def to_internal(value: object, dimension: str, field: str, bare: Bare = "interna
     raise InputError(
         field, f'expected a number or a quantity string such as "90 mm", got {value!r}'
     )
+
+
+_DEG = math.pi / 180.0
+
+#: The common units of each dimension, as written in problem files, and their factor to
+#: the internal unit. Building pint's registry costs ~0.9 s of a ~3 s command; these
+#: strings never need it (``tests/test_units_fast.py`` checks every factor against
+#: pint). Anything else, and every error, takes the pint path.
+FAST_UNITS: dict[str, dict[str, float]] = {
+    "length": {"mm": 1.0, "m": 1e3, "cm": 10.0, "um": 1e-3, "µm": 1e-3, "μm": 1e-3},
+    "force": {"N": 1.0, "kN": 1e3},
+    "pressure": {"MPa": 1.0, "GPa": 1e3, "kPa": 1e-3, "Pa": 1e-6, "N/mm^2": 1.0},
+    "moment": {"N*mm": 1.0, "N*m": 1e3, "Nm": 1e3, "kN*m": 1e6, "Nmm": 1.0},
+    "angle": {"rad": 1.0, "deg": _DEG, "degree": _DEG, "°": _DEG},
+    "stiffness": {"N/mm": 1.0, "kN/mm": 1e3, "N/um": 1e3, "N/µm": 1e3},
+    "speed": {"1/min": 1.0, "rpm": 1.0},
+    "time": {"h": 1.0, "min": 1.0 / 60.0, "s": 1.0 / 3600.0},
+    "angular_speed": {"rad/s": 1.0, "deg/s": _DEG},
+    "rotational_stiffness": {"N*mm/rad": 1.0, "N*m/rad": 1e3, "kN*m/rad": 1e6},
+}
+
+_FAST = re.compile(r"([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(\S+)")
+
+
+def _fast_internal(text: str, dimension: str) -> float | None:
+    """``text`` in the internal unit when it is a number and a unit of
+    :data:`FAST_UNITS` for ``dimension``; None otherwise (the caller takes pint's path)."""
+    m = _FAST.fullmatch(text)
+    if m is None:
+        return None
+    factor = FAST_UNITS.get(dimension, {}).get(m.group(2))
+    if factor is None:
+        return None
+    number = float(m.group(1))
+    result = number * factor
+    return result if math.isfinite(number) and math.isfinite(result) else None
 
 
 def _is_quantity(value: object) -> bool:

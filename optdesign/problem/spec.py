@@ -386,6 +386,8 @@ class SolverOptions(_Model):
 
     starts: int = Field(8, ge=1, le=10_000)
     seed: int = 0
+    #: The multistart stops once this many starts agree on the best value (0: run all).
+    agree: int = Field(3, ge=0, le=10_000)
     ipopt: dict[str, Any] = Field(default_factory=dict)
 
 

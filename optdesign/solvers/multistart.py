@@ -18,12 +18,10 @@ from optdesign.solvers.result import MultistartInfo, Result
 
 def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.ndarray:
     """``n`` scrambled-Sobol points in the box [lower, upper] (reproducible from ``seed``)."""
-    from scipy.stats import qmc
+    from optdesign.solvers.sobol import sobol_points
 
-    d = len(lower)
-    sampler = qmc.Sobol(d, scramble=True, seed=seed)
     m = max(0, math.ceil(math.log2(max(n, 1))))
-    pts = sampler.random_base2(m)[:n]
+    pts = sobol_points(len(lower), m, seed)[:n]
     return lower + pts * (upper - lower)
 
 

@@ -136,18 +136,21 @@ def solve_nlp(
     x0
         First start (default: the declared start, else the middle of the bounds).
     agree
-        Stop once this many starts agree on the best value (None: every start).
+        Stop once this many starts agree on the best value (default: the problem file's
+        ``[solver] agree``, 3; 0: every start). On every shipped problem all 8 default
+        starts reach the same optimum (benchmarks/README.md, "Overhead").
     """
     _no_catalogue(problem, "nlp")
     objective = objective or problem.objective_names[0]
     objectives = _objective_set(problem, objective)
     n_starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
+    agree = agree if agree is not None else problem.spec.solver.agree
     backend = solver_for(problem, solver, options, objectives)
     target = backend.nlp.target(objective)
     pts = start_points(problem, n_starts, seed, x0)
     result = multistart(
-        lambda x: backend.solve(x, target), pts, workers=workers, seed=seed, agree=agree
+        lambda x: backend.solve(x, target), pts, workers=workers, seed=seed, agree=agree or None
     )
     return finish(problem, result, objective)
 
@@ -183,12 +186,24 @@ def optimal_ranges(
     scale together). A search that fails keeps the optimal value on its side.
     """
     objective = result.objective_name or problem.objective_names[0]
+    warm = solver == "ipopt" and "lam_g" in result.raw
+    if warm:
+        # Primal and dual start at the optimum (benchmarks/README.md, "Overhead").
+        from optdesign.solvers.casadi_nlp import IPOPT_WARM
+
+        options = {**IPOPT_WARM, **(options or {})}
     backend = solver_for(problem, solver, options, _objective_set(problem, objective))
     nlp = backend.nlp
     limit = result.objective + rel * max(abs(result.objective), 1e-12)
     bounds = nlp.bounds(eps={objective: limit})
     x_opt = np.array([result.design[v.name] for v in problem.free])
-    start = nlp.start(z0=result.raw["z"]) if "z" in result.raw else nlp.start(x0=x_opt)
+    if warm:
+        raw = result.raw
+        start = nlp.start(z0=raw["z"], lam_x0=raw["lam_x"], lam_g0=raw["lam_g"])
+    elif "z" in result.raw:
+        start = nlp.start(z0=result.raw["z"])
+    else:
+        start = nlp.start(x0=x_opt)
     ranges = {}
     for var in problem.free:
         ends = []

@@ -23,21 +23,14 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, Start
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.casadi_nlp import IPOPT_WARM
 from optdesign.solvers.result import Result
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.solve import formulation_for, solver_for
 
 #: Ipopt options of warm-started sweep points: take the neighbour's multipliers and start
 #: close to the central path instead of pushing the point back into the interior.
-WARM_OPTIONS: dict[str, Any] = {
-    "warm_start_init_point": "yes",
-    "warm_start_bound_push": 1e-9,
-    "warm_start_bound_frac": 1e-9,
-    "warm_start_slack_bound_push": 1e-9,
-    "warm_start_slack_bound_frac": 1e-9,
-    "warm_start_mult_bound_push": 1e-9,
-    "mu_init": 1e-6,
-}
+WARM_OPTIONS: dict[str, Any] = IPOPT_WARM
 
 #: Ipopt options of the lexicographic tie-breaks. Their start is an optimum of the
 #: objective fixed before, so it is feasible (to the slack) and close to the tie-break's

@@ -1,0 +1,65 @@
+"""Imports paid only by the command that needs them (issue 15): each case runs the CLI
+in a fresh interpreter and lists the heavy modules it loaded."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("cvxpy", "pymoo", "dask", "matplotlib", "scipy.stats", "pint", "pandas")
+
+RUN = """
+import json, sys
+from optdesign.cli import main
+try:
+    code = main(sys.argv[1:])
+except SystemExit as exc:
+    code = exc.code
+heavy = [m for m in json.loads(HEAVY) if m in sys.modules]
+print(json.dumps({"code": code, "heavy": heavy}))
+"""
+
+
+def loaded(*args: str, cwd: Path = ROOT) -> dict:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
+    code = RUN.replace("json.loads(HEAVY)", repr(list(HEAVY)))
+    proc = subprocess.run(
+        [sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, cwd=cwd
+    )
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_help_imports_no_heavy_module():
+    out = loaded("--help")
+    assert out["code"] == 0 and out["heavy"] == []
+
+
+@pytest.mark.parametrize(
+    "text", ["garbage = [", '[problem]\nmechanism = "crank_slider"\nfoo = 1\n']
+)
+def test_bad_file_error_imports_no_heavy_module(tmp_path, text):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    out = loaded("solve", str(bad))
+    assert out["code"] == 2 and out["heavy"] == []
+
+
+def test_solve_without_plot_imports_no_heavy_module(tmp_path):
+    out = loaded(
+        "solve",
+        str(ROOT / "problems" / "fork_min_backlash.toml"),
+        "--formulation",
+        "nlp",
+        "--starts",
+        "2",
+        "--no-ranges",
+        "--no-plot",
+        "--out",
+        str(tmp_path / "out"),
+    )
+    assert out["code"] == 0 and out["heavy"] == []

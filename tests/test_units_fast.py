@@ -1,0 +1,48 @@
+"""The table of common units (read without pint) against pint's own conversion."""
+
+import math
+from pathlib import Path
+
+import pytest
+
+from optdesign import units
+from optdesign.units import FAST_UNITS, registry, to_internal
+
+CASES = [(dim, unit) for dim, table in FAST_UNITS.items() for unit in table]
+
+
+@pytest.mark.parametrize(("dimension", "unit"), CASES)
+def test_fast_table_agrees_with_pint(dimension, unit):
+    for number in (1.0, 37.5, -0.25):
+        fast = to_internal(f"{number} {unit}", dimension, "x")
+        q = registry().Quantity(number, units._parse(f"1 {unit}")[1])
+        slow = units._convert(q, unit, dimension, "x")
+        assert math.isclose(fast, slow, rel_tol=1e-14), (unit, fast, slow)
+
+
+def test_fast_path_leaves_errors_to_pint():
+    # A unit of the wrong dimension is not in that dimension's table: pint's message.
+    with pytest.raises(units.InputError, match="expected a length"):
+        to_internal("3 N", "length", "R")
+    assert units._fast_internal("1e999 mm", "length") is None
+    assert units._fast_internal("3 mm", "force") is None
+    assert units._fast_internal("3 mm mm", "length") is None
+
+
+def test_problem_file_loads_without_pint(tmp_path):
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from optdesign.problem.load import load_problem; "
+        "load_problem('problems/cs_min_backlash.toml'); "
+        "print('pint' in sys.modules)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=Path(__file__).resolve().parents[1],
+    ).stdout
+    assert out.strip() == "False"
