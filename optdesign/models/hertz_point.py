@@ -95,9 +95,17 @@ def curvature_sum_difference(rho11, rho12, rho21, rho22, omega):
     d1 = np.asarray(rho11) - np.asarray(rho12)
     d2 = np.asarray(rho21) - np.asarray(rho22)
     s = np.asarray(rho11) + np.asarray(rho12) + np.asarray(rho21) + np.asarray(rho22)
-    # max(., 0): the radicand is a sum of squares in exact arithmetic; guard round-off.
-    root = np.sqrt(np.maximum(d1**2 + d2**2 + 2.0 * d1 * d2 * np.cos(2.0 * np.asarray(omega)), 0))
-    return s, root / s
+    # d1^2 + d2^2 + 2 d1 d2 cos 2w written as a sum of two non-negative terms, so that
+    # nearly cancelling differences (d1 ~ -d2 at w = 0) keep their relative accuracy:
+    # (d1 + d2)^2 + 4 |d1 d2| sin^2 w when d1 d2 <= 0, (d1 - d2)^2 + 4 d1 d2 cos^2 w else.
+    w = np.asarray(omega)
+    p = d1 * d2
+    radicand = np.where(
+        p <= 0.0,
+        (d1 + d2) ** 2 - 4.0 * p * np.sin(w) ** 2,
+        (d1 - d2) ** 2 + 4.0 * p * np.cos(w) ** 2,
+    )
+    return s, np.sqrt(radicand) / s
 
 
 def curvature_sum_difference_aligned(rho11, rho12, rho21, rho22):
