@@ -16,7 +16,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 from optdesign.errors import OptDesignError
-from optdesign.interrupts import Interrupted, exit_code, interrupts_as_exceptions
+from optdesign.interrupts import (
+    Interrupted,
+    exit_code,
+    forget_store,
+    interrupts_as_exceptions,
+    saved_store,
+)
 
 __all__ = ["COMMANDS", "Interrupted", "build_parser", "command", "main", "run_guarded"]
 
@@ -100,6 +106,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
         (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143).
     """
+    forget_store()
     try:
         with interrupts_as_exceptions():
             code = func()
@@ -111,7 +118,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         return 2
     except KeyboardInterrupt as exc:
         name, code = exit_code(exc)
-        store = getattr(exc, "run_store", None)
+        store = saved_store(exc)
         if store:
             n = store["records"]
             print(

@@ -233,3 +233,24 @@ def test_run_guarded_exit_codes_and_one_line(capsys):
     assert run_guarded(bad_input) == 2
     assert capsys.readouterr().err == "optdesign: error: --points: need at least 2 points\n"
     assert run_guarded(lambda: 1) == 1
+
+
+def test_an_interrupt_after_the_solving_still_names_the_saved_store(tmp_path, capsys):
+    # Interrupted while the command writes its front (its store complete): the message
+    # names the store and its count, as an interrupt during the solving does.
+    from optdesign.cli import run_guarded
+
+    store = tmp_path / "out" / "s.jsonl"
+
+    def solved_then_terminated():
+        run_tasks(_tasks(0.0)[:3], _work, store, workers=1, key="sig")
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)
+
+    assert run_guarded(solved_then_terminated) == 143
+    assert capsys.readouterr().err == (
+        f"optdesign: interrupted (SIGTERM); 3 records saved in {store}, --resume continues\n"
+    )
+    # a new command starts with no store saved
+    assert run_guarded(lambda: os.kill(os.getpid(), signal.SIGTERM) or time.sleep(5)) == 143
+    assert capsys.readouterr().err == "optdesign: interrupted (SIGTERM)\n"
