@@ -27,6 +27,7 @@ if [ ${#MODULES[@]} -eq 0 ]; then
     optdesign/models/fork.py
     optdesign/models/crank_slider.py
     optdesign/mechanisms/fork.py
+    optdesign/mechanisms/crank_slider.py
   )
 fi
 # The fast, targeted subset (about 25 s together); slow and CLI tests stay out.
