@@ -9,7 +9,9 @@ exit code 130 or 143 (128 + the signal number, as a shell reports a killed comma
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
+import signal
 import sys
 import time
 from collections.abc import Callable
@@ -143,7 +145,36 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         return args.func(args)
 
+    if argv is None:  # the program itself, not a call from Python
+        _late_signals_exit()
     return run_guarded(run)
+
+
+def _late_signals_exit() -> None:
+    """SIGINT / SIGTERM outside the command (while the interpreter starts the command or
+    shuts down after it, which takes a second or more with the solvers loaded): the same
+    one line and exit code 130 / 143 as during the run, not a silent death by the signal.
+    Every output is complete by then (written atomically), so exiting at once is safe.
+    run_guarded puts these handlers back when the command ends."""
+
+    def handler(signum: int, frame: object) -> None:
+        name, code = exit_code(Interrupted(signum))
+        store = saved_store(Interrupted(signum))
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+        line = f"optdesign: interrupted ({name})"
+        if store:
+            n = store["records"]
+            line += (
+                f"; {n} record{'' if n == 1 else 's'} saved in {store['path']}, --resume continues"
+            )
+        with contextlib.suppress(Exception):
+            print(line, file=sys.stderr, flush=True)
+        os._exit(code)
+
+    with contextlib.suppress(ValueError):  # not the main thread
+        signal.signal(signal.SIGINT, handler)
+        signal.signal(signal.SIGTERM, handler)
 
 
 if __name__ == "__main__":

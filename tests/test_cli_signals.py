@@ -114,10 +114,11 @@ def _alive(pids: list[int], wait: float = 5.0) -> list[int]:
         time.sleep(0.05)
 
 
-def _interrupt(args: list[str], store: Path, sig: int, rng: random.Random, n_records: int):
-    """Run the CLI and send ``sig`` at a seeded random moment of its solving: once the
-    store holds a random number k < n_records - 2 of records, after a further random
-    delay of up to 0.3 s. Returns (returncode, stderr, records before, processes left)."""
+def _interrupt(args: list[str], store: Path, sig: int, rng: random.Random, k_max: int):
+    """Run the CLI and send ``sig`` at a seeded random moment: once the store holds a
+    random number k <= k_max of records, after a further random delay of up to 0.3 s
+    (late moments may find the run finished). Returns (returncode, stderr, records
+    before, processes left)."""
     proc = subprocess.Popen(
         [sys.executable, "-m", "optdesign", *args],
         stdout=subprocess.PIPE,
@@ -137,7 +138,7 @@ def _interrupt(args: list[str], store: Path, sig: int, rng: random.Random, n_rec
             if kids:
                 break
             time.sleep(0.01)
-        k = rng.randint(0, n_records - 3)
+        k = rng.randint(0, k_max)
         delay = rng.uniform(0.0, 0.3)
         while len(_store_lines(store)) < k and proc.poll() is None:
             try:
@@ -217,16 +218,16 @@ def pareto_reference(tmp_path_factory) -> tuple[list[dict], list[dict]]:
     return _front_rows(out / "front.csv"), _store_lines(out / "epsilon.jsonl")
 
 
-def _pareto_case(tmp_path: Path, reference, sig: int, seed: int) -> dict:
+def _pareto_case(tmp_path: Path, reference, sig: int, seed: int, early: bool) -> None:
     front_ref, store_ref = reference
     out = tmp_path / "run"
     store = out / "epsilon.jsonl"
     rng = random.Random(seed)
     code, err, before, left = _interrupt(
-        [*PARETO, "--out", str(out)], store, sig, rng, len(store_ref)
+        [*PARETO, "--out", str(out)], store, sig, rng, len(store_ref) // (3 if early else 1)
     )
     assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
-    assert code != 0, "the run ended before the signal"
+    assert code != 0 or not early, "the run ended before the signal"
     _check_exit(code, err, sig, store, len(before))
     res = _cli([*PARETO, "--out", str(out), "--resume"])
     assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
@@ -234,19 +235,20 @@ def _pareto_case(tmp_path: Path, reference, sig: int, seed: int) -> dict:
     _check_records(before, after)
     assert sorted(r["id"] for r in after) == sorted(r["id"] for r in store_ref)
     _same_front(_front_rows(out / "front.csv"), front_ref)
-    return {"signal": signal.Signals(sig).name, "code": code, "saved": len(before)}
+    # one line per case for the record (pytest -s): figures of the issue's closing note
+    print(f"signal-case pareto {signal.Signals(sig).name} exit={code} saved={len(before)}")
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL])
 def test_pareto_signal_then_resume(tmp_path, pareto_reference, sig):
-    _pareto_case(tmp_path, pareto_reference, sig, seed=100 + int(sig))
+    _pareto_case(tmp_path, pareto_reference, sig, seed=100 + int(sig), early=True)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
 def test_pareto_signal_then_resume_more_moments(tmp_path, pareto_reference, sig, seed):
-    _pareto_case(tmp_path, pareto_reference, sig, seed=1000 * seed + int(sig))
+    _pareto_case(tmp_path, pareto_reference, sig, seed=1000 * seed + int(sig), early=False)
 
 
 # --- bench --------------------------------------------------------------------------------
@@ -261,15 +263,17 @@ def bench_reference(tmp_path_factory) -> dict[str, dict]:
     return {r["id"]: r for r in _store_lines(out / "bench_runs.jsonl")}
 
 
-def _bench_case(tmp_path: Path, reference: dict[str, dict], sig: int, seed: int) -> None:
+def _bench_case(
+    tmp_path: Path, reference: dict[str, dict], sig: int, seed: int, early: bool
+) -> None:
     out = tmp_path / "run"
     store = out / "bench_runs.jsonl"
     rng = random.Random(seed)
     code, err, before, left = _interrupt(
-        [*BENCH, "--out", str(out)], store, sig, rng, len(reference)
+        [*BENCH, "--out", str(out)], store, sig, rng, len(reference) // (3 if early else 1)
     )
     assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
-    assert code != 0, "the run ended before the signal"
+    assert code != 0 or not early, "the run ended before the signal"
     _check_exit(code, err, sig, store, len(before))
     res = _cli([*BENCH, "--out", str(out), "--resume"])
     assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
@@ -285,15 +289,16 @@ def _bench_case(tmp_path: Path, reference: dict[str, dict], sig: int, seed: int)
                 assert r[k] == pytest.approx(ref[k], rel=1e-6, abs=1e-9), (r["id"], k)
             else:
                 assert r.get(k) == ref.get(k), (r["id"], k)
+    print(f"signal-case bench {signal.Signals(sig).name} exit={code} saved={len(before)}")
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM])
 def test_bench_signal_then_resume(tmp_path, bench_reference, sig):
-    _bench_case(tmp_path, bench_reference, sig, seed=200 + int(sig))
+    _bench_case(tmp_path, bench_reference, sig, seed=200 + int(sig), early=True)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
 def test_bench_signal_then_resume_more_moments(tmp_path, bench_reference, sig, seed):
-    _bench_case(tmp_path, bench_reference, sig, seed=1000 * seed + int(sig))
+    _bench_case(tmp_path, bench_reference, sig, seed=1000 * seed + int(sig), early=False)
