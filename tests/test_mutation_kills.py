@@ -331,8 +331,15 @@ def test_crank_slider_guarded_path_stays_finite_past_the_toggle():
     guarded = CrankSlider(bad, guarded=True)
     assert guarded.floor == 1e-6
     assert float(guarded.rod_run(0.0)) == pytest.approx(1e-3)  # sqrt of the floor
-    u = 90.0 - 200.0
+    u = 90.0 * math.cos(0.2) - 200.0  # a = phi0 + 0 = 0.2 rad
     assert float(guarded.rod_inclination(0.0)) == pytest.approx(math.atan2(u, 1e-3))
+    # the nut position R sin a - s with s = 1e-3 mm, and the nut-slide sensitivity
+    # |u| / (s |dm/dphi|) stay finite on the guarded path, NaN on the plain one
+    assert float(guarded.nut_position(0.0)) == pytest.approx(90.0 * math.sin(0.2) - 1e-3)
+    assert np.isfinite(float(guarded.sensitivity_lateral(0.0)))
+    with np.errstate(invalid="ignore"):
+        assert np.isnan(float(CrankSlider(**bad).nut_position(0.0)))
+        assert np.isnan(float(CrankSlider(**bad).sensitivity_lateral(0.0)))
 
 
 def test_crank_slider_joints_are_the_papers_chain():
@@ -423,3 +430,70 @@ def test_crank_slider_drawing_and_bench_family():
         "transmission_angle": {"min": "40 deg", "max": "140 deg"},
         "rod_inclination_max": "30 deg",
     }
+
+
+def test_crank_slider_guarded_transmission_angle_past_the_toggle():
+    import numpy as np
+
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    # a = 1.2 rad, n = 113.6 mm: u = 90 cos 1.2 - 113.6 = -81.0 mm, |u| > l = 80 mm (no
+    # assembly); the guarded path uses s = sqrt(1e-6) = 1e-3 mm and stays finite:
+    # cos mu = (s sin a + u cos a) / l = -0.36682
+    bad = {"R": 90.0, "l": 80.0, "n": 113.6, "phi0": 0.0, "p": 5.0, "i_a": 2.0}
+    a = 1.2
+    u = 90.0 * math.cos(a) - 113.6
+    cos_mu = (1e-3 * math.sin(a) + u * math.cos(a)) / 80.0
+    assert u == pytest.approx(-80.988, abs=1e-3) and cos_mu == pytest.approx(-0.36682, abs=1e-4)
+    guarded = CrankSlider(bad, guarded=True)
+    assert float(guarded.transmission_angle(a)) == pytest.approx(math.acos(cos_mu))
+    band = type("Band", (), {"min": None, "max": None})()
+    (row,) = guarded.requirement_rows("transmission_angle", band, np.array([a]))
+    assert float(np.asarray(row.expr)[0]) == pytest.approx(cos_mu)
+    assert row.lower is None and row.upper is None  # no limit given: none set
+    with np.errstate(invalid="ignore"):
+        assert np.isnan(float(CrankSlider(**bad).transmission_angle(a)))
+
+
+def test_crank_slider_rows_describe_themselves():
+    # the rows' unit and description are what a report prints next to the values
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    mech = CrankSlider(**CS)
+    phi = np.array([0.0])
+    (margin,) = mech.requirement_rows("assembly_margin_min", 0.05, phi)
+    band = SimpleNamespace(min=math.radians(40), max=math.radians(140))
+    (ta,) = mech.requirement_rows("transmission_angle", band, phi)
+    (inc,) = mech.requirement_rows("rod_inclination_max", math.radians(30), phi)
+    assert [(r.unit, r.description) for r in (margin, ta, inc)] == [
+        ("", "(l^2 - u^2)/l^2: the rod reaches the nut line"),
+        ("", "transmission angle"),
+        ("", "rod inclination to the screw axis"),
+    ]
+    # below -1 the display clips to -90 deg instead of NaN
+    assert inc.display(np.array([-1.0 - 1e-12])) == pytest.approx([-90.0])
+
+
+def test_crank_slider_drawing_with_the_nut_right_of_the_axis():
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    # phi = 1.0 with phi0 = 0.2 (a = 1.2): B = (83.88, 32.61), C = (5.80, 50): the axis
+    # runs from 0 - l/2 = -40 mm to 5.80 + 10 mm
+    mech = CrankSlider(**CS)
+    _, (Cx, _) = _cs_loop(1.0)
+    assert Cx == pytest.approx(5.80, abs=0.01)
+    sk = mech.sketch(1.0)
+    assert sk.axis[0] == pytest.approx((-40.0, 50.0))
+    assert sk.axis[1] == pytest.approx((Cx + 10.0, 50.0))
+
+
+def test_back_drivable_exactly_at_the_locking_limit_is_not():
+    from optdesign.models.screw_efficiency import is_back_drivable
+
+    # mu = tan(lambda) exactly (the same expression): lambda - phi = 0, eta' = 0: locked
+    mu = 5.0 / (math.pi * 20.0)
+    assert not is_back_drivable("ball", 5.0, 20.0, mu)
