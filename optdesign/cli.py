@@ -147,15 +147,35 @@ def main(argv: list[str] | None = None) -> int:
 
     if argv is None:  # the program itself, not a call from Python
         _late_signals_exit()
-    return run_guarded(run)
+    code = run_guarded(run)
+    if argv is None:
+        _exit_now(code)
+    return code
+
+
+def _exit_now(code: int) -> None:
+    """End the program without the interpreter's shutdown.
+
+    Every output is written (atomically) and every worker stopped by now; the shutdown
+    that follows would only free memory (a second or more with the solvers loaded), and
+    during it Python has put the default signal handlers back, so a Ctrl-C there would
+    kill the program silently with the signal instead of exit 130 and the one line."""
+    import logging
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    with contextlib.suppress(Exception):
+        logging.shutdown()
+    os._exit(code)
 
 
 def _late_signals_exit() -> None:
-    """SIGINT / SIGTERM outside the command (while the interpreter starts the command or
-    shuts down after it, which takes a second or more with the solvers loaded): the same
-    one line and exit code 130 / 143 as during the run, not a silent death by the signal.
-    Every output is complete by then (written atomically), so exiting at once is safe.
-    run_guarded puts these handlers back when the command ends."""
+    """SIGINT / SIGTERM outside the command (before it starts, or after it while the
+    program ends): the same one line and exit code 130 / 143 as during the run, not a
+    traceback or a silent death by the signal. Every output is complete by then (written
+    atomically), so exiting at once is safe. run_guarded puts these handlers back when
+    the command ends."""
 
     def handler(signum: int, frame: object) -> None:
         name, code = exit_code(Interrupted(signum))
