@@ -114,10 +114,12 @@ def _alive(pids: list[int], wait: float = 5.0) -> list[int]:
         time.sleep(0.05)
 
 
-def _interrupt(args: list[str], store: Path, sig: int, rng: random.Random, k_max: int):
+def _interrupt(
+    args: list[str], store: Path, sig: int, rng: random.Random, k_max: int, delay_max: float
+):
     """Run the CLI and send ``sig`` at a seeded random moment: once the store holds a
-    random number k <= k_max of records, after a further random delay of up to 0.3 s
-    (late moments may find the run finished). Returns (returncode, stderr, records
+    random number k <= k_max of records, after a further random delay of up to
+    ``delay_max`` s (late moments may find the run finished). Returns (returncode, stderr, records
     before, processes left)."""
     proc = subprocess.Popen(
         [sys.executable, "-m", "optdesign", *args],
@@ -139,7 +141,7 @@ def _interrupt(args: list[str], store: Path, sig: int, rng: random.Random, k_max
                 break
             time.sleep(0.01)
         k = rng.randint(0, k_max)
-        delay = rng.uniform(0.0, 0.3)
+        delay = rng.uniform(0.0, delay_max)
         while len(_store_lines(store)) < k and proc.poll() is None:
             try:
                 seen |= {c.pid for c in psutil.Process(proc.pid).children(recursive=True)}
@@ -224,7 +226,12 @@ def _pareto_case(tmp_path: Path, reference, sig: int, seed: int, early: bool) ->
     store = out / "epsilon.jsonl"
     rng = random.Random(seed)
     code, err, before, left = _interrupt(
-        [*PARETO, "--out", str(out)], store, sig, rng, len(store_ref) // (3 if early else 1)
+        [*PARETO, "--out", str(out)],
+        store,
+        sig,
+        rng,
+        len(store_ref) // 3 if early else len(store_ref) - 2,
+        0.02 if early else 0.05,  # the 12-point front takes about 1 s once started
     )
     assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
     assert code != 0 or not early, "the run ended before the signal"
@@ -270,7 +277,12 @@ def _bench_case(
     store = out / "bench_runs.jsonl"
     rng = random.Random(seed)
     code, err, before, left = _interrupt(
-        [*BENCH, "--out", str(out)], store, sig, rng, len(reference) // (3 if early else 1)
+        [*BENCH, "--out", str(out)],
+        store,
+        sig,
+        rng,
+        len(reference) // (3 if early else 1),
+        0.02 if early else 0.3,
     )
     assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
     assert code != 0 or not early, "the run ended before the signal"
