@@ -11,13 +11,20 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import signal
 import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 from optdesign.errors import OptDesignError
-from optdesign.interrupts import Interrupted, exit_code, interrupts_as_exceptions
+from optdesign.interrupts import (
+    Interrupted,
+    exit_code,
+    forget_store,
+    interrupts_as_exceptions,
+    saved_store,
+)
 
 __all__ = ["COMMANDS", "Interrupted", "build_parser", "command", "main", "run_guarded"]
 
@@ -173,6 +180,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143);
         1 for any other exception (one line; ``OPTDESIGN_DEBUG=1`` re-raises it).
     """
+    forget_store()
     try:
         with interrupts_as_exceptions():
             code = func()
@@ -196,7 +204,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         return 1
     except KeyboardInterrupt as exc:
         name, code = exit_code(exc)
-        store = getattr(exc, "run_store", None)
+        store = saved_store(exc)
         if store:
             n = store["records"]
             print(
@@ -221,7 +229,56 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         return args.func(args)
 
-    return run_guarded(run)
+    if argv is None:  # the program itself, not a call from Python
+        _late_signals_exit()
+    code = run_guarded(run)
+    if argv is None:
+        _exit_now(code)
+    return code
+
+
+def _exit_now(code: int) -> None:
+    """End the program without the interpreter's shutdown.
+
+    Every output is written (atomically) and every worker stopped by now; the shutdown
+    that follows would only free memory (a second or more with the solvers loaded), and
+    during it Python has put the default signal handlers back, so a Ctrl-C there would
+    kill the program silently with the signal instead of exit 130 and the one line."""
+    import logging
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    with contextlib.suppress(Exception):
+        logging.shutdown()
+    os._exit(code)
+
+
+def _late_signals_exit() -> None:
+    """SIGINT / SIGTERM outside the command (before it starts, or after it while the
+    program ends): the same one line and exit code 130 / 143 as during the run, not a
+    traceback or a silent death by the signal. Every output is complete by then (written
+    atomically), so exiting at once is safe. run_guarded puts these handlers back when
+    the command ends."""
+
+    def handler(signum: int, frame: object) -> None:
+        name, code = exit_code(Interrupted(signum))
+        store = saved_store(Interrupted(signum))
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+        line = f"optdesign: interrupted ({name})"
+        if store:
+            n = store["records"]
+            line += (
+                f"; {n} record{'' if n == 1 else 's'} saved in {store['path']}, --resume continues"
+            )
+        with contextlib.suppress(Exception):
+            print(line, file=sys.stderr, flush=True)
+        os._exit(code)
+
+    with contextlib.suppress(ValueError):  # not the main thread
+        signal.signal(signal.SIGINT, handler)
+        signal.signal(signal.SIGTERM, handler)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,9 @@ from collections.abc import Iterator
 
 _depth = 0  # nesting of deferred() sections in the main thread
 _pending: int | None = None  # a signal that arrived inside one
+# The store of the last run that finished in this command: an interrupt after the
+# solving (writing the front, the plot) still names what is saved.
+_last_store: dict[str, object] | None = None
 
 
 class Interrupted(KeyboardInterrupt):
@@ -84,6 +87,25 @@ def interrupts_as_exceptions() -> Iterator[None]:
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
+
+
+def note_store(path: str, records: int) -> None:
+    """Remember ``path`` (holding ``records`` records) as the store of the last run that
+    completed, for the message of an interrupt that comes after it."""
+    global _last_store
+    _last_store = {"path": str(path), "records": int(records)}
+
+
+def saved_store(exc: BaseException) -> dict[str, object] | None:
+    """What an interrupted command has saved: the interrupted run's store, else the
+    store of the last run that completed (``None`` before any)."""
+    return getattr(exc, "run_store", None) or _last_store
+
+
+def forget_store() -> None:
+    """Start of a command: no store saved yet."""
+    global _last_store
+    _last_store = None
 
 
 def exit_code(exc: KeyboardInterrupt) -> tuple[str, int]:

@@ -233,3 +233,59 @@ def test_run_guarded_exit_codes_and_one_line(capsys):
     assert run_guarded(bad_input) == 2
     assert capsys.readouterr().err == "optdesign: error: --points: need at least 2 points\n"
     assert run_guarded(lambda: 1) == 1
+
+
+def test_an_interrupt_after_the_solving_still_names_the_saved_store(tmp_path, capsys):
+    # Interrupted while the command writes its front (its store complete): the message
+    # names the store and its count, as an interrupt during the solving does.
+    from optdesign.cli import run_guarded
+
+    store = tmp_path / "out" / "s.jsonl"
+
+    def solved_then_terminated():
+        run_tasks(_tasks(0.0)[:3], _work, store, workers=1, key="sig")
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)
+
+    assert run_guarded(solved_then_terminated) == 143
+    assert capsys.readouterr().err == (
+        f"optdesign: interrupted (SIGTERM); 3 records saved in {store}, --resume continues\n"
+    )
+    # a new command starts with no store saved
+    assert run_guarded(lambda: os.kill(os.getpid(), signal.SIGTERM) or time.sleep(5)) == 143
+    assert capsys.readouterr().err == "optdesign: interrupted (SIGTERM)\n"
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_program_exits_gives_the_same_line(tmp_path, sig):
+    # After the command (interpreter shutdown, a second or more with the solvers loaded)
+    # a signal ends the program with the one line and 130/143, naming the saved store.
+    store = tmp_path / "out" / "s.jsonl"
+    code = f"""
+import os, signal, sys, time
+from optdesign.cli import _late_signals_exit, run_guarded
+from optdesign.studies.runner import run_tasks
+
+def work(task, deps):
+    return {{"value": task["n"]}}
+
+_late_signals_exit()
+assert run_guarded(lambda: len(run_tasks([{{"id": "a", "n": 1}}], work, {str(store)!r},
+                                          workers=1, key="k"))) == 1
+print("done", flush=True)
+os.kill(os.getpid(), {int(sig)})
+time.sleep(5)
+"""
+    res = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        timeout=60,
+    )
+    assert res.stdout == "done\n"
+    assert res.returncode == 128 + sig
+    name = signal.Signals(sig).name
+    assert res.stderr == (
+        f"optdesign: interrupted ({name}); 1 record saved in {store}, --resume continues\n"
+    )

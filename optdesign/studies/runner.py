@@ -44,7 +44,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from optdesign.interrupts import deferred
+from optdesign.interrupts import deferred, note_store
 from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
 from optdesign.studies.processes import (
     WorkerPool,
@@ -341,10 +341,14 @@ def _run(
                 }
         raise
     finally:
-        if store is not None:
-            store.close()
-        if bar is not None:
-            bar.close()
+        # An interrupt while the store closes waits for the close, and finds the store
+        # noted for the CLI's message (it may come after the last record is written).
+        with deferred():
+            if store is not None:
+                store.close()
+            if bar is not None:
+                bar.close()
+            note_store(str(path), store.count if store is not None else n_stored)
     return {i: done[i] for i in by_id if i in done}
 
 

@@ -1,0 +1,60 @@
+"""Count the outcome of each mutant in ``mutmut results --all true`` output, per module.
+
+Usage: python benchmarks/mutation/summary.py mutmut-results.txt
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from collections import Counter, defaultdict
+
+LINE = re.compile(r"^\s*(?P<name>[\w.]+)__mutmut_\d+: (?P<status>.+?)\s*$")
+
+
+def main(path: str) -> int:
+    per_module: dict[str, Counter] = defaultdict(Counter)
+    survivors: list[str] = []
+    with open(path, encoding="utf-8") as fh:
+        for line in fh:
+            match = LINE.match(line)
+            if not match:
+                continue
+            name, status = match["name"], match["status"]
+            # optdesign.models.loads.x_motor_torque / ...crank_slider.xǁCrankSliderǁjoints
+            module = re.sub(r"\.(x[ΛǁŁ_].*|[A-Za-z_]+ǁ.*)$", "", name)
+            per_module[module][status] += 1
+            if status == "survived":
+                survivors.append(line.strip().split(":")[0])
+    total: Counter = Counter()
+    print(f"{'module':45s} {'tried':>6s} {'killed':>7s} {'survived':>9s} {'timeout':>8s} other")
+    for module in sorted(per_module):
+        c = per_module[module]
+        total.update(c)
+        other = sum(v for k, v in c.items() if k not in ("killed", "survived", "timeout"))
+        print(
+            f"{module:45s} {sum(c.values()):6d} {c['killed']:7d} {c['survived']:9d} "
+            f"{c['timeout']:8d} {other}"
+        )
+    tried = sum(total.values())
+    other = sum(v for k, v in total.items() if k not in ("killed", "survived", "timeout"))
+    print(
+        f"{'total':45s} {tried:6d} {total['killed']:7d} {total['survived']:9d} "
+        f"{total['timeout']:8d} {other}"
+    )
+    if tried:
+        print(
+            f"killed (timeouts count as killed): {100 * (total['killed'] + total['timeout']) / tried:.1f} %"
+        )
+    print(
+        "other statuses:",
+        dict((k, v) for k, v in total.items() if k not in ("killed", "survived", "timeout")),
+    )
+    print("survivors:")
+    for s in survivors:
+        print("  " + s)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1]))

@@ -1,0 +1,316 @@
+"""SIGINT, SIGTERM and SIGKILL of the real `optdesign pareto` and `optdesign bench` at
+seeded random moments, then `--resume` (issue 13).
+
+Each case checks: the run's stdout/stderr pipes reach EOF (no orphan holds them); no
+process of the run is left (its descendants, and anything else in its process group);
+exit 130 / 143 with the one-line message and no traceback (-9 for SIGKILL); every record
+saved before the signal is kept as it was after the resume, no record lost or written
+twice; the resumed front (pareto `--deterministic`) or the resumed bench rows equal an
+uninterrupted run's.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+psutil = pytest.importorskip("psutil")
+
+ROOT = Path(__file__).resolve().parents[1]
+FORK = ROOT / "problems" / "fork_min_backlash.toml"
+PARETO = [
+    "pareto",
+    str(FORK),
+    "--objectives",
+    "size,backlash",
+    "--points",
+    "12",
+    "--workers",
+    "2",
+    "--starts",
+    "2",
+    "--deterministic",
+    "--no-plot",
+    "--no-progress",
+]
+BENCH = [
+    "bench",
+    "--suite",
+    "quick",
+    "--solvers",
+    "slsqp-exact",
+    "ipopt-exact",
+    "--workers",
+    "2",
+    "--time-limit",
+    "30",
+    "--hard-timeout",
+    "60",
+    "--no-progress",
+]
+
+
+def _env() -> dict[str, str]:
+    path = os.environ.get("PYTHONPATH")
+    return {
+        **os.environ,
+        "PYTHONPATH": str(ROOT) + (os.pathsep + path if path else ""),
+        "MPLBACKEND": "Agg",
+    }
+
+
+def _cli(args: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "optdesign", *args],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=timeout,
+    )
+
+
+def _store_lines(store: Path) -> list[dict]:
+    if not store.exists():
+        return []
+    data = store.read_bytes()
+    if not data.endswith(b"\n"):  # a torn tail (SIGKILL mid-write) is cut on resume
+        data = data[: data.rfind(b"\n") + 1]
+    return [json.loads(line) for line in data.decode().splitlines()[1:] if line.strip()]
+
+
+def _group(pgid: int) -> list[int]:
+    """Live (not zombie) processes of process group ``pgid``."""
+    out = []
+    for proc in psutil.process_iter(["pid", "status"]):
+        try:
+            if os.getpgid(proc.pid) == pgid and proc.info["status"] != psutil.STATUS_ZOMBIE:
+                out.append(proc.pid)
+        except (ProcessLookupError, psutil.NoSuchProcess, PermissionError):
+            pass
+    return out
+
+
+def _alive(pids: list[int], wait: float = 5.0) -> list[int]:
+    end = time.monotonic() + wait
+    while True:
+        alive = []
+        for pid in pids:
+            try:
+                if psutil.Process(pid).status() != psutil.STATUS_ZOMBIE:
+                    alive.append(pid)
+            except psutil.NoSuchProcess:
+                pass
+        if not alive or time.monotonic() > end:
+            return alive
+        time.sleep(0.05)
+
+
+def _interrupt(
+    args: list[str], store: Path, sig: int, rng: random.Random, k_max: int, delay_max: float
+):
+    """Run the CLI and send ``sig`` at a seeded random moment: once the store holds a
+    random number k <= k_max of records, after a further random delay of up to
+    ``delay_max`` s (late moments may find the run finished). Returns (returncode, stderr, records
+    before, processes left)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "optdesign", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=_env(),
+        start_new_session=True,  # its own process group, as a job in a terminal
+    )
+    seen: set[int] = set()
+    try:
+        end = time.monotonic() + 60
+        while time.monotonic() < end and proc.poll() is None:
+            try:
+                kids = psutil.Process(proc.pid).children(recursive=True)
+            except psutil.NoSuchProcess:
+                break
+            seen |= {k.pid for k in kids}
+            if kids:
+                break
+            time.sleep(0.01)
+        k = rng.randint(0, k_max)
+        delay = rng.uniform(0.0, delay_max)
+        while len(_store_lines(store)) < k and proc.poll() is None:
+            try:
+                seen |= {c.pid for c in psutil.Process(proc.pid).children(recursive=True)}
+            except psutil.NoSuchProcess:
+                break
+            time.sleep(0.005)
+        t_sig = time.monotonic() + delay
+        while time.monotonic() < t_sig and proc.poll() is None:
+            try:
+                seen |= {k.pid for k in psutil.Process(proc.pid).children(recursive=True)}
+            except psutil.NoSuchProcess:
+                break
+            time.sleep(0.02)
+        if proc.poll() is None:
+            if sig == signal.SIGINT:
+                os.killpg(proc.pid, sig)  # Ctrl-C reaches every process of the job
+            else:
+                os.kill(proc.pid, sig)
+        # a reader of the output must get EOF: no orphan may hold the pipes
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    left = _alive(sorted(seen)) + [p for p in _group(proc.pid) if p not in seen]
+    return proc.returncode, err.decode(), _store_lines(store), left
+
+
+def _check_exit(code: int, err: str, sig: int, store: Path, n_before: int) -> None:
+    assert "Traceback" not in err, err
+    if code == 0:  # it finished before the signal
+        return
+    if sig == signal.SIGKILL:
+        assert code == -signal.SIGKILL
+        return
+    assert code == 128 + sig, (code, err)
+    name = signal.Signals(sig).name
+    s = "" if n_before == 1 else "s"
+    assert err.strip() == (
+        f"optdesign: interrupted ({name}); {n_before} record{s} saved in {store}, "
+        "--resume continues"
+    )
+    assert store.read_bytes().endswith(b"\n")  # an interrupt leaves no torn line
+
+
+def _check_records(before: list[dict], after: list[dict]) -> None:
+    ids = [r["id"] for r in after]
+    assert len(ids) == len(set(ids)), "a record written twice"
+    by_id = {r["id"]: r for r in after}
+    for rec in before:
+        assert by_id.get(rec["id"]) == rec, f"record {rec['id']} lost or changed"
+
+
+def _front_rows(path: Path) -> list[dict]:
+    with path.open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _same_front(a: list[dict], b: list[dict]) -> None:
+    assert len(a) == len(b) and len(a) >= 10
+    for ra, rb in zip(a, b, strict=True):
+        assert ra.keys() == rb.keys()
+        for k in ra:
+            try:
+                assert float(ra[k]) == pytest.approx(float(rb[k]), rel=1e-8, abs=1e-12), k
+            except ValueError:
+                assert ra[k] == rb[k], k
+
+
+# --- pareto -------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def pareto_reference(tmp_path_factory) -> tuple[list[dict], list[dict]]:
+    out = tmp_path_factory.mktemp("pareto_ref") / "run"
+    res = _cli([*PARETO, "--out", str(out)])
+    assert res.returncode == 0, res.stderr
+    return _front_rows(out / "front.csv"), _store_lines(out / "epsilon.jsonl")
+
+
+def _pareto_case(tmp_path: Path, reference, sig: int, seed: int, early: bool) -> None:
+    front_ref, store_ref = reference
+    out = tmp_path / "run"
+    store = out / "epsilon.jsonl"
+    rng = random.Random(seed)
+    code, err, before, left = _interrupt(
+        [*PARETO, "--out", str(out)],
+        store,
+        sig,
+        rng,
+        len(store_ref) // 3 if early else len(store_ref) - 2,
+        0.02 if early else 0.05,  # the 12-point front takes about 1 s once started
+    )
+    assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
+    assert code != 0 or not early, "the run ended before the signal"
+    _check_exit(code, err, sig, store, len(before))
+    res = _cli([*PARETO, "--out", str(out), "--resume"])
+    assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
+    after = _store_lines(store)
+    _check_records(before, after)
+    assert sorted(r["id"] for r in after) == sorted(r["id"] for r in store_ref)
+    _same_front(_front_rows(out / "front.csv"), front_ref)
+    # one line per case for the record (pytest -s): figures of the issue's closing note
+    print(f"signal-case pareto {signal.Signals(sig).name} exit={code} saved={len(before)}")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL])
+def test_pareto_signal_then_resume(tmp_path, pareto_reference, sig):
+    _pareto_case(tmp_path, pareto_reference, sig, seed=100 + int(sig), early=True)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+def test_pareto_signal_then_resume_more_moments(tmp_path, pareto_reference, sig, seed):
+    _pareto_case(tmp_path, pareto_reference, sig, seed=1000 * seed + int(sig), early=False)
+
+
+# --- bench --------------------------------------------------------------------------------
+_BENCH_FIELDS = ("status", "objective", "verified", "violation", "design", "applicable")
+
+
+@pytest.fixture(scope="module")
+def bench_reference(tmp_path_factory) -> dict[str, dict]:
+    out = tmp_path_factory.mktemp("bench_ref") / "run"
+    res = _cli([*BENCH, "--out", str(out)])
+    assert res.returncode == 0, res.stderr
+    return {r["id"]: r for r in _store_lines(out / "bench_runs.jsonl")}
+
+
+def _bench_case(
+    tmp_path: Path, reference: dict[str, dict], sig: int, seed: int, early: bool
+) -> None:
+    out = tmp_path / "run"
+    store = out / "bench_runs.jsonl"
+    rng = random.Random(seed)
+    code, err, before, left = _interrupt(
+        [*BENCH, "--out", str(out)],
+        store,
+        sig,
+        rng,
+        len(reference) // (3 if early else 1),
+        0.02 if early else 0.3,
+    )
+    assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
+    assert code != 0 or not early, "the run ended before the signal"
+    _check_exit(code, err, sig, store, len(before))
+    res = _cli([*BENCH, "--out", str(out), "--resume"])
+    assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
+    after = _store_lines(store)
+    _check_records(before, after)
+    assert sorted(r["id"] for r in after) == sorted(reference)
+    for r in after:
+        ref = reference[r["id"]]
+        for k in _BENCH_FIELDS:
+            if isinstance(ref.get(k), float):
+                assert r[k] == pytest.approx(ref[k], rel=1e-6, abs=1e-9), (r["id"], k)
+            elif isinstance(ref.get(k), dict):
+                assert r[k] == pytest.approx(ref[k], rel=1e-6, abs=1e-9), (r["id"], k)
+            else:
+                assert r.get(k) == ref.get(k), (r["id"], k)
+    print(f"signal-case bench {signal.Signals(sig).name} exit={code} saved={len(before)}")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM])
+def test_bench_signal_then_resume(tmp_path, bench_reference, sig):
+    _bench_case(tmp_path, bench_reference, sig, seed=200 + int(sig), early=True)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+def test_bench_signal_then_resume_more_moments(tmp_path, bench_reference, sig, seed):
+    _bench_case(tmp_path, bench_reference, sig, seed=1000 * seed + int(sig), early=False)
