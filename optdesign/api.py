@@ -38,6 +38,7 @@ def solve(
     solver: str = "ipopt",
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
+    agree: int | None = None,
 ) -> Result:
     """The optimal design of ``problem``, with its evidence.
 
@@ -59,6 +60,9 @@ def solve(
         Registered solver back-end (:func:`optdesign.solvers.solver_names`) and options.
     ranges
         Also compute the range of each variable over the optimal set (NLP optima).
+    agree
+        NLP multistart: stop once this many starts agree on the best value (default: the
+        problem's ``[solver] agree``, 3); 0 runs every start.
 
     Returns
     -------
@@ -78,6 +82,7 @@ def solve(
         solver=solver,
         options=options,
         ranges=ranges,
+        **({"agree": agree} if agree is not None else {}),
     )
 
 

@@ -364,7 +364,9 @@ def _fast_internal(text: str, dimension: str) -> float | None:
         return None
     number = float(m.group(1))
     result = number * factor
-    return result if math.isfinite(number) and math.isfinite(result) else None
+    if not (math.isfinite(number) and math.isfinite(result)) or abs(result) > MAX_MAGNITUDE:
+        return None  # pint's path gives the message
+    return result
 
 
 def _is_quantity(value: object) -> bool:
