@@ -364,7 +364,8 @@ def _fast_internal(text: str, dimension: str) -> float | None:
         return None
     number = float(m.group(1))
     result = number * factor
-    return result if math.isfinite(number) and math.isfinite(result) else None
+    # Out of range (or not finite): pint's path, which names the field and the limit.
+    return result if abs(number) <= MAX_MAGNITUDE and abs(result) <= MAX_MAGNITUDE else None
 
 
 def _is_quantity(value: object) -> bool:

@@ -25,6 +25,12 @@ def test_fast_path_leaves_errors_to_pint():
     with pytest.raises(units.InputError, match="expected a length"):
         to_internal("3 N", "length", "R")
     assert units._fast_internal("1e999 mm", "length") is None
+    # Beyond MAX_MAGNITUDE (1e15) the fast path steps aside and the range is refused.
+    assert units._fast_internal("1e308 mm", "length") is None
+    assert units._fast_internal("2e12 m", "length") is None  # 2e15 mm
+    assert units._fast_internal("1e15 mm", "length") == 1e15
+    with pytest.raises(units.InputError, match="out of range"):
+        to_internal("1e308 mm", "length", "R.upper")
     assert units._fast_internal("3 mm", "force") is None
     assert units._fast_internal("3 mm mm", "length") is None
 
