@@ -65,7 +65,9 @@ def test_declared_start_does_not_change_the_nlp():
 
 @pytest.mark.parametrize("fraction", [0.02, 0.98, np.array([0.1, 0.9, 0.3, 0.7, 0.2, 0.8])])
 def test_declared_start_is_one_start_among_the_others(fraction):
-    problem = problem_from_dict(_with_starts("cs_min_backlash", fraction), bare="refuse")
+    data = _with_starts("cs_min_backlash", fraction)
+    data.setdefault("solver", {})["agree"] = 0  # every start runs (no early stop)
+    problem = problem_from_dict(data, bare="refuse")
     result = solve(problem, starts=8, ranges=False)
     assert result.status == "optimal"
     assert result.objective == pytest.approx(OPTIMUM, rel=1e-5)  # not 0.0365466
