@@ -16,7 +16,7 @@ Measures in one run, as ratios between things timed on the same machine in the s
     command's hypervolume as a fraction of the dense reference front's;
 (d) with ``--suite``, the wall time of the default ``optdesign bench`` suite.
 
-    PYTHONPATH=$PWD python benchmarks/bench_overhead.py --label after [--suite]
+    PYTHONPATH=$PWD python benchmarks/bench_overhead.py --label after [--suite] [--bytecode]
 
 The commands run with this interpreter and this environment (``PYTHONPATH`` picks the
 source tree, an absolute path, so ``PYTHONPATH=/path/to/old/tree`` measures an older version with this
