@@ -16,7 +16,7 @@ Measures in one run, as ratios between things timed on the same machine in the s
     command's hypervolume as a fraction of the dense reference front's;
 (d) with ``--suite``, the wall time of the default ``optdesign bench`` suite.
 
-    PYTHONPATH=$PWD python benchmarks/bench_overhead.py --label after [--suite]
+    PYTHONPATH=$PWD python benchmarks/bench_overhead.py --label after [--suite] [--bytecode]
 
 The commands run with this interpreter and this environment (``PYTHONPATH`` picks the
 source tree, an absolute path, so ``PYTHONPATH=/path/to/old/tree`` measures an older version with this
@@ -61,7 +61,8 @@ result = solve_nlp(problem)
 t.append(time.perf_counter())
 result.ranges = optimal_ranges(problem, result)
 t.append(time.perf_counter())
-text = result.to_json()
+from optdesign.reports.result_json import result_json  # what the command prints
+text = result_json(result)
 t.append(time.perf_counter())
 names = ["import casadi", "import optdesign", "load file", "build NLP", "build solver",
          "multistart", "ranges", "report JSON"]
@@ -87,9 +88,22 @@ compute_front(problem, ["ripple", "backlash"], method=NSGA2(100, 500, seed=0))
 NEUTRAL = Path(tempfile.gettempdir())
 
 
+#: The environment of every command: this one, or with ``--bytecode`` one that keeps
+#: compiled bytecode (in a temporary folder) as an installed package does.
+ENV = os.environ.copy()
+
+
+def use_bytecode(folder: str) -> None:
+    """Let the commands write and reuse bytecode under ``folder`` (PYTHONDONTWRITEBYTECODE
+    makes every run compile optdesign's ~100 modules from source, ~0.1 s; ``pip install``
+    compiles them once)."""
+    ENV.pop("PYTHONDONTWRITEBYTECODE", None)
+    ENV["PYTHONPYCACHEPREFIX"] = folder
+
+
 def wall(cmd: list[str], cwd: Path = NEUTRAL) -> float:
     t0 = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=os.environ.copy())
+    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=ENV)
     dt = time.perf_counter() - t0
     if proc.returncode not in (0, 1):
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}): {proc.stderr[-500:]}")
@@ -206,7 +220,7 @@ def part_b(repeats: int) -> dict:
                 capture_output=True,
                 text=True,
                 check=True,
-                env=os.environ.copy(),
+                env=ENV,
             )
             .stdout.strip()
             .splitlines()[-1]
@@ -282,7 +296,20 @@ def main() -> None:
     ap.add_argument("--suite", action="store_true", help="also part d (minutes)")
     ap.add_argument("--redo", action="store_true", help="measure parts already stored")
     ap.add_argument("--out", type=Path, default=OUT)
+    ap.add_argument(
+        "--bytecode",
+        action="store_true",
+        help="commands keep compiled bytecode (as installed), after one warm-up run each",
+    )
     args = ap.parse_args()
+    if args.bytecode:
+        use_bytecode(tempfile.mkdtemp(prefix="overhead-pyc-"))
+        file = str(PROBLEMS / "cs_min_backlash.toml")
+        with tempfile.TemporaryDirectory() as tmp:
+            wall([sys.executable, "-m", "optdesign", "solve", file, "--json"])
+            wall([sys.executable, "-c", NSGA2_SCRIPT.replace("500", "1"), file])
+            cmd = [sys.executable, "-m", "optdesign", "pareto", file, "--objectives"]
+            wall([*cmd, "ripple,backlash", "--points", "4", "--out", tmp, "--no-progress"])
     parts = [p for p in args.parts.split(",") if p] + (["d"] if args.suite else [])
     data = json.loads(args.out.read_text()) if args.out.exists() else {}
     run = data.setdefault(args.label, {})

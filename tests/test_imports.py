@@ -63,3 +63,17 @@ def test_solve_without_plot_imports_no_heavy_module(tmp_path):
         str(tmp_path / "out"),
     )
     assert out["code"] == 0 and out["heavy"] == []
+
+
+def test_solve_json_shows_written_units_without_pint():
+    # cs_min_backlash writes its requirements in kN, deg, mm...: the JSON shows them in
+    # those units from the table of common units, not from a pint registry.
+    out = loaded(
+        "solve",
+        str(ROOT / "problems" / "cs_min_backlash.toml"),
+        "--json",
+        "--starts",
+        "1",
+        "--no-ranges",
+    )
+    assert out["code"] == 0 and out["heavy"] == []

@@ -11,7 +11,6 @@ problem schema (variables, requirements, clearances) is derived from the class.
 from __future__ import annotations
 
 from collections.abc import Callable
-from importlib.metadata import entry_points
 from typing import TYPE_CHECKING, TypeVar, overload
 
 from optdesign.errors import InputError
@@ -84,6 +83,10 @@ def _load_entry_points() -> None:
     if _ENTRY_POINTS_LOADED:
         return
     _ENTRY_POINTS_LOADED = True
+    # Imported here: importlib.metadata (with the email package) costs ~20 ms, and a
+    # shipped mechanism never needs it.
+    from importlib.metadata import entry_points
+
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         if ep.name in _REGISTRY:
             continue

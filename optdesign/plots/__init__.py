@@ -15,7 +15,15 @@ def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Pa
     import matplotlib.pyplot as plt
 
     if tight:
-        fig.tight_layout()
+        from matplotlib.layout_engine import TightLayoutEngine
+
+        if fig.get_layout_engine() is None:
+            # fig.tight_layout()'s own computation, without the placeholder layout engine
+            # it leaves on the figure: with one, savefig lays the figure out once more
+            # (~40 ms of a front plot's ~150 ms; the PNG is byte-identical).
+            TightLayoutEngine(rect=None).execute(fig)
+        else:
+            fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi)

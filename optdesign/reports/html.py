@@ -31,10 +31,11 @@ from optdesign.reports.units import (
 
 def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str, Any]:
     """Everything the page shows of one design (JSON-ready)."""
-    active, violated = rows_at(problem, design)
     with np.errstate(all="ignore"):
+        ev = problem.evaluate(np.array([design[v.name] for v in problem.free], dtype=float))
         facts = design_facts(problem, design)
-        objectives = problem.evaluate(np.array([design[v.name] for v in problem.free])).objectives
+    active, violated = rows_at(problem, design, ev=ev)  # one evaluation for both
+    objectives = ev.objectives
     rows = []
     for var in problem.variables:
         v = variable_shown(problem, var, design[var.name])

@@ -259,14 +259,15 @@ def _decreasing(f: Callable[[Any], Any], x: float) -> bool:
     return float(f(x + step)) < float(f(x))
 
 
-def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5):
+def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5, ev: Any = None):
     """(active, violated) constraint reports of any design on the NumPy path: a row is
-    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond."""
+    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond.
+    ``ev``: the design's ``problem.evaluate`` when the caller has it already."""
     from optdesign.problem.design_problem import relative_violation
     from optdesign.solvers.result import ConstraintReport
 
-    x = np.array([design[v.name] for v in problem.free], dtype=float)
-    ev = problem.evaluate(x)
+    if ev is None:
+        ev = problem.evaluate(np.array([design[v.name] for v in problem.free], dtype=float))
     active, violated = [], []
     for name, block in ev.constraints.items():
         values = np.atleast_1d(np.asarray(block.values, dtype=float))

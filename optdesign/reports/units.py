@@ -196,6 +196,9 @@ def _in_written_unit(problem: Any, path: str, value: float, dim: str) -> Shown |
     unit = (getattr(problem, "written_units", None) or {}).get(path)
     if not unit:
         return None
+    factor = _shown_factor(dim, unit)
+    if factor is not None:
+        return Shown(value * factor, unit)
     from optdesign.units import registry
 
     try:
@@ -203,3 +206,21 @@ def _in_written_unit(problem: Any, path: str, value: float, dim: str) -> Shown |
     except Exception:  # a display nicety: fall back to the package's own unit
         return None
     return Shown(float(q.magnitude), unit)
+
+
+#: Units of the input table that pint converts otherwise (it reads "rpm" as revolutions,
+#: and neither "Nm" nor "Nmm" as a moment): pint decides, as before.
+_NOT_FAST_SHOWN = {("speed", "rpm"), ("moment", "Nm"), ("moment", "Nmm")}
+
+
+def _shown_factor(dim: str, unit: str) -> float | None:
+    """Internal -> ``unit`` factor for the common units of problem files, without pint
+    (importing it and building its registry costs ~0.3 s, more than a solve). ``value *
+    (1 / factor)`` is what pint computes, bit for bit (``tests/test_units_fast.py``);
+    None when pint must decide."""
+    from optdesign.units import FAST_UNITS
+
+    if (dim, unit) in _NOT_FAST_SHOWN:
+        return None
+    factor = FAST_UNITS.get(dim, {}).get(unit)
+    return None if factor is None else 1.0 / factor
