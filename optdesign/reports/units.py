@@ -198,14 +198,20 @@ def _in_written_unit(problem: Any, path: str, value: float, dim: str) -> Shown |
         return None
     factor = _shown_factor(dim, unit)
     if factor is not None:
-        return Shown(value * factor, unit)
+        return Shown(_tidy(value * factor), unit)
     from optdesign.units import registry
 
     try:
         q = registry().Quantity(value, _DIMENSION_UNITS[dim]).to(unit)
     except Exception:  # a display nicety: fall back to the package's own unit
         return None
-    return Shown(float(q.magnitude), unit)
+    return Shown(_tidy(float(q.magnitude)), unit)
+
+
+def _tidy(x: float) -> float:
+    """A value converted back to the unit the file wrote, without the last bit of the
+    round trip ("30 deg" shown as 30, not 29.999999999999996): 15 significant digits."""
+    return float(f"{x:.15g}")
 
 
 #: Units of the input table that pint converts otherwise (it reads "rpm" as revolutions,
