@@ -67,7 +67,7 @@ def test_pip_install_then_solve_and_bench_elsewhere(tmp_path):
         env=env,
     )
     assert run.returncode == 0, run.stderr[-2000:]
-    assert json.loads(run.stdout)["objective"] == pytest.approx(0.0362197, rel=1e-5)
+    assert json.loads(run.stdout)["objective"]["value"] == pytest.approx(0.0362197, rel=1e-5)
     bench = subprocess.run(
         [
             exe,
