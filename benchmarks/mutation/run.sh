@@ -44,6 +44,8 @@ TESTS=(
   tests/test_error_budget.py
   tests/test_pivoting_screw.py
   tests/test_mutation_kills.py
+  tests/test_drive.py
+  tests/test_drive_requirements.py
 )
 rm -rf "$WORK"
 mkdir -p "$WORK"
