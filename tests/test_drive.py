@@ -383,3 +383,68 @@ def test_screw_requirements_without_a_screw_are_refused(field, value):
     with pytest.raises(ProblemError, match=rf"requirements\.{field}: needs a \[screw\]"):
         problem = problem_from_dict(data)
         problem.evaluate(np.array([80.0, 120.0, 60.0, 5.0, 0.1]))
+
+
+def test_screw_side_compliance_by_hand(fin):
+    """Bearings, nut, and the shaft between the fixed bearing and the nut (tension and
+    torsion through the lead) in series: 1/K_b + 1/K_nut + x/(A E) + x (p/2pi)^2/(G J),
+    x = nut_offset + the nut's travel from its position at -30 deg (fin_actuator)."""
+    from optdesign.problem import drive
+
+    _, q = fin
+    with CATALOGUE_CSV.open() as f:
+        rows = [r for r in csv.DictReader(line for line in f if not line.startswith("#"))]
+    row = max(
+        (r for r in rows if float(r["d0"]) == 25.0 and float(r["p"]) == 5.0),
+        key=lambda r: (float(r["Ca"]), float(r["C0a"])),
+    )
+    d1, K_nut = float(row["d1"]), float(row["rigidity_N_per_um"]) * 1e3
+    E, G = 2.06e5, 2.06e5 / 2.6
+    phi = np.radians(np.linspace(-30, 30, 61))
+    xs = _x(100.0, 150.0, 90.0, 0.2, phi)
+    x = 40.0 + np.abs(xs - xs[0])
+    A, J = math.pi * d1**2 / 4, math.pi * d1**4 / 32
+    expected = 1 / 400e3 + 1 / K_nut + x / (A * E) + x * (5.0 / (2 * math.pi)) ** 2 / (G * J)
+    got = np.asarray(drive.axial_compliance(q), dtype=float).ravel()
+    assert got == pytest.approx(expected, rel=1e-9)
+    # the output: the screw side through (dx/dphi)^2, each pin through its own
+    # sensitivity over its contact stiffness, taken here as a central difference of the
+    # loaded pin's clearance in its force
+    total = expected / _dx(100.0, 150.0, 90.0, 0.2, phi) ** 2
+    for joint in q.joints:
+        if joint.pin is None:
+            continue
+        F = np.abs(np.asarray(joint.force, dtype=float).ravel())
+        h = 1e-3 * F
+        slope = (
+            np.asarray(joint.pin.clearance(F + h), dtype=float)
+            - np.asarray(joint.pin.clearance(F - h), dtype=float)
+        ) / (2 * h)
+        total = total + np.asarray(joint.sensitivity, dtype=float).ravel() ** 2 * slope
+    assert np.asarray(q.output_compliance, dtype=float).ravel() == pytest.approx(total, rel=1e-6)
+
+
+def test_a_pair_the_catalogue_lacks_is_not_a_screw(fin):
+    """d0 = 14 mm and p = 5 mm are both catalogue values, but HIWIN sells no 14 x 5."""
+    problem, _ = fin
+    on = problem.evaluate(np.array([FIN_DESIGN[v.name] for v in problem.free]))
+    design = dict(FIN_DESIGN, d0=14.0)
+    off = problem.evaluate(np.array([design[v.name] for v in problem.free]))
+    assert float(np.ravel(on.constraints["screw_catalogue_membership"].values)[0]) == 1.0
+    assert float(np.ravel(off.constraints["screw_catalogue_membership"].values)[0]) == 0.0
+    assert off.violation >= 1.0
+
+
+def test_efficiency_min_requirement():
+    screw = {"kind": "trapezoidal", "friction": 0.1, "gear_efficiency": 0.9}
+    problem = problem_from_dict(_data(screw, {"d0": "20 mm"}, efficiency_min=0.5))
+    ev = problem.evaluate(np.array([DESIGN[v.name] for v in problem.free]))
+    block = ev.constraints["efficiency"]
+    # Tr thread by hand at p = 5, d 20: lam = atan(5/(20 pi)), phi' = atan(0.1/cos alpha_n)
+    lam = math.atan(5.0 / (math.pi * 20.0))
+    alpha_n = math.atan(math.tan(math.radians(15.0)) * math.cos(lam))
+    eta = math.tan(lam) / math.tan(lam + math.atan(0.1 / math.cos(alpha_n)))
+    assert float(np.ravel(block.values)[0]) == pytest.approx(eta * 0.9, rel=1e-9)
+    assert block.lower == 0.5 and block.upper is None
+    # 0.9 x 0.431 = 0.388 < 0.5: the design violates the requirement by that much
+    assert ev.violation >= 0.5 - eta * 0.9 - 1e-12

@@ -50,6 +50,23 @@ TESTS=(
 rm -rf "$WORK"
 mkdir -p "$WORK"
 cp -r "$ROOT/optdesign" "$ROOT/tests" "$ROOT/problems" "$WORK/"
+# A precaution: the formulation and solver caches are keyed on the problem, not on the
+# code, so a test must not reuse an NLP built before its mutant was selected. Every test
+# of the scratch copy starts with empty caches (the figures in docs/testing.md did not
+# change with it).
+cat >>"$WORK/tests/conftest.py" <<'PY'
+
+
+@pytest.fixture(autouse=True)
+def _empty_formulation_caches():
+    from optdesign.studies import runner as _runner
+    from optdesign.studies import solve as _solve
+
+    _solve._NLPS.clear()
+    _solve._SOLVERS.clear()
+    _runner._CACHE.clear()
+    yield
+PY
 # pytest's markers and options, without a [tool.mutmut] table (mutmut would read it first)
 cp "$ROOT/pyproject.toml" "$WORK/"
 {
