@@ -25,6 +25,8 @@ import pytest
 
 psutil = pytest.importorskip("psutil")
 
+from test_signals import _alive  # noqa: E402  (the same wait for processes to end)
+
 ROOT = Path(__file__).resolve().parents[1]
 FORK = ROOT / "problems" / "fork_min_backlash.toml"
 PARETO = [
@@ -99,21 +101,6 @@ def _group(pgid: int) -> list[int]:
     return out
 
 
-def _alive(pids: list[int], wait: float = 5.0) -> list[int]:
-    end = time.monotonic() + wait
-    while True:
-        alive = []
-        for pid in pids:
-            try:
-                if psutil.Process(pid).status() != psutil.STATUS_ZOMBIE:
-                    alive.append(pid)
-            except psutil.NoSuchProcess:
-                pass
-        if not alive or time.monotonic() > end:
-            return alive
-        time.sleep(0.05)
-
-
 def _interrupt(
     args: list[str], store: Path, sig: int, rng: random.Random, k_max: int, delay_max: float
 ):
@@ -166,7 +153,7 @@ def _interrupt(
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
-    left = _alive(sorted(seen)) + [p for p in _group(proc.pid) if p not in seen]
+    left = _alive(sorted(seen), wait=5.0) + [p for p in _group(proc.pid) if p not in seen]
     return proc.returncode, err.decode(), _store_lines(store), left
 
 
