@@ -185,3 +185,29 @@ def test_best_configuration_and_paired_time_ratio():
     assert best_config(stats) == "slow"
     ratio, n = paired_time_ratio(rows, "fast", "slow")
     assert n == 2 and ratio == pytest.approx(np.median([1 / 3, 2 / 10]))
+
+
+def test_front_configurations_keep_a_catalogue_lead_on_its_items():
+    # fork_front-001 takes its lead from a 3-item catalogue. The epsilon configuration
+    # once raised (a continuous sweep refuses catalogue problems) and NSGA-II evaluated
+    # leads between the items. Both must return catalogue designs only.
+    from optdesign.studies.bench.configs import get_config
+
+    inst = make_instance("fork_front", 1)
+    problem, objectives = inst.problem(), inst.objectives
+    (lead,) = [v for v in problem.free if v.discrete]
+    items = np.asarray(lead.values)
+    fronts = {}
+    for name in ("front-nsga2", "front-epsilon"):
+        out = get_config(name).run(problem, objectives, 10.0)
+        assert len(out["F"]) >= 5, name
+        leads = np.array([d[lead.name] for d in out["designs"]])
+        assert np.min(np.abs(leads[:, None] - items[None, :]), axis=1).max() == 0.0, name
+        fronts[name] = np.array(out["F"])
+    # the catalogue front is the exact one: NSGA-II never dominates any of its points
+    eps, ga = fronts["front-epsilon"], fronts["front-nsga2"]
+    dominated = [
+        np.any(np.all(ga <= f * (1 - 1e-6), axis=1) & np.any(ga < f * (1 - 1e-6), axis=1))
+        for f in eps
+    ]
+    assert not any(dominated)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.variables import Variable
 
@@ -50,3 +52,38 @@ def branch(value: float, values: list[float]) -> tuple[list[float], list[float]]
     below = [v for v in values if v < value]
     above = [v for v in values if v > value]
     return below, above
+
+
+class CatalogueCoordinates:
+    """Search coordinates of a problem with catalogue variables, for population methods
+    (differential evolution, NSGA-II): a catalogue variable is searched as the index of
+    its value (rounded to the nearest item), so that the search visits catalogue items
+    only, as the catalogue formulation does; continuous variables keep their bounds.
+
+    Attributes
+    ----------
+    discrete
+        Positions of the catalogue variables among the free ones.
+    bounds
+        (lower, upper) of every coordinate: 0 and the last index for catalogue variables.
+    integrality
+        True where the coordinate is an index (scipy's ``integrality``).
+    """
+
+    def __init__(self, problem: DesignProblem):
+        self.free = problem.free
+        self.discrete = [k for k, v in enumerate(self.free) if v.discrete]
+        self.values = {k: np.asarray(self.free[k].values, dtype=float) for k in self.discrete}
+        lo, hi = problem.lower().astype(float), problem.upper().astype(float)
+        for k in self.discrete:
+            lo[k], hi[k] = 0.0, float(len(self.values[k]) - 1)
+        self.bounds = list(zip(lo, hi, strict=True))
+        self.integrality = np.array([k in self.values for k in range(len(self.free))])
+
+    def to_design(self, Z: np.ndarray) -> np.ndarray:
+        """Design vectors (rows, or one vector) from search coordinates."""
+        X = np.array(Z, dtype=float, copy=True)
+        for k, vals in self.values.items():
+            idx = np.clip(np.rint(X[..., k]), 0, len(vals) - 1).astype(int)
+            X[..., k] = vals[idx]
+        return X

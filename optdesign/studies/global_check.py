@@ -12,6 +12,7 @@ import time
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
+from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
 
 #: Penalty weight on the largest relative constraint violation.
@@ -30,30 +31,6 @@ def penalised_objective(problem: DesignProblem, objective: str):
         return out if X.ndim == 2 else out[0]
 
     return fun
-
-
-class _CatalogueMap:
-    """DE coordinates of a problem with catalogue variables: a catalogue variable is
-    searched as the integer index of its value (scipy's ``integrality``), so that the
-    search visits catalogue items only, as the catalogue formulation does."""
-
-    def __init__(self, problem: DesignProblem):
-        self.free = problem.free
-        self.discrete = [k for k, v in enumerate(self.free) if v.discrete]
-        self.values = {k: np.asarray(self.free[k].values, dtype=float) for k in self.discrete}
-        lo, hi = problem.lower().astype(float), problem.upper().astype(float)
-        for k in self.discrete:
-            lo[k], hi[k] = 0.0, float(len(self.values[k]) - 1)
-        self.bounds = list(zip(lo, hi, strict=True))
-        self.integrality = np.array([k in self.values for k in range(len(self.free))])
-
-    def to_design(self, Z: np.ndarray) -> np.ndarray:
-        """Design vectors (rows, or one vector) from DE coordinates."""
-        X = np.array(Z, dtype=float, copy=True)
-        for k, vals in self.values.items():
-            idx = np.clip(np.rint(X[..., k]), 0, len(vals) - 1).astype(int)
-            X[..., k] = vals[idx]
-        return X
 
 
 def differential_evolution_optimum(
@@ -76,7 +53,7 @@ def differential_evolution_optimum(
         ``x``, ``objective``, ``violation`` (relative, at x), ``nfev``, ``wall_time_s``.
     """
     objective = objective or problem.objective_names[0]
-    coords = _CatalogueMap(problem)
+    coords = CatalogueCoordinates(problem)
     penalised = penalised_objective(problem, objective)
 
     def fun(Z: np.ndarray) -> np.ndarray:

@@ -208,10 +208,14 @@ def _front_dict(front) -> dict[str, Any]:
 def _eps_front(problem, objectives, time_limit):
     import tempfile
 
-    from optdesign.studies.pareto import EpsilonConstraint, compute_front
+    from optdesign.studies.pareto import CatalogueEpsilon, EpsilonConstraint, compute_front
+    from optdesign.studies.pareto.catalogue_front import has_catalogue
 
+    # An instance whose lead comes from a catalogue gets the catalogue front (every point
+    # a catalogue design), as `optdesign pareto` does; a continuous sweep would leave it.
+    kind = CatalogueEpsilon if has_catalogue(problem) else EpsilonConstraint
     with tempfile.TemporaryDirectory() as tmp:
-        method = EpsilonConstraint(points=FRONT_OPTIONS["eps_points"])
+        method = kind(points=FRONT_OPTIONS["eps_points"])
         return _front_dict(compute_front(problem, list(objectives), method=method, out=tmp))
 
 

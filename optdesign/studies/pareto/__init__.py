@@ -13,6 +13,7 @@ from optdesign.studies.pareto.io import read_front_csv, write_front_csv, write_f
 from optdesign.studies.pareto.methods import (
     METHODS,
     NSGA2,
+    CatalogueEpsilon,
     EpsilonConstraint,
     RunOptions,
     WeightedSum,
@@ -23,6 +24,7 @@ from optdesign.studies.pareto.records import PointRecord
 __all__ = [
     "METHODS",
     "NSGA2",
+    "CatalogueEpsilon",
     "EpsilonConstraint",
     "Front",
     "FrontPoint",

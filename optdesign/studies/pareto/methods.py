@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import InputError, ProblemError
+from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, has_catalogue
 from optdesign.studies.pareto.chains import (
@@ -340,6 +341,7 @@ class NSGA2:
         wall = time.perf_counter() - t0
         pts = []
         X = np.atleast_2d(res.X) if res.X is not None else np.zeros((0, len(problem.free)))
+        X = CatalogueCoordinates(problem).to_design(X)
         if len(X):
             ev = problem.evaluate(X)
             for j, x in enumerate(X):
@@ -371,10 +373,16 @@ class NSGA2:
 
 
 def pymoo_problem(problem: DesignProblem, objectives: Sequence[str]):
-    """The problem as a vectorised pymoo ``Problem`` (NumPy path, relative violations)."""
+    """The problem as a vectorised pymoo ``Problem`` (NumPy path, relative violations).
+
+    Catalogue variables are searched as indices of their items
+    (:class:`~optdesign.formulations.discrete.CatalogueCoordinates`): every design
+    evaluated is a catalogue design."""
     from pymoo.core.problem import Problem
 
     n_con = len(problem.evaluate(problem.start()[None, :]).constraints)
+    coords = CatalogueCoordinates(problem)
+    lower, upper = (np.array(b, dtype=float) for b in zip(*coords.bounds, strict=True))
 
     class _Vectorised(Problem):
         def __init__(self):
@@ -382,12 +390,12 @@ def pymoo_problem(problem: DesignProblem, objectives: Sequence[str]):
                 n_var=len(problem.free),
                 n_obj=len(objectives),
                 n_ieq_constr=n_con,
-                xl=problem.lower(),
-                xu=problem.upper(),
+                xl=lower,
+                xu=upper,
             )
 
         def _evaluate(self, X, out, *args, **kwargs):
-            ev = problem.evaluate(X)
+            ev = problem.evaluate(coords.to_design(X))
             out["F"] = np.column_stack(
                 [np.nan_to_num(ev.objectives[k], nan=1e6, posinf=1e6) for k in objectives]
             )
@@ -433,14 +441,16 @@ def compute_front(
         raise InputError("workers", f"need at least 1 worker, got {run.workers}")
     if isinstance(method, str) and has_catalogue(problem):
         # every point a catalogue design: each one solved by the catalogue search
-        if method not in ("epsilon", "uniform"):
+        if method not in ("epsilon", "uniform", "nsga2"):
             raise InputError(
                 "method",
-                f"{method!r} would leave the catalogue: with catalogue variables use 'epsilon'",
+                f"{method!r} would leave the catalogue: with catalogue variables use "
+                "'epsilon' or 'nsga2'",
             )
-        keep = {k: options[k] for k in ("starts", "seed") if k in options}
-        method = CatalogueEpsilon(points=options.get("points", points), **keep)
-        options = {}
+        if method != "nsga2":
+            keep = {k: options[k] for k in ("starts", "seed") if k in options}
+            method = CatalogueEpsilon(points=options.get("points", points), **keep)
+            options = {}
     if isinstance(method, str):
         if method not in METHODS:
             raise InputError("method", f"unknown method {method!r} (known: {', '.join(METHODS)})")
