@@ -298,3 +298,38 @@ def test_deterministic_front_is_the_same_for_any_workers_and_after_resume(fork, 
     warm = [recs[f"epsilon-{i:04d}"]["warm"] for i in range(8)]
     assert warm[0] == "anchor-size" and warm[7] == "anchor-backlash"
     assert warm[1:7] == [f"epsilon-{i:04d}" for i in (0, 1, 2, 5, 6, 7)]
+
+
+def test_catalogue_problem_fronts_stay_on_the_catalogue_or_are_refused(tmp_path, capsys):
+    from optdesign.cli import main
+    from optdesign.studies.pareto import NSGA2, WeightedSum
+    from optdesign.studies.pareto.methods import RunOptions
+
+    problem = load_problem(PROBLEMS / "cs_min_backlash_catalogue.toml")
+    # a weighted sum of continuous NLPs would report off-catalogue designs as optimal
+    with pytest.raises(Exception, match="leave the catalogue"):
+        WeightedSum(points=3).run(problem, ["backlash", "ripple"], RunOptions(out=tmp_path))
+    code = main(
+        [
+            "pareto",
+            str(PROBLEMS / "cs_min_backlash_catalogue.toml"),
+            "--objectives",
+            "backlash,ripple",
+            "--method",
+            "weighted_sum",
+            "--out",
+            str(tmp_path / "ws"),
+            "--no-progress",
+        ]
+    )
+    assert code == 2
+    assert "method: weighted sums" in capsys.readouterr().err
+    # NSGA-II searches the catalogue variables as item indices
+    front = NSGA2(pop_size=20, generations=10, seed=1).run(
+        problem, ["backlash", "ripple"], RunOptions()
+    )
+    items = {v.name: set(v.values) for v in problem.free if v.discrete}
+    assert items and len(front.points) > 0
+    for p in front.points:
+        for name, values in items.items():
+            assert p.design[name] in values

@@ -14,7 +14,7 @@ import copy
 import os
 import signal
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -52,6 +52,10 @@ class Config:
     applies
         ``applies(problem) -> bool``: whether the configuration has a run on an instance
         (None: every instance of its kind).
+    preload
+        Modules its runs import (the solver library): the benchmark imports them once
+        before the runs are forked, so that no run's time includes importing its solver
+        library (a user's process pays that once, not at every solve).
     """
 
     name: str
@@ -62,6 +66,22 @@ class Config:
     hidden: bool = False
     time_factor: float = 1.0
     applies: Callable[[DesignProblem], bool] | None = None
+    preload: tuple[str, ...] = ()
+
+
+#: Modules of the built-in back-ends' libraries (see ``Config.preload``).
+SCIPY_MODULES = ("optdesign.solvers.scipy_nlp",)
+CVXPY_MODULES = ("cvxpy", "optdesign.solvers.cvxpy_gp", "optdesign.formulations.gp")
+PYMOO_MODULES = ("pymoo.algorithms.moo.nsga2", "pymoo.optimize", "pymoo.core.problem")
+
+
+def preload_modules(names: Sequence[str]) -> None:
+    """Import the ``preload`` modules of configurations ``names`` (once per process)."""
+    import importlib
+
+    for name in names:
+        for module in get_config(name).preload:
+            importlib.import_module(module)
 
 
 #: name -> configuration, in registration order.
@@ -112,7 +132,15 @@ def nlp_config(
         opts = {**copy.deepcopy(options), **time_limit_options(solver, time_limit)}
         return make_solver(nlp, solver, opts).solve(problem.start(), objective)
 
-    return Config(name, "nlp", run, description, {**options, "solver": solver, "form": form})
+    preload = SCIPY_MODULES if solver in ("slsqp", "trust-constr") else ()
+    return Config(
+        name,
+        "nlp",
+        run,
+        description,
+        {**options, "solver": solver, "form": form},
+        preload=preload,
+    )
 
 
 #: sqpmethod common options: quiet, bounded iterations, convexified exact Hessian.
@@ -187,7 +215,7 @@ def _gp_config(solver: str, description: str) -> Config:
             options = {"time_limit": float(time_limit)}
         return make_solver(gp, solver, options).solve()
 
-    return Config(f"gp-{solver}", "gp", run, description, applies=gp_applies)
+    return Config(f"gp-{solver}", "gp", run, description, applies=gp_applies, preload=CVXPY_MODULES)
 
 
 def gp_applies(problem: DesignProblem) -> bool:
@@ -287,6 +315,7 @@ def _register_defaults() -> None:
             _de_run,
             "scipy differential_evolution on the NumPy path (vectorised)",
             dict(DE_OPTIONS),
+            preload=SCIPY_MODULES,
         )
     )
     register_config(Config("debug-crash", "debug", _debug_crash, "raises (tests)", hidden=True))
@@ -306,6 +335,7 @@ def _register_defaults() -> None:
             "epsilon-constraint front (SLSQP sweep, Ipopt tie-breaks)",
             dict(FRONT_OPTIONS),
             time_factor=10.0,
+            preload=SCIPY_MODULES,
         )
     )
     register_config(
@@ -316,6 +346,7 @@ def _register_defaults() -> None:
             "NSGA-II front (pymoo, NumPy path)",
             dict(FRONT_OPTIONS),
             time_factor=10.0,
+            preload=PYMOO_MODULES,
         )
     )
 

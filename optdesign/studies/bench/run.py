@@ -15,7 +15,7 @@ from typing import Any
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.storage import atomic_write_text
-from optdesign.studies.bench.configs import default_configs, get_config
+from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
 from optdesign.studies.bench.instances import Instance, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
 from optdesign.studies.bench.metrics import add_gaps, config_stats
@@ -151,6 +151,9 @@ def run_bench(
     else:
         suite_name = suite or "custom"
     tasks = make_tasks(instances, names, time_limit, hard)
+    # Solver libraries imported here, before the workers and the runs' children are
+    # forked: a run's time is then its solve, not the import of its library.
+    preload_modules(names)
     out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-bench-"))
     out.mkdir(parents=True, exist_ok=True)
     store = out / "bench_runs.jsonl"

@@ -236,6 +236,12 @@ class WeightedSum:
 
     def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
         objectives = check_objectives(problem, objectives)
+        if has_catalogue(problem):
+            raise InputError(
+                "method",
+                "weighted sums of continuous NLPs would leave the catalogue: with catalogue "
+                "variables use 'epsilon' or 'nsga2'",
+            )
         t0 = time.perf_counter()
         store = _store(run.out, self.name)
         starts = self.starts if self.starts is not None else problem.spec.solver.starts
