@@ -81,3 +81,19 @@ def test_catalogue_problem_is_never_solved_as_continuous():
         solve(problem, "nlp", starts=1)
     with pytest.raises(ProblemError, match=r"variable p: .*catalogue"):
         solve(problem, "gp", starts=1)
+
+
+def test_node_solver_ipopt_options_file_wins_over_node_defaults():
+    # Nodes enter Ipopt's restoration phase early (many boxes are infeasible); a problem
+    # file's own [solver] ipopt options still decide, and a caller's override both.
+    from optdesign.studies.catalogue import NODE_IPOPT_OPTIONS, NodeSolver
+
+    assert NODE_IPOPT_OPTIONS["expect_infeasible_problem"] == "yes"
+    default = NodeSolver(_small_catalogue())
+    assert default.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
+    data = tomllib.loads(CATALOGUE.read_text())
+    data["solver"] = {"ipopt": {"expect_infeasible_problem": "no"}}
+    own = NodeSolver(problem_from_dict(data))
+    assert own.backend.options["ipopt"]["expect_infeasible_problem"] == "no"
+    caller = NodeSolver(problem_from_dict(data), options={"expect_infeasible_problem": "yes"})
+    assert caller.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
