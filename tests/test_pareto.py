@@ -323,7 +323,8 @@ def test_catalogue_problem_fronts_stay_on_the_catalogue_or_are_refused(tmp_path,
         ]
     )
     assert code == 2
-    assert "method: weighted sums" in capsys.readouterr().err
+    assert "--method: weighted_sum would leave the catalogue" in capsys.readouterr().err
+    assert not (tmp_path / "ws").exists()  # refused before any output
     # NSGA-II searches the catalogue variables as item indices
     front = NSGA2(pop_size=20, generations=10, seed=1).run(
         problem, ["backlash", "ripple"], RunOptions()

@@ -99,6 +99,15 @@ def run_pareto(args) -> int:
     for m in methods:
         if m not in METHOD_NAMES:
             raise InputError("--method", f"unknown method {m!r} (known: {', '.join(METHOD_NAMES)})")
+    if "weighted_sum" in methods:
+        from optdesign.studies.pareto.catalogue_front import has_catalogue
+
+        if has_catalogue(problem):  # refused before the output folder is made
+            raise InputError(
+                "--method",
+                "weighted_sum would leave the catalogue: with catalogue variables use "
+                "epsilon or nsga2",
+            )
     if args.points < 2:
         raise InputError("--points", "need at least 2 points")
     if args.resume and args.out is None:
