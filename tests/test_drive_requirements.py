@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from test_drive import _data  # the drive's crank-slider problem
 
 from optdesign.errors import ProblemError
 from optdesign.mechanisms import CrankSlider
@@ -13,28 +14,11 @@ from optdesign.studies.solve import solve_nlp
 
 def _problem(**req):
     objective = req.pop("_objective", "ripple")
-    data = {
-        "name": "drive",
-        "mechanism": "crank_slider",
-        "variables": {
-            "R": {"lower": 30, "upper": 120},
-            "l": {"lower": 40, "upper": 200},
-            "n": {"lower": 0, "upper": 150},
-            "p": {"lower": 2, "upper": 10},
-            "phi0": {"lower": -0.6, "upper": 0.6},
-            "i_a": 2,
-        },
-        "requirements": {
-            "deflection": {"min": "-30 deg", "max": "30 deg", "points": 31},
-            "hinge_moment": "500 N*m",
-            "mean_ratio": {"min": 200, "max": 260},
-            "nut_travel_max": "110 mm",
-            "transmission_angle": {"min": "40 deg", "max": "140 deg"},
-            "rod_inclination_max": "30 deg",
-            **req,
-        },
-        "objective": {"minimize": objective},
-    }
+    # requirements.screw (the screw's own requirements), not _data's [screw] section
+    screw_requirements = req.pop("screw", None)
+    data = _data(objective=objective, **req)
+    if screw_requirements is not None:
+        data["requirements"]["screw"] = screw_requirements
     return problem_from_dict(data)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from test_physics_independent import cs_loop  # the loop solved by bisection
 
 from optdesign.models.loads import backdriven_motor_torque, fork_pin_normal_force, motor_torque
 
@@ -253,24 +254,10 @@ def test_screw_efficiency_errors_name_the_field():
 CS = {"R": 90.0, "l": 80.0, "n": 50.0, "phi0": 0.2, "p": 5.0, "i_a": 2.0}
 
 
-def _cs_loop(phi, R=90.0, l=80.0, n=50.0, phi0=0.2):
-    """B, C of the crank-slider with C = (m, n) on the near side of B, by bisection."""
-    a = phi0 + phi
-    Bx, By = R * math.sin(a), R * math.cos(a)
-    lo, hi = Bx - l, Bx
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if (mid - Bx) ** 2 + (n - By) ** 2 > l**2:
-            lo = mid
-        else:
-            hi = mid
-    return (Bx, By), (0.5 * (lo + hi), n)
-
-
 def _phi_holding_nut(m_target, n, guess, l=80.0):
     """Output angle at which the loop closes with the nut at m_target (secant)."""
     x0, x1 = guess, guess + 1e-3
-    f = lambda p: _cs_loop(p, n=n, l=l)[1][0] - m_target  # noqa: E731
+    f = lambda p: cs_loop(p, n=n, l=l)[1][0] - m_target  # noqa: E731
     for _ in range(60):
         f0, f1 = f(x0), f(x1)
         if f1 == f0:
@@ -284,7 +271,7 @@ def test_crank_slider_geometry_against_the_loop():
 
     mech = CrankSlider(**CS)
     for phi in (-0.3, 0.1, 0.4):
-        (Bx, By), (Cx, Cy) = _cs_loop(phi)
+        (Bx, By), (Cx, Cy) = cs_loop(phi)
         B, C = mech.pin_positions(phi)
         assert [float(v) for v in B] == pytest.approx([Bx, By], rel=1e-9)
         assert [float(v) for v in C] == pytest.approx([Cx, Cy], rel=1e-9)
@@ -300,7 +287,7 @@ def test_crank_slider_geometry_against_the_loop():
         h = 1e-6
 
         def dist(f, C=(Cx, Cy)):
-            (bx, by), _ = _cs_loop(f)
+            (bx, by), _ = cs_loop(f)
             return math.hypot(C[0] - bx, C[1] - by)
 
         rate = (dist(phi + h) - dist(phi - h)) / (2 * h)
@@ -377,7 +364,7 @@ def test_crank_slider_requirement_rows_by_hand():
 
     mech = CrankSlider(**CS)
     phi = np.array([-0.3, 0.1, 0.4])
-    loops = [_cs_loop(f) for f in phi]
+    loops = [cs_loop(f) for f in phi]
     u = np.array([B[1] - 50.0 for B, _ in loops])
     (margin,) = mech.requirement_rows("assembly_margin_min", 0.05, phi)
     assert margin.name == "assembly_margin"
@@ -408,7 +395,7 @@ def test_crank_slider_drawing_and_bench_family():
     from optdesign.mechanisms.crank_slider import CrankSlider
 
     mech = CrankSlider(**CS)
-    (Bx, By), (Cx, Cy) = _cs_loop(0.1)
+    (Bx, By), (Cx, Cy) = cs_loop(0.1)
     sk = mech.sketch(0.1)
     assert sk.links[0][0] == (0.0, 0.0) and sk.links[0][1] == pytest.approx((Bx, By))
     assert sk.links[1][0] == pytest.approx((Bx, By)) and sk.links[1][1] == pytest.approx((Cx, Cy))
@@ -484,7 +471,7 @@ def test_crank_slider_drawing_with_the_nut_right_of_the_axis():
     # phi = 1.0 with phi0 = 0.2 (a = 1.2): B = (83.88, 32.61), C = (5.80, 50): the axis
     # runs from 0 - l/2 = -40 mm to 5.80 + 10 mm
     mech = CrankSlider(**CS)
-    _, (Cx, _) = _cs_loop(1.0)
+    _, (Cx, _) = cs_loop(1.0)
     assert Cx == pytest.approx(5.80, abs=0.01)
     sk = mech.sketch(1.0)
     assert sk.axis[0] == pytest.approx((-40.0, 50.0))

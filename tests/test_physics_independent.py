@@ -76,6 +76,23 @@ def test_fork_neutral_angle_written_out():
     )
 
 
+def cs_loop(phi, R=90.0, l=80.0, n=50.0, phi0=0.2):
+    """Arm pin B and nut pin C = (m, n) of the crank-slider at deflection ``phi``: B at
+    angle phi0 + phi from the normal to the screw's line, C on that line at distance n
+    from O, on the near side of B, with |BC| = l by bisection on m in [Bx - l, Bx] (no
+    closed form taken from the model)."""
+    a = phi0 + phi
+    Bx, By = R * math.sin(a), R * math.cos(a)
+    lo, hi = Bx - l, Bx
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if (mid - Bx) ** 2 + (n - By) ** 2 > l**2:
+            lo = mid
+        else:
+            hi = mid
+    return (Bx, By), (0.5 * (lo + hi), n)
+
+
 def test_crank_slider_ratio_from_finite_differences_of_the_loop():
     # The nut pin C = (m, n) on the screw's line at distance n from O; the arm pin B at
     # angle a = phi0 + phi from the normal to that line; rod |BC| = l. Solve the loop for
@@ -83,18 +100,7 @@ def test_crank_slider_ratio_from_finite_differences_of_the_loop():
     R, l, n, phi0, p, i_a = 90.0, 80.0, 50.0, 0.3, 5.0, 2.0
 
     def m_of(phi):
-        a = phi0 + phi
-        Bx, By = R * math.sin(a), R * math.cos(a)
-        # (m - Bx)^2 + (n - By)^2 = l^2 by bisection on m in [Bx - l, Bx] (no closed form
-        # taken from the model)
-        lo, hi = Bx - l, Bx
-        for _ in range(200):
-            mid = 0.5 * (lo + hi)
-            if (mid - Bx) ** 2 + (n - By) ** 2 > l**2:
-                lo = mid
-            else:
-                hi = mid
-        return 0.5 * (lo + hi)
+        return cs_loop(phi, R, l, n, phi0)[1][0]
 
     mech = CrankSlider(R=R, l=l, n=n, phi0=phi0, p=p, i_a=i_a)
     for phi in (-0.2, 0.0, 0.25):
