@@ -1,7 +1,9 @@
 """Command line: ``optdesign reproduce|solve|pareto|bench ...``.
 
 Errors that a user can act on (:class:`optdesign.errors.OptDesignError`) are printed as
-one line naming the field, with exit code 2 and no traceback. SIGINT (Ctrl-C) and
+one line naming the field, with exit code 2 and no traceback; a message that echoes an
+input is shown :func:`~optdesign.text.printable` (its control characters and newlines
+escaped), so it stays one line and never reaches the terminal raw. SIGINT (Ctrl-C) and
 SIGTERM end a run cleanly - workers stopped, finished records saved - with one line and
 exit code 130 or 143 (128 + the signal number, as a shell reports a killed command).
 """
@@ -25,6 +27,7 @@ from optdesign.interrupts import (
     interrupts_as_exceptions,
     saved_store,
 )
+from optdesign.text import printable
 
 __all__ = ["COMMANDS", "Interrupted", "build_parser", "command", "main", "run_guarded"]
 
@@ -113,7 +116,7 @@ def bounded_float(lo: float, hi: float) -> Callable[[str], float]:
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
         if not lo < value <= hi:  # also refuses nan
-            raise argparse.ArgumentTypeError(f"{text} is outside ({lo:g}, {hi:g}]")
+            raise argparse.ArgumentTypeError(f"{value:g} is outside ({lo:g}, {hi:g}]")
         return value
 
     return parse
@@ -132,10 +135,18 @@ def _version() -> str:
     return __version__
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, whose refusals (which echo the words given, e.g. unrecognized
+    arguments) are shown :func:`~optdesign.text.printable`, on one line."""
+
+    def error(self, message: str):
+        super().error(printable(message))
+
+
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every registered subcommand."""
+    """The argument parser with every registered subcommand (they share its class)."""
     _load_plugins()
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="optdesign",
         description="Design optimisation of ball-screw actuator transmissions.",
     )
@@ -185,17 +196,17 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         with interrupts_as_exceptions():
             code = func()
     except OptDesignError as exc:
-        print(f"optdesign: error: {exc}", file=sys.stderr)
+        print(f"optdesign: error: {printable(exc)}", file=sys.stderr)
         return 2
     except OSError as exc:  # e.g. no space left while writing the results
-        print(f"optdesign: error: {exc}", file=sys.stderr)
+        print(f"optdesign: error: {printable(exc)}", file=sys.stderr)
         return 2
     except Exception as exc:
         # Last resort: a bug (or an input no check foresaw) is one line, not a traceback;
         # OPTDESIGN_DEBUG=1 shows the traceback for a report.
         if os.environ.get("OPTDESIGN_DEBUG"):
             raise
-        text = " ".join(str(exc).split())[:300]
+        text = printable(" ".join(str(exc).split())[:300])
         print(
             f"optdesign: internal error: {type(exc).__name__}: {text} "
             "(set OPTDESIGN_DEBUG=1 for the traceback, and please report it)",
@@ -209,7 +220,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
             n = store["records"]
             print(
                 f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved "
-                f"in {store['path']}, --resume continues",
+                f"in {printable(store['path'])}, --resume continues",
                 file=sys.stderr,
             )
         else:
@@ -270,7 +281,8 @@ def _late_signals_exit() -> None:
         if store:
             n = store["records"]
             line += (
-                f"; {n} record{'' if n == 1 else 's'} saved in {store['path']}, --resume continues"
+                f"; {n} record{'' if n == 1 else 's'} saved in {printable(store['path'])}, "
+                "--resume continues"
             )
         with contextlib.suppress(Exception):
             print(line, file=sys.stderr, flush=True)

@@ -183,3 +183,119 @@ def test_solve_report_shows_optimum_against_initial(browser, tmp_path):
     limits = browser.find_element(By.ID, "limits").text
     assert "pin bearing pressure" in limits and "MPa" in limits
     assert not math.isnan(_not_blank(browser)) and _not_blank(browser) > 10.0
+
+
+#: A name that breaks out of the page's data element (``<!--`` then ``<script`` swallowed
+#: the rest of the page), out of an attribute (``"``), into plotly's markup and templates
+#: (``<b>``, ``%{x}``), with a JavaScript line separator; the injected code would set
+#: ``window.__pwned``.
+HOSTILE = (
+    "<!--<script>x</SCRIPT><script>window.__pwned=1</script>"
+    '"><img src=x onerror="window.__pwned=2">\'\u2028&amp;<b>%{x}</b>'
+)
+
+
+@pytest.fixture(scope="module")
+def hostile_dir(tmp_path_factory):
+    _need_browser()
+    out = tmp_path_factory.mktemp("hostile")
+    src = (PROBLEMS / "cs_min_backlash.toml").read_text()
+    path = out / "hostile.toml"
+    path.write_text(src.replace('name = "cs_min_backlash"', "name = " + json.dumps(HOSTILE)))
+    common = ["--starts", "1", "--no-plot"]
+    code = main(["solve", str(path), *common, "--no-ranges", "--out", str(out / "solve")])
+    assert code == 0
+    args = ["pareto", str(path), "--objectives", "backlash,size", "--points", "4"]
+    assert main([*args, *common, "--workers", "1", "--out", str(out / "front")]) == 0
+    return out
+
+
+def _every_string_hostile(page: Path, target: Path) -> dict:
+    """The page of ``page`` again, with every string of its data that a user could name
+    (variables, labels, limits, objectives, binding requirements, methods, axes) made
+    hostile: the page's own script must show all of them as text."""
+    from optdesign.reports.html_page import render
+
+    text = page.read_text()
+    start = text.index(">", text.index('id="report-data"')) + 1
+    data = json.loads(text[start : text.index("</script>", start)])
+    for d in data["designs"]:
+        d["label"] = HOSTILE + " label"
+        for k, row in enumerate(d["design"]):
+            row.update(name=f"{HOSTILE}{k}", description=HOSTILE, unit=HOSTILE)
+        d["limits"] = [HOSTILE + " limit"]
+        d["violated"] = [HOSTILE + " violated"]
+        for o in d["objectives"] + d["facts"]:
+            o["text"] = HOSTILE + " objective"
+        angles = [a for values in d["active_angles"].values() for a in values]
+        d["active_angles"] = {HOSTILE + " req": angles} if angles else {}
+    if data["front"]:
+        data["front"]["axes"] = [f"{HOSTILE} axis {k}" for k in range(len(data["front"]["axes"]))]
+        for t in data["front"]["traces"]:
+            t["method"] = HOSTILE
+    target.write_text(render(data, title=HOSTILE))
+    return data
+
+
+def _nothing_injected(driver) -> None:
+    from selenium.webdriver.common.by import By
+
+    assert driver.execute_script("return window.__pwned === undefined")
+    assert driver.find_elements(By.TAG_NAME, "img") == []
+    assert len(driver.find_elements(By.TAG_NAME, "script")) == 3
+    # the tables the script builds carry their own attributes only (a name with a '"'
+    # closed the data-var attribute and added its own, e.g. an onerror handler)
+    attributes = driver.execute_script(
+        "return Array.from(document.querySelectorAll('#design *, #limits *, #objectives *'),"
+        " (e) => Array.from(e.attributes, (a) => a.name)).flat()"
+    )
+    assert set(attributes) <= {"class", "data-var"}
+    assert _console_errors(driver) == []
+
+
+def test_hostile_names_are_shown_as_text_and_run_nothing(browser, hostile_dir):
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    from optdesign.text import printable
+
+    points = json.loads((hostile_dir / "front" / "front.json").read_text())["fronts"][0]["points"]
+    # the pages as the commands wrote them: the page renders its data
+    for page in ("front", "solve"):
+        _open(browser, hostile_dir / page / "report.html")
+        _nothing_injected(browser)
+        h1 = browser.find_element(By.TAG_NAME, "h1").text
+        assert h1 == f"{printable(HOSTILE)} (crank-slider)"
+        cells = browser.find_elements(By.CSS_SELECTOR, "#design td[data-var]")
+        names = [c.get_attribute("data-var") for c in cells]
+        assert names == ["R", "l", "n", "p", "phi0", "d", "i_a", "pin_length_ratio"]
+        assert browser.find_elements(By.CSS_SELECTOR, "#curves .scatterlayer .trace")
+    markers = browser.find_elements(By.CSS_SELECTOR, "#front .scatterlayer .trace .points path")
+    assert markers == []  # the solve page has no front
+    _open(browser, hostile_dir / "front" / "report.html")
+    markers = browser.find_elements(By.CSS_SELECTOR, "#front .scatterlayer .trace .points path")
+    assert len(markers) == len(points) >= 3
+    # every string the page's script inserts, hostile: still text, nothing runs
+    target = hostile_dir / "front" / "every_string.html"
+    data = _every_string_hostile(hostile_dir / "front" / "report.html", target)
+    _open(browser, target)
+    _nothing_injected(browser)
+    markers = browser.find_elements(By.CSS_SELECTOR, "#front .scatterlayer .trace .points path")
+    assert len(markers) == len(points)
+    ActionChains(browser).move_to_element(markers[0]).click().perform()
+    assert int(browser.execute_script("return document.body.dataset.selected")) == 0
+    _nothing_injected(browser)
+    cells = browser.find_elements(By.CSS_SELECTOR, "#design td[data-var]")
+    assert [c.get_attribute("data-var") for c in cells] == [f"{HOSTILE}{k}" for k in range(8)]
+    assert float(cells[0].text) == pytest.approx(points[0]["design"]["R"], rel=1e-5)
+    text_of = "return document.getElementById(arguments[0]).textContent"
+    assert browser.execute_script(text_of, "selected-label") == HOSTILE + " label"
+    assert browser.execute_script(text_of, "limits") == HOSTILE + " limit"
+    # plotly shows the names as written: no markup read, no template filled
+    legend = browser.execute_script(
+        "return Array.from(document.querySelectorAll('#curves .legendtext'), (e) => e.textContent)"
+    )
+    assert HOSTILE + " req binds" in legend
+    axis = browser.execute_script("return document.querySelector('#front .xtitle').textContent")
+    assert axis == data["front"]["axes"][0]
+    assert _not_blank(browser) > 10.0

@@ -116,16 +116,17 @@ def _run_locked(args, bench, solvers, out: Path) -> int:
         hard_timeout=args.hard_timeout,
         overwrite=args.overwrite,
     )
-    print(report.summary())
+    from optdesign.text import printable
+
+    print(printable(report.summary(), newlines=True))
     paths = report.paths
-    print(
-        f"wrote {out / 'bench_runs.jsonl'}, {paths['csv']}, {paths['profiles']}, {paths['summary']}"
-    )
+    written = [out / "bench_runs.jsonl", paths["csv"], paths["profiles"], paths["summary"]]
+    print("wrote " + ", ".join(printable(p) for p in written))
     if args.update_readme is not None:
         from optdesign.studies.bench.report import update_readme
 
         if update_readme(args.update_readme, report.summary()):
-            print(f"updated the generated block of {args.update_readme}")
+            print(f"updated the generated block of {printable(args.update_readme)}")
         else:
             raise InputError(
                 "--update-readme", f"{args.update_readme} has no generated-block markers"

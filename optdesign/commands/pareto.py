@@ -176,15 +176,17 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         points=args.points,
         created=time.strftime("%Y-%m-%d %H:%M:%S"),
     )
+    wrote = [out / "front.csv", out / "front.json"]
+    notes = []
     if not args.no_plot:
-        from optdesign.plots import save_figure
+        from optdesign.plots import write_figure
         from optdesign.plots.front import plot_fronts
-        from optdesign.storage import atomic_output
 
-        fig = plot_fronts(problem, fronts)
-        with atomic_output(out / "front.png") as tmp:
-            save_figure(fig, tmp)
-    wrote = [out / "front.csv", out / "front.json"] + ([] if args.no_plot else [out / "front.png"])
+        failed = write_figure(lambda: plot_fronts(problem, fronts), out / "front.png")
+        if failed is None:
+            wrote.append(out / "front.png")
+        else:  # the front's files are written; the report and the summary follow
+            notes.append(failed)
     if not args.no_report and any(f.points for f in fronts):
         from optdesign.reports.html import front_report
         from optdesign.storage import atomic_write_text
@@ -192,7 +194,10 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         atomic_write_text(out / "report.html", front_report(problem, fronts))
         wrote.append(out / "report.html")
     from optdesign.reports.front_text import front_summary
+    from optdesign.text import printable
 
     print(front_summary(fronts))
-    print("\nwrote " + ", ".join(str(w) for w in wrote))
+    for note in notes:
+        print(f"note: {printable(note)}")
+    print("\nwrote " + ", ".join(printable(w) for w in wrote))
     return 0 if all(f.points for f in fronts) else 1

@@ -77,6 +77,7 @@ def run_solve(args) -> int:
 def _solve_and_report(args, problem, out: Path | None) -> int:
     from optdesign.api import solve
     from optdesign.cli import stdout_to_stderr
+    from optdesign.text import printable
 
     # With --json, stdout carries the JSON only: a solver's log goes to stderr.
     quiet = stdout_to_stderr() if args.json else contextlib.nullcontext()
@@ -98,16 +99,20 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
     text = result_json(result)
     wrote = []
     if out is not None:
-        from optdesign.plots import save_figure
-        from optdesign.storage import atomic_output, atomic_write_text
+        from optdesign.plots import write_figure
+        from optdesign.storage import atomic_write_text
 
+        # result.json first: whatever fails after it, the result is kept.
         atomic_write_text(out / "result.json", text)
         wrote.append(out / "result.json")
         if not args.no_plot and result.design:
-            fig = result.plot()
-            with atomic_output(out / "solution.png") as tmp:
-                save_figure(fig, tmp)
-            wrote.append(out / "solution.png")
+            failed = write_figure(result.plot, out / "solution.png")
+            if failed is None:
+                wrote.append(out / "solution.png")
+            else:  # said in the summary and in result.json
+                result.notes.append(failed)
+                text = result_json(result)
+                atomic_write_text(out / "result.json", text)
         if not args.no_report:
             from optdesign.reports.html import solve_report
 
@@ -118,7 +123,7 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
     else:
         print(result.summary())
         if wrote:
-            print("\nwrote " + ", ".join(str(w) for w in wrote))
+            print("\nwrote " + ", ".join(printable(w) for w in wrote))
     return 0 if result.success else 1
 
 

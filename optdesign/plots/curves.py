@@ -8,7 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from optdesign.plots import save_figure
+from optdesign.plots import plain, save_figure
 
 
 def plot_curves(
@@ -22,9 +22,9 @@ def plot_curves(
     """Plot several curves against the deflection (degrees) into a PNG at ``path``."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
     for label, y in curves.items():
-        ax.plot(phi_deg, y, (styles or {}).get(label, "-"), label=label)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
+        ax.plot(phi_deg, y, (styles or {}).get(label, "-"), label=plain(label))
+    ax.set_ylabel(plain(ylabel))
+    ax.set_title(plain(title))
     return save_deflection_figure(fig, [ax], path)
 
 

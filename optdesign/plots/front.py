@@ -1,11 +1,15 @@
 """Plot of Pareto fronts: objective space (methods overlaid) and sketches of picked designs
-(the two ends of the front and its knee), drawn from each mechanism's :meth:`sketch`."""
+(the two ends of the front and its knee), drawn from each mechanism's :meth:`sketch`.
+Names (the problem's, the objectives', the methods') are drawn as plain text
+(:func:`optdesign.plots.plain`)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
 import numpy as np
+
+from optdesign.plots import plain
 
 _STYLE = {
     "epsilon": dict(marker="o", ms=4, lw=1.0),
@@ -81,7 +85,7 @@ def draw_linkage(ax, problem, design: dict, title: str = "") -> None:
         ax.set_xlabel("x (mm)", fontsize=7)
         ax.set_ylabel("y (mm)", fontsize=7)
         ax.legend(fontsize=6, loc="best")
-    ax.set_title(title, fontsize=8)
+    ax.set_title(plain(title), fontsize=8)
     ax.tick_params(labelsize=7)
 
 
@@ -116,7 +120,7 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
         if not len(F):
             continue
         style = _STYLE.get(f.method, dict(marker="o", ms=3, lw=0.0))
-        label = f"{f.method} ({len(F)} pts, {f.wall_time_s:.1f} s)"
+        label = f"{plain(f.method)} ({len(F)} pts, {f.wall_time_s:.1f} s)"
         if three:
             ax.scatter(
                 F[:, 0], F[:, 1], F[:, 2], s=12, marker=style.get("marker") or "o", label=label
@@ -132,14 +136,14 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
         else:
             ax.plot(*pt, "o", mfc="none", mec="r", ms=10)
             ax.annotate(chr(65 + k), pt, textcoords="offset points", xytext=(6, 6), color="r")
-    ax.set_xlabel(labels[0][0])
-    ax.set_ylabel(labels[1][0])
+    ax.set_xlabel(plain(labels[0][0]))
+    ax.set_ylabel(plain(labels[1][0]))
     if three:
-        ax.set_zlabel(labels[2][0])
+        ax.set_zlabel(plain(labels[2][0]))
     else:
         ax.grid(True, alpha=0.3)
     name = problem.name if problem is not None else ""
-    ax.set_title(f"{name}: Pareto front (A, B...: designs sketched)", fontsize=10)
+    ax.set_title(f"{plain(name)}: Pareto front (A, B...: designs sketched)", fontsize=10)
     ax.legend(fontsize=7)
     if sketches and problem is not None:
         for k, i in enumerate(picks):

@@ -26,6 +26,8 @@ def plot_profiles(
     """
     import matplotlib.pyplot as plt
 
+    from optdesign.plots import plain
+
     keys = [k for k in ("time", "gap") if k in profiles]
     fig, axes = plt.subplots(1, len(keys), figsize=(6.0 * len(keys), 5.4), dpi=110, squeeze=False)
     cmap = plt.get_cmap("tab20")
@@ -35,7 +37,9 @@ def plot_profiles(
         for j, name in enumerate(configs):
             if np.all(np.isnan(rho[j])):
                 continue
-            ax.step(taus, rho[j], where="post", color=cmap(j % 20), ls=styles[j % 4], label=name)
+            ax.step(
+                taus, rho[j], where="post", color=cmap(j % 20), ls=styles[j % 4], label=plain(name)
+            )
         ax.set_xscale("log")
         ax.set_ylim(-0.02, 1.02)
         ax.grid(True, which="major", alpha=0.3)

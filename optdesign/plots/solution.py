@@ -1,6 +1,7 @@
 """Plot of a solved design: ratio and backlash over the stroke, optimum vs initial, with
 the requirements a designer reads off it: the mean-ratio band, the backlash limit, and
-where each limit binds (markers at those angles; the full list under the plot)."""
+where each limit binds (markers at those angles; the full list under the plot). Names
+and labels are drawn as plain text (:func:`optdesign.plots.plain`)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from optdesign.plots import plain
 from optdesign.problem.design_problem import DesignProblem
 
 
@@ -48,10 +50,14 @@ def plot_designs(
         with np.errstate(invalid="ignore", divide="ignore"):
             q = problem.quantities(design)
             ratio = np.asarray(q.ratio, dtype=float).ravel()
-            axes[0].plot(phi_deg, ratio, color=f"C{k}", label=label)
+            axes[0].plot(phi_deg, ratio, color=f"C{k}", label=plain(label))
             if req.mean_ratio is not None:
                 axes[0].axhline(
-                    float(np.mean(ratio)), color=f"C{k}", ls=":", lw=0.9, label=f"mean, {label}"
+                    float(np.mean(ratio)),
+                    color=f"C{k}",
+                    ls=":",
+                    lw=0.9,
+                    label=f"mean, {plain(label)}",
                 )
             if has_pin:
                 axes[1].plot(
@@ -59,7 +65,7 @@ def plot_designs(
                     np.asarray(q.backlash.worst_case, dtype=float).ravel(),
                     "--",
                     color=f"C{k}",
-                    label=label,
+                    label=plain(label),
                 )
     if has_pin and req.backlash_max is not None:
         axes[1].axhline(
@@ -75,10 +81,10 @@ def plot_designs(
                 ms=8,
                 mew=2,
                 color=f"C{4 + j}",
-                label=f"{name} binds",
+                label=f"{plain(name)} binds",
             )
     axes[0].set_ylabel("reduction ratio i (motor rad / output rad)")
-    axes[0].set_title(f"{problem.name}: ratio over the stroke")
+    axes[0].set_title(f"{plain(problem.name)}: ratio over the stroke")
     if has_pin:
         axes[1].set_ylabel("worst-case backlash (deg)")
         axes[1].set_title("output backlash over the stroke")
@@ -89,7 +95,7 @@ def plot_designs(
     if limits:
         text = "what limits the design: " + "; ".join(lim.text() for lim in limits[:6])
         # a figure x-label: tight_layout (save_figure) keeps room for it
-        fig.supxlabel(_wrap(text, 170), fontsize=7, x=0.01, ha="left")
+        fig.supxlabel(_wrap(plain(text), 170), fontsize=7, x=0.01, ha="left")
     return fig
 
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.reports.units import Shown, objective_shown
+from optdesign.text import printable
 
 
 @dataclass(frozen=True)
@@ -22,8 +23,9 @@ class Fact:
     description: str = ""
 
     def text(self) -> str:
-        extra = f" ({self.description})" if self.description else ""
-        return f"{self.name} = {self.value.text()}{extra}"
+        """One line (a user's objective name and description shown printable)."""
+        extra = f" ({printable(self.description)})" if self.description else ""
+        return f"{printable(self.name)} = {self.value.text()}{extra}"
 
     def to_json(self) -> dict[str, Any]:
         return {**self.value.to_json(), "description": self.description}

@@ -1,4 +1,5 @@
-"""The plain-text summary of one or several fronts: metrics and a selection of points."""
+"""The plain-text summary of one or several fronts: metrics and a selection of points
+(names from the user one line each, the whole text :func:`~optdesign.text.printable`)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from optdesign.reports.limits import bound_limits, is_internal
 from optdesign.reports.solve_text import objective_unit
 from optdesign.reports.tables import format_table
 from optdesign.reports.units import variable_shown
+from optdesign.text import printable
 
 
 def front_summary(fronts: Sequence) -> str:
@@ -31,7 +33,8 @@ def front_summary(fronts: Sequence) -> str:
             ]
         )
     name = problem.name if problem is not None else ""
-    lines = [f"problem   {name}: objectives {', '.join(main.objectives)}", ""]
+    objectives = ", ".join(printable(o) for o in main.objectives)
+    lines = [f"problem   {printable(name)}: objectives {objectives}", ""]
     lines.append(
         format_table(
             [
@@ -48,12 +51,12 @@ def front_summary(fronts: Sequence) -> str:
         )
     )
     lines.append(
-        f"(hypervolume in {hv_unit}; reference points: nadir + 10 % of the range of the "
+        f"(hypervolume in {printable(hv_unit)}; reference points: nadir + 10 % of the range of the "
         "front itself (own) or of all fronts together (common))"
     )
     pts = main.points
     if not pts:
-        return "\n".join(lines)
+        return printable("\n".join(lines), newlines=True)
     step = max(1, len(pts) // 12)
     shown = pts[::step] + ([pts[-1]] if pts[-1] is not pts[::step][-1] else [])
     heads = []
@@ -71,9 +74,9 @@ def front_summary(fronts: Sequence) -> str:
         cells.append(p.status)
         cells.append(", ".join(point_limits(problem, main.objectives, p))[:70])
         table.append(cells)
-    lines += ["", f"{main.method} front ({len(pts)} points, every {step}th shown):"]
+    lines += ["", f"{printable(main.method)} front ({len(pts)} points, every {step}th shown):"]
     lines.append(format_table([*heads, "design", "status", "what limits it"], table))
-    return "\n".join(lines)
+    return printable("\n".join(lines), newlines=True)
 
 
 def _design_cell(problem, var, value: float) -> str:

@@ -8,6 +8,11 @@ that design; for a solve, the optimum is shown against the initial design.
 
 The sketch comes from the mechanism's public :meth:`~optdesign.mechanisms.Mechanism.
 sketch`: no mechanism is named here.
+
+Any text in the data may come from a user (a problem's name, a label, a constraint's
+name): :func:`to_json` embeds it so that no string can end or re-open the ``<script>``
+element that carries it, and the page inserts every string as text (see
+:mod:`optdesign.reports.html_page`).
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ from optdesign.reports.units import (
     requirement_echo,
     variable_shown,
 )
+from optdesign.solvers.result import clean_json
 
 
 def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str, Any]:
@@ -187,9 +193,24 @@ def front_report(problem: Any, fronts: Sequence[Any]) -> str:
     return render(data, title=f"optdesign: {problem.name} front")
 
 
+#: Characters written as JSON escapes inside the page's ``<script>`` element: ``<`` and
+#: ``>`` (no ``</script>``, ``<!--`` or ``<script`` can appear, in any case), ``&`` (no
+#: character reference), U+2028 and U+2029 (line ends to older JavaScript parsers). In
+#: JSON they can only occur inside strings, where the escape means the same character.
+_IN_SCRIPT = str.maketrans(
+    {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+)
+
+
 def to_json(data: Any) -> str:
-    """JSON for embedding in a <script> element (no ``</`` inside)."""
-    return json.dumps(data, allow_nan=False, default=_default).replace("</", "<\\/")
+    """JSON for embedding in a ``<script type="application/json">`` element.
+
+    Non-finite numbers become ``null`` (``NaN`` is not JSON); ``<``, ``>``, ``&``,
+    U+2028 and U+2029 are written as ``\\uXXXX`` escapes, so no text in the data can
+    close the element or start a comment in it (a ``<!--`` followed by ``<script`` would
+    swallow the rest of the page), and ``JSON.parse`` reads back the same strings."""
+    text = json.dumps(clean_json(data), allow_nan=False, default=_default)
+    return text.translate(_IN_SCRIPT)
 
 
 def _default(obj: Any) -> Any:

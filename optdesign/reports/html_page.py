@@ -1,10 +1,21 @@
 """The page of ``report.html``: HTML, CSS and the script that draws the embedded data
-with plotly (inlined: the page opens without a network)."""
+with plotly (inlined: the page opens without a network).
+
+Every string of the data is shown as text, whatever it holds: the header is escaped
+here (``&``, ``<``, ``>``, ``"`` and ``'``; control characters shown as escapes); the
+script builds HTML only through ``esc``, which escapes the same five characters (so a
+name is safe in an attribute too); text handed to plotly, which reads a few HTML tags
+and ``%{...}`` placeholders in names, titles and hover templates, goes through
+``ptext`` (``&``, ``<``, ``>`` and ``%`` as character references, which plotly shows
+as the characters).
+"""
 
 from __future__ import annotations
 
 import html
 from typing import Any
+
+from optdesign.text import printable
 
 _CSS = """
 body { font-family: system-ui, sans-serif; margin: 1em 2em; color: #222; }
@@ -25,7 +36,12 @@ _SCRIPT = r"""
   const DATA = JSON.parse(document.getElementById('report-data').textContent);
   const fmt = (v) => (v === null || v === undefined) ? '-' : Number(v).toPrecision(6).replace(/\.?0+(e|$)/, '$1');
   const el = (id) => document.getElementById(id);
-  function esc(s) { const d = document.createElement('div'); d.textContent = String(s); return d.innerHTML; }
+  // Text into HTML (element content or a quoted attribute value).
+  const ESC = { '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;' };
+  const esc = (s) => String(s).replace(/[&<>"']/g, (c) => ESC[c]);
+  // Text into plotly (trace names, titles, hover templates): shown as written.
+  const PTEXT = { '&': '&amp;', '<': '&lt;', '>': '&gt;', '%': '&#37;' };
+  const ptext = (s) => String(s).replace(/[&<>%]/g, (c) => PTEXT[c]);
   function list(items, cls) {
     if (!items.length) return '<p class="meta">none</p>';
     return '<ul' + (cls ? ' class="' + cls + '"' : '') + '>' + items.map((t) => '<li>' + esc(t) + '</li>').join('') + '</ul>';
@@ -48,12 +64,12 @@ _SCRIPT = r"""
     const n = d.sketch.length;
     d.sketch.forEach((pose, j) => {
       const op = 0.35 + 0.65 * j / Math.max(1, n - 1);
-      const name = (grey ? d.label + ', ' : '') + 'phi = ' + pose.phi.toFixed(0) + ' deg';
+      const name = ptext((grey ? d.label + ', ' : '') + 'phi = ' + pose.phi.toFixed(0) + ' deg');
       pose.links.forEach((link, k) => out.push({
         x: link.map((p) => p[0]), y: link.map((p) => p[1]), mode: 'lines+markers', type: 'scatter',
         line: { width: 3, color: grey ? '#999' : ['#1f77b4', '#ff7f0e', '#2ca02c', '#9467bd'][k % 4], dash: grey ? 'dot' : 'solid' },
         marker: { size: 5 }, opacity: op, name: name, legendgroup: name, showlegend: k === 0,
-        hovertemplate: 'x %{x:.1f} mm, y %{y:.1f} mm<extra>' + esc(name) + '</extra>' }));
+        hovertemplate: 'x %{x:.1f} mm, y %{y:.1f} mm<extra>' + name + '</extra>' }));
       if (pose.slider) out.push({ x: [pose.slider[0]], y: [pose.slider[1]], type: 'scatter', mode: 'markers',
         marker: { symbol: 'square', size: 10, color: grey ? '#999' : '#2ca02c' }, opacity: op,
         name: 'nut', legendgroup: 'nut' + grey, showlegend: j === 0 && !grey });
@@ -69,7 +85,7 @@ _SCRIPT = r"""
   }
   function curveTraces(d, grey) {
     const c = d.curves, out = [];
-    const lab = (s) => grey ? s + ' (' + d.label + ')' : s + ' (' + d.label + ')';
+    const lab = (s) => ptext(s + ' (' + d.label + ')');
     out.push({ x: c.phi, y: c.ratio, type: 'scatter', mode: 'lines', name: lab('ratio'),
       line: { color: grey ? '#999' : '#1f77b4', dash: grey ? 'dot' : 'solid' } });
     if (c.backlash) out.push({ x: c.phi, y: c.backlash, type: 'scatter', mode: 'lines', name: lab('backlash'),
@@ -86,7 +102,7 @@ _SCRIPT = r"""
     Object.entries(d.active_angles).forEach(([name, angles]) => {
       const ys = angles.map((a) => d.curves.ratio[phi.findIndex((p) => Math.abs(p - a) < 0.051)]);
       out.push({ x: angles, y: ys, type: 'scatter', mode: 'markers', marker: { symbol: 'x', size: 9 },
-        name: name + ' binds' });
+        name: ptext(name + ' binds') });
     });
     return out;
   }
@@ -120,16 +136,16 @@ _SCRIPT = r"""
       margin: { t: 40 }, legend: { font: { size: 10 }, orientation: 'h', y: -0.25 } }, config);
   }
   function drawFront() {
-    const f = DATA.front, three = f.axes.length === 3;
+    const f = DATA.front, three = f.axes.length === 3, axes = f.axes.map(ptext);
     const traces = f.traces.map((t) => ({
       x: t.coords[0], y: t.coords[1], z: three ? t.coords[2] : undefined,
       customdata: t.index, type: three ? 'scatter3d' : 'scatter', mode: 'markers' + (three ? '' : '+lines'),
-      marker: { size: three ? 4 : 8 }, name: t.method + ' (' + t.index.length + ' points)',
-      hovertemplate: f.axes[0] + ' %{x}<br>' + f.axes[1] + ' %{y}' + (three ? '<br>' + f.axes[2] + ' %{z}' : '') + '<extra>%{fullData.name}</extra>' }));
+      marker: { size: three ? 4 : 8 }, name: ptext(t.method + ' (' + t.index.length + ' points)'),
+      hovertemplate: axes[0] + ' %{x}<br>' + axes[1] + ' %{y}' + (three ? '<br>' + axes[2] + ' %{z}' : '') + '<extra>%{fullData.name}</extra>' }));
     const layout = { title: { text: 'Pareto front: hover or click a point' }, hovermode: 'closest', margin: { t: 40 },
       legend: { font: { size: 10 } } };
-    if (three) layout.scene = { xaxis: { title: { text: f.axes[0] } }, yaxis: { title: { text: f.axes[1] } }, zaxis: { title: { text: f.axes[2] } } };
-    else { layout.xaxis = { title: { text: f.axes[0] } }; layout.yaxis = { title: { text: f.axes[1] } }; }
+    if (three) layout.scene = { xaxis: { title: { text: axes[0] } }, yaxis: { title: { text: axes[1] } }, zaxis: { title: { text: axes[2] } } };
+    else { layout.xaxis = { title: { text: axes[0] } }; layout.yaxis = { title: { text: axes[1] } }; }
     return Plotly.newPlot('front', traces, layout, config).then((gd) => {
       const pick = (ev) => { if (ev && ev.points && ev.points.length) show(ev.points[0].customdata); };
       gd.on('plotly_click', pick);
@@ -148,7 +164,9 @@ def render(data: dict[str, Any], title: str) -> str:
 
     from optdesign.reports.html import to_json
 
-    e = html.escape
+    def e(text: object) -> str:  # one line of text, escaped for element content
+        return html.escape(printable(text), quote=True)
+
     reqs = "".join(f"<li>{e(r)}</li>" for r in data["requirements"])
     front = '<div id="front" class="plot"></div>' if data.get("front") else ""
     return f"""<!DOCTYPE html>

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.reports.units import Shown, angle_unit, shown
+from optdesign.text import printable
 
 #: Row names never shown as limits: the objective's epigraph rows, and membership checks
 #: (a design is a catalogue item: met with equality by every catalogue design).
@@ -61,7 +62,7 @@ class Limit:
 
     def text(self) -> str:
         """One line: ``rod inclination (rod_inclination) = 25 deg, max 25 deg at phi=...``."""
-        what = f"{self.description} ({self.name})" if self.description else self.name
+        what = _what(self)
         if self.kind == "bound":
             return f"{what} = {self.value.text()}, at its {self.side} bound"
         line = f"{what} = {self.value.text()}, {self.side} {self.limit.text()}"
@@ -248,10 +249,17 @@ def relaxation_limits(problem: Any, items: Sequence[Any]) -> list[Limit]:
 
 def relaxation_text(lim: Limit) -> str:
     """``nut travel (nut_travel): max 25 mm -> 33.4 mm`` (or why there is no answer)."""
-    what = f"{lim.description} ({lim.name})" if lim.description else lim.name
+    what = _what(lim)
     if math.isnan(lim.value.value):
         return f"{what}: relaxing it alone gave no feasible design (it conflicts with others too)"
     return f"{what}: {lim.side} {lim.limit.text()} -> {lim.value.text()}"
+
+
+def _what(lim: Limit) -> str:
+    """``description (name)`` of a limit, one printable line (both may come from a user's
+    plug-in or :meth:`add_constraint`)."""
+    name = printable(lim.name)
+    return f"{printable(lim.description)} ({name})" if lim.description else name
 
 
 def _decreasing(f: Callable[[Any], Any], x: float) -> bool:

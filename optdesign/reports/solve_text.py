@@ -4,7 +4,9 @@ problem the smallest change of each conflicting requirement that makes it feasib
 
 Every number carries its unit, in the units the problem file wrote where that is
 unambiguous (:mod:`optdesign.reports.units`); the formulation's internal rows are never
-shown (:mod:`optdesign.reports.limits`).
+shown (:mod:`optdesign.reports.limits`). Names from the user are shown one line each and
+the whole text is :func:`~optdesign.text.printable`: no control character of a problem
+file reaches the terminal.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from optdesign.reports.limits import (
 from optdesign.reports.tables import format_table
 from optdesign.reports.units import objective_shown, requirement_echo, variable_shown
 from optdesign.solvers.result import Result
+from optdesign.text import printable
 
 
 def objective_unit(problem, name: str) -> tuple[str, float]:
@@ -42,7 +45,7 @@ def result_summary(result: Result) -> str:
     """Readable summary: status, objective, requirements, design, limits, diagnosis."""
     problem = result.problem_object
     label = problem.mechanism.label() if problem is not None else result.mechanism
-    lines = [f"problem   {result.problem} ({label})"]
+    lines = [f"problem   {printable(result.problem)} ({printable(label)})"]
     check = {True: "passed", False: "FAILED", None: "n/a"}[result.verified]
     lines.append(
         f"status    {result.status} (solver {result.solver}, {result.formulation}, "
@@ -51,7 +54,7 @@ def result_summary(result: Result) -> str:
     name = result.objective_name
     value = objective_shown(problem, name, objective_value(result)).text(8)
     where = "" if result.success else " at the best point found (requirements not met)"
-    lines.append(f"objective {name} = {value}{where}")
+    lines.append(f"objective {printable(name)} = {value}{where}")
     lines.append(f"time      {result.wall_time_s:.3f} s")
     if result.multistart:
         ms = result.multistart
@@ -77,7 +80,7 @@ def result_summary(result: Result) -> str:
         lines += [f"  {f.text()}" for f in facts]
     attained = objective_where(result.active)
     if attained:
-        lines += ["", f"objective attained at: {', '.join(attained)}"]
+        lines += ["", f"objective attained at: {printable(', '.join(attained))}"]
     limits = limits_of(problem, result.active) if problem is not None else []
     bounds = bound_limits(problem, result.design) if problem is not None and result.design else []
     if limits or bounds:
@@ -90,7 +93,7 @@ def result_summary(result: Result) -> str:
         lines += [f"  {lim.text()}" for lim in violated[:30]]
     elif result.violated and problem is None:
         lines += ["", "violated constraints:"]
-        lines += [f"  {r.describe()}" for r in result.violated[:25]]
+        lines += [f"  {printable(r.describe())}" for r in result.violated[:25]]
     relax = result.extra.get("relaxations")
     if relax:
         lines += ["", "smallest change of one requirement that makes the problem feasible:"]
@@ -106,9 +109,10 @@ def result_summary(result: Result) -> str:
                 "next: relax one of the violated requirements, or widen a bound at its limit"
             )
     elif bounds:
-        names = ", ".join(sorted({b.name for b in bounds}))
+        names = ", ".join(sorted({printable(b.name) for b in bounds}))
         lines += ["", f"next: widening the bounds of {names} may improve the objective"]
-    return "\n".join(lines)
+    # Our own lines break where we chose; anything else a user wrote is shown escaped.
+    return printable("\n".join(lines), newlines=True)
 
 
 def _moves(result: Result, name: str) -> bool:

@@ -1,4 +1,7 @@
-"""Plain-text tables for the terminal: paper-vs-computed comparisons and design tables."""
+"""Plain-text tables for the terminal: paper-vs-computed comparisons and design tables.
+
+Every cell and heading is one line of :func:`~optdesign.text.printable` text: a name
+from a user cannot break the table or reach the terminal as a control sequence."""
 
 from __future__ import annotations
 
@@ -6,10 +9,14 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from optdesign.text import printable
+
 
 def format_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    """Left-aligned text table with a header rule."""
-    cells = [[_fmt(c) for c in row] for row in rows]
+    """Left-aligned text table with a header rule (cells and headings made
+    :func:`~optdesign.text.printable`, one line each)."""
+    headers = [printable(h) for h in headers]
+    cells = [[printable(_fmt(c)) for c in row] for row in rows]
     widths = [len(h) for h in headers]
     for row in cells:
         for k, c in enumerate(row):

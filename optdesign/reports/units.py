@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from optdesign.text import printable
 from optdesign.units import INTERNAL_UNITS
 
 #: Unit texts that mean degrees or radians in a problem file.
@@ -69,7 +70,7 @@ class Shown:
         number = f"{self.value:.{digits}g}"
         if self.unit == "%":
             return number + " %"
-        return f"{number} {self.unit}".rstrip()
+        return f"{number} {printable(self.unit)}".rstrip()
 
     def to_json(self) -> dict[str, Any]:
         """``{"value": ..., "unit": ...}`` (NaN as None)."""
@@ -133,7 +134,7 @@ def _text(value: Any) -> str:
         return "{" + ", ".join(f"{k} = {_text(v)}" for k, v in value.items()) + "}"
     if isinstance(value, float):
         return f"{value:.6g}"
-    return str(value)
+    return printable(value)
 
 
 def json_value(value: Any) -> Any:

@@ -17,6 +17,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.reports.tables import format_table
 from optdesign.solvers.result import Result
 from optdesign.studies.verify import verify_design
+from optdesign.text import printable
 
 #: Quantities of the side-by-side table: (objective name, label, unit, scale).
 QUANTITIES = (
@@ -96,7 +97,7 @@ def compare_reference(problem: DesignProblem, result: Result) -> dict[str, Any] 
 
 def comparison_text(problem: DesignProblem, comparison: dict[str, Any]) -> str:
     """Side-by-side table of a :func:`compare_reference` result."""
-    label = comparison["label"]
+    label = printable(comparison["label"])  # one line: it heads the table
     texts = {name: (text, unit) for name, text, unit, _ in QUANTITIES}
     texts["ratio_min"] = ("ratio min", "")
     texts["ratio_max"] = ("ratio max", "")
@@ -120,7 +121,7 @@ def comparison_text(problem: DesignProblem, comparison: dict[str, Any]) -> str:
     state = (
         "meets the requirements"
         if ok
-        else "violates " + ", ".join(comparison["reference_violated"])
+        else "violates " + printable(", ".join(comparison["reference_violated"]))
     )
     head = f"{label} vs optimum, same models ({label} {state}):"
     return head + "\n" + format_table(["quantity", "unit", label, "optimum", "change"], table)

@@ -54,6 +54,7 @@ from optdesign.studies.processes import (
     limit_blas_threads,
     process_pool,
 )
+from optdesign.text import printable
 
 __all__ = [
     "Isolation",
@@ -286,7 +287,7 @@ def _run(
                 bar = tqdm(
                     total=len(by_id),
                     initial=sum(1 for i in by_id if i in done),
-                    desc=progress if isinstance(progress, str) else None,
+                    desc=printable(progress) if isinstance(progress, str) else None,
                     leave=False,
                     disable=None,  # no bar outside a terminal: its redraws would fill logs
                 )

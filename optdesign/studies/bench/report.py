@@ -1,5 +1,9 @@
 """Benchmark outputs: the runs as CSV, the profiles as PNG, the Markdown summary, and the
-:class:`BenchReport` a caller reads (summary, frame, figure)."""
+:class:`BenchReport` a caller reads (summary, frame, figure).
+
+Names in them (configurations, instances: a user's problem names its instance) are
+made safe for each: CSV cells by :func:`optdesign.text.csv_cell`, Markdown table cells
+by :func:`md_cell`; ``bench_stats.json`` writes a value that is not finite as ``null``."""
 
 from __future__ import annotations
 
@@ -13,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.solvers.result import clean_json
 from optdesign.storage import atomic_output, atomic_write_text
 from optdesign.studies.bench.configs import get_config
 from optdesign.studies.bench.metrics import (
@@ -25,6 +30,18 @@ from optdesign.studies.bench.metrics import (
     performance_profile,
 )
 from optdesign.studies.verify import VERIFY_TOL
+from optdesign.text import csv_cell, printable
+
+
+def md_cell(text: object) -> str:
+    """``text`` as one Markdown table cell: one printable line
+    (:func:`~optdesign.text.printable`), with ``\\``, ``|`` (a new cell), ``<`` (inline
+    HTML) and a backtick (code) escaped by a backslash, which Markdown shows as the
+    character itself."""
+    out = printable(text)
+    for ch in ("\\", "|", "<", "`"):
+        out = out.replace(ch, "\\" + ch)
+    return out
 
 
 def stats_table(
@@ -53,9 +70,11 @@ def stats_table(
         if not s["runs"]:
             continue
         ratio, n_pairs = paired_time_ratio(rows, c, best) if best else (float("nan"), 0)
-        fails = ", ".join(f"{k} {v}" for k, v in sorted(s["failures"].items())) or "-"
+        fails = ", ".join(f"{md_cell(k)} {v}" for k, v in sorted(s["failures"].items())) or "-"
+        name = md_cell(c)
         lines.append(
-            f"| {'**' + c + '**' if c == best else c} | {descriptions.get(c, '')} | {s['runs']} | "
+            f"| {'**' + name + '**' if c == best else name} | {md_cell(descriptions.get(c, ''))} "
+            f"| {s['runs']} | "
             f"{100 * s['success_rate']:.0f} % | {100 * s['solved_rate']:.0f} % | "
             f"{_fmt(s['median_time_s'], '.3g')} | {_fmt(ratio, '.2f')} ({n_pairs}) | "
             f"{_fmt(s['median_gap'], '.1e')} | {fails} |"
@@ -115,15 +134,9 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
         w.writeheader()
         for r in rows:
             f, g, h = eval_counts(r.get("n_evals") or {})
-            w.writerow(
-                {
-                    **r,
-                    "n_fun": f,
-                    "n_grad": g,
-                    "n_hess": h,
-                    "reason": str(r.get("reason", ""))[:200],
-                }
-            )
+            row = {**r, "n_fun": f, "n_grad": g, "n_hess": h}
+            row["reason"] = str(r.get("reason", ""))[:200]
+            w.writerow({k: csv_cell(v) for k, v in row.items() if k in CSV_FIELDS})
         atomic_write_text(out / "bench_runs.csv", fh.getvalue())
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
     fronts = [c for c in configs if get_config(c).kind == "front"]
@@ -176,7 +189,10 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
     atomic_write_text(
         out / "bench_stats.json",
         json.dumps(
-            {"all": stats_all, "wall_time_s": wall, "suite": suite_name}, indent=1, default=str
+            clean_json({"all": stats_all, "wall_time_s": wall, "suite": suite_name}),
+            indent=1,
+            default=str,
+            allow_nan=False,
         ),
     )
     return {
@@ -189,7 +205,7 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
 
 def _shipped_table(rows, configs) -> str:
     insts = sorted({r["instance"] for r in rows})
-    head = "| configuration | " + " | ".join(f"{i}: time (s) / gap" for i in insts) + " |"
+    head = "| configuration | " + " | ".join(f"{md_cell(i)}: time (s) / gap" for i in insts) + " |"
     lines = [head, "|---|" + "---|" * len(insts)]
     by = {(r["instance"], r["config"]): r for r in rows}
     for c in configs:
@@ -199,10 +215,10 @@ def _shipped_table(rows, configs) -> str:
             if r is None or not r.get("applicable", True):
                 cells.append("n/a")
             elif not r.get("success"):
-                cells.append(f"{r['status']}")
+                cells.append(md_cell(r["status"]))
             else:
                 cells.append(f"{r['time_s']:.3g} / {r['gap']:.1e}")
-        lines.append(f"| {c} | " + " | ".join(cells) + " |")
+        lines.append(f"| {md_cell(c)} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 

@@ -1,8 +1,16 @@
-"""Files of a front: ``front.csv`` (a row per point) and ``front.json`` (everything)."""
+"""Files of a front: ``front.csv`` (a row per point) and ``front.json`` (everything).
+
+``front.csv`` is written with :mod:`csv` (a name holding a comma, a quote or a newline
+is quoted) and is safe to open in a spreadsheet: a text cell or heading that starts
+with ``=``, ``+``, ``-``, ``@``, a tab or a carriage return gets a leading ``'``
+(:func:`optdesign.text.csv_cell`); numbers, negative ones too, are written as numbers.
+``front.json`` writes a value that is not finite as ``null``.
+"""
 
 from __future__ import annotations
 
 import csv
+import io
 import json
 from collections.abc import Sequence
 from pathlib import Path
@@ -13,6 +21,7 @@ import numpy as np
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.result import clean_json
 from optdesign.studies.pareto.front import Front
+from optdesign.text import csv_cell
 
 
 def front_rows(front: Front, problem: DesignProblem, rejected: bool = False) -> list[dict]:
@@ -41,27 +50,19 @@ def write_front_csv(
     fronts = [front] if isinstance(front, Front) else list(front)
     rows = [r for f in fronts for r in front_rows(f, problem, rejected=True)]
     fields = list(rows[0]) if rows else ["method"]
-    lines = [",".join(fields)]
-    for r in rows:
-        lines.append(
-            _csv_line([f"{v:.12g}" if isinstance(v, float) else str(v) for v in r.values()])
-        )
-    return atomic_write_text(Path(path), "\n".join(lines) + "\n")
-
-
-def _csv_line(cells: list[str]) -> str:
-    import io
-
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="").writerow(cells)
-    return buf.getvalue()
+    with io.StringIO() as buf:
+        writer = csv.writer(buf, lineterminator="\n")
+        writer.writerow([csv_cell(f) for f in fields])
+        writer.writerows([csv_cell(v, digits=12) for v in r.values()] for r in rows)
+        return atomic_write_text(Path(path), buf.getvalue())
 
 
 def read_front_csv(path: Path | str, objectives: Sequence[str]) -> np.ndarray:
-    """Objective values of the on-front rows of a ``front.csv``."""
-    with Path(path).open() as fh:
+    """Objective values of the on-front rows of a ``front.csv`` (``objectives`` named as
+    the problem names them: a heading neutralised for spreadsheets is found too)."""
+    with Path(path).open(newline="") as fh:
         rows = [r for r in csv.DictReader(fh) if r.get("on_front", "True") == "True"]
-    return np.array([[float(r[k]) for k in objectives] for r in rows], dtype=float)
+    return np.array([[float(r[csv_cell(k)]) for k in objectives] for r in rows], dtype=float)
 
 
 def write_front_json(fronts: Sequence[Front], path: Path | str, **meta) -> Path:
