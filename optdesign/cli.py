@@ -46,13 +46,22 @@ def command(name: str):
 
 
 def default_out(prefix: str) -> Path:
-    """A new output folder under the working directory, e.g. ``optdesign-out/duan2017-...``."""
+    """A new output folder under the working directory, e.g. ``optdesign-out/duan2017-...``.
+
+    ``prefix`` may hold a problem's name, which comes from a file: it is reduced to a
+    safe slug (:func:`optdesign.safe_io.slug`: no ``/``, no ``..``, no leading dot, no
+    control character, at most 60 characters), so the folder is always a new child of
+    ``./optdesign-out``.
+    """
+    from optdesign.safe_io import slug
+
     stamp = time.strftime("%Y%m%d-%H%M%S")
-    base = Path.cwd() / "optdesign-out" / f"{prefix}-{stamp}"
+    root = Path.cwd() / "optdesign-out"
+    base = root / f"{slug(prefix)}-{stamp}"
     path, k = base, 1
-    while path.exists():
+    while os.path.lexists(path):
         k += 1
-        path = base.with_name(f"{base.name}-{k}")
+        path = root / f"{base.name}-{k}"
     return path
 
 

@@ -1,11 +1,12 @@
 """Safe output: atomic result files, one writer per output folder, the JSONL task store.
 
-Long runs write into an output folder that a user may reuse, interrupt, or (by mistake)
-share between two runs. This module makes each of those safe:
+Long runs write into an output folder that a user may reuse, interrupt, share between
+two runs by mistake, or receive from someone else. This module makes each of those safe:
 
 - :func:`atomic_write_text` / :func:`atomic_write_bytes` / :func:`atomic_output`: a
   result file is either the old one or the complete new one, never a partial file (a
-  temporary file in the same folder, fsynced, then ``os.replace``);
+  new temporary file in the same folder, created with ``O_EXCL``, fsynced, then
+  ``os.replace``: a link planted at the result's name is replaced, never followed);
 - :func:`lock_folder`: an advisory lock (``flock`` on ``.optdesign.lock`` in the folder),
   non-blocking, so a second run into the same folder is refused at once with the pid of
   the first. The kernel drops the lock with the process, whatever ends it: no stale
@@ -13,10 +14,17 @@ share between two runs. This module makes each of those safe:
   the task runner takes it again for each store);
 - :func:`open_store` / :class:`StoreWriter` / :func:`read_store`: the append-only JSON
   Lines store of :func:`optdesign.studies.runner.run_tasks`. Its first line is the run's
-  identity ``{"__store__": 1, "key": ...}``, written with the file's creation (the file
-  appears complete with it, atomically), so a store without its identity is never ours.
-  Resuming checks the identity, refuses damaged or foreign stores, and cuts a torn last
-  line (a run killed while writing) before appending.
+  identity ``{"__store__": 2, "key": ..., "identity": {...}}``, written with the file's
+  creation (the file appears complete with it, atomically), so a store without its
+  identity is never ours. Resuming checks the format version, the identity (naming the
+  component that changed, :mod:`optdesign.store_identity`) and every record, refuses
+  damaged or foreign stores, and cuts a torn last line (a run killed while writing)
+  before appending.
+
+The lock file and the stores are opened without following links, and must be regular
+files with one link (:mod:`optdesign.safe_io`): nothing outside the folder is truncated,
+appended to or read through them. An ``--out`` that is itself a link, given on the
+command line, is the user's choice and is used as given.
 """
 
 from __future__ import annotations
@@ -26,13 +34,14 @@ import json
 import os
 import tempfile
 import threading
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from optdesign.errors import OptDesignError
 from optdesign.interrupts import deferred
+from optdesign.safe_io import CLOEXEC, NOFOLLOW, open_file, read_file
 
 try:  # POSIX; elsewhere folders are not locked
     import fcntl
@@ -44,8 +53,9 @@ Record = dict[str, Any]
 #: Name of the lock file in a locked output folder.
 LOCK_NAME = ".optdesign.lock"
 
-#: Identity line version.
-STORE_VERSION = 1
+#: Store format version (the identity line's ``__store__``): 2 stores the identity's
+#: components; a store of another format is refused, naming its version.
+STORE_VERSION = 2
 
 _EMPTY = "it is empty (no identity line)"
 
@@ -86,17 +96,26 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
-def _temp_name(path: Path) -> Path:
+def _temp_file(path: Path) -> tuple[int, Path]:
     # Hidden, in the same folder (os.replace must not cross file systems), keeping the
     # suffix so that writers choosing the format by extension (matplotlib) still work.
+    # mkstemp creates it with O_EXCL | O_NOFOLLOW: a new file, never a planted one.
     try:
         fd, tmp = tempfile.mkstemp(
             prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent
         )
     except OSError as exc:
         raise StoreError(f"cannot write {path}: {exc.strerror}") from None
-    os.close(fd)
-    return Path(tmp)
+    return fd, Path(tmp)
+
+
+def _commit(fd: int, tmp: Path, path: Path) -> None:
+    # The temporary file's content is complete: make it durable and put it in place.
+    # os.replace swaps the directory entry: a link planted at ``path`` is replaced, its
+    # target never opened.
+    os.fchmod(fd, 0o666 & ~_umask())  # mkstemp made it 0600
+    os.fsync(fd)
+    os.replace(tmp, path)
 
 
 @contextlib.contextmanager
@@ -104,7 +123,8 @@ def atomic_output(path: Path | str) -> Iterator[Path]:
     """A temporary path to write ``path``'s new content to; it replaces ``path`` on exit.
 
     For writers that want a file name (``savefig``). On an exception (an interrupt too)
-    the temporary file is removed and ``path`` is unchanged.
+    the temporary file is removed and ``path`` is unchanged. A symbolic link at ``path``
+    is replaced by the new file, never followed.
 
     Examples
     --------
@@ -113,16 +133,17 @@ def atomic_output(path: Path | str) -> Iterator[Path]:
     """
     path = Path(path)
     _make_folder(path.parent)
-    tmp = _temp_name(path)
+    fd, tmp = _temp_file(path)
+    os.close(fd)
     try:
         yield tmp
-        fd = os.open(tmp, os.O_RDWR)
+        # The writer wrote by name (it may even have replaced the file, atomically):
+        # reopened without following a link, made durable, put in place.
+        fd = os.open(tmp, os.O_RDWR | NOFOLLOW | CLOEXEC)
         try:
-            os.fchmod(fd, 0o666 & ~_umask())  # mkstemp made it 0600
-            os.fsync(fd)
+            _commit(fd, tmp, path)
         finally:
             os.close(fd)
-        os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -133,14 +154,29 @@ def atomic_output(path: Path | str) -> Iterator[Path]:
 def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically: readers see the old file or the whole new one.
 
+    The data goes through the descriptor of the new temporary file (created with
+    ``O_EXCL``), never through a name: a link at ``path`` is replaced, not followed.
+
     Returns
     -------
     Path
         ``path``.
     """
     path = Path(path)
-    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
-        fh.write(data)
+    _make_folder(path.parent)
+    fd, tmp = _temp_file(path)
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view) :]
+        _commit(fd, tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    finally:
+        os.close(fd)
+    _fsync_dir(path.parent)
     return path
 
 
@@ -203,16 +239,18 @@ if hasattr(os, "register_at_fork"):
 
 def _lock_holder(path: Path) -> str:
     try:
-        pid = path.read_text().strip()
-    except OSError:
+        pid = (read_file(path, what="the lock file", limit=64) or b"").decode().strip()
+    except (OSError, OptDesignError, UnicodeDecodeError):
         pid = ""
     return f"pid {pid}" if pid.isdigit() else "pid unknown"
 
 
 def _acquire(folder: Path) -> int:
     path = folder / LOCK_NAME
+    # A lock file planted as a link (to ~/.bashrc) is refused, never truncated; so is
+    # a hard link, a FIFO or a device.
     try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+        fd = open_file(path, os.O_RDWR | os.O_CREAT, 0o644, what="the lock file", single_link=True)
     except OSError as exc:
         raise StoreError(f"cannot write to the output folder {folder}: {exc.strerror}") from None
     if fcntl is None:  # pragma: no cover - no advisory locks on this platform
@@ -267,6 +305,11 @@ def holds_lock(folder: Path | str) -> bool:
 
 
 # --- the JSONL store --------------------------------------------------------------------
+#: Largest store read back (a pareto record with its multipliers is ~10 kB, a bench row
+#: ~1 kB: 10 000 points are ~100 MB).
+STORE_MAX_BYTES = 1 << 30
+
+
 @dataclass
 class StoreScan:
     """What a store file holds (see :func:`scan_store`)."""
@@ -275,7 +318,13 @@ class StoreScan:
     exists: bool = False
     key: str | None = None
     has_identity: bool = False
+    #: The identity line's ``__store__`` (the store format version).
+    version: Any = None
+    #: The identity line's components (what the run's records depend on), if stored.
+    identity: dict[str, Any] | None = None
     records: dict[str, Record] = field(default_factory=dict)
+    #: Line number of each record (for messages).
+    lines: dict[str, int] = field(default_factory=dict)
     #: Length of the part made of complete lines (a torn tail starts there).
     good_bytes: int = 0
     #: The file's bytes after the last newline (a record being written when killed).
@@ -290,16 +339,17 @@ def scan_store(path: Path | str) -> StoreScan:
     """Read a store without trusting it: the identity, the records, a torn tail, damage.
 
     Never raises for content (an unreadable file gives ``problem``); only for a file that
-    cannot be opened.
+    cannot be opened, or that is a symbolic link, not a regular file, or larger than
+    :data:`STORE_MAX_BYTES` (:class:`~optdesign.safe_io.UnsafeFileError`).
     """
     path = Path(path)
     scan = StoreScan(path)
     try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        return scan
+        data = read_file(path, what="the store", limit=STORE_MAX_BYTES)
     except OSError as exc:
         raise StoreError(f"cannot read the store {path}: {exc.strerror}") from None
+    if data is None:
+        return scan
     scan.exists = True
     end = data.rfind(b"\n") + 1
     scan.good_bytes, scan.torn = end, data[end:]
@@ -319,6 +369,9 @@ def scan_store(path: Path | str) -> StoreScan:
                 scan.problem = f"line {n} is a second identity line (two runs wrote into it)"
                 return scan
             scan.has_identity, scan.key = True, obj.get("key")
+            scan.version = obj["__store__"]
+            ident = obj.get("identity")
+            scan.identity = ident if isinstance(ident, dict) else None
             continue
         if n == 1:
             scan.problem = "its first line is not the identity of an optdesign run"
@@ -331,6 +384,7 @@ def scan_store(path: Path | str) -> StoreScan:
             scan.problem = f"record {rid!r} appears twice (line {n}): two runs wrote into it"
             return scan
         scan.records[rid] = obj
+        scan.lines[rid] = n
     if not scan.has_identity:
         scan.problem = "it has no identity line"
     elif scan.torn:
@@ -338,6 +392,7 @@ def scan_store(path: Path | str) -> StoreScan:
         if why is None and obj is not None and isinstance(obj.get("id"), str):
             if obj["id"] not in scan.records and "__store__" not in obj:
                 scan.torn_record = obj
+                scan.lines[obj["id"]] = len(lines) + 1
     return scan
 
 
@@ -358,6 +413,12 @@ def _parse_line(raw: bytes) -> tuple[dict | None, str | None]:
     return obj, None
 
 
+def _version_problem(scan: StoreScan) -> str | None:
+    from optdesign.store_identity import version_problem
+
+    return version_problem(scan.has_identity, scan.version, STORE_VERSION)
+
+
 def read_store(store_path: Path | str) -> tuple[str | None, dict[str, Record]]:
     """The key and the records (id -> record) of a JSONL store.
 
@@ -368,24 +429,40 @@ def read_store(store_path: Path | str) -> tuple[str | None, dict[str, Record]]:
     Raises
     ------
     StoreError
-        If the file is not a readable store (damaged, binary, two runs interleaved).
+        If the file is not a readable store (damaged, binary, two runs interleaved, or
+        in another store format).
     """
     scan = scan_store(store_path)
-    if scan.problem not in (None, _EMPTY):
-        raise StoreError(f"{scan.path} is not a usable optdesign store: {scan.problem}")
+    problem = scan.problem if scan.problem not in (None, _EMPTY) else _version_problem(scan)
+    if problem is not None:
+        raise StoreError(f"{scan.path} is not a usable optdesign store: {problem}")
     if scan.torn_record is not None:
         scan.records[scan.torn_record["id"]] = scan.torn_record
     return scan.key, scan.records
 
 
+#: ``check(record) -> None`` or why a stored record cannot be trusted.
+RecordCheck = Callable[[Record], "str | None"]
+
+
 def open_store(
-    path: Path | str, key: str | None, resume: bool, overwrite: bool = False
+    path: Path | str,
+    key: str | Mapping[str, Any] | None,
+    resume: bool,
+    overwrite: bool = False,
+    check: RecordCheck | None = None,
 ) -> dict[str, Record]:
     """Make ``path`` ready for appending the records of run ``key``; return its records.
 
-    - ``resume`` and the store exists: its identity must be present and carry ``key``,
-      every line must be readable; a torn last line is completed (a whole record that
-      only lacks its newline) or cut. Returns the stored records.
+    ``key`` is the run's identity: a string, or a mapping of its components (what the
+    records depend on: the problem, the objectives, the method's and the solver's
+    settings, the code's version...), stored component by component so that a refused
+    resume can say which one changed (:mod:`optdesign.store_identity`).
+
+    - ``resume`` and the store exists: it must be in this store format, its identity
+      must equal ``key``, every line must be readable and every record must pass
+      ``check``; a torn last line is completed (a whole record that only lacks its
+      newline) or cut. Returns the stored records.
     - otherwise a new store holding only the identity replaces ``path``, atomically.
       An existing store with records (or unreadable content) is not replaced unless
       ``overwrite``: a run without ``resume`` must not silently empty an earlier one.
@@ -395,31 +472,54 @@ def open_store(
     Raises
     ------
     StoreError
-        Naming the file and the reason, and what to do.
+        Naming the file and the reason (the changed component, the line of a record
+        that fails ``check`` and why), and what to do.
     """
+    from optdesign.store_identity import describe_difference, identity_key
+
     path = Path(path)
-    scan = scan_store(path)
+    key_text = identity_key(key)
+    components = dict(key) if isinstance(key, Mapping) else None
+    scan = scan_store(path) if resume or not overwrite else StoreScan(path)
     if resume and scan.exists:
-        if scan.problem is not None:
+        problem = scan.problem or _version_problem(scan)
+        if problem is not None:
+            raise StoreError(f"--resume: {path} cannot be resumed: {problem}; {_START_OVER}")
+        if scan.key != key_text:
+            diff = describe_difference(scan.identity, scan.key, components, key_text)
             raise StoreError(
-                f"--resume: {path} cannot be resumed: {scan.problem}; "
-                "start over with --overwrite or use a new output folder"
+                f"--resume: the store {path} belongs to another run: {diff}; resume with the "
+                f"same settings, or {_START_OVER}"
             )
-        if scan.key != key:
-            raise StoreError(
-                f"--resume: the store {path} belongs to another run (key {scan.key!r}, "
-                f"this run {key!r}); use a new output folder or the same settings"
-            )
+        if scan.torn_record is not None:
+            scan.records[scan.torn_record["id"]] = scan.torn_record
+        if check is not None:
+            _check_records(scan, check)
         if scan.torn:
             _repair_tail(path, scan)
-            if scan.torn_record is not None:
-                scan.records[scan.torn_record["id"]] = scan.torn_record
         return scan.records
     if not overwrite:
         _refuse_replacing(scan)
-    identity = {"__store__": STORE_VERSION, "key": key}
-    atomic_write_text(path, json.dumps(identity) + "\n")
+    identity: dict[str, Any] = {"__store__": STORE_VERSION, "key": key_text}
+    if components is not None:
+        identity["identity"] = components
+    atomic_write_text(path, json.dumps(identity, sort_keys=True, default=str) + "\n")
     return {}
+
+
+_START_OVER = "start over with --overwrite or use another output folder"
+
+
+def _check_records(scan: StoreScan, check: RecordCheck) -> None:
+    from optdesign.store_identity import check_records
+
+    bad = check_records(scan.records, scan.lines, check)
+    if bad is not None:
+        rid, line, why = bad
+        raise StoreError(
+            f"--resume: {scan.path} line {line}: record {rid!r} {why}; it cannot be "
+            f"trusted: {_START_OVER}"
+        )
 
 
 def _refuse_replacing(scan: StoreScan) -> None:
@@ -447,7 +547,7 @@ def check_new_store(path: Path | str) -> None:
 def _repair_tail(path: Path, scan: StoreScan) -> None:
     # The next record must start on a line of its own: appended onto the partial line,
     # it would make that line unreadable and be lost with it.
-    fd = os.open(path, os.O_RDWR)
+    fd = open_file(path, os.O_RDWR, what="the store", single_link=True)
     try:
         if scan.torn_record is not None:
             os.lseek(fd, 0, os.SEEK_END)
@@ -486,8 +586,10 @@ class StoreWriter:
     def __init__(self, path: Path | str, count: int = 0):
         self.path = Path(path)
         self.count = count
-        flags = os.O_WRONLY | os.O_APPEND | getattr(os, "O_CLOEXEC", 0)
-        self.fd = os.open(self.path, flags)
+        # Not through a link, nor into a file with other hard links (see safe_io).
+        self.fd = open_file(
+            self.path, os.O_WRONLY | os.O_APPEND, what="the store", single_link=True
+        )
         self._dirty = threading.Event()
         self._closing = False
         self._syncer = threading.Thread(target=self._sync_loop, daemon=True)

@@ -6,6 +6,7 @@ import os
 import pytest
 
 from optdesign.errors import OptDesignError
+from optdesign.storage import STORE_VERSION
 from optdesign.studies.runner import read_store, run_tasks
 
 
@@ -40,7 +41,7 @@ def test_chains_are_computed_in_order_and_stored(tmp_path):
     assert done["t3"]["value"] == 27  # by hand: 2, 5, 12, 27
     assert done["t7"]["value"] == 2 * (2 * (2 * 6 + 5) + 6) + 7
     lines = store.read_text().splitlines()
-    assert json.loads(lines[0]) == {"__store__": 1, "key": "k1"}
+    assert json.loads(lines[0]) == {"__store__": STORE_VERSION, "key": "k1"}
     assert len(lines) == 9
 
 

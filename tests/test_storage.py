@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from optdesign.storage import (
+    STORE_VERSION,
     FolderInUseError,
     StoreError,
     atomic_output,
@@ -66,7 +67,7 @@ def test_a_new_store_starts_with_its_identity_before_any_record(tmp_path):
 
     run_tasks(_tasks(2), _double, store, key="k1", on_record=peek)
     assert {json.loads(x)["key"] for x in seen_first_line} == {"k1"}
-    assert _lines(store)[0] == {"__store__": 1, "key": "k1"}
+    assert _lines(store)[0] == {"__store__": STORE_VERSION, "key": "k1"}
 
 
 @pytest.mark.parametrize(
@@ -89,7 +90,7 @@ def test_resume_refuses_a_store_that_is_not_this_runs(tmp_path, damage, message)
         "empty": b"",
         "identity deleted": b"".join(lines[1:]),
         "identity only deleted, nothing left": b"\n",
-        "foreign key": json.dumps({"__store__": 1, "key": "other"}).encode()
+        "foreign key": json.dumps({"__store__": STORE_VERSION, "key": "other"}).encode()
         + b"\n"
         + b"".join(lines[1:]),
         "binary junk": lines[0] + os.urandom(64).replace(b"\n", b"") + b"\x80\xff\n",
@@ -174,7 +175,7 @@ def test_a_new_run_does_not_silently_empty_an_earlier_store(tmp_path):
     run_tasks(_tasks(), _double, store, key="new", overwrite=True)
     assert _lines(store)[0]["key"] == "new" and len(_lines(store)) == 7
     # a store holding only its identity has nothing to lose: replaced without a word
-    store.write_text(json.dumps({"__store__": 1, "key": "x"}) + "\n")
+    store.write_text(json.dumps({"__store__": STORE_VERSION, "key": "x"}) + "\n")
     run_tasks(_tasks(2), _double, store, key="k")
     assert len(_lines(store)) == 3
 

@@ -95,6 +95,15 @@ def run_bench_command(args) -> int:
         raise InputError("--overwrite", "excludes --resume (start over, or continue)")
     if args.resume and args.out is None:
         raise InputError("--resume", "give the --out folder of the run to resume")
+    if args.update_readme is not None:
+        # Checked before the benchmark runs: a FIFO, /dev/zero, a folder or a file
+        # without the markers is refused at once, not after an hour of runs.
+        from optdesign.studies.bench.report import has_readme_markers, read_readme
+
+        if not has_readme_markers(read_readme(args.update_readme)):
+            raise InputError(
+                "--update-readme", f"{args.update_readme} has no generated-block markers"
+            )
     out = args.out or default_out("bench")
     with storage.lock_folder(out):
         storage.ensure_writable(out)

@@ -59,7 +59,8 @@ def write_figure(draw: Callable[[], Any], path: str | Path, **kw: Any) -> str | 
 
 
 def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Path:
-    """Lay out ``fig``, write it as PNG at ``path`` (folders made), close it; return the path."""
+    """Lay out ``fig``, write it as PNG at ``path`` (folders made, the file replaced
+    atomically), close it; return the path."""
     import matplotlib.pyplot as plt
 
     if tight:
@@ -72,8 +73,12 @@ def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Pa
             TightLayoutEngine(rect=None).execute(fig)
         else:
             fig.tight_layout()
+    from optdesign.storage import atomic_output
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi)
+    # Atomically, through a new temporary file: a link planted at ``path`` (in a reused
+    # output folder) is replaced, never followed, and a failed write leaves the old file.
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=path.suffix.lstrip(".").lower() or "png")
     plt.close(fig)
     return path

@@ -390,6 +390,19 @@ class SolverOptions(_Model):
     agree: int = Field(3, ge=0, le=10_000)
     ipopt: dict[str, Any] = Field(default_factory=dict)
 
+    @field_validator("ipopt")
+    @classmethod
+    def _no_files(cls, value: dict[str, Any]) -> dict[str, Any]:
+        # A problem file comes from anyone: an option that writes or reads a file
+        # (output_file) or loads code (hsllib) is refused on load, before any solve.
+        from optdesign.safe_io import file_option_problem
+
+        found = file_option_problem(value, "ipopt")
+        if found:
+            where, reason = found
+            raise ValueError(f"{where.removeprefix('ipopt.')}: refused: it {reason}")
+        return value
+
 
 def _band_table(data: Any) -> Any:
     # ``R = "0.05 mm"`` is short for ``R = { band = "0.05 mm" }``.

@@ -21,6 +21,7 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
+from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.result import Result, TerminationCondition
 
@@ -89,6 +90,7 @@ def ipopt_option_names() -> frozenset[str]:
         "print_advanced_options": "yes",
         "print_options_mode": "text",
         "max_iter": 0,
+        "option_file_name": "",  # never an ipopt.opt of the working directory
     }
     with contextlib.redirect_stdout(buf):  # CasADi prints through Python's sys.stdout
         solver = ca.nlpsol(
@@ -100,7 +102,9 @@ def ipopt_option_names() -> frozenset[str]:
 
 
 def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt") -> None:
-    """Refuse an option Ipopt does not know (with the nearest name) or a value it refuses.
+    """Refuse an option Ipopt does not know (with the nearest name) or a value it refuses,
+    and every option that would read or write a file or load code (``output_file``,
+    ``option_file_name``, ``hsllib``..., see :func:`optdesign.safe_io.file_option_problem`).
 
     Each option is tried on a one-variable problem, so the check is Ipopt's own.
 
@@ -109,6 +113,7 @@ def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt")
     InputError
         Naming ``field.<option>`` and the reason.
     """
+    refuse_file_options(options, field)  # first: never tried, even on a probe
     known = ipopt_option_names()
     for key, value in options.items():
         where = f"{field}.{key}"
@@ -125,9 +130,9 @@ def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt")
 def _try_ipopt_option(key: str, value: Any, where: str) -> None:
     x = ca.MX.sym("x")
     buf = io.StringIO()
-    opts = {"print_level": 0, "sb": "yes", "max_iter": 0, key: value}
-    if key in ("output_file", "print_options_documentation"):
-        return  # side effects (a file, the whole manual); the solve itself checks them
+    opts = {"print_level": 0, "sb": "yes", "max_iter": 0, key: value, "option_file_name": ""}
+    if key == "print_options_documentation":
+        return  # prints the whole manual; the solve itself checks it
     try:
         with contextlib.redirect_stdout(buf):
             solver = ca.nlpsol(
@@ -163,7 +168,11 @@ class CasadiNLPSolver:
             check_ipopt_options(options or {})
             opts["ipopt"] = {**IPOPT_DEFAULTS, **(options or {})}
         else:
+            refuse_file_options(options, "options")
             opts.update(options or {})
+        # No Ipopt (this one, or one nested in a QP solver's options) reads ipopt.opt
+        # from the working directory.
+        opts = without_option_files(opts)
         self.options = opts
         self.solver = ca.nlpsol(
             "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts

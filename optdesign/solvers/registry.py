@@ -68,12 +68,18 @@ def make_solver(
     formulation: Any, name: str | None = None, options: Mapping[str, Any] | None = None
 ):
     """The back-end ``name`` built for ``formulation`` (default: ipopt for an NLP,
-    clarabel for a GP)."""
+    clarabel for a GP). Options that would read or write a file or load code are
+    refused (:func:`optdesign.safe_io.refuse_file_options`)."""
     from optdesign.formulations.nlp import NLP
+    from optdesign.safe_io import refuse_file_options
 
     kind = "nlp" if isinstance(formulation, NLP) else "gp"
     name = name or ("ipopt" if kind == "nlp" else "clarabel")
-    return solver_entry(name, kind).factory(formulation, dict(options or {}))
+    entry = solver_entry(name, kind)
+    # No back-end option may read or write a file or load code (Ipopt's output_file,
+    # CasADi's dump/jit, SCS's write_data_filename...), wherever it comes from.
+    refuse_file_options(options, "options")
+    return entry.factory(formulation, dict(options or {}))
 
 
 # --- built-in back-ends -------------------------------------------------------------------

@@ -19,11 +19,14 @@ benchmark command can reuse it):
   decides its next steps from results, e.g. two chains of a sweep meeting wherever they
   meet); on resume it sees the stored records too, so the same tasks are generated;
 - ``resume=True`` reads the store first, skips every task with a record and hands the
-  stored records to dependants as if just computed. The first line of the store holds a
-  ``key`` (e.g. a hash of the run's settings); resuming with another key, or from a
-  store without that identity line, is an error, so a resumed run cannot silently mix
-  two configurations. Without ``resume``, a store holding records is not replaced
-  unless ``overwrite=True``. The store's folder has one writer at a time;
+  stored records to dependants as if just computed. The first line of the store holds
+  the run's identity ``key`` (a string, or a mapping of everything the records depend
+  on: problem, objectives, settings, solver options, version); resuming with another
+  identity (the message names the components that changed), from a store without that
+  line or in another store format is an error, so a resumed run cannot silently mix two
+  configurations; ``check`` refuses stored records that cannot be trusted (a NaN, a
+  design outside the bounds). Without ``resume``, a store holding records is not
+  replaced unless ``overwrite=True``. The store's folder has one writer at a time;
 - ``isolate=Isolation(timeout=...)`` runs each task in a forked child: a hang past the
   timeout is killed, a crash or exception becomes a failure record (the benchmark).
 
@@ -123,7 +126,7 @@ def run_tasks(
     scheduler: str | Any | None = None,
     resume: bool = False,
     progress: bool | str = False,
-    key: str | None = None,
+    key: str | Mapping[str, Any] | None = None,
     on_record: Callable[[Record], None] | None = None,
     known: Mapping[str, Record] | None = None,
     pool: WorkerPool | None = None,
@@ -131,6 +134,7 @@ def run_tasks(
     *,
     overwrite: bool = False,
     isolate: Isolation | None = None,
+    check: Callable[[Record], str | None] | None = None,
 ) -> dict[str, Record]:
     """Run ``tasks`` through ``fn``, storing each record as it finishes.
 
@@ -155,7 +159,9 @@ def run_tasks(
     progress
         Show a tqdm bar (a string is used as its description).
     key
-        Identity of the run written to / checked against the store on resume.
+        Identity of the run written to / checked against the store on resume: a string,
+        or a mapping of its components (JSON-able), stored one by one so that a refused
+        resume names what changed.
     on_record
         Called in this process with each new record after it is stored (for example to
         stop a run in a test by raising).
@@ -178,6 +184,10 @@ def run_tasks(
     isolate
         Run every task in a forked child with a hard timeout; a timeout, crash or
         exception becomes a failure record (see :class:`Isolation`) instead of an error.
+    check
+        ``check(record) -> None`` or why a stored record cannot be trusted; on resume
+        every stored record is checked before any is used, and one that fails refuses
+        the resume naming the store, its line and the reason.
 
     Returns
     -------
@@ -190,8 +200,9 @@ def run_tasks(
     optdesign.storage.FolderInUseError
         Another process writes into the store's folder.
     optdesign.storage.StoreError
-        The store cannot be resumed (no identity, another key, damaged), or holds records
-        and neither ``resume`` nor ``overwrite`` is given.
+        The store cannot be resumed (no identity, another key, another format, damaged,
+        a record failing ``check``), or holds records and neither ``resume`` nor
+        ``overwrite`` is given.
     KeyboardInterrupt
         Re-raised after the cleanup when the run is interrupted (Ctrl-C, or SIGTERM turned
         into one by the CLI): workers stopped, every finished record written, the store
@@ -200,7 +211,7 @@ def run_tasks(
     """
     path = Path(store_path)
     with lock_folder(path.parent):
-        stored = open_store(path, key, resume, overwrite)
+        stored = open_store(path, key, resume, overwrite, check)
         return _run(
             tasks,
             fn,

@@ -344,6 +344,10 @@ def solve(
     **extra: Any,
 ) -> Result:
     """The optimal design of ``problem`` with its evidence (see :func:`optdesign.solve`)."""
+    from optdesign.safe_io import refuse_file_options
+
+    # Before any work and whatever the formulation: no option may read or write a file.
+    refuse_file_options(options, "options")
     name = choose_formulation(problem, formulation)
     result = FORMULATIONS[name].run(
         problem,

@@ -3,8 +3,8 @@ checkpointed store, then gaps, statistics, profiles and the summary."""
 
 from __future__ import annotations
 
-import hashlib
 import json
+import math
 import tempfile
 import time
 from collections.abc import Sequence
@@ -14,7 +14,9 @@ from typing import Any
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.safe_io import read_file
 from optdesign.storage import atomic_write_text
+from optdesign.store_identity import identity_key
 from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
 from optdesign.studies.bench.instances import Instance, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
@@ -129,8 +131,8 @@ def run_bench(
     refused unless ``resume``).
     """
     from optdesign.studies.bench.report import write_outputs
-    from optdesign.studies.bench.sandbox import failed_run
-    from optdesign.studies.runner import Isolation, read_store, run_tasks
+    from optdesign.studies.bench.sandbox import failed_run, row_check
+    from optdesign.studies.runner import Isolation, run_tasks
 
     names = list(configs) if configs else default_configs()
     for c in names:
@@ -157,25 +159,8 @@ def run_bench(
     out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-bench-"))
     out.mkdir(parents=True, exist_ok=True)
     store = out / "bench_runs.jsonl"
-    identity = {
-        "suite": suite_name,
-        "ids": [t["id"] for t in tasks],
-        "tl": time_limit,
-        "hard": hard,
-    }
-    if problems is not None:
-        from optdesign.studies.solve import formulation_for
-
-        identity["formulations"] = [formulation_for(p).fingerprint for p in problems]
-    key = hashlib.sha256(json.dumps(identity).encode()).hexdigest()[:16]
+    key = bench_identity(suite_name, tasks, time_limit, hard, problems)
     t0 = time.perf_counter()
-    if resume and store.exists():
-        prev_key, _ = read_store(store)
-        if prev_key is not None and prev_key != key:
-            raise OptDesignError(
-                f"--resume: {store} holds another run (other suite, configurations or time "
-                "limit); use the same settings or a new --out"
-            )
     records = run_tasks(
         tasks,
         run_task,
@@ -187,15 +172,15 @@ def run_bench(
         key=key,
         overwrite=overwrite,
         isolate=Isolation(timeout="hard_timeout", failure=failed_run, quiet=True),
+        check=row_check(tasks),
     )
     wall = time.perf_counter() - t0
     # Wall time over all invocations of this run (a resumed run adds to the stored one).
     meta_path = out / "bench_meta.json"
-    if resume and meta_path.exists():
-        meta = json.loads(meta_path.read_text())
-        if meta.get("key") == key:
-            wall += float(meta.get("wall_time_s", 0.0))
-    atomic_write_text(meta_path, json.dumps({"key": key, "wall_time_s": wall}))
+    key_text = identity_key(key)
+    if resume:
+        wall += _stored_wall(meta_path, key_text)
+    atomic_write_text(meta_path, json.dumps({"key": key_text, "wall_time_s": wall}))
     rows = add_gaps([dict(records[t["id"]]) for t in tasks if t["id"] in records])
     paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard)
     single = [c for c in names if get_config(c).kind not in ("front", "debug")]
@@ -207,3 +192,46 @@ def run_bench(
         paths=paths,
         wall_time_s=wall,
     )
+
+
+def bench_identity(
+    suite_name: str,
+    tasks: Sequence[dict[str, Any]],
+    time_limit: float,
+    hard: float,
+    problems: Sequence[DesignProblem] | None,
+) -> dict[str, Any]:
+    """The identity of a benchmark's store: suite, runs (instances x configurations),
+    time limits, optdesign version (instances and configurations are code) and, for the
+    caller's own problems, each one's content, formulation and ``[solver]`` table."""
+    from optdesign.studies.identity import problem_digest, solver_identity, version
+
+    identity: dict[str, Any] = {
+        "suite": suite_name,
+        "runs": [t["id"] for t in tasks],
+        "time_limit": time_limit,
+        "hard_timeout": hard,
+        "optdesign": version(),
+    }
+    if problems is not None:
+        from optdesign.studies.solve import formulation_for
+
+        identity["problems"] = [
+            {
+                "problem": problem_digest(p),
+                "formulation": formulation_for(p).fingerprint,
+                "solver": solver_identity(p, "")["file"],
+            }
+            for p in problems
+        ]
+    return identity
+
+
+def _stored_wall(meta_path: Path, key: str | None) -> float:
+    """Wall time of the earlier invocations of this run (0 if none, or not this run's)."""
+    try:
+        meta = json.loads(read_file(meta_path, what="the bench meta file", limit=1 << 16) or b"{}")
+        wall = float(meta.get("wall_time_s", 0.0)) if meta.get("key") == key else 0.0
+    except (ValueError, TypeError, AttributeError, OptDesignError):
+        return 0.0  # not ours, or damaged: the time of this invocation only
+    return wall if math.isfinite(wall) and wall >= 0 else 0.0

@@ -293,3 +293,94 @@ def _fix(inst: Instance, problem: DesignProblem, combo: Mapping[str, float]) -> 
         sub._objectives.setdefault(info.name, info)
     sub._constraints = list(problem.user_constraints)
     return sub
+
+
+# --- trusting a stored row ---------------------------------------------------------------
+def _num(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def row_check(tasks: list[Mapping[str, Any]]):
+    """``check(row)`` for the runner's resume: why a stored benchmark row cannot be
+    trusted (see :func:`row_problem`); each instance's problem is built once."""
+    by_id = {t["id"]: t for t in tasks}
+    problems: dict[str, DesignProblem] = {}
+
+    def check(row: Mapping[str, Any]) -> str | None:
+        task = by_id.get(row["id"])
+        if task is None:
+            return None  # not a run of this benchmark: never read
+        return row_problem(task, row, problems)
+
+    return check
+
+
+def row_problem(
+    task: Mapping[str, Any], row: Mapping[str, Any], problems: dict[str, DesignProblem]
+) -> str | None:
+    """Why a stored row of ``task`` cannot be trusted, or None.
+
+    Every row must name its configuration and carry a status, a success flag and a
+    finite time. A successful single-objective row must hold a finite objective and a
+    design inside the instance's bounds that the independent check confirms, with the
+    same objective value (a resumed benchmark recomputes nothing it trusts); a
+    successful front row finite objective vectors and a violation within the check's
+    tolerance.
+    """
+    if row.get("config") != task["config"]:
+        return f"is not a run of configuration {task['config']!r}"
+    if not isinstance(row.get("status"), str) or not isinstance(row.get("success"), bool):
+        return "has no status or success flag"
+    if not (_num(row.get("time_s")) and math.isfinite(row["time_s"]) and row["time_s"] >= 0):
+        return f"has a time that is not a finite number ({row.get('time_s')!r:.40})"
+    if row.get("objective") is not None and not _num(row["objective"]):
+        return "has an objective that is not a number"
+    if not row["success"]:
+        return None
+    if row["status"] not in ("optimal", "feasible"):
+        return f"counts as a success with status {row['status']!r}"
+    if get_config(task["config"]).kind == "front":
+        return _front_row_problem(row)
+    inst = task_instance(task)
+    if inst.id not in problems:
+        problems[inst.id] = inst.problem()
+    problem = problems[inst.id]
+    objective = inst.objectives[0]
+    design = row.get("design")
+    if row.get("verified") is not True or not isinstance(design, dict):
+        return "counts as a success without a design confirmed by the independent check"
+    if not (_num(row["objective"]) and math.isfinite(row["objective"])):
+        return f"counts as a success with objective {row['objective']!r}"
+    missing = [v.name for v in problem.free if not _num(design.get(v.name))]
+    if missing:
+        return f"has no value of {missing[0]} in its design"
+    x = np.array([design[v.name] for v in problem.free], dtype=float)
+    if not np.isfinite(x).all():
+        return "has a design that is not finite"
+    outside = _outside_bounds(problem, x)
+    if outside:
+        return f"has a design outside the bounds: {outside}"
+    ok, violated, objs = verify_design(problem, x)
+    if not ok:
+        return f"has a design that violates {violated[0].describe()}"
+    value = float(objs[objective])
+    if abs(row["objective"] - value) > 1e-7 * max(abs(value), 1e-12):
+        return f"has objective {row['objective']:.10g}, but its design gives {value:.10g}"
+    return None
+
+
+def _front_row_problem(row: Mapping[str, Any]) -> str | None:
+    front = row.get("front")
+    if not (
+        isinstance(front, list)
+        and len(front) >= 2
+        and all(
+            isinstance(p, list) and p and all(_num(v) and math.isfinite(v) for v in p)
+            for p in front
+        )
+    ):
+        return "counts as a success without at least two finite front points"
+    v = row.get("violation")
+    if not (_num(v) and 0 <= v <= VERIFY_TOL):
+        return f"counts as a success with violation {v!r}"
+    return None

@@ -73,7 +73,12 @@ class CatalogueEpsilon:
     name: str = "epsilon-catalogue"
 
     def run(self, problem: DesignProblem, objectives: Sequence[str], run) -> Front:
-        from optdesign.studies.pareto.methods import _store, check_objectives, run_key
+        from optdesign.studies.pareto.methods import (
+            _store,
+            check_objectives,
+            record_check,
+            run_key,
+        )
 
         objectives = check_objectives(problem, objectives)
         if len(objectives) != 2:
@@ -116,7 +121,13 @@ class CatalogueEpsilon:
                 }
             )
         key = run_key(
-            problem, objectives, method=self.name, points=self.points, starts=starts, seed=seed
+            problem,
+            objectives,
+            "ipopt",
+            method=self.name,
+            points=self.points,
+            starts=starts,
+            seed=seed,
         )
         store = _store(run.out, self.name)
         done = run_tasks(
@@ -129,6 +140,7 @@ class CatalogueEpsilon:
             f"{self.name}: points" if run.progress else False,
             key,
             run.on_record,
+            check=record_check(problem, objectives),
         )
         anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
         for k, rec in anchors.items():

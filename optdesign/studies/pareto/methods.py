@@ -8,15 +8,16 @@
 
 Every run of the first two goes through :func:`optdesign.studies.runner.run_tasks`: each
 record is written to a JSONL store as it finishes (resumable), on local processes or a
-Dask cluster. The store's identity is the formulation's fingerprint plus the settings,
-so a resumed run never mixes records of another problem or setting.
+Dask cluster. The store's identity (:func:`run_key`) holds the problem's content, its
+formulation, the objectives, the method's settings, the solver with every option and the
+optdesign version, and every stored record is checked again before a resume trusts it
+(:func:`~optdesign.studies.pareto.records.record_problem`), so a resumed run never mixes
+records of another problem, setting or solver option, nor shows a tampered record.
 """
 
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
 import math
 import tempfile
 import time
@@ -30,6 +31,8 @@ import numpy as np
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.safe_io import slug
+from optdesign.studies.identity import run_identity
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, has_catalogue
 from optdesign.studies.pareto.chains import (
     TwoChains,
@@ -38,7 +41,7 @@ from optdesign.studies.pareto.chains import (
     three_objective_tasks,
 )
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
-from optdesign.studies.pareto.records import PointRecord
+from optdesign.studies.pareto.records import PointRecord, record_problem
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK, front_task
 from optdesign.studies.runner import forks_workers, process_pool, run_tasks
 from optdesign.studies.solve import formulation_for
@@ -75,20 +78,30 @@ def check_objectives(problem: DesignProblem, objectives: Sequence[str]) -> list[
 
 
 def _store(out: Path | str | None, name: str) -> Path:
+    # The method's name names its store: a plain file name, never a path.
+    if not isinstance(name, str) or slug(name) != name:
+        raise InputError(
+            "name", f"{name!r}: a method's name names its store file: use letters, digits, ._-"
+        )
     base = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-pareto-"))
     base.mkdir(parents=True, exist_ok=True)
     return base / f"{name}.jsonl"
 
 
-def run_key(problem: DesignProblem, objectives: Sequence[str], **settings: Any) -> str:
-    """Identity of a front's run: the formulation's content and the settings."""
+def run_key(
+    problem: DesignProblem, objectives: Sequence[str], back_end: str, /, **settings: Any
+) -> dict[str, Any]:
+    """Identity of a front's run (the components of
+    :func:`optdesign.studies.identity.run_identity`): problem, formulation, objectives,
+    the method's ``settings``, the solver ``back_end`` with every option, version."""
+    return run_identity(problem, objectives, back_end=back_end, method=settings)
+
+
+def record_check(problem: DesignProblem, objectives: Sequence[str]):
+    """``check(record)`` for :func:`run_tasks`: why a stored record of a front of
+    ``problem`` cannot be trusted (see :func:`record_problem`)."""
     nlp = formulation_for(problem, tuple(sorted(objectives)))
-    text = json.dumps(
-        {"formulation": nlp.fingerprint, "objectives": list(objectives), **settings},
-        sort_keys=True,
-        default=str,
-    )
-    return hashlib.sha1(text.encode()).hexdigest()[:16]
+    return functools.partial(record_problem, problem, nlp=nlp)
 
 
 def _common(
@@ -156,7 +169,11 @@ class EpsilonConstraint:
         seed = self.seed if self.seed is not None else problem.spec.solver.seed
         settings = {k: v for k, v in asdict(self).items() if k != "name"}
         key = run_key(
-            problem, objectives, method="epsilon", **{**settings, "starts": starts, "seed": seed}
+            problem,
+            objectives,
+            self.solver,
+            method="epsilon",
+            **{**settings, "starts": starts, "seed": seed},
         )
         common = _common(
             problem,
@@ -183,6 +200,7 @@ class EpsilonConstraint:
                 key=key,
                 on_record=run.on_record,
                 pool=pool,
+                check=record_check(problem, objectives),
             )
             anchor_list = anchor_tasks(common, objectives, starts, seed, self.agree)
             if len(objectives) == 2:
@@ -247,8 +265,15 @@ class WeightedSum:
         starts = self.starts if self.starts is not None else problem.spec.solver.starts
         seed = self.seed if self.seed is not None else problem.spec.solver.seed
         key = run_key(
-            problem, objectives, method="weighted_sum", n=self.points, starts=starts, seed=seed
+            problem,
+            objectives,
+            "ipopt",
+            method="weighted_sum",
+            n=self.points,
+            starts=starts,
+            seed=seed,
         )
+        check = record_check(problem, objectives)
         common = _common(problem, objectives, "ipopt")
         done = run_tasks(
             anchor_tasks(common, objectives, starts, seed, 3),
@@ -260,6 +285,7 @@ class WeightedSum:
             False,
             key,
             run.on_record,
+            check=check,
         )
         anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
         for k, rec in anchors.items():
@@ -295,6 +321,7 @@ class WeightedSum:
             key,
             run.on_record,
             known={f"anchor-{objectives[-1]}": done[f"anchor-{objectives[-1]}"]},
+            check=check,
         )
         recs = [PointRecord.from_dict(done[t["id"]]) for t in tasks]
         pts = [FrontPoint.from_record(r, self.name) for r in recs]

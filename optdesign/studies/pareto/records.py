@@ -20,7 +20,7 @@ import numpy as np
 from optdesign.problem.design_problem import DesignProblem, relative_violation
 from optdesign.solvers.result import Result, clean_json
 from optdesign.studies.solve import finish
-from optdesign.studies.verify import VERIFY_TOL
+from optdesign.studies.verify import VERIFY_TOL, verify_design
 
 
 @dataclass
@@ -195,3 +195,156 @@ def vector(obj) -> np.ndarray:
         )
         return a
     return np.asarray([math.nan if v is None else v for v in obj], dtype=float)
+
+
+# --- trusting a stored record -----------------------------------------------------------
+#: A stored objective must equal its recomputation at the stored design to this
+#: (relative): the same code on the same design gives the same value, so a larger
+#: difference is a record edited by hand or damaged.
+RECHECK_RTOL = 1e-7
+
+#: How far (relative to the span, at least 1) a stored design may lie outside the bounds.
+BOUNDS_RTOL = 1e-9
+
+_TEXT = ("kind", "status", "target")
+_OPTIONAL_TEXT = ("message", "solver", "fallback", "retried")
+_TABLES = ("design", "objectives", "eps", "weights")
+_LISTS = ("active", "violated", "order")
+
+
+def _num(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def _vector_ok(v: Any) -> bool:
+    if isinstance(v, dict):
+        return (
+            isinstance(v.get("size"), int)
+            and isinstance(v.get("index"), list)
+            and isinstance(v.get("value"), list)
+            and len(v["index"]) == len(v["value"])
+            and all(isinstance(i, int) and 0 <= i < v["size"] for i in v["index"])
+            and all(x is None or _num(x) for x in v["value"])
+        )
+    return isinstance(v, list) and all(x is None or _num(x) for x in v)
+
+
+def _shape_problem(d: Mapping[str, Any]) -> str | None:
+    """Why ``d`` is not a front record as this code writes them (None: it is one)."""
+    for name in _TEXT:
+        if not isinstance(d.get(name), str):
+            return f"has no text field {name!r}"
+    for name in _OPTIONAL_TEXT:
+        if name in d and not isinstance(d[name], str):
+            return f"field {name!r} is not text"
+    if d.get("verified") not in (True, False, None):
+        return "field 'verified' is not true, false or null"
+    for name in _TABLES:
+        table = d.get(name)
+        if table is not None and not (
+            isinstance(table, dict) and all(v is None or _num(v) for v in table.values())
+        ):
+            return f"field {name!r} is not a table of numbers"
+    for name in _LISTS:
+        items = d.get(name)
+        if items is not None and not (
+            isinstance(items, list) and all(isinstance(s, str) for s in items)
+        ):
+            return f"field {name!r} is not a list of names"
+    if d.get("x") is not None and not (
+        isinstance(d["x"], list) and all(v is None or _num(v) for v in d["x"])
+    ):
+        return "field 'x' is not a list of numbers"
+    for name, ok in (
+        ("wall_time_s", lambda v: _num(v)),
+        ("n_solves", lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0),
+        ("iterations", lambda v: v is None or (isinstance(v, int) and not isinstance(v, bool))),
+        ("slope", lambda v: v is None or _num(v)),
+        ("warm", lambda v: v is None or isinstance(v, str)),
+    ):
+        if name in d and not ok(d[name]):
+            return f"field {name!r} has a value of the wrong type ({d[name]!r:.40})"
+    raw = d.get("raw")
+    if raw is not None and not (
+        isinstance(raw, dict)
+        and isinstance(raw.get("nlp"), str)
+        and all(_vector_ok(raw.get(k)) for k in ("z", "lam_x", "lam_g"))
+    ):
+        return "field 'raw' is not a solution with its multipliers"
+    ms = d.get("multistart")
+    if ms is not None:
+        names = {f.name for f in fields(AnchorStarts)}
+        if not isinstance(ms, dict) or set(ms) != names:
+            return "field 'multistart' is not a multistart record"
+    return None
+
+
+def record_problem(problem: DesignProblem, record: Mapping[str, Any], nlp=None) -> str | None:
+    """Why a stored front record cannot be trusted, or None if it can.
+
+    Every record must have the fields and types this code writes. A record that counts
+    as a solution (status optimal or feasible, not refused by the independent check)
+    must also hold: a design with every free variable, finite and inside the bounds
+    (catalogue variables on a catalogue value, fixed variables at their value), finite
+    objectives equal (to :data:`RECHECK_RTOL`) to the NumPy path's at that design, no
+    violated requirement and its epsilon bounds met - the independent check, again.
+    With ``nlp`` (the formulation), a stored warm start of that formulation must have
+    its size.
+    """
+    why = _shape_problem(record)
+    if why is not None:
+        return why
+    rec = PointRecord.from_dict(record)
+    if rec.raw is not None and nlp is not None and rec.raw.nlp == nlp.fingerprint:
+        if len(rec.raw.z) != len(nlp.lbz) or len(rec.raw.lam_x) != len(nlp.lbz):
+            return "holds a warm start of the wrong size"
+        if not np.isfinite(rec.raw.z).all():
+            return "holds a warm start that is not finite"
+    if rec.status not in ("optimal", "feasible") or rec.verified is False:
+        return None  # shown as failed: never trusted as a design
+    if rec.verified is not True:
+        return f"has status {rec.status!r} without the independent check"
+    return _design_problem(problem, rec)
+
+
+def _design_problem(problem: DesignProblem, rec: PointRecord) -> str | None:
+    free = problem.free
+    missing = [v.name for v in free if v.name not in rec.design]
+    if missing:
+        return f"has no value of {missing[0]} in its design"
+    x = np.array([rec.design[v.name] for v in free], dtype=float)
+    lo, hi = problem.lower(), problem.upper()
+    for k, v in enumerate(free):
+        tol = BOUNDS_RTOL * max(hi[k] - lo[k], 1.0)
+        if not (math.isfinite(x[k]) and lo[k] - tol <= x[k] <= hi[k] + tol):
+            return f"has {v.name} = {x[k]:.10g} {v.unit}, outside its bounds [{lo[k]:g}, {hi[k]:g}]"
+        if v.discrete and min(abs(x[k] - c) for c in v.values) > tol:
+            return f"has {v.name} = {x[k]:.10g} {v.unit}, not one of its catalogue values"
+    for name, value in problem.fixed_values.items():
+        stored = rec.design.get(name, value)
+        if not math.isclose(stored, value, rel_tol=1e-12, abs_tol=1e-15):
+            return f"has the fixed variable {name} = {stored:.10g}, the problem {value:.10g}"
+    if rec.x is not None and (
+        len(rec.x) != len(x) or not np.allclose(rec.x, x, rtol=1e-12, atol=0.0, equal_nan=False)
+    ):
+        return "has an 'x' that is not its design"
+    for name, value in rec.objectives.items():
+        if not math.isfinite(value):
+            return f"has objective {name} = {value}"
+    ok, violated, objectives = verify_design(problem, x)
+    if not ok:
+        return f"has a design that violates {violated[0].describe()}"
+    for name, value in objectives.items():
+        value = float(value)
+        if name not in rec.objectives:
+            return f"has no value of objective {name}"
+        stored = rec.objectives[name]
+        if abs(stored - value) > RECHECK_RTOL * max(abs(value), 1e-12):
+            return f"has objective {name} = {stored:.10g}, but its design gives {value:.10g}"
+    for name, bound in rec.eps.items():
+        if (
+            name in objectives
+            and relative_violation(float(objectives[name]), None, bound) > VERIFY_TOL
+        ):
+            return f"has objective {name} above its epsilon bound {bound:.10g}"
+    return None
