@@ -15,6 +15,7 @@ tests/test_report_browser.py.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import re
@@ -296,7 +297,9 @@ def hostile_front():
     from optdesign.studies.pareto import EpsilonConstraint
 
     problem = _hostile_objective_problem()
-    method = EpsilonConstraint(points=3, starts=1, name="-method=1")
+    # A method's name names its store file, so it must be a plain file name
+    # (tests/test_file_safety.py); the CSV test gives the front a hostile one afterwards.
+    method = EpsilonConstraint(points=3, starts=1, name="method-1")
     return problem, od.pareto(problem, ["backlash", OBJ], method=method, workers=1)
 
 
@@ -304,8 +307,17 @@ def test_front_csv_reads_back_with_formulas_neutralised(hostile_front, tmp_path)
     from optdesign.studies.pareto.io import read_front_csv, write_front_csv
 
     problem, front = hostile_front
-    # a constraint name that a plug-in chose, active at a point
+    # a constraint name that a plug-in chose, active at a point; a method's name as a
+    # plug-in method could set it (the built-in ones refuse such a name for their store)
     front.points[0].active = ["=1+1", *front.points[0].active]
+    front = dataclasses.replace(
+        front,
+        method="-method=1",
+        points=[
+            dataclasses.replace(p, method="-method=1", id=p.id.replace("method-1", "-method=1"))
+            for p in front.points
+        ],
+    )
     path = write_front_csv(front, problem, tmp_path / "front.csv")
     with path.open(newline="") as fh:
         rows = list(csv.reader(fh))
@@ -332,7 +344,7 @@ def test_front_api_summary_frame_and_plot(hostile_front):
     _, front = hostile_front
     summary = front.summary()
     assert _unsafe(summary) == []
-    assert printable(OBJ) in summary and "-method=1 front" in summary
+    assert printable(OBJ) in summary and "method-1 front" in summary
     frame = front.to_frame()
     assert OBJ in frame.columns  # the frame holds the data as it is
     fig = front.plot()
@@ -352,7 +364,7 @@ def test_front_report_carries_every_name_as_data(hostile_front):
     content, data = _data_of(page)
     assert "<" not in content and ">" not in content
     assert data["front"]["axes"][1] == f"{OBJ} (mm)"
-    assert data["front"]["traces"][0]["method"] == "-method=1"
+    assert data["front"]["traces"][0]["method"] == "method-1"
 
 
 # --- bench: bench_runs.csv, summary.md, bench_stats.json --------------------------------
