@@ -4,16 +4,24 @@ The package computes in one internal system: mm, N, MPa (N/mm^2), N*mm, rad.
 Problem files and the CLI may give quantities with units ("90 mm", "500 N*m", "30 deg");
 :func:`to_internal` converts them to the internal unit of the expected dimension.
 
-A quantity string is read with a restricted grammar before pint sees any of it: a
-decimal number literal, then an optional unit expression of unit names joined by ``*``,
-``/``, ``.``, ``·`` or a space, with small integer powers (``^`` or ``**``) and
-parentheses. pint's own parser evaluates arithmetic (``"10**10**10 mm"`` computes a
-number with ten billion digits and hangs); here every string is accepted or refused in
-microseconds. Unit names go to pint one at a time.
+A quantity string is read by the restricted grammar of :mod:`optdesign.unit_grammar` (a
+number and a unit expression, no arithmetic: every string is accepted or refused in
+microseconds); unit names go to pint one at a time.
 
 A bare number is taken as already in internal units (``bare="internal"``, the default),
 or refused for a dimensioned field (``bare="refuse"``), with the unit to write.
 pint is imported, and its registry built, on first use: importing this module is cheap.
+
+Angles are a dimension of their own. pint, like SI, counts the radian as dimensionless,
+so to pint ``"500 N*m/deg"`` is a moment (57.3 x 500 N*m) and ``"1 Hz"`` an angular
+speed. The grammar therefore counts the *angle exponent* of every unit expression next
+to pint's dimensionality (rad, deg, arcmin, arcsec, turn, rev, grad and their prefixed
+forms count 1; rpm 1; sr 2; Hz and percent 0). A quantity fits a dimension when both
+pint's dimensionality and the angle exponent match (:data:`ANGLE_EXPONENTS`): a moment
+has no angle, a rotational stiffness is a moment per angle (exponent -1), an angular
+speed an angle per time (+1); ``"30 mm*rad"``, ``"600 kN*m"`` for a stiffness and
+``"1 Hz"`` for a rate are refused. Percent is a plain number (``"90 %"`` is 0.9), never
+an angle.
 """
 
 from __future__ import annotations
@@ -21,13 +29,45 @@ from __future__ import annotations
 import math
 import numbers
 import re
-from functools import lru_cache
-from typing import TYPE_CHECKING, Any, Literal
+from functools import cache
+from typing import Any, Literal
 
 from optdesign.errors import InputError
+from optdesign.unit_grammar import (
+    ALIASES,
+    MAX_DEPTH,
+    MAX_LENGTH,
+    MAX_POWER,
+    Parsed,
+    Refused,
+    angle_exponent,
+    describe,
+    parse,
+    parse_unit_expression,
+    registry,
+)
 
-if TYPE_CHECKING:
-    import pint
+__all__ = [
+    "ALIASES",
+    "ANGLE_EXPONENTS",
+    "FAST_UNITS",
+    "INTERNAL_UNITS",
+    "MAX_DEPTH",
+    "MAX_LENGTH",
+    "MAX_MAGNITUDE",
+    "MAX_POWER",
+    "SUGGESTED_UNITS",
+    "Parsed",
+    "angle_exponent",
+    "convert",
+    "describe",
+    "parse",
+    "parse_quantity",
+    "parse_unit",
+    "registry",
+    "to_internal",
+    "unit_factor",
+]
 
 #: Internal unit for each physical dimension name used in problem files.
 INTERNAL_UNITS: dict[str, str] = {
@@ -66,58 +106,36 @@ _DIMENSION_NAMES: dict[str, str] = {
     "pressure": "a pressure",
     "moment": "a moment",
     "angle": "an angle",
-    "dimensionless": "a plain number (no unit)",
-    "stiffness": "a stiffness",
-    "speed": "a speed",
+    "dimensionless": "a plain number (no unit, or %)",
+    "stiffness": "a linear stiffness, a force per length",
+    "speed": "a rotational speed (turns per time)",
     "time": "a time",
-    "angular_speed": "an angular speed",
-    "rotational_stiffness": "a rotational stiffness",
+    "angular_speed": "an angular speed, an angle per time",
+    "rotational_stiffness": "a rotational stiffness, a moment per angle",
 }
 
-#: Spellings pint does not read as meant ("Nm" is pint's "number * metre" per gram!).
-ALIASES: dict[str, str] = {
-    "Nm": "N*m",
-    "kNm": "kN*m",
-    "MNm": "MN*m",
-    "mNm": "mN*m",
-    "Nmm": "N*mm",
-    "Ncm": "N*cm",
-    "°": "degree",
-    "%": "percent",
-    "rev": "revolution",
-    "revs": "revolution",
-    "grad": "gradian",
+#: The angle exponents a quantity of each dimension may have (see the module docstring).
+#: ``speed`` is ISO's n in min^-1: turns per minute, with the turn written ("rpm",
+#: "rad/s") or implied ("1/min", "Hz").
+ANGLE_EXPONENTS: dict[str, tuple[int, ...]] = {
+    "length": (0,),
+    "force": (0,),
+    "pressure": (0,),
+    "moment": (0,),
+    "angle": (1,),
+    "dimensionless": (0,),
+    "stiffness": (0,),
+    "speed": (0, 1),
+    "time": (0,),
+    "angular_speed": (1,),
+    "rotational_stiffness": (-1,),
 }
 
-#: Longest quantity string read (a real one is a few characters).
-MAX_LENGTH = 100
-#: Largest power of a unit (mm^4 is the largest in use).
-MAX_POWER = 9
-#: Deepest nesting of parentheses.
-MAX_DEPTH = 4
 #: Largest magnitude accepted in internal units: 1e15 mm is a billion kilometres; beyond
 #: it a bound only breaks the solver's scaling (1e308 overflows to inf in the first sum).
 MAX_MAGNITUDE = 1e15
 
 Bare = Literal["internal", "refuse"]
-
-_NUMBER = re.compile(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)")
-_TOKEN = re.compile(
-    r"\s*(?:(?P<name>(?:[^\W\d_]|[°%])+)|(?P<pow>\^|\*\*)|(?P<mul>[*.·⋅×])|(?P<div>/)"
-    r"|(?P<int>[+-]?\d+)|(?P<lp>\()|(?P<rp>\)))"
-)
-
-
-@lru_cache(maxsize=1)
-def registry() -> pint.UnitRegistry:
-    """The shared pint registry (degrees and radians are dimensionless angles in pint)."""
-    import pint
-
-    return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
-
-
-class _Refused(Exception):
-    """Why a string is not a quantity (becomes an InputError naming the field)."""
 
 
 def parse_quantity(text: str) -> tuple[float, Any]:
@@ -127,132 +145,13 @@ def parse_quantity(text: str) -> tuple[float, Any]:
     ------
     InputError
         (field ``"quantity"``) when ``text`` is not a number optionally followed by a
-        unit expression of the restricted grammar (see the module docstring).
+        unit expression of the restricted grammar (:mod:`optdesign.unit_grammar`).
     """
     try:
-        return _parse(text)
-    except _Refused as exc:
+        parsed = parse(text)
+    except Refused as exc:
         raise InputError("quantity", str(exc)) from None
-
-
-def _parse(text: str) -> tuple[float, Any]:
-    if len(text) > MAX_LENGTH:
-        raise _Refused(f"too long for a quantity ({len(text)} characters)")
-    m = _NUMBER.match(text)
-    if m is None:
-        raise _Refused(
-            f'cannot read {text!r} as a quantity: it must start with a number, e.g. "90 mm"'
-        )
-    number = float(m.group(1))
-    if not math.isfinite(number):
-        raise _Refused(f"{text!r} is not a finite number")
-    rest = text[m.end() :]
-    if not rest.strip():
-        return number, None
-    star = re.match(r"\s*[*·⋅×](?!\*)", rest)  # "2*mm", as pint allowed
-    if star is not None:
-        rest = rest[star.end() :]
-    # "N-m", "lbf-ft": a hyphen between two unit names multiplies (engineering usage).
-    rest = re.sub(r"(?<=[^\W\d_])-(?=[^\W\d_])", "*", rest)
-    parser = _UnitParser(rest, text)
-    unit = parser.expression(0)
-    parser.expect_end()
-    return number, unit
-
-
-class _UnitParser:
-    """Recursive descent over the unit part: expr := factor ((*|/|.|space) factor)*;
-    factor := (name | 1 | '(' expr ')') [(^|**) int]."""
-
-    def __init__(self, text: str, whole: str):
-        text = text.replace("²", "^2").replace("³", "^3")  # N/mm²
-        self.tokens: list[tuple[str, str]] = []
-        pos = 0
-        while pos < len(text):
-            m = _TOKEN.match(text, pos)
-            if m is None or m.end() == pos:
-                if not text[pos:].strip():
-                    break
-                raise _Refused(
-                    f"cannot read {whole!r} as a quantity: {text[pos:].strip()[:20]!r} is not "
-                    'part of a unit (write a number and a unit, e.g. "500 N*m"; no arithmetic)'
-                )
-            kind = m.lastgroup or ""
-            self.tokens.append((kind, m.group(kind)))
-            pos = m.end()
-        self.i = 0
-        self.whole = whole
-
-    def peek(self) -> tuple[str, str]:
-        return self.tokens[self.i] if self.i < len(self.tokens) else ("end", "")
-
-    def take(self) -> tuple[str, str]:
-        tok = self.peek()
-        self.i += 1
-        return tok
-
-    def fail(self, what: str) -> _Refused:
-        return _Refused(
-            f"cannot read {self.whole!r} as a quantity: {what} (write a number and a unit, "
-            'e.g. "500 N*m"; no arithmetic)'
-        )
-
-    def expression(self, depth: int) -> Any:
-        unit = self.factor(depth)
-        while True:
-            kind, _ = self.peek()
-            if kind in ("mul", "div"):
-                self.take()
-                rhs = self.factor(depth)
-                unit = unit * rhs if kind == "mul" else unit / rhs
-            elif kind in ("name", "lp"):
-                unit = unit * self.factor(depth)  # "N m": a space multiplies
-            else:
-                return unit
-
-    def factor(self, depth: int) -> Any:
-        kind, value = self.take()
-        if kind == "name":
-            unit = _unit(value, self)
-        elif kind == "int" and value == "1":
-            unit = registry().dimensionless  # "1/min"
-        elif kind == "lp":
-            if depth >= MAX_DEPTH:
-                raise self.fail("too many parentheses")
-            unit = self.expression(depth + 1)
-            if self.take()[0] != "rp":
-                raise self.fail("a parenthesis is not closed")
-        else:
-            raise self.fail(f"expected a unit name, found {value or 'the end'!r}")
-        if self.peek()[0] == "pow":
-            self.take()
-            kind, value = self.take()
-            if kind == "lp":  # mm^(-1)
-                kind, value = self.take()
-                if self.take()[0] != "rp":
-                    raise self.fail("a parenthesis is not closed")
-            if kind != "int" or abs(int(value)) > MAX_POWER:
-                raise self.fail(f"a power must be a whole number from -{MAX_POWER} to {MAX_POWER}")
-            unit = unit ** int(value)
-        return unit
-
-    def expect_end(self) -> None:
-        kind, value = self.peek()
-        if kind != "end":
-            raise self.fail(f"unexpected {value!r}")
-
-
-def _unit(name: str, parser: _UnitParser) -> Any:
-    ureg = registry()
-    spelled = ALIASES.get(name)
-    if spelled is None and name[0] in "µμ" and len(name) > 1:
-        spelled = "u" + name[1:]  # micro sign or Greek mu: pint's "u" prefix
-    try:
-        if spelled is not None:
-            return ureg.parse_units(spelled)  # our own spellings only: safe
-        return ureg.Unit(name)
-    except Exception:  # pint raises several types for an unknown name
-        raise parser.fail(f"unknown unit {name!r}") from None
+    return parsed.number, parsed.unit
 
 
 def _number_text(value: float) -> str:
@@ -262,12 +161,6 @@ def _number_text(value: float) -> str:
 def _suggest(number: str, dimension: str) -> str:
     unit = SUGGESTED_UNITS.get(dimension, "")
     return f'"{number} {unit}"' if unit else f'"{number}"'
-
-
-def _angle_like(q: Any) -> bool:
-    # pint treats rad, deg and also percent as dimensionless; only the angle units have
-    # the radian as root unit.
-    return q.to_root_units().units == q._REGISTRY.radian
 
 
 def to_internal(value: object, dimension: str, field: str, bare: Bare = "internal") -> float:
@@ -313,19 +206,15 @@ def to_internal(value: object, dimension: str, field: str, bare: Bare = "interna
         if fast is not None:
             return fast
         try:
-            number, unit = _parse(text)
-        except _Refused as exc:
+            number, unit, angle = parse(text)
+        except Refused as exc:
             raise InputError(field, str(exc)) from None
         if unit is None:
             return _bare(number, text, dimension, field, bare)
-        return _convert(registry().Quantity(number, unit), value, dimension, field)
+        return _convert(registry().Quantity(number, unit), angle, value, dimension, field)
     if _is_quantity(value):
-        magnitude = getattr(value, "magnitude", None)
-        if not isinstance(magnitude, numbers.Real) or isinstance(magnitude, bool):
-            raise InputError(field, f"expected a scalar quantity, got {value!r}")
-        if not math.isfinite(float(magnitude)):
-            raise InputError(field, f"{value!r} is not a finite number")
-        return _convert(value, str(value), dimension, field)
+        _check_scalar(value, field)
+        return _convert(value, angle_exponent(value), str(value), dimension, field)
     raise InputError(
         field, f'expected a number or a quantity string such as "90 mm", got {value!r}'
     )
@@ -383,31 +272,37 @@ def _bare(number: float, text: str, dimension: str, field: str, bare: Bare) -> f
     return number
 
 
-def _convert(q: Any, shown: object, dimension: str, field: str) -> float:
-    import pint
+def _check_scalar(q: Any, field: str) -> None:
+    magnitude = getattr(q, "magnitude", None)
+    if not isinstance(magnitude, numbers.Real) or isinstance(magnitude, bool):
+        raise InputError(field, f"expected a scalar quantity, got {q!r}")
+    if not math.isfinite(float(magnitude)):
+        raise InputError(field, f"{q!r} is not a finite number")
 
-    if dimension in ("angle", "dimensionless") and q.dimensionless:
-        angle = _angle_like(q)
-        if dimension == "angle" and not angle:
-            raise InputError(
-                field,
-                f"{shown!r} is not an angle (use rad, deg, arcmin, arcsec, turn or grad, "
-                f'e.g. "{_number_text(float(q.magnitude))} deg")',
-            )
-        if dimension == "dimensionless" and angle:
-            raise InputError(field, f"{shown!r} is an angle, expected a plain number")
-    unit = INTERNAL_UNITS[dimension]
-    if dimension == "speed" and "radian" in str(q.to_root_units().units):
-        unit = "turn/min"  # rpm and rad/s count turns: internal 1/min is turns per minute
-    try:
-        result = float(q.to(unit).magnitude)
-    except pint.DimensionalityError:
+
+@cache
+def _dimensionality(dimension: str) -> Any:
+    """pint's dimensionality of ``dimension`` (angles left out, as pint does)."""
+    return registry().Quantity(1.0, INTERNAL_UNITS[dimension]).dimensionality
+
+
+def _convert(q: Any, angle: float, shown: object, dimension: str, field: str) -> float:
+    """``q`` (angle exponent ``angle``) in the internal unit of ``dimension``."""
+    if q.dimensionality != _dimensionality(dimension) or angle not in ANGLE_EXPONENTS[dimension]:
+        expected = _DIMENSION_NAMES[dimension]
+        if dimension == "dimensionless":
+            raise InputError(field, f"{shown!r} is {describe(q, angle)}, expected {expected}")
         number = _number_text(float(q.magnitude))
+        hint = "; angle units: rad, deg, arcmin, arcsec, turn, grad" if dimension == "angle" else ""
         raise InputError(
             field,
-            f"{shown!r} has dimension {q.dimensionality}, expected "
-            f"{_DIMENSION_NAMES[dimension]} (write e.g. {_suggest(number, dimension)})",
-        ) from None
+            f"{shown!r} is {describe(q, angle, _dimensionality(dimension))}, expected {expected} "
+            f"(write e.g. {_suggest(number, dimension)}{hint})",
+        )
+    unit = INTERNAL_UNITS[dimension]
+    if dimension == "speed" and angle == 1:
+        unit = "turn/min"  # rpm and rad/s count turns: internal 1/min is turns per minute
+    result = float(q.to(unit).magnitude)
     if not math.isfinite(result):
         raise InputError(field, f"{shown!r} is out of range")
     _check_magnitude(result, str(shown), field, INTERNAL_UNITS[dimension])
@@ -425,7 +320,9 @@ def _check_magnitude(value: float, shown: str, field: str, unit: str = "") -> No
 def convert(value: object, unit: str, field: str) -> float:
     """A quantity (string, pint Quantity or number) in ``unit``; a bare number is taken as
     already in ``unit``. For bounds of user-declared constraints, e.g.
-    ``convert("3 kN", "N", "nut_force.upper")``."""
+    ``convert("3 kN", "N", "nut_force.upper")``. The quantity must have ``unit``'s
+    dimension, angles counted (``"5 N*m"`` is refused for ``"N*mm/rad"``)."""
+    target, target_angle = parse_unit(unit, field)
     if isinstance(value, numbers.Real) and not isinstance(value, bool):
         number = float(value)
         if not math.isfinite(number):
@@ -433,26 +330,60 @@ def convert(value: object, unit: str, field: str) -> float:
         return number
     if isinstance(value, str):
         try:
-            number, parsed = _parse(value.strip())
-        except _Refused as exc:
+            number, parsed, angle = parse(value.strip())
+        except Refused as exc:
             raise InputError(field, str(exc)) from None
         if parsed is None:
             return number
         q = registry().Quantity(number, parsed)
     elif _is_quantity(value):
-        q = value
+        _check_scalar(value, field)
+        q, angle = value, angle_exponent(value)
     else:
         raise InputError(field, f"expected a number or a quantity string, got {value!r}")
-    import pint
-
-    try:
-        target = registry().Unit(unit or "dimensionless")
-    except Exception as exc:
-        raise InputError(field, f"unknown unit {unit!r} ({exc})") from None
-    try:
-        result = float(q.to(target).magnitude)
-    except pint.DimensionalityError:
-        raise InputError(field, f"{value!r} cannot be expressed in {unit!r}") from None
+    expected = registry().Quantity(1.0, target)
+    if q.dimensionality != expected.dimensionality or angle != target_angle:
+        shown = f" ({unit!r})" if unit.strip() else ""
+        raise InputError(
+            field,
+            f"{value!r} is {describe(q, angle)}, expected {describe(expected, target_angle)}"
+            + shown,
+        )
+    result = float(q.to(str(target)).magnitude)  # by name: q may be of a user's registry
     if not math.isfinite(result):
         raise InputError(field, f"{value!r} is out of range")
     return result
+
+
+def unit_factor(unit: str, to: str, field: str) -> float:
+    """The factor from ``unit`` to ``to`` (a value in ``unit`` times it is in ``to``), for
+    units of one dimension, angles counted; InputError naming ``field`` otherwise, e.g.
+    ``unit_factor("N*mm", "N*m/deg", ...)``."""
+    source, source_angle = parse_unit(unit, field)
+    target, target_angle = parse_unit(to, field)
+    q = registry().Quantity(1.0, source)
+    if q.dimensionality != target.dimensionality or source_angle != target_angle:
+        shown = {u: f"{u!r}" if u.strip() else "no unit" for u in (unit, to)}
+        expected = describe(registry().Quantity(1.0, target), target_angle)
+        raise InputError(
+            field,
+            f"{shown[to]} is {expected} and {shown[unit]} {describe(q, source_angle)}: "
+            "a unit of the same dimension is needed",
+        )
+    return float(q.to(target).magnitude)
+
+
+def parse_unit(unit: str, field: str) -> tuple[Any, int]:
+    """(pint unit, angle exponent) of a unit expression such as ``"N*mm/rad"`` (``""``:
+    a plain number), read by the restricted grammar; InputError naming ``field``."""
+    if not isinstance(unit, str):
+        raise InputError(field, f'a unit is a string such as "N*mm", got {unit!r}')
+    if not unit.strip():
+        return registry().dimensionless, 0
+    if len(unit) > MAX_LENGTH:
+        raise InputError(field, f"too long for a unit ({len(unit)} characters)")
+    try:
+        return parse_unit_expression(unit, unit)
+    except Refused as exc:
+        reason = str(exc).replace("as a quantity", "as a unit").split(" (write a number")[0]
+        raise InputError(field, f'{reason} (e.g. "N*mm", "rad/s"; "" for a plain number)') from None

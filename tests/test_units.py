@@ -69,13 +69,18 @@ def test_spellings(text, dimension, expected):
 
 def test_percent_is_not_an_angle_and_an_angle_is_not_a_plain_number():
     # pint treats percent as dimensionless, like rad: a 5 % deflection would be 0.05 rad
-    with pytest.raises(InputError, match=r"^requirements\.phi_max: '5 percent' is not an angle"):
+    with pytest.raises(InputError) as info:
         to_internal("5 percent", "angle", "requirements.phi_max")
-    with pytest.raises(InputError, match="phi_max: '5 %' is not an angle"):
+    assert str(info.value) == (
+        "requirements.phi_max: '5 percent' is a plain number, expected an angle "
+        '(write e.g. "5 deg"; angle units: rad, deg, arcmin, arcsec, turn, grad)'
+    )
+    with pytest.raises(InputError, match="phi_max: '5 %' is a plain number, expected an angle"):
         to_internal("5 %", "angle", "phi_max")
-    with pytest.raises(InputError, match="i_a: '30 deg' is an angle, expected a plain number"):
+    with pytest.raises(InputError) as info:
         to_internal("30 deg", "dimensionless", "i_a")
-    with pytest.raises(InputError, match="not an angle"):
+    assert str(info.value) == "i_a: '30 deg' is an angle, expected a plain number (no unit, or %)"
+    with pytest.raises(InputError, match=r"'2 rad[*]rad' is angle\^2, expected an angle"):
         to_internal("2 rad*rad", "angle", "phi")
 
 
@@ -83,7 +88,7 @@ def test_wrong_dimension_names_the_field_and_what_to_write():
     with pytest.raises(InputError) as info:
         to_internal("500 mm", "moment", "requirements.hinge_moment")
     assert str(info.value) == (
-        "requirements.hinge_moment: '500 mm' has dimension [length], expected a moment "
+        "requirements.hinge_moment: '500 mm' is a length, expected a moment "
         '(write e.g. "500 N*m")'
     )
 
@@ -93,7 +98,8 @@ def test_arithmetic_is_refused_at_once():
         t0 = time.perf_counter()
         with pytest.raises(InputError, match=r"quantity|no arithmetic"):
             to_internal(text, "length", "variables.R.upper")
-        assert time.perf_counter() - t0 < 0.01  # pint itself hangs on the first one
+        # pint itself hangs on the first one; the bound catches a hang, not a slow machine
+        assert time.perf_counter() - t0 < 1.0
 
 
 @pytest.mark.parametrize(
@@ -138,10 +144,12 @@ def test_pint_quantities_are_accepted():
 
     other = pint.UnitRegistry()  # a user's own registry
     assert to_internal(other.Quantity(30, "deg"), "angle", "a") == pytest.approx(math.radians(30))
-    with pytest.raises(InputError, match="not an angle"):
+    with pytest.raises(InputError, match="is a plain number, expected an angle"):
         to_internal(other.Quantity(5, "percent"), "angle", "a")
-    with pytest.raises(InputError, match="dimension"):
+    with pytest.raises(InputError, match="is a length, expected a force"):
         to_internal(other.Quantity(5, "mm"), "force", "F")
+    with pytest.raises(InputError, match="is a moment per angle, expected a moment"):
+        to_internal(other.Quantity(5, "N*m/deg"), "moment", "M")
     with pytest.raises(InputError, match="finite"):
         to_internal(other.Quantity(math.nan, "mm"), "length", "L")
 
@@ -186,16 +194,21 @@ def _only_input_errors(text, dimension):
         assert exc.field == "fuzz"
     else:
         assert math.isfinite(value)
-    assert time.perf_counter() - t0 < 0.05
+    assert time.perf_counter() - t0 < 1.0  # a hang, not a timing: a loaded machine may pause a case
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=200,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)
 @given(text=st.text(max_size=40), dimension=st.sampled_from(sorted(INTERNAL_UNITS)))
 def test_fuzz_any_text_raises_only_input_error_quickly(text, dimension):
     _only_input_errors(text, dimension)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300, deadline=None, derandomize=True)
 @given(
     parts=st.lists(_ALPHABET, max_size=25),
     dimension=st.sampled_from(sorted(INTERNAL_UNITS)),
@@ -222,7 +235,7 @@ _UNITS = [
 ]
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200, deadline=None, derandomize=True)
 @given(
     number=st.floats(min_value=-1e12, max_value=1e12, allow_nan=False),
     unit=st.sampled_from(_UNITS),

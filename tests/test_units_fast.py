@@ -15,8 +15,9 @@ CASES = [(dim, unit) for dim, table in FAST_UNITS.items() for unit in table]
 def test_fast_table_agrees_with_pint(dimension, unit):
     for number in (1.0, 37.5, -0.25):
         fast = to_internal(f"{number} {unit}", dimension, "x")
-        q = registry().Quantity(number, units._parse(f"1 {unit}")[1])
-        slow = units._convert(q, unit, dimension, "x")
+        parsed = units.parse(f"1 {unit}")
+        q = registry().Quantity(number, parsed.unit)
+        slow = units._convert(q, parsed.angle, unit, dimension, "x")
         assert math.isclose(fast, slow, rel_tol=1e-14), (unit, fast, slow)
 
 

@@ -256,7 +256,7 @@ class DesignProblem:
         description: str = "",
         formula: str = "",
         display_unit: str | None = None,
-        display_scale: float = 1.0,
+        display_scale: float | None = None,
     ) -> ObjectiveInfo:
         """Declare an objective ``fn(q)`` (see :class:`~optdesign.problem.quantities.
         Quantities` for ``q``), written with :mod:`optdesign.math`.
@@ -264,11 +264,15 @@ class DesignProblem:
         ``kind``: ``"max"`` (largest value over the stroke), ``"spread"`` ((max - min)/
         (max + min) over the stroke) or ``"scalar"`` (one value per design); default:
         ``"max"`` when ``fn`` returns a value per grid angle, else ``"scalar"``. ``unit``
-        is the internal unit of the value. The objective is then available to every
-        study (solve, Pareto, bench ...) by its name.
+        is the internal unit of the value (a unit expression such as ``"N*mm/rad"``, ``""``
+        for a plain number). Reports show ``value * display_scale`` in ``display_unit``, a
+        unit of the same dimension, angles counted; ``display_scale`` defaults to the
+        factor between the two units and, when given, must equal it. The objective is then
+        available to every study (solve, Pareto, bench ...) by its name.
         """
         if not name or not isinstance(name, str):
             raise InputError("add_objective.name", "give a non-empty name")
+        display_scale = _display_scale(unit, display_unit, display_scale)
         if kind is None:
             value = fn(self.quantities(self.design_dict(self.midpoint())))
             kind = "max" if self.quantities_on_grid(value) else "scalar"
@@ -297,6 +301,9 @@ class DesignProblem:
         """
         if any(c.name == name for c in self._constraints):
             raise InputError("add_constraint.name", f"a constraint {name!r} exists already")
+        from optdesign.units import parse_unit
+
+        parse_unit(unit, f"{name}.unit")
         info = ConstraintInfo(
             name,
             fn,
@@ -466,10 +473,34 @@ class DesignProblem:
         return Evaluation(objectives, constraints, worst)
 
 
+def _display_scale(unit: str, display_unit: str | None, scale: float | None) -> float:
+    """The factor from an objective's ``unit`` to its ``display_unit`` (checked against
+    ``scale`` when one is given)."""
+    from optdesign.units import parse_unit, unit_factor
+
+    parse_unit(unit, "add_objective.unit")
+    if display_unit is None:
+        factor = 1.0
+    else:
+        factor = unit_factor(unit, display_unit, "add_objective.display_unit")
+    if scale is None:
+        return factor
+    if isinstance(scale, bool) or not isinstance(scale, int | float) or not np.isfinite(scale):
+        raise InputError("add_objective.display_scale", f"expected a number, got {scale!r}")
+    if not np.isclose(scale, factor, rtol=1e-9, atol=0.0):
+        shown = f"{unit!r}" if unit else "a plain number"
+        raise InputError(
+            "add_objective.display_scale",
+            f"{scale:g} does not turn {shown} into {display_unit or unit!r} "
+            f"(the factor is {factor:.10g}; leave display_scale out to use it)",
+        )
+    return float(scale)
+
+
 def _bound(value: Any, unit: str, field: str) -> float | None:
     if value is None:
         return None
-    if isinstance(value, str):
+    if isinstance(value, str) or type(value).__module__.startswith("pint"):
         from optdesign.units import convert
 
         return convert(value, unit, field)

@@ -6,7 +6,10 @@ mechanism-specific part is *derived from the mechanism plug-in* by :func:`spec_m
 its requirements (e.g. a crank-slider's transmission angle), the keys of its fixed
 clearances, the variables a tolerance or a reference design may name. Quantities are
 converted to the internal units (mm, N, MPa, N*mm, rad) on load by
-:func:`optdesign.units.to_internal`.
+:func:`optdesign.units.to_internal`, which counts the angle as a dimension of its own (a
+moment carries none, a rotational stiffness is a moment per angle). Plain numbers
+(efficiencies, ratios, factors) are :data:`Dimensionless`: bare, or in percent
+(``"90 %"`` is 0.9); an angle there is refused.
 """
 
 from __future__ import annotations
@@ -121,8 +124,8 @@ class _OrderedBand(_Model):
 class Band(_OrderedBand):
     """A dimensionless band [min, max]."""
 
-    min: float | None = None
-    max: float | None = None
+    min: Dimensionless | None = None
+    max: Dimensionless | None = None
 
 
 class AngleBand(_OrderedBand):
@@ -151,7 +154,7 @@ class Material(_Model):
     """Elastic constants of a pin material."""
 
     E: Pressure = 2.1e5
-    nu: float = 0.3
+    nu: Dimensionless = 0.3
 
     @model_validator(mode="after")
     def _physical(self):
@@ -197,10 +200,10 @@ class Screw(_Model):
     """
 
     kind: Literal["ball", "roller", "sliding", "trapezoidal", "acme"] = "ball"
-    friction: float | None = Field(None, ge=0.0, lt=1.0)
+    friction: Dimensionless | None = Field(None, ge=0.0, lt=1.0)
     catalogue: Literal["HIWIN"] | None = None
     nut: Literal["FSI", "FSC"] | None = None
-    root_ratio: float = Field(0.83, gt=0.0, lt=1.0)
+    root_ratio: Dimensionless = Field(0.83, gt=0.0, lt=1.0)
     mounting: Literal["fixed-free", "supported-supported", "fixed-supported", "fixed-fixed"] = (
         "fixed-supported"
     )
@@ -208,8 +211,8 @@ class Screw(_Model):
     nut_offset: Length | None = None
     nut_stiffness: Stiffness | None = None
     bearing_stiffness: Stiffness | None = None
-    gear_efficiency: float = Field(1.0, gt=0.0, le=1.0)
-    gear_back_efficiency: float = Field(1.0, gt=0.0, le=1.0)
+    gear_efficiency: Dimensionless = Field(1.0, gt=0.0, le=1.0)
+    gear_back_efficiency: Dimensionless = Field(1.0, gt=0.0, le=1.0)
     check_buckling: bool = True
     check_yield: bool = True
 
@@ -230,7 +233,7 @@ class DutyStep(_Model):
 
     deflection: Angle
     hinge_moment: Moment
-    time: float = Field(gt=0.0)
+    time: Dimensionless = Field(gt=0.0)
 
     @model_validator(mode="after")
     def _positive(self):
@@ -247,9 +250,9 @@ class MotorLock(_Model):
     radius: Length | None = None
     r1: Length | None = None
     r2: Length | None = None
-    mu: float = Field(0.3, gt=0.0)
-    eta_screw_back: float = Field(1.0, gt=0.0, le=1.0)
-    eta_gear_back: float = Field(1.0, gt=0.0, le=1.0)
+    mu: Dimensionless = Field(0.3, gt=0.0)
+    eta_screw_back: Dimensionless = Field(1.0, gt=0.0, le=1.0)
+    eta_gear_back: Dimensionless = Field(1.0, gt=0.0, le=1.0)
     force_max: Force | None = None
 
     @model_validator(mode="after")
@@ -280,10 +283,10 @@ class Requirements(_Model):
     pin_shear_stress_max: Pressure | None = None
     pin_shear_planes: int | None = Field(None, ge=1, le=2)
     motor_torque_max: Moment | None = None
-    eta_screw: float = Field(1.0, gt=0.0, le=1.0)
-    eta_gear: float = Field(1.0, gt=0.0, le=1.0)
+    eta_screw: Dimensionless = Field(1.0, gt=0.0, le=1.0)
+    eta_gear: Dimensionless = Field(1.0, gt=0.0, le=1.0)
     backlash_max: Angle | None = None
-    ripple_max: float | None = Field(None, gt=0.0)
+    ripple_max: Dimensionless | None = Field(None, gt=0.0)
     fit: str = "H7/g6"
     fit_clearance: Literal["min", "max"] = "max"
     screw: ScrewSizing | None = None
@@ -291,15 +294,15 @@ class Requirements(_Model):
     fit_values: Literal["table", "smooth"] | None = None
     pin_contact: Literal["duan2017", "conforming"] = "duan2017"
     pin_contact_pressure_max: Pressure | None = None
-    efficiency_min: float | None = Field(None, gt=0.0, le=1.0)
+    efficiency_min: Dimensionless | None = Field(None, gt=0.0, le=1.0)
     back_drive: Literal["required", "forbidden"] | None = None
     deflection_rate: AngularSpeed | None = None
     critical_speed: bool = False
     dn_max: float | Literal["rolled", "peeled", "ground", "high-speed"] | None = None
-    static_safety_min: float | None = Field(None, ge=1.0)
+    static_safety_min: Dimensionless | None = Field(None, ge=1.0)
     life_min: Time | None = None
     duty_cycle: list[DutyStep] | None = Field(None, max_length=1000)
-    f_w: float = Field(1.0, ge=1.0, le=3.0)
+    f_w: Dimensionless = Field(1.0, ge=1.0, le=3.0)
     stiffness_min: RotationalStiffness | None = None
 
     @model_validator(mode="after")
@@ -453,8 +456,8 @@ class Tolerances(_Model):
     samples: int = Field(32, ge=1, le=2000)
     seed: int = 0
     risk: Literal["cvar", "mean_std"] = "cvar"
-    alpha: float = Field(0.9, ge=0.0, lt=1.0)
-    k: float = Field(2.0, ge=0.0)
+    alpha: Dimensionless = Field(0.9, ge=0.0, lt=1.0)
+    k: Dimensionless = Field(2.0, ge=0.0)
 
     def variables(self) -> dict[str, Any]:
         """Variable name -> tolerance, for the variables that have one."""

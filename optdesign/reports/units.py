@@ -180,7 +180,11 @@ def _value(problem: Any, path: str, value: Any, dim: str | None) -> Any:
         }
     if isinstance(value, list):
         return f"[{len(value)} items]"
-    if isinstance(value, float) and dim is not None:
+    if isinstance(value, float) and dim is None:
+        # a plain number the file wrote in percent ("90 %") is shown so
+        written = (getattr(problem, "written_units", None) or {}).get(path, "").strip()
+        return Shown(_tidy(value * 100.0), "%") if written in ("%", "percent") else value
+    if isinstance(value, float):
         written = _in_written_unit(problem, path, value, dim)
         if written is not None:
             return written
