@@ -30,6 +30,11 @@ pi = np.pi
 
 #: Smallest argument of a guarded square root on the CasADi path.
 SQRT_GUARD = 1e-12
+#: Smallest magnitude of a rate that the solver path divides by (mm/rad): a linkage at a
+#: dead point (the nut standing still, dx/dphi = 0) gives huge but finite forces and
+#: sensitivities there instead of inf and NaN. No design a requirement admits moves that
+#: slowly (the ratio band alone keeps |dx/dphi| above a few mm/rad).
+RATE_GUARD = 1e-9
 
 
 _F = TypeVar("_F", bound=Callable[..., Any])
@@ -116,6 +121,15 @@ def sqrt_domain(x):
     return ca.sqrt(ca.fmax(x, SQRT_GUARD)) if isinstance(x, _CASADI_TYPES) else np.sqrt(x)
 
 
+def away_from_zero(x, tiny: float = RATE_GUARD):
+    """``x`` where ``|x| >= tiny``, else ``tiny`` with the sign of ``x`` (``+tiny`` at 0):
+    a divisor that is never zero, for the solver path (guarded mechanisms)."""
+    if is_symbolic(x):
+        return ca.if_else(ca.fabs(x) < tiny, ca.if_else(x < 0, -tiny, tiny), x)
+    x = np.asarray(x, dtype=float)
+    return np.where(np.abs(x) < tiny, np.where(x < 0, -tiny, tiny), x)
+
+
 def arctan2(y, x):
     """Element-wise two-argument arctangent."""
     return ca.atan2(y, x) if is_symbolic(y, x) else np.arctan2(y, x)
@@ -167,7 +181,13 @@ def grid_sum(x):
 
 def spread(lo, hi):
     """Relative spread (hi - lo)/(hi + lo) of a band [lo, hi]: half its width over its
-    mid-value (the papers' ratio ripple, [D17]). The one definition of the formula."""
+    mid-value (the papers' ratio ripple, [D17]). The one definition of the formula.
+
+    On the CasADi path the divisor is kept away from zero (:func:`away_from_zero`): a
+    band centred on zero (a linkage at a dead point, or an iterate of the envelope's
+    bounds) gives a huge value instead of inf or NaN; the NumPy path shows it as it is."""
+    if is_symbolic(lo, hi):
+        return (hi - lo) / away_from_zero(hi + lo)
     return (hi - lo) / (hi + lo)
 
 

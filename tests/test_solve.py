@@ -89,6 +89,46 @@ def test_no_nan_anywhere_inside_the_bounds(name):
     check()
 
 
+def _finite_everywhere(problem, design: dict[str, float]) -> bool:
+    nlp = build_nlp(problem)
+    fg = ca.Function(
+        "fg",
+        [nlp.z, nlp.p],
+        [nlp.f, nlp.g, ca.gradient(nlp.f, nlp.z), ca.jacobian(nlp.g, nlp.z)],
+    )
+    x = np.array([design[v.name] for v in problem.free])
+    z = nlp.z_from_x(x)
+    outs = fg(z, nlp.params(nlp.target()))
+    return all(np.all(np.isfinite(np.asarray(o.full() if hasattr(o, "full") else o))) for o in outs)
+
+
+@pytest.mark.parametrize(
+    ("name", "design"),
+    [
+        # R = l, n = 0: the nut stands still (dm/dphi = 0 over the whole stroke); the
+        # point a property test once drew, now checked on every run
+        ("cs_min_backlash", {"R": 120, "l": 120, "n": 0, "p": 2, "phi0": 0.6, "d": 4}),
+        ("cs_min_ripple", {"R": 90, "l": 90, "n": 0, "p": 5, "phi0": 0.6}),
+        # the actuator's line through O at phi = -20 deg (dL/dphi = 0 there):
+        # b_T sin a = a_T cos a with a = -20 deg
+        (
+            "pivot_min_backlash",
+            {"R": 60, "a_T": -40, "b_T": 40 / np.tan(np.radians(20)), "p": 5, "phi0": 0, "d": 8},
+        ),
+    ],
+)
+def test_the_solver_path_stays_finite_at_a_dead_point(name, design):
+    problem = load_problem(PROBLEMS / f"{name}.toml")
+    free = {v.name for v in problem.free}
+    design = {k: float(v) for k, v in design.items() if k in free}
+    assert set(design) == free
+    # the NumPy path says what it is: the nut stands still somewhere on the grid
+    values = problem.design_dict(np.array([design[v.name] for v in problem.free]))
+    velocity = np.ravel(problem.quantities(values).nut_velocity)
+    assert np.min(np.abs(velocity)) < 1e-9
+    assert _finite_everywhere(problem, design)
+
+
 def test_warm_start_converges_fast():
     problem = load_problem(PROBLEMS / "cs_min_backlash.toml")
     nlp = build_nlp(problem)

@@ -261,7 +261,7 @@ class Mechanism:
     # --- loads ---------------------------------------------------------------------------
     def nut_force(self, phi, M_h):
         """Nut axial force (N) carrying the hinge moment M_h (N*mm), by virtual work."""
-        return force_from_rate(M_h, self.nut_velocity(phi))
+        return force_from_rate(M_h, self._divisor(self.nut_velocity(phi)))
 
     def motor_torque(self, phi, M_h, eta_screw=1.0, eta_gear=1.0):
         """Motor torque (N*mm) that holds/drives the hinge moment M_h."""
@@ -270,7 +270,12 @@ class Mechanism:
     # --- clearance chain -------------------------------------------------------------------
     def sensitivity_axial(self, phi):
         """Output rotation per unit nut-side axial clearance (rad/mm) = 1/(dx/dphi)."""
-        return 1.0 / self.nut_velocity(phi)
+        return 1.0 / self._divisor(self.nut_velocity(phi))
+
+    def _divisor(self, rate):
+        # The solver path never divides by zero: a design at a dead point (dx/dphi = 0
+        # somewhere on the grid) gets huge, finite forces and sensitivities.
+        return m.away_from_zero(rate) if self.guarded else rate
 
     def joints(self, phi, M_h, pin: PinJoint | None = None) -> list[Joint]:
         """The clearance chain (joints whose clearance reaches the output).

@@ -58,11 +58,16 @@ def nut_position(R, l, n, phi, phi0=0.0, floor=None):
 
 @m.shareable
 def nut_velocity(R, l, n, phi, phi0=0.0, floor=None):
-    """dm/dphi = R cos a - u R sin a / s (mm/rad): derivative of eq. 2."""
+    """dm/dphi = R cos a - u R sin a / s (mm/rad): derivative of eq. 2.
+
+    With a ``floor`` (the solver path) it is kept away from zero (``m.away_from_zero``):
+    at a dead point of the linkage (R = l, n = 0: the nut stands still) the sensitivities
+    and forces, which divide by it, stay finite."""
     a = arm_angle(phi, phi0)
     u = R * m.cos(a) - n
     s = rod_run(R, l, n, phi, phi0, floor)
-    return R * m.cos(a) - u * R * m.sin(a) / s
+    v = R * m.cos(a) - u * R * m.sin(a) / s
+    return v if floor is None else m.away_from_zero(v)
 
 
 @m.shareable
