@@ -229,6 +229,7 @@ def unit(argument: str, value: Any) -> str:
             parse_quantity(f"1 {value}")
         except InputError as exc:
             detail = re.sub(r"^cannot read .* as a quantity: ", "", exc.reason)
+            detail = re.sub(r" \(write a number and a unit.*\)$", "", detail)
             raise ArgumentError(argument, f"{shown(value)} is not a unit ({detail})") from None
     return value
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
+from optdesign import validation
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem import drive
 from optdesign.problem.catalogue import (
@@ -33,6 +34,7 @@ from optdesign.problem.quantities import Quantities
 from optdesign.problem.requirements import requirement_blocks
 from optdesign.problem.spec import ProblemSpec
 from optdesign.problem.variables import Variable
+from optdesign.user_code import UserCodeError, is_users, quantity_of
 
 
 @dataclass
@@ -97,7 +99,23 @@ class DesignProblem:
         self._constraints: list[ConstraintInfo] = []
         self._grid()
         self._check_consistency()
+        self._try_mechanism()
         self._touch()
+
+    def _try_mechanism(self) -> None:
+        """A user's mechanism runs once at the middle of the bounds, so that an error in
+        its code is reported when the problem is loaded (its class, method, file, line)."""
+        if not is_users(self.mechanism):
+            return
+        q = self.quantities(self.design_dict(self.midpoint()))
+        q.doing = "while loading the problem (the mechanism at the middle of the bounds)"
+        try:
+            with np.errstate(all="ignore"):
+                q.nut_position, q.ratio  # noqa: B018 (computed for their errors)
+        except UserCodeError:
+            raise
+        except Exception:  # not the user's code: the solve reports it where it belongs
+            return
 
     def _grid(self) -> None:
         d = self.spec.requirements.deflection
@@ -257,20 +275,34 @@ class DesignProblem:
         formula: str = "",
         display_unit: str | None = None,
         display_scale: float = 1.0,
+        *,
+        replace: bool = False,
     ) -> ObjectiveInfo:
         """Declare an objective ``fn(q)`` (see :class:`~optdesign.problem.quantities.
         Quantities` for ``q``), written with :mod:`optdesign.math`.
 
-        ``kind``: ``"max"`` (largest value over the stroke), ``"spread"`` ((max - min)/
-        (max + min) over the stroke) or ``"scalar"`` (one value per design); default:
-        ``"max"`` when ``fn`` returns a value per grid angle, else ``"scalar"``. ``unit``
-        is the internal unit of the value. The objective is then available to every
-        study (solve, Pareto, bench ...) by its name.
+        ``name``: letters, digits and underscores (it becomes a column header and a JSON
+        key); an existing objective - a built-in one such as ``backlash`` included - is
+        replaced only with ``replace=True``. ``kind``: ``"max"`` (largest value over the
+        stroke), ``"spread"`` ((max - min)/(max + min) over the stroke) or ``"scalar"``
+        (one value per design); default: ``"max"`` when ``fn`` returns a value per grid
+        angle, else ``"scalar"``. ``unit`` is the internal unit of the value. ``fn`` is
+        tried at the middle of the bounds now: an error, or a value no formulation can
+        use, is refused naming the function and its file and line. The objective is then
+        available to every study (solve, Pareto, bench ...) by its name.
         """
-        if not name or not isinstance(name, str):
-            raise InputError("add_objective.name", "give a non-empty name")
+        validation.objective_declaration(
+            self, name, fn, unit, kind, description, formula, display_unit, display_scale, replace
+        )
+        q = self.quantities(self.design_dict(self.midpoint()))
+        value = quantity_of(
+            fn,
+            q,
+            f"objective {name!r}",
+            kind != "scalar",
+            "while trying it at the middle of the bounds",
+        )
         if kind is None:
-            value = fn(self.quantities(self.design_dict(self.midpoint())))
             kind = "max" if self.quantities_on_grid(value) else "scalar"
         info = ObjectiveInfo(
             name, fn, kind, unit, description or name, formula, display_unit, display_scale
@@ -292,20 +324,23 @@ class DesignProblem:
         """Require ``lower <= fn(q) <= upper`` (at every grid angle for ``over="stroke"``,
         once for ``over="design"``).
 
-        Bounds are numbers in ``unit`` or quantity strings (``"3 kN"``) converted to
-        ``unit``; ``unit`` is the internal unit of ``fn``'s value (e.g. ``"N"``).
+        ``name``: a new name of letters, digits and underscores. Bounds are numbers in
+        ``unit`` or quantity strings (``"3 kN"``) converted to ``unit``; ``unit`` is the
+        internal unit of ``fn``'s value (e.g. ``"N"``). ``fn`` is tried at the middle of
+        the bounds now (see :meth:`add_objective`).
         """
-        if any(c.name == name for c in self._constraints):
-            raise InputError("add_constraint.name", f"a constraint {name!r} exists already")
-        info = ConstraintInfo(
-            name,
-            fn,
-            _bound(lower, unit, f"{name}.lower"),
-            _bound(upper, unit, f"{name}.upper"),
-            unit,
-            over,
-            description,
+        lower, upper = validation.constraint_declaration(
+            self, name, fn, lower, upper, unit, over, description
         )
+        q = self.quantities(self.design_dict(self.midpoint()))
+        quantity_of(
+            fn,
+            q,
+            f"constraint {name!r}",
+            over == "stroke",
+            "while trying it at the middle of the bounds",
+        )
+        info = ConstraintInfo(name, fn, lower, upper, unit, over, description)
         self._constraints.append(info)
         self._touch()
         return info
@@ -414,14 +449,10 @@ class DesignProblem:
         q = self.quantities(design, guarded, first_order, fit_fractions)
         objectives: dict[str, ObjectiveTerm] = {}
         for info in self._objectives.values():
-            try:
-                expr = info.fn(q)
-            except Exception as exc:
-                if info.name in BUILTIN_OBJECTIVES:
-                    raise
-                raise ProblemError(
-                    f"objective {info.name!r}: its function raised {type(exc).__name__}: {exc}"
-                ) from exc
+            if not is_users(info.fn):  # built-in (also after pickling to a worker)
+                expr = info.fn(q)  # None: not available for this problem (e.g. no pin)
+            else:  # a user's function: its failure names it, its file and line
+                expr = quantity_of(info.fn, q, f"objective {info.name!r}", info.kind != "scalar")
             if expr is not None:
                 objectives[info.name] = ObjectiveTerm(
                     info.name, info.kind, expr, info.unit, info.description
@@ -464,22 +495,6 @@ class DesignProblem:
             }
             worst = float(worst[0])
         return Evaluation(objectives, constraints, worst)
-
-
-def _bound(value: Any, unit: str, field: str) -> float | None:
-    if value is None:
-        return None
-    if isinstance(value, str):
-        from optdesign.units import convert
-
-        return convert(value, unit, field)
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"expected a number or a quantity string, got {value!r}") from None
-    if not np.isfinite(v):
-        raise InputError(field, f"must be finite, got {value!r}")
-    return v
 
 
 def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
