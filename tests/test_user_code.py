@@ -201,6 +201,27 @@ def test_a_user_mechanism_that_returns_nan_is_never_a_verified_result():
     assert np.isnan(rows["ratio_positive[phi=+30.0deg]"].value)
 
 
+@pytest.mark.parametrize("mode", ["default", "json"])
+def test_the_command_line_reports_a_nan_mechanism_as_no_design(mode, tmp_path, capsys):
+    import json
+
+    out = tmp_path / "out"
+    argv = ["solve", str(yoke_file(tmp_path, "t21_nan")), "--starts", "1", "--no-ranges"]
+    argv += ["--json"] if mode == "json" else ["--out", str(out)]
+    assert main(argv) == 1
+    captured = capsys.readouterr()
+    assert "internal error" not in captured.err and "Traceback" not in captured.err
+    if mode == "json":
+        doc = json.loads(captured.out)
+        assert doc["status"] == "failed" and not doc["verified"]
+        assert "objective 'motor_torque' is NaN at this design" in doc["notes"]
+        assert any(v["side"] == "number" for v in doc["violated"])
+    else:
+        assert "objective 'motor_torque' is NaN at this design" in captured.out
+        assert "is not a number (NaN)" in captured.out
+        assert (out / "result.json").is_file() and (out / "report.html").is_file()
+
+
 def test_a_user_mechanism_written_in_a_notebook_file(tmp_path):
     cell = tmp_path / "notebook_cell.py"
     cell.write_text(
