@@ -176,7 +176,7 @@ def bench(
         progress=progress,
         scheduler=scheduler,
     )
-    loaded = None if problems is None else [load(p) for p in problems]
+    loaded = None if args["problems"] is None else [load(p) for p in args["problems"]]
     return run_bench(
         suite=args["suite"],
         problems=loaded,

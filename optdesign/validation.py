@@ -113,10 +113,13 @@ def number(
         return None
     if not is_number(value):
         raise ArgumentError(argument, f"{shown(value)} is not a number")
-    value = float(value)
-    if not lo < value <= hi:  # also refuses nan
-        raise ArgumentError(argument, f"{value:g} is outside ({lo:g}, {hi:g}]")
-    return value
+    try:
+        number_ = float(value)
+    except OverflowError:  # an int of hundreds of digits
+        raise ArgumentError(argument, f"{shown(value)} is outside ({lo:g}, {hi:g}]") from None
+    if not lo < number_ <= hi:  # also refuses nan
+        raise ArgumentError(argument, f"{number_:g} is outside ({lo:g}, {hi:g}]")
+    return number_
 
 
 def flag(argument: str, value: Any) -> bool:
@@ -503,6 +506,9 @@ def bench_arguments(**arguments: Any) -> dict[str, Any]:
             "problems",
             f"expected a list of problems (files, dicts or problems), got {shown(problems)}",
         )
+    problems = None if problems is None else list(problems)  # a generator is read once
+    if problems is not None and not problems:
+        raise ArgumentError("problems", "give at least one problem (or None for a suite)")
     if problems is not None and arguments["suite"] is not None:
         raise ArgumentError(
             "suite", "excludes {problems} (run your problems or a suite)", ("problems",)
@@ -525,6 +531,7 @@ def bench_arguments(**arguments: Any) -> dict[str, Any]:
     if checked["time_limit"] is None:
         raise ArgumentError("time_limit", "give a time limit in seconds")
     run_folder(checked["out"], checked["resume"], checked["overwrite"])
+    checked["problems"] = problems
     return checked
 
 

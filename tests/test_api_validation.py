@@ -204,6 +204,12 @@ CASES = [
     bench("time_limit", -1, ["-1"], "-1 is outside (0, 86400]"),
     bench("time_limit", 1e9, ["1e9"], "1e+09 is outside (0, 86400]"),
     bench("hard_timeout", 0, ["0"], "0 is outside (0, 86400]"),
+    bench(
+        "time_limit",
+        10**400,
+        ["1" + "0" * 400],
+        "an integer of more than 100 digits is outside (0, 86400]",
+    ),
     bench("resume", True, [], "give the {out} folder of the run to resume"),
     bench("overwrite", True, [], "excludes {resume} (start over, or continue)", resume=True),
 ]
@@ -319,6 +325,10 @@ def test_every_command_line_option_is_an_api_argument():
             "suite: excludes problems (run your problems or a suite)",
         ),
         (lambda: od.bench(time_limit=True), "time_limit: True is not a number"),
+        (
+            lambda: od.bench(problems=[]),
+            "problems: give at least one problem (or None for a suite)",
+        ),
     ],
 )
 def test_api_only_arguments_are_checked_before_any_work(call, message, tmp_path, monkeypatch):
