@@ -347,3 +347,36 @@ def test_numpy_integers_are_integers_and_a_refusal_crosses_processes():
     back = pickle.loads(pickle.dumps(err))
     assert str(back) == "overwrite: excludes resume (start over)"
     assert back.render(lambda a: "--" + a) == "excludes --resume (start over)"
+
+
+def test_overwrite_discards_the_store_of_the_method_that_runs(tmp_path):
+    seen = {}
+
+    class Stub:
+        name = "stub"
+
+        def run(self, problem, objectives, run):
+            seen["store left"] = (tmp_path / "stub.jsonl").exists()
+            seen["other store"] = (tmp_path / "epsilon.jsonl").exists()
+            return "front"
+
+    (tmp_path / "stub.jsonl").write_text('{"old": 1}\n')
+    (tmp_path / "epsilon.jsonl").write_text('{"old": 1}\n')
+    assert od.pareto(RIPPLE, "ripple,size", method=Stub(), out=tmp_path, overwrite=True) == "front"
+    assert seen == {"store left": False, "other store": True}
+    with pytest.raises(InputError, match=r"starts: goes into the method object, not pareto\(\)"):
+        od.pareto(RIPPLE, "ripple,size", method=Stub(), starts=3)
+
+
+@pytest.mark.slow
+def test_overwrite_starts_a_front_afresh_through_the_api(tmp_path):
+    """``overwrite`` (the command line's --overwrite) discards the method's own store,
+    the catalogue front's ``epsilon-catalogue.jsonl`` too."""
+    from optdesign.errors import OptDesignError
+
+    args = (CATALOGUE, "backlash,ripple")
+    first = od.pareto(*args, points=3, out=tmp_path, workers=1)
+    with pytest.raises(OptDesignError, match=r"epsilon-catalogue\.jsonl holds \d+ records"):
+        od.pareto(*args, points=3, out=tmp_path, workers=1)
+    again = od.pareto(*args, points=3, out=tmp_path, workers=1, overwrite=True)
+    assert again.F.tolist() == first.F.tolist()
