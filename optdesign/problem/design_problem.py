@@ -20,9 +20,8 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
-from optdesign import validation
 from optdesign.errors import InputError, ProblemError
-from optdesign.problem import drive
+from optdesign.problem import declarations, drive
 from optdesign.problem.catalogue import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
@@ -291,7 +290,7 @@ class DesignProblem:
         use, is refused naming the function and its file and line. The objective is then
         available to every study (solve, Pareto, bench ...) by its name.
         """
-        validation.objective_declaration(
+        declarations.objective_declaration(
             self, name, fn, unit, kind, description, formula, display_unit, display_scale, replace
         )
         q = self.quantities(self.design_dict(self.midpoint()))
@@ -329,7 +328,7 @@ class DesignProblem:
         internal unit of ``fn``'s value (e.g. ``"N"``). ``fn`` is tried at the middle of
         the bounds now (see :meth:`add_objective`).
         """
-        lower, upper = validation.constraint_declaration(
+        lower, upper = declarations.constraint_declaration(
             self, name, fn, lower, upper, unit, over, description
         )
         q = self.quantities(self.design_dict(self.midpoint()))
