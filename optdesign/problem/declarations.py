@@ -39,7 +39,8 @@ def objective_declaration(
     text(where + "formula", formula)
     if display_unit is not None:
         unit(where + "display_unit", display_unit)
-    scale = number(where + "display_scale", display_scale, -math.inf, math.inf)
+    # None: a default factor (the units' own, where the caller derives one)
+    scale = number(where + "display_scale", display_scale, -math.inf, math.inf, optional=True)
     if scale == 0.0:
         raise ArgumentError(where + "display_scale", "0 would show every value as 0")
     if not flag(where + "replace", replace) and name_ in problem.objectives:
