@@ -523,3 +523,19 @@ def test_an_unknown_quantity_still_says_so_and_an_error_inside_one_is_not_hidden
     q = problem.quantities(problem.design_dict(problem.midpoint()))
     with pytest.raises(AttributeError, match="the drive lost its lead"):
         q.screw  # noqa: B018
+
+
+def test_a_scalar_user_objective_reduced_over_the_grid_evaluates_a_population():
+    """od.math.grid_max of a population gives one value per design: a population of
+    any size (the grid's own size too) has each design's own value, as NSGA-II needs."""
+    problem = od.load(BACKLASH)
+    problem.add_objective("peak", lambda q: m.grid_max(m.fabs(q.nut_force)), unit="N")
+    assert problem.objectives["peak"].kind == "scalar"
+    rng = np.random.default_rng(5)
+    lo, hi = problem.lower(), problem.upper()
+    for size in (3, len(problem.phi)):
+        X = lo + (hi - lo) * rng.random((size, len(lo)))
+        one_by_one = [problem.evaluate(x).objectives["peak"] for x in X]
+        assert problem.evaluate(X).objectives["peak"] == pytest.approx(
+            one_by_one, rel=1e-12, nan_ok=True
+        )

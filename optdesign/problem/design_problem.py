@@ -498,7 +498,12 @@ class DesignProblem:
 
 def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
     """Value of an objective term for each of ``pop`` designs on the NumPy path."""
-    e = np.broadcast_to(np.asarray(term.expr, dtype=float), (pop, n_phi))
+    e = np.asarray(term.expr, dtype=float)
+    if term.kind == "scalar" and e.shape == (pop,):
+        # one value per design already reduced over the grid (od.math.grid_max of a
+        # population): a column, not a row to spread over the angles
+        e = e[:, None]
+    e = np.broadcast_to(e, (pop, n_phi))
     if term.kind == "spread":
         return m.grid_spread(e)
     if term.kind == "max":
