@@ -11,7 +11,10 @@
     report = od.bench(problems=[problem], solvers=["ipopt", "slsqp"])
 
 Every function takes keyword arguments and returns typed results; none prints, none
-changes the matplotlib back-end.
+changes the matplotlib back-end. Every argument is checked before any work, by the checks
+the command line uses (:mod:`optdesign.validation`): a refusal is an
+:class:`~optdesign.errors.InputError` naming the argument, with the command line's
+message (``starts: 0 is outside 1..10000``).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from optdesign import validation
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
 from optdesign.solvers.result import Result
@@ -53,11 +57,13 @@ def solve(
     objective
         Objective to minimise (default: the problem's first).
     starts, seed
-        Multistart size and Sobol seed (default: the problem's ``[solver]``).
+        Multistart size (1..10000) and Sobol seed (0..2**32-1) (default: the problem's
+        ``[solver]``).
     workers
-        Local processes for the starts.
+        Local processes for the starts (1..256).
     solver, options
-        Registered solver back-end (:func:`optdesign.solvers.solver_names`) and options.
+        Registered solver back-end (:func:`optdesign.solver_names`) and its options
+        (Ipopt's are checked by Ipopt before the solve).
     ranges
         Also compute the range of each variable over the optimal set (NLP optima).
     agree
@@ -72,9 +78,8 @@ def solve(
     """
     from optdesign.studies.solve import solve as run
 
-    return run(
-        load(problem),
-        formulation,
+    args = validation.solve_arguments(
+        formulation=formulation,
         objective=objective,
         starts=starts,
         seed=seed,
@@ -82,24 +87,32 @@ def solve(
         solver=solver,
         options=options,
         ranges=ranges,
-        **({"agree": agree} if agree is not None else {}),
+        agree=agree,
     )
+    problem = load(problem)
+    validation.objective_of(problem, args["objective"])
+    agree = args.pop("agree")
+    return run(problem, **args, **({"agree": agree} if agree is not None else {}))
 
 
 def pareto(
     problem: DesignProblem | str | Path | Mapping[str, Any],
-    objectives: Sequence[str],
+    objectives: Sequence[str] | str,
     points: int = 50,
-    method: str = "epsilon",
+    method: str | Any = "epsilon",
     **options: Any,
 ):
     """The Pareto front of two or three objectives of ``problem``.
 
-    ``method``: ``"epsilon"`` (epsilon-constraint between exact anchors, evenly spread
-    along the front; default), ``"uniform"`` (epsilon evenly spaced), ``"weighted_sum"``
-    or ``"nsga2"``. Options (all keywords): ``out`` (folder of the resumable store),
-    ``workers``, ``scheduler`` (Dask), ``resume``, ``starts``, ``seed``, ``solver``,
-    ``deterministic``, NSGA-II's ``pop_size`` and ``generations``.
+    ``objectives``: a list of names, or one string ``"ripple,backlash"`` (the command
+    line's form). ``points``: 2..10000. ``method``: ``"epsilon"`` (epsilon-constraint
+    between exact anchors, evenly spread along the front; default), ``"uniform"``
+    (epsilon evenly spaced), ``"weighted_sum"`` or ``"nsga2"``, or a method object.
+    Options (all keywords; an option the method does not use is refused): ``out``
+    (folder of the resumable store), ``workers``, ``scheduler`` (Dask), ``resume``,
+    ``overwrite`` (start afresh over a stored run), ``progress``, ``starts``, ``seed``,
+    ``solver``, ``agree``, ``spacing``, ``eps_values``, ``retry_starts``,
+    ``extra_starts``, ``deterministic``, NSGA-II's ``pop_size`` and ``generations``.
 
     Returns
     -------
@@ -109,26 +122,38 @@ def pareto(
     """
     from optdesign.studies.pareto import compute_front
 
-    return compute_front(load(problem), list(objectives), points, method, **options)
+    objectives, points, method, options = validation.pareto_arguments(
+        objectives, points, method, options
+    )
+    problem = load(problem)
+    validation.front_objectives(problem, objectives)
+    validation.method_for(problem, method)
+    return compute_front(problem, objectives, points, method, **options)
 
 
 def bench(
     problems: Sequence[DesignProblem | str | Path | Mapping[str, Any]] | None = None,
     *,
     suite: str | None = None,
-    solvers: Sequence[str] | None = None,
+    solvers: Sequence[str] | str | None = None,
     out: str | Path | None = None,
     workers: int = 1,
     resume: bool = False,
+    overwrite: bool = False,
     time_limit: float = 1.0,
+    hard_timeout: float | None = None,
     progress: bool = False,
+    scheduler: str | None = None,
 ):
     """Benchmark solver configurations on problems (yours) or on a seeded suite.
 
     ``problems``: problems to run every configuration on; ``suite``: ``"quick"`` or
-    ``"default"`` (instance families of the registered mechanisms). ``solvers``: names of
-    configurations (default: all). Runs stream to ``out`` (a new temporary folder by
-    default) and can be resumed.
+    ``"default"`` (instance families of the registered mechanisms; the default when no
+    problems are given). ``solvers``: names of configurations (default: all). Runs
+    stream to ``out`` (a new temporary folder by default) and can be resumed
+    (``resume``) or started afresh (``overwrite``). ``time_limit``: soft wall-time limit
+    of each solver call (s, at most a day); ``hard_timeout``: a run is killed after it
+    (default ``time_limit + 3``). ``scheduler``: address of a Dask scheduler.
 
     Returns
     -------
@@ -138,14 +163,30 @@ def bench(
     """
     from optdesign.studies.bench import run_bench
 
-    loaded = None if problems is None else [load(p) for p in problems]
-    return run_bench(
+    args = validation.bench_arguments(
+        problems=problems,
         suite=suite,
-        problems=loaded,
-        configs=solvers,
+        solvers=solvers,
         out=out,
         workers=workers,
         resume=resume,
+        overwrite=overwrite,
         time_limit=time_limit,
+        hard_timeout=hard_timeout,
         progress=progress,
+        scheduler=scheduler,
+    )
+    loaded = None if args["problems"] is None else [load(p) for p in args["problems"]]
+    return run_bench(
+        suite=args["suite"],
+        problems=loaded,
+        configs=args["solvers"],
+        out=args["out"],
+        workers=args["workers"],
+        scheduler=args["scheduler"],
+        resume=args["resume"],
+        overwrite=args["overwrite"],
+        time_limit=args["time_limit"],
+        hard_timeout=args["hard_timeout"],
+        progress=args["progress"],
     )

@@ -16,10 +16,12 @@ import os
 import signal
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
-from optdesign.errors import OptDesignError
+from optdesign import validation
+from optdesign.errors import InputError, OptDesignError
 from optdesign.interrupts import (
     Interrupted,
     exit_code,
@@ -29,7 +31,16 @@ from optdesign.interrupts import (
 )
 from optdesign.text import printable
 
-__all__ = ["COMMANDS", "Interrupted", "build_parser", "command", "main", "run_guarded"]
+__all__ = [
+    "COMMANDS",
+    "Interrupted",
+    "as_options",
+    "build_parser",
+    "checked",
+    "command",
+    "main",
+    "run_guarded",
+]
 
 #: subcommand name -> function(subparsers) that registers it. Add one line per command.
 COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {}
@@ -100,42 +111,70 @@ PLUGIN_MODULES: list[str] = [
 ]
 
 
+def literal(text: str) -> int | float | str:
+    """A command-line word as the value a Python caller would pass: an int, else a float,
+    else the text itself (the checks of :mod:`optdesign.validation` then say what is
+    wrong with it, as they do for the API)."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def checked(check: Callable[[str, Any], Any], parse: Callable[[str], Any] = str):
+    """An argparse type from a check of :mod:`optdesign.validation`: ``parse`` the word,
+    then ``check(argument, value)``; a refusal becomes argparse's error with the check's
+    own reason (``argument --starts: 0 is outside 1..10000``)."""
+
+    def convert(text: str) -> Any:
+        try:
+            return check("value", parse(text))
+        except InputError as exc:
+            raise argparse.ArgumentTypeError(exc.reason) from None
+
+    return convert
+
+
 def bounded_int(lo: int, hi: int) -> Callable[[str], int]:
     """An argparse type: an integer from ``lo`` to ``hi`` (sizes are capped, so that a
     typo cannot start unbounded work)."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-        if not lo <= value <= hi:
-            raise argparse.ArgumentTypeError(f"{value} is outside {lo}..{hi}")
-        return value
-
-    return parse
+    return checked(lambda a, v: validation.integer(a, v, lo, hi), literal)
 
 
 def bounded_float(lo: float, hi: float) -> Callable[[str], float]:
     """An argparse type: a finite number with ``lo < value <= hi``."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not lo < value <= hi:  # also refuses nan
-            raise argparse.ArgumentTypeError(f"{value:g} is outside ({lo:g}, {hi:g}]")
-        return value
-
-    return parse
+    return checked(lambda a, v: validation.number(a, v, lo, hi), literal)
 
 
-#: Caps of the command-line sizes (a front of 10^7 points is a typo, not a study).
-MAX_WORKERS = 256
-MAX_STARTS = 10_000
-MAX_POINTS = 10_000
-MAX_SEED = 2**32 - 1
+def option(argument: str, renamed: Mapping[str, str] | None = None) -> str:
+    """The command-line option of an API argument: ``--time-limit`` for ``time_limit``
+    (``renamed`` for options spelt otherwise, e.g. ``{"pop_size": "--pop"}``)."""
+    if renamed and argument in renamed:
+        return renamed[argument]
+    return "--" + argument.replace("_", "-")
+
+
+@contextlib.contextmanager
+def as_options(renamed: Mapping[str, str] | None = None):
+    """Refusals of the shared checks (:class:`~optdesign.validation.ArgumentError`)
+    raised inside name the command-line options instead of the API's arguments."""
+    try:
+        yield
+    except validation.ArgumentError as exc:
+
+        def name(a: str) -> str:
+            return option(a, renamed)
+
+        raise InputError(name(exc.argument), exc.render(name)) from None
+
+
+#: Caps of the command-line sizes, the API's (optdesign.validation).
+MAX_WORKERS = validation.MAX_WORKERS
+MAX_STARTS = validation.MAX_STARTS
+MAX_POINTS = validation.MAX_POINTS
+MAX_SEED = validation.MAX_SEED
 
 
 def _version() -> str:
@@ -205,6 +244,12 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         with interrupts_as_exceptions():
             code = func()
     except OptDesignError as exc:
+        if os.environ.get("OPTDESIGN_DEBUG") and exc.__cause__ is not None:
+            # e.g. a user's function that raised: its own traceback, down to its file
+            # and line, before the one line
+            import traceback
+
+            traceback.print_exception(exc, file=sys.stderr)
         print(f"optdesign: error: {printable(exc)}", file=sys.stderr)
         return 2
     except OSError as exc:  # e.g. no space left while writing the results

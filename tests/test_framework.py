@@ -246,6 +246,22 @@ def test_mechanism_names_stay_in_the_mechanisms():
     assert not offenders, offenders
 
 
+def yoke_data(mechanism: str) -> dict:
+    """A problem of a one-arm yoke ``mechanism`` (variable R): the least peak motor
+    torque, R at the nut travel's limit 2 R sin 30 deg = 100 mm."""
+    return {
+        "name": "y",
+        "mechanism": mechanism,
+        "variables": {"R": {"lower": "30 mm", "upper": "120 mm"}, "p": "5 mm", "i_a": 2},
+        "requirements": {
+            "deflection": {"min": "-30 deg", "max": "30 deg", "points": 21},
+            "hinge_moment": "500 N*m",
+            "nut_travel_max": "100 mm",
+        },
+        "objective": {"minimize": "motor_torque"},
+    }
+
+
 def test_gp_diagnosis_of_a_user_mechanism_is_never_a_wrong_model():
     from optdesign import math as m
     from optdesign.formulations.gp import build_gp
@@ -263,19 +279,9 @@ def test_gp_diagnosis_of_a_user_mechanism_is_never_a_wrong_model():
         def nut_velocity(self, phi):
             return self.R * m.cos(phi)
 
-    data = {
-        "name": "y",
-        "variables": {"R": {"lower": "30 mm", "upper": "120 mm"}, "p": "5 mm", "i_a": 2},
-        "requirements": {
-            "deflection": {"min": "-30 deg", "max": "30 deg", "points": 21},
-            "hinge_moment": "500 N*m",
-            "nut_travel_max": "100 mm",
-        },
-        "objective": {"minimize": "motor_torque"},
-    }
     od.register_mechanism(AutoYoke, replace=True)
     od.register_mechanism(ClosedYoke, replace=True)
-    auto = od.load({**data, "mechanism": "auto_yoke"})
+    auto = od.load(yoke_data("auto_yoke"))
     # the automatic derivative cannot be traced: not a GP, and the reason says why
     gp = build_gp(auto)
     assert not gp.is_gp and "automatic derivative" in gp.explain()
@@ -283,7 +289,7 @@ def test_gp_diagnosis_of_a_user_mechanism_is_never_a_wrong_model():
     r_auto = od.solve(auto, starts=2, ranges=False)
     assert r_auto.formulation.startswith("nlp")
     assert r_auto.design["R"] == pytest.approx(100.0, rel=1e-6)
-    closed = od.load({**data, "mechanism": "closed_yoke"})
+    closed = od.load(yoke_data("closed_yoke"))
     assert build_gp(closed).is_gp
     r_gp = od.solve(closed, ranges=False)
     assert r_gp.formulation == "gp" and r_gp.certificate.gap_rel < 1e-6

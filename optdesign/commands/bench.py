@@ -13,13 +13,15 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from optdesign.cli import MAX_WORKERS, bounded_float, bounded_int, command, default_out
+from optdesign import validation as check
+from optdesign.cli import as_options, checked, command, default_out, literal
+from optdesign.errors import InputError
 
 
 @command("bench")
 def _bench(sub):
     p = sub.add_parser("bench", help="benchmark solver configurations on seeded instance families")
-    p.add_argument("--suite", choices=["default", "quick"], default="default")
+    p.add_argument("--suite", type=checked(check.suite), default="default", help="default or quick")
     p.add_argument(
         "--solvers",
         nargs="+",
@@ -30,7 +32,7 @@ def _bench(sub):
     p.add_argument("--list", action="store_true", help="list the configurations and exit")
     p.add_argument(
         "--workers",
-        type=bounded_int(1, MAX_WORKERS),
+        type=checked(check.workers, literal),
         default=os.cpu_count() or 1,
         help="local processes",
     )
@@ -53,13 +55,13 @@ def _bench(sub):
     )
     p.add_argument(
         "--time-limit",
-        type=bounded_float(0.0, 86_400.0),
+        type=checked(check.seconds, literal),
         default=1.0,
         help="soft wall-time limit of each solver call, s (default 1; set-up not included)",
     )
     p.add_argument(
         "--hard-timeout",
-        type=bounded_float(0.0, 86_400.0),
+        type=checked(check.seconds, literal),
         default=None,
         help="kill a run after this many s (default time limit + 3)",
     )
@@ -76,7 +78,6 @@ def _bench(sub):
 
 def run_bench_command(args) -> int:
     from optdesign import storage
-    from optdesign.errors import InputError
     from optdesign.studies import bench
 
     if args.list:
@@ -84,17 +85,9 @@ def run_bench_command(args) -> int:
             c = bench.get_config(name)
             print(f"{name:20s} {c.kind:7s} {c.description}")
         return 0
-    if args.workers < 1:
-        raise InputError("--workers", f"must be at least 1, got {args.workers}")
-    if args.time_limit <= 0:
-        raise InputError("--time-limit", f"must be positive, got {args.time_limit}")
-    solvers = None
-    if args.solvers:
-        solvers = [s for item in args.solvers for s in item.split(",") if s]
-    if args.resume and args.overwrite:
-        raise InputError("--overwrite", "excludes --resume (start over, or continue)")
-    if args.resume and args.out is None:
-        raise InputError("--resume", "give the --out folder of the run to resume")
+    with as_options():  # the checks of optdesign.bench, before any work
+        solvers = check.configs("solvers", args.solvers)
+        check.run_folder(args.out, args.resume, args.overwrite)
     if args.update_readme is not None:
         # Checked before the benchmark runs: a FIFO, /dev/zero, a folder or a file
         # without the markers is refused at once, not after an hour of runs.
@@ -111,7 +104,6 @@ def run_bench_command(args) -> int:
 
 
 def _run_locked(args, bench, solvers, out: Path) -> int:
-    from optdesign.errors import InputError
 
     report = bench.run_bench(
         args.suite,

@@ -10,18 +10,12 @@ import os
 import time
 from pathlib import Path
 
-from optdesign.cli import (
-    MAX_POINTS,
-    MAX_SEED,
-    MAX_STARTS,
-    MAX_WORKERS,
-    bounded_int,
-    command,
-    default_out,
-)
-from optdesign.errors import InputError
+from optdesign import validation as check
+from optdesign.cli import as_options, checked, command, default_out, literal
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
+#: Options spelt otherwise than their API argument (optdesign.pareto).
+RENAMED = {"pop_size": "--pop"}
 
 
 @command("pareto")
@@ -33,7 +27,7 @@ def _pareto(sub):
     )
     p.add_argument(
         "--points",
-        type=bounded_int(2, MAX_POINTS),
+        type=checked(check.points, literal),
         default=50,
         help="points of the front (default 50)",
     )
@@ -52,25 +46,31 @@ def _pareto(sub):
     )
     p.add_argument(
         "--workers",
-        type=bounded_int(1, MAX_WORKERS),
+        type=checked(check.workers, literal),
         default=os.cpu_count() or 1,
         help="local processes (default: the CPU count)",
     )
     p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
     p.add_argument(
         "--starts",
-        type=bounded_int(1, MAX_STARTS),
+        type=checked(check.starts, literal),
         default=None,
         help="anchor multistarts (default: file's)",
     )
     p.add_argument(
-        "--seed", type=bounded_int(0, MAX_SEED), default=None, help="seed (default: file's)"
+        "--seed", type=checked(check.seed, literal), default=None, help="seed (default: file's)"
     )
     p.add_argument(
-        "--pop", type=bounded_int(4, 100_000), default=100, help="NSGA-II population (default 100)"
+        "--pop",
+        type=checked(check.pop_size, literal),
+        default=100,
+        help="NSGA-II population (default 100)",
     )
     p.add_argument(
-        "--generations", type=bounded_int(1, 100_000), default=500, help="NSGA-II generations"
+        "--generations",
+        type=checked(check.generations, literal),
+        default=500,
+        help="NSGA-II generations",
     )
     p.add_argument(
         "--deterministic",
@@ -90,30 +90,13 @@ def run_pareto(args) -> int:
     from optdesign.problem import load_problem
 
     problem = load_problem(args.file)
-    objectives = [s.strip() for s in args.objectives.split(",") if s.strip()]
-    methods = (
-        list(METHOD_NAMES)
-        if args.method == "all"
-        else [s.strip() for s in args.method.split(",") if s.strip()]
-    )
-    for m in methods:
-        if m not in METHOD_NAMES:
-            raise InputError("--method", f"unknown method {m!r} (known: {', '.join(METHOD_NAMES)})")
-    if "weighted_sum" in methods:
-        from optdesign.studies.pareto.catalogue_front import has_catalogue
-
-        if has_catalogue(problem):  # refused before the output folder is made
-            raise InputError(
-                "--method",
-                "weighted_sum would leave the catalogue: with catalogue variables use "
-                "epsilon or nsga2",
-            )
-    if args.points < 2:
-        raise InputError("--points", "need at least 2 points")
-    if args.resume and args.out is None:
-        raise InputError("--resume", "give the --out folder of the run to resume")
-    if args.resume and args.overwrite:
-        raise InputError("--overwrite", "excludes --resume (start over, or continue)")
+    with as_options(RENAMED):  # the checks of optdesign.pareto, before any work
+        objectives = check.front_objectives(problem, args.objectives)
+        methods = list(METHOD_NAMES) if args.method == "all" else check.names("method", args.method)
+        for m in methods:
+            check.method("method", m)
+            check.method_for(problem, m)  # refused before the output folder is made
+        check.run_folder(args.out, args.resume, args.overwrite)
     out = args.out or default_out(f"pareto-{problem.name}")
     # One run per folder for the whole command (the runner re-enters the lock per store),
     # checked before any solving.
@@ -140,6 +123,7 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         workers=args.workers,
         scheduler=args.scheduler,
         resume=args.resume,
+        overwrite=args.overwrite,
         progress=not args.no_progress,
     )
     fronts = []

@@ -5,14 +5,11 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-from optdesign.cli import (
-    MAX_SEED,
-    MAX_STARTS,
-    MAX_WORKERS,
-    bounded_int,
-    command,
-    default_out,
-)
+from optdesign import validation as check
+from optdesign.cli import as_options, checked, command, default_out, literal
+
+#: Options spelt otherwise than their API argument (optdesign.solve).
+RENAMED = {"ranges": "--no-ranges", "problem": "file"}
 
 
 @command("solve")
@@ -22,25 +19,33 @@ def _solve(sub):
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
     p.add_argument("--json", action="store_true", help="print the result JSON to stdout")
     p.add_argument(
-        "--formulation", default="auto", help="auto (default), nlp, gp, catalogue, robust"
+        "--formulation",
+        type=checked(check.formulation),
+        default="auto",
+        help="auto (default), nlp, gp, catalogue, robust",
     )
-    p.add_argument("--solver", default="ipopt", help="solver back-end (default ipopt)")
+    p.add_argument(
+        "--solver",
+        type=checked(check.solver),
+        default="ipopt",
+        help="solver back-end (default ipopt)",
+    )
     p.add_argument("--objective", default=None, help="objective to minimise (default: file's)")
     p.add_argument(
         "--starts",
-        type=bounded_int(1, MAX_STARTS),
+        type=checked(check.starts, literal),
         default=None,
-        help="multistart count (default: file's)",
+        help=f"multistart count, 1..{check.MAX_STARTS} (default: file's)",
     )
     p.add_argument(
         "--seed",
-        type=bounded_int(0, MAX_SEED),
+        type=checked(check.seed, literal),
         default=None,
         help="multistart seed (default: file's)",
     )
     p.add_argument(
         "--workers",
-        type=bounded_int(1, MAX_WORKERS),
+        type=checked(check.workers, literal),
         default=1,
         help="local processes for the starts",
     )
@@ -64,6 +69,8 @@ def run_solve(args) -> int:
     from optdesign.problem import load_problem
 
     problem = load_problem(args.file)
+    with as_options(RENAMED):  # before the output folder is made
+        check.objective_of(problem, args.objective)
     write_files = args.out is not None or not args.json
     if not write_files:
         return _solve_and_report(args, problem, None)
@@ -81,7 +88,7 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
 
     # With --json, stdout carries the JSON only: a solver's log goes to stderr.
     quiet = stdout_to_stderr() if args.json else contextlib.nullcontext()
-    with quiet:
+    with quiet, as_options(RENAMED):
         result = solve(
             problem,
             formulation=args.formulation,

@@ -278,7 +278,8 @@ class ConstraintRows:
 
     def add(self, expr, lo, hi, scale, name, labels, unit) -> None:
         """Add ``lo <= expr <= hi`` (element-wise), each row named ``name[label]``."""
-        expr = ca.vec(ca.SX(expr))
+        # dense: a structural zero (e.g. a user's x/0 at phi = 0) is a row too
+        expr = ca.densify(ca.vec(ca.SX(expr)))
         k = expr.shape[0]
         self.exprs.append(expr / scale)
         self.lbg.extend([-np.inf if lo is None else lo / scale] * k)
@@ -295,8 +296,8 @@ class ConstraintRows:
 
 def typical(value) -> float:
     """Largest finite magnitude of ``value`` (1 when none): a row's or value's scale."""
-    with np.errstate(invalid="ignore"):
-        v = np.nanmax(np.abs(np.asarray(value, dtype=float)))
+    a = np.abs(np.asarray(value, dtype=float))
+    v = np.nanmax(a) if a.size and not np.isnan(a).all() else np.nan  # all NaN: no warning
     return float(v) if np.isfinite(v) and v > 0 else 1.0
 
 

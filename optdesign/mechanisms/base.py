@@ -19,6 +19,7 @@ problem, not here.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
@@ -32,6 +33,7 @@ from optdesign.mechanisms.joints import Backlash, Joint, PinJoint, backlash_of
 from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import force_from_rate, motor_torque
 from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity
+from optdesign.user_code import call_method
 
 #: Physical dimensions a variable may have (keys of optdesign.units.INTERNAL_UNITS).
 DIMENSIONS = ("length", "angle", "dimensionless")
@@ -60,7 +62,9 @@ class VariableInfo:
 
     def __post_init__(self):
         if self.dimension not in DIMENSIONS:
-            raise ValueError(f"dimension {self.dimension!r} not in {DIMENSIONS}")
+            raise InputError(
+                "dimension", f"{self.dimension!r} is not one of {', '.join(DIMENSIONS)}"
+            )
 
 
 def as_variable_info(value: VariableInfo | str | tuple) -> VariableInfo:
@@ -225,7 +229,14 @@ class Mechanism:
         values = self.__dict__.get("values")
         if values is not None and item in values:
             return values[item]
-        raise AttributeError(f"{type(self).__name__} has no attribute {item!r}")
+        attr = inspect.getattr_static(type(self), item, None)
+        if hasattr(attr, "__get__") and not item.startswith("__"):
+            # A property of the class that raised AttributeError, which Python turns into
+            # this call: run again here, its own error (file, line) propagates instead
+            # of "no attribute" for an attribute the class defines.
+            return attr.__get__(self, type(self))
+        known = f" (its variables: {', '.join(values)})" if values else ""
+        raise AttributeError(f"{type(self).__name__} has no attribute {item!r}{known}")
 
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.values.items())
@@ -398,7 +409,7 @@ def _derivative(mech: Mechanism, phi):
         probe = cls.__new__(cls)
         probe.values = dict(syms)
         probe.guarded = mech.guarded
-        x = probe.nut_position(phi_s)
+        x = call_method(probe, "nut_position", phi_s, doing="while differentiating it (CasADi)")
         fun = ca.Function(f"dx_{cls.__name__}", [phi_s, *syms.values()], [ca.jacobian(x, phi_s)])
         _DERIVATIVES[key] = fun
     args = [mech.values[k] for k in names]

@@ -47,9 +47,9 @@ def register_mechanism(arg=None, /, *, replace: bool = False):
         from optdesign.mechanisms.base import Mechanism
 
         if not (isinstance(cls, type) and issubclass(cls, Mechanism)):
-            raise TypeError(f"register_mechanism: {cls!r} is not a Mechanism subclass")
+            raise InputError("register_mechanism", f"{cls!r} is not a Mechanism subclass")
         key = key or cls.name
-        if not key:
+        if not key or not isinstance(key, str):
             raise InputError("mechanism", f"{cls.__name__} has no name; set name = '...'")
         if key != cls.name:
             cls.name = key
@@ -65,17 +65,36 @@ def register_mechanism(arg=None, /, *, replace: bool = False):
                 f"{key!r} is registered already ({old.__module__}.{old.__qualname__}); "
                 "pass replace=True to replace it",
             )
-        cls.variable_table()  # validates the declared variables now, not at first use
+        _check_declarations(cls, key)  # now, not at first use
         _REGISTRY[key] = cls
         return cls
 
     if isinstance(arg, type):
         return add(arg, None)
+    if arg is not None and not isinstance(arg, str):
+        raise InputError("register_mechanism", f"{arg!r} is not a Mechanism subclass (or a name)")
 
     def deco(cls):
         return add(cls, arg)
 
     return deco
+
+
+def _check_declarations(cls: type[Mechanism], key: str) -> None:
+    """The class's variables are valid declarations and it writes nut_position; a
+    refusal names the class and points at its file and line."""
+    from optdesign.mechanisms.base import Mechanism
+    from optdesign.user_code import UserCodeError, describe_class
+
+    subject = f"mechanism {key!r} ({describe_class(cls)})"  # cls.name is set after the checks
+    try:
+        cls.variable_table()
+    except Exception as exc:
+        raise UserCodeError(
+            f"{subject}: its variables: {type(exc).__name__}: {exc}", subject
+        ) from exc
+    if cls.nut_position is Mechanism.nut_position:
+        raise UserCodeError(f"{subject}: define nut_position(self, phi)", subject)
 
 
 def _load_entry_points() -> None:

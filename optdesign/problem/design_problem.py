@@ -21,7 +21,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
-from optdesign.problem import drive
+from optdesign.problem import declarations, drive
 from optdesign.problem.catalogue import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
@@ -33,6 +33,7 @@ from optdesign.problem.quantities import Quantities
 from optdesign.problem.requirements import requirement_blocks
 from optdesign.problem.spec import ProblemSpec
 from optdesign.problem.variables import Variable
+from optdesign.user_code import UserCodeError, is_users, quantity_of
 
 
 @dataclass
@@ -97,7 +98,23 @@ class DesignProblem:
         self._constraints: list[ConstraintInfo] = []
         self._grid()
         self._check_consistency()
+        self._try_mechanism()
         self._touch()
+
+    def _try_mechanism(self) -> None:
+        """A user's mechanism runs once at the middle of the bounds, so that an error in
+        its code is reported when the problem is loaded (its class, method, file, line)."""
+        if not is_users(self.mechanism):
+            return
+        q = self.quantities(self.design_dict(self.midpoint()))
+        q.doing = "while loading the problem (the mechanism at the middle of the bounds)"
+        try:
+            with np.errstate(all="ignore"):
+                q.nut_position, q.ratio  # noqa: B018 (computed for their errors)
+        except UserCodeError:
+            raise
+        except Exception:  # not the user's code: the solve reports it where it belongs
+            return
 
     def _grid(self) -> None:
         d = self.spec.requirements.deflection
@@ -257,24 +274,39 @@ class DesignProblem:
         formula: str = "",
         display_unit: str | None = None,
         display_scale: float | None = None,
+        *,
+        replace: bool = False,
     ) -> ObjectiveInfo:
         """Declare an objective ``fn(q)`` (see :class:`~optdesign.problem.quantities.
         Quantities` for ``q``), written with :mod:`optdesign.math`.
 
-        ``kind``: ``"max"`` (largest value over the stroke), ``"spread"`` ((max - min)/
-        (max + min) over the stroke) or ``"scalar"`` (one value per design); default:
-        ``"max"`` when ``fn`` returns a value per grid angle, else ``"scalar"``. ``unit``
-        is the internal unit of the value (a unit expression such as ``"N*mm/rad"``, ``""``
-        for a plain number). Reports show ``value * display_scale`` in ``display_unit``, a
-        unit of the same dimension, angles counted; ``display_scale`` defaults to the
-        factor between the two units and, when given, must equal it. The objective is then
-        available to every study (solve, Pareto, bench ...) by its name.
+        ``name``: letters, digits and underscores (it becomes a column header and a JSON
+        key); an existing objective - a built-in one such as ``backlash`` included - is
+        replaced only with ``replace=True``. ``kind``: ``"max"`` (largest value over the
+        stroke), ``"spread"`` ((max - min)/(max + min) over the stroke) or ``"scalar"``
+        (one value per design); default: ``"max"`` when ``fn`` returns a value per grid
+        angle, else ``"scalar"``. ``unit`` is the internal unit of the value (a unit
+        expression such as ``"N*mm/rad"``, ``""`` for a plain number). Reports show
+        ``value * display_scale`` in ``display_unit``, a unit of the same dimension, angles
+        counted; ``display_scale`` defaults to the factor between the two units and, when
+        given, must equal it. ``fn`` is tried at the middle of the bounds now: an error, or
+        a value no formulation can use, is refused naming the function and its file and
+        line. The objective is then available to every study (solve, Pareto, bench ...) by
+        its name.
         """
-        if not name or not isinstance(name, str):
-            raise InputError("add_objective.name", "give a non-empty name")
+        declarations.objective_declaration(
+            self, name, fn, unit, kind, description, formula, display_unit, display_scale, replace
+        )
         display_scale = _display_scale(unit, display_unit, display_scale)
+        q = self.quantities(self.design_dict(self.midpoint()))
+        value = quantity_of(
+            fn,
+            q,
+            f"objective {name!r}",
+            kind != "scalar",
+            "while trying it at the middle of the bounds",
+        )
         if kind is None:
-            value = fn(self.quantities(self.design_dict(self.midpoint())))
             kind = "max" if self.quantities_on_grid(value) else "scalar"
         info = ObjectiveInfo(
             name, fn, kind, unit, description or name, formula, display_unit, display_scale
@@ -296,23 +328,23 @@ class DesignProblem:
         """Require ``lower <= fn(q) <= upper`` (at every grid angle for ``over="stroke"``,
         once for ``over="design"``).
 
-        Bounds are numbers in ``unit`` or quantity strings (``"3 kN"``) converted to
-        ``unit``; ``unit`` is the internal unit of ``fn``'s value (e.g. ``"N"``).
+        ``name``: a new name of letters, digits and underscores. Bounds are numbers in
+        ``unit`` or quantity strings (``"3 kN"``) converted to ``unit``; ``unit`` is the
+        internal unit of ``fn``'s value (e.g. ``"N"``). ``fn`` is tried at the middle of
+        the bounds now (see :meth:`add_objective`).
         """
-        if any(c.name == name for c in self._constraints):
-            raise InputError("add_constraint.name", f"a constraint {name!r} exists already")
-        from optdesign.units import parse_unit
-
-        parse_unit(unit, f"{name}.unit")
-        info = ConstraintInfo(
-            name,
-            fn,
-            _bound(lower, unit, f"{name}.lower"),
-            _bound(upper, unit, f"{name}.upper"),
-            unit,
-            over,
-            description,
+        lower, upper = declarations.constraint_declaration(
+            self, name, fn, lower, upper, unit, over, description
         )
+        q = self.quantities(self.design_dict(self.midpoint()))
+        quantity_of(
+            fn,
+            q,
+            f"constraint {name!r}",
+            over == "stroke",
+            "while trying it at the middle of the bounds",
+        )
+        info = ConstraintInfo(name, fn, lower, upper, unit, over, description)
         self._constraints.append(info)
         self._touch()
         return info
@@ -421,14 +453,10 @@ class DesignProblem:
         q = self.quantities(design, guarded, first_order, fit_fractions)
         objectives: dict[str, ObjectiveTerm] = {}
         for info in self._objectives.values():
-            try:
-                expr = info.fn(q)
-            except Exception as exc:
-                if info.name in BUILTIN_OBJECTIVES:
-                    raise
-                raise ProblemError(
-                    f"objective {info.name!r}: its function raised {type(exc).__name__}: {exc}"
-                ) from exc
+            if not is_users(info.fn):  # built-in (also after pickling to a worker)
+                expr = info.fn(q)  # None: not available for this problem (e.g. no pin)
+            else:  # a user's function: its failure names it, its file and line
+                expr = quantity_of(info.fn, q, f"objective {info.name!r}", info.kind != "scalar")
             if expr is not None:
                 objectives[info.name] = ObjectiveTerm(
                     info.name, info.kind, expr, info.unit, info.description
@@ -497,25 +525,14 @@ def _display_scale(unit: str, display_unit: str | None, scale: float | None) -> 
     return float(scale)
 
 
-def _bound(value: Any, unit: str, field: str) -> float | None:
-    if value is None:
-        return None
-    if isinstance(value, str) or type(value).__module__.startswith("pint"):
-        from optdesign.units import convert
-
-        return convert(value, unit, field)
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"expected a number or a quantity string, got {value!r}") from None
-    if not np.isfinite(v):
-        raise InputError(field, f"must be finite, got {value!r}")
-    return v
-
-
 def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
     """Value of an objective term for each of ``pop`` designs on the NumPy path."""
-    e = np.broadcast_to(np.asarray(term.expr, dtype=float), (pop, n_phi))
+    e = np.asarray(term.expr, dtype=float)
+    if term.kind == "scalar" and e.shape == (pop,):
+        # one value per design already reduced over the grid (od.math.grid_max of a
+        # population): a column, not a row to spread over the angles
+        e = e[:, None]
+    e = np.broadcast_to(e, (pop, n_phi))
     if term.kind == "spread":
         return m.grid_spread(e)
     if term.kind == "max":

@@ -126,12 +126,28 @@ def load_problem(path: str | Path) -> DesignProblem:
 
 
 def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProblem:
-    """A problem from a file path, a dict (the parsed-TOML form) or a problem (returned)."""
+    """A problem from a file path, a dict (the parsed-TOML form) or a problem (returned).
+
+    Raises
+    ------
+    InputError
+        (argument ``problem``) for anything else, e.g. a number or bytes.
+    """
     if isinstance(problem, DesignProblem):
         return problem
     if isinstance(problem, Mapping):
         return problem_from_dict(dict(problem))
-    return load_problem(problem)
+    from optdesign import validation
+
+    try:
+        path = validation.path("problem", problem)
+    except validation.ArgumentError:
+        raise validation.ArgumentError(
+            "problem",
+            "expected a problem file path, a problem dict or a DesignProblem, got "
+            + validation.shown(problem),
+        ) from None
+    return load_problem(path)
 
 
 def validate_spec(

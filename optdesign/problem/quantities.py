@@ -13,6 +13,7 @@ in the GP diagnosis: write functions of ``q`` with :mod:`optdesign.math`.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Mapping, Sequence
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -27,6 +28,7 @@ from optdesign.mechanisms.joints import (
     with_sampled_fits,
 )
 from optdesign.problem import drive
+from optdesign.user_code import call_method, stage
 
 if TYPE_CHECKING:
     from optdesign.problem.design_problem import DesignProblem
@@ -72,10 +74,26 @@ class Quantities:
         design = self.__dict__.get("design")
         if design is not None and item in design and not item.startswith(drive.PARAM):
             return design[item]
+        if _defined(type(self), item):
+            # A quantity whose computation raised AttributeError, which Python turns into
+            # this call: computed again here, its own error (file, line) propagates
+            # instead of "no quantity" for a quantity that exists.
+            return inspect.getattr_static(type(self), item).__get__(self, type(self))
         raise AttributeError(
             f"no quantity or variable {item!r} (variables: {', '.join(design or {})}; "
             "quantities: see optdesign.problem.quantities.Quantities)"
         )
+
+    @cached_property
+    def doing(self) -> str:
+        """What these quantities are computed for, for the errors of a user's code
+        ("while building the solver's model", ...)."""
+        return stage(self.design)
+
+    def call_mechanism(self, method: str, *args: Any) -> Any:
+        """``self.mechanism.method(*args)``; a user's mechanism that fails gives an error
+        naming its class, the method and the user's file and line."""
+        return call_method(self.mechanism, method, *args, doing=self.doing)
 
     # --- mechanism ---------------------------------------------------------------------
     @cached_property
@@ -84,39 +102,41 @@ class Quantities:
         cls = self.problem.mechanism
         names = cls.variable_table()
         values = {k: v for k, v in self.design.items() if k in names}
-        return cls(values, guarded=self.guarded)
+        return call_method(cls, "__init__", values, guarded=self.guarded, doing=self.doing)
 
     @cached_property
     def nut_position(self):
         """Drive coordinate x(phi) over the grid (mm)."""
-        return self.mechanism.nut_position(self.phi)
+        return self.call_mechanism("nut_position", self.phi)
 
     @cached_property
     def nut_velocity(self):
         """dx/dphi over the grid (mm/rad)."""
-        return self.mechanism.nut_velocity(self.phi)
+        return self.call_mechanism("nut_velocity", self.phi)
 
     @cached_property
     def ratio(self):
         """Reduction ratio i(phi) = 2 pi i_a (dx/dphi)/p over the grid."""
-        return self.mechanism.ratio(self.phi)
+        return self.call_mechanism("ratio", self.phi)
 
     @cached_property
     def nut_travel(self):
         """x(phi_max) - x(phi_min) (mm)."""
-        return self.mechanism.nut_travel(self.phi[0], self.phi[-1])
+        return self.call_mechanism("nut_travel", self.phi[0], self.phi[-1])
 
     @cached_property
     def nut_force(self):
         """Nut axial force over the grid (N), by virtual work."""
-        return self.mechanism.nut_force(self.phi, self.hinge_moment)
+        return self.call_mechanism("nut_force", self.phi, self.hinge_moment)
 
     @cached_property
     def motor_torque(self):
         """Motor torque over the grid (N*mm) through the forward efficiencies of the screw
         and the gear."""
         gear, _ = drive.gear_efficiencies(self.problem.spec)
-        return self.mechanism.motor_torque(self.phi, self.hinge_moment, self.efficiency, gear)
+        return self.call_mechanism(
+            "motor_torque", self.phi, self.hinge_moment, self.efficiency, gear
+        )
 
     # --- the drive (screw, efficiency, speed, life, stiffness) ---------------------------
     @cached_property
@@ -167,7 +187,7 @@ class Quantities:
     @cached_property
     def size(self):
         """The mechanism's size measure (mm)."""
-        return self.mechanism.size()
+        return self.call_mechanism("size")
 
     # --- pins and clearance --------------------------------------------------------------
     @cached_property
@@ -203,12 +223,12 @@ class Quantities:
     @cached_property
     def pin_force(self):
         """Force on the sized pin(s) over the grid (N)."""
-        return self.mechanism.pin_force(self.phi, self.hinge_moment)
+        return self.call_mechanism("pin_force", self.phi, self.hinge_moment)
 
     @cached_property
     def joints(self) -> list[Joint]:
         """The clearance chain: sized pins and the declared fixed clearances."""
-        chain = self.mechanism.joints(self.phi, self.hinge_moment, self.pin)
+        chain = self.call_mechanism("joints", self.phi, self.hinge_moment, self.pin)
         clearances = self.problem.spec.clearances
         fixed = dict(clearances) if clearances is not None else {}
         chain = with_fixed_clearances(chain, fixed)
@@ -219,7 +239,7 @@ class Quantities:
     @cached_property
     def backlash(self) -> Backlash:
         """Output backlash over the grid (deg): per joint, worst case, RSS."""
-        return self.mechanism.backlash(self.phi, self.joints)
+        return self.call_mechanism("backlash", self.phi, self.joints)
 
     # --- drive extras ----------------------------------------------------------------------
     @cached_property
@@ -253,3 +273,8 @@ class Quantities:
             return value.shape[0] == len(self.phi) and len(self.phi) > 1
         shape = np.shape(value)
         return bool(shape) and shape[-1] == len(self.phi) and len(self.phi) > 1
+
+
+def _defined(cls: type, item: str) -> bool:
+    """``item`` is a property (or cached property) of ``cls``."""
+    return hasattr(inspect.getattr_static(cls, item, None), "__get__") and not item.startswith("__")

@@ -14,11 +14,11 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import ProblemError
 from optdesign.mechanisms.base import Rows
 from optdesign.models.loads import pin_bearing_pressure, pin_shear_stress
 from optdesign.problem.catalogue import ConstraintBlock, ConstraintInfo
 from optdesign.problem.drive_requirements import drive_blocks
+from optdesign.user_code import quantity_of
 
 
 def _block(rows: Rows, labels: list[str]) -> ConstraintBlock:
@@ -51,11 +51,12 @@ def requirement_blocks(
         # The linkage must not pass a dead point inside the stroke: positive ratio.
         ConstraintBlock("ratio_positive", q.ratio, 1.0, None, labels, "", "ratio i(phi) >= 1")
     ]
-    blocks += [_block(r, labels) for r in mech.assembly_rows(phi)]
+    blocks += [_block(r, labels) for r in q.call_mechanism("assembly_rows", phi)]
     for name in type(mech).requirements:
         value = getattr(req, name)
         if value is not None:
-            blocks += [_block(r, labels) for r in mech.requirement_rows(name, value, phi)]
+            rows = q.call_mechanism("requirement_rows", name, value, phi)
+            blocks += [_block(r, labels) for r in rows]
     if req.mean_ratio is not None:
         blocks.append(
             ConstraintBlock(
@@ -202,14 +203,8 @@ def _screw_blocks(q, labels) -> list[ConstraintBlock]:
 
 
 def user_block(c: ConstraintInfo, q) -> ConstraintBlock:
-    """The block of a user constraint, with a clear error when ``fn`` fails."""
-    try:
-        expr: Any = c.fn(q)
-    except Exception as exc:
-        raise ProblemError(
-            f"constraint {c.name!r}: its function raised {type(exc).__name__}: {exc}"
-        ) from exc
-    if expr is None:
-        raise ProblemError(f"constraint {c.name!r}: its function returned None")
+    """The block of a user constraint; a function that fails, or returns a value no
+    formulation can use, is reported naming it, its file and line."""
+    expr: Any = quantity_of(c.fn, q, f"constraint {c.name!r}", c.over == "stroke")
     labels = q.labels if c.over == "stroke" else [""]
     return ConstraintBlock(c.name, expr, c.lower, c.upper, labels, c.unit, c.description or c.name)

@@ -33,6 +33,7 @@ from pydantic import (
 from optdesign.errors import InputError
 from optdesign.models.fits import Fit
 from optdesign.units import to_internal
+from optdesign.validation import MAX_SEED, MAX_STARTS
 
 
 def _quantity(dimension: str):
@@ -387,10 +388,11 @@ class Objective(_Model):
 class SolverOptions(_Model):
     """Defaults of ``optdesign solve`` for this problem (the CLI may override them)."""
 
-    starts: int = Field(8, ge=1, le=10_000)
-    seed: int = 0
+    # the caps of the API's and the command line's arguments (optdesign.validation)
+    starts: int = Field(8, ge=1, le=MAX_STARTS)
+    seed: int = Field(0, ge=0, le=MAX_SEED)
     #: The multistart stops once this many starts agree on the best value (0: run all).
-    agree: int = Field(3, ge=0, le=10_000)
+    agree: int = Field(3, ge=0, le=MAX_STARTS)
     ipopt: dict[str, Any] = Field(default_factory=dict)
 
     @field_validator("ipopt")

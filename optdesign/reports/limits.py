@@ -42,7 +42,8 @@ class Limit:
     kind
         ``"requirement"`` or ``"bound"`` (a design variable at its bound).
     side
-        ``"max"`` or ``"min"``: which side of the requirement binds.
+        ``"max"`` or ``"min"``: which side of the requirement binds; ``"number"``: a row
+        without bounds, violated because its value is NaN.
     value, limit
         The worst value over the binding angles, and the limit, in ``value.unit``.
     where
@@ -65,6 +66,8 @@ class Limit:
         what = _what(self)
         if self.kind == "bound":
             return f"{what} = {self.value.text()}, at its {self.side} bound"
+        if self.side == "number":
+            return f"{what} is not a number (NaN)"
         line = f"{what} = {self.value.text()}, {self.side} {self.limit.text()}"
         if self.where:
             shown_where = ", ".join(self.where[:4]) + (" ..." if len(self.where) > 4 else "")
@@ -139,6 +142,11 @@ def limits_of(problem: Any, rows: Sequence[Any], infos: dict[str, BlockInfo] | N
 
 def _limit(problem: Any, name: str, group: list[Any], info: BlockInfo | None) -> Limit:
     worst = max(group, key=lambda r: r.amount)
+    if worst.lower is None and worst.upper is None:  # violated because it is not a number
+        nan = Shown(math.nan, info.unit if info is not None else worst.unit)
+        where = [_label(r.name) for r in group if _label(r.name)]
+        description = info.description if info is not None else ""
+        return Limit(name, description, "requirement", "number", nan, nan, where, 0.0)
     bound_hi = worst.upper is not None and (
         worst.lower is None or abs(worst.value - worst.upper) <= abs(worst.value - worst.lower)
     )

@@ -78,6 +78,13 @@ def constraint_reports(
     return violated, active
 
 
+def _bound_scale(report: ConstraintReport) -> float:
+    """max(1, |bound|) of a violated row; 1 for a row without bounds (violated because
+    its value is NaN)."""
+    bound = report.upper if report.upper is not None else report.lower
+    return max(1.0, abs(bound)) if bound is not None else 1.0
+
+
 def make_result(
     solver: str,
     nlp: NLP,
@@ -102,10 +109,7 @@ def make_result(
     theta = nlp.parameter_values(bounds.parameters)
     g = np.asarray(nlp.g_fun(z, theta), dtype=float).ravel()
     violated, active = constraint_reports(nlp, g, bounds)
-    max_viol = max(
-        (r.amount / max(1.0, abs(r.upper if r.upper is not None else r.lower)) for r in violated),
-        default=0.0,
-    )
+    max_viol = max((r.amount / _bound_scale(r) for r in violated), default=0.0)
     if status in ("optimal", "feasible") and violated:
         status, termination = "infeasible", TerminationCondition.INFEASIBLE
     if status in ("max_iterations", "time_limit", "failed") and not violated:

@@ -38,6 +38,10 @@ def register_solver(
     replace: bool = False,
 ) -> SolverEntry:
     """Register ``factory(formulation, options) -> solver`` as back-end ``name``."""
+    if not isinstance(name, str) or not name.strip() or not name.isprintable():
+        raise InputError("register_solver.name", f"expected a name (a string), got {name!r}")
+    if not callable(factory):
+        raise InputError("register_solver.factory", f"expected a function, got {factory!r}")
     if kind not in ("nlp", "gp"):
         raise InputError("register_solver.kind", f"{kind!r}: use 'nlp' or 'gp'")
     if name in _SOLVERS and not replace:

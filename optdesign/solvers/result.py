@@ -59,10 +59,9 @@ class ConstraintReport:
             bound.append(f">= {self.lower:.6g}")
         if self.upper is not None:
             bound.append(f"<= {self.upper:.6g}")
-        text = f"{self.name} = {self.value:.6g} {self.unit} ({' and '.join(bound)})".replace(
-            "  ", " "
-        )
-        if self.amount > 0:
+        limits = " and ".join(bound) or "must be a number"  # a row without bounds: NaN
+        text = f"{self.name} = {self.value:.6g} {self.unit} ({limits})".replace("  ", " ")
+        if 0 < self.amount < float("inf"):
             text += f", violated by {self.amount:.3g} {self.unit}".rstrip()
         return text
 

@@ -30,7 +30,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.multistart import multistart, sobol_starts
 from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
-from optdesign.studies.verify import verify_design
+from optdesign.studies.verify import nan_notes, verify_design
 
 # --- formulation and solver caches ------------------------------------------------------
 _NLPS: OrderedDict[tuple, NLP] = OrderedDict()
@@ -227,6 +227,7 @@ def finish(problem: DesignProblem, result: Result, objective: str | None = None)
     x = np.array([result.design[v.name] for v in problem.free])
     ok, violated, objectives = verify_design(problem, x)
     result.verified = ok
+    result.notes += nan_notes(problem, objectives, violated)
     result.objectives = {k: float(v) for k, v in objectives.items()}
     result.design = {**problem.fixed_values, **result.design}
     if result.success and not ok:

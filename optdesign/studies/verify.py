@@ -18,8 +18,9 @@ def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = VERIFY_TOL
     Returns
     -------
     (ok, violated, objectives)
-        ``ok`` if no row is violated by more than ``tol`` (relative); the violated rows
-        as :class:`ConstraintReport`; the objective values on the NumPy path.
+        ``ok`` if no row is violated by more than ``tol`` (relative) and no objective
+        is NaN; the violated rows (and the NaN objectives) as
+        :class:`ConstraintReport`; the objective values on the NumPy path.
     """
     ev = problem.evaluate(np.asarray(x, dtype=float))
     violated = []
@@ -33,4 +34,36 @@ def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = VERIFY_TOL
             amount = max((lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0)
             label = f"{name}[{labels[k]}]" if labels[k] else name
             violated.append(ConstraintReport(label, v, lo, hi, float(amount)))
+    for name, value in ev.objectives.items():
+        # e.g. a user's objective that is NaN here: the design is no verified result
+        if np.isnan(value):
+            violated.append(ConstraintReport(f"objective {name}", float(value), None, None, np.inf))
     return not violated, violated, ev.objectives
+
+
+def nan_notes(problem: DesignProblem, objectives: dict[str, float], violated) -> list[str]:
+    """Notes for the objectives and user constraints that are NaN at a design: which
+    function returns NaN there (a user's: its name, file and line)."""
+    from optdesign.user_code import describe_function, is_users, location_of
+
+    def whose(kind: str, name: str, fn) -> str:
+        if fn is None:
+            return f"{kind} {name!r} is NaN at this design"
+        where = location_of(fn)
+        at = f" (defined at {where})" if where else ""
+        return (
+            f"{kind} {name!r} is NaN at this design: its function {describe_function(fn)}{at} "
+            "returns NaN there, so the design is not a verified result"
+        )
+
+    notes = []
+    for name, value in objectives.items():
+        if np.isnan(value):
+            info = problem.objectives.get(name)
+            user = info is not None and is_users(info.fn)
+            notes.append(whose("objective", name, info.fn if user else None))
+    user = {c.name: c for c in problem.user_constraints}
+    for name in dict.fromkeys(r.name.split("[", 1)[0] for r in violated if np.isnan(r.value)):
+        if name in user:
+            notes.append(whose("constraint", name, user[name].fn))
+    return notes

@@ -205,6 +205,10 @@ def make_instance(family: str, seed: int) -> Instance:
     return Instance(family, int(seed), instance_dict(family, seed))
 
 
+#: The suites :func:`suite` builds.
+SUITES = ("default", "quick")
+
+
 def suite(name: str, fronts: bool = True) -> list[Instance]:
     """The instances of suite ``name``.
 
@@ -228,7 +232,7 @@ def suite(name: str, fronts: bool = True) -> list[Instance]:
         if fronts:
             out.append(make_instance("fork_front", 0))
         return out
-    raise KeyError(f"unknown suite {name!r} (known: default, quick)")
+    raise KeyError(f"unknown suite {name!r} (known: {', '.join(SUITES)})")
 
 
 #: Seed of the quick suite's fork instance: its lead comes from the catalogue.

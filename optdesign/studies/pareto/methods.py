@@ -58,6 +58,7 @@ class RunOptions:
     resume: bool = False
     progress: bool = False
     on_record: Callable | None = None
+    overwrite: bool = False  # start afresh over a store of an earlier run in ``out``
 
 
 def check_objectives(problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
@@ -455,7 +456,7 @@ METHODS: dict[str, Callable[..., Any]] = {
     "nsga2": NSGA2,
 }
 
-_RUN_FIELDS = ("out", "workers", "scheduler", "resume", "progress", "on_record")
+_RUN_FIELDS = ("out", "workers", "scheduler", "resume", "progress", "on_record", "overwrite")
 
 
 def compute_front(
@@ -497,6 +498,12 @@ def compute_front(
             raise InputError("pareto", f"option not understood by {method!r}: {exc}") from None
     elif options:
         raise ProblemError(f"options {sorted(options)} go into the method object, not pareto()")
+    store_name = getattr(method, "name", None)
+    if run.overwrite and run.out is not None and not run.resume and store_name:
+        from optdesign import storage
+
+        with storage.lock_folder(run.out):
+            storage.discard_store(Path(run.out) / f"{store_name}.jsonl")
     return method.run(problem, objectives, run)
 
 

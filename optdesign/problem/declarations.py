@@ -1,0 +1,96 @@
+"""The checks of what a user adds to a problem (:meth:`DesignProblem.add_objective`,
+:meth:`DesignProblem.add_constraint`), with the argument checks of
+:mod:`optdesign.validation`: refusals name ``add_objective.<argument>``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from optdesign.errors import InputError
+from optdesign.validation import ArgumentError, choice, flag, function, name, number, text, unit
+
+
+def objective_declaration(
+    problem: Any,
+    name_: Any,
+    fn: Any,
+    unit_: Any,
+    kind: Any,
+    description: Any,
+    formula: Any,
+    display_unit: Any,
+    display_scale: Any,
+    replace: Any,
+) -> None:
+    """The arguments of :meth:`DesignProblem.add_objective`: a new name (an existing
+    objective, a built-in one included, is replaced only with ``replace=True``), a
+    function, units, a kind."""
+    from optdesign.problem.catalogue import BUILTIN_OBJECTIVES, KINDS
+
+    where = "add_objective."
+    name(where + "name", name_)
+    function(where + "fn", fn)
+    unit(where + "unit", unit_)
+    choice(where + "kind", kind, KINDS, "kind", optional=True)
+    text(where + "description", description)
+    text(where + "formula", formula)
+    if display_unit is not None:
+        unit(where + "display_unit", display_unit)
+    # None: a default factor (the units' own, where the caller derives one)
+    scale = number(where + "display_scale", display_scale, -math.inf, math.inf, optional=True)
+    if scale == 0.0:
+        raise ArgumentError(where + "display_scale", "0 would show every value as 0")
+    if not flag(where + "replace", replace) and name_ in problem.objectives:
+        what = "a built-in objective" if name_ in BUILTIN_OBJECTIVES else "an objective"
+        raise ArgumentError(
+            where + "name",
+            f"{name_!r} is {what} of the problem already; pass replace=True to replace it on "
+            "purpose, or choose another name",
+        )
+
+
+def constraint_declaration(
+    problem: Any,
+    name_: Any,
+    fn: Any,
+    lower: Any,
+    upper: Any,
+    unit_: Any,
+    over: Any,
+    description: Any,
+) -> tuple[float | None, float | None]:
+    """The arguments of :meth:`DesignProblem.add_constraint`: a new name, a function,
+    bounds (numbers in ``unit`` or quantity strings), ``over``; returns the bounds in
+    ``unit``."""
+    from optdesign.units import convert
+
+    where = "add_constraint."
+    name(where + "name", name_)
+    if any(c.name == name_ for c in problem.user_constraints):
+        raise ArgumentError(where + "name", f"a constraint {name_!r} exists already")
+    function(where + "fn", fn)
+    unit(where + "unit", unit_)
+    choice(where + "over", over, ("stroke", "design"), "over")
+    text(where + "description", description)
+    lo, hi = (
+        None if v is None else _as_argument(convert, v, unit_, where + side)
+        for side, v in (("lower", lower), ("upper", upper))
+    )
+    if lo is None and hi is None:
+        raise ArgumentError(where + "upper", "give a lower or an upper bound (or both)")
+    if lo is not None and hi is not None and lo > hi:
+        raise ArgumentError(where + "lower", f"{lo:g} is above the upper bound {hi:g}")
+    return lo, hi
+
+
+def _as_argument(convert: Callable[..., Any], *args: Any) -> Any:
+    """``convert(*args)``; its InputError as an :class:`ArgumentError`."""
+    try:
+        return convert(*args)
+    except ArgumentError:
+        raise
+    except InputError as exc:
+        raise ArgumentError(exc.field, exc.reason) from None

@@ -1,0 +1,553 @@
+"""One validation layer for the public entry points, shared by the Python API and the CLI.
+
+``od.load``, ``od.solve``, ``od.pareto``, ``od.bench`` and the :class:`~optdesign.
+DesignProblem` methods a user calls check every argument here, before any work: its type
+(``True`` is not an integer, nor is ``2.5``; NumPy integers are), its range (the caps
+below, the same as the command line's), a known name (formulation, solver, objective,
+method, suite, configuration: with the nearest valid one) and the options that exclude
+each other. A refusal is an :class:`ArgumentError` (an :class:`~optdesign.errors.
+InputError`) naming the argument: ``starts: 0 is outside 1..10000``.
+
+The command line derives its argparse types from the same checks
+(:func:`optdesign.cli.checked`) and renames the argument to its option
+(``argument --starts: 0 is outside 1..10000``), so one check gives one message on
+both paths. Nothing here imports a solver: the known names are looked up when a check
+runs.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import numbers
+import os
+import re
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Any
+
+from optdesign.errors import InputError
+
+#: Caps of the sizes (a front of 10^7 points or 10^9 starts is a typo, not a study).
+MAX_WORKERS = 256
+MAX_STARTS = 10_000
+MAX_POINTS = 10_000
+MAX_SEED = 2**32 - 1
+MAX_POP = 100_000
+MAX_GENERATIONS = 100_000
+#: Longest time limit (s) of a benchmark run: a day.
+MAX_SECONDS = 86_400.0
+#: Longest name of an objective or a constraint (it becomes a column header).
+MAX_NAME = 64
+
+
+class ArgumentError(InputError):
+    """An argument of a public entry point refused before any work.
+
+    ``argument`` is the API's name of the argument; ``reason`` may name other arguments
+    as ``{name}`` for each ``name`` in ``mentions``, so that the command line can show
+    them as its options (:meth:`render`).
+    """
+
+    def __init__(self, argument: str, reason: str, mentions: Sequence[str] = ()):
+        self.argument = argument
+        self.template = reason
+        self.mentions = tuple(mentions)
+        super().__init__(argument, self.render(str))
+
+    def render(self, name: Callable[[str], str]) -> str:
+        """The reason with every mentioned argument shown as ``name(argument)``."""
+        text = self.template
+        for other in self.mentions:
+            text = text.replace("{" + other + "}", name(other))
+        return text
+
+    def __reduce__(self):  # raised in a worker process, re-raised in the caller
+        return (type(self), (self.argument, self.template, self.mentions))
+
+
+# --- values -----------------------------------------------------------------------------
+def shown(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` short enough for a one-line message."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        digits = len(str(abs(value))) if abs(value) < 10**100 else 101
+        if digits > 20:
+            return f"an integer of {'more than 100' if digits > 100 else digits} digits"
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def is_integer(value: Any) -> bool:
+    """An int or a NumPy integer; not a bool, not a float with an integer value."""
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool | _np_bool())
+
+
+def is_number(value: Any) -> bool:
+    """A real number (int, float, NumPy scalar); not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool | _np_bool())
+
+
+def _np_bool() -> type:
+    import numpy as np
+
+    return np.bool_
+
+
+def integer(argument: str, value: Any, lo: int, hi: int, *, optional: bool = False) -> int | None:
+    """``value`` as an int with ``lo <= value <= hi`` (None passes when ``optional``)."""
+    if value is None and optional:
+        return None
+    if not is_integer(value):
+        raise ArgumentError(argument, f"{shown(value)} is not an integer")
+    value = int(value)
+    if not lo <= value <= hi:
+        raise ArgumentError(argument, f"{shown(value)} is outside {lo}..{hi}")
+    return value
+
+
+def number(
+    argument: str, value: Any, lo: float, hi: float, *, optional: bool = False
+) -> float | None:
+    """``value`` as a finite float with ``lo < value <= hi`` (None passes when
+    ``optional``)."""
+    if value is None and optional:
+        return None
+    if not is_number(value):
+        raise ArgumentError(argument, f"{shown(value)} is not a number")
+    try:
+        number_ = float(value)
+    except OverflowError:  # an int of hundreds of digits
+        raise ArgumentError(argument, f"{shown(value)} is outside ({lo:g}, {hi:g}]") from None
+    if not lo < number_ <= hi:  # also refuses nan
+        raise ArgumentError(argument, f"{number_:g} is outside ({lo:g}, {hi:g}]")
+    return number_
+
+
+def flag(argument: str, value: Any) -> bool:
+    """``value`` as a bool: True or False (a NumPy bool too), nothing else."""
+    if isinstance(value, bool | _np_bool()):
+        return bool(value)
+    raise ArgumentError(argument, f"{shown(value)} is not True or False")
+
+
+def text(argument: str, value: Any, *, optional: bool = False) -> str | None:
+    """A string (None passes when ``optional``)."""
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise ArgumentError(argument, f"expected a string, got {shown(value)}")
+    return value
+
+
+def nearest(value: str, known: Iterable[str]) -> str:
+    """``"did you mean 'x'? "`` for the closest of ``known``, or ``""``."""
+    close = difflib.get_close_matches(value, list(known), n=1, cutoff=0.6)
+    return f"did you mean {close[0]!r}? " if close else ""
+
+
+def choice(
+    argument: str, value: Any, known: Iterable[str], what: str = "", *, optional: bool = False
+) -> str | None:
+    """One of ``known``; the refusal names the nearest (``what``: the kind of name,
+    default the argument)."""
+    if value is None and optional:
+        return None
+    known = list(known)
+    what = what or argument
+    if not isinstance(value, str):
+        raise ArgumentError(
+            argument,
+            f"expected the name of a {what}, got {shown(value)} (known: {', '.join(known)})",
+        )
+    if value not in known:
+        raise ArgumentError(
+            argument,
+            f"unknown {what} {shown(value)} ({nearest(value, known)}known: {', '.join(known)})",
+        )
+    return value
+
+
+_NAME = re.compile(r"[^\W\d]\w*")
+
+
+def name(argument: str, value: Any) -> str:
+    """A name that can be a column header, a JSON key and part of a file name: letters,
+    digits and underscores, not starting with a digit, at most :data:`MAX_NAME` long."""
+    if not isinstance(value, str):
+        raise ArgumentError(argument, f"expected a name (a string), got {shown(value)}")
+    if not (_NAME.fullmatch(value) and len(value) <= MAX_NAME):
+        raise ArgumentError(
+            argument,
+            f"{shown(value)} is not a name: use letters, digits and underscores, not "
+            f"starting with a digit, at most {MAX_NAME} characters (it becomes a column "
+            "header, a JSON key and a file label)",
+        )
+    return value
+
+
+def names(argument: str, value: Any) -> list[str]:
+    """A list of names: a sequence of strings, or one string of comma-separated names
+    (the command line's form)."""
+    if isinstance(value, str):
+        return [s.strip() for s in value.split(",") if s.strip()]
+    if isinstance(value, Mapping) or not isinstance(value, Iterable):
+        raise ArgumentError(argument, f"expected a list of names, got {shown(value)}")
+    items = list(value)
+    for item in items:
+        if not isinstance(item, str):
+            raise ArgumentError(argument, f"expected names (strings), got {shown(item)}")
+    return items
+
+
+def path(argument: str, value: Any, *, optional: bool = False):
+    """A file system path (str or os.PathLike; None passes when ``optional``)."""
+    from pathlib import Path
+
+    if value is None and optional:
+        return None
+    if not isinstance(value, str | os.PathLike) or isinstance(value, bytes):
+        raise ArgumentError(argument, f"expected a folder or file path, got {shown(value)}")
+    text_ = os.fspath(value)
+    if not isinstance(text_, str) or not text_ or "\x00" in text_:
+        raise ArgumentError(argument, f"{shown(value)} is not a usable path")
+    return Path(text_)
+
+
+def function(argument: str, value: Any, *, optional: bool = False):
+    """A callable (None passes when ``optional``)."""
+    if value is None and optional:
+        return None
+    if not callable(value):
+        raise ArgumentError(argument, f"expected a function, got {shown(value)}")
+    return value
+
+
+def unit(argument: str, value: Any) -> str:
+    """A unit expression of the restricted grammar of :mod:`optdesign.units` ("" for a
+    dimensionless value)."""
+    value = text(argument, value)
+    if value.strip():
+        from optdesign.units import parse_quantity
+
+        try:
+            parse_quantity(f"1 {value}")
+        except InputError as exc:
+            detail = re.sub(r"^cannot read .* as a quantity: ", "", exc.reason)
+            detail = re.sub(r" \(write a number and a unit.*\)$", "", detail)
+            raise ArgumentError(argument, f"{shown(value)} is not a unit ({detail})") from None
+    return value
+
+
+# --- the arguments (one check each, the API's and the command line's) -----------------
+def starts(argument: str, value: Any) -> int | None:
+    """Multistart size (None: the problem file's)."""
+    return integer(argument, value, 1, MAX_STARTS, optional=True)
+
+
+def seed(argument: str, value: Any) -> int | None:
+    """Sobol / random seed (None: the problem file's)."""
+    return integer(argument, value, 0, MAX_SEED, optional=True)
+
+
+def workers(argument: str, value: Any) -> int:
+    """Local processes."""
+    return integer(argument, value, 1, MAX_WORKERS)
+
+
+def agree(argument: str, value: Any) -> int | None:
+    """Starts that must agree before a multistart stops (0: all run; None: the file's)."""
+    return integer(argument, value, 0, MAX_STARTS, optional=True)
+
+
+def points(argument: str, value: Any) -> int:
+    """Points of a front."""
+    return integer(argument, value, 2, MAX_POINTS)
+
+
+def pop_size(argument: str, value: Any) -> int:
+    """NSGA-II population."""
+    return integer(argument, value, 4, MAX_POP)
+
+
+def generations(argument: str, value: Any) -> int:
+    """NSGA-II generations."""
+    return integer(argument, value, 1, MAX_GENERATIONS)
+
+
+def seconds(argument: str, value: Any) -> float | None:
+    """A time limit in seconds, at most a day (None: the default)."""
+    return number(argument, value, 0.0, MAX_SECONDS, optional=True)
+
+
+def formulation(argument: str, value: Any) -> str:
+    """``auto`` or a registered formulation."""
+    from optdesign.studies.solve import FORMULATIONS
+
+    return choice(argument, value, ["auto", *FORMULATIONS], "formulation")
+
+
+def solver(argument: str, value: Any) -> str:
+    """A registered solver back-end (NLP or GP)."""
+    from optdesign.solvers.registry import solver_names
+
+    return choice(argument, value, solver_names(), "solver")
+
+
+def method(argument: str, value: Any) -> str:
+    """A Pareto-front method."""
+    from optdesign.studies.pareto.methods import METHODS
+
+    return choice(argument, value, list(METHODS), "method")
+
+
+def suite(argument: str, value: Any) -> str | None:
+    """A benchmark suite (None: the default)."""
+    from optdesign.studies.bench.instances import SUITES
+
+    return choice(argument, value, SUITES, "suite", optional=True)
+
+
+# --- the entry points -------------------------------------------------------------------
+Check = Callable[[str, Any], Any]
+
+
+def _checked(checks: Mapping[str, Check], arguments: Mapping[str, Any]) -> dict[str, Any]:
+    """Each argument through its check, in the order of ``checks``."""
+    return {key: check(key, arguments[key]) for key, check in checks.items()}
+
+
+def _optional_text(argument: str, value: Any) -> str | None:
+    return text(argument, value, optional=True)
+
+
+def _optional_path(argument: str, value: Any):
+    return path(argument, value, optional=True)
+
+
+def _optional_function(argument: str, value: Any):
+    return function(argument, value, optional=True)
+
+
+def _anything(argument: str, value: Any) -> Any:
+    return value
+
+
+def solve_arguments(**arguments: Any) -> dict[str, Any]:
+    """The checked arguments of :func:`optdesign.solve`: ``formulation``, ``objective``
+    (a string; the problem's names are checked by :func:`objective_of` once it is
+    loaded), ``starts``, ``seed``, ``workers``, ``solver``, ``options``, ``ranges``,
+    ``agree``."""
+    checked = _checked(
+        {
+            "formulation": formulation,
+            "objective": _optional_text,
+            "starts": starts,
+            "seed": seed,
+            "workers": workers,
+            "solver": solver,
+            "ranges": flag,
+            "agree": agree,
+        },
+        arguments,
+    )
+    checked["options"] = solver_options("options", arguments["options"], checked["solver"])
+    return checked
+
+
+def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] | None:
+    """Options of a solver back-end: a mapping with string keys; Ipopt's are checked by
+    Ipopt itself (the check the problem file's ``[solver] ipopt`` gets)."""
+    if options is None:
+        return None
+    if not isinstance(options, Mapping):
+        raise ArgumentError(argument, f"expected a dict of solver options, got {shown(options)}")
+    for key in options:
+        if not isinstance(key, str):
+            raise ArgumentError(argument, f"option names are strings, got {shown(key)}")
+    if solver == "ipopt" and options:
+        from optdesign.solvers.casadi_nlp import check_ipopt_options
+
+        check_ipopt_options(dict(options), field=argument)
+    return dict(options)
+
+
+def objective_of(problem: Any, objective: str | None, argument: str = "objective") -> None:
+    """``objective`` (None: the problem's first) is one the problem declares."""
+    if objective is not None:
+        choice(argument, objective, problem.objectives, "objective")
+
+
+#: Options of :func:`optdesign.pareto` that say where and how a front runs (any method).
+RUN_OPTIONS = ("out", "workers", "scheduler", "resume", "overwrite", "progress", "on_record")
+
+
+def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
+    """The options of :func:`optdesign.pareto`: name -> (check, the methods that use it;
+    empty: every method)."""
+    eps = ("epsilon", "uniform")
+
+    def retries(a: str, v: Any) -> int:
+        return integer(a, v, 0, MAX_STARTS)
+
+    return {
+        "out": (_optional_path, ()),
+        "workers": (workers, ()),
+        "scheduler": (_anything, ()),
+        "resume": (flag, ()),
+        "overwrite": (flag, ()),
+        "progress": (flag, ()),
+        "on_record": (_optional_function, ()),
+        "starts": (starts, (*eps, "weighted_sum")),
+        "seed": (seed, ()),
+        "agree": (agree, eps),
+        "solver": (lambda a, v: choice(a, v, ("slsqp", "ipopt"), "front solver"), eps),
+        "spacing": (lambda a, v: choice(a, v, ("arc", "uniform"), "spacing"), ("epsilon",)),
+        "eps_values": (_eps_values, eps),
+        "retry_starts": (retries, eps),
+        "extra_starts": (retries, eps),
+        "deterministic": (flag, eps),
+        "pop_size": (pop_size, ("nsga2",)),
+        "generations": (generations, ("nsga2",)),
+        "name": (name, ("epsilon", "weighted_sum", "nsga2")),
+    }
+
+
+def _eps_values(argument: str, value: Any) -> list[float] | None:
+    if value is None:
+        return None
+    if isinstance(value, str | bytes | Mapping) or not isinstance(value, Iterable):
+        raise ArgumentError(argument, f"expected a list of numbers, got {shown(value)}")
+    values = list(value)
+    if not 1 <= len(values) <= MAX_POINTS:
+        raise ArgumentError(argument, f"give 1..{MAX_POINTS} values, got {len(values)}")
+    for v in values:
+        if not is_number(v) or not math.isfinite(float(v)):
+            raise ArgumentError(argument, f"{shown(v)} is not a finite number")
+    return [float(v) for v in values]
+
+
+def pareto_arguments(
+    objectives: Any, points_: Any, method_: Any, options: Mapping[str, Any]
+) -> tuple[list[str], int, Any, dict[str, Any]]:
+    """The checked arguments of :func:`optdesign.pareto` (the objectives' names are
+    checked by :func:`front_objectives` once the problem is loaded)."""
+    objectives = front_objectives(None, objectives)
+    n = points("points", points_)
+    if isinstance(method_, str) or not hasattr(method_, "run"):
+        method_ = method("method", method_)
+    else:  # a method object carries its own settings
+        extra = sorted(set(options) - set(RUN_OPTIONS))
+        if extra:
+            raise ArgumentError(extra[0], "goes into the method object, not pareto()")
+    table = _pareto_options()
+    checked: dict[str, Any] = {}
+    for key, value in options.items():
+        if key not in table:
+            raise ArgumentError(
+                key,
+                f"unknown option of pareto() ({nearest(key, [*table, 'points', 'method'])}"
+                f"known: {', '.join(table)})",
+            )
+        check, methods = table[key]
+        if methods and isinstance(method_, str) and method_ not in methods:
+            raise ArgumentError(
+                key, f"not an option of method {method_!r} (it is one of {', '.join(methods)})"
+            )
+        checked[key] = check(key, value)
+    run_folder(checked.get("out"), checked.get("resume", False), checked.get("overwrite", False))
+    return objectives, n, method_, checked
+
+
+def run_folder(out: Any, resume: bool, overwrite: bool) -> None:
+    """A stored run is continued (``resume``) or started afresh (``overwrite``), not
+    both; continuing needs the folder of the run."""
+    if resume and overwrite:
+        raise ArgumentError("overwrite", "excludes {resume} (start over, or continue)", ("resume",))
+    if resume and out is None:
+        raise ArgumentError("resume", "give the {out} folder of the run to resume", ("out",))
+
+
+def method_for(problem: Any, method_: Any, argument: str = "method") -> None:
+    """A front method that keeps the problem's designs valid: a weighted sum of
+    continuous NLPs would leave a catalogue."""
+    if method_ == "weighted_sum" or type(method_).__name__ == "WeightedSum":
+        from optdesign.studies.pareto.catalogue_front import has_catalogue
+
+        if has_catalogue(problem):
+            raise ArgumentError(
+                argument,
+                "weighted_sum would leave the catalogue: with catalogue variables use "
+                "epsilon or nsga2",
+            )
+
+
+def front_objectives(problem: Any, objectives: Any, argument: str = "objectives") -> list[str]:
+    """Two or three distinct objective names (of ``problem``, when given)."""
+    objectives = names(argument, objectives)
+    if len(objectives) not in (2, 3):
+        raise ArgumentError(argument, f"give two or three objectives, got {objectives}")
+    if len(set(objectives)) != len(objectives):
+        raise ArgumentError(argument, f"repeated objective in {objectives}")
+    if problem is not None:
+        for k in objectives:
+            choice(argument, k, problem.objectives, "objective")
+    return objectives
+
+
+def bench_arguments(**arguments: Any) -> dict[str, Any]:
+    """The checked arguments of :func:`optdesign.bench`: ``problems`` (a list; loaded by
+    the caller), ``suite``, ``solvers``, ``out``, ``workers``, ``resume``,
+    ``overwrite``, ``time_limit``, ``hard_timeout``, ``progress``, ``scheduler``."""
+    problems = arguments["problems"]
+    if problems is not None and (
+        isinstance(problems, str | bytes | Mapping | os.PathLike)
+        or not isinstance(problems, Iterable)
+    ):
+        raise ArgumentError(
+            "problems",
+            f"expected a list of problems (files, dicts or problems), got {shown(problems)}",
+        )
+    problems = None if problems is None else list(problems)  # a generator is read once
+    if problems is not None and not problems:
+        raise ArgumentError("problems", "give at least one problem (or None for a suite)")
+    if problems is not None and arguments["suite"] is not None:
+        raise ArgumentError(
+            "suite", "excludes {problems} (run your problems or a suite)", ("problems",)
+        )
+    checked = _checked(
+        {
+            "suite": suite,
+            "solvers": configs,
+            "out": _optional_path,
+            "workers": workers,
+            "resume": flag,
+            "overwrite": flag,
+            "time_limit": seconds,
+            "hard_timeout": seconds,
+            "progress": flag,
+            "scheduler": _optional_text,
+        },
+        arguments,
+    )
+    if checked["time_limit"] is None:
+        raise ArgumentError("time_limit", "give a time limit in seconds")
+    run_folder(checked["out"], checked["resume"], checked["overwrite"])
+    checked["problems"] = problems
+    return checked
+
+
+def configs(argument: str, value: Any) -> list[str] | None:
+    """Benchmark configuration names (a list, or comma-separated in one string; None:
+    all)."""
+    if value is None:
+        return None
+    items = [s.strip() for item in names(argument, value) for s in item.split(",") if s.strip()]
+    if not items:
+        raise ArgumentError(argument, "give at least one configuration (or None for all)")
+    from optdesign.solvers.registry import solver_names
+    from optdesign.studies.bench.configs import default_configs
+
+    known = default_configs(include_hidden=True)
+    for item in items:
+        if item not in known and item not in solver_names("nlp"):
+            choice(argument, item, default_configs(), "configuration")
+    return items
