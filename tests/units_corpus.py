@@ -268,13 +268,17 @@ def _pint(text: str, dimension: str) -> Callable[[], float]:
 
 
 API_WRONG: list[ApiCase] = [
-    ApiCase("constraint force times angle", _constraint("3 kN*rad", "N"), "c.upper"),
-    ApiCase("constraint force per angle", _constraint("3 kN/deg", "N"), "c.upper"),
-    ApiCase("constraint angle for a ratio", _constraint("0.1 deg", ""), "c.upper"),
+    ApiCase("constraint force times angle", _constraint("3 kN*rad", "N"), "add_constraint.upper"),
+    ApiCase("constraint force per angle", _constraint("3 kN/deg", "N"), "add_constraint.upper"),
+    ApiCase("constraint angle for a ratio", _constraint("0.1 deg", ""), "add_constraint.upper"),
     ApiCase(
-        "constraint moment for stiffness", _constraint("5 N*m", "N*mm/rad", "lower"), "c.lower"
+        "constraint moment for stiffness",
+        _constraint("5 N*m", "N*mm/rad", "lower"),
+        "add_constraint.lower",
     ),
-    ApiCase("constraint frequency for a rate", _constraint("1 Hz", "rad/s"), "c.upper"),
+    ApiCase(
+        "constraint frequency for a rate", _constraint("1 Hz", "rad/s"), "add_constraint.upper"
+    ),
     ApiCase(
         "requirement moment per angle",
         _requirement("hinge_moment", "500 N*m/deg"),
@@ -297,14 +301,19 @@ API_WRONG: list[ApiCase] = [
 ]
 
 API_RIGHT: list[ApiCase] = [
-    ApiCase("constraint force", _constraint("3 kN", "N"), "c.upper", 3000.0),
-    ApiCase("constraint angle", _constraint("30 deg", "rad"), "c.upper", 30 * DEG),
+    ApiCase("constraint force", _constraint("3 kN", "N"), "add_constraint.upper", 3000.0),
+    ApiCase("constraint angle", _constraint("30 deg", "rad"), "add_constraint.upper", 30 * DEG),
     ApiCase(
-        "constraint stiffness", _constraint("5 N*m/deg", "N*mm/rad", "lower"), "c.lower", 5e3 / DEG
+        "constraint stiffness",
+        _constraint("5 N*m/deg", "N*mm/rad", "lower"),
+        "add_constraint.lower",
+        5e3 / DEG,
     ),
-    ApiCase("constraint rate", _constraint("20 rpm", "rad/s"), "c.upper", 2 * math.pi / 3),
-    ApiCase("constraint ratio in percent", _constraint("5 %", ""), "c.upper", 0.05),
-    ApiCase("constraint bare number", _constraint(7.5, "N*mm/rad"), "c.upper", 7.5),
+    ApiCase(
+        "constraint rate", _constraint("20 rpm", "rad/s"), "add_constraint.upper", 2 * math.pi / 3
+    ),
+    ApiCase("constraint ratio in percent", _constraint("5 %", ""), "add_constraint.upper", 0.05),
+    ApiCase("constraint bare number", _constraint(7.5, "N*mm/rad"), "add_constraint.upper", 7.5),
     ApiCase(
         "requirement rate in rpm",
         _requirement("deflection_rate", "20 rpm"),
