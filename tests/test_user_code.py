@@ -455,7 +455,7 @@ def test_a_builtin_objective_is_replaced_only_on_purpose():
         ({"name": "a,b"}, "add_constraint.name: 'a,b' is not a name"),
         ({"fn": 3}, "add_constraint.fn: expected a function, got 3"),
         ({"upper": True}, "add_constraint.upper: expected a number or a quantity string, got True"),
-        ({"upper": "12 mm"}, "add_constraint.upper: '12 mm' cannot be expressed in 'N'"),
+        ({"upper": "12 mm"}, "add_constraint.upper: '12 mm' is a length, expected a force ('N')"),
         ({"upper": float("inf")}, "add_constraint.upper: inf is not a finite number"),
         ({"upper": None}, "add_constraint.upper: give a lower or an upper bound (or both)"),
         (
