@@ -294,9 +294,8 @@ def child_signals() -> None:
 def _after_fork_in_child() -> None:
     # A forked child starts with none of the parent's interrupt state: no section open
     # (the parent forks inside one), no signal received, no watchdog.
-    global _depth, _pending, _received, _native, _muted, _streams, _exit_lock, _watch_fds
-    global _active_store, _last_store
-    global _live
+    global _depth, _pending, _received, _native, _muted, _streams, _live
+    global _exit_lock, _watch_fds, _active_store, _last_store
     _depth, _pending, _received, _native, _muted, _streams = 0, None, None, 0, False, None
     _live = None
     _exit_lock = threading.RLock()
@@ -326,8 +325,9 @@ def start_watchdog(finish: Callable[[int], None], grace: float = WATCHDOG_GRACE)
     write) meanwhile. If instead the handler ran but no :class:`Interrupted` is alive
     ``RERAISE_AFTER`` s after the signal (outside critical sections, which raise it at
     their end), its exception was dropped by code between the handler and the command:
-    the signal is sent to the main thread again. Main thread only; returns whether the
-    watchdog runs.
+    the signal is sent to the main thread again. Native code that holds the GIL would
+    stop this thread too (CasADi's solvers and Clarabel release it). Main thread only;
+    returns whether the watchdog runs.
     """
     global _watch_fds
     if not _main_thread() or _watch_fds is not None:
