@@ -338,8 +338,10 @@ def _bench_run_started(pid: int, workers: int) -> bool:
     return any(k.ppid() != pid for k in kids) if workers > 1 else bool(kids)
 
 
-def _check_inside(case, sig: int, store: Path | None) -> None:
+def _check_inside(case, sig: int, store: Path | None, label: str) -> None:
     code, seconds, out, err, left = case
+    # one line per case for the record (pytest -s)
+    print(f"signal-inside {label} {_signame(sig)} exit={code} after {seconds:.3f} s")
     assert code == 128 + sig, (code, err[-2000:])
     assert seconds < 1.0, f"exit {seconds:.2f} s after the signal"
     assert left == [], f"processes left: {left}"
@@ -385,13 +387,9 @@ def _solve_inside(tmp_path: Path, case: str, sig: int, group: bool = False) -> N
     name, extra = _SOLVE_CASES[case]
     args = ["solve", _slow_problem(tmp_path, name), "--out", str(tmp_path / "out"), *extra]
     result = signal_inside(_cli(args), sig, _ipopt_running, group)
-    _check_inside(result, sig, None)
+    _check_inside(result, sig, None, f"solve-{case}")
     _inside_a_solve(result[2] + result[3])
     assert not (tmp_path / "out" / "result.json").exists()  # no result of a half solve
-    print(
-        f"signal-inside solve-{case} {signal.Signals(sig).name} exit={result[0]} "
-        f"after {result[1]:.3f} s"
-    )
 
 
 def _pareto_inside(tmp_path: Path, workers: int, sig: int, group: bool = False) -> None:
@@ -402,12 +400,8 @@ def _pareto_inside(tmp_path: Path, workers: int, sig: int, group: bool = False) 
         "--no-progress", "--out", str(out),
     ]  # fmt: skip
     result = signal_inside(_cli(args), sig, _ipopt_running, group)
-    _check_inside(result, sig, out / "epsilon.jsonl")
+    _check_inside(result, sig, out / "epsilon.jsonl", f"pareto-{workers}w")
     _inside_a_solve(result[2] + result[3])
-    print(
-        f"signal-inside pareto-{workers}w {signal.Signals(sig).name} exit={result[0]} "
-        f"after {result[1]:.3f} s"
-    )
 
 
 def _bench_inside(tmp_path: Path, workers: int, sig: int, group: bool = False) -> None:
@@ -418,22 +412,14 @@ def _bench_inside(tmp_path: Path, workers: int, sig: int, group: bool = False) -
         "--time-limit", "60", "--hard-timeout", "120", "--no-progress", "--out", str(out),
     ]  # fmt: skip
     result = signal_inside(_cli(args), sig, lambda _o, pid: _bench_run_started(pid, workers), group)
-    _check_inside(result, sig, out / "bench_runs.jsonl")
-    print(
-        f"signal-inside bench-{workers}w {signal.Signals(sig).name} exit={result[0]} "
-        f"after {result[1]:.3f} s"
-    )
+    _check_inside(result, sig, out / "bench_runs.jsonl", f"bench-{workers}w")
 
 
 def _reproduce_inside(tmp_path: Path, sig: int) -> None:
     # the PRSM contact sweeps: Newton solves of the contact equations, one after another
     args = ["reproduce", "prsm-contact", "--out", str(tmp_path / "out")]
     result = signal_inside(_cli(args), sig, lambda o, _pid: b"\n1. Hertz" in b"\n" + o)
-    _check_inside(result, sig, None)
-    print(
-        f"signal-inside reproduce {signal.Signals(sig).name} exit={result[0]} "
-        f"after {result[1]:.3f} s"
-    )
+    _check_inside(result, sig, None, "reproduce")
 
 
 def test_ctrl_c_inside_the_solver_call_of_a_one_worker_solve(tmp_path):
