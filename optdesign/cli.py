@@ -3,9 +3,10 @@
 Errors that a user can act on (:class:`optdesign.errors.OptDesignError`) are printed as
 one line naming the field, with exit code 2 and no traceback; a message that echoes an
 input is shown :func:`~optdesign.text.printable` (its control characters and newlines
-escaped), so it stays one line and never reaches the terminal raw. SIGINT (Ctrl-C) and
-SIGTERM end a run cleanly - workers stopped, finished records saved - with one line and
-exit code 130 or 143 (128 + the signal number, as a shell reports a killed command).
+escaped), so it stays one line and never reaches the terminal raw. SIGINT (Ctrl-C),
+SIGTERM and SIGHUP end a run cleanly - workers stopped, finished records saved - with one
+line and exit code 130, 143 or 129 (128 + the signal number, as a shell reports a killed
+command), within a second, solver calls included (:mod:`optdesign.interrupts`).
 """
 
 from __future__ import annotations
@@ -15,12 +16,13 @@ import contextlib
 import os
 import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from optdesign import validation
+from optdesign import interrupts, validation
 from optdesign.errors import InputError, OptDesignError
 from optdesign.interrupts import (
     Interrupted,
@@ -236,8 +238,9 @@ def run_guarded(func: Callable[[], int | None]) -> int:
     -------
     int
         ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
-        (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143);
-        1 for any other exception (one line; ``OPTDESIGN_DEBUG=1`` re-raises it).
+        (disk full, no permission); 128 + signal number for SIGINT (130), SIGTERM (143)
+        and SIGHUP (129); 1 for any other exception (one line; ``OPTDESIGN_DEBUG=1``
+        re-raises it).
     """
     forget_store()
     try:
@@ -268,17 +271,10 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         )
         return 1
     except KeyboardInterrupt as exc:
-        name, code = exit_code(exc)
-        store = saved_store(exc)
-        if store:
-            n = store["records"]
-            print(
-                f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved "
-                f"in {printable(store['path'])}, --resume continues",
-                file=sys.stderr,
-            )
-        else:
-            print(f"optdesign: interrupted ({name})", file=sys.stderr)
+        _, code = exit_code(exc)
+        line = interrupts.message(code - 128, saved_store(exc))
+        with interrupts.exit_lock():  # not interleaved with the watchdog's line
+            print(line, file=sys.stderr)
         return code
     return int(code or 0)
 
@@ -296,6 +292,7 @@ def main(argv: list[str] | None = None) -> int:
 
     if argv is None:  # the program itself, not a call from Python
         _late_signals_exit()
+        interrupts.start_watchdog(_finish_interrupted)
     code = run_guarded(run)
     if argv is None:
         _exit_now(code)
@@ -319,32 +316,42 @@ def _exit_now(code: int) -> None:
     os._exit(code)
 
 
+def _finish_interrupted(signum: int) -> None:
+    """End the program at once with the one line and 128 + ``signum``: the main thread
+    cannot unwind (a signal before or after the command, or one that finds it stuck in
+    native solver code - see :func:`optdesign.interrupts.start_watchdog`). Every output
+    is complete (written atomically, or not yet begun) and no record half-written."""
+    line = interrupts.message(signum, saved_store(None)) + "\n"
+    # Flushed from a helper thread: the main thread may hold a stream's lock (stuck in
+    # native code that prints); what it had buffered is not worth a hang.
+    flusher = threading.Thread(target=_flush_streams, daemon=True)
+    flusher.start()
+    flusher.join(0.1)
+    with contextlib.suppress(OSError):
+        os.write(2, line.encode(errors="replace"))
+    os._exit(128 + int(signum))
+
+
+def _flush_streams() -> None:
+    for stream in (sys.__stdout__, sys.__stderr__):
+        with contextlib.suppress(Exception):
+            stream.flush()
+
+
 def _late_signals_exit() -> None:
-    """SIGINT / SIGTERM outside the command (before it starts, or after it while the
-    program ends): the same one line and exit code 130 / 143 as during the run, not a
-    traceback or a silent death by the signal. Every output is complete by then (written
-    atomically), so exiting at once is safe. run_guarded puts these handlers back when
-    the command ends."""
+    """SIGINT / SIGTERM / SIGHUP outside the command (before it starts, or after it while
+    the program ends): the same one line and exit code 130 / 143 / 129 as during the run,
+    not a traceback or a silent death by the signal. Every output is complete by then
+    (written atomically), so exiting at once is safe. run_guarded puts these handlers
+    back when the command ends."""
 
     def handler(signum: int, frame: object) -> None:
-        name, code = exit_code(Interrupted(signum))
-        store = saved_store(Interrupted(signum))
-        with contextlib.suppress(Exception):
-            sys.stdout.flush()
-        line = f"optdesign: interrupted ({name})"
-        if store:
-            n = store["records"]
-            line += (
-                f"; {n} record{'' if n == 1 else 's'} saved in {printable(store['path'])}, "
-                "--resume continues"
-            )
-        with contextlib.suppress(Exception):
-            print(line, file=sys.stderr, flush=True)
-        os._exit(code)
+        with interrupts.exit_lock():
+            _finish_interrupted(signum)
 
     with contextlib.suppress(ValueError):  # not the main thread
-        signal.signal(signal.SIGINT, handler)
-        signal.signal(signal.SIGTERM, handler)
+        for s in interrupts.SIGNALS:
+            signal.signal(s, handler)
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ import csv
 import json
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -25,7 +26,9 @@ import pytest
 
 psutil = pytest.importorskip("psutil")
 
-from test_signals import _alive  # noqa: E402  (the same wait for processes to end)
+from test_signals import _alive, _env, _group, signal_inside  # noqa: E402  (shared helpers)
+
+from optdesign.storage import read_store  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 FORK = ROOT / "problems" / "fork_min_backlash.toml"
@@ -61,18 +64,14 @@ BENCH = [
 ]
 
 
-def _env() -> dict[str, str]:
-    path = os.environ.get("PYTHONPATH")
-    return {
-        **os.environ,
-        "PYTHONPATH": str(ROOT) + (os.pathsep + path if path else ""),
-        "MPLBACKEND": "Agg",
-    }
+def _cli(args: list[str]) -> list[str]:
+    """The command line of ``optdesign ARGS`` run from this tree."""
+    return [sys.executable, "-m", "optdesign", *args]
 
 
-def _cli(args: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
+def _run_cli(args: list[str], timeout: float = 300) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "optdesign", *args],
+        _cli(args),
         capture_output=True,
         text=True,
         env=_env(),
@@ -87,18 +86,6 @@ def _store_lines(store: Path) -> list[dict]:
     if not data.endswith(b"\n"):  # a torn tail (SIGKILL mid-write) is cut on resume
         data = data[: data.rfind(b"\n") + 1]
     return [json.loads(line) for line in data.decode().splitlines()[1:] if line.strip()]
-
-
-def _group(pgid: int) -> list[int]:
-    """Live (not zombie) processes of process group ``pgid``."""
-    out = []
-    for proc in psutil.process_iter(["pid", "status"]):
-        try:
-            if os.getpgid(proc.pid) == pgid and proc.info["status"] != psutil.STATUS_ZOMBIE:
-                out.append(proc.pid)
-        except (ProcessLookupError, psutil.NoSuchProcess, PermissionError):
-            pass
-    return out
 
 
 def _interrupt(
@@ -202,7 +189,7 @@ def _same_front(a: list[dict], b: list[dict]) -> None:
 @pytest.fixture(scope="module")
 def pareto_reference(tmp_path_factory) -> tuple[list[dict], list[dict]]:
     out = tmp_path_factory.mktemp("pareto_ref") / "run"
-    res = _cli([*PARETO, "--out", str(out)])
+    res = _run_cli([*PARETO, "--out", str(out)])
     assert res.returncode == 0, res.stderr
     return _front_rows(out / "front.csv"), _store_lines(out / "epsilon.jsonl")
 
@@ -223,7 +210,7 @@ def _pareto_case(tmp_path: Path, reference, sig: int, seed: int, early: bool) ->
     assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
     assert code != 0 or not early, "the run ended before the signal"
     _check_exit(code, err, sig, store, len(before))
-    res = _cli([*PARETO, "--out", str(out), "--resume"])
+    res = _run_cli([*PARETO, "--out", str(out), "--resume"])
     assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
     after = _store_lines(store)
     _check_records(before, after)
@@ -252,7 +239,7 @@ _BENCH_FIELDS = ("status", "objective", "verified", "violation", "design", "appl
 @pytest.fixture(scope="module")
 def bench_reference(tmp_path_factory) -> dict[str, dict]:
     out = tmp_path_factory.mktemp("bench_ref") / "run"
-    res = _cli([*BENCH, "--out", str(out)])
+    res = _run_cli([*BENCH, "--out", str(out)])
     assert res.returncode == 0, res.stderr
     return {r["id"]: r for r in _store_lines(out / "bench_runs.jsonl")}
 
@@ -274,7 +261,7 @@ def _bench_case(
     assert left == [], f"processes left after {signal.Signals(sig).name}: {left}"
     assert code != 0 or not early, "the run ended before the signal"
     _check_exit(code, err, sig, store, len(before))
-    res = _cli([*BENCH, "--out", str(out), "--resume"])
+    res = _run_cli([*BENCH, "--out", str(out), "--resume"])
     assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
     after = _store_lines(store)
     _check_records(before, after)
@@ -301,3 +288,180 @@ def test_bench_signal_then_resume(tmp_path, bench_reference, sig):
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
 def test_bench_signal_then_resume_more_moments(tmp_path, bench_reference, sig, seed):
     _bench_case(tmp_path, bench_reference, sig, seed=1000 * seed + int(sig), early=False)
+
+
+# --- a signal inside one long solver call (issue 21) -------------------------------------
+# Ipopt options that keep one call going for minutes: the tolerances cannot be met, so
+# Ipopt iterates (tiny steps) until max_iter, checking for Python signals between its
+# function evaluations; print_level 5 shows when it has started.
+SLOW_IPOPT_OPTIONS = {
+    "max_iter": 100000,
+    "tol": 1e-300,
+    "acceptable_tol": 1e-300,
+    "acceptable_iter": 1000000000,
+    "constr_viol_tol": 1e-300,
+    "dual_inf_tol": 1e-300,
+    "compl_inf_tol": 1e-300,
+    "acceptable_constr_viol_tol": 1e-300,
+    "acceptable_dual_inf_tol": 1e-300,
+    "acceptable_compl_inf_tol": 1e-300,
+    "tiny_step_tol": 0,
+}
+SLOW_IPOPT = (
+    "\n[solver]\nstarts = 4\nagree = 0\nipopt = { print_level = 5, "
+    + ", ".join(f"{k} = {v}" for k, v in SLOW_IPOPT_OPTIONS.items())
+    + " }\n"
+)
+IPOPT_RUNNING = re.compile(rb"^iter\s+objective\s+inf_pr", re.MULTILINE)
+
+
+SIGNALS = [signal.SIGINT, signal.SIGTERM, signal.SIGHUP]
+
+
+def _signame(sig: int) -> str:
+    return signal.Signals(sig).name
+
+
+def _slow_problem(tmp_path: Path, name: str) -> str:
+    path = tmp_path / f"{name}_slow.toml"
+    path.write_text((ROOT / "problems" / f"{name}.toml").read_text() + SLOW_IPOPT)
+    return str(path)
+
+
+def _bench_run_started(pid: int, workers: int) -> bool:
+    # A bench run is a forked child (of this process with 1 worker, of a worker with 2)
+    # that lives exactly as long as the run's solve.
+    try:
+        kids = psutil.Process(pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        return False
+    return any(k.ppid() != pid for k in kids) if workers > 1 else bool(kids)
+
+
+def _check_inside(case, sig: int, store: Path | None, label: str) -> None:
+    code, seconds, out, err, left = case
+    # one line per case for the record (pytest -s)
+    print(f"signal-inside {label} {_signame(sig)} exit={code} after {seconds:.3f} s")
+    assert code == 128 + sig, (code, err[-2000:])
+    assert seconds < 1.0, f"exit {seconds:.2f} s after the signal"
+    assert left == [], f"processes left: {left}"
+    both = out + err
+    assert "Traceback" not in both and "internal error" not in both, err[-2000:]
+    assert "KeyboardInterruptException" not in both  # CasADi's warning: not for the user
+    line = err.rstrip("\n").splitlines()[-1]
+    name = signal.Signals(sig).name
+    if store is None:
+        assert line == f"optdesign: interrupted ({name})"
+        return
+    key, records = read_store(store)  # a store --resume accepts: identity, whole lines
+    lines = _store_lines(store)
+    assert key and store.read_bytes().endswith(b"\n")
+    assert len({r["id"] for r in lines}) == len(lines) == len(records)  # none twice
+    n = len(records)
+    assert line == (
+        f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved in "
+        f"{store}, --resume continues"
+    )
+
+
+def _ipopt_running(output: bytes, pid: int) -> bool:
+    return IPOPT_RUNNING.search(output) is not None
+
+
+def _inside_a_solve(output: str) -> None:
+    # the interrupted call never finished: one more Ipopt solve began than ended
+    assert output.count("This is Ipopt version") > output.count("EXIT:"), output[-1000:]
+
+
+_SOLVE_CASES = {
+    # name: (problem, extra arguments)
+    "nlp-1-worker": ("cs_min_backlash", []),
+    "nlp-2-workers": ("cs_min_backlash", ["--workers", "2", "--json"]),
+    "catalogue": ("cs_min_backlash_catalogue", ["--json"]),
+    "robust": ("cs_min_backlash_robust", ["--formulation", "robust"]),
+    "gp": ("fork_min_backlash", ["--formulation", "gp", "--json"]),
+}
+
+
+def _solve_inside(tmp_path: Path, case: str, sig: int, group: bool = False) -> None:
+    name, extra = _SOLVE_CASES[case]
+    args = ["solve", _slow_problem(tmp_path, name), "--out", str(tmp_path / "out"), *extra]
+    result = signal_inside(_cli(args), sig, _ipopt_running, group)
+    _check_inside(result, sig, None, f"solve-{case}")
+    _inside_a_solve(result[2] + result[3])
+    assert not (tmp_path / "out" / "result.json").exists()  # no result of a half solve
+
+
+def _pareto_inside(tmp_path: Path, workers: int, sig: int, group: bool = False) -> None:
+    out = tmp_path / "out"
+    args = [
+        "pareto", _slow_problem(tmp_path, "fork_min_backlash"), "--objectives",
+        "size,backlash", "--points", "6", "--workers", str(workers), "--no-plot",
+        "--no-progress", "--out", str(out),
+    ]  # fmt: skip
+    result = signal_inside(_cli(args), sig, _ipopt_running, group)
+    _check_inside(result, sig, out / "epsilon.jsonl", f"pareto-{workers}w")
+    _inside_a_solve(result[2] + result[3])
+
+
+def _bench_inside(tmp_path: Path, workers: int, sig: int, group: bool = False) -> None:
+    # differential evolution with a 60 s limit: each run is one long solver call
+    out = tmp_path / "out"
+    args = [
+        "bench", "--suite", "quick", "--solvers", "de", "--workers", str(workers),
+        "--time-limit", "60", "--hard-timeout", "120", "--no-progress", "--out", str(out),
+    ]  # fmt: skip
+    result = signal_inside(_cli(args), sig, lambda _o, pid: _bench_run_started(pid, workers), group)
+    _check_inside(result, sig, out / "bench_runs.jsonl", f"bench-{workers}w")
+
+
+def _reproduce_inside(tmp_path: Path, sig: int) -> None:
+    # the PRSM contact sweeps: Newton solves of the contact equations, one after another
+    args = ["reproduce", "prsm-contact", "--out", str(tmp_path / "out")]
+    result = signal_inside(_cli(args), sig, lambda o, _pid: b"\n1. Hertz" in b"\n" + o)
+    _check_inside(result, sig, None, "reproduce")
+
+
+def test_ctrl_c_inside_the_solver_call_of_a_one_worker_solve(tmp_path):
+    # the issue's case: SIGINT used to be lost inside CasADi (the next start ran, exit 0)
+    _solve_inside(tmp_path, "nlp-1-worker", signal.SIGINT)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", SIGNALS, ids=_signame)
+@pytest.mark.parametrize("case", list(_SOLVE_CASES))
+def test_signal_inside_a_solver_call_of_solve(tmp_path, case, sig):
+    _solve_inside(tmp_path, case, sig)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", SIGNALS, ids=_signame)
+@pytest.mark.parametrize("workers", [1, 2])
+def test_signal_inside_a_solver_call_of_pareto(tmp_path, workers, sig):
+    _pareto_inside(tmp_path, workers, sig)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", SIGNALS, ids=_signame)
+@pytest.mark.parametrize("workers", [1, 2])
+def test_signal_inside_a_solver_call_of_bench(tmp_path, workers, sig):
+    _bench_inside(tmp_path, workers, sig)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", SIGNALS, ids=_signame)
+def test_signal_inside_a_solver_call_of_reproduce(tmp_path, sig):
+    _reproduce_inside(tmp_path, sig)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["solve", "pareto", "bench"])
+def test_sigterm_to_the_whole_process_group_with_two_workers(tmp_path, command):
+    # `timeout`, a service manager: the workers get SIGTERM too and die at once; the
+    # run still ends as interrupted (143), not as "a worker died" or a crash record
+    if command == "solve":
+        _solve_inside(tmp_path, "nlp-2-workers", signal.SIGTERM, group=True)
+    elif command == "pareto":
+        _pareto_inside(tmp_path, 2, signal.SIGTERM, group=True)
+    else:
+        _bench_inside(tmp_path, 2, signal.SIGTERM, group=True)

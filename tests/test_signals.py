@@ -1,10 +1,12 @@
-"""Interrupting a run: SIGINT (to the whole process group, as a terminal's Ctrl-C does),
-SIGTERM and SIGKILL at random moments of a 2-worker run_tasks, then resume.
+"""Interrupting a run: SIGINT and SIGHUP (to the whole process group, as a terminal's
+Ctrl-C and hangup do), SIGTERM and SIGKILL at random moments of a 2-worker run_tasks,
+then resume; and a signal inside a solver call, in library use, in native code that
+never returns, or whose exception C code dropped.
 
-Each case checks: exit code 130 / 143 and one line, no traceback; a reader of the run's
-stdout pipe is not kept waiting (communicate with a timeout); no worker or isolated task
-process left; the store readable, every record written before the signal kept, and after
-resuming every task exactly once.
+Each case checks: exit code 130 / 143 / 129 and one line, no traceback; a reader of the
+run's stdout pipe is not kept waiting (communicate with a timeout); no worker or isolated
+task process left; the store readable, every record written before the signal kept, and
+after resuming every task exactly once.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import random
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -96,6 +99,83 @@ def _alive(pids: list[int], wait: float = 3.0) -> list[int]:
         time.sleep(0.02)
 
 
+def _group(pgid: int) -> list[int]:
+    """Live (not zombie) processes of process group ``pgid``."""
+    out = []
+    for proc in psutil.process_iter(["pid", "status"]):
+        try:
+            if os.getpgid(proc.pid) == pgid and proc.info["status"] != psutil.STATUS_ZOMBIE:
+                out.append(proc.pid)
+        except (ProcessLookupError, psutil.NoSuchProcess, PermissionError):
+            pass
+    return out
+
+
+def _env() -> dict[str, str]:
+    path = os.environ.get("PYTHONPATH")
+    return {
+        **os.environ,
+        "PYTHONPATH": str(ROOT) + (os.pathsep + path if path else ""),
+        "MPLBACKEND": "Agg",
+        "PYTHONUNBUFFERED": "1",  # a solver's log as it is written
+    }
+
+
+def signal_inside(command: list[str], sig: int, started, group: bool = False):
+    """Run ``command``, send ``sig`` once ``started(output so far, pid)`` holds (e.g. the
+    solver's log shows it running), and return (exit code, seconds from the signal to
+    the exit, stdout, stderr, processes left). SIGINT goes to the process group
+    (Ctrl-C), like SIGTERM with ``group`` (``timeout``, a service manager); otherwise
+    the signal goes to the process alone."""
+    proc = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=_env(),
+        start_new_session=True,  # its own process group, as a job in a terminal
+    )
+    chunks: dict[str, list[bytes]] = {"out": [], "err": []}
+
+    def pump(stream, key: str) -> None:
+        for chunk in iter(lambda: stream.read1(1 << 16), b""):
+            chunks[key].append(chunk)
+
+    readers = [
+        threading.Thread(target=pump, args=(proc.stdout, "out"), daemon=True),
+        threading.Thread(target=pump, args=(proc.stderr, "err"), daemon=True),
+    ]
+    for r in readers:
+        r.start()
+    try:
+        end = time.monotonic() + 180
+        while not started(b"".join(chunks["out"] + chunks["err"]), proc.pid):
+            assert proc.poll() is None, b"".join(chunks["err"]).decode()[-2000:]
+            assert time.monotonic() < end, "the solver did not start"
+            time.sleep(0.01)
+        seen = [k.pid for k in psutil.Process(proc.pid).children(recursive=True)]
+        t_signal = time.monotonic()
+        if sig == signal.SIGINT or group:
+            os.killpg(proc.pid, sig)
+        else:
+            os.kill(proc.pid, sig)
+        try:
+            code = proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"still running 30 s after {signal.Signals(sig).name}") from None
+        seconds = time.monotonic() - t_signal
+        for r in readers:  # a reader gets EOF: no orphan holds the pipes
+            r.join(10)
+            assert not r.is_alive(), "the output pipes are still open"
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    left = _alive(seen, wait=2.0) + [p for p in _group(proc.pid) if p not in seen]
+    out = b"".join(chunks["out"]).decode(errors="replace")
+    err = b"".join(chunks["err"]).decode(errors="replace")
+    return code, seconds, out, err, left
+
+
 def _interrupt_and_resume(tmp_path: Path, sig: int, seed: int, isolated: bool = False):
     rng = random.Random(seed)
     script = tmp_path / "run.py"
@@ -115,8 +195,9 @@ def _interrupt_and_resume(tmp_path: Path, sig: int, seed: int, isolated: bool = 
         assert len(kids) >= 2, "the pool did not start"
         time.sleep(rng.uniform(0.0, 0.5))  # 16 tasks of 0.1 s on 2 workers: ~0.8 s
         kids = sorted(set(kids) | set(_descendants(proc.pid, wait=0)))
-        if sig == signal.SIGINT:
-            os.killpg(proc.pid, sig)  # the terminal's Ctrl-C: every process of the job
+        if sig in (signal.SIGINT, signal.SIGHUP):
+            # the terminal's Ctrl-C or hangup: every process of the job
+            os.killpg(proc.pid, sig)
         else:
             os.kill(proc.pid, sig)
         # A reader of the run's output must get EOF: no orphan may hold the pipe.
@@ -154,7 +235,7 @@ def _interrupt_and_resume(tmp_path: Path, sig: int, seed: int, isolated: bool = 
     return len(before)
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGKILL])
 def test_signal_then_resume(tmp_path, sig):
     _interrupt_and_resume(tmp_path, sig, seed=int(sig))
 
@@ -165,7 +246,7 @@ def test_sigkill_of_a_run_with_isolated_tasks_leaves_no_grandchild(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(1, 6))
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGKILL])
 def test_signal_then_resume_more_seeds(tmp_path, sig, seed):
     _interrupt_and_resume(tmp_path, sig, seed=100 * seed + int(sig), isolated=seed % 2 == 0)
 
@@ -228,8 +309,14 @@ def test_run_guarded_exit_codes_and_one_line(capsys):
     def bad_input():
         raise InputError("--points", "need at least 2 points")
 
+    def hung_up():
+        os.kill(os.getpid(), signal.SIGHUP)
+        time.sleep(5)
+
     assert run_guarded(terminated) == 143
     assert capsys.readouterr().err == "optdesign: interrupted (SIGTERM)\n"
+    assert run_guarded(hung_up) == 129
+    assert capsys.readouterr().err == "optdesign: interrupted (SIGHUP)\n"
     assert run_guarded(bad_input) == 2
     assert capsys.readouterr().err == "optdesign: error: --points: need at least 2 points\n"
     assert run_guarded(lambda: 1) == 1
@@ -256,7 +343,7 @@ def test_an_interrupt_after_the_solving_still_names_the_saved_store(tmp_path, ca
     assert capsys.readouterr().err == "optdesign: interrupted (SIGTERM)\n"
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
 def test_a_signal_while_the_program_exits_gives_the_same_line(tmp_path, sig):
     # After the command (interpreter shutdown, a second or more with the solvers loaded)
     # a signal ends the program with the one line and 130/143, naming the saved store.
@@ -289,3 +376,215 @@ time.sleep(5)
     assert res.stderr == (
         f"optdesign: interrupted ({name}); 1 record saved in {store}, --resume continues\n"
     )
+
+
+# --- solver calls, library use, native code (issue 21) ---------------------------------
+LIBRARY_SCRIPT = """
+import signal, sys
+import optdesign as od
+
+problem = od.load(sys.argv[1])
+try:
+    od.solve(problem)
+except KeyboardInterrupt as exc:
+    restored = signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    print(f"raised {type(exc).__name__} handler restored={restored}", file=sys.stderr)
+    sys.exit(7)
+print("returned a result", file=sys.stderr)
+"""
+
+
+def test_ctrl_c_during_od_solve_raises_keyboard_interrupt_in_library_use(tmp_path):
+    # A notebook's Ctrl-C inside Ipopt: CasADi returned the start as failed and the
+    # multistart went on; now KeyboardInterrupt, Python's own handler back afterwards.
+    from test_cli_signals import IPOPT_RUNNING, _slow_problem
+
+    script = tmp_path / "use.py"
+    script.write_text(LIBRARY_SCRIPT)
+    problem = _slow_problem(tmp_path, "cs_min_backlash")
+    code, seconds, out, err, left = signal_inside(
+        [sys.executable, str(script), problem],
+        signal.SIGINT,
+        lambda output, _pid: IPOPT_RUNNING.search(output) is not None,
+    )
+    print(f"signal-inside od.solve SIGINT exit={code} after {seconds:.3f} s")
+    assert code == 7, err[-2000:]
+    assert seconds < 1.0, f"exit {seconds:.2f} s after Ctrl-C"
+    assert err.splitlines()[-1] == "raised Interrupted handler restored=True"
+    assert "KeyboardInterruptException" not in out + err  # CasADi's warning muted
+    assert left == []
+
+
+STUCK_SCRIPT = """
+import ctypes, sys
+from optdesign import cli, interrupts
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+
+libc = ctypes.CDLL(None)
+mutex = ctypes.create_string_buffer(64)  # a PTHREAD_MUTEX_INITIALIZER (zeros)
+
+
+def stuck(self, *args, **kwargs):
+    # native code that never returns nor looks at Python's signals (a mutex locked twice)
+    with interrupts.solver_call():
+        print("inside the solver call", file=sys.stderr, flush=True)
+        libc.pthread_mutex_lock(mutex)
+        libc.pthread_mutex_lock(mutex)
+
+
+CasadiNLPSolver.solve = stuck
+sys.argv = ["optdesign", *sys.argv[1:]]
+cli.main()
+"""
+
+
+@pytest.mark.parametrize(
+    "sig",
+    [signal.SIGTERM, pytest.param(signal.SIGHUP, marks=pytest.mark.slow)],
+    ids=lambda s: signal.Signals(s).name,
+)
+def test_a_signal_ends_the_program_stuck_in_native_solver_code(tmp_path, sig):
+    # The main thread never comes back to Python: the watchdog ends the program with
+    # the line and the code, naming the store and the records it holds (the front's
+    # SLSQP anchors are written; the first Ipopt call never returns).
+    script = tmp_path / "stuck.py"
+    script.write_text(STUCK_SCRIPT)
+    out = tmp_path / "out"
+    args = ["pareto", str(ROOT / "problems" / "fork_min_backlash.toml"), "--objectives"]
+    args += ["size,backlash", "--points", "6", "--workers", "1", "--no-plot", "--out", str(out)]
+    code, seconds, _, err, left = signal_inside(
+        [sys.executable, str(script), *args], sig, lambda o, _pid: b"inside the solver" in o
+    )
+    print(f"signal-inside native {signal.Signals(sig).name} exit={code} after {seconds:.3f} s")
+    assert code == 128 + sig and seconds < 1.0, (code, seconds, err[-2000:])
+    assert "Traceback" not in err and left == []
+    store = out / "epsilon.jsonl"
+    _, records = read_store(store)
+    assert store.read_bytes().endswith(b"\n") and len(records) >= 1
+    n = len(records)
+    assert err.splitlines()[-1] == (
+        f"optdesign: interrupted ({signal.Signals(sig).name}); {n} record"
+        f"{'' if n == 1 else 's'} saved in {store}, --resume continues"
+    )
+
+
+DROPPED_SCRIPT = """
+import sys, time
+import numpy as np
+import optdesign.reproduce
+from optdesign import cli
+
+
+class Sized:
+    # NumPy asks an unknown object for its length and clears any error that raises
+    def __getitem__(self, i):
+        raise IndexError(i)
+
+    def __len__(self):
+        print("asked for the length", file=sys.stderr, flush=True)
+        time.sleep(10)  # the signal's handler raises here; NumPy drops the exception
+        return 0
+
+
+def run(name, out):
+    np.asarray(Sized(), dtype=object)
+    print("numpy returned", file=sys.stderr, flush=True)
+    end = time.monotonic() + 30
+    while time.monotonic() < end:  # Python code that would hear a signal again
+        time.sleep(0.01)
+    return 0
+
+
+optdesign.reproduce.run = run
+sys.argv = ["optdesign", "reproduce", "duan2017", "--out", sys.argv[1]]
+cli.main()
+"""
+
+
+def test_a_signal_whose_exception_c_code_dropped_is_raised_again(tmp_path):
+    # reproduce prsm-contact ran on for 4.8 s and exited 0 after SIGTERM: NumPy cleared
+    # the handler's exception while converting a CasADi object; the watchdog sees no
+    # interrupt alive and signals the main thread again.
+    script = tmp_path / "dropped.py"
+    script.write_text(DROPPED_SCRIPT)
+    code, seconds, _, err, left = signal_inside(
+        [sys.executable, str(script), str(tmp_path / "out")],
+        signal.SIGTERM,
+        lambda output, _pid: b"asked for the length" in output,
+    )
+    print(f"signal-inside dropped SIGTERM exit={code} after {seconds:.3f} s")
+    assert "numpy returned" in err  # the first exception was indeed dropped
+    assert code == 143 and seconds < 1.0, (code, seconds, err[-2000:])
+    assert err.splitlines()[-1] == "optdesign: interrupted (SIGTERM)" and left == []
+
+
+def _after(seconds: float, sig: int) -> threading.Timer:
+    timer = threading.Timer(seconds, os.kill, (os.getpid(), sig))
+    timer.start()
+    return timer
+
+
+@pytest.mark.parametrize("library", ["swallows", "wraps"])
+def test_solver_call_raises_the_signal_a_library_lost(library):
+    # CasADi returns an interrupted Ipopt solve as failed, or raises RuntimeError from
+    # its own KeyboardInterruptException: the signal is raised all the same.
+    from optdesign.interrupts import Interrupted, interrupts_as_exceptions, solver_call
+
+    def native():
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)  # the handler raises here
+        except BaseException:
+            if library == "wraps":
+                raise RuntimeError("KeyboardInterrupt") from None
+            return "failed"
+        return "solved"
+
+    with interrupts_as_exceptions():
+        with pytest.raises(Interrupted) as info:
+            with solver_call():
+                native()
+    assert info.value.signum == signal.SIGTERM
+
+
+@pytest.mark.slow
+def test_an_ipopt_solve_is_interrupted_not_returned_as_a_failed_start(capfd):
+    # The root of issue 21's class 3, in this process: Ipopt (print_level 0) in a long
+    # call, SIGTERM after 0.3 s; Interrupted within a second, CasADi's warning muted.
+    from test_cli_signals import SLOW_IPOPT_OPTIONS
+
+    import optdesign as od
+    from optdesign.interrupts import Interrupted, interrupts_as_exceptions
+    from optdesign.studies.solve import solver_for
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    backend = solver_for(problem, "ipopt", {**SLOW_IPOPT_OPTIONS, "max_iter": 20000})
+    x0 = problem.start()
+    with interrupts_as_exceptions():
+        timer = _after(0.3, signal.SIGTERM)
+        t0 = time.monotonic()
+        with pytest.raises(Interrupted) as info:
+            backend.solve(x0)
+        timer.join()
+    assert info.value.signum == signal.SIGTERM
+    assert time.monotonic() - t0 < 1.3
+    assert "KeyboardInterruptException" not in "".join(capfd.readouterr())
+
+
+@pytest.mark.slow
+def test_ctrl_c_in_a_solve_raises_keyboard_interrupt_without_the_cli():
+    # library use: Python's own SIGINT handler, which the solve lends a recording twin
+    from test_cli_signals import SLOW_IPOPT_OPTIONS
+
+    import optdesign as od
+    from optdesign.studies.solve import solver_for
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    backend = solver_for(problem, "ipopt", {**SLOW_IPOPT_OPTIONS, "max_iter": 20000})
+    timer = _after(0.3, signal.SIGINT)
+    with pytest.raises(KeyboardInterrupt):
+        backend.solve(problem.start())
+    timer.join()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    # the interrupt is spent: the next solve runs to its end
+    assert solver_for(problem, "ipopt").solve(problem.start()).success

@@ -3,6 +3,11 @@
 The CasADi solver is built once per NLP and reused by every solve: the objective
 weights are its parameter ``p``, the bounds are arguments of each call, and primal and
 dual values warm-start it.
+
+A signal during a call stops Ipopt within an iteration (CasADi checks for Python signals
+between function evaluations) but CasADi then returns the solve as failed
+(``NonIpopt_Exception_Thrown``) or raises a ``RuntimeError``: every call runs inside
+:func:`optdesign.interrupts.solver_call`, which raises the interrupt instead.
 """
 
 from __future__ import annotations
@@ -11,6 +16,7 @@ import contextlib
 import difflib
 import io
 import re
+import signal
 import time
 from collections.abc import Mapping
 from functools import lru_cache
@@ -21,6 +27,7 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
+from optdesign.interrupts import Interrupted, solver_call
 from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.result import Result, TerminationCondition
@@ -73,6 +80,8 @@ _IPOPT_STATUS = {
     "Maximum_WallTime_Exceeded": (TerminationCondition.MAX_TIME, "time_limit"),
     "Diverging_Iterates": (TerminationCondition.UNBOUNDED, "failed"),
     "User_Requested_Stop": (TerminationCondition.INTERRUPTED, "failed"),
+    # NonIpopt_Exception_Thrown: only CasADi's KeyboardInterruptException escapes its
+    # callbacks (a signal handler raised); raised as the interrupt, never a result.
     "Restoration_Failed": (TerminationCondition.NUMERICAL_ERROR, "failed"),
     "Error_In_Step_Computation": (TerminationCondition.NUMERICAL_ERROR, "failed"),
     "Invalid_Number_Detected": (TerminationCondition.NUMERICAL_ERROR, "failed"),
@@ -92,7 +101,8 @@ def ipopt_option_names() -> frozenset[str]:
         "max_iter": 0,
         "option_file_name": "",  # never an ipopt.opt of the working directory
     }
-    with contextlib.redirect_stdout(buf):  # CasADi prints through Python's sys.stdout
+    # CasADi prints through Python's sys.stdout
+    with solver_call(), contextlib.redirect_stdout(buf):
         solver = ca.nlpsol(
             "options", "ipopt", {"x": x, "f": x**2}, {"ipopt": opts, "print_time": False}
         )
@@ -134,7 +144,7 @@ def _try_ipopt_option(key: str, value: Any, where: str) -> None:
     if key == "print_options_documentation":
         return  # prints the whole manual; the solve itself checks it
     try:
-        with contextlib.redirect_stdout(buf):
+        with solver_call(), contextlib.redirect_stdout(buf):
             solver = ca.nlpsol(
                 "check", "ipopt", {"x": x, "f": x**2}, {"ipopt": opts, "print_time": False}
             )
@@ -174,9 +184,10 @@ class CasadiNLPSolver:
         # from the working directory.
         opts = without_option_files(opts)
         self.options = opts
-        self.solver = ca.nlpsol(
-            "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts
-        )
+        with solver_call():
+            self.solver = ca.nlpsol(
+                "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts
+            )
 
     @property
     def name(self) -> str:
@@ -202,13 +213,18 @@ class CasadiNLPSolver:
             args["lam_g0"] = start.lam_g0
         t0 = time.perf_counter()
         try:
-            sol = self.solver(**args)
+            with solver_call():  # a signal meanwhile is raised here, not made a result
+                sol = self.solver(**args)
         except RuntimeError as exc:  # CasADi raises on evaluation errors it cannot recover
             wall = time.perf_counter() - t0
             return failed_result(self.plugin, nlp, target, str(exc).splitlines()[0], wall)
         wall = time.perf_counter() - t0
         stats = self.solver.stats()
         return_status = str(stats.get("return_status", ""))
+        if return_status == "NonIpopt_Exception_Thrown":
+            # a signal handler raised inside the call (one that solver_call does not know
+            # of, e.g. the user's own): an interrupt all the same
+            raise Interrupted(signal.SIGINT)
         term, status = _IPOPT_STATUS.get(
             return_status,
             (

@@ -11,6 +11,10 @@ computed from the solver's multipliers, independent of the solver's own stopping
 
 g is a smooth convex minimisation over a box (SLSQP); ``gap_rel = 1 - exp(g - log p)``
 says how far the returned objective p can be above the true global optimum.
+
+Both calls run inside :func:`optdesign.interrupts.solver_call`: a signal during them is
+raised as the interrupt once they return (the conic solvers do not look at Python's
+signals; the CLI's watchdog ends a call that would not return within a second).
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from scipy.optimize import minimize
 from scipy.special import logsumexp
 
 from optdesign.formulations.gp import GPData, GPRow, to_cvxpy
+from optdesign.interrupts import solver_call
 from optdesign.solvers.result import (
     Certificate,
     ConstraintReport,
@@ -89,14 +94,15 @@ def dual_bound(
     y0 = 0.5 * (lo + hi)
     # L is convex: one local minimisation from the box centre is the minimum. SLSQP
     # (bounds) is used because L-BFGS-B was 10x slower per call here.
-    best = minimize(
-        L,
-        y0,
-        jac=True,
-        method="SLSQP",
-        bounds=list(zip(lo, hi, strict=True)),
-        options={"ftol": 1e-15, "maxiter": 500},
-    )
+    with solver_call():
+        best = minimize(
+            L,
+            y0,
+            jac=True,
+            method="SLSQP",
+            bounds=list(zip(lo, hi, strict=True)),
+            options={"ftol": 1e-15, "maxiter": 500},
+        )
     return float(best.fun), bool(best.success)
 
 
@@ -119,7 +125,8 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
     t_build = time.perf_counter() - t0
     error = ""
     try:
-        prob.solve(gp=True, solver=solver, **(options or {}))
+        with solver_call():
+            prob.solve(gp=True, solver=solver, **(options or {}))
     except cp.error.SolverError as exc:
         error = str(exc).splitlines()[0]
     wall = time.perf_counter() - t0

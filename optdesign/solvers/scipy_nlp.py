@@ -11,6 +11,10 @@ differences), and differential evolution on a vectorised NumPy objective.
   ``objective(X) -> (value, violation)`` (population rows), typically
   :meth:`DesignProblem.evaluate`, and handles catalogue variables as integer indices.
 
+A signal during a solve is raised as :class:`optdesign.interrupts.Interrupted`, never
+turned into a failed start (:func:`optdesign.interrupts.solver_call`: CasADi's
+evaluations inside SciPy's callbacks may report it as a ``RuntimeError``).
+
 None of this knows a mechanism.
 """
 
@@ -26,6 +30,7 @@ import numpy as np
 import scipy.optimize as so
 
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
+from optdesign.interrupts import solver_call
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
 
@@ -243,7 +248,8 @@ class ScipyNLPSolver:
             kwargs["jac"] = self._grad if exact else None
         lam_g = np.zeros(len(lb))
         try:
-            res = so.minimize(self._f, z0, **kwargs)
+            with solver_call():
+                res = so.minimize(self._f, z0, **kwargs)
             z, iters, message = (
                 np.asarray(res.x, dtype=float),
                 int(res.get("nit", 0)),
@@ -398,20 +404,21 @@ def differential_evolution(
             return True
         return False
 
-    res = so.differential_evolution(
-        func,
-        so.Bounds(lo, hi),
-        constraints=so.NonlinearConstraint(cons, -np.inf, 0.0),
-        integrality=integrality if catalogues else None,
-        seed=seed,
-        popsize=popsize,
-        maxiter=maxiter,
-        tol=tol,
-        polish=False,
-        vectorized=True,
-        updating="deferred",
-        callback=callback,
-    )
+    with solver_call():
+        res = so.differential_evolution(
+            func,
+            so.Bounds(lo, hi),
+            constraints=so.NonlinearConstraint(cons, -np.inf, 0.0),
+            integrality=integrality if catalogues else None,
+            seed=seed,
+            popsize=popsize,
+            maxiter=maxiter,
+            tol=tol,
+            polish=False,
+            vectorized=True,
+            updating="deferred",
+            callback=callback,
+        )
     wall = time.perf_counter() - t0
     X = to_design(np.asarray(res.x, dtype=float)[None, :])
     f, v = evaluate(X)

@@ -2,7 +2,8 @@
 
 Split from :mod:`optdesign.studies.runner` (which re-exports the public names). Every
 process forked here dies with its parent, whatever signal ends the parent (Linux
-``PR_SET_PDEATHSIG``), and ignores SIGINT, which the parent alone handles.
+``PR_SET_PDEATHSIG``), and ignores SIGINT and SIGHUP, which the parent alone handles
+(:func:`optdesign.interrupts.child_signals`).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from contextlib import contextmanager
 from typing import Any
 
 from optdesign.errors import OptDesignError
-from optdesign.interrupts import deferred
+from optdesign.interrupts import child_signals, deferred, signals_blocked
 
 
 @contextmanager
@@ -58,10 +59,12 @@ class WorkerPool:
     Workers die with this process whatever ends it, SIGKILL included (Linux
     ``PR_SET_PDEATHSIG``, see :func:`die_with_parent`): orphans would keep running, and
     keep the run's stdout open, so that a reader of it through a pipe would wait for
-    them. They ignore SIGINT: Ctrl-C in a terminal signals the whole process group, and
-    this process alone decides what an interrupt stops. Create the pool in the thread
-    that outlives it (the main thread): the kernel ties the workers to the forking
-    thread.
+    them. They ignore SIGINT and SIGHUP: Ctrl-C in a terminal, or the terminal closing,
+    signals the whole process group, and this process alone decides what an interrupt
+    stops. The signals are blocked from the fork until the worker has set that up, so
+    none reaches the parent's handler inherited by the fork. Create the pool in the
+    thread that outlives it (the main thread): the kernel ties the workers to the
+    forking thread.
     """
 
     def __init__(self, size: int):
@@ -85,7 +88,8 @@ class WorkerPool:
                 inherited = [*self.conns, parent] if ctx.get_start_method() == "fork" else []
                 proc = ctx.Process(target=_worker_loop, args=(child, me, inherited), daemon=True)
                 self.conns.append(parent)
-                with deferred():  # not inside the fork's callbacks, where it would be lost
+                # not inside the fork's callbacks, where it would be lost
+                with deferred(), signals_blocked():
                     proc.start()
                 child.close()
                 self.procs.append(proc)
@@ -119,6 +123,7 @@ class WorkerPool:
                 ok, value = self.conns[i].recv()
             except EOFError:
                 self.procs[i].join(1.0)
+                _signalled_with_us(self.procs[i].exitcode)
                 raise OptDesignError(
                     f"worker process {self.procs[i].pid} died "
                     f"(exit code {self.procs[i].exitcode}) while running a task"
@@ -159,7 +164,7 @@ def _worker_loop(conn, parent_pid: int | None = None, inherited: Iterable[Any] =
         die_with_parent(parent_pid)
     for other in inherited:
         other.close()
-    _child_signals()
+    child_signals()
     _init_process()
     while True:
         try:
@@ -184,13 +189,12 @@ def _worker_loop(conn, parent_pid: int | None = None, inherited: Iterable[Any] =
                 return
 
 
-def _child_signals() -> None:
-    # SIGINT is for the parent (a terminal's Ctrl-C reaches the whole process group);
-    # SIGTERM kills at once (the parent's handler, inherited through fork, would raise
-    # inside the task instead).
-    with contextlib.suppress(ValueError):  # not the main thread: cannot change handlers
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+def _signalled_with_us(exitcode: int | None) -> None:
+    """A child that died of SIGTERM may have been signalled with this process (``kill``
+    of the whole process group, as ``timeout`` does): let this process's own signal
+    arrive and raise (its interrupt, not "a worker died" nor a crash record)."""
+    if exitcode == -signal.SIGTERM:
+        time.sleep(0.2)
 
 
 _PR_SET_PDEATHSIG = 1
@@ -245,7 +249,8 @@ def fork_call(
         with contextlib.suppress(Exception):
             stream.flush()
     rfd, wfd = os.pipe()
-    with deferred():  # not inside the fork's callbacks, where it would be lost
+    # not inside the fork's callbacks, where it would be lost
+    with deferred(), signals_blocked():
         pid = os.fork()
         if pid == 0:  # pragma: no cover - the child (coverage does not follow it)
             _fork_child(fn, rfd, wfd, me, quiet)
@@ -277,6 +282,8 @@ def fork_call(
     try:
         return pickle.loads(b"".join(chunks))
     except Exception:
+        if os.WIFSIGNALED(status):
+            _signalled_with_us(-os.WTERMSIG(status))
         return "crash", f"worker process died (wait status {status})"
 
 
@@ -284,7 +291,7 @@ def _fork_child(fn: Callable[[], Any], rfd: int, wfd: int, parent: int, quiet: b
     try:
         os.close(rfd)
         die_with_parent(parent)
-        _child_signals()
+        child_signals()
         if quiet:
             import faulthandler
 

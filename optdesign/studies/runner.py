@@ -11,7 +11,7 @@ benchmark command can reuse it):
   built once per worker) belongs in a module-level cache inside ``fn``'s module;
 - every finished record is appended to ``store_path`` (JSON Lines, one record a line,
   one ``write`` each), so a killed run loses at most the tasks in flight; an interrupted
-  run (Ctrl-C, SIGTERM through the CLI) writes every record it received before it
+  run (Ctrl-C, SIGTERM, SIGHUP through the CLI) writes every record it received before it
   stops its workers. The store and the folder lock live in :mod:`optdesign.storage`;
   the worker processes (which die with this process, whatever kills it) in
   :mod:`optdesign.studies.processes`;
@@ -47,7 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from optdesign.interrupts import deferred, note_store
+from optdesign.interrupts import deferred, note_active_store, note_store
 from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
 from optdesign.studies.processes import (
     WorkerPool,
@@ -204,10 +204,10 @@ def run_tasks(
         a record failing ``check``), or holds records and neither ``resume`` nor
         ``overwrite`` is given.
     KeyboardInterrupt
-        Re-raised after the cleanup when the run is interrupted (Ctrl-C, or SIGTERM turned
-        into one by the CLI): workers stopped, every finished record written, the store
-        closed. Its attribute ``run_store = {"path": ..., "records": n}`` tells the CLI
-        what was saved.
+        Re-raised after the cleanup when the run is interrupted (Ctrl-C, or SIGTERM /
+        SIGHUP turned into one by the CLI): workers stopped, every finished record
+        written, the store closed. Its attribute ``run_store = {"path": ..., "records":
+        n}`` tells the CLI what was saved.
     """
     path = Path(store_path)
     with lock_folder(path.parent):
@@ -292,6 +292,8 @@ def _run(
         # the forking one, and whatever locks the others held.
         with _executor(fn, workers, scheduler, pool, isolate) as ex:
             store = StoreWriter(path, n_stored)
+            # what an interrupt that ends the process from the watchdog names as saved
+            note_active_store(str(path), lambda: store.count)
             if progress:
                 from tqdm.auto import tqdm
 
@@ -360,6 +362,7 @@ def _run(
                 store.close()
             if bar is not None:
                 bar.close()
+            note_active_store(None)
             note_store(str(path), store.count if store is not None else n_stored)
     return {i: done[i] for i in by_id if i in done}
 
