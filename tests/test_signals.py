@@ -416,7 +416,7 @@ def test_ctrl_c_during_od_solve_raises_keyboard_interrupt_in_library_use(tmp_pat
 
 
 STUCK_SCRIPT = """
-import ctypes, sys
+import ctypes, os, sys
 from optdesign import cli, interrupts
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 
@@ -427,7 +427,9 @@ mutex = ctypes.create_string_buffer(64)  # a PTHREAD_MUTEX_INITIALIZER (zeros)
 def stuck(self, *args, **kwargs):
     # native code that never returns nor looks at Python's signals (a mutex locked twice)
     with interrupts.solver_call():
-        print("inside the solver call", file=sys.stderr, flush=True)
+        # one write: a signal sent on seeing the words must not split them from the
+        # newline (the handler runs between two writes of print)
+        os.write(2, b"inside the solver call\\n")
         libc.pthread_mutex_lock(mutex)
         libc.pthread_mutex_lock(mutex)
 
