@@ -96,13 +96,14 @@ def register_config(config: Config) -> Config:
 
 def get_config(name: str) -> Config:
     """The configuration ``name``; a registered NLP solver back-end of that name becomes
-    a configuration with its default options."""
+    a configuration with its default options (made for the caller, not registered: a
+    lookup leaves the list of configurations as it was)."""
     if name in CONFIGS:
         return CONFIGS[name]
     from optdesign.solvers.registry import solver_names
 
     if name in solver_names("nlp"):
-        return register_config(nlp_config(name, name, {}, description=f"registered solver {name}"))
+        return nlp_config(name, name, {}, description=f"registered solver {name}")
     from optdesign.errors import InputError
 
     raise InputError(
