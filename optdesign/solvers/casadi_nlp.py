@@ -22,6 +22,7 @@ import numpy as np
 from optdesign.errors import InputError
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.base import failed_result, make_result, resolve
+from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults: quiet, tight tolerances (the tests compare optima to 1e-4 relative and
@@ -173,6 +174,7 @@ class CasadiNLPSolver:
     def name(self) -> str:
         return self.plugin
 
+    @one_blas_thread()
     def solve(
         self, start: Start | Any, target: Target | str | None = None, bounds: Bounds | None = None
     ) -> Result:

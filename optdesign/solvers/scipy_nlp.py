@@ -27,6 +27,7 @@ import scipy.optimize as so
 
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.base import failed_result, make_result, resolve
+from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
 
 
@@ -204,6 +205,7 @@ class ScipyNLPSolver:
             )
         return cons
 
+    @one_blas_thread()
     def solve(
         self, start: Start | Any, target: Target | str | None = None, bounds: Bounds | None = None
     ) -> Result:
