@@ -270,6 +270,24 @@ def test_cli_writes_front_files(fork, tmp_path):
     )
 
 
+@pytest.fixture
+def threaded_blas():
+    """Every OpenBLAS of this process at two threads (as a machine with OPENBLAS_NUM_THREADS
+    unset or 2 starts them), the counts restored after: the main process then differs
+    from the one-thread workers unless the solves set their own count."""
+    from optdesign.solvers.blas import blas_libraries
+    from optdesign.studies.solve import solver_for
+
+    solver_for(load_problem(PROBLEMS / "fork_min_backlash.toml"), "ipopt")  # CasADi's BLAS
+    before = [(lib, lib.get_threads()) for lib in blas_libraries()]
+    for lib, _ in before:
+        lib.set_threads(2)
+    yield
+    for lib, n in before:
+        lib.set_threads(n)
+
+
+@pytest.mark.usefixtures("threaded_blas")
 def test_deterministic_front_is_the_same_for_any_workers_and_after_resume(fork, tmp_path):
     objectives = ["size", "backlash"]
     kw = dict(starts=2, deterministic=True)
