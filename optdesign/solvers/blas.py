@@ -12,11 +12,12 @@ problems (the processes are the parallelism).
 :func:`one_blas_thread` gives a context manager (and decorator) that sets every OpenBLAS
 loaded in this process to one thread and restores each library's own count on the way
 out, so that a program that imports optdesign keeps its NumPy threading outside the
-solver calls. It nests and is shared by threads (the outermost exit restores), and it
-also limits a library loaded inside it (CasADi loads its OpenBLAS with the first Ipopt
-solver). The loaded libraries are found with ``dl_iterate_phdr`` and rescanned only when
-the dynamic loader reports a new object, so a solve pays a few microseconds. Where that
-call or OpenBLAS is missing (macOS, an MKL NumPy) nothing changes.
+solver calls. It nests and is shared by threads (the outermost exit restores). The loaded
+libraries are read from ``/proc/self/maps`` once, and again by :func:`rescan_blas` when a
+solver is built (CasADi loads its OpenBLAS with the first Ipopt solver), so a solve pays
+a few microseconds. (Not ``dl_iterate_phdr``: its Python callback would swallow a Ctrl-C
+that lands inside it.) Where ``/proc`` or OpenBLAS is missing (macOS, an MKL NumPy)
+nothing changes.
 """
 
 from __future__ import annotations
@@ -47,57 +48,6 @@ class BlasLibrary:
     get_threads: Callable[[], int]
 
 
-class _PhdrInfo(ctypes.Structure):
-    # struct dl_phdr_info (glibc, musl, the BSDs): only the fields read here.
-    _fields_ = (
-        ("addr", ctypes.c_void_p),
-        ("name", ctypes.c_char_p),
-        ("phdr", ctypes.c_void_p),
-        ("phnum", ctypes.c_uint16),
-        ("adds", ctypes.c_ulonglong),
-        ("subs", ctypes.c_ulonglong),
-    )
-
-
-_CALLBACK = ctypes.CFUNCTYPE(
-    ctypes.c_int, ctypes.POINTER(_PhdrInfo), ctypes.c_size_t, ctypes.c_void_p
-)
-_COUNTERS_END = _PhdrInfo.subs.offset + ctypes.sizeof(ctypes.c_ulonglong)
-
-
-def _dl_iterate_phdr():
-    try:
-        fn = ctypes.CDLL(None).dl_iterate_phdr
-    except (OSError, AttributeError):
-        return None
-    fn.argtypes = (_CALLBACK, ctypes.c_void_p)
-    fn.restype = ctypes.c_int
-    return fn
-
-
-_ITERATE = _dl_iterate_phdr()
-
-
-def _loaded(names: list[str] | None) -> int:
-    """The loader's count of objects loaded so far; with ``names``, the path of every
-    loaded object is appended to it (without, the walk stops at the first object)."""
-    if _ITERATE is None:
-        return 0
-    seen = [0]
-
-    def visit(info, size, _data) -> int:
-        if size >= _COUNTERS_END:
-            seen[0] = info.contents.adds
-        if names is None:
-            return 1
-        if info.contents.name:
-            names.append(os.fsdecode(info.contents.name))
-        return 0
-
-    _ITERATE(_CALLBACK(visit), None)
-    return seen[0]
-
-
 def _probe(path: str) -> BlasLibrary | None:
     try:
         handle = ctypes.CDLL(path)
@@ -113,31 +63,41 @@ def _probe(path: str) -> BlasLibrary | None:
 
 
 _LOCK = threading.RLock()
-_SCAN: dict[str, object] = {"adds": -1, "libraries": ()}
+_FOUND: list[tuple[BlasLibrary, ...]] = []  # the last scan (empty: none yet)
+
+
+def rescan_blas() -> tuple[BlasLibrary, ...]:
+    """Find the OpenBLAS libraries loaded in this process now (call it after loading one,
+    e.g. once a solver is built); :func:`blas_libraries` returns them until the next scan."""
+    try:
+        with open("/proc/self/maps") as fh:
+            paths = {line.split()[-1] for line in fh if "blas" in line.lower()}
+    except OSError:
+        paths = set()
+    found, addresses = [], set()
+    for path in sorted(paths):
+        if "blas" not in os.path.basename(path).lower():
+            continue
+        lib = _probe(path)
+        if lib is None:
+            continue
+        # a module linked to an OpenBLAS (SciPy's _fblas) finds its symbols too: one
+        # entry per library, by the function's address
+        address = ctypes.cast(lib.set_threads, ctypes.c_void_p).value
+        if address not in addresses:
+            addresses.add(address)
+            found.append(lib)
+    with _LOCK:
+        _FOUND[:] = [tuple(found)]
+    return tuple(found)
 
 
 def blas_libraries() -> tuple[BlasLibrary, ...]:
-    """The OpenBLAS libraries loaded in this process (rescanned when the loader has
-    loaded something since the last call)."""
+    """The OpenBLAS libraries of the last :func:`rescan_blas` (one is made the first time)."""
     with _LOCK:
-        adds = _loaded(None)
-        if adds != _SCAN["adds"] or adds == 0:
-            names: list[str] = []
-            adds = _loaded(names)
-            found, addresses = [], set()
-            for path in sorted(set(names)):
-                if "blas" in os.path.basename(path).lower():
-                    lib = _probe(path)
-                    # a module linked to an OpenBLAS (SciPy's _fblas) finds its symbols
-                    # too: one entry per library, by the function's address
-                    address = (
-                        None if lib is None else ctypes.cast(lib.set_threads, ctypes.c_void_p).value
-                    )
-                    if lib is not None and address not in addresses:
-                        addresses.add(address)
-                        found.append(lib)
-            _SCAN.update(adds=adds, libraries=tuple(found))
-        return _SCAN["libraries"]  # type: ignore[return-value]
+        if _FOUND:
+            return _FOUND[0]
+    return rescan_blas()
 
 
 def blas_thread_counts() -> dict[str, int]:
@@ -148,7 +108,7 @@ def blas_thread_counts() -> dict[str, int]:
 def limit_blas_threads(n: int = 1) -> int:
     """Set the thread count of every OpenBLAS loaded in this process to ``n`` (for good:
     a worker process's setting). Returns how many libraries were set."""
-    libs = blas_libraries()
+    libs = rescan_blas()
     for lib in libs:
         lib.set_threads(n)
     return len(libs)
@@ -163,13 +123,17 @@ class _OneThread(ContextDecorator):
     def __enter__(self):
         with _LOCK:
             cls = type(self)
-            for lib in blas_libraries():
-                if lib.path not in cls.saved:  # new, or loaded since the outermost entry
-                    count = int(lib.get_threads())
-                    cls.saved[lib.path] = (lib, count)
-                    if count != 1:
-                        lib.set_threads(1)
             cls.depth += 1
+            try:
+                for lib in blas_libraries():
+                    if lib.path not in cls.saved:  # new, or found since the outermost entry
+                        count = int(lib.get_threads())
+                        cls.saved[lib.path] = (lib, count)
+                        if count != 1:
+                            lib.set_threads(1)
+            except BaseException:  # e.g. Ctrl-C here: no __exit__ will come, restore now
+                self.__exit__()
+                raise
         return self
 
     def __exit__(self, *exc) -> None:

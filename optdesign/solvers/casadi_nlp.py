@@ -22,7 +22,7 @@ import numpy as np
 from optdesign.errors import InputError
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.base import failed_result, make_result, resolve
-from optdesign.solvers.blas import one_blas_thread
+from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults: quiet, tight tolerances (the tests compare optima to 1e-4 relative and
@@ -169,6 +169,7 @@ class CasadiNLPSolver:
         self.solver = ca.nlpsol(
             "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts
         )
+        rescan_blas()  # the plugin may have loaded CasADi's OpenBLAS, for one_blas_thread
 
     @property
     def name(self) -> str:
