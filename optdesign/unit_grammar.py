@@ -38,7 +38,7 @@ ALIASES: dict[str, str] = {
     "%": "percent",
     "rev": "revolution",
     "revs": "revolution",
-    "grad": "gradian",
+    "grad": "grade",  # pint's name since 0.23 at least ("gradian" only from 0.25)
 }
 
 #: Longest quantity string read (a real one is a few characters).

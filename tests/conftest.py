@@ -2,8 +2,32 @@ import os
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+# Property tests find a bug every run or never, not by luck: by default (the README's test
+# command, CI) Hypothesis draws the same examples on every run - seeded from each test's
+# own code - and replays no example database. OPTDESIGN_HYPOTHESIS=explore (or pytest's
+# --hypothesis-profile=explore) draws new random examples each run and keeps the failing
+# ones in .hypothesis/, to hunt for new bugs; a bug found so becomes a fixed example or a
+# case of the deterministic run. Generation time is no test (a loaded machine is slow).
+settings.register_profile(
+    "deterministic",
+    derandomize=True,
+    database=None,
+    deadline=None,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.register_profile(
+    "explore",
+    derandomize=False,
+    deadline=None,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.load_profile(os.environ.get("OPTDESIGN_HYPOTHESIS") or "deterministic")
 
 
 @pytest.fixture

@@ -107,7 +107,7 @@ def test_user_objective_and_constraint_reach_every_formulation():
     assert not checks["peak_nut_force"].ok
 
 
-def test_a_solver_back_end_registered_from_outside_the_package():
+def test_a_solver_back_end_registered_from_outside_the_package(tmp_path):
     import scipy.optimize as so
 
     from optdesign.solvers.base import make_result, resolve
@@ -157,12 +157,24 @@ def test_a_solver_back_end_registered_from_outside_the_package():
 
     od.register_solver("cobyqa", TrustRegionCobyqa, replace=True)
     assert "cobyqa" in od.solver_names("nlp")
-    problem = od.load(PROBLEMS / "fork_min_backlash.toml")
-    result = od.solve(problem, "nlp", solver="cobyqa", starts=2, ranges=False)
+    # COBYQA is local and derivative-free: from the middle of the box its path ends at the
+    # global optimum or at a local one (backlash 0.01958 deg) depending on the SciPy and
+    # NumPy releases. Declared 3 % off Ipopt's optimum, the start leads it to that optimum
+    # with any of them (the solve and the benchmark both start there).
+    text = (PROBLEMS / "fork_min_backlash.toml").read_text()
+    x_opt = od.solve(od.load(PROBLEMS / "fork_min_backlash.toml"), "nlp", ranges=False).design
+    for name in ("R", "p", "d"):
+        line = next(li for li in text.splitlines() if li.startswith(f"{name} = {{ lower"))
+        start = f', start = "{1.03 * x_opt[name]:.4f} mm" }}'
+        text = text.replace(line, line.rstrip().removesuffix("}").rstrip() + start)
+    (tmp_path / "fork.toml").write_text(text)
+    problem = od.load(tmp_path / "fork.toml")
+    result = od.solve(problem, "nlp", solver="cobyqa", starts=1, ranges=False)
     assert result.solver == "cobyqa" and result.verified
     assert result.objective == pytest.approx(0.0194989, rel=1e-4)
     # and the benchmark takes it by its name
-    report = od.bench(problems=[problem], solvers=["cobyqa", "ipopt-exact"], time_limit=20.0)
+    # a generous soft limit: a loaded machine must not turn the check into a timing test
+    report = od.bench(problems=[problem], solvers=["cobyqa", "ipopt-exact"], time_limit=300.0)
     rows = {r["config"]: r for r in report.rows}
     assert rows["cobyqa"]["success"] and rows["cobyqa"]["gap"] < 1e-4
 

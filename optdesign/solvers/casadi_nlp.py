@@ -30,6 +30,7 @@ from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.interrupts import Interrupted, solver_call
 from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import failed_result, make_result, resolve
+from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults: quiet, tight tolerances (the tests compare optima to 1e-4 relative and
@@ -188,11 +189,13 @@ class CasadiNLPSolver:
             self.solver = ca.nlpsol(
                 "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts
             )
+        rescan_blas()  # the plugin may have loaded CasADi's OpenBLAS, for one_blas_thread
 
     @property
     def name(self) -> str:
         return self.plugin
 
+    @one_blas_thread()
     def solve(
         self, start: Start | Any, target: Target | str | None = None, bounds: Bounds | None = None
     ) -> Result:

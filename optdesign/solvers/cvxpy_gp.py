@@ -28,6 +28,7 @@ from scipy.special import logsumexp
 
 from optdesign.formulations.gp import GPData, GPRow, to_cvxpy
 from optdesign.interrupts import solver_call
+from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import (
     Certificate,
     ConstraintReport,
@@ -229,5 +230,6 @@ class GPSolver:
     def name(self) -> str:
         return f"cvxpy-{self.solver.lower()}"
 
+    @one_blas_thread()
     def solve(self, *_args, **_kwargs) -> Result:
         return solve_gp(self.gp, self.solver, self.options)

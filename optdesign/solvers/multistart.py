@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import MultistartInfo, Result
 
 
@@ -26,18 +27,37 @@ def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.
 
 
 def best_of(results: Sequence[Result], rel_tol: float = 1e-6) -> tuple[Result, int]:
-    """The best successful result and how many reached it within ``rel_tol``."""
+    """The best successful result and how many reached it within ``rel_tol``.
+
+    Ties are decided by value, then by index, never by rounding: every successful result
+    within ``rel_tol`` of the least objective reached the best, and the first of them (the
+    lowest start index) wins. A strict minimum would let a 1e-14 difference - another BLAS
+    thread count, another machine - pick another start, and with it another design when
+    the optimum is not unique. With no successful result, the least violated one is
+    returned (the first of those within ``rel_tol`` of the least violation).
+    """
     ok = [r for r in results if r.success and math.isfinite(r.objective)]
     if not ok:
         # No feasible start: report the least violated one.
-        worst = min(
-            results, key=lambda r: r.max_violation if math.isfinite(r.max_violation) else math.inf
-        )
-        return worst, 0
-    best = min(ok, key=lambda r: r.objective)
-    tol = rel_tol * max(abs(best.objective), 1e-12)
-    n_at_best = sum(1 for r in ok if r.objective <= best.objective + tol)
-    return best, n_at_best
+        viol = [r.max_violation if math.isfinite(r.max_violation) else math.inf for r in results]
+        least = min(viol)
+        first = next(k for k, v in enumerate(viol) if v <= least + _tolerance(least, rel_tol))
+        return results[first], 0
+    least = min(r.objective for r in ok)
+    tol = _tolerance(least, rel_tol)
+    at_best = [r for r in ok if r.objective <= least + tol]
+    return at_best[0], len(at_best)
+
+
+def _tolerance(value: float, rel_tol: float) -> float:
+    # the absolute width of a tie at ``value`` (values near 0 tie within rel_tol * 1e-12)
+    return rel_tol * max(abs(value), 1e-12) if math.isfinite(value) else 0.0
+
+
+def improves(value: float, best: float, rel_tol: float = 1e-6) -> bool:
+    """Whether ``value`` is better than ``best`` by more than a tie (``rel_tol``
+    relative): a search keeps its earlier incumbent on a tie, as :func:`best_of` does."""
+    return value < best - _tolerance(best, rel_tol)
 
 
 def multistart(
@@ -60,22 +80,27 @@ def multistart(
         Local processes (the starts are split among them).
     agree
         Stop once this many successful starts agree on the best value (within
-        ``rel_tol``); None runs every start. With several workers the starts run in
-        rounds of ``workers``.
+        ``rel_tol``); None runs every start. The starts considered are always the
+        shortest prefix of ``starts`` (in their order) on which that many agree, whatever
+        the number of workers and whichever start finishes first: the same starts, the
+        same winner (:func:`best_of`) and the same record as a run on one worker.
     """
     t0 = time.perf_counter()
     starts = list(np.atleast_2d(starts))
     results: list[Result] = []
-    if workers > 1 and len(starts) > 1:
-        from optdesign.studies.runner import map_inherited
+    # One BLAS thread in this process as in the workers (a back-end of the user's own
+    # gets it too): the same arithmetic whatever the number of workers.
+    with one_blas_thread():
+        if workers > 1 and len(starts) > 1:
+            from optdesign.studies.runner import map_inherited
 
-        results = map_inherited(solve, starts, workers, stop=_stop_rule(rel_tol, agree))
-    else:
-        stop = _stop_rule(rel_tol, agree)
-        for x0 in starts:
-            results.append(solve(x0))
-            if stop(results):
-                break
+            results = map_inherited(solve, starts, workers, stop=_stop_rule(rel_tol, agree))
+        else:
+            stop = _stop_rule(rel_tol, agree)
+            for x0 in starts:
+                results.append(solve(x0))
+                if stop(results):
+                    break
     best, n_at_best = best_of(results, rel_tol)
     best.multistart = MultistartInfo(
         n_starts=len(results),

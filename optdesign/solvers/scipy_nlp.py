@@ -32,6 +32,7 @@ import scipy.optimize as so
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.interrupts import solver_call
 from optdesign.solvers.base import failed_result, make_result, resolve
+from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
 
 
@@ -110,6 +111,7 @@ class ScipyNLPSolver:
         # g (SLSQP asks for its inequality and equality rows at the same point).
         self._cache: dict[str, tuple[bytes, Any]] = {}
         self._p = np.zeros(nlp.p.shape[0])
+        rescan_blas()  # SciPy's OpenBLAS, for one_blas_thread (imported with this module)
 
     @property
     def name(self) -> str:
@@ -209,6 +211,7 @@ class ScipyNLPSolver:
             )
         return cons
 
+    @one_blas_thread()
     def solve(
         self, start: Start | Any, target: Target | str | None = None, bounds: Bounds | None = None
     ) -> Result:

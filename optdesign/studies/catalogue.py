@@ -35,7 +35,7 @@ from optdesign.formulations.discrete import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
-from optdesign.solvers.multistart import best_of, sobol_starts
+from optdesign.solvers.multistart import best_of, improves, sobol_starts
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.solve import _objective_set, finish, solver_for, solver_options
 
@@ -155,7 +155,8 @@ def enumerate_catalogue(ns: NodeSolver, x_hint=None) -> tuple[Result | None, lis
         items = {v.name: float(c) for v, c in zip(dvars, combo, strict=True)}
         r = ns.solve(_fixed(items), x_hint)
         table.append({"items": items, "status": r.status, "objective": r.objective})
-        if r.success and (best is None or r.objective < best.objective):
+        # a tie (within PRUNE_TOL) keeps the earlier combination, as branch and bound does
+        if r.success and (best is None or improves(r.objective, best.objective, PRUNE_TOL)):
             best = r
     return best, table
 
@@ -198,8 +199,10 @@ def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict]
                 leaf = ns.solve(_fixed(items), x)
                 stats["nodes"] += 1
             stats["leaves"] += 1
-            if leaf.success and (incumbent is None or leaf.objective < incumbent.objective):
-                incumbent = leaf
+            if leaf.success and (
+                incumbent is None or improves(leaf.objective, incumbent.objective, PRUNE_TOL)
+            ):
+                incumbent = leaf  # a tie keeps the incumbent found first
             continue
         allowed = items_within(worst.values, *box[worst.name])
         for side in branch(res.design[worst.name], allowed):

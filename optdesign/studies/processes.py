@@ -23,6 +23,7 @@ from typing import Any
 
 from optdesign.errors import OptDesignError
 from optdesign.interrupts import child_signals, deferred, signals_blocked
+from optdesign.solvers.blas import limit_blas_threads
 
 
 @contextmanager
@@ -337,37 +338,6 @@ def _init_process() -> None:
     # The environment variable is read when a BLAS library loads; forked workers inherit
     # NumPy's and SciPy's OpenBLAS already loaded with one thread per core. Two workers
     # each running two BLAS threads (SLSQP's QP) on 2 cores ran ~3x slower per point.
+    # A library loaded later (CasADi's, with the first Ipopt solver) is set to one thread
+    # by the solve itself (optdesign.solvers.blas.one_blas_thread), as in the main process.
     limit_blas_threads(1)
-
-
-def limit_blas_threads(n: int = 1) -> int:
-    """Set the thread count of every OpenBLAS already loaded in this process.
-
-    Returns how many libraries were limited (0 where there is no OpenBLAS or no
-    ``/proc``; nothing else changes then).
-    """
-    import ctypes
-
-    try:
-        with open("/proc/self/maps") as fh:
-            libs = {line.split()[-1] for line in fh if "openblas" in line.lower()}
-    except OSError:
-        return 0
-    count = 0
-    for lib in sorted(libs):
-        try:
-            handle = ctypes.CDLL(lib)
-        except OSError:
-            continue
-        for symbol in (
-            "openblas_set_num_threads",
-            "openblas_set_num_threads64_",
-            "scipy_openblas_set_num_threads",
-            "scipy_openblas_set_num_threads64_",
-        ):
-            fn = getattr(handle, symbol, None)
-            if fn is not None:
-                fn(ctypes.c_int(n))
-                count += 1
-                break
-    return count

@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from optdesign.interrupts import deferred, note_active_store, note_store
+from optdesign.solvers.blas import one_blas_thread
 from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
 from optdesign.studies.processes import (
     WorkerPool,
@@ -373,18 +374,21 @@ def _call(
     deps: Mapping[str, Record],
     isolate: Isolation | None = None,
 ) -> Record:
-    if isolate is None:
-        record = dict(fn(task, deps))
-    else:
-        t0 = time.perf_counter()
-        kind, value = fork_call(
-            functools.partial(fn, task, deps), isolate.timeout_for(task), isolate.quiet
-        )
-        if kind == "ok":
-            record = dict(value)
+    # One BLAS thread for the task wherever it runs (this process or a worker): the same
+    # arithmetic, and so the same record, for any number of workers.
+    with one_blas_thread():
+        if isolate is None:
+            record = dict(fn(task, deps))
         else:
-            failure = isolate.failure or failure_record
-            record = dict(failure(task, kind, value, time.perf_counter() - t0))
+            t0 = time.perf_counter()
+            kind, value = fork_call(
+                functools.partial(fn, task, deps), isolate.timeout_for(task), isolate.quiet
+            )
+            if kind == "ok":
+                record = dict(value)
+            else:
+                failure = isolate.failure or failure_record
+                record = dict(failure(task, kind, value, time.perf_counter() - t0))
     record["id"] = task["id"]
     return record
 
@@ -525,8 +529,11 @@ def map_inherited(
     """``[fn(item) for item in items]`` on ``workers`` forked processes that inherit
     ``fn`` (e.g. a solver's bound ``solve``: built once here, never pickled).
 
-    Results come back in the order of ``items``; with ``stop``, no new item is started
-    once ``stop(results so far, in order)`` holds. Off Linux (no fork) it runs here.
+    Results come back in the order of ``items``. With ``stop``, the answer is the
+    shortest prefix ``results[:k]`` for which ``stop(results[:k])`` holds (all of them if
+    none): the list a serial run returns, whatever the number of workers and the order in
+    which they finish. Results of later items that finished first are dropped, items
+    still running are stopped. Off Linux (no fork) it runs here.
     """
     if workers <= 1 or not forks_workers() or len(items) <= 1:
         out: list[Any] = []
@@ -543,19 +550,19 @@ def map_inherited(
             results: dict[int, Any] = {}
             running: dict[int, int] = {}  # worker -> item index
             nxt = 0
-            stopped = False
-            while nxt < len(items) or running:
-                while not stopped and nxt < len(items) and pool.idle:
+            prefix = 0  # results[0:prefix] are in, and stop() was asked at each length
+            while prefix < len(items):
+                while nxt < len(items) and pool.idle:
                     running[pool.submit(_call_inherited, (key, items[nxt]))] = nxt
                     nxt += 1
                 for worker, value in pool.wait():
                     results[running.pop(worker)] = value
-                done = [results[k] for k in sorted(results)]
-                if stop is not None and stop(done):
-                    stopped = True
-                    nxt = len(items)
-            return [results[k] for k in sorted(results)]
+                while prefix in results:
+                    prefix += 1
+                    if stop is not None and stop([results[k] for k in range(prefix)]):
+                        return [results[k] for k in range(prefix)]
+            return [results[k] for k in range(len(items))]
         finally:
-            pool.close()
+            pool.close()  # terminates the workers still running items past the prefix
     finally:
         _INHERITED.pop(key, None)

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem import DesignProblem, problem_from_dict
+from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import Result
 from optdesign.studies.bench.configs import Config, NotApplicable, get_config
 from optdesign.studies.bench.instances import Instance, make_instance
@@ -186,18 +187,6 @@ def _execute(task: Mapping[str, Any]) -> dict[str, Any]:
 
 
 _STRIKES: dict[tuple[str, str], int] = {}
-_BLAS_LIMITED = False
-
-
-def _single_thread_blas() -> None:
-    """One BLAS thread per process: threaded OpenBLAS on a loaded 2-core machine made a
-    trust-constr QR 100x slower in a trial."""
-    global _BLAS_LIMITED
-    if not _BLAS_LIMITED:
-        from optdesign.studies.runner import limit_blas_threads
-
-        limit_blas_threads(1)
-        _BLAS_LIMITED = True
 
 
 def _row_base(task: Mapping[str, Any]) -> dict[str, Any]:
@@ -225,7 +214,13 @@ def run_task(task: Mapping[str, Any], deps: Mapping[str, Any] | None = None) -> 
     crash, hang or exception becomes the row of :func:`failed_run`); called directly it
     runs in this process.
     """
-    _single_thread_blas()
+    # One BLAS thread (threaded OpenBLAS on a loaded 2-core machine made a trust-constr QR
+    # 100x slower in a trial), the caller's own count restored when called directly.
+    with one_blas_thread():
+        return _run_task(task)
+
+
+def _run_task(task: Mapping[str, Any]) -> dict[str, Any]:
     base = _row_base(task)
     # The strikes are counted by failed_run in the worker; this (forked) run sees them.
     if _STRIKES.get((base["config"], base["mechanism"]), 0) >= TIMEOUT_STRIKES:

@@ -75,7 +75,9 @@ class TwoChains:
     Arc spacing (default) normalises the objectives by a frame from anchor A and anchor
     B's *multistart* optimum, so chain A can start while B's tie-break still runs; the
     last point (epsilon = A at the tie-broken anchor B) is exact. Uniform or explicit
-    epsilon values need both tie-broken anchors before the first point.
+    epsilon values, and a fixed ``split``, need both tie-broken anchors before the first
+    point: the frame is then the front's own two ends (B's multistart optimum is one
+    point of a set when B's optimum is not unique).
     """
 
     def __init__(
@@ -103,8 +105,11 @@ class TwoChains:
         tie_a, ms_b, tie_b = f"anchor-{a}", f"anchor-{b}-ms", f"anchor-{b}"
         new: list[dict[str, Any]] = []
         if self.frame is None and tie_a in done and ms_b in done:
-            arc = self.spacing == "arc" and self.eps_values is None
-            if arc or tie_b in done:  # uniform or explicit epsilon need B's tie-break
+            # Uniform or explicit epsilon need B's tie-break; so does a fixed split: its
+            # frame then rests on the two ends of the front, not on whichever point of B's
+            # optimal set the multistart returned.
+            arc = self.spacing == "arc" and self.eps_values is None and self.split is None
+            if arc or tie_b in done:
                 rec_a = PointRecord.from_dict(done[tie_a])
                 check_anchor(rec_a, a)
                 far = PointRecord.from_dict(done[ms_b] if arc else done[tie_b])

@@ -17,23 +17,25 @@ import numpy as np
 
 
 def non_dominated(F: np.ndarray) -> np.ndarray:
-    """Boolean mask of the non-dominated rows of ``F`` (duplicates, equal to 1e-9
-    relative: the first is kept)."""
+    """Boolean mask of the non-dominated rows of ``F``.
+
+    Rows equal to 1e-9 relative are one point (two solves that reach the same design, a
+    catalogue front's epsilon limit that does not bind, differ by rounding only): the
+    first row of them is kept, and a row is dominated only by a row that is not such a
+    duplicate - so rounding never decides which of two equal points stays.
+    """
     F = np.asarray(F, dtype=float)
     n = len(F)
     keep = np.isfinite(F).all(axis=1)
     for i in range(n):
         if not keep[i]:
             continue
+        same = np.isclose(F, F[i], rtol=1e-9, atol=0.0).all(axis=1)
         le = (F <= F[i]).all(axis=1)
         lt = (F < F[i]).any(axis=1)
-        dominated_by = le & lt & keep
-        if dominated_by.any():
+        if (le & lt & keep & ~same).any():
             keep[i] = False
             continue
-        # two solves that reach the same design (a catalogue front's epsilon limit that
-        # does not bind) differ by rounding only: one point
-        same = np.isclose(F, F[i], rtol=1e-9, atol=0.0).all(axis=1)
         same[: i + 1] = False
         keep &= ~same
     return keep

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.multistart import best_of, sobol_starts
+from optdesign.solvers.multistart import best_of, improves, sobol_starts
 from optdesign.solvers.result import Result
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_from_result
@@ -202,7 +202,11 @@ def eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
             res = solver.solve(target, eps, solver.nlp.start(x0=x0))
             cand = _record(task, solver, res, "eps", target, eps)
             n_solves += 1
-            if cand.ok and (not rec.ok or cand.objectives[target] < rec.objectives[target]):
+            # a tie (1e-6 relative) keeps the earlier point: the warm start's, else the
+            # first start's - decided by value and order, not by rounding
+            if cand.ok and (
+                not rec.ok or improves(cand.objectives[target], rec.objectives[target])
+            ):
                 rec = cand
     if rec.ok and len(eps) == 1:
         rec.slope = solver.slope(target, next(iter(eps)), rec)
