@@ -45,6 +45,12 @@ ENUMERATE_MAX = 16
 PRUNE_TOL = 1e-6
 
 
+def cannot_improve(bound: float, incumbent: float) -> bool:
+    """Whether a node whose relaxation gives ``bound`` can be pruned: it cannot beat the
+    incumbent's objective by more than ``PRUNE_TOL`` (relative)."""
+    return bound >= incumbent - PRUNE_TOL * abs(incumbent)
+
+
 #: Sobol starts a node tries before it is called infeasible, when its own starts fail.
 RETRY_STARTS = 4
 
@@ -173,9 +179,7 @@ def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict]
     incumbent: Result | None = None
     while heap:
         bound, _, box, res = heapq.heappop(heap)
-        if incumbent is not None and bound >= incumbent.objective - PRUNE_TOL * abs(
-            incumbent.objective
-        ):
+        if incumbent is not None and cannot_improve(bound, incumbent.objective):
             stats["pruned"] += 1
             continue
         x = ns.x_of(res)
@@ -215,9 +219,7 @@ def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict]
             if not r.success:
                 stats["infeasible"] += 1
                 continue
-            if incumbent is not None and r.objective >= incumbent.objective - PRUNE_TOL * abs(
-                incumbent.objective
-            ):
+            if incumbent is not None and cannot_improve(r.objective, incumbent.objective):
                 stats["pruned"] += 1
                 continue
             heapq.heappush(heap, (r.objective, next(counter), child, r))
