@@ -105,6 +105,9 @@ cp "$ROOT/pyproject.toml" "$WORK/"
 } >"$WORK/setup.cfg"
 cd "$WORK"
 export MPLBACKEND=Agg
+# Tests that start `python -m optdesign` (signals, CLI) import the mutated tree too, not
+# an installed optdesign.
+export PYTHONPATH="$WORK/mutants${PYTHONPATH:+:$PYTHONPATH}"
 "$MUTMUT" run --max-children "${JOBS:-2}" >mutmut-run.log 2>&1 || true
 "$MUTMUT" results --all true >mutmut-results.txt 2>&1 || true
 "$PY" "$ROOT/benchmarks/mutation/summary.py" mutmut-results.txt
