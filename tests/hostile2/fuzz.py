@@ -1,7 +1,7 @@
 """A hypothesis fuzz of problem dicts through ``od.load`` / ``od.solve``.
 
 Each draw takes a shipped problem (as the dict a script passes to ``od.load``) and
-replaces, deletes or adds one to three fields with hostile values (non-finite and huge
+replaces, deletes or adds one to three fields (mostly one) with hostile values (non-finite and huge
 numbers, 400-digit integers, booleans, tables and lists where a number goes, quantities
 of the wrong dimension, control characters, paths). Each draw must end as a clear
 refusal (an OptDesignError naming a field it touched, or a failed result naming the
@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import re
 import signal
 import time
 import tomllib
@@ -37,6 +38,7 @@ HOSTILE: tuple[Any, ...] = (
     [1, [2]], {"a": 1}, {"min": "1 deg"}, ["1 mm", "2 mm"], "H7/s6", "R7/s6", "ma97",
 )  # fmt: skip
 NEW_KEYS = ("bogus", "\x1b[31m", "", "../x", "lock", "duty_cycle", "stiffness_min", "deflection_rate", "life_min", "values", "catalogue", "start", "output_file")  # fmt: skip
+_ORDER = {"requirements": 0, "screw": 1, "variables": 2, "materials": 3, "objective": 4}
 #: Seconds one draw may take.
 DRAW_TIMEOUT = 90
 
@@ -46,14 +48,47 @@ def bases() -> dict[str, dict[str, Any]]:
 
 
 def _leaves(d: Any, path: tuple = ()) -> list[tuple]:
+    """Paths of the scalar values, and of the tables two levels down (a variable's bounds:
+    replacing them fixes the variable, or breaks it)."""
     out = []
     items = d.items() if isinstance(d, dict) else enumerate(d) if isinstance(d, list) else []
     for k, v in items:
         here = (*path, k)
-        out.append(here)
         if isinstance(v, dict | list):
+            if len(here) == 2:
+                out.append(here)
             out += _leaves(v, here)
+        else:
+            out.append(here)
     return out
+
+
+_QUANTITY = re.compile(r"^\s*([-+]?[0-9.eE+-]+)\s*(.*)$")
+#: Factors and values that keep a field's unit but not its sense.
+_EXTREMES = (0.0, -1.0, 1e-300, 1e300, 1e-12, 1e12, math.nan, math.inf, -math.inf)
+
+
+def _near(original: Any):
+    """Values of the original's kind (the same unit) at magnitudes that make no sense."""
+    from hypothesis import strategies as st
+
+    plausible = st.sampled_from((0.1, 0.5, 0.9, 1.1, 2.0, 10.0))
+    factors = st.one_of(
+        plausible, plausible, st.sampled_from(_EXTREMES), st.floats(allow_nan=False, width=32)
+    )
+    if isinstance(original, bool):
+        return st.sampled_from((1, 0, "true", "yes"))
+    if isinstance(original, int | float):
+        x = float(original) if abs(original) < 1e300 else 1.0  # an earlier draw's 10**400
+        return st.one_of(
+            factors.map(lambda f: x * f if f not in (0.0, 1e-300, 1e300) else f),
+            st.sampled_from((10**400, -(10**400), 2**63, -1)),
+        )
+    m = _QUANTITY.match(original) if isinstance(original, str) else None
+    if m is None:
+        return st.sampled_from(HOSTILE)
+    x, unit = float(m.group(1)), m.group(2)
+    return factors.map(lambda f: f"{x * f if f not in (0.0, 1e-300, 1e300) else f!r} {unit}")
 
 
 def _tables(d: dict[str, Any], path: tuple = ()) -> list[tuple]:
@@ -88,7 +123,7 @@ def strategy():
         data = copy.deepcopy(originals[name])
         done: list[str] = []
         names: set[str] = set()
-        for _ in range(draw_(st.integers(1, 3))):
+        for _ in range(draw_(st.sampled_from((1, 1, 2, 3)))):
             op = draw_(st.sampled_from(("replace", "replace", "delete", "add")))
             if op == "add":
                 table = draw_(st.sampled_from(_tables(data)))
@@ -99,7 +134,9 @@ def strategy():
                 if not key and table:  # an empty key: the message names its table
                     names.add(str(table[-1]))
             else:
-                leaves = _leaves(data)
+                # the drive and the requirements first: hypothesis prefers early items,
+                # and the top-level name or mechanism would end most draws at the loader
+                leaves = sorted(_leaves(data), key=lambda p: _ORDER.get(str(p[0]), 9))
                 if not leaves:
                     continue
                 path = draw_(st.sampled_from(leaves))
@@ -107,7 +144,8 @@ def strategy():
                 if op == "delete":
                     del parent[path[-1]]
                 else:
-                    value = draw_(values)
+                    near = _near(parent[path[-1]])
+                    value = draw_(st.one_of(near, near, values))
                     parent[path[-1]] = value
             done.append(
                 f"{op} {'.'.join(map(str, path))}"
@@ -118,6 +156,8 @@ def strategy():
             keys = [p for p in path if not isinstance(p, int)]
             if keys:
                 names.add(str(keys[-1]))
+            if len(keys) >= 3:  # a band's min, a bound: naming the band or variable will do
+                names.add(str(keys[-2]))
         return name, data, done, names
 
     return draw()

@@ -239,7 +239,10 @@ def serve() -> None:
     chan.write("ready\n")
     for line in sys.stdin:
         req = json.loads(line)
-        res = execute_fuzz(req) if "fuzz" in req else execute(cases[req["case"]], req)
+        try:
+            res = execute_fuzz(req) if "fuzz" in req else execute(cases[req["case"]], req)
+        except Exception:  # the corpus's own bug: the parent raises it
+            res = {"harness_error": traceback.format_exc()}
         chan.write(json.dumps(res, default=str) + "\n")
 
 
@@ -324,7 +327,10 @@ class Server:
         self.proc.stdin.flush()
         line = self._readline(t0 + timeout + GRACE)
         if line is not None:
-            return json.loads(line)
+            res = json.loads(line)
+            if "harness_error" in res:
+                raise RuntimeError(f"the corpus itself failed:\n{res['harness_error']}")
+            return res
         seconds = time.monotonic() - t0
         code = self.proc.poll()
         if code is not None:
