@@ -5,7 +5,7 @@ the command line in the default output mode and with ``--json``, and through the
 API where it applies, plus the hypothesis fuzz of problem dicts; writes every run's
 verdict to OUT.json and prints the counts per class. Options: ``--classes 2,5`` (only
 those classes), ``--fast`` (the fast test's subset), ``--match TEXT``, ``--fuzz N`` (draws,
-default 100 for the whole corpus, else 0), ``--workdir DIR`` (keep the case folders), ``--quiet``.
+default 200 for the whole corpus, else 0), ``--workdir DIR`` (keep the case folders), ``--quiet``.
 """
 
 from __future__ import annotations

@@ -32,6 +32,7 @@ from hostile2.server import Server  # noqa: E402
 
 #: Fast cases that fail today, by name: empty it as the fixes of issue 21 land.
 KNOWN_FAILURES: set[str] = {
+    "1:od.pareto deterministic fork, workers 1 then 2 in one process (the README's failing test)",
     "2:output_file ../outside",
     "2:name x/../../../outside",
     "2:lock file a link outside",
@@ -156,12 +157,12 @@ def test_the_judge_is_not_blind(name, verdicts, server, tmp_path):
 
 @pytest.mark.slow
 def test_full_corpus(tmp_path):
-    """The whole corpus and 100 fuzz draws: every case gets a verdict, the counts add up,
+    """The whole corpus and 200 fuzz draws: every case gets a verdict, the counts add up,
     and no case that passed in the saved "before" run fails now (signals and
     determinism, which depend on timing, aside)."""
     out = tmp_path / "corpus2.json"
     proc = subprocess.run(
-        [sys.executable, str(HERE / "hostile_corpus2.py"), str(out), "--fuzz", "100", "--quiet"],
+        [sys.executable, str(HERE / "hostile_corpus2.py"), str(out), "--quiet"],
         capture_output=True,
         text=True,
         timeout=7200,

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from hostile2.common import PROBLEMS, base
+from hostile2.common import PROBLEMS, ROOT, base, solving
 from hostile2.model import SUCCESS, Case, either, refuse
 
 RIPPLE = base("cs_min_ripple")
@@ -14,14 +14,7 @@ BACKLASH = base("cs_min_backlash")
 CATALOGUE = base("cs_min_backlash_catalogue")
 
 
-def _solve(**kw: Any):
-    def api(ctx: Any) -> Any:
-        import optdesign as od
-
-        kw.setdefault("ranges", False)
-        return od.solve(od.load(ctx.data()), **kw)
-
-    return api
+_solve = solving
 
 
 def _pareto(objectives: Any = ("ripple", "size"), points: Any = 3, **kw: Any):
@@ -306,27 +299,18 @@ def _mech(
 
 
 def yoke_problem(key: str) -> dict[str, Any]:
-    """The README's Scotch-yoke problem for the mechanism ``key``."""
-    return {
-        "name": f"{key}_min_backlash",
-        "mechanism": key,
-        "variables": {
-            "R": {"lower": "30 mm", "upper": "120 mm"},
-            "p": {"lower": "2 mm", "upper": "10 mm"},
-            "phi0": {"lower": "-10 deg", "upper": "10 deg"},
-            "d": {"lower": "4 mm", "upper": "30 mm"},
-            "i_a": 2,
-            "pin_length_ratio": 1.5,
-        },
-        "requirements": {
-            "deflection": {"min": "-30 deg", "max": "30 deg", "points": 31},
-            "hinge_moment": "500 N*m",
-            "mean_ratio": {"min": 200, "max": 260},
-            "nut_travel_max": "110 mm",
-            "pin_bearing_pressure_max": "100 MPa",
-        },
-        "objective": {"minimize": "backlash"},
-    }
+    """The Scotch-yoke problem of examples/custom_mechanism.py (read, not imported: the
+    example registers its own mechanism) for the mechanism ``key``."""
+    import ast
+
+    tree = ast.parse((ROOT / "examples" / "custom_mechanism.py").read_text())
+    node = next(
+        n.value
+        for n in tree.body
+        if isinstance(n, ast.Assign) and getattr(n.targets[0], "id", "") == "PROBLEM"
+    )
+    data = ast.literal_eval(node)
+    return {**data, "name": f"{key}_min_backlash", "mechanism": key}
 
 
 def _mech_api(uf: UserFile, key: str, plot: bool = False, objective: str = "backlash"):

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from hostile2.common import base, sub
+from hostile2.common import base, solving, sub
 from hostile2.model import SUCCESS, Case
 
 RIPPLE = base("cs_min_ripple")
@@ -29,14 +29,8 @@ DRIVE = base("drive_continuous")
 
 
 def _solve(**kw: Any):
-    def api(ctx: Any) -> Any:
-        import optdesign as od
-
-        kw.setdefault("ranges", False)
-        kw.setdefault("starts", 4)
-        return od.solve(od.load(ctx.data()), **kw)
-
-    return api
+    kw.setdefault("starts", 4)
+    return solving(**kw)
 
 
 def _tol(a: float, b: float, rel: float = 1e-5) -> bool:

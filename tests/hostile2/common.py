@@ -57,10 +57,21 @@ def toml_str(s: str) -> str:
     return "".join(f"\\u{ord(c):04x}" if 0x7F <= ord(c) <= 0x9F else c for c in text)
 
 
-def api_solve(ctx: Any) -> Any:
-    import optdesign as od
+def solving(**kw: Any):
+    """An API form: the case's file as a dict through od.load, then od.solve(**kw) (no
+    ranges unless asked)."""
+    kw.setdefault("ranges", False)
 
-    return od.solve(od.load(ctx.data()), starts=1, ranges=False)
+    def api(ctx: Any) -> Any:
+        import optdesign as od
+
+        return od.solve(od.load(ctx.data()), **kw)
+
+    return api
+
+
+def api_solve(ctx: Any) -> Any:
+    return solving(starts=1)(ctx)
 
 
 def api_load(ctx: Any) -> Any:

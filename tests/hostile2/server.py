@@ -37,13 +37,20 @@ MEMORY_LIMIT = 6 << 30
 GRACE = 20.0
 
 
-def child_env(extra: dict[str, str] | None = None) -> dict[str, str]:
-    """The environment of a run: the repository and tests importable, Agg, one BLAS thread
-    (the machine is shared), no OPTDESIGN_DEBUG unless a case sets it."""
+def child_env(extra: dict[str, str] | None = None, one_thread: bool = True) -> dict[str, str]:
+    """The environment of a run: the repository and tests importable, Agg, no
+    OPTDESIGN_DEBUG unless a case sets it; ``one_thread``: one BLAS / OpenMP thread (the
+    machine is shared). The determinism cases run with the user's default threads: the
+    front of ``pareto --deterministic`` depends on them."""
     env = {k: v for k, v in os.environ.items() if k != "OPTDESIGN_DEBUG"}
     path = env.get("PYTHONPATH")
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), str(HERE.parent), *([path] if path else [])])
-    env.update(MPLBACKEND="Agg", OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    env["MPLBACKEND"] = "Agg"
+    if one_thread:
+        env.update(OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    else:
+        for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+            env.pop(k, None)
     env.update(extra or {})
     return env
 
