@@ -81,6 +81,13 @@ def _group_left(pgid: int) -> list[int]:
     return left
 
 
+def _default_signals() -> None:
+    # A runner started under nohup (or from a job that ignores SIGHUP) passes the ignored
+    # disposition on through exec: the command must see the signals a terminal sends.
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
+
+
 def signal_run(
     root: Path, argv: list[str], text: str | None, sig: int, group: bool, marker: str, delay: float
 ) -> dict[str, Any]:
@@ -96,6 +103,7 @@ def signal_run(
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         start_new_session=True,
+        preexec_fn=_default_signals,
     )
     readers = [_Reader(proc.stdout), _Reader(proc.stderr)]
     for r in readers:
