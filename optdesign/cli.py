@@ -70,6 +70,14 @@ def default_out(prefix: str) -> Path:
 
     stamp = time.strftime("%Y%m%d-%H%M%S")
     root = Path.cwd() / "optdesign-out"
+    # The parent is the program's choice, not the user's: a link planted there (or a file)
+    # would send the outputs elsewhere, so it must be a real folder or not exist yet.
+    if os.path.islink(root) or (os.path.lexists(root) and not root.is_dir()):
+        what = "a link" if os.path.islink(root) else "not a folder"
+        raise InputError(
+            "--out",
+            f"the default output folder's parent {root} is {what}: give --out, or remove it",
+        )
     base = root / f"{slug(prefix)}-{stamp}"
     path, k = base, 1
     while os.path.lexists(path):

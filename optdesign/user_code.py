@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import inspect
 import os
+import sys
 import sysconfig
 import traceback
 from collections.abc import Callable, Mapping
@@ -181,13 +182,51 @@ def raised(subject: str, who: str, exc: Exception, doing: str, fallback: Any = N
 
 
 def returned(
-    subject: str, who: str, fn: Any, reason: str, doing: str, advice: str
+    subject: str,
+    who: str,
+    fn: Any,
+    reason: str,
+    doing: str,
+    advice: str,
+    at: Location | None = None,
 ) -> UserCodeError:
-    """The :class:`UserCodeError` for an unusable value returned by ``fn``."""
+    """The :class:`UserCodeError` for an unusable value returned by ``fn`` (``at``: the
+    line of the ``return`` that gave it, when known)."""
     where = location_of(fn)
     message = f"{subject}: {who}" + (f" (defined at {where})" if where else "") + f" {reason}"
+    if at is not None:
+        message += f" at {at}"
+        where = at
     message += (f" {doing}" if doing else "") + f"; {advice}"
     return UserCodeError(message, subject, where)
+
+
+def return_line(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Location | None:
+    """The line of the ``return`` of ``fn`` (the user's own code object) when called with
+    these arguments again, found by a profile hook: an unusable value has no traceback to
+    point at. Only on the error path; the call's own failure (a second run may differ)
+    gives None."""
+    target = getattr(fn, "__func__", getattr(fn, "func", fn))
+    code = getattr(target, "__code__", None)
+    if code is None:
+        return None
+    seen: list[int] = []
+
+    def hook(frame: Any, event: str, arg: Any) -> None:
+        if event == "return" and frame.f_code is code:
+            seen.append(frame.f_lineno)
+
+    previous = sys.getprofile()
+    sys.setprofile(hook)
+    try:
+        fn(*args, **kwargs)
+    except Exception:
+        return None
+    finally:
+        sys.setprofile(previous)
+    if not seen:
+        return None
+    return Location(code.co_filename, seen[-1], code.co_qualname)
 
 
 def unusable(value: Any) -> str:
@@ -252,7 +291,8 @@ def call_function(fn: Callable[[Any], Any], q: Any, subject: str, doing: str | N
         raise raised(subject, who, exc, doing, fn) from exc
     reason = unusable(value)
     if reason:
-        raise returned(subject, who, fn, reason, doing, "return a number or an expression of q")
+        advice = "return a number or an expression of q"
+        raise returned(subject, who, fn, reason, doing, advice, return_line(fn, q))
     return value
 
 
@@ -284,6 +324,7 @@ def call_method(mechanism: Any, method: str, *args: Any, doing: str = "", **kwar
                 reason,
                 doing,
                 "return a number or an expression of phi (optdesign.math)",
+                return_line(fn, *args, **kwargs),
             )
     return value
 
@@ -310,7 +351,8 @@ def quantity_of(
                     "NaN: write the function with optdesign.math"
                 )
     if reason:
-        raise returned(subject, f"its function {describe_function(fn)}", fn, reason, doing, advice)
+        who = f"its function {describe_function(fn)}"
+        raise returned(subject, who, fn, reason, doing, advice, return_line(fn, q))
     return value
 
 

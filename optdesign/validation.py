@@ -464,6 +464,17 @@ def run_folder(out: Any, resume: bool, overwrite: bool) -> None:
         raise ArgumentError("overwrite", "excludes {resume} (start over, or continue)", ("resume",))
     if resume and out is None:
         raise ArgumentError("resume", "give the {out} folder of the run to resume", ("out",))
+    if out is not None:
+        from pathlib import Path
+
+        # the nearest part of the path that exists must be a folder (a file there fails
+        # only when the first result is written, after the work)
+        part = Path(out)
+        while not os.path.lexists(part) and part != part.parent:
+            part = part.parent
+        if os.path.lexists(part) and not part.is_dir():
+            where = "is" if part == Path(out) else f"is under {part}, which is"
+            raise ArgumentError("out", f"{shown(str(out))} {where} a file, not a folder")
 
 
 def method_for(problem: Any, method_: Any, argument: str = "method") -> None:

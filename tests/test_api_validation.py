@@ -380,3 +380,21 @@ def test_overwrite_starts_a_front_afresh_through_the_api(tmp_path):
         od.pareto(*args, points=3, out=tmp_path, workers=1)
     again = od.pareto(*args, points=3, out=tmp_path, workers=1, overwrite=True)
     assert again.F.tolist() == first.F.tolist()
+
+
+@pytest.mark.parametrize("under", [False, True])
+def test_an_out_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, under):
+    from optdesign.cli import main
+
+    sentinel = tmp_path / "results.txt"
+    sentinel.write_text("a file, not a folder\n")
+    out = sentinel / "run" if under else sentinel
+    fork = str(ROOT / "problems" / "fork_min_backlash.toml")
+    with pytest.raises(InputError, match=r"^out: .* a file, not a folder"):
+        od.pareto(fork, ["size", "backlash"], points=3, out=out)
+    with pytest.raises(InputError, match=r"^out: .* a file, not a folder"):
+        od.bench(problems=[fork], solvers=["ipopt-exact"], out=out)
+    argv = ["pareto", fork, "--objectives", "size,backlash", "--points", "3", "--out", str(out)]
+    assert main(argv) == 2
+    assert "--out: " in capsys.readouterr().err
+    assert sentinel.read_text() == "a file, not a folder\n"

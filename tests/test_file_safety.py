@@ -282,6 +282,31 @@ def test_solve_with_a_hostile_name_writes_only_into_optdesign_out(
     assert len(list((work / "optdesign-out").iterdir())) == 1
 
 
+@pytest.mark.parametrize("planted", ["link", "file"])
+def test_a_planted_optdesign_out_is_refused_before_any_work(tmp_path, monkeypatch, capsys, planted):
+    # ./optdesign-out is the program's folder: a link there would send the default output
+    # folder elsewhere (the target's tree), a file would fail late
+    work = tmp_path / "work"
+    work.mkdir()
+    target = tmp_path / "elsewhere"
+    target.mkdir()
+    monkeypatch.chdir(work)
+    if planted == "link":
+        (work / "optdesign-out").symlink_to(target)
+    else:
+        (work / "optdesign-out").write_text("not a folder\n")
+    problem = _problem(tmp_path, "planted")
+    code, _, err = _run(["solve", problem, *QUICK, "--no-plot"], capsys)
+    assert code == 2, err
+    assert "optdesign-out" in err and ("a link" if planted == "link" else "not a folder") in err
+    assert list(target.iterdir()) == []
+    code, _, err = _run(
+        ["pareto", problem, "--objectives", "size,backlash", "--points", "2"], capsys
+    )
+    assert code == 2 and "optdesign-out" in err, err
+    assert list(target.iterdir()) == []
+
+
 def test_pareto_with_a_hostile_name_writes_only_into_optdesign_out(tmp_path, monkeypatch, capsys):
     work = tmp_path / "a" / "work"
     work.mkdir(parents=True)

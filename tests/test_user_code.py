@@ -133,8 +133,9 @@ MECHANISM_BUGS = [
     (ZeroBug, line_of(ZeroBug.nut_position, 2), "ZeroBug.nut_position raised ZeroDivisionError"),
     (
         TextBug,
-        line_of(TextBug.nut_position, 0),
-        "TextBug.nut_position (defined at {where}) returned a str ('R sin(phi)')",
+        line_of(TextBug.nut_position),  # the line of its return
+        f"TextBug.nut_position (defined at {line_of(TextBug.nut_position, 0)}) returned a str "
+        "('R sin(phi)') at {where}",
     ),
     (
         SymbolicBug,
@@ -335,13 +336,14 @@ def unknown_quantity(q):
             none_objective,
             {},
             "objective 'bad': its function none_objective (test_user_code.none_objective) "
-            f"(defined at {line_of(none_objective, 0)}) returned None while trying it at the "
-            "middle of the bounds; return a number or an expression of q",
+            f"(defined at {line_of(none_objective, 0)}) returned None at "
+            f"{line_of(none_objective)} while trying it at the middle of the bounds; return a "
+            "number or an expression of q",
         ),
         (
             lambda q: "peak",
             {},
-            "returned a str ('peak') while trying it at the middle of the bounds",
+            "returned a str ('peak') at ",
         ),
         (
             lambda q: np.ones(3),
@@ -483,10 +485,20 @@ def test_add_constraint_refuses_a_second_constraint_of_the_same_name():
     problem = od.load(BACKLASH)
     problem.add_constraint("nut_force", lambda q: q.nut_force, upper="12 kN", unit="N")
     with pytest.raises(
-        InputError, match=r"add_constraint\.name: a constraint 'nut_force' exists already"
+        InputError, match=r"add_constraint\.name: 'nut_force' names a constraint of the problem"
     ):
         problem.add_constraint("nut_force", lambda q: q.nut_force, upper="11 kN", unit="N")
     assert [c.upper for c in problem.user_constraints] == [12_000.0]
+    # a requirement's rows, and an objective's limit, are constraints of the problem too
+    for taken in ("nut_travel", "transmission_angle", "pin_bearing_pressure"):
+        with pytest.raises(InputError, match=rf"add_constraint\.name: '{taken}' names a"):
+            problem.add_constraint(taken, lambda q: q.nut_force, upper="11 kN", unit="N")
+    # a refusal of another argument names the constraint being declared
+    with pytest.raises(InputError) as caught:
+        problem.add_constraint("nut_cap", lambda q: q.nut_force, upper="3 deg", unit="N")
+    assert str(caught.value) == (
+        "add_constraint.upper: '3 deg' is an angle, expected a force ('N') (constraint 'nut_cap')"
+    )
 
 
 @pytest.mark.parametrize(

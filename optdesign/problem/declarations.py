@@ -5,8 +5,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from optdesign.errors import InputError
@@ -28,10 +29,29 @@ def objective_declaration(
     """The arguments of :meth:`DesignProblem.add_objective`: a new name (an existing
     objective, a built-in one included, is replaced only with ``replace=True``), a
     function, units, a kind."""
+    where = "add_objective."
+    name(where + "name", name_)
+    with _naming("objective", name_):
+        _objective_arguments(
+            problem,
+            name_,
+            fn,
+            unit_,
+            kind,
+            description,
+            formula,
+            display_unit,
+            display_scale,
+            replace,
+        )
+
+
+def _objective_arguments(
+    problem, name_, fn, unit_, kind, description, formula, display_unit, display_scale, replace
+) -> None:
     from optdesign.problem.catalogue import BUILTIN_OBJECTIVES, KINDS
 
     where = "add_objective."
-    name(where + "name", name_)
     function(where + "fn", fn)
     unit(where + "unit", unit_)
     choice(where + "kind", kind, KINDS, "kind", optional=True)
@@ -65,12 +85,23 @@ def constraint_declaration(
     """The arguments of :meth:`DesignProblem.add_constraint`: a new name, a function,
     bounds (numbers in ``unit`` or quantity strings), ``over``; returns the bounds in
     ``unit``."""
+    where = "add_constraint."
+    name(where + "name", name_)
+    with _naming("constraint", name_):
+        return _constraint_arguments(problem, name_, fn, lower, upper, unit_, over, description)
+
+
+def _constraint_arguments(problem, name_, fn, lower, upper, unit_, over, description):
     from optdesign.units import convert
 
     where = "add_constraint."
-    name(where + "name", name_)
-    if any(c.name == name_ for c in problem.user_constraints):
-        raise ArgumentError(where + "name", f"a constraint {name_!r} exists already")
+    taken = {c.name for c in problem.user_constraints} | _row_names(problem)
+    if name_ in taken:
+        raise ArgumentError(
+            where + "name",
+            f"{name_!r} names a constraint of the problem already (a requirement or one "
+            "added before): choose another name",
+        )
     function(where + "fn", fn)
     unit(where + "unit", unit_)
     choice(where + "over", over, ("stroke", "design"), "over")
@@ -94,3 +125,27 @@ def _as_argument(convert: Callable[..., Any], *args: Any) -> Any:
         raise
     except InputError as exc:
         raise ArgumentError(exc.field, exc.reason) from None
+
+
+@contextlib.contextmanager
+def _naming(what: str, name_: str) -> Iterator[None]:
+    """A refusal of one of the declaration's other arguments also names the objective or
+    constraint being declared (a script may declare many)."""
+    try:
+        yield
+    except ArgumentError as exc:
+        if exc.argument.endswith(".name"):  # the refusal names it already
+            raise
+        raise ArgumentError(
+            exc.argument, f"{exc.template} ({what} {name_!r})", exc.mentions
+        ) from None
+
+
+def _row_names(problem: Any) -> set[str]:
+    """Names of the problem's constraint blocks (its requirements' rows, the objective
+    limits): a user's constraint of the same name would be confused with one in reports,
+    stores and the relaxations."""
+    expressions = problem.expressions(problem.design_dict(problem.midpoint()))
+    return {b.name for b in expressions.constraints} | {
+        f"{name}_max" for name in problem.objective_limits()
+    }

@@ -201,7 +201,12 @@ def check_csv(text: str) -> list[str]:
 _DATA = re.compile(
     r'<script type="application/json" id="report-data">(.*?)</script', re.DOTALL | re.IGNORECASE
 )
-_ESC_FUNCTION = re.compile(r"function esc\((\w+)\)\s*\{(.*?)\n", re.DOTALL)
+#: The page's escape of text into HTML: a function ``esc`` or an arrow function with its
+#: table of replacements on the line before (``const ESC = {...}; const esc = (s) =>``).
+_ESC_FUNCTION = re.compile(
+    r"(?:function esc\((\w+)\)\s*\{(.*?)\n|const ESC = (\{.*?\});\s*\n\s*const esc = )",
+    re.DOTALL,
+)
 
 
 def check_report(text: str, quote: bool = False) -> list[str]:
@@ -222,7 +227,8 @@ def check_report(text: str, quote: bool = False) -> list[str]:
             out.append(f"report.html's embedded JSON holds {bad!r} raw")
     if quote:
         esc = _ESC_FUNCTION.search(text)
-        if esc is None or not any(q in esc.group(2) for q in ("&quot;", "&#34;", "&#x22;")):
+        body_ = (esc and (esc.group(2) or esc.group(3))) or ""
+        if not any(q in body_ for q in ("&quot;", "&#34;", "&#x22;")):
             out.append('report.html escapes no " in text its script writes into attributes')
     return out
 
