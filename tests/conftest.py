@@ -34,3 +34,21 @@ settings.load_profile(os.environ.get("OPTDESIGN_HYPOTHESIS") or "deterministic")
 def paper_phi():
     """The paper's stroke, -30...+30 deg, on a dense grid (rad)."""
     return np.radians(np.linspace(-30.0, 30.0, 6001))
+
+
+@pytest.fixture(autouse=True)
+def _registries_restored():
+    """A solver back-end or benchmark configuration a test registers is gone after it:
+    the lists of known names (in refusals' messages, in the benchmark's default suite)
+    never depend on which tests ran before."""
+    from optdesign.solvers import registry
+    from optdesign.studies.bench import configs
+
+    registry.solver_names()  # the built-ins are registered at first use: before the copy
+    configs.default_configs()
+    solvers, bench = dict(registry._SOLVERS), dict(configs.CONFIGS)
+    yield
+    registry._SOLVERS.clear()
+    registry._SOLVERS.update(solvers)
+    configs.CONFIGS.clear()
+    configs.CONFIGS.update(bench)

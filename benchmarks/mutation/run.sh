@@ -99,6 +99,10 @@ cp "$ROOT/pyproject.toml" "$WORK/"
   # DESELECT: space-separated test ids left out (a test failing on the unmutated tree
   # stops mutmut's first pass).
   for t in ${DESELECT:-}; do printf '    --deselect\n    %s\n' "$t"; done
+  # The second hostile corpus runs its cases in a server process: it calls no mutated
+  # function in pytest's process (mutmut selects no mutant for it) and takes minutes.
+  printf '    --ignore\n    tests/test_hostile2.py\n'
+  printf '    --ignore\n    tests/hostile2\n'
   printf "also_copy =\n"
   for f in problems examples docs benchmarks README.md setup.py; do printf '    %s\n' "$f"; done
   echo "use_git_change_detection = false"
