@@ -91,16 +91,23 @@ def result_summary(result: Result) -> str:
     elif result.violated and problem is None:
         lines += ["", "violated constraints:"]
         lines += [f"  {r.describe()}" for r in result.violated[:25]]
-    relax = result.extra.get("relaxations")
+    diagnosis = result.diagnosis
+    relax = diagnosis.relaxations if diagnosis is not None and problem is not None else []
     if relax:
         lines += ["", "smallest change of one requirement that makes the problem feasible:"]
         lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, relax)]
+    if diagnosis is not None and diagnosis.basis and (relax or diagnosis.note):
+        lines.append(f"  (computed on {diagnosis.basis})")
+    if diagnosis is not None and diagnosis.note:
+        lines += ["", f"diagnosis: {diagnosis.note}"]
     if not result.success:
-        lines += [
-            "",
-            "no feasible design found"
-            + (": the requirements above conflict within the bounds" if result.violated else ""),
-        ]
+        if result.formulation == "fixed":
+            end = "the fixed design does not meet the requirements above"
+        else:
+            end = "no feasible design found" + (
+                ": the requirements above conflict within the bounds" if result.violated else ""
+            )
+        lines += ["", end]
         if not relax:
             lines.append(
                 "next: relax one of the violated requirements, or widen a bound at its limit"

@@ -76,8 +76,12 @@ class NodeSolver:
         plugin: str = "ipopt",
         options: Mapping[str, Any] | None = None,
         eps: Mapping[str, float] | None = None,
+        free_rows: tuple[int, ...] = (),
     ):
         self.problem = problem
+        #: Constraint rows left unbounded at every node (a requirement dropped, to find
+        #: which catalogue items the others allow: the diagnosis of an infeasible problem).
+        self.free_rows = np.asarray(free_rows, dtype=int)
         self.objective = objective or problem.objective_names[0]
         self.eps = dict(eps or {})
         names = _objective_set(problem, self.objective)
@@ -116,6 +120,12 @@ class NodeSolver:
             )
         params = self.problem.parameter_values(node)
         box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
+        if self.free_rows.size:
+            from dataclasses import replace
+
+            lbg, ubg = np.array(box.lbg, dtype=float), np.array(box.ubg, dtype=float)
+            lbg[self.free_rows], ubg[self.free_rows] = -np.inf, np.inf
+            box = replace(box, lbg=lbg, ubg=ubg)
         first = self.problem.start() if x_hint is None else np.asarray(x_hint, dtype=float)
         pts = [np.clip(first, lo, hi)]
         if self.starts > 1:
@@ -326,6 +336,17 @@ def solve_catalogue(
         f"catalogue items chosen: {items}; {bound}; {method}, {info['nlp_solves']} NLP solves"
     )
     return finish(problem, best, objective)
+
+
+def search(ns: NodeSolver, method: str = "auto") -> Result | None:
+    """The best catalogue design of the node solver's problem (enumeration or branch and
+    bound from the continuous relaxation), None when none is feasible."""
+    if method == "auto":
+        method = "enumerate" if n_combinations(ns.problem) <= ENUMERATE_MAX else "bnb"
+    root = ns.solve({})
+    if method == "enumerate":
+        return enumerate_catalogue(ns, ns.x_of(root))[0]
+    return branch_and_bound(ns, root)[0]
 
 
 def relaxation_bound(result: Result) -> float:
