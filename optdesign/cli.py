@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from optdesign.errors import OptDesignError
+from optdesign.errors import InfeasibleRequirementsError, OptDesignError
 from optdesign.interrupts import (
     Interrupted,
     exit_code,
@@ -176,7 +176,8 @@ def run_guarded(func: Callable[[], int | None]) -> int:
     Returns
     -------
     int
-        ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
+        ``func``'s code (0 for None); 1 for an :class:`InfeasibleRequirementsError` (no
+        feasible design, the requirements named); 2 for an :class:`OptDesignError` or an I/O error
         (disk full, no permission); 128 + signal number for SIGINT (130) / SIGTERM (143);
         1 for any other exception (one line; ``OPTDESIGN_DEBUG=1`` re-raises it).
     """
@@ -184,6 +185,9 @@ def run_guarded(func: Callable[[], int | None]) -> int:
     try:
         with interrupts_as_exceptions():
             code = func()
+    except InfeasibleRequirementsError as exc:  # no feasible design: a result, exit 1
+        print(f"optdesign: infeasible: {exc}", file=sys.stderr)
+        return 1
     except OptDesignError as exc:
         print(f"optdesign: error: {exc}", file=sys.stderr)
         return 2
