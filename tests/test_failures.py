@@ -362,6 +362,12 @@ REFUSED = {
         "",
         ["requirements.fit", "R7/s6", "interference"],
     ),
+    "tolerances on a catalogue problem": (
+        "cs_min_backlash_catalogue",
+        [],
+        '\n[tolerances]\nR = "0.05 mm"\n',
+        ["tolerances", "catalogue values"],
+    ),
     "a table-only fit on a continuous pin": (
         CS,
         [('fit = "H7/g6"', 'fit = "D10/s6"')],
@@ -424,3 +430,49 @@ def test_available_linear_solvers_come_from_ipopt_itself():
     assert runtime_library("linear_solver", "mumps") is None
     available = available_linear_solvers()
     assert "mumps" in available and "custom" not in available
+
+
+# --- edge values in every field of the drive sections (tests/drive_corpus.py) ----------
+def _refusal(case, path: Path) -> str | None:
+    """The API's refusal of a corpus case before any solve (None: accepted)."""
+    from optdesign.studies.solve import plan_solve
+
+    path.write_text(case.text)
+    try:
+        plan_solve(od.load(path))
+    except OptDesignError as exc:
+        return str(exc)
+    return None
+
+
+def test_drive_corpus_refusals_name_the_field(tmp_path):
+    """Every edge value the loader refuses names the field (or its table); a sample of
+    them through the command line, in both output modes, is one line with exit 2."""
+    from drive_corpus import drive_cases, run
+
+    refused = []
+    for k, case in enumerate(drive_cases()):
+        message = _refusal(case, tmp_path / f"c{k}.toml")
+        if message is not None:
+            assert any(n in message for n in case.names), (case.name, message)
+            refused.append(case)
+    assert len(refused) >= 700
+    for k, case in enumerate(refused[::40]):
+        for json_mode in (True, False):
+            v = run(case, tmp_path / f"cli{k}-{json_mode}", json_mode)
+            assert (v.code, v.verdict) == (2, "refused"), v
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("json_mode", [True, False], ids=["json", "text"])
+def test_drive_corpus_every_case_ends_cleanly(tmp_path, json_mode):
+    """Every case of the corpus - solved when accepted - ends refused, infeasible with
+    the violated requirements named, or a success with a finite objective."""
+    from collections import Counter
+
+    from drive_corpus import CLEAN, drive_cases, run
+
+    verdicts = [run(c, tmp_path / f"c{k}", json_mode) for k, c in enumerate(drive_cases())]
+    print(Counter(v.verdict for v in verdicts))
+    bad = [v for v in verdicts if v.verdict not in CLEAN]
+    assert not bad, "\n".join(f"{v.name}: {v.verdict} ({v.code}): {v.message}" for v in bad[:20])

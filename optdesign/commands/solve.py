@@ -62,10 +62,10 @@ def _solve(sub):
 def run_solve(args) -> int:
     from optdesign import storage
     from optdesign.problem import load_problem
-    from optdesign.studies.solve import solver_options
+    from optdesign.studies.solve import plan_solve
 
     problem = load_problem(args.file)
-    solver_options(problem, "ipopt")  # the file's Ipopt options, before the folder is made
+    plan_solve(problem, args.formulation)  # what needs no solve, before the folder is made
     write_files = args.out is not None or not args.json
     if not write_files:
         return _solve_and_report(args, problem, None)

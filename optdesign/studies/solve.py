@@ -373,6 +373,21 @@ def choose_formulation(problem: DesignProblem, requested: str = "auto") -> str:
     return "nlp"
 
 
+def plan_solve(problem: DesignProblem, requested: str = "auto") -> str:
+    """The formulation :func:`solve` will use, after the checks that need no solve (the
+    file's Ipopt options, a combination no formulation honours), so that a caller can
+    refuse before any work."""
+    name = choose_formulation(problem, requested)
+    solver_options(problem, "ipopt")
+    if name == "catalogue" and problem.spec.tolerances is not None and problem.free:
+        disc = ", ".join(v.name for v in problem.free if v.discrete)
+        raise ProblemError(
+            f"tolerances: robust design needs continuous variables, and {disc} take "
+            "catalogue values; remove [tolerances] for the nominal catalogue optimum"
+        )
+    return name
+
+
 def solve(
     problem: DesignProblem,
     formulation: str = "auto",
@@ -392,11 +407,10 @@ def solve(
     (:func:`check_fixed_design`). ``diagnose``: on a result with no feasible design, the
     smallest relaxation of each conflicting requirement (:mod:`optdesign.studies.
     diagnosis`)."""
+    name = plan_solve(problem, formulation)
     if not problem.free:
-        choose_formulation(problem, formulation)  # an unknown name is still refused
         result = check_fixed_design(problem, objective)
     else:
-        name = choose_formulation(problem, formulation)
         result = FORMULATIONS[name].run(
             problem,
             objective=objective,
