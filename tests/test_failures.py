@@ -257,6 +257,12 @@ REFUSED = {
         "",
         ["variables.d0", "needs d0"],
     ),
+    "a screw section without d0": (
+        CS,
+        [],
+        '\n[screw]\nkind = "ball"\n',
+        ["variables.d0", "needs the screw's diameter"],
+    ),
     "nut offset beyond the shaft": (
         FIN,
         [('nut_offset = "40 mm"', 'nut_offset = "400 mm"')],

@@ -11,7 +11,8 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
   life model would evaluate the linkage where the stroke never goes (extrapolated, or
   where it does not assemble);
 - ``[screw] catalogue`` with a ``kind`` the catalogue does not sell (HIWIN: ball screws);
-- a catalogue screw whose ``d0`` or ``p`` is missing, continuous, or whose declared values
+- a ``[screw]`` section without ``d0`` (its efficiency needs the mean diameter); a
+  catalogue screw whose ``d0`` or ``p`` is missing, continuous, or whose declared values
   (fixed, or the bounds of ``catalogue = ...``) hold no pair of the catalogue;
 - ``screw.nut_offset`` not shorter than ``screw.length`` (the nut outside the shaft);
 - a pin fit the chosen ISO 286 values cannot evaluate (``fit_values``), at a pin diameter
@@ -90,6 +91,12 @@ def _screw(problem: Any, screw: Any) -> None:
                 f"({screw.length:g} mm): the nut would sit outside the shaft"
             )
     if screw.catalogue is None:
+        if "d0" not in problem.by_name:
+            raise ProblemError(
+                "variables.d0: a [screw] section needs the screw's diameter d0 (its "
+                "efficiency follows from the lead and the mean diameter): declare d0, or a "
+                'catalogue screw ([screw] catalogue = "HIWIN")'
+            )
         return
     kinds = CATALOGUE_KINDS.get(screw.catalogue, ())
     if kinds and screw.kind not in kinds:
