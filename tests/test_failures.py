@@ -257,6 +257,12 @@ REFUSED = {
         "",
         ["variables.d0", "needs d0"],
     ),
+    "a reference pin of 0 mm": (
+        CS,
+        [],
+        '\n[reference]\nR = "80 mm"\nl = "120 mm"\nn = "60 mm"\np = "5 mm"\nphi0 = "0.1 rad"\nd = "0 mm"\n',
+        ["reference.d", "must be positive"],
+    ),
     "a screw section without d0": (
         CS,
         [],

@@ -15,6 +15,7 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
   catalogue screw whose ``d0`` or ``p`` is missing, continuous, or whose declared values
   (fixed, or the bounds of ``catalogue = ...``) hold no pair of the catalogue;
 - ``screw.nut_offset`` not shorter than ``screw.length`` (the nut outside the shaft);
+- a ``[reference]`` value of a positive variable (a length, a lead) that is not positive;
 - a pin fit the chosen ISO 286 values cannot evaluate (``fit_values``), at a pin diameter
   outside the tables, or whose clearance is negative (an interference: a pin joint needs a
   clearance, and the backlash model would subtract it);
@@ -48,6 +49,7 @@ def check_problem(problem: Any) -> None:
     data = spec.model_dump(mode="python", exclude={"variables", "solver"})
     _magnitudes(data, "")  # variables: read by optdesign.units; solver: Ipopt's own checks
     _duty_cycle(spec.requirements)
+    _reference(problem)
     if spec.screw is not None:
         _screw(problem, spec.screw)
     _fit(problem)
@@ -81,6 +83,21 @@ def _duty_cycle(req: Any) -> None:
                 f"deg lies outside the stroke (requirements.deflection, "
                 f"{math.degrees(lo):g} to {math.degrees(hi):g} deg)"
             )
+
+
+def _reference(problem: Any) -> None:
+    """A reference design's values where the models are defined (a pin of 0 mm is not)."""
+    from optdesign.problem.variables import UNITS, variable_table
+
+    reference = problem.spec.reference
+    if reference is None:
+        return
+    table = variable_table(problem.mechanism)
+    for name, value in reference.values().items():
+        info = table.get(name)
+        if info is not None and info.positive and not value > 0:
+            unit = UNITS[info.dimension]
+            raise ProblemError(f"reference.{name}: must be positive, got {value:g} {unit}".rstrip())
 
 
 def _screw(problem: Any, screw: Any) -> None:
