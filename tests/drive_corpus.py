@@ -19,21 +19,17 @@ nothing. ``python tests/drive_corpus.py [json|text]`` runs them all and prints t
 
 from __future__ import annotations
 
-import contextlib
 import copy
-import io
 import json
 import math
 import re
-import signal
 import sys
-import time
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from hostile_corpus import Case, _Hang, _on_alarm, _prepare, _Raw, dumps
+from hostile_corpus import Case, _prepare, _Raw, dumps, run_main
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"
@@ -229,34 +225,10 @@ class Verdict:
 def run(case: Case, tmp: Path, json_mode: bool) -> Verdict:
     """Run one case through ``optdesign.cli.main`` (``--json``, or the default mode with
     an output folder) and judge it."""
-    from optdesign.cli import main
-
     extra = ["--json"] if json_mode else ["--no-plot", "--out", "{tmp}/out"]
     case = copy.copy(case)
     case.argv = [*case.argv, *extra]
-    argv = _prepare(case, tmp)
-    out, err = io.StringIO(), io.StringIO()
-    old = signal.signal(signal.SIGALRM, _on_alarm)
-    signal.alarm(CASE_TIMEOUT)
-    t0 = time.perf_counter()
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                code: Any = main(argv)
-            except SystemExit as exc:
-                code = exc.code
-            except _Hang:
-                code = "hang"
-            except BaseException:
-                import traceback
-
-                traceback.print_exc(file=err)
-                code = "exception"
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
-    seconds = time.perf_counter() - t0
-    o, e = out.getvalue(), err.getvalue()
+    code, o, e, seconds = run_main(_prepare(case, tmp), CASE_TIMEOUT)
     lines = [ln for ln in e.strip().splitlines() if ln.strip() and "WARNING(" not in ln]
     message = lines[-1] if lines else ""
     verdict = _judge(case, code, o, e, json_mode)
