@@ -488,3 +488,20 @@ def test_drive_corpus_every_case_ends_cleanly(tmp_path, json_mode):
     print(Counter(v.verdict for v in verdicts))
     bad = [v for v in verdicts if v.verdict not in CLEAN]
     assert not bad, "\n".join(f"{v.name}: {v.verdict} ({v.code}): {v.message}" for v in bad[:20])
+
+
+def test_a_model_undefined_at_the_midpoint_prints_no_warning():
+    """A hinge moment that crushes every pin (Hertz's sqrt(D^2/4 - k F) of a negative at
+    the midpoint design, where the NLP takes its scales) builds its NLP without a
+    RuntimeWarning on stderr (the solve then reports the requirements it violates)."""
+    import warnings
+
+    from optdesign.formulations.nlp import build_nlp, typical
+
+    data = tomllib.loads(_text(CS, ('hinge_moment = "500 N*m"', 'hinge_moment = "1e12 N*m"')))
+    problem = od.load(data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert typical([math.nan, math.nan]) == 1.0 and typical([math.nan, -3.0]) == 3.0
+        nlp = build_nlp(problem)
+    assert nlp.g_names

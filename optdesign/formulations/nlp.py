@@ -295,8 +295,9 @@ class ConstraintRows:
 
 def typical(value) -> float:
     """Largest finite magnitude of ``value`` (1 when none): a row's or value's scale."""
-    with np.errstate(invalid="ignore"):
-        v = np.nanmax(np.abs(np.asarray(value, dtype=float)))
+    a = np.abs(np.asarray(value, dtype=float))
+    # NaN where a model is undefined at the scales' design; all NaN: no scale (no warning)
+    v = np.nanmax(a) if a.size and not np.isnan(a).all() else np.nan
     return float(v) if np.isfinite(v) and v > 0 else 1.0
 
 
@@ -351,7 +352,8 @@ def build_nlp(
     design.update(problem.parameter_design(dict(zip(defaults, ca.vertsplit(theta), strict=True))))
     ex = problem.expressions(design, guarded=True, first_order=first_order)
     mid = problem.midpoint()
-    ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
+    with np.errstate(all="ignore"):  # the scales' design may lie where a model is undefined
+        ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
     for name in names:
         if name not in ex.objectives:
             raise ProblemError(
