@@ -338,15 +338,46 @@ def solve_catalogue(
     return finish(problem, best, objective)
 
 
-def search(ns: NodeSolver, method: str = "auto") -> Result | None:
-    """The best catalogue design of the node solver's problem (enumeration or branch and
-    bound from the continuous relaxation), None when none is feasible."""
-    if method == "auto":
-        method = "enumerate" if n_combinations(ns.problem) <= ENUMERATE_MAX else "bnb"
+def first_feasible(ns: NodeSolver) -> Result | None:
+    """A feasible catalogue design of the node solver's problem, or None: branch and bound
+    from the continuous relaxation, depth first, stopping at the first feasible leaf (a
+    design, not the optimum; e.g. which items allow a requirement to be dropped)."""
+    dvars = discrete_variables(ns.problem)
     root = ns.solve({})
-    if method == "enumerate":
-        return enumerate_catalogue(ns, ns.x_of(root))[0]
-    return branch_and_bound(ns, root)[0]
+    stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []
+    while stack:
+        box, res = stack.pop()
+        worst, worst_d = None, ON_ITEM_TOL
+        for v in dvars:
+            _item, dist = nearest_item(
+                res.design[v.name], tuple(items_within(v.values, *box[v.name]))
+            )
+            if dist > worst_d:
+                worst, worst_d = v, dist
+        if worst is None:  # on items: the leaf with them fixed
+            items = {
+                v.name: nearest_item(
+                    res.design[v.name], tuple(items_within(v.values, *box[v.name]))
+                )[0]
+                for v in dvars
+            }
+            leaf = ns.solve(_fixed(items), ns.x_of(res))
+            if leaf.success:
+                return leaf
+            continue
+        allowed = items_within(worst.values, *box[worst.name])
+        sides = [side for side in branch(res.design[worst.name], allowed) if side]
+        children = []
+        for side in sides:
+            child = dict(box)
+            child[worst.name] = (side[0], side[-1])
+            r = ns.solve(child, ns.x_of(res))
+            if r.success:
+                children.append((r.objective, child, r))
+        # the better child on top of the stack (explored first)
+        for _, child, r in sorted(children, key=lambda c: -c[0]):
+            stack.append((child, r))
+    return None
 
 
 def relaxation_bound(result: Result) -> float:

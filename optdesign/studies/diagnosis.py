@@ -40,7 +40,9 @@ from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Re
 #: Items of each catalogue variable tried around the continuous best point, and the most
 #: combinations of them solved (nearest first).
 NEAREST_ITEMS = 3
-MAX_ITEM_COMBINATIONS = 8
+MAX_ITEM_COMBINATIONS = 4
+#: Ipopt iteration cap of the solve at each combination (the relaxations' own cap is 80).
+NODE_MAX_ITER = 150
 #: Combinations tried for each requirement beyond the nearest one.
 MAX_ALTERNATIVES = 3
 
@@ -154,7 +156,7 @@ def _catalogue(
     relax: bool,
 ) -> Diagnosis:
     from optdesign.formulations.discrete import discrete_variables, nearest_item
-    from optdesign.studies.catalogue import NodeSolver, search
+    from optdesign.studies.catalogue import NodeSolver, first_feasible
     from optdesign.studies.relaxation import Site, relaxations
     from optdesign.studies.verify import constraint_rows
 
@@ -167,7 +169,10 @@ def _catalogue(
         value = root.get(v.name)
         if value is not None and math.isfinite(value):
             x0[k] = value
-    ns = NodeSolver(problem, objective, 1, problem.spec.solver.seed, solver, options)
+    # Each combination is solved once, capped like the relaxations' solves: a best point
+    # to report, not an optimum (its infeasible solves are where Ipopt spends its time).
+    capped = {**(options or {}), "max_iter": NODE_MAX_ITER} if solver == "ipopt" else options
+    ns = NodeSolver(problem, objective, 1, problem.spec.solver.seed, solver, capped)
     tried: list[tuple[float, int, dict[str, float], Result]] = []
     for k, items in enumerate(_item_combinations(problem, dvars, x0)):
         box = {name: (v, v) for name, v in items.items()}
@@ -241,7 +246,7 @@ def _catalogue(
         # none of them: the catalogue search without the requirement (reached only then)
         rows = tuple(k for k, g in enumerate(ns.nlp.g_names) if g.split("[", 1)[0] == name)
         free = NodeSolver(problem, objective, 1, ns.seed, solver, options, free_rows=rows)
-        found = search(free)
+        found = first_feasible(free)
         if found is not None and found.design:
             items = {v.name: nearest_item(found.design[v.name], v.values)[0] for v in dvars}
             yield site(items, free.x_of(found), found.raw.get("z"))

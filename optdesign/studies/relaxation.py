@@ -12,7 +12,7 @@ conflicts only together with another one.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,7 +35,6 @@ def relaxations(
     box: Mapping[str, tuple[float, float]] | None = None,
     parameters: Mapping[str, float] | None = None,
     x_start: np.ndarray | None = None,
-    alternatives: Sequence[Site] = (),
     sites_for: Callable[[str, Callable[[Site], tuple[float | None, Any]]], Iterable[Site]]
     | None = None,
 ) -> list[Relaxation]:
@@ -64,15 +63,12 @@ def relaxations(
     x_start
         A design (free-variable vector) to start from, for a result of another
         formulation (GP, robust).
-    alternatives
-        Other sites (catalogue items) tried, in order, for a requirement whose removal
-        alone leaves no feasible design at ``box``; a relaxation found at one of them
-        says where (:attr:`Relaxation.at`).
     sites_for
-        Instead: the sites of each requirement, ``sites_for(name, at)``, where
-        ``at(site)`` is the smallest relaxation at a site and the design there ((None,
-        None) if removing the requirement is not enough) - e.g. the catalogue items
-        nearest the design of the continuous relaxation's smallest one.
+        Instead of ``box``: the sites of each requirement, tried in order,
+        ``sites_for(name, at)``, where ``at(site)`` is the smallest relaxation at a site
+        and the design there ((None, None) if removing the requirement is not enough) -
+        e.g. the catalogue items nearest the design of the continuous relaxation's
+        smallest one. A relaxation found at a site says where (:attr:`Relaxation.at`).
     """
     from optdesign.studies.solve import _objective_set, solver_for
 
@@ -96,8 +92,7 @@ def relaxations(
     z_best = result.raw.get("z")
     if z_best is not None and np.size(z_best) != nlp.z.numel():
         z_best = None  # another formulation's point (e.g. the robust NLP's)
-    primary = Site(box, parameters, x_start, z_best)
-    sites = [_Prepared(problem, nlp, site) for site in (primary, *alternatives)]
+    sites = [_Prepared(problem, nlp, Site(box, parameters, x_start, z_best))]
     base_names = [g.split("[", 1)[0] for g in nlp.g_names]
     out = []
     for name, row in list(names.items())[:max_requirements]:
@@ -155,7 +150,7 @@ def relaxations(
             if t_hi is not None:
                 break
         record = _record(row, hi_side, t_hi, count)
-        if t_hi is not None and used is not None and (used is not sites[0] or sites_for):
+        if t_hi is not None and used is not None:
             record.at = used.site.label
         out.append(record)
     return out
