@@ -24,6 +24,7 @@ import re
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import optdesign as od
@@ -262,6 +263,12 @@ REFUSED = {
         [],
         '\n[reference]\nR = "80 mm"\nl = "120 mm"\nn = "60 mm"\np = "5 mm"\nphi0 = "0.1 rad"\nd = "0 mm"\n',
         ["reference.d", "must be positive"],
+    ),
+    "a tolerance wider than its variable": (
+        "cs_min_backlash_robust",
+        [('R = "0.05 mm"', 'R = "20 mm"')],
+        "",
+        ["tolerances.R", "negative"],
     ),
     "a screw section without d0": (
         CS,
@@ -505,3 +512,45 @@ def test_a_model_undefined_at_the_midpoint_prints_no_warning():
         assert typical([math.nan, math.nan]) == 1.0 and typical([math.nan, -3.0]) == 3.0
         nlp = build_nlp(problem)
     assert nlp.g_names
+
+
+def test_a_solve_that_stops_early_is_not_called_infeasible(tmp_path, capsys):
+    """Ipopt stopped at its start (max_iter = 0): the diagnosis finds that the mean ratio
+    needs no change - a design meeting every requirement exists - and says the solve
+    missed it, instead of calling the requirements conflicting."""
+    path = tmp_path / "early.toml"
+    path.write_text(_text(CS, COARSE, extra="\n[solver]\nipopt = { max_iter = 0 }\n"))
+    code, out, _ = _run(capsys, "solve", path, "--json", *FAST)
+    doc = json.loads(out)
+    assert code == 1 and doc["status"] == "max_iterations"
+    assert "a design meeting every requirement as written exists" in doc["diagnosis"]["note"]
+    relax = {r["name"]: r for r in doc["diagnosis"]["relaxations"]}
+    assert relax["mean_ratio"]["needed"] == relax["mean_ratio"]["limit"]
+    code, out, _ = _run(capsys, "solve", path, "--out", tmp_path / "o", "--no-plot", *FAST)
+    assert code == 1 and "no feasible design found (the solver stopped: max_iterations)" in out
+    assert "conflict within the bounds" not in out
+    result = od.solve(path, starts=1, ranges=False)
+    assert "the solve missed it" in result.diagnosis.note
+
+
+def test_a_solution_stays_within_its_bounds():
+    """Ipopt relaxes its bounds by ~1e-8 of the scaled variable: over a span of 1e12 mm a
+    design came back 1e4 mm below its lower bound (a negative diameter); the design read
+    from the solution is held within the declared bounds."""
+    from optdesign.studies.solve import formulation_for
+
+    data = tomllib.loads(
+        _text(
+            CS,
+            (
+                'd = { lower = "4 mm", upper = "30 mm" }',
+                'd = { lower = "4 mm", upper = "1e12 mm" }',
+            ),
+        )
+    )
+    problem = od.load(data)
+    nlp = formulation_for(problem)
+    z = np.full(nlp.z.numel(), -1e-8)
+    x = nlp.x_from_z(z)
+    assert np.array_equal(x, problem.lower())
+    assert np.array_equal(nlp.x_from_z(np.full(nlp.z.numel(), 1 + 1e-8)), problem.upper())

@@ -224,7 +224,10 @@ class NLP:
 
     def x_from_z(self, z) -> np.ndarray:
         z = np.asarray(z, dtype=float).ravel()
-        return self.x_lo + self.x_span * z[: self.n_design]
+        # within the declared bounds: Ipopt relaxes its bounds by ~1e-8 (relative to the
+        # scaled variable), which over a span of 1e12 mm put a diameter 1e4 mm below 0
+        x = self.x_lo + self.x_span * z[: self.n_design]
+        return np.clip(x, self.x_lo, self.x_lo + self.x_span)
 
     def z_from_x(self, x, parameters: np.ndarray | None = None) -> np.ndarray:
         """Full start vector from a design: aux variables set to their tightest values

@@ -15,7 +15,8 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
   catalogue screw whose ``d0`` or ``p`` is missing, continuous, or whose declared values
   (fixed, or the bounds of ``catalogue = ...``) hold no pair of the catalogue;
 - ``screw.nut_offset`` not shorter than ``screw.length`` (the nut outside the shaft);
-- a ``[reference]`` value of a positive variable (a length, a lead) that is not positive;
+- a ``[reference]`` value of a positive variable (a length, a lead) that is not positive,
+  or a ``[tolerances]`` band that can take one below zero;
 - a pin fit the chosen ISO 286 values cannot evaluate (``fit_values``), at a pin diameter
   outside the tables, or whose clearance is negative (an interference: a pin joint needs a
   clearance, and the backlash model would subtract it);
@@ -50,6 +51,7 @@ def check_problem(problem: Any) -> None:
     _magnitudes(data, "")  # variables: read by optdesign.units; solver: Ipopt's own checks
     _duty_cycle(spec.requirements)
     _reference(problem)
+    _tolerances(problem)
     if spec.screw is not None:
         _screw(problem, spec.screw)
     _fit(problem)
@@ -98,6 +100,30 @@ def _reference(problem: Any) -> None:
         if info is not None and info.positive and not value > 0:
             unit = UNITS[info.dimension]
             raise ProblemError(f"reference.{name}: must be positive, got {value:g} {unit}".rstrip())
+
+
+def _tolerances(problem: Any) -> None:
+    """A tolerance leaves a positive variable positive in every sample: uniform within
+    +-band, normal (sigma = band/3) within +-2 band (6 sigma)."""
+    from optdesign.problem.variables import UNITS, variable_table
+
+    tolerances = problem.spec.tolerances
+    if tolerances is None:
+        return
+    table = variable_table(problem.mechanism)
+    for name, t in tolerances.variables().items():
+        info, var = table.get(name), problem.by_name.get(name)
+        if info is None or var is None or not info.positive:
+            continue
+        smallest = var.lower if var.free else var.value
+        reach = t.band if t.distribution == "uniform" else 2.0 * t.band
+        if not reach < smallest:
+            unit = UNITS[info.dimension]
+            raise ProblemError(
+                f"tolerances.{name}: a {t.distribution} band of {t.band:g} {unit} reaches "
+                f"{reach:g} {unit} from {name}'s smallest value {smallest:g} {unit}: a "
+                f"sample would make {name} negative (a tolerance is a small deviation)"
+            )
 
 
 def _screw(problem: Any, screw: Any) -> None:

@@ -96,7 +96,7 @@ def result_summary(result: Result) -> str:
     if relax:
         lines += ["", "smallest change of one requirement that makes the problem feasible:"]
         lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, relax)]
-    if diagnosis is not None and diagnosis.basis and (relax or diagnosis.note):
+    if relax and diagnosis.basis:
         lines.append(f"  (computed on {diagnosis.basis})")
     if diagnosis is not None and diagnosis.note:
         lines += ["", f"diagnosis: {diagnosis.note}"]
@@ -104,14 +104,18 @@ def result_summary(result: Result) -> str:
         if result.formulation == "fixed":
             end = "the fixed design does not meet the requirements above"
         else:
-            end = "no feasible design found" + (
-                ": the requirements above conflict within the bounds" if result.violated else ""
-            )
+            end = "no feasible design found"
+            if result.status != "infeasible":  # not proven: the solver stopped
+                end += f" (the solver stopped: {result.status})"
+            elif result.violated:
+                end += ": the requirements above conflict within the bounds"
         lines += ["", end]
-        if not relax:
+        if not relax and result.violated:
             lines.append(
                 "next: relax one of the violated requirements, or widen a bound at its limit"
             )
+        elif not relax:
+            lines.append("next: more starts (--starts), or widen a bound at its limit")
     elif bounds:
         names = ", ".join(sorted({b.name for b in bounds}))
         lines += ["", f"next: widening the bounds of {names} may improve the objective"]

@@ -60,19 +60,39 @@ def diagnose(
     ``relax=False``: the best point only, no relaxation (e.g. for an error message)."""
     if result.success:
         return result
+    result.diagnosis = _diagnosis(problem, result, solver, options, relax)
+    missed = [r for r in result.diagnosis.relaxations if r.needed == r.written]
+    if missed:
+        # a relaxation of nothing: the diagnosis met every requirement as written
+        where = f" with {missed[0].at}" if missed[0].at else ""
+        found = (
+            f"a design meeting every requirement as written exists{where} (found while "
+            f"relaxing {missed[0].name}): the solve missed it ({result.status}); more starts "
+            "(--starts) may find it"
+        )
+        old = result.diagnosis.note
+        result.diagnosis.note = f"{found}; {old}" if old else found
+    return result
+
+
+def _diagnosis(
+    problem: DesignProblem,
+    result: Result,
+    solver: str,
+    options: Mapping[str, Any] | None,
+    relax: bool,
+) -> Diagnosis:
     nlp_solver = _nlp_solver(solver)
     kind = result.formulation
     if kind == "fixed":
-        result.diagnosis = _fixed(problem, result)
-    elif kind.startswith("catalogue"):
-        result.diagnosis = _catalogue(problem, result, nlp_solver, options, relax)
-    elif kind == "gp":
-        result.diagnosis = _gp(problem, result, relax)
-    elif kind.startswith("robust"):
-        result.diagnosis = _robust(problem, result, nlp_solver, relax)
-    else:
-        result.diagnosis = _nlp(problem, result, nlp_solver, relax)
-    return result
+        return _fixed(problem, result)
+    if kind.startswith("catalogue"):
+        return _catalogue(problem, result, nlp_solver, options, relax)
+    if kind == "gp":
+        return _gp(problem, result, relax)
+    if kind.startswith("robust"):
+        return _robust(problem, result, nlp_solver, relax)
+    return _nlp(problem, result, nlp_solver, relax)
 
 
 def _nlp_solver(solver: str) -> str:
