@@ -554,3 +554,23 @@ def test_a_solution_stays_within_its_bounds():
     x = nlp.x_from_z(z)
     assert np.array_equal(x, problem.lower())
     assert np.array_equal(nlp.x_from_z(np.full(nlp.z.numel(), 1 + 1e-8)), problem.upper())
+
+
+def test_report_of_a_design_with_overflowing_quantities(tmp_path, capsys):
+    """A nut of 1e-11 N/um: the design's stiffness quantities overflow to inf; the
+    default mode still writes report.html (a non-finite number becomes null in its data)
+    instead of 'internal error: Out of range float values are not JSON compliant'."""
+    from drive_corpus import _set, bases
+    from hostile_corpus import dumps
+
+    from optdesign.reports.html import to_json
+
+    assert to_json({"x": [1.0, math.inf, math.nan]}) == '{"x": [1.0, null, null]}'
+    data, _ = bases()["cont"]
+    path = tmp_path / "soft.toml"
+    path.write_text(dumps(_set(data, ("screw", "nut_stiffness"), "1e-11 N/um")))
+    out_dir = tmp_path / "out"
+    code, out, _ = _run(capsys, "solve", path, "--out", out_dir, "--no-plot", *FAST)
+    assert code in (0, 1) and (out_dir / "report.html").exists()
+    code, out, _ = _run(capsys, "solve", path, "--json", *FAST)
+    assert code in (0, 1) and json.loads(out)["status"]

@@ -188,8 +188,11 @@ def front_report(problem: Any, fronts: Sequence[Any]) -> str:
 
 
 def to_json(data: Any) -> str:
-    """JSON for embedding in a <script> element (no ``</`` inside)."""
-    return json.dumps(data, allow_nan=False, default=_default).replace("</", "<\\/")
+    """JSON for embedding in a <script> element (no ``</`` inside); a non-finite number
+    (a quantity of an infeasible design that overflows) becomes null."""
+    from optdesign.solvers.result import clean_json
+
+    return json.dumps(clean_json(data), allow_nan=False, default=_default).replace("</", "<\\/")
 
 
 def _default(obj: Any) -> Any:
