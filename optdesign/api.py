@@ -43,6 +43,7 @@ def solve(
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
     agree: int | None = None,
+    diagnose: bool = True,
 ) -> Result:
     """The optimal design of ``problem``, with its evidence.
 
@@ -69,12 +70,18 @@ def solve(
     agree
         NLP multistart: stop once this many starts agree on the best value (default: the
         problem's ``[solver] agree``, 3); 0 runs every start.
+    diagnose
+        When no feasible design is found: the best point's violated requirements and
+        the smallest relaxation of each conflicting requirement (``result.diagnosis``),
+        for every formulation. A problem with no free variable is not optimised: its
+        fixed design is checked (formulation ``"fixed"``).
 
     Returns
     -------
     Result
         Status, objective, design, every objective at the design, active and violated
-        constraints, the independent check, the multistart record, bounds/certificates.
+        constraints, the independent check, the multistart record, bounds/certificates,
+        and for a result with no feasible design its diagnosis.
     """
     from optdesign.studies.solve import solve as run
 
@@ -88,6 +95,7 @@ def solve(
         options=options,
         ranges=ranges,
         agree=agree,
+        diagnose=diagnose,
     )
     problem = load(problem)
     validation.objective_of(problem, args["objective"])

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from optdesign import interrupts, validation
-from optdesign.errors import InputError, OptDesignError
+from optdesign.errors import InfeasibleRequirementsError, InputError, OptDesignError
 from optdesign.interrupts import (
     Interrupted,
     exit_code,
@@ -245,15 +245,19 @@ def run_guarded(func: Callable[[], int | None]) -> int:
     Returns
     -------
     int
-        ``func``'s code (0 for None); 2 for an :class:`OptDesignError` or an I/O error
-        (disk full, no permission); 128 + signal number for SIGINT (130), SIGTERM (143)
-        and SIGHUP (129); 1 for any other exception (one line; ``OPTDESIGN_DEBUG=1``
-        re-raises it).
+        ``func``'s code (0 for None); 1 for an :class:`InfeasibleRequirementsError` (no
+        feasible design, the requirements named); 2 for an :class:`OptDesignError` or an
+        I/O error (disk full, no permission); 128 + signal number for SIGINT (130),
+        SIGTERM (143) and SIGHUP (129); 1 for any other exception (one line;
+        ``OPTDESIGN_DEBUG=1`` re-raises it).
     """
     forget_store()
     try:
         with interrupts_as_exceptions():
             code = func()
+    except InfeasibleRequirementsError as exc:  # no feasible design: a result, exit 1
+        print(f"optdesign: infeasible: {printable(exc)}", file=sys.stderr)
+        return 1
     except OptDesignError as exc:
         if os.environ.get("OPTDESIGN_DEBUG") and exc.__cause__ is not None:
             # e.g. a user's function that raised: its own traceback, down to its file

@@ -134,6 +134,10 @@ ANGLE_EXPONENTS: dict[str, tuple[int, ...]] = {
 #: Largest magnitude accepted in internal units: 1e15 mm is a billion kilometres; beyond
 #: it a bound only breaks the solver's scaling (1e308 overflows to inf in the first sum).
 MAX_MAGNITUDE = 1e15
+#: Smallest nonzero magnitude accepted in internal units: 1e-12 mm is a hundredth of an
+#: atom; below it the models' products and quotients (a buckling load over a squared
+#: length, a compliance over a stiffness) overflow to inf and NaN.
+MIN_MAGNITUDE = 1e-12
 
 Bare = Literal["internal", "refuse"]
 
@@ -199,7 +203,11 @@ def to_internal(value: object, dimension: str, field: str, bare: Bare = "interna
     if isinstance(value, bool) or type(value).__name__ == "bool_":
         raise InputError(field, f"expected {_DIMENSION_NAMES[dimension]}, got a boolean")
     if isinstance(value, numbers.Real):
-        return _bare(float(value), _number_text(float(value)), dimension, field, bare)
+        try:
+            number = float(value)
+        except OverflowError:  # an integer of hundreds of digits
+            raise InputError(field, "an integer too large for a number is out of range") from None
+        return _bare(number, _number_text(number), dimension, field, bare)
     if isinstance(value, str):
         text = value.strip()
         fast = _fast_internal(text, dimension)
@@ -253,7 +261,7 @@ def _fast_internal(text: str, dimension: str) -> float | None:
         return None
     number = float(m.group(1))
     result = number * factor
-    if not (math.isfinite(number) and math.isfinite(result)) or abs(result) > MAX_MAGNITUDE:
+    if not (math.isfinite(number) and math.isfinite(result)) or not _in_range(result):
         return None  # pint's path gives the message
     return result
 
@@ -309,11 +317,20 @@ def _convert(q: Any, angle: float, shown: object, dimension: str, field: str) ->
     return result
 
 
+def _in_range(value: float) -> bool:
+    return value == 0.0 or MIN_MAGNITUDE <= abs(value) <= MAX_MAGNITUDE
+
+
 def _check_magnitude(value: float, shown: str, field: str, unit: str = "") -> None:
+    internal = f" {unit}" if unit and unit != "dimensionless" else ""
     if abs(value) > MAX_MAGNITUDE:
-        internal = f" {unit}" if unit and unit != "dimensionless" else ""
         raise InputError(
             field, f"{shown} is out of range (magnitude above {MAX_MAGNITUDE:g}{internal})"
+        )
+    if not _in_range(value):
+        raise InputError(
+            field,
+            f"{shown} is out of range (a nonzero magnitude below {MIN_MAGNITUDE:g}{internal})",
         )
 
 

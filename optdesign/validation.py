@@ -335,7 +335,7 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
     """The checked arguments of :func:`optdesign.solve`: ``formulation``, ``objective``
     (a string; the problem's names are checked by :func:`objective_of` once it is
     loaded), ``starts``, ``seed``, ``workers``, ``solver``, ``options``, ``ranges``,
-    ``agree``."""
+    ``agree``, ``diagnose``."""
     checked = _checked(
         {
             "formulation": formulation,
@@ -346,6 +346,7 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
             "solver": solver,
             "ranges": flag,
             "agree": agree,
+            "diagnose": flag,
         },
         arguments,
     )

@@ -514,15 +514,15 @@ def judge(case: Case, code: Any, out: str, err: str, seconds: float) -> Outcome:
     return o
 
 
-def run_case(case: Case, tmp: Path) -> Outcome:
-    """Run one case in this process through ``optdesign.cli.main``."""
+def run_main(argv: list[str], timeout: int = CASE_TIMEOUT) -> tuple[Any, str, str, float]:
+    """Run ``optdesign.cli.main(argv)`` in this process with its output captured and a
+    time limit: (exit code, or "hang" / "exception"; stdout; stderr; seconds)."""
     from optdesign.cli import main
 
-    argv = _prepare(case, tmp)
     out, err = io.StringIO(), io.StringIO()
     t0 = time.perf_counter()
     old = signal.signal(signal.SIGALRM, _on_alarm)
-    signal.alarm(CASE_TIMEOUT)
+    signal.alarm(timeout)
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
@@ -539,9 +539,18 @@ def run_case(case: Case, tmp: Path) -> Outcome:
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)
+    return code, out.getvalue(), err.getvalue(), time.perf_counter() - t0
+
+
+def run_case(case: Case, tmp: Path) -> Outcome:
+    """Run one case in this process through ``optdesign.cli.main``."""
+    argv = _prepare(case, tmp)
+    try:
+        code, out, err, seconds = run_main(argv)
+    finally:
         if case.setup == "readonly":
             (tmp / "ro").chmod(0o755)
-    return judge(case, code, out.getvalue(), err.getvalue(), time.perf_counter() - t0)
+    return judge(case, code, out, err, seconds)
 
 
 def run_cases(cases: list[Case], tmp: Path) -> list[Outcome]:

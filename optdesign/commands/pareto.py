@@ -7,6 +7,7 @@ points as they finish; ``--resume`` continues from them) to the output folder.
 from __future__ import annotations
 
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -88,8 +89,12 @@ def _pareto(sub):
 def run_pareto(args) -> int:
     from optdesign import storage
     from optdesign.problem import load_problem
+    from optdesign.studies.pareto.methods import check_front_problem
+    from optdesign.studies.solve import solver_options
 
     problem = load_problem(args.file)
+    check_front_problem(problem)  # before the output folder is made
+    solver_options(problem, "ipopt")
     with as_options(RENAMED):  # the checks of optdesign.pareto, before any work
         objectives = check.front_objectives(problem, args.objectives)
         methods = list(METHOD_NAMES) if args.method == "all" else check.names("method", args.method)
@@ -184,4 +189,25 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
     for note in notes:
         print(f"note: {printable(note)}")
     print("\nwrote " + ", ".join(printable(w) for w in wrote))
+    for front in fronts:
+        if not front.points:
+            line = printable(_no_point(problem, front))
+            print(f"optdesign: infeasible: {line}", file=sys.stderr)
     return 0 if all(f.points for f in fronts) else 1
+
+
+def _no_point(problem, front) -> str:
+    """Why a front has no point: the requirements its least violating design violates."""
+    import numpy as np
+
+    from optdesign.studies.diagnosis import violated_text
+
+    head = f"{front.method}: no feasible design"
+    designs = [p.design for p in front.rejected if p.design]
+    if not designs:
+        return head
+    X = np.array([[d[v.name] for v in problem.free] for d in designs])
+    worst = np.asarray(problem.evaluate(X).violation, dtype=float)
+    best = X[int(np.argmin(np.where(np.isfinite(worst), worst, np.inf)))]
+    shown = violated_text(problem, best)
+    return f"{head} among {len(designs)} designs; the least violating one: {shown or 'none'}"

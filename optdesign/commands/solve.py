@@ -67,10 +67,12 @@ def _solve(sub):
 def run_solve(args) -> int:
     from optdesign import storage
     from optdesign.problem import load_problem
+    from optdesign.studies.solve import plan_solve
 
     problem = load_problem(args.file)
     with as_options(RENAMED):  # before the output folder is made
         check.objective_of(problem, args.objective)
+    plan_solve(problem, args.formulation)  # what needs no solve, before the folder is made
     write_files = args.out is not None or not args.json
     if not write_files:
         return _solve_and_report(args, problem, None)
@@ -98,9 +100,8 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
             workers=args.workers,
             solver=args.solver,
             ranges=not args.no_ranges,
+            diagnose=not args.no_diagnosis,
         )
-        if not result.success and result.design and not args.no_diagnosis:
-            _diagnose(problem, result, args.solver)
     from optdesign.reports.result_json import result_json
 
     text = result_json(result)
@@ -120,7 +121,7 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
                 result.notes.append(failed)
                 text = result_json(result)
                 atomic_write_text(out / "result.json", text)
-        if not args.no_report:
+        if not args.no_report and result.design:
             from optdesign.reports.html import solve_report
 
             atomic_write_text(out / "report.html", solve_report(result))
@@ -132,15 +133,3 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
         if wrote:
             print("\nwrote " + ", ".join(printable(w) for w in wrote))
     return 0 if result.success else 1
-
-
-def _diagnose(problem, result, solver: str) -> None:
-    """The smallest relaxation of each violated requirement (NLP results only)."""
-    if not result.formulation.startswith("nlp") or any(v.discrete for v in problem.free):
-        return
-    from optdesign.studies.relaxation import relaxations
-
-    try:
-        result.extra["relaxations"] = relaxations(problem, result, solver=solver)
-    except Exception as exc:  # a diagnosis, not the result: never lose the report
-        result.notes.append(f"relaxations not computed: {exc}")

@@ -224,7 +224,10 @@ class NLP:
 
     def x_from_z(self, z) -> np.ndarray:
         z = np.asarray(z, dtype=float).ravel()
-        return self.x_lo + self.x_span * z[: self.n_design]
+        # within the declared bounds: Ipopt relaxes its bounds by ~1e-8 (relative to the
+        # scaled variable), which over a span of 1e12 mm put a diameter 1e4 mm below 0
+        x = self.x_lo + self.x_span * z[: self.n_design]
+        return np.clip(x, self.x_lo, self.x_lo + self.x_span)
 
     def z_from_x(self, x, parameters: np.ndarray | None = None) -> np.ndarray:
         """Full start vector from a design: aux variables set to their tightest values
@@ -297,7 +300,8 @@ class ConstraintRows:
 def typical(value) -> float:
     """Largest finite magnitude of ``value`` (1 when none): a row's or value's scale."""
     a = np.abs(np.asarray(value, dtype=float))
-    v = np.nanmax(a) if a.size and not np.isnan(a).all() else np.nan  # all NaN: no warning
+    # NaN where a model is undefined at the scales' design; all NaN: no scale (no warning)
+    v = np.nanmax(a) if a.size and not np.isnan(a).all() else np.nan
     return float(v) if np.isfinite(v) and v > 0 else 1.0
 
 
@@ -352,7 +356,8 @@ def build_nlp(
     design.update(problem.parameter_design(dict(zip(defaults, ca.vertsplit(theta), strict=True))))
     ex = problem.expressions(design, guarded=True, first_order=first_order)
     mid = problem.midpoint()
-    ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
+    with np.errstate(all="ignore"):  # the scales' design may lie where a model is undefined
+        ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
     for name in names:
         if name not in ex.objectives:
             raise ProblemError(

@@ -86,7 +86,7 @@ class PinJoint:
         require_positive("pin.E", self.E)
         if not m.is_symbolic(self.nu) and not 0.0 < float(self.nu) < 0.5:
             raise InputError("pin.nu", f"Poisson ratio must lie in (0, 0.5), got {self.nu!r}")
-        Fit.parse(self.fit, "pin.fit")
+        Fit.parse(self.fit, "pin.fit", values=self.values)
         if self.contact not in ("duan2017", "conforming"):
             raise InputError("pin.contact", f"{self.contact!r}: use 'duan2017' or 'conforming'")
 
@@ -104,7 +104,12 @@ class PinJoint:
 
             return clearance(self.fit, self.d, which, values="table")
         ratio = self.ratio_max if which == "max" else self.ratio_min
-        return Fit.parse(self.fit).clearance(self.d, which) * ratio
+        fit = Fit.parse(self.fit, values=self.values)
+        if not fit.has_smooth:
+            # A table-only fit (r, s, R, S letters) has no formula in d: the parameter is
+            # the table's clearance itself (mm), set per solve from the node's items.
+            return ratio + 0.0 * self.d
+        return fit.clearance(self.d, which) * ratio
 
     def clearance(self, F):
         """Effective clearance (mm) under normal force F (N): the fit's, plus the contact

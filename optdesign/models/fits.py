@@ -297,6 +297,16 @@ class Fit:
     def __str__(self) -> str:
         return f"{self.hole}{self.hole_grade}/{self.shaft}{self.shaft_grade}"
 
+    @property
+    def has_smooth(self) -> bool:
+        """Whether ISO 286-1's formulas give this fit (r, s, R, S and IT1..IT4 exist only
+        as table values)."""
+        letters = (self.hole in SMOOTH_HOLE_LETTERS, self.shaft in SMOOTH_SHAFT_LETTERS)
+        return all(letters) and not (
+            _smooth_reason(self.hole, self.hole_grade, True)
+            or _smooth_reason(self.shaft, self.shaft_grade, False)
+        )
+
     def hole_deviations(self, D, values: str = "smooth"):
         """(EI, ES) of the hole in um (``values``: "smooth" formulas or "table")."""
         _check_values(values)

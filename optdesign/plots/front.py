@@ -144,7 +144,8 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
         ax.grid(True, alpha=0.3)
     name = problem.name if problem is not None else ""
     ax.set_title(f"{plain(name)}: Pareto front (A, B...: designs sketched)", fontsize=10)
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:  # a front with no point has nothing to list
+        ax.legend(fontsize=7)
     if sketches and problem is not None:
         for k, i in enumerate(picks):
             sub = fig.add_subplot(gs[k % 2, 1 + k // 2])

@@ -262,6 +262,9 @@ class DesignProblem:
                 f"objective.minimize: unknown objective {unknown[0]!r} "
                 f"(known: {', '.join(self._objectives)})"
             )
+        from optdesign.problem.consistency import check_problem
+
+        check_problem(self)
 
     # --- user additions ----------------------------------------------------------------
     def add_objective(

@@ -144,8 +144,11 @@ def parameter_defaults(problem) -> dict[str, float]:
                 "requirements.fit_values: table values need pin diameters from a catalogue "
                 '(d = { catalogue = "ISO 2338", ... }); use "smooth" for a continuous d'
             )
-        out["fit_ratio_max"] = 1.0
-        out["fit_ratio_min"] = 1.0
+        if _fit(problem).has_smooth:
+            out["fit_ratio_max"] = 1.0
+            out["fit_ratio_min"] = 1.0
+        else:  # the parameter is the clearance itself: the catalogue's favourable one
+            out.update(_fit_ratios(problem, {}))
     screw = problem.spec.screw
     if screw is not None and screw.catalogue is not None:
         for field in SCREW_FIELDS:
@@ -178,19 +181,29 @@ def _items_in(values, lo, hi) -> list[float]:
     return [v for v in values if lo - tol <= v <= hi + tol]
 
 
-def _fit_ratios(problem, box) -> dict[str, float]:
-    from optdesign.fits import clearance
+def _fit(problem):
+    from optdesign.models.fits import Fit
 
+    return Fit.parse(problem.spec.requirements.fit, "requirements.fit", values="table")
+
+
+def _fit_ratios(problem, box) -> dict[str, float]:
+    """The table fit's parameters over the node's items: the table clearance over the
+    smooth one (the smallest ratio), or for a fit with no smooth formula the table
+    clearance itself (the smallest, mm)."""
     d = problem.by_name["d"]
     lo, hi = _range(problem, "d", box)
     items = _items_in(d.values if d.discrete else (d.value,), lo, hi)
-    fit = problem.spec.requirements.fit
+    fit = _fit(problem)
     out = {}
     for which in ("max", "min"):
         ratios = []
         for D in items:
-            smooth = float(clearance(fit, D, which, values="smooth"))
-            table = float(clearance(fit, D, which, values="table"))
+            table = float(fit.clearance(D, which, values="table"))
+            if not fit.has_smooth:
+                ratios.append(table)
+                continue
+            smooth = float(fit.clearance(D, which, values="smooth"))
             ratios.append(table / smooth if smooth > 0 else 1.0)
         out[f"fit_ratio_{which}"] = min(ratios) if ratios else 1.0
     return out

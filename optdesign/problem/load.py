@@ -119,6 +119,8 @@ def load_problem(path: str | Path) -> DesignProblem:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ProblemError(f"{path}: not valid TOML ({exc})") from None
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        raise ProblemError(f"{path}: not valid TOML ({' '.join(str(exc).split())[:120]})") from None
     except RecursionError:
         raise ProblemError(f"{path}: arrays or tables nested too deeply") from None
     data.setdefault("name", path.stem)
@@ -223,6 +225,7 @@ def problem_from_dict(
     """
     if not isinstance(data, dict):
         raise ProblemError(f"{source}: a problem is a table of sections, got {type(data).__name__}")
+    _check_raw(data, source)
     name = data.get("mechanism")
     if not isinstance(name, str):
         misspelt = [k for k in data if difflib.get_close_matches(str(k), ["mechanism"], 1, 0.6)]
@@ -265,6 +268,31 @@ def problem_from_dict(
     # Reports show numbers in the units the file wrote (degrees in, degrees out).
     problem.written_units = written_units(data)
     return problem
+
+
+#: Largest integer a problem accepts: every integer of the file is also used as a float
+#: somewhere (a count, a seed, a bound), and floats are exact up to 2**53.
+MAX_INTEGER = 2**53
+
+
+def _check_raw(data: Any, source: str, path: str = "") -> None:
+    """What no field accepts, refused before the schema sees it: an integer beyond
+    :data:`MAX_INTEGER` (a 400-digit number overflows the conversion to float) and a NUL
+    character in a key or a string (no name, unit or option contains one)."""
+    items = data.items() if isinstance(data, Mapping) else enumerate(data)
+    for key, value in items:
+        here = f"{path}[{key}]" if isinstance(key, int) else f"{path}.{key}" if path else key
+        if isinstance(key, str) and "\x00" in key:
+            raise ProblemError(f"{source}: {here!r}: a NUL character in a key")
+        if isinstance(value, Mapping | list | tuple):
+            _check_raw(value, source, here)
+        elif isinstance(value, str) and "\x00" in value:
+            raise ProblemError(f"{source}: {here}: a NUL character in the text")
+        elif isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
+            raise ProblemError(
+                f"{source}: {here}: an integer of about {int(value.bit_length() * 0.30103) + 1} digits is out of "
+                f"range (at most {MAX_INTEGER:,})"
+            )
 
 
 _UNIT_TEXT = re.compile(r"^\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*(.*?)\s*$")

@@ -18,6 +18,7 @@ import math
 from functools import cache
 from typing import Annotated, Any, Literal, get_args
 
+import numpy as np
 from pydantic import (
     AfterValidator,
     BaseModel,
@@ -78,16 +79,17 @@ class _Model(BaseModel):
     @model_validator(mode="before")
     @classmethod
     def _no_boolean_numbers(cls, data: Any) -> Any:
-        # pydantic reads true as 1 in a number field (`pin_shear_planes = true`): refused.
+        # pydantic reads true as 1 in a number field (`pin_shear_planes = true`): refused;
+        # and "yes" or 1 as true in a switch (`critical_speed = "yes"`): refused too.
         if isinstance(data, dict):
             for key, value in data.items():
                 info = cls.model_fields.get(key)
-                if (
-                    isinstance(value, bool)
-                    and info is not None
-                    and not _takes_bool(info.annotation)
-                ):
+                if info is None:
+                    continue
+                if isinstance(value, bool) and not _takes_bool(info.annotation):
                     raise ValueError(f"{key}: expected a number or a string, got {value}")
+                if info.annotation is bool and not isinstance(value, bool | np.bool_):
+                    raise ValueError(f"{key}: expected true or false, got {value!r}")
         return data
 
 
@@ -342,8 +344,11 @@ class Requirements(_Model):
     @field_validator("fit")
     @classmethod
     def _fit(cls, value: str) -> str:
+        # Any fit the ISO 286-2 tables give; whether the problem's values (smooth formulas
+        # for a continuous d) can evaluate it is checked with the problem
+        # (optdesign.problem.consistency).
         try:
-            Fit.parse(value)
+            Fit.parse(value, values="table")
         except InputError as exc:
             raise ValueError(exc.reason) from None
         return value
@@ -456,7 +461,7 @@ class Tolerances(_Model):
 
     fit: Literal["fixed", "uniform"] = "fixed"
     samples: int = Field(32, ge=1, le=2000)
-    seed: int = 0
+    seed: int = Field(0, ge=0, le=MAX_SEED)
     risk: Literal["cvar", "mean_std"] = "cvar"
     alpha: Dimensionless = Field(0.9, ge=0.0, lt=1.0)
     k: Dimensionless = Field(2.0, ge=0.0)

@@ -152,6 +152,8 @@ def parse_variable(
         return Variable(**make, value=value)
     lower = q(raw["lower"], "lower") if "lower" in raw else None
     upper = q(raw["upper"], "upper") if "upper" in raw else None
+    if lower is not None:  # also when a catalogue narrows the bounds to its items below
+        positive(lower, f"{field}.lower")
     values = None
     if "values" in raw or "catalogue" in raw:
         if "values" in raw:

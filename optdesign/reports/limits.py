@@ -229,7 +229,8 @@ def objective_where(rows: Iterable[Any]) -> list[str]:
 def relaxation_limits(problem: Any, items: Sequence[Any]) -> list[Limit]:
     """:class:`~optdesign.studies.relaxation.Relaxation` records as limits a user reads:
     ``limit`` as written, ``value`` the limit that makes the problem feasible (None:
-    relaxing it alone is not enough)."""
+    relaxing it alone is not enough), ``where`` the catalogue items it needs when they
+    are not the diagnosis' basis."""
     infos = block_infos(problem)
     out = []
     for r in items:
@@ -251,7 +252,8 @@ def relaxation_limits(problem: Any, items: Sequence[Any]) -> list[Limit]:
             lim = shown(written, unit, angle)
             need = None if needed is None else shown(needed, unit, angle)
         description = info.description if info is not None else ""
-        out.append(Limit(r.name, description, "relaxation", side, need or Shown(math.nan), lim))
+        at = [r.at] if getattr(r, "at", "") else []  # other catalogue items than the basis
+        out.append(Limit(r.name, description, "relaxation", side, need or Shown(math.nan), lim, at))
     return out
 
 
@@ -260,7 +262,8 @@ def relaxation_text(lim: Limit) -> str:
     what = _what(lim)
     if math.isnan(lim.value.value):
         return f"{what}: relaxing it alone gave no feasible design (it conflicts with others too)"
-    return f"{what}: {lim.side} {lim.limit.text()} -> {lim.value.text()}"
+    at = f" (with {', '.join(lim.where)})" if lim.where else ""
+    return f"{what}: {lim.side} {lim.limit.text()} -> {lim.value.text()}{at}"
 
 
 def _what(lim: Limit) -> str:
@@ -276,34 +279,11 @@ def _decreasing(f: Callable[[Any], Any], x: float) -> bool:
 
 
 def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5, ev: Any = None):
-    """(active, violated) constraint reports of any design on the NumPy path: a row is
-    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond.
-    ``ev``: the design's ``problem.evaluate`` when the caller has it already."""
-    from optdesign.problem.design_problem import relative_violation
-    from optdesign.solvers.result import ConstraintReport
+    """(active, violated) constraint reports of any design on the NumPy path (see
+    :func:`optdesign.studies.verify.constraint_rows`)."""
+    from optdesign.studies.verify import constraint_rows
 
-    if ev is None:
-        ev = problem.evaluate(np.array([design[v.name] for v in problem.free], dtype=float))
-    active, violated = [], []
-    for name, block in ev.constraints.items():
-        values = np.atleast_1d(np.asarray(block.values, dtype=float))
-        lo, hi = block.lower, block.upper
-        labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
-        viol = relative_violation(values, lo, hi)
-        for k, v in enumerate(values):
-            label = f"{name}[{labels[k]}]" if labels[k] else name
-            gap = min(
-                abs(v - lo) / max(1.0, abs(lo)) if lo is not None else math.inf,
-                abs(v - hi) / max(1.0, abs(hi)) if hi is not None else math.inf,
-            )
-            if viol[k] > rel:
-                amount = max(
-                    (lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0
-                )
-                violated.append(ConstraintReport(label, float(v), lo, hi, float(amount)))
-            elif gap <= rel:
-                active.append(ConstraintReport(label, float(v), lo, hi, 0.0))
-    return active, violated
+    return constraint_rows(problem, design, rel, ev)
 
 
 def binding_angles(rows: Iterable[Any]) -> dict[str, list[float]]:

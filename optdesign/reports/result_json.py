@@ -69,18 +69,22 @@ def result_document(result: Result) -> dict[str, Any]:
         limits += bound_limits(problem, result.design)
     doc["limits"] = [lim.to_json() for lim in limits]
     doc["violated"] = [lim.to_json() for lim in limits_of(problem, result.violated)]
-    relax = result.extra.get("relaxations")
-    if relax:
-        doc["relaxations"] = [
+    diagnosis = result.diagnosis
+    if diagnosis is not None:
+        relax = [
             {
                 "name": lim.name,
                 "description": lim.description,
                 "side": lim.side,
                 "limit": lim.limit.to_json(),
                 "needed": lim.value.to_json(),
+                "at": lim.where[0] if lim.where else "",
             }
-            for lim in relaxation_limits(problem, relax)
+            for lim in relaxation_limits(problem, diagnosis.relaxations)
         ]
+        if relax:
+            doc["relaxations"] = relax
+        doc["diagnosis"] = {"basis": diagnosis.basis, "note": diagnosis.note, "relaxations": relax}
     if result.bound is not None:
         doc["bound"] = objective_shown(problem, name, result.bound).to_json()
     if result.certificate is not None:

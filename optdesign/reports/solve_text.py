@@ -94,20 +94,31 @@ def result_summary(result: Result) -> str:
     elif result.violated and problem is None:
         lines += ["", "violated constraints:"]
         lines += [f"  {printable(r.describe())}" for r in result.violated[:25]]
-    relax = result.extra.get("relaxations")
+    diagnosis = result.diagnosis
+    relax = diagnosis.relaxations if diagnosis is not None and problem is not None else []
     if relax:
         lines += ["", "smallest change of one requirement that makes the problem feasible:"]
         lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, relax)]
+    if relax and diagnosis.basis:
+        lines.append(f"  (computed on {diagnosis.basis})")
+    if diagnosis is not None and diagnosis.note:
+        lines += ["", f"diagnosis: {diagnosis.note}"]
     if not result.success:
-        lines += [
-            "",
-            "no feasible design found"
-            + (": the requirements above conflict within the bounds" if result.violated else ""),
-        ]
-        if not relax:
+        if result.formulation == "fixed":
+            end = "the fixed design does not meet the requirements above"
+        else:
+            end = "no feasible design found"
+            if result.status != "infeasible":  # not proven: the solver stopped
+                end += f" (the solver stopped: {result.status})"
+            elif result.violated:
+                end += ": the requirements above conflict within the bounds"
+        lines += ["", end]
+        if not relax and result.violated:
             lines.append(
                 "next: relax one of the violated requirements, or widen a bound at its limit"
             )
+        elif not relax:
+            lines.append("next: more starts (--starts), or widen a bound at its limit")
     elif bounds:
         names = ", ".join(sorted({printable(b.name) for b in bounds}))
         lines += ["", f"next: widening the bounds of {names} may improve the objective"]

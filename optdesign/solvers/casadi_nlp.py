@@ -91,8 +91,8 @@ _IPOPT_STATUS = {
 
 
 @lru_cache(maxsize=1)
-def ipopt_option_names() -> frozenset[str]:
-    """Every option this Ipopt build knows, read from Ipopt's own documentation output."""
+def ipopt_documentation() -> str:
+    """Ipopt's own documentation of its options (this build's), as text."""
     x = ca.MX.sym("x")
     buf = io.StringIO()
     opts = {
@@ -108,8 +108,77 @@ def ipopt_option_names() -> frozenset[str]:
             "options", "ipopt", {"x": x, "f": x**2}, {"ipopt": opts, "print_time": False}
         )
         solver(x0=1.0)
-    names = frozenset(re.findall(r"^([a-z]\w*)\s{2,}", buf.getvalue(), re.MULTILINE))
+    return buf.getvalue()
+
+
+@lru_cache(maxsize=1)
+def ipopt_option_names() -> frozenset[str]:
+    """Every option this Ipopt build knows, read from Ipopt's own documentation output."""
+    names = frozenset(re.findall(r"^([a-z]\w*)\s{2,}", ipopt_documentation(), re.MULTILINE))
     return names | {"sb"}  # "sb" (suppress the banner) is undocumented
+
+
+#: Options that name a shared library for Ipopt to load: a problem file may not set them
+#: (loading a library runs its code, and a missing one crashed the process).
+LIBRARY_OPTIONS = ("hsllib", "pardisolib")
+
+
+def _option_block(name: str) -> str:
+    doc = ipopt_documentation()
+    m = re.search(rf"^{re.escape(name)}\s{{2,}}.*?(?=^[a-z]\w*\s{{2,}}\(|\Z)", doc, re.M | re.S)
+    return m.group(0) if m else ""
+
+
+@lru_cache(maxsize=64)
+def runtime_library(option: str, value: str) -> str | None:
+    """The library Ipopt loads at run time for ``option = value`` (e.g. ``libhsl.so`` for
+    ``linear_solver = "ma97"``), read from Ipopt's documentation; None if it loads none."""
+    block = _option_block(option)
+    m = re.search(
+        rf"^\s+- {re.escape(value)}\s+\[(.*?)\](?=\s*(?:^\s+- |\Z|^\S))", block, re.M | re.S
+    )
+    if m is None:
+        return None
+    text = " ".join(m.group(1).split())
+    if "library" not in text or "runtime" not in text.replace("run time", "runtime"):
+        return None
+    holder = "pardisolib" if "pardiso" in text.lower() else "hsllib"
+    default = re.search(r'\("([^"]+)"\)', _option_block(holder))
+    return default.group(1) if default else None
+
+
+@lru_cache(maxsize=16)
+def library_loads(name: str) -> bool:
+    """Whether the shared library ``name`` loads (the dynamic loader's search, as Ipopt's)."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(name)
+    except OSError:
+        return False
+    return True
+
+
+def option_choices(option: str) -> list[str]:
+    """The values Ipopt's documentation lists for a choice option."""
+    return re.findall(r"^\s+- (\S+)\s+\[", _option_block(option), re.M)
+
+
+@lru_cache(maxsize=1)
+def available_linear_solvers() -> tuple[str, ...]:
+    """The ``linear_solver`` values this Ipopt build can use: its documented choices whose
+    run-time library (HSL, Pardiso) is installed and that Ipopt accepts."""
+    out = []
+    for value in option_choices("linear_solver"):
+        lib = runtime_library("linear_solver", value)
+        if lib is not None and not library_loads(lib):
+            continue
+        try:
+            _try_ipopt_option("linear_solver", value, "linear_solver")
+        except InputError:
+            continue
+        out.append(value)
+    return tuple(out)
 
 
 def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt") -> None:
@@ -134,6 +203,20 @@ def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt")
             raise InputError(where, f"unknown Ipopt option{hint}")
         if isinstance(value, bool) or not isinstance(value, str | int | float):
             raise InputError(where, f"expected a number or a string, got {value!r}")
+        if key in LIBRARY_OPTIONS:
+            raise InputError(
+                where,
+                "a problem file may not name a library for Ipopt to load (loading runs its "
+                "code); install it where the loader finds the default name",
+            )
+        lib = runtime_library(key, value) if isinstance(value, str) else None
+        if lib is not None and not library_loads(lib):
+            # Trying it is not safe: Ipopt refuses it, then its solver object crashes the
+            # process when it is freed (ma97).
+            choices = ""
+            if key == "linear_solver":
+                choices = f"; available: {', '.join(available_linear_solvers())}"
+            raise InputError(where, f"{value!r} needs {lib}, which is not installed{choices}")
         _try_ipopt_option(key, value, where)
 
 

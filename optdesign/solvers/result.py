@@ -95,6 +95,61 @@ class Certificate:
 
 
 @dataclass
+class Relaxation:
+    """The smallest change of one requirement that makes the problem feasible, in the
+    requirement rows' own (internal) quantity; reports show it as the user wrote it
+    (:func:`optdesign.reports.limits.relaxation_limits`).
+
+    Attributes
+    ----------
+    name
+        The requirement (constraint block) name.
+    upper
+        True when its upper limit must rise, False when its lower limit must fall.
+    written, needed
+        The row limit as written and the one that makes the problem feasible (None:
+        relaxing this requirement alone gave no feasible design).
+    lower_row, upper_row
+        Both row bounds as written (for showing a band ``|x| <= a`` as its magnitude).
+    solves
+        Solves spent on it.
+    at
+        Where it holds when not at the diagnosis' basis (other catalogue items), else "".
+    """
+
+    name: str
+    upper: bool
+    written: float
+    needed: float | None
+    lower_row: float | None = None
+    upper_row: float | None = None
+    solves: int = 0
+    at: str = ""
+
+
+@dataclass
+class Diagnosis:
+    """Why no feasible design was found: the smallest relaxation of each conflicting
+    requirement, what they were computed on, or why there are none.
+
+    Attributes
+    ----------
+    relaxations
+        One record per requirement in the conflict (empty when none was computed).
+    basis
+        What the relaxations rest on, in words (``"the NLP"``, ``"the catalogue items
+        d = 6 mm, p = 2 mm"``, ``"the fixed design"``).
+    note
+        Why no relaxation is given, or what a reader must know about them (empty if
+        nothing).
+    """
+
+    relaxations: list[Relaxation] = field(default_factory=list)
+    basis: str = ""
+    note: str = ""
+
+
+@dataclass
 class Result:
     """Outcome of one optimisation, whatever the solver.
 
@@ -121,6 +176,9 @@ class Result:
         How the starts went.
     ranges
         Range of each free variable over the (near-)optimal set, when computed.
+    diagnosis
+        For a result with no feasible design: the relaxations of the conflicting
+        requirements (:class:`Diagnosis`), when computed.
     notes
         Plain-language remarks for the summary.
     """
@@ -146,6 +204,7 @@ class Result:
     certificate: Certificate | None = None
     multistart: MultistartInfo | None = None
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    diagnosis: Diagnosis | None = None
     problem: str = ""
     mechanism: str = ""
     notes: list[str] = field(default_factory=list)

@@ -82,8 +82,12 @@ class NodeSolver:
         plugin: str = "ipopt",
         options: Mapping[str, Any] | None = None,
         eps: Mapping[str, float] | None = None,
+        free_rows: tuple[int, ...] = (),
     ):
         self.problem = problem
+        #: Constraint rows left unbounded at every node (a requirement dropped, to find
+        #: which catalogue items the others allow: the diagnosis of an infeasible problem).
+        self.free_rows = np.asarray(free_rows, dtype=int)
         self.objective = objective or problem.objective_names[0]
         self.eps = dict(eps or {})
         names = _objective_set(problem, self.objective)
@@ -122,6 +126,12 @@ class NodeSolver:
             )
         params = self.problem.parameter_values(node)
         box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
+        if self.free_rows.size:
+            from dataclasses import replace
+
+            lbg, ubg = np.array(box.lbg, dtype=float), np.array(box.ubg, dtype=float)
+            lbg[self.free_rows], ubg[self.free_rows] = -np.inf, np.inf
+            box = replace(box, lbg=lbg, ubg=ubg)
         first = self.problem.start() if x_hint is None else np.asarray(x_hint, dtype=float)
         pts = [np.clip(first, lo, hi)]
         if self.starts > 1:
@@ -331,6 +341,48 @@ def solve_catalogue(
         f"catalogue items chosen: {items}; {bound}; {method}, {info['nlp_solves']} NLP solves"
     )
     return finish(problem, best, objective)
+
+
+def first_feasible(ns: NodeSolver) -> Result | None:
+    """A feasible catalogue design of the node solver's problem, or None: branch and bound
+    from the continuous relaxation, depth first, stopping at the first feasible leaf (a
+    design, not the optimum; e.g. which items allow a requirement to be dropped)."""
+    dvars = discrete_variables(ns.problem)
+    root = ns.solve({})
+    stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []
+    while stack:
+        box, res = stack.pop()
+        worst, worst_d = None, ON_ITEM_TOL
+        for v in dvars:
+            _item, dist = nearest_item(
+                res.design[v.name], tuple(items_within(v.values, *box[v.name]))
+            )
+            if dist > worst_d:
+                worst, worst_d = v, dist
+        if worst is None:  # on items: the leaf with them fixed
+            items = {
+                v.name: nearest_item(
+                    res.design[v.name], tuple(items_within(v.values, *box[v.name]))
+                )[0]
+                for v in dvars
+            }
+            leaf = ns.solve(_fixed(items), ns.x_of(res))
+            if leaf.success:
+                return leaf
+            continue
+        allowed = items_within(worst.values, *box[worst.name])
+        sides = [side for side in branch(res.design[worst.name], allowed) if side]
+        children = []
+        for side in sides:
+            child = dict(box)
+            child[worst.name] = (side[0], side[-1])
+            r = ns.solve(child, ns.x_of(res))
+            if r.success:
+                children.append((r.objective, child, r))
+        # the better child on top of the stack (explored first)
+        for _, child, r in sorted(children, key=lambda c: -c[0]):
+            stack.append((child, r))
+    return None
 
 
 def relaxation_bound(result: Result) -> float:

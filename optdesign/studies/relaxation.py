@@ -12,40 +12,15 @@ conflicts only together with another one.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from optdesign.solvers.result import Relaxation
 
-@dataclass
-class Relaxation:
-    """The smallest change of one requirement that makes the problem feasible, in the
-    requirement rows' own (internal) quantity; reports show it as the user wrote it
-    (:func:`optdesign.reports.limits.relaxation_limits`).
-
-    Attributes
-    ----------
-    name
-        The requirement (constraint block) name.
-    upper
-        True when its upper limit must rise, False when its lower limit must fall.
-    written, needed
-        The row limit as written and the one that makes the problem feasible (None:
-        relaxing this requirement alone gave no feasible design).
-    lower_row, upper_row
-        Both row bounds as written (for showing a band ``|x| <= a`` as its magnitude).
-    solves
-        Solves spent on it.
-    """
-
-    name: str
-    upper: bool
-    written: float
-    needed: float | None
-    lower_row: float | None = None
-    upper_row: float | None = None
-    solves: int = 0
+__all__ = ["Relaxation", "Site", "relaxations"]
 
 
 def relaxations(
@@ -55,13 +30,22 @@ def relaxations(
     iterations: int = 8,
     max_requirements: int = 6,
     max_iter: int = 80,
+    *,
+    objective: str | None = None,
+    box: Mapping[str, tuple[float, float]] | None = None,
+    parameters: Mapping[str, float] | None = None,
+    x_start: np.ndarray | None = None,
+    sites_for: Callable[[str, Callable[[Site], tuple[float | None, Any]]], Iterable[Site]]
+    | None = None,
 ) -> list[Relaxation]:
     """The smallest relaxation of each requirement ``result`` violates.
 
     Parameters
     ----------
     problem, result
-        The problem and its infeasible NLP result (its best point starts each solve).
+        The problem and its infeasible result: its violated and active rows name the
+        candidates; its best point starts each solve (the NLP's own point ``raw["z"]``
+        when ``result`` is a solve of this NLP, else ``x_start``).
     solver
         The back-end of the solve.
     iterations
@@ -71,6 +55,20 @@ def relaxations(
         At most this many requirements are diagnosed (the largest violations first).
     max_iter
         Iteration cap of each Ipopt solve.
+    objective
+        The objective of the NLP (default: the result's, if the problem has it).
+    box, parameters
+        Variables held in a sub-box (name -> (lower, upper); a catalogue item as (v, v))
+        and the problem's parameter values there: the relaxation at those items.
+    x_start
+        A design (free-variable vector) to start from, for a result of another
+        formulation (GP, robust).
+    sites_for
+        Instead of ``box``: the sites of each requirement, tried in order,
+        ``sites_for(name, at)``, where ``at(site)`` is the smallest relaxation at a site
+        and the design there ((None, None) if removing the requirement is not enough) -
+        e.g. the catalogue items nearest the design of the continuous relaxation's
+        smallest one. A relaxation found at a site says where (:attr:`Relaxation.at`).
     """
     from optdesign.studies.solve import _objective_set, solver_for
 
@@ -81,7 +79,9 @@ def relaxations(
         base = r.name.split("[", 1)[0]
         if "_envelope" not in base and base not in names:  # not the objective's rows
             names[base] = r
-    objective = result.objective_name or problem.objective_names[0]
+    if objective is None:
+        own = result.objective_name
+        objective = own if own in problem.objectives else problem.objective_names[0]
     # Infeasible sub-problems are where Ipopt spends its time (restoration phase): a
     # capped iteration count keeps the diagnosis cheap; a capped solve counts as
     # infeasible, so the reported relaxation stays a feasible one (at worst a little
@@ -89,12 +89,10 @@ def relaxations(
     options = {"max_iter": max_iter} if solver == "ipopt" else None
     backend = solver_for(problem, solver, options, _objective_set(problem, objective))
     nlp = backend.nlp
-    base = nlp.bounds()
-    theta = nlp.parameter_values(base.parameters)
     z_best = result.raw.get("z")
-    x_start = nlp.start(x0=problem.start(), parameters=base.parameters)
-    starts = [nlp.start(z0=z_best)] if z_best is not None else []
-    starts.append(x_start)
+    if z_best is not None and np.size(z_best) != nlp.z.numel():
+        z_best = None  # another formulation's point (e.g. the robust NLP's)
+    sites = [_Prepared(problem, nlp, Site(box, parameters, x_start, z_best))]
     base_names = [g.split("[", 1)[0] for g in nlp.g_names]
     out = []
     for name, row in list(names.items())[:max_requirements]:
@@ -104,9 +102,9 @@ def relaxations(
         scale = np.asarray(nlp.g_scale, dtype=float)[idx]
         count = 0
 
-        def feasible(t: float, starts=starts, idx=idx, scale=scale):
+        def feasible(t: float, site: _Prepared, starts: list, idx=idx, scale=scale):
             nonlocal count
-            b = _relaxed(base, idx, scale, t)
+            b = _relaxed(site.bounds, idx, scale, t)
             for s in starts:
                 count += 1
                 r = backend.solve(s, None, b)
@@ -117,22 +115,77 @@ def relaxations(
         hi_side = row.upper is not None and (
             row.lower is None or abs(row.value - row.upper) <= abs(row.value - row.lower)
         )
-        ok = feasible(np.inf)
-        if ok is None:
-            out.append(_record(row, hi_side, None, count))
-            continue
-        g = np.asarray(nlp.g_fun(ok.raw["z"], theta), dtype=float).ravel()[idx] * scale
-        t_hi = float(_need(g, row, hi_side))
-        t_lo = 0.0
-        starts = [nlp.start(z0=ok.raw["z"]), *starts]
-        for _ in range(iterations):
-            mid = 0.5 * (t_lo + t_hi)
-            if feasible(mid, starts=starts) is not None:
-                t_hi = mid
-            else:
-                t_lo = mid
-        out.append(_record(row, hi_side, t_hi, count))
+
+        def smallest(site: _Prepared, idx=idx, scale=scale, row=row, hi_side=hi_side):
+            """(t, the design at it): the smallest relaxation found at ``site``, or
+            (None, None) when removing the requirement leaves no feasible design."""
+            ok = feasible(np.inf, site, site.starts, idx, scale)
+            if ok is None:
+                return None, None
+            g = np.asarray(nlp.g_fun(ok.raw["z"], site.theta), dtype=float).ravel()[idx]
+            t_hi, t_lo = float(_need(g * scale, row, hi_side)), 0.0
+            starts = [nlp.start(z0=ok.raw["z"]), *site.starts]
+            for _ in range(iterations):
+                mid = 0.5 * (t_lo + t_hi)
+                r = feasible(mid, site, starts, idx, scale)
+                if r is not None:
+                    t_hi, ok = mid, r
+                else:
+                    t_lo = mid
+            return t_hi, ok
+
+        here = sites
+        if sites_for is not None:
+
+            def at(site: Site, smallest=smallest) -> tuple[float | None, Any]:
+                return smallest(_Prepared(problem, nlp, site))
+
+            # lazily: a site may be costly to find, and is looked for only when needed
+            here = (_Prepared(problem, nlp, s) for s in sites_for(name, at))
+        # At the first site (catalogue items) where removing the requirement leaves a
+        # feasible design (which brackets its relaxation).
+        t_hi, used = None, None
+        for used in here:
+            t_hi, _ = smallest(used)
+            if t_hi is not None:
+                break
+        record = _record(row, hi_side, t_hi, count)
+        if t_hi is not None and used is not None:
+            record.at = used.site.label
+        out.append(record)
     return out
+
+
+@dataclass
+class Site:
+    """Where a relaxation is sought: variables held in a sub-box (catalogue items as
+    (v, v)) with the problem's parameter values there, and where the solves start.
+
+    ``label`` names it in a report (e.g. ``"d0 = 25 mm, p = 5 mm"``)."""
+
+    box: Mapping[str, tuple[float, float]] | None = None
+    parameters: Mapping[str, float] | None = None
+    x_start: np.ndarray | None = None
+    z_start: np.ndarray | None = None
+    label: str = ""
+
+
+class _Prepared:
+    """A :class:`Site` on one NLP: its bounds, parameter values and starts."""
+
+    def __init__(self, problem: Any, nlp: Any, site: Site):
+        self.site = site
+        self.bounds = nlp.bounds(box=site.box, parameters=site.parameters)
+        self.theta = nlp.parameter_values(self.bounds.parameters)
+        first = problem.start() if site.x_start is None else np.asarray(site.x_start, float)
+        if site.box:
+            lo, hi = problem.lower().copy(), problem.upper().copy()
+            for k, v in enumerate(problem.free):
+                if v.name in site.box:
+                    lo[k], hi[k] = site.box[v.name]
+            first = np.clip(first, lo, hi)
+        self.starts = [nlp.start(z0=site.z_start)] if site.z_start is not None else []
+        self.starts.append(nlp.start(x0=first, parameters=self.bounds.parameters))
 
 
 def _need(g: np.ndarray, row: Any, hi_side: bool) -> float:

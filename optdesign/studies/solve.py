@@ -29,7 +29,7 @@ from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.multistart import multistart, sobol_starts
 from optdesign.solvers.registry import make_solver
-from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+from optdesign.solvers.result import Diagnosis, Result, SolutionStatus, TerminationCondition
 from optdesign.studies.verify import nan_notes, verify_design
 
 # --- formulation and solver caches ------------------------------------------------------
@@ -242,6 +242,48 @@ def finish(problem: DesignProblem, result: Result, objective: str | None = None)
     return result
 
 
+def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> Result:
+    """The check of a problem with no free variable: its one design, every requirement
+    and objective evaluated on the NumPy path. Status ``optimal`` when it meets every
+    requirement (the only feasible design is optimal), ``infeasible`` otherwise;
+    formulation ``"fixed"``, solver ``"none"``."""
+    import time
+
+    from optdesign.studies.verify import constraint_rows
+
+    t0 = time.perf_counter()
+    objective = objective or problem.objective_names[0]
+    if objective not in problem.objectives:
+        raise InputError(
+            "objective", f"unknown objective {objective!r} (known: {', '.join(problem.objectives)})"
+        )
+    x = np.zeros(0)
+    ok, violated, objectives = verify_design(problem, x)
+    active, _ = constraint_rows(problem, x)
+    values = {k: float(v) for k, v in objectives.items()}
+    result = Result(
+        "optimal" if ok else "infeasible",
+        values.get(objective, float("nan")),
+        dict(problem.fixed_values),
+        "none",
+        "fixed",
+        time.perf_counter() - t0,
+        termination=TerminationCondition.CONVERGED if ok else TerminationCondition.INFEASIBLE,
+        solution_status=SolutionStatus.OPTIMAL if ok else SolutionStatus.INFEASIBLE,
+        message="no free variable: the fixed design checked, nothing optimised",
+        objective_name=objective,
+        objectives=values,
+        violated=violated,
+        active=active,
+        max_violation=max((r.amount for r in violated), default=0.0),
+        verified=ok,
+        problem=problem.name,
+        mechanism=problem.mechanism_name,
+        problem_object=problem,
+    )
+    return result
+
+
 # --- formulation registry ---------------------------------------------------------------
 @dataclass(frozen=True)
 class Formulation:
@@ -332,6 +374,21 @@ def choose_formulation(problem: DesignProblem, requested: str = "auto") -> str:
     return "nlp"
 
 
+def plan_solve(problem: DesignProblem, requested: str = "auto") -> str:
+    """The formulation :func:`solve` will use, after the checks that need no solve (the
+    file's Ipopt options, a combination no formulation honours), so that a caller can
+    refuse before any work."""
+    name = choose_formulation(problem, requested)
+    solver_options(problem, "ipopt")
+    if name == "catalogue" and problem.spec.tolerances is not None and problem.free:
+        disc = ", ".join(v.name for v in problem.free if v.discrete)
+        raise ProblemError(
+            f"tolerances: robust design needs continuous variables, and {disc} take "
+            "catalogue values; remove [tolerances] for the nominal catalogue optimum"
+        )
+    return name
+
+
 def solve(
     problem: DesignProblem,
     formulation: str = "auto",
@@ -342,24 +399,41 @@ def solve(
     solver: str = "ipopt",
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
+    diagnose: bool = True,
     **extra: Any,
 ) -> Result:
-    """The optimal design of ``problem`` with its evidence (see :func:`optdesign.solve`)."""
+    """The optimal design of ``problem`` with its evidence (see :func:`optdesign.solve`).
+
+    A problem with no free variable is not optimised: its fixed design is checked
+    (:func:`check_fixed_design`). ``diagnose``: on a result with no feasible design, the
+    smallest relaxation of each conflicting requirement (:mod:`optdesign.studies.
+    diagnosis`)."""
     from optdesign.safe_io import refuse_file_options
 
     # Before any work and whatever the formulation: no option may read or write a file.
     refuse_file_options(options, "options")
-    name = choose_formulation(problem, formulation)
-    result = FORMULATIONS[name].run(
-        problem,
-        objective=objective,
-        starts=starts,
-        seed=seed,
-        workers=workers,
-        solver=solver,
-        options=options,
-        **extra,
-    )
+    name = plan_solve(problem, formulation)
+    if not problem.free:
+        result = check_fixed_design(problem, objective)
+    else:
+        result = FORMULATIONS[name].run(
+            problem,
+            objective=objective,
+            starts=starts,
+            seed=seed,
+            workers=workers,
+            solver=solver,
+            options=options,
+            **extra,
+        )
+    if diagnose and not result.success:
+        from optdesign.studies.diagnosis import diagnose as diagnose_result
+
+        try:
+            diagnose_result(problem, result, solver, options)
+        except Exception as exc:  # a diagnosis, not the result: never lose the result
+            text = " ".join(str(exc).split())[:300]
+            result.diagnosis = Diagnosis(note=f"not computed: {type(exc).__name__}: {text}")
     continuous = result.formulation.startswith("nlp") and not any(v.discrete for v in problem.free)
     if ranges and result.success and continuous and result.design and "z" in result.raw:
         try:

@@ -67,3 +67,38 @@ def nan_notes(problem: DesignProblem, objectives: dict[str, float], violated) ->
         if name in user:
             notes.append(whose("constraint", name, user[name].fn))
     return notes
+
+
+def constraint_rows(problem: DesignProblem, design, rel: float = 1e-5, ev=None):
+    """(active, violated) constraint reports of any design on the NumPy path: a row is
+    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond.
+
+    ``design``: a full design dict (name -> value) or the free-variable vector; ``ev``:
+    the design's ``problem.evaluate`` when the caller has it already.
+    """
+    import math
+
+    if ev is None:
+        if isinstance(design, dict):
+            design = [design[v.name] for v in problem.free]
+        ev = problem.evaluate(np.asarray(design, dtype=float))
+    active, violated = [], []
+    for name, block in ev.constraints.items():
+        values = np.atleast_1d(np.asarray(block.values, dtype=float))
+        lo, hi = block.lower, block.upper
+        labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
+        viol = relative_violation(values, lo, hi)
+        for k, v in enumerate(values):
+            label = f"{name}[{labels[k]}]" if labels[k] else name
+            gap = min(
+                abs(v - lo) / max(1.0, abs(lo)) if lo is not None else math.inf,
+                abs(v - hi) / max(1.0, abs(hi)) if hi is not None else math.inf,
+            )
+            if viol[k] > rel:
+                amount = max(
+                    (lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0
+                )
+                violated.append(ConstraintReport(label, float(v), lo, hi, float(amount)))
+            elif gap <= rel:
+                active.append(ConstraintReport(label, float(v), lo, hi, 0.0))
+    return active, violated

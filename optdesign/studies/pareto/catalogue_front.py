@@ -42,12 +42,23 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         a, b = task["eps_name"], task["target"]
         lo_rec = PointRecord.from_dict(deps[f"anchor-{a}"])
         hi_rec = PointRecord.from_dict(deps[f"anchor-{b}"])
+        if not (lo_rec.ok and hi_rec.ok):  # no frame: the run stops at check_anchor
+            failed = a if not lo_rec.ok else b
+            return PointRecord(
+                task["id"], task["kind"], "failed", None, b, f"anchor {failed} has no design"
+            ).to_dict()
         lo = lo_rec.objectives[a] * (1 + ANCHOR_SLACK) + 1e-12
         hi = max(hi_rec.objectives[a], lo)
         eps = {a: float(lo + task["eps_frac"] * (hi - lo))}
     result = solve_catalogue(
         problem, starts=task["starts"], seed=task["seed"], objective=task["target"], eps=eps
     )
+    if task["kind"] == "anchor-multistart" and not result.success and not result.design:
+        # An anchor with no catalogue design: its best point, for the error to name the
+        # requirements it violates (no relaxations: the front stops here).
+        from optdesign.studies.diagnosis import diagnose
+
+        diagnose(problem, result, relax=False)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
     rec.n_solves = int(result.extra.get("catalogue", {}).get("nlp_solves", 0))
     rec.wall_time_s = time.perf_counter() - t0
@@ -144,7 +155,7 @@ class CatalogueEpsilon:
         )
         anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
         for k, rec in anchors.items():
-            check_anchor(rec, k)
+            check_anchor(rec, k, problem)
         recs = [PointRecord.from_dict(done[t["id"]]) for t in points]
         pts = [FrontPoint.from_record(r, self.name) for r in recs]
         n_solves = sum(PointRecord.from_dict(r).n_solves for r in done.values())

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.errors import ProblemError
+from optdesign.errors import InfeasibleRequirementsError
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 
@@ -53,12 +53,41 @@ def anchor_tasks(
     return ms + ties
 
 
-def check_anchor(rec: PointRecord, name: str) -> None:
-    if not rec.ok:
-        raise ProblemError(
-            f"anchor {name}: no verified optimum of {name} found (status {rec.status}, "
-            f"violated: {', '.join(rec.violated) or 'none reported'})"
+class NoFeasibleAnchor(InfeasibleRequirementsError):
+    """An anchor of a front (the optimum of one objective) has no feasible design: the
+    front cannot be traced. The message names the requirements the best point found
+    violates, by name and amount in the problem file's units."""
+
+    def __init__(self, objective: str, record: PointRecord, problem: Any = None):
+        self.objective = objective
+        self.record = record
+        super().__init__(anchor_message(objective, record, problem))
+
+
+def anchor_message(objective: str, rec: PointRecord, problem: Any = None) -> str:
+    """Why anchor ``objective`` failed, in one line."""
+    head = f"anchor {objective}: no feasible design found (status {rec.status})"
+    free = [v.name for v in problem.free] if problem is not None else []
+    if problem is None or not rec.design or any(k not in rec.design for k in free):
+        return f"{head}; violated: {', '.join(rec.violated) or 'none reported'}"
+    from optdesign.studies.diagnosis import violated_text
+
+    shown = violated_text(problem, np.array([rec.design[k] for k in free]))
+    if not shown:
+        return (
+            f"{head}: no requirement is violated at the best point found (the solver "
+            f"stopped: {rec.message or rec.status}); more starts (--starts) may find one"
         )
+    return (
+        f"{head}; at the best point found: {shown}; `optdesign solve` gives the smallest "
+        "relaxation of each"
+    )
+
+
+def check_anchor(rec: PointRecord, name: str, problem: Any = None) -> None:
+    """Raise :class:`NoFeasibleAnchor` unless ``rec`` is a verified feasible anchor."""
+    if not rec.ok:
+        raise NoFeasibleAnchor(name, rec, problem)
 
 
 class TwoChains:
@@ -111,14 +140,14 @@ class TwoChains:
             arc = self.spacing == "arc" and self.eps_values is None and self.split is None
             if arc or tie_b in done:
                 rec_a = PointRecord.from_dict(done[tie_a])
-                check_anchor(rec_a, a)
+                check_anchor(rec_a, a, self.common.get("problem"))
                 far = PointRecord.from_dict(done[ms_b] if arc else done[tie_b])
-                check_anchor(far, b)
+                check_anchor(far, b, self.common.get("problem"))
                 tie = PointRecord.from_dict(done[tie_b]) if tie_b in done else None
                 self._make_frame(rec_a, far, tie)
                 new.append(self._point(0, +1, tie_a, done))
         if self.frame is not None and tie_b in done and n - 1 not in self.claimed:
-            check_anchor(PointRecord.from_dict(done[tie_b]), b)
+            check_anchor(PointRecord.from_dict(done[tie_b]), b, self.common.get("problem"))
             new.append(self._point(n - 1, -1, tie_b, done))
         if task.get("kind") == "eps" and task["id"].startswith(f"{self.name}-"):
             # The ascending chain stops before n-1: that point's epsilon is A at the

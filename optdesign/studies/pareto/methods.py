@@ -61,8 +61,19 @@ class RunOptions:
     overwrite: bool = False  # start afresh over a store of an earlier run in ``out``
 
 
+def check_front_problem(problem: DesignProblem) -> None:
+    """Refuse, before any work, a problem no front can be traced on."""
+    if not problem.free:
+        raise InputError(
+            "variables",
+            "no free variable: a front trades objectives by moving the design, and this "
+            "problem's design is fixed (optdesign solve checks it)",
+        )
+
+
 def check_objectives(problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
     """Two or three distinct objectives the problem can compute."""
+    check_front_problem(problem)
     objectives = list(objectives)
     if len(objectives) not in (2, 3):
         raise InputError("objectives", f"give two or three objectives, got {objectives}")
@@ -218,13 +229,13 @@ class EpsilonConstraint:
                 done = phase(anchor_list, resume=run.resume)
                 anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
                 for k, rec in anchors.items():
-                    check_anchor(rec, k)
+                    check_anchor(rec, k, problem)
                 tasks = three_objective_tasks(anchors, objectives, n_points, self.name, common)
                 known = {f"anchor-{k}": done[f"anchor-{k}"] for k in objectives}
                 # the anchors are in the store already: resume over them
                 done = phase(tasks, resume=True, known=known)
         for k, rec in anchors.items():
-            check_anchor(rec, k)
+            check_anchor(rec, k, problem)
         recs = [
             PointRecord.from_dict(done[t["id"]]) for t in sorted(tasks, key=lambda t: t["index"])
         ]
@@ -290,7 +301,7 @@ class WeightedSum:
         )
         anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
         for k, rec in anchors.items():
-            check_anchor(rec, k)
+            check_anchor(rec, k, problem)
         F = np.array([[r.objectives[k] for k in objectives] for r in anchors.values()])
         ideal, nadir = F.min(axis=0), F.max(axis=0)
         normalise = {k: (float(ideal[j]), float(nadir[j])) for j, k in enumerate(objectives)}
@@ -375,6 +386,11 @@ class NSGA2:
         wall = time.perf_counter() - t0
         pts = []
         X = np.atleast_2d(res.X) if res.X is not None else np.zeros((0, len(problem.free)))
+        if res.X is None and res.pop is not None and len(res.pop):
+            # no feasible design: keep the least violating one, for the report to name
+            # what it violates (it is rejected as infeasible below)
+            cv = np.asarray(res.pop.get("CV"), dtype=float).ravel()
+            X = np.atleast_2d(res.pop.get("X")[int(np.argmin(cv))])
         X = CatalogueCoordinates(problem).to_design(X)
         if len(X):
             ev = problem.evaluate(X)
@@ -470,6 +486,7 @@ def compute_front(
     object with ``run(problem, objectives, RunOptions)``). ``options`` holds the run's
     options (``out``, ``workers``, ``scheduler``, ``resume``, ``progress``,
     ``on_record``) and the method's settings (see the method classes)."""
+    check_front_problem(problem)
     run = RunOptions(**{k: options.pop(k) for k in _RUN_FIELDS if k in options})
     if run.workers < 1:
         raise InputError("workers", f"need at least 1 worker, got {run.workers}")
@@ -515,5 +532,6 @@ __all__ = [
     "EpsilonConstraint",
     "RunOptions",
     "WeightedSum",
+    "check_front_problem",
     "compute_front",
 ]
