@@ -174,7 +174,9 @@ def validate_spec(
         lines = []
         for err in exc.errors():
             parts = [str(p) for p in err["loc"] if not str(p).startswith("function-")]
-            loc = ".".join(parts)
+            # a list's item as in the file's arrays: duty_cycle[0].time, not duty_cycle.0.time
+            loc = ".".join(parts).replace(".[", "[")
+            loc = re.sub(r"\.(\d+)(?=\.|$)", r"[\1]", loc)
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "missing":
                 msg = "missing (a required field)"
