@@ -30,41 +30,9 @@ from hostile2.model import CLASSES  # noqa: E402
 from hostile2.run import all_cases, run_case  # noqa: E402
 from hostile2.server import Server  # noqa: E402
 
-#: Fast cases that fail today, by name: empty it as the fixes of issue 21 land.
-KNOWN_FAILURES: set[str] = {
-    "1:od.pareto deterministic fork, workers 1 then 2 in one process (the README's failing test)",
-    "2:output_file ../outside",
-    "2:name x/../../../outside",
-    "2:lock file a link outside",
-    "3:solve, 1 worker, SIGTERM",
-    "4:catalogue infeasible travel",
-    "4:no free variable",
-    "4:off-catalogue d0",
-    '5:stiffness_min "600 kN*m"',
-    "5:API set_requirement N*m/deg",
-    "6:name html comment",
-    "6:name mathtext frac",
-    "6:name ANSI colour",
-    "6:front.csv formula objective",
-    "7:400-digit hinge_moment",
-    "7:NUL in name",
-    "7:1e-300 screw length",
-    "7:catalogue lead without d0",
-    "7:linear_solver ma97",
-    "7:table fit H7/s6",
-    "8:store version 99",
-    "8:record with NaN objectives",
-    "9:solve starts=0",
-    "9:solve starts=10**9",
-    "9:solve workers=0",
-    "9:solve agree=-1",
-    "9:pareto points=2.5",
-    "9:add_objective backlash replaces the built-in",
-    "9:add_constraint empty name",
-    "10:self.undefined_thing in nut_position",
-    "10:CLI plug-in self.undefined_thing",
-    "10:objective raising ZeroDivisionError",
-}
+#: Fast cases that fail today, by name (each an xfail(strict=True)): empty since the
+#: fixes of issue 21 landed; a case that regresses fails the suite.
+KNOWN_FAILURES: set[str] = set()
 #: Draws of the fuzz in the fast suite (the script runs more).
 FAST_FUZZ = 12
 
