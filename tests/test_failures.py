@@ -363,6 +363,24 @@ REFUSED = {
         '\n[solver]\nipopt = { linear_solver = "ma97" }\n',
         ["solver.ipopt.linear_solver", "'ma97'", "available: ", "mumps"],
     ),
+    "an Ipopt tolerance that is not finite": (
+        CS,
+        [],
+        "\n[solver]\nipopt = { tol = nan }\n",
+        ["solver.ipopt.tol", "nan is not a finite number"],
+    ),
+    "an Ipopt tolerance of 1e400": (
+        CS,
+        [],
+        "\n[solver]\nipopt = { tol = 1e400 }\n",
+        ["solver.ipopt.tol", "inf is not a finite number"],
+    ),
+    "an Ipopt integer beyond 32 bits": (
+        CS,
+        [],
+        f"\n[solver]\nipopt = {{ max_iter = {2**40} }}\n",
+        ["solver.ipopt.max_iter", "outside Ipopt's integers"],
+    ),
     "a library to load": (
         CS,
         [],

@@ -91,7 +91,17 @@ class SymbolicBug(_Yoke):
         return 50 * m.sin(phi)
 
 
-for _cls in (AttrBug, PropertyBug, ZeroBug, NaNBug, TextBug, SymbolicBug):
+class SketchBug(_Yoke):
+    name = "t21_sketch"
+
+    def nut_position(self, phi):
+        return self.R * m.sin(phi)
+
+    def sketch(self, phi):
+        return self.undefined_drawing  # used only where the linkage is drawn
+
+
+for _cls in (AttrBug, PropertyBug, ZeroBug, NaNBug, TextBug, SymbolicBug, SketchBug):
     od.register_mechanism(_cls, replace=True)
 
 
@@ -551,3 +561,22 @@ def test_a_scalar_user_objective_reduced_over_the_grid_evaluates_a_population():
         assert problem.evaluate(X).objectives["peak"] == pytest.approx(
             one_by_one, rel=1e-12, nan_ok=True
         )
+
+
+def test_a_user_sketch_bug_names_its_line_where_the_linkage_is_drawn(tmp_path, capsys):
+    from optdesign.reports.html import solve_report
+
+    result = od.solve(od.load(yoke_data("t21_sketch")), starts=1, ranges=False)
+    assert result.success and result.verified  # the optimisation never draws the linkage
+    with pytest.raises(UserCodeError) as caught:
+        solve_report(result)  # the report's sketches
+    text = str(caught.value)
+    assert "SketchBug.sketch raised AttributeError" in text and "while drawing its sketch" in text
+    assert str(caught.value.location) == line_of(SketchBug.sketch)
+    # the command line keeps the result and says why the page is missing
+    path = yoke_file(tmp_path, "t21_sketch")
+    out = tmp_path / "out"
+    assert main(["solve", str(path), "--starts", "1", "--no-ranges", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "report.html not written: mechanism 't21_sketch'" in printed
+    assert (out / "result.json").exists() and not (out / "report.html").exists()

@@ -109,6 +109,8 @@ cp "$ROOT/pyproject.toml" "$WORK/"
 } >"$WORK/setup.cfg"
 cd "$WORK"
 export MPLBACKEND=Agg
+# mutmut puts mutants/ on sys.path only if it exists when it starts (a fresh WORK: not yet)
+mkdir -p mutants
 # Tests that start `python -m optdesign` (signals, CLI) import the mutated tree too, not
 # an installed optdesign.
 export PYTHONPATH="$WORK/mutants${PYTHONPATH:+:$PYTHONPATH}"

@@ -177,11 +177,17 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         else:  # the front's files are written; the report and the summary follow
             notes.append(failed)
     if not args.no_report and any(f.points for f in fronts):
+        from optdesign.errors import OptDesignError
         from optdesign.reports.html import front_report
         from optdesign.storage import atomic_write_text
 
-        atomic_write_text(out / "report.html", front_report(problem, fronts))
-        wrote.append(out / "report.html")
+        try:
+            page = front_report(problem, fronts)
+        except OptDesignError as exc:  # a user's mechanism that cannot draw itself
+            notes.append(f"report.html not written: {exc}")
+        else:
+            atomic_write_text(out / "report.html", page)
+            wrote.append(out / "report.html")
     from optdesign.reports.front_text import front_summary
     from optdesign.text import printable
 

@@ -122,10 +122,18 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
                 text = result_json(result)
                 atomic_write_text(out / "result.json", text)
         if not args.no_report and result.design:
+            from optdesign.errors import OptDesignError
             from optdesign.reports.html import solve_report
 
-            atomic_write_text(out / "report.html", solve_report(result))
-            wrote.append(out / "report.html")
+            try:
+                page = solve_report(result)
+            except OptDesignError as exc:  # a user's mechanism that cannot draw itself
+                result.notes.append(f"report.html not written: {exc}")
+                text = result_json(result)
+                atomic_write_text(out / "result.json", text)
+            else:
+                atomic_write_text(out / "report.html", page)
+                wrote.append(out / "report.html")
     if args.json:
         print(text)
     else:

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from optdesign.plots import plain
+from optdesign.user_code import call_method
 
 _STYLE = {
     "epsilon": dict(marker="o", ms=4, lw=1.0),
@@ -52,7 +53,7 @@ def draw_linkage(ax, problem, design: dict, title: str = "") -> None:
     phis = [problem.phi[0], 0.5 * (problem.phi[0] + problem.phi[-1]), problem.phi[-1]]
     drawn = False
     for j, phi in enumerate(phis):
-        sk = mech.sketch(float(phi))
+        sk = call_method(mech, "sketch", float(phi), doing="while drawing its sketch")
         if sk is None:
             continue
         drawn = True

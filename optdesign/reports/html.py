@@ -33,6 +33,7 @@ from optdesign.reports.units import (
     variable_shown,
 )
 from optdesign.solvers.result import clean_json
+from optdesign.user_code import call_method
 
 
 def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str, Any]:
@@ -74,7 +75,7 @@ def _sketch(problem: Any, design: dict[str, float]) -> list[dict[str, Any]]:
     out = []
     for phi in phis:
         with np.errstate(all="ignore"):
-            sk = mech.sketch(float(phi))
+            sk = call_method(mech, "sketch", float(phi), doing="while drawing its sketch")
         if sk is None:
             return []
         out.append(

@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import difflib
 import io
+import math
 import re
 import signal
 import time
@@ -203,6 +204,13 @@ def check_ipopt_options(options: Mapping[str, Any], field: str = "solver.ipopt")
             raise InputError(where, f"unknown Ipopt option{hint}")
         if isinstance(value, bool) or not isinstance(value, str | int | float):
             raise InputError(where, f"expected a number or a string, got {value!r}")
+        if isinstance(value, float) and not math.isfinite(value):
+            # Ipopt takes nan and inf for a tolerance without a word, then stops at once
+            # or never: a value no option means
+            raise InputError(where, f"{value!r} is not a finite number")
+        if isinstance(value, int) and not -(2**31) < value < 2**31:
+            # Ipopt's integers are 32 bits: a larger one wraps around to another value
+            raise InputError(where, f"{value} is outside Ipopt's integers (|n| < 2**31)")
         if key in LIBRARY_OPTIONS:
             raise InputError(
                 where,

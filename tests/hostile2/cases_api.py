@@ -325,8 +325,11 @@ def _mech_api(uf: UserFile, key: str, plot: bool = False, objective: str = "back
         data = yoke_problem(key)
         data["objective"] = {"minimize": objective}
         result = od.solve(od.load(data), starts=1, ranges=False)
-        if plot:
+        if plot:  # what draws the linkage: the report's sketches (and front.plot())
+            from optdesign.reports.html import solve_report
+
             result.plot()
+            solve_report(result)
         return result
 
     return api
