@@ -225,7 +225,8 @@ def angle_exponent(q: Any) -> int:
     units (pint keeps the radian as a base unit of its own, with no dimension). Whole
     for every unit pint defines; a fractional exponent (only from a user's own pint
     arithmetic) is refused by the callers' checks, as no dimension has one."""
-    for name, exponent in q.to_root_units().unit_items():
+    # (the units container: Quantity.unit_items() exists only from pint 0.24 on)
+    for name, exponent in q.to_root_units()._units.items():
         if name == "radian":
             return int(exponent) if float(exponent).is_integer() else exponent
     return 0
