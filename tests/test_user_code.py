@@ -382,13 +382,16 @@ def test_pythons_max_in_an_objective_is_refused_at_the_solve_with_the_od_math_hi
     with pytest.raises(UserCodeError) as caught:
         od.solve(problem, objective="peak", starts=1, ranges=False)
     text = str(caught.value)
+    # CasADi 3.8.2 raises TypeError, 3.6.1 a plain Exception: the message names
+    # the type that was raised
+    cause = caught.value.__cause__
+    assert type(cause) in (TypeError, Exception)
     assert text.startswith(
         "objective 'peak': its function peak_force (test_user_code.peak_force) raised "
-        f"TypeError: CasADi matrices are not iterable at {line_of(peak_force)}, while "
-        "building the solver's model; "
+        f"{type(cause).__name__}: CasADi matrices are not iterable at "
+        f"{line_of(peak_force)}, while building the solver's model; "
     )
     assert "od.math.grid_max" in text
-    assert isinstance(caught.value.__cause__, TypeError)
 
 
 def test_a_user_constraint_that_fails_names_its_function():
