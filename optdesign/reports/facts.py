@@ -49,11 +49,13 @@ def design_facts(problem: Any, design: dict[str, float]) -> list[Fact]:
         Fact("ratio_max", Shown(float(np.max(ratio)), ""), "largest ratio over the stroke"),
     ]
     req = problem.spec.requirements
-    source = (
-        "screw x gear, from the file"
-        if problem.spec.screw is None
-        else "screw x gear, screw from its lead and friction"
-    )
+    screw = problem.spec.screw
+    if screw is None:
+        source = "screw x gear, from the file"
+    elif screw.efficiency_design == "HIWIN":
+        source = "screw x gear, screw at HIWIN's design value 0.85 for sizing"
+    else:
+        source = "screw x gear, screw from its lead and friction"
     if req.eta_screw == 1.0 and req.eta_gear == 1.0 and problem.spec.screw is None:
         source = "lossless: the file gives no eta_screw, eta_gear or [screw]"
     out.append(Fact("drive_efficiency", Shown(100.0 * float(np.min(eta)), "%"), source))
