@@ -248,9 +248,29 @@ def test_dn_rule_is_stated_in_the_summary_where_it_binds():
 
     data = tomllib.loads(FIN.read_text())
     data["requirements"]["dn_max"] = 69000.0
-    text = od.solve(data).summary()
+    result = od.solve(data)
+    text = result.summary()
     limits = text[text.index("what limits the optimum") :]
     assert "rule ball-centre" in limits and "on the ball-centre diameter" in limits
+    # the --json document carries the same text with the binding requirement
+    import json
+
+    from optdesign.reports.result_json import result_json
+
+    doc = json.loads(result_json(result))
+    texts = [d.get("description", "") for d in _dicts(doc) if d.get("name") == "dn"]
+    assert any("rule ball-centre" in t and "ball-centre diameter" in t for t in texts)
+
+
+def _dicts(node):
+    """Every dict inside a JSON document."""
+    if isinstance(node, dict):
+        yield node
+        for v in node.values():
+            yield from _dicts(v)
+    elif isinstance(node, list):
+        for v in node:
+            yield from _dicts(v)
 
 
 # --- efficiency for sizing -----------------------------------------------------------------------
