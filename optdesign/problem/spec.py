@@ -320,7 +320,7 @@ class Requirements(_Model):
     screw: ScrewSizing | None = None
     lock: MotorLock | None = None
     fit_values: Literal["table", "smooth"] | None = None
-    pin_contact: Literal["duan2017", "conforming"] = "duan2017"
+    pin_contact: Literal["duan2017", "conforming", "palmgren"] = "duan2017"
     pin_contact_pressure_max: Pressure | None = None
     efficiency_min: Dimensionless | None = Field(None, gt=0.0, le=1.0)
     back_drive: Literal["required", "forbidden"] | None = None
