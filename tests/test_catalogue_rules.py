@@ -137,8 +137,15 @@ def test_nut_stiffness_at_the_duty_cycles_mean_load():
 
 
 def test_preloaded_nut_and_the_choices_refused():
-    q = _quantities(_fin(screw={"nut_stiffness_rule": "preload", "nut_preload": 0.05}))
+    problem = _fin(screw={"nut_stiffness_rule": "preload", "nut_preload": 0.05})
+    q = _quantities(problem)
     assert _flat(drive.nut_stiffness(q)) == pytest.approx([0.8 * 480e3 * 0.5 ** (1 / 3)])
+    from optdesign.reports.limits import block_infos
+
+    text = block_infos(problem)["stiffness"].description
+    assert "HIWIN F 3.34 at a preload of 0.05 Ca" in text
+    text = block_infos(_fin(screw={"nut_stiffness_rule": "table"}))["stiffness"].description
+    assert "(nut: the catalogue's table value)" in text
     from optdesign.errors import OptDesignError
 
     with pytest.raises(OptDesignError, match="nut_preload"):

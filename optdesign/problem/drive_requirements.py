@@ -20,14 +20,16 @@ def _need(value, what: str, field: str):
 def _nut_text(q) -> str:
     spec = q.problem.spec
     rule = nut_stiffness_rule(spec)
+    if spec.screw.catalogue is None:
+        return "as given" if spec.screw.nut_stiffness is not None else "rigid"
     if rule == "table":
-        return "table value"
+        return "the catalogue's table value"
     if rule == "preload":
         return f"HIWIN F 3.34 at a preload of {spec.screw.nut_preload:g} Ca"
     load = (
         "the duty cycle's mean load"
         if spec.requirements.stiffness_load == "duty-mean"
-        else ("the hinge moment's nut force")
+        else "the hinge moment's nut force"
     )
     return f"HIWIN F 3.35 at {load}"
 
