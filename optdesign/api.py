@@ -44,6 +44,7 @@ def solve(
     ranges: bool = True,
     agree: int | None = None,
     diagnose: bool = True,
+    contact_models: bool = False,
 ) -> Result:
     """The optimal design of ``problem``, with its evidence.
 
@@ -75,6 +76,10 @@ def solve(
         the smallest relaxation of each conflicting requirement (``result.diagnosis``),
         for every formulation. A problem with no free variable is not optimised: its
         fixed design is checked (formulation ``"fixed"``).
+    contact_models
+        Also the worst-case backlash of the optimum under each pin contact model
+        (``duan2017``, ``conforming``, ``palmgren``), as a note of the result: the
+        spread of the models a designer should read beside the file's choice.
 
     Returns
     -------
@@ -96,11 +101,19 @@ def solve(
         ranges=ranges,
         agree=agree,
         diagnose=diagnose,
+        contact_models=contact_models,
     )
     problem = load(problem)
     validation.objective_of(problem, args["objective"])
     agree = args.pop("agree")
-    return run(problem, **args, **({"agree": agree} if agree is not None else {}))
+    spread = args.pop("contact_models")
+    result = run(problem, **args, **({"agree": agree} if agree is not None else {}))
+    if spread and result.design:
+        from optdesign.reports.facts import contact_model_spread
+
+        line = contact_model_spread(problem, result.design)
+        result.notes.append(line or "backlash by pin contact model: no sized pin or no backlash")
+    return result
 
 
 def pareto(

@@ -18,7 +18,7 @@ def test_buckling_catalogue_example():
     # The exact Euler constant is 0.2 % lower (eta_2 = 10 rounds 9.98).
     euler = screw_sizing.buckling_load(12.5, 820.0, "fixed-supported", form="euler")
     assert euler == pytest.approx(3623.7, abs=0.1)
-    # Mounting factors scale as 1.3 : 10 : 20.
+    # Mounting factors scale as 1.2725 : 10 : 20 (the default, conservative rule).
     ff = screw_sizing.buckling_load(12.5, 820.0, "fixed-fixed")
     assert ff / screw_sizing.buckling_load(12.5, 820.0, "fixed-supported") == pytest.approx(2.0)
 
@@ -46,8 +46,10 @@ def test_mean_load_of_a_duty_cycle():
 
 def test_yield_speed_and_stiffness():
     assert screw_sizing.yield_load(12.5) == pytest.approx(147.0 * np.pi * 12.5**2 / 4)
-    # lambda_2 = 15.1: 15.1 x 12.5 / 1000^2 x 1e7 = 1887.5 min^-1
-    assert screw_sizing.critical_speed(12.5, 1000.0) == pytest.approx(1887.5)
+    # common lambda_2 = 15.1: 15.1 x 12.5 / 1000^2 x 1e7 = 1887.5 min^-1; the default
+    # (conservative) takes HIWIN's 0.8 x 2.71e8 x 0.692 (F 3.27-3.28): 1875.32 min^-1
+    assert screw_sizing.critical_speed(12.5, 1000.0, rule="common") == pytest.approx(1887.5)
+    assert screw_sizing.critical_speed(12.5, 1000.0) == pytest.approx(1875.32)
     A = np.pi * 12.5**2 / 4
     k1 = screw_sizing.shaft_stiffness(12.5, 500.0, "fixed-free")
     assert k1 == pytest.approx(A * 2.06e5 / 500.0)
@@ -110,8 +112,11 @@ def test_buckling_fixed_free_factor_is_on_the_unsafe_side():
     # Euler with safety 0.5 and E = 2.06e5: eta_2 = 0.5 x 0.25 x pi^3 E / 64 x 1e-4 = 1.2475
     euler = screw_sizing.buckling_load(20.0, 1000.0, "fixed-free", form="euler")
     assert euler * 1000.0**2 / 20.0**4 / 1e4 == pytest.approx(1.24752, abs=1e-5)
-    cat = screw_sizing.buckling_load(20.0, 1000.0, "fixed-free")
-    assert cat / euler == pytest.approx(1.0421, abs=1e-4)  # the catalogue's 1.3: +4.2 %
+    cat = screw_sizing.buckling_load(20.0, 1000.0, "fixed-free", rule="common")
+    assert cat / euler == pytest.approx(1.0421, abs=1e-4)  # the common 1.3: +4.2 %
+    # HIWIN's fixed-free factor (the default's) is 0.5 x 40.72 x 0.0625 = 1.2725: +2.0 %
+    hiwin = screw_sizing.buckling_load(20.0, 1000.0, "fixed-free")
+    assert hiwin / euler == pytest.approx(1.2725 / 1.24752, rel=1e-5)
     # HIWIN's constant 4.072e5 is pi^3 E / 16 with E = 2.1e5 MPa (to 0.06 %)
     assert 4.072e5 == pytest.approx(np.pi**3 * 2.1e5 / 16, rel=1e-3)
 

@@ -61,6 +61,11 @@ def _solve(sub):
         action="store_true",
         help="skip the ranges of the variables over the optimal set (2 solves per variable)",
     )
+    p.add_argument(
+        "--contact-models",
+        action="store_true",
+        help="also the backlash of the optimum under each pin contact model (the spread)",
+    )
     p.set_defaults(func=run_solve)
 
 
@@ -101,6 +106,7 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
             solver=args.solver,
             ranges=not args.no_ranges,
             diagnose=not args.no_diagnosis,
+            contact_models=args.contact_models,
         )
     from optdesign.reports.result_json import result_json
 

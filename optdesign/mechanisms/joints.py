@@ -28,6 +28,9 @@ from optdesign.models.hertz_line import (
     pin_flattening_first_order,
 )
 
+#: Contact models of a loaded pin (``requirements.pin_contact``).
+CONTACT_MODELS = ("duan2017", "conforming", "palmgren")
+
 
 def _numeric(value) -> bool:
     """A plain number or NumPy array (not a CasADi symbol nor a GP tracer)."""
@@ -59,7 +62,9 @@ class PinJoint:
     contact
         ``"duan2017"``: [D17] eq. 10-11, a cylinder on a flat (``surfaces`` x Delta);
         ``"conforming"``: the pin in its bore with the fit's clearance
-        (:mod:`optdesign.models.pin_contact`), the elastic approach of the pair.
+        (:mod:`optdesign.models.pin_contact`), the elastic approach of the pair;
+        ``"palmgren"``: Palmgren's empirical approach of a steel line contact,
+        3.84e-5 F^0.9 / L^0.8 ([P59]; the bulk compression included, steel only).
     values
         ISO 286 values: ``"smooth"`` (the formulas at D) or ``"table"`` (as ISO 286-2
         prints them; a symbolic D takes the smooth value times ``ratio_max`` /
@@ -87,8 +92,15 @@ class PinJoint:
         if not m.is_symbolic(self.nu) and not 0.0 < float(self.nu) < 0.5:
             raise InputError("pin.nu", f"Poisson ratio must lie in (0, 0.5), got {self.nu!r}")
         Fit.parse(self.fit, "pin.fit", values=self.values)
-        if self.contact not in ("duan2017", "conforming"):
-            raise InputError("pin.contact", f"{self.contact!r}: use 'duan2017' or 'conforming'")
+        if self.contact not in CONTACT_MODELS:
+            raise InputError("pin.contact", f"{self.contact!r}: use one of {CONTACT_MODELS}")
+        if self.contact == "palmgren" and not m.is_symbolic(self.E):
+            if not 1.9e5 <= float(self.E) <= 2.2e5:
+                raise InputError(
+                    "materials.pin.E",
+                    f"Palmgren's approach is an empirical law of steel (E about 2.1e5 MPa), "
+                    f"got {float(self.E):g} MPa; use pin_contact duan2017 or conforming",
+                )
 
     @staticmethod
     @cache
@@ -118,6 +130,8 @@ class PinJoint:
         if self.contact == "conforming":
             approach = pin_contact.approach(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
             return self.extra + c + approach
+        if self.contact == "palmgren":
+            return self.extra + c + pin_contact.palmgren_approach(F, self.L)
         flat = pin_flattening_first_order if self.first_order else pin_flattening
         return self.extra + c + self.surfaces * flat(self.d, F, self.L, self.E, self.nu)
 
@@ -126,14 +140,16 @@ class PinJoint:
         if self.contact == "conforming":
             c = self.fit_clearance()
             return pin_contact.contact_stiffness(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
+        if self.contact == "palmgren":
+            return pin_contact.palmgren_stiffness(F, self.L)
         # Delta = D/2 - sqrt(D^2/4 - k F) (eq. 11): dDelta/dF = k / (2 sqrt(D^2/4 - k F))
         k = 4.0 * self.d * (1.0 - self.nu**2) / (np.pi * self.E * self.L)
         root = m.sqrt_domain(0.25 * self.d**2 - k * F)
         return 2.0 * root / (self.surfaces * k)
 
     def contact_pressure(self, F):
-        """Largest contact pressure (MPa) under F: Hertz line contact (eq. 10) or the
-        conforming solution."""
+        """Largest contact pressure (MPa) under F: Hertz line contact (eq. 10; also for
+        Palmgren's approach, which gives no pressure) or the conforming solution."""
         if self.contact == "conforming":
             c = self.fit_clearance()
             return pin_contact.max_pressure(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)

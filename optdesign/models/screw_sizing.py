@@ -32,22 +32,62 @@ EULER_END_FACTOR = {
     "fixed-fixed": 4.0,
 }
 
-#: Catalogue buckling factor eta_2 in P1 = eta_2 d1^4 / la^2 x 1e4 N (safety 0.5 included).
-BUCKLING_FACTOR = {
-    "fixed-free": 1.3,
-    "supported-supported": 5.0,
-    "fixed-supported": 10.0,
-    "fixed-fixed": 20.0,
+#: HIWIN's mounting factors, BS-08-2-EN-1704-K section 3.7.4-3.7.5 (p. 28): buckling
+#: F_kmax = 0.5 x 4.072e5 f_k dk^4 / ls^2 (F 3.25-3.26) and critical speed
+#: n_kmax = 0.8 x 2.71e8 f_n dk / ls^2 (F 3.27-3.28).
+HIWIN_FK = {
+    "fixed-free": 0.0625,
+    "supported-supported": 0.25,
+    "fixed-supported": 0.5,
+    "fixed-fixed": 1.0,
+}
+HIWIN_FN = {
+    "fixed-free": 0.147,
+    "supported-supported": 0.446,
+    "fixed-supported": 0.692,
+    "fixed-fixed": 1.0,
 }
 
-#: Catalogue critical-speed factor lambda_2 in N1 = lambda_2 d1 / lb^2 x 1e7 min^-1
-#: (includes the catalogues' 0.8 safety factor).
-CRITICAL_SPEED_FACTOR = {
-    "fixed-free": 3.4,
-    "supported-supported": 9.7,
-    "fixed-supported": 15.1,
-    "fixed-fixed": 21.9,
+#: Buckling factor eta_2 in P1 = eta_2 d1^4 / la^2 x 1e4 N (safety 0.5 included), by the
+#: rule that gives it: ``"HIWIN"`` 0.5 x 40.72 f_k (F 3.25-3.26, exact); ``"common"`` the
+#: rounded factors printed by THK, NSK and others ([CAT]), whose fixed-free 1.3 lies 2.2 %
+#: above HIWIN's 1.2725 (unsafe side); ``"conservative"`` (the default) the smaller of the
+#: two for each mounting.
+BUCKLING_FACTORS: dict[str, dict[str, float]] = {
+    "HIWIN": {k: 0.5 * 40.72 * f for k, f in HIWIN_FK.items()},
+    "common": {
+        "fixed-free": 1.3,
+        "supported-supported": 5.0,
+        "fixed-supported": 10.0,
+        "fixed-fixed": 20.0,
+    },
 }
+
+#: Critical-speed factor lambda_2 in N1 = lambda_2 d1 / lb^2 x 1e7 min^-1 (the catalogues'
+#: 0.8 safety factor included), by rule: ``"HIWIN"`` 0.8 x 27.1 f_n (F 3.27-3.28);
+#: ``"common"`` 3.4, 9.7, 15.1, 21.9 ([CAT]; the fixed-free 3.4 is 6.7 % above HIWIN's
+#: 3.187); ``"conservative"`` the smaller of the two for each mounting.
+CRITICAL_SPEED_FACTORS: dict[str, dict[str, float]] = {
+    "HIWIN": {k: 0.8 * 27.1 * f for k, f in HIWIN_FN.items()},
+    "common": {
+        "fixed-free": 3.4,
+        "supported-supported": 9.7,
+        "fixed-supported": 15.1,
+        "fixed-fixed": 21.9,
+    },
+}
+for _table in (BUCKLING_FACTORS, CRITICAL_SPEED_FACTORS):
+    _table["conservative"] = {
+        k: min(_table["HIWIN"][k], _table["common"][k]) for k in _table["HIWIN"]
+    }
+
+#: The rules :func:`buckling_load` and :func:`critical_speed` know; the default is the
+#: conservative one.
+MOUNTING_RULES = ("conservative", "HIWIN", "common")
+
+#: Buckling and critical-speed factors of the default (conservative) rule.
+BUCKLING_FACTOR = BUCKLING_FACTORS["conservative"]
+CRITICAL_SPEED_FACTOR = CRITICAL_SPEED_FACTORS["conservative"]
 
 #: Permissible tensile/compressive stress of the screw shaft in the catalogues (MPa).
 SIGMA_ALLOWABLE = 147.0
@@ -57,8 +97,34 @@ STEEL_DENSITY = 7.85e-6
 
 #: DN = d0 x n_max limits (mm x min^-1), HIWIN *Ballscrews & Accessories*
 #: BS-08-2-EN-1704-K, section 3.7.6 (p. 29): rolled 70 000, peeled and ground 90 000,
-#: high-speed series 180 000. Other makers print their own limits.
+#: high-speed series 180 000, on the nominal (shaft) diameter ds. Other makers print their own limits.
 DN_LIMIT = {"rolled": 70_000.0, "peeled": 90_000.0, "ground": 90_000.0, "high-speed": 180_000.0}
+
+#: A DN rule: which diameter it multiplies by the speed and its limit for each grade.
+#: ``"HIWIN"``: the nominal diameter d0 (HIWIN's ds), :data:`DN_LIMIT`. ``"ball-centre"``
+#: (the default, the conservative one): the ball-centre diameter d_m and 70 000 whatever
+#: the grade - the rule of the makers that rate DN on the ball circle ([CAT]), at or
+#: below HIWIN's limit for every grade.
+DN_RULES: dict[str, tuple[str, dict[str, float]]] = {
+    "HIWIN": ("nominal", DN_LIMIT),
+    "ball-centre": ("ball-centre", {grade: 70_000.0 for grade in DN_LIMIT}),
+}
+
+
+def dn_rule(rule: str, grade: str | None = None) -> tuple[str, float | None]:
+    """(diameter it applies to, limit for ``grade``) of DN rule ``rule``.
+
+    The diameter is ``"nominal"`` (d0) or ``"ball-centre"`` (d_m); the limit is None when
+    no grade is named (a limit given as a number).
+    """
+    if rule not in DN_RULES:
+        raise InputError("dn_rule", f"{rule!r} not in {sorted(DN_RULES)}")
+    diameter, limits = DN_RULES[rule]
+    if grade is None:
+        return diameter, None
+    if grade not in limits:
+        raise InputError("dn_max", f"{grade!r} not in {sorted(limits)}")
+    return diameter, limits[grade]
 
 
 def _factor(table: dict[str, float], mounting: str) -> float:
@@ -66,6 +132,13 @@ def _factor(table: dict[str, float], mounting: str) -> float:
         return table[mounting]
     except KeyError:
         raise InputError("mounting", f"{mounting!r} not in {sorted(table)}") from None
+
+
+def _rule_table(tables: dict[str, dict[str, float]], rule: str) -> dict[str, float]:
+    try:
+        return tables[rule]
+    except KeyError:
+        raise InputError("rule", f"{rule!r} not in {list(MOUNTING_RULES)}") from None
 
 
 def second_moment(d1):
@@ -79,7 +152,13 @@ def root_area(d1):
 
 
 def buckling_load(
-    d1, la, mounting: str = "fixed-supported", form: str = "catalogue", E=E_STEEL, safety=0.5
+    d1,
+    la,
+    mounting: str = "fixed-supported",
+    form: str = "catalogue",
+    E=E_STEEL,
+    safety=0.5,
+    rule: str = "conservative",
 ):
     """Permissible axial (buckling) load P1 (N) of the screw shaft.
 
@@ -93,8 +172,8 @@ def buckling_load(
         ``"fixed-free"``, ``"supported-supported"``, ``"fixed-supported"`` or
         ``"fixed-fixed"``.
     form
-        ``"catalogue"``: P1 = eta_2 d1^4 / la^2 x 1e4 with the published, rounded eta_2
-        of :data:`BUCKLING_FACTOR` (the form the catalogues' examples use);
+        ``"catalogue"``: P1 = eta_2 d1^4 / la^2 x 1e4 with eta_2 of
+        :data:`BUCKLING_FACTORS` by ``rule`` (the form the catalogues' examples use);
         ``"euler"``: P1 = safety eta_m pi^2 E I / la^2 with the end factor eta_m of
         :data:`EULER_END_FACTOR` and the exact constant. With E = 2.06e5 MPa and safety
         0.5 the Euler form is eta_2 = 0.5 eta_m pi^3 E / 64 x 1e-4 = 1.2475, 4.99, 9.98,
@@ -106,11 +185,14 @@ def buckling_load(
         Young's modulus (MPa), Euler form only.
     safety
         Safety factor on the Euler load, Euler form only (catalogues: 0.5).
+    rule
+        ``"conservative"`` (default), ``"HIWIN"`` or ``"common"``: whose factors
+        (:data:`BUCKLING_FACTORS`), catalogue form only.
     """
     require_positive("d1", d1)
     require_positive("la", la)
     if form == "catalogue":
-        return _factor(BUCKLING_FACTOR, mounting) * d1**4 / la**2 * 1e4
+        return _factor(_rule_table(BUCKLING_FACTORS, rule), mounting) * d1**4 / la**2 * 1e4
     if form == "euler":
         eta_m = _factor(EULER_END_FACTOR, mounting)
         return safety * eta_m * m.pi**2 * E * second_moment(d1) / la**2
@@ -123,7 +205,7 @@ def yield_load(d1, sigma=SIGMA_ALLOWABLE):
     return sigma * root_area(d1)
 
 
-def critical_speed(d1, lb, mounting: str = "fixed-supported"):
+def critical_speed(d1, lb, mounting: str = "fixed-supported", rule: str = "conservative"):
     """Permissible rotational speed N1 = lambda_2 d1 / lb^2 x 1e7 (min^-1).
 
     Parameters
@@ -134,10 +216,13 @@ def critical_speed(d1, lb, mounting: str = "fixed-supported"):
         Distance between the supports (mm).
     mounting
         End conditions, keys of :data:`CRITICAL_SPEED_FACTOR`.
+    rule
+        ``"conservative"`` (default), ``"HIWIN"`` or ``"common"``: whose factors
+        (:data:`CRITICAL_SPEED_FACTORS`).
     """
     require_positive("d1", d1)
     require_positive("lb", lb)
-    return _factor(CRITICAL_SPEED_FACTOR, mounting) * d1 / lb**2 * 1e7
+    return _factor(_rule_table(CRITICAL_SPEED_FACTORS, rule), mounting) * d1 / lb**2 * 1e7
 
 
 def mean_load(forces, revolutions):
@@ -322,10 +407,50 @@ def axial_stiffness_chain(K_shaft, K_nut, K_bearing, K_housing=None):
     return series_stiffness(*parts)
 
 
+# --- nut stiffness by the catalogue's rule ------------------------------------------------
+#: Nut stiffness rules: ``"table"`` the printed value as it stands; ``"load"`` HIWIN F 3.35
+#: (a single nut with play, at an axial load); ``"preload"`` HIWIN F 3.34 (a preloaded nut).
+NUT_STIFFNESS_RULES = ("load", "table", "preload")
+
+
+def nut_stiffness_at_load(K_table, Ca, Fa):
+    """Stiffness of a single nut with play under the axial load ``Fa`` (N/mm), HIWIN
+    BS-08-2-EN-1704-K F 3.35: R_n = 0.8 K (F / (0.28 Ca))^(1/3).
+
+    Parameters
+    ----------
+    K_table
+        The dimension table's rigidity (N/mm; HIWIN's ground-screw tables print it
+        "calculated without preload for loading of 30 % of the dynamic load rating").
+    Ca
+        Dynamic load rating of the nut (N).
+    Fa
+        Axial load on the nut (N, sign ignored). The catalogue writes the mean operating
+        load F_bm; a requirement passes the load it concerns (the hinge moment's nut force
+        for a stiffness requirement). The ball contacts are Hertzian (deflection as
+        F^(2/3)), hence the cube root: the nut is softer at light load.
+    """
+    require_positive("K_table", K_table)
+    require_positive("Ca", Ca)
+    return 0.8 * K_table * (m.fabs(Fa) / (0.28 * Ca)) ** (1.0 / 3.0)
+
+
+def nut_stiffness_preloaded(K_table, Ca, preload):
+    """Stiffness of a preloaded nut (N/mm), HIWIN BS-08-2-EN-1704-K F 3.34:
+    R_n = 0.8 K (F_pr / (0.1 Ca))^(1/3), with the preload F_pr (N); the catalogue's
+    highest preload is 10 % of Ca (double nut), 5 % for a single nut (F 3.5)."""
+    require_positive("K_table", K_table)
+    require_positive("Ca", Ca)
+    require_positive("preload", preload)
+    return 0.8 * K_table * (preload / (0.1 * Ca)) ** (1.0 / 3.0)
+
+
 # --- constraints, g >= 0 ---------------------------------------------------------------------
-def buckling_margin(F_max, d1, la, mounting: str = "fixed-supported", form: str = "catalogue"):
+def buckling_margin(
+    F_max, d1, la, mounting: str = "fixed-supported", form: str = "catalogue", rule="conservative"
+):
     """1 - F_max / P1 (>= 0 where the shaft does not buckle)."""
-    return 1.0 - m.fabs(F_max) / buckling_load(d1, la, mounting, form)
+    return 1.0 - m.fabs(F_max) / buckling_load(d1, la, mounting, form, rule=rule)
 
 
 def yield_margin(F_max, d1, sigma=SIGMA_ALLOWABLE):
@@ -333,9 +458,11 @@ def yield_margin(F_max, d1, sigma=SIGMA_ALLOWABLE):
     return 1.0 - m.fabs(F_max) / yield_load(d1, sigma)
 
 
-def critical_speed_margin(speed_max, d1, lb, mounting: str = "fixed-supported"):
+def critical_speed_margin(
+    speed_max, d1, lb, mounting: str = "fixed-supported", rule: str = "conservative"
+):
     """1 - N_max / N1 (>= 0 below the critical speed)."""
-    return 1.0 - speed_max / critical_speed(d1, lb, mounting)
+    return 1.0 - speed_max / critical_speed(d1, lb, mounting, rule)
 
 
 def static_safety_margin(Fa_max, C0a, f_s_min):

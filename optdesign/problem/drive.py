@@ -36,12 +36,16 @@ from optdesign.models.screw_catalogue import BallScrew, load_ball_screws
 from optdesign.models.screw_efficiency import MU_BALL_DEFAULT, MU_SLIDING_DEFAULT, screw_efficiency
 from optdesign.models.stiffness import G_STEEL, polar_moment
 
+#: HIWIN's design value of the forward efficiency for torque sizing, the lower end of its
+#: 0.85-0.95 (BS-08-2-EN-1704-K, F 3.15).
+EFFICIENCY_DESIGN_FORWARD = 0.85
+
 #: Prefix of the design-dict keys that carry parameters on the solver path.
 PARAM = "param:"
 
 #: Screw item fields that are parameters, with the direction that is favourable for a
 #: relaxation (+1: the largest value of the node's items, -1: the smallest).
-SCREW_FIELDS = {"d1": +1, "Ca": +1, "C0a": +1, "K_nut": +1}
+SCREW_FIELDS = {"d1": +1, "Ca": +1, "C0a": +1, "K_nut": +1, "K_load": +1}
 
 
 @dataclass(frozen=True)
@@ -50,6 +54,9 @@ class ScrewData:
 
     ``on_catalogue``: 1 where the design's (d0, p) is a catalogue item, 0 where not
     (NumPy path; None on the solver path, where the search solves items only).
+    ``K_load``: the nut's stiffness by HIWIN F 3.35 per cube root of the axial load,
+    0.8 K_nut / (0.28 Ca)^(1/3) (N/mm per N^(1/3)); a relaxation takes its largest value
+    over the node's items (the stiffness at any load grows with it).
     """
 
     d0: Any
@@ -59,6 +66,7 @@ class ScrewData:
     Ca: Any = None
     C0a: Any = None
     K_nut: Any = None
+    K_load: Any = None
     on_catalogue: Any = None
 
 
@@ -92,6 +100,8 @@ def catalogue_values(name: str, variable: str, nut: str | None = None) -> tuple[
 def _row_value(row: BallScrew | None, field: str) -> float:
     if row is None:
         return np.nan
+    if field == "K_load":
+        return 0.8 * float(row.K_nut) / (0.28 * float(row.Ca)) ** (1.0 / 3.0)
     value = getattr(row, field)
     return np.nan if value is None else float(value)
 
@@ -288,6 +298,13 @@ def efficiencies(q) -> tuple[Any, Any]:
     kind, mu = spec.screw.kind, friction(spec)
     fwd = screw_efficiency(kind, data.p, data.d_m, mu, "forward")
     back = screw_efficiency(kind, data.p, data.d_m, mu, "back")
+    if spec.screw.efficiency_design == "HIWIN":
+        # HIWIN's design value for torque sizing (F 3.15: 0.85-0.95 forward), its lower
+        # end; the back-driving efficiency stays the friction model's, which exceeds the
+        # catalogue's 0.75-0.85 and so loads the lock more (the safe side for the lock)
+        # (added to 0 x the model's value: the same type and shape, and a design that
+        # does not assemble stays NaN)
+        fwd = EFFICIENCY_DESIGN_FORWARD + 0.0 * fwd
     return fwd, back
 
 
@@ -307,8 +324,9 @@ def screw_speed(q, phi=None):
     return m.fabs(v) * rate / q.screw.p * 60.0
 
 
-def life_hours(q):
-    """Rated life (h) over the duty cycle, ISO 3408-5 L10 with the stated f_w."""
+def duty_cycle_means(q) -> tuple[Any, Any]:
+    """(cubic mean load F_m in N, mean speed n_m in 1/min) of the duty cycle, ISO 3408-5
+    (HIWIN F 3.4, F 3.8): the steps weighted by the revolutions they take."""
     req = q.requirements
     steps = req.duty_cycle
     phis = np.array([s.deflection for s in steps])
@@ -320,9 +338,13 @@ def life_hours(q):
     # The cubic mean load and mean speed of the cycle (written out so it holds on CasADi).
     work = sum(F**3 * n * t for F, n, t in zip(forces, speeds, times, strict=True))
     revs = sum(n * t for n, t in zip(speeds, times, strict=True))
-    F_m = (work / revs) ** (1.0 / 3.0)
-    n_m = revs / sum(times)
-    return (q.screw.Ca / (req.f_w * F_m)) ** 3 * 1e6 / (60.0 * n_m)
+    return (work / revs) ** (1.0 / 3.0), revs / sum(times)
+
+
+def life_hours(q):
+    """Rated life (h) over the duty cycle, ISO 3408-5 L10 with the stated f_w."""
+    F_m, n_m = duty_cycle_means(q)
+    return (q.screw.Ca / (q.requirements.f_w * F_m)) ** 3 * 1e6 / (60.0 * n_m)
 
 
 def _at(v, k):
@@ -342,8 +364,9 @@ def axial_compliance(q):
     total = 0.0
     if screw.bearing_stiffness is not None:
         total = total + 1.0 / screw.bearing_stiffness
-    if data.K_nut is not None:
-        total = total + 1.0 / data.K_nut
+    K_nut = nut_stiffness(q)
+    if K_nut is not None:
+        total = total + 1.0 / K_nut
     if screw.nut_offset is not None:
         x = screw.nut_offset + m.fabs(q.nut_position - _at(q.nut_position, 0))
         area = np.pi * data.d1**2 / 4.0
@@ -354,6 +377,40 @@ def axial_compliance(q):
         # instead of failing the models' input checks
         total = total + x * (data.p / (2.0 * m.pi)) ** 2 / (G_STEEL * polar_moment(data.d1))
     return total
+
+
+def nut_stiffness_rule(spec) -> str:
+    """The file's ``nut_stiffness_rule``, else ``"load"`` for a catalogue screw (HIWIN
+    F 3.35) and ``"table"`` (the given ``nut_stiffness`` as it stands) otherwise."""
+    screw = spec.screw
+    if screw.nut_stiffness_rule is not None:
+        return screw.nut_stiffness_rule
+    return "load" if screw.catalogue is not None else "table"
+
+
+def nut_load(q):
+    """The axial load (N) the nut stiffness is evaluated at: the nut force under the
+    hinge moment at each grid angle (``stiffness_load = "hinge"``), or the duty cycle's
+    cubic mean load (``"duty-mean"``, one value)."""
+    if q.requirements.stiffness_load == "duty-mean":
+        return duty_cycle_means(q)[0]
+    return m.fabs(q.nut_force)
+
+
+def nut_stiffness(q):
+    """Axial stiffness of the nut (N/mm) by the problem's rule, over the grid (or one
+    value): the table value, HIWIN F 3.35 at :func:`nut_load`, or F 3.34 at the preload;
+    None for a rigid nut (a continuous screw without ``nut_stiffness``)."""
+    spec = q.problem.spec
+    data = q.screw
+    rule = nut_stiffness_rule(spec)
+    if rule == "table" or data.K_nut is None:
+        return data.K_nut
+    if rule == "preload":
+        return 0.8 * data.K_nut * (spec.screw.nut_preload / 0.1) ** (1.0 / 3.0)
+    # HIWIN F 3.35, 0.8 K (F / (0.28 Ca))^(1/3), with its item factor K_load (a parameter
+    # on the solver path, so that a relaxation node keeps its bound)
+    return data.K_load * nut_load(q) ** (1.0 / 3.0)
 
 
 def output_compliance(q):

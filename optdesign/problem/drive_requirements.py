@@ -8,12 +8,30 @@ from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import screw_sizing as sizing
 from optdesign.problem.catalogue import ConstraintBlock
+from optdesign.problem.drive import nut_stiffness_rule
 
 
 def _need(value, what: str, field: str):
     if value is None:
         raise ProblemError(f"{field}: needs {what}")
     return value
+
+
+def _nut_text(q) -> str:
+    spec = q.problem.spec
+    rule = nut_stiffness_rule(spec)
+    if spec.screw.catalogue is None:
+        return "as given" if spec.screw.nut_stiffness is not None else "rigid"
+    if rule == "table":
+        return "the catalogue's table value"
+    if rule == "preload":
+        return f"HIWIN F 3.34 at a preload of {spec.screw.nut_preload:g} Ca"
+    load = (
+        "the duty cycle's mean load"
+        if spec.requirements.stiffness_load == "duty-mean"
+        else "the hinge moment's nut force"
+    )
+    return f"HIWIN F 3.35 at {load}"
 
 
 def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
@@ -79,7 +97,9 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
             )
         )
     if screw.length is not None and screw.check_buckling:
-        P1 = sizing.buckling_load(data.d1, screw.length, screw.mounting)
+        rule = screw.mounting_factors
+        P1 = sizing.buckling_load(data.d1, screw.length, screw.mounting, rule=rule)
+        eta2 = sizing.BUCKLING_FACTORS[rule][screw.mounting]
         out.append(
             ConstraintBlock(
                 "screw_buckling",
@@ -88,7 +108,7 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 1.0,
                 labels,
                 "",
-                f"nut force / buckling load ({screw.mounting})",
+                f"nut force / buckling load ({screw.mounting}, {rule} factor eta_2 = {eta2:.4g})",
             )
         )
     if screw.check_yield and data.d1 is not None:
@@ -109,7 +129,9 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
             "screw.length (the distance between the supports)",
             "requirements.critical_speed",
         )
-        N1 = sizing.critical_speed(data.d1, length, screw.mounting)
+        rule = screw.mounting_factors
+        N1 = sizing.critical_speed(data.d1, length, screw.mounting, rule)
+        lam2 = sizing.CRITICAL_SPEED_FACTORS[rule][screw.mounting]
         out.append(
             ConstraintBlock(
                 "critical_speed",
@@ -118,21 +140,30 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 1.0,
                 labels,
                 "",
-                "screw speed / critical speed",
+                f"screw speed / critical speed ({screw.mounting}, {rule} factor "
+                f"lambda_2 = {lam2:.4g})",
             )
         )
     if req.dn_max is not None:
         d0 = _need(data.d0, "the screw's diameter d0 (a variable)", "requirements.dn_max")
-        limit = sizing.DN_LIMIT[req.dn_max] if isinstance(req.dn_max, str) else float(req.dn_max)
+        grade = req.dn_max if isinstance(req.dn_max, str) else None
+        diameter, limit = sizing.dn_rule(req.dn_rule, grade)
+        limit = float(req.dn_max) if limit is None else limit
+        # the ball-centre diameter is the thread's mean diameter d_m (= d0 for the shipped
+        # catalogue, which prints no ball-circle diameter)
+        d = d0 if diameter == "nominal" else data.d_m
+        symbol = "d0" if diameter == "nominal" else "d_m"
+        what = f"{grade} " if grade else ""
         out.append(
             ConstraintBlock(
                 "dn",
-                d0 * q.screw_speed,
+                d * q.screw_speed,
                 None,
                 limit,
                 labels,
                 "mm/min",
-                "d0 x screw speed (DN value)",
+                f"{symbol} x screw speed (DN value; rule {req.dn_rule}: {what}limit "
+                f"{limit:,.0f} on the {diameter} diameter)",
             )
         )
     if req.static_safety_min is not None:
@@ -162,7 +193,8 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 None,
                 [""],
                 "h",
-                f"rated life L10 over the duty cycle (f_w = {req.f_w:g})",
+                f"rated life L10 over the duty cycle (f_w = {req.f_w:g}; HIWIN f_p: 1.1-1.2 "
+                "without impact, 1.3-1.8 normal, 2-3 impact and vibration)",
             )
         )
     if req.stiffness_min is not None:
@@ -174,7 +206,7 @@ def drive_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 1.0,
                 labels,
                 "",
-                "required stiffness / stiffness at the output",
+                f"required stiffness / stiffness at the output (nut: {_nut_text(q)})",
             )
         )
     return out

@@ -218,6 +218,31 @@ class Screw(_Model):
     gear_back_efficiency: Dimensionless = Field(1.0, gt=0.0, le=1.0)
     check_buckling: bool = True
     check_yield: bool = True
+    nut_stiffness_rule: Literal["load", "table", "preload"] | None = None
+    nut_preload: Dimensionless | None = Field(None, gt=0.0, le=0.1)
+    mounting_factors: Literal["conservative", "HIWIN", "common"] = "conservative"
+    efficiency_design: Literal["friction", "HIWIN"] = "friction"
+
+    @model_validator(mode="after")
+    def _nut_rule(self):
+        rule = self.nut_stiffness_rule
+        if rule == "preload" and self.nut_preload is None:
+            raise ValueError(
+                'nut_stiffness_rule: "preload" needs nut_preload (the preload over Ca, e.g. 0.05)'
+            )
+        if self.nut_preload is not None and rule != "preload":
+            raise ValueError('nut_preload: only with nut_stiffness_rule = "preload"')
+        if self.efficiency_design == "HIWIN" and self.kind != "ball":
+            raise ValueError(
+                f'efficiency_design: "HIWIN" gives design values of ball screws, not of a '
+                f'{self.kind} screw; use "friction"'
+            )
+        if rule is not None and self.catalogue is None:
+            raise ValueError(
+                "nut_stiffness_rule: the catalogue's rule needs the nut's table stiffness "
+                'and rating: give catalogue (e.g. "HIWIN")'
+            )
+        return self
 
     @model_validator(mode="after")
     def _positive(self):
@@ -295,18 +320,20 @@ class Requirements(_Model):
     screw: ScrewSizing | None = None
     lock: MotorLock | None = None
     fit_values: Literal["table", "smooth"] | None = None
-    pin_contact: Literal["duan2017", "conforming"] = "duan2017"
+    pin_contact: Literal["duan2017", "conforming", "palmgren"] = "duan2017"
     pin_contact_pressure_max: Pressure | None = None
     efficiency_min: Dimensionless | None = Field(None, gt=0.0, le=1.0)
     back_drive: Literal["required", "forbidden"] | None = None
     deflection_rate: AngularSpeed | None = None
     critical_speed: bool = False
     dn_max: float | Literal["rolled", "peeled", "ground", "high-speed"] | None = None
+    dn_rule: Literal["ball-centre", "HIWIN"] = "ball-centre"
     static_safety_min: Dimensionless | None = Field(None, ge=1.0)
     life_min: Time | None = None
     duty_cycle: list[DutyStep] | None = Field(None, max_length=1000)
     f_w: Dimensionless = Field(1.0, ge=1.0, le=3.0)
     stiffness_min: RotationalStiffness | None = None
+    stiffness_load: Literal["hinge", "duty-mean"] = "hinge"
 
     @model_validator(mode="after")
     def _physical(self):
@@ -332,6 +359,8 @@ class Requirements(_Model):
     def _drive_rules(self):
         if self.life_min is not None and not self.duty_cycle:
             raise ValueError("life_min needs a duty_cycle (deflection, hinge_moment, time)")
+        if self.stiffness_load == "duty-mean" and not self.duty_cycle:
+            raise ValueError('stiffness_load: "duty-mean" needs a duty_cycle')
         if (self.life_min is not None or self.critical_speed or self.dn_max is not None) and (
             self.deflection_rate is None
         ):
