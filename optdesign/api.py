@@ -28,7 +28,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
 from optdesign.solvers.result import Result
 
-__all__ = ["bench", "load", "pareto", "solve"]
+__all__ = ["bench", "load", "pareto", "report", "solve"]
 
 
 def solve(
@@ -198,3 +198,35 @@ def bench(
         hard_timeout=args["hard_timeout"],
         progress=args["progress"],
     )
+
+
+def report(result: Any, path: str | Path) -> Path:
+    """Write the interactive ``report.html`` of a result or a front made in Python - the
+    page the command line writes for ``optdesign solve`` / ``optdesign pareto``.
+
+    Parameters
+    ----------
+    result
+        A :class:`Result` with a design (:func:`solve`), a :class:`Front` with points
+        (:func:`pareto`), or a list of fronts of one problem (drawn together).
+    path
+        The page's file; or an existing folder, to write ``report.html`` in it. Written
+        as the command line writes it: atomically, through a new file (a link planted at
+        ``path`` is replaced, never followed; a failed write leaves the old file).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    InputError
+        Naming ``result`` or ``path`` and the reason (no design, not a folder...).
+    """
+    from optdesign.reports.html import front_report, solve_report
+    from optdesign.storage import atomic_write_text
+
+    problem, fronts, target = validation.report_arguments(result, path)
+    page = front_report(problem, fronts) if fronts else solve_report(result)
+    return atomic_write_text(target, page)
