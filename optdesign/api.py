@@ -44,6 +44,7 @@ def solve(
     ranges: bool = True,
     agree: int | None = None,
     diagnose: bool = True,
+    time_limit: float | None = None,
 ) -> Result:
     """The optimal design of ``problem``, with its evidence.
 
@@ -75,6 +76,11 @@ def solve(
         the smallest relaxation of each conflicting requirement (``result.diagnosis``),
         for every formulation. A problem with no free variable is not optimised: its
         fixed design is checked (formulation ``"fixed"``).
+    time_limit
+        Wall-clock seconds for the NLP multistart (at most a day; None: no limit): no
+        start begins after it, an Ipopt solve stops at it, and the result says so (a
+        note; the starts cut or not begun counted in ``result.multistart.failed``); the
+        diagnosis and the ranges are then skipped, with a note.
 
     Returns
     -------
@@ -96,6 +102,7 @@ def solve(
         ranges=ranges,
         agree=agree,
         diagnose=diagnose,
+        time_limit=time_limit,
     )
     problem = load(problem)
     validation.objective_of(problem, args["objective"])

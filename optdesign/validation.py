@@ -335,7 +335,7 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
     """The checked arguments of :func:`optdesign.solve`: ``formulation``, ``objective``
     (a string; the problem's names are checked by :func:`objective_of` once it is
     loaded), ``starts``, ``seed``, ``workers``, ``solver``, ``options``, ``ranges``,
-    ``agree``, ``diagnose``."""
+    ``agree``, ``diagnose``, ``time_limit``."""
     checked = _checked(
         {
             "formulation": formulation,
@@ -347,6 +347,7 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
             "ranges": flag,
             "agree": agree,
             "diagnose": flag,
+            "time_limit": seconds,
         },
         arguments,
     )
