@@ -83,7 +83,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "data" / "bench_pareto.json")
     args = ap.parse_args()
     problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
-    R = read_front_csv(REFERENCE, OBJECTIVES)
+    R = read_front_csv(REFERENCE, OBJECTIVES, problem)  # internal units
     R = R[non_dominated(R)]
     ref = reference_point(R)
     hv_ref = hypervolume(R, ref)

@@ -28,7 +28,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
 from optdesign.solvers.result import Result
 
-__all__ = ["bench", "load", "pareto", "solve"]
+__all__ = ["bench", "load", "pareto", "report", "solve"]
 
 
 def solve(
@@ -45,6 +45,7 @@ def solve(
     agree: int | None = None,
     diagnose: bool = True,
     contact_models: bool = False,
+    time_limit: float | None = None,
 ) -> Result:
     """The optimal design of ``problem``, with its evidence.
 
@@ -80,6 +81,11 @@ def solve(
         Also the worst-case backlash of the optimum under each pin contact model
         (``duan2017``, ``conforming``, ``palmgren``), as a note of the result: the
         spread of the models a designer should read beside the file's choice.
+    time_limit
+        Wall-clock seconds for the NLP multistart (at most a day; None: no limit): no
+        start begins after it, an Ipopt solve stops at it, and the result says so (a
+        note; the starts cut or not begun counted in ``result.multistart.failed``); the
+        diagnosis and the ranges are then skipped, with a note.
 
     Returns
     -------
@@ -102,6 +108,7 @@ def solve(
         agree=agree,
         diagnose=diagnose,
         contact_models=contact_models,
+        time_limit=time_limit,
     )
     problem = load(problem)
     validation.objective_of(problem, args["objective"])
@@ -211,3 +218,35 @@ def bench(
         hard_timeout=args["hard_timeout"],
         progress=args["progress"],
     )
+
+
+def report(result: Any, path: str | Path) -> Path:
+    """Write the interactive ``report.html`` of a result or a front made in Python - the
+    page the command line writes for ``optdesign solve`` / ``optdesign pareto``.
+
+    Parameters
+    ----------
+    result
+        A :class:`Result` with a design (:func:`solve`), a :class:`Front` with points
+        (:func:`pareto`), or a list of fronts of one problem (drawn together).
+    path
+        The page's file; or an existing folder, to write ``report.html`` in it. Written
+        as the command line writes it: atomically, through a new file (a link planted at
+        ``path`` is replaced, never followed; a failed write leaves the old file).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    InputError
+        Naming ``result`` or ``path`` and the reason (no design, not a folder...).
+    """
+    from optdesign.reports.html import front_report, solve_report
+    from optdesign.storage import atomic_write_text
+
+    problem, fronts, target = validation.report_arguments(result, path)
+    page = front_report(problem, fronts) if fronts else solve_report(result)
+    return atomic_write_text(target, page)

@@ -303,6 +303,9 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
 
     if argv is None:  # the program itself, not a call from Python
+        from optdesign.pipes import QuietPipe
+
+        sys.stdout = QuietPipe(sys.stdout)  # `optdesign ... | head -1` ends quietly
         _late_signals_exit()
         interrupts.start_watchdog(_finish_interrupted)
     code = run_guarded(run)

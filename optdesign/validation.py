@@ -335,7 +335,7 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
     """The checked arguments of :func:`optdesign.solve`: ``formulation``, ``objective``
     (a string; the problem's names are checked by :func:`objective_of` once it is
     loaded), ``starts``, ``seed``, ``workers``, ``solver``, ``options``, ``ranges``,
-    ``agree``, ``diagnose``, ``contact_models``."""
+    ``agree``, ``diagnose``, ``contact_models``, ``time_limit``."""
     checked = _checked(
         {
             "formulation": formulation,
@@ -348,6 +348,7 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
             "agree": agree,
             "diagnose": flag,
             "contact_models": flag,
+            "time_limit": seconds,
         },
         arguments,
     )
@@ -467,16 +468,57 @@ def run_folder(out: Any, resume: bool, overwrite: bool) -> None:
     if resume and out is None:
         raise ArgumentError("resume", "give the {out} folder of the run to resume", ("out",))
     if out is not None:
-        from pathlib import Path
+        folder("out", out)
 
-        # the nearest part of the path that exists must be a folder (a file there fails
-        # only when the first result is written, after the work)
-        part = Path(out)
-        while not os.path.lexists(part) and part != part.parent:
-            part = part.parent
-        if os.path.lexists(part) and not part.is_dir():
-            where = "is" if part == Path(out) else f"is under {part}, which is"
-            raise ArgumentError("out", f"{shown(str(out))} {where} a file, not a folder")
+
+def folder(argument: str, out: Any) -> None:
+    """``out`` can be (or become) a folder: the nearest part of the path that exists is
+    a folder (a file there would fail only when the first result is written, after the
+    work)."""
+    from pathlib import Path
+
+    part = Path(out)
+    while not os.path.lexists(part) and part != part.parent:
+        part = part.parent
+    if os.path.lexists(part) and not part.is_dir():
+        where = "is" if part == Path(out) else f"is under {part}, which is"
+        raise ArgumentError(argument, f"{shown(str(out))} {where} a file, not a folder")
+
+
+def report_arguments(subject: Any, path_: Any) -> tuple[Any, list[Any], Any]:
+    """The checked arguments of :func:`optdesign.report`: (problem, fronts or [],
+    the page's path). ``subject`` is a :class:`~optdesign.Result` with a design, a
+    :class:`~optdesign.Front` with points, or a list of fronts of one problem (drawn
+    together, as ``optdesign pareto --method all`` does); ``path_`` the page's file,
+    or a folder to write ``report.html`` in (as the command line's ``--out``)."""
+    from optdesign.solvers.result import Result
+    from optdesign.studies.pareto.front import Front
+
+    target = path("path", path_)
+    if target.is_dir():
+        target = target / "report.html"
+    elif os.path.lexists(target) and not os.path.islink(target) and not target.is_file():
+        raise ArgumentError("path", f"{shown(str(target))} is not a regular file")
+    folder("path", target.parent)
+    items = list(subject) if isinstance(subject, list | tuple) else [subject]
+    if isinstance(subject, Result):
+        problem = subject.problem_object
+        if problem is None:
+            raise ArgumentError("result", "carries no problem (a result made by od.solve does)")
+        if not subject.design:
+            raise ArgumentError("result", f"has no design to report (status {subject.status})")
+        return problem, [], target
+    if not items or not all(isinstance(f, Front) for f in items):
+        raise ArgumentError(
+            "result",
+            f"expected a Result (od.solve) or a Front (od.pareto), got {shown(subject)}",
+        )
+    problem = items[0].problem_object
+    if problem is None or any(f.problem_object is not problem for f in items):
+        raise ArgumentError("result", "the fronts carry no problem, or not the same one")
+    if not any(f.points for f in items):
+        raise ArgumentError("result", "the front has no point to report")
+    return problem, items, target
 
 
 def method_for(problem: Any, method_: Any, argument: str = "method") -> None:

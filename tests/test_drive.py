@@ -320,13 +320,13 @@ def test_catalogue_front_backlash_against_motor_torque():
     front = od.pareto(problem, ["backlash", "motor_torque"], points=3, starts=2)
     frame = front.to_frame()
     assert len(frame) == 3
-    backlash = frame["backlash"].to_numpy()
-    torque = frame["motor_torque"].to_numpy()
+    backlash = frame["backlash [deg]"].to_numpy()
+    torque = frame["motor_torque [N*m]"].to_numpy()
     assert backlash.min() == pytest.approx(0.0340646, rel=1e-5)  # test_catalogue's optimum
     order = np.argsort(backlash)
     assert np.all(np.diff(torque[order]) < 0)  # more backlash buys less torque
     for _, row in frame.iterrows():
-        assert row["p"] in (5.0, 6.0) and row["d"] in (5.0, 6.0, 8.0)
+        assert row["p [mm]"] in (5.0, 6.0) and row["d [mm]"] in (5.0, 6.0, 8.0)
 
 
 def test_conforming_pin_contact_in_a_problem():

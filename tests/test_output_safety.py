@@ -274,7 +274,7 @@ def test_pareto_files_and_summary_with_a_hostile_name(hostile_file, tmp_path, ca
     assert front["problem"] == NAME
     with (out / "front.csv").open(newline="") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0][:4] == ["method", "id", "backlash", "size"]
+    assert rows[0][:4] == ["method", "id", "backlash [deg]", "size [mm]"]
     assert len(rows) == 4 and all(len(r) == len(rows[0]) for r in rows)
     assert (out / "front.png").stat().st_size > 10_000
     data = _check_page((out / "report.html").read_text(), NAME)
@@ -328,15 +328,16 @@ def test_front_csv_reads_back_with_formulas_neutralised(hostile_front, tmp_path)
     with path.open(newline="") as fh:
         rows = list(csv.reader(fh))
     head = rows[0]
-    assert head[2:4] == ["backlash", "'" + OBJ]  # quoted by csv (it holds a quote), prefixed
+    # quoted by csv (it holds a quote), prefixed; the unit after the name
+    assert head[2:4] == ["backlash [deg]", "'" + OBJ + " [mm]"]
     assert '"\'=HYPERLINK(""x"")' in path.read_text()  # the csv module's quoting
     first = dict(zip(head, rows[1], strict=True))
     assert first["method"] == "'-method=1" and first["id"].startswith("'-method=1-")
     assert first["active"].startswith("'=1+1;")
     # a negative number is written as a number, not neutralised
     value = front.points[0].objectives[OBJ]
-    assert value < 0 and first["'" + OBJ] == f"{value:.12g}"
-    assert float(first["'" + OBJ]) == pytest.approx(value, rel=1e-11)
+    assert value < 0 and first["'" + OBJ + " [mm]"] == f"{value:.12g}"
+    assert float(first["'" + OBJ + " [mm]"]) == pytest.approx(value, rel=1e-11)
     F = read_front_csv(path, ["backlash", OBJ])
     assert F.shape == (3, 2) and np.all(F[:, 1] < 0)
 
@@ -352,7 +353,7 @@ def test_front_api_summary_frame_and_plot(hostile_front):
     assert _unsafe(summary) == []
     assert printable(OBJ) in summary and "method-1 front" in summary
     frame = front.to_frame()
-    assert OBJ in frame.columns  # the frame holds the data as it is
+    assert OBJ + " [mm]" in frame.columns  # the frame holds the data as it is
     fig = front.plot()
     texts = [fig.axes[0].get_ylabel(), fig.axes[0].get_title()]
     texts += [t.get_text() for t in fig.axes[0].get_legend().get_texts()]

@@ -251,7 +251,8 @@ def test_cli_writes_front_files(fork, tmp_path):
     assert code == 0
     rows = list(csv.DictReader((out / "front.csv").open()))
     assert len(rows) == 6
-    assert {"size", "backlash", "R", "p", "d", "status", "active"} <= set(rows[0])
+    heads = {"size [mm]", "backlash [deg]", "R [mm]", "p [mm]", "d [mm]", "status", "active"}
+    assert heads <= set(rows[0])
     assert all(r["status"] == "optimal" for r in rows)
     assert (out / "front.json").exists() and (out / "front.png").exists()
     assert (

@@ -49,6 +49,13 @@ def _solve(sub):
         default=1,
         help="local processes for the starts",
     )
+    p.add_argument(
+        "--time-limit",
+        type=checked(check.seconds, literal),
+        default=None,
+        help="wall-clock limit of the multistart, s (default: none); the summary says "
+        "when it stopped the solve",
+    )
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.add_argument("--no-report", action="store_true", help="skip the interactive report.html")
     p.add_argument(
@@ -107,6 +114,7 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
             ranges=not args.no_ranges,
             diagnose=not args.no_diagnosis,
             contact_models=args.contact_models,
+            time_limit=args.time_limit,
         )
     from optdesign.reports.result_json import result_json
 

@@ -1,7 +1,10 @@
 """Plots (matplotlib): every function returns a Figure and leaves the back-end alone.
 
-Importing optdesign never selects a matplotlib back-end: in a notebook figures show as
-usual; the command line selects the file-only Agg back-end for itself
+Importing optdesign never selects a matplotlib back-end, and no figure is made through
+pyplot's global state: :func:`new_figure` makes a :class:`matplotlib.figure.Figure` that
+pyplot does not track, so a notebook shows a returned figure once (as the cell's value;
+the inline back-end draws only the figures pyplot holds) and a script that makes many
+figures keeps none open. The command line selects the file-only Agg back-end for itself
 (:func:`optdesign.cli.main`). :func:`save_figure` writes a figure as PNG.
 
 Text from a user (a problem's name, an objective's or a constraint's, a label) is drawn
@@ -13,11 +16,15 @@ instead of losing the command's other outputs.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from optdesign.text import printable
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 def plain(text: object) -> str:
@@ -25,6 +32,16 @@ def plain(text: object) -> str:
     (:func:`~optdesign.text.printable`), every ``$`` escaped as ``\\$`` so that no part
     of it is read as mathtext (an escaped dollar is drawn as ``$``)."""
     return printable(text).replace("$", r"\$")
+
+
+def new_figure(figsize: tuple[float, float], dpi: int = 120, layout: str | None = None) -> Figure:
+    """A figure outside pyplot's state (never shown by a back-end on its own, never left
+    open: it is freed with its last reference). ``layout="constrained"`` when a figure
+    label (``supxlabel``) must keep its own room below the axes' labels, in a notebook as
+    in a file."""
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=figsize, dpi=dpi, layout=layout)
 
 
 def write_figure(draw: Callable[[], Any], path: str | Path, **kw: Any) -> str | None:
@@ -39,12 +56,10 @@ def write_figure(draw: Callable[[], Any], path: str | Path, **kw: Any) -> str | 
         report), so it is reported instead of raised. I/O errors (a full disk, no
         permission) and interrupts are raised as usual.
     """
-    import matplotlib.pyplot as plt
-
     from optdesign.storage import atomic_output
 
     path = Path(path)
-    before = set(plt.get_fignums())
+    before = _pyplot_figures()
     try:
         fig = draw()
         with atomic_output(path) as tmp:
@@ -52,26 +67,26 @@ def write_figure(draw: Callable[[], Any], path: str | Path, **kw: Any) -> str | 
     except OSError:
         raise
     except Exception as exc:
-        for num in set(plt.get_fignums()) - before:  # the figures this draw opened
-            plt.close(num)
+        # a user's code (a mechanism's sketch) may have opened pyplot figures
+        for num in (_pyplot_figures() or set()) - (before or set()):
+            sys.modules["matplotlib.pyplot"].close(num)
         return f"{path.name} not written: {type(exc).__name__}: {' '.join(str(exc).split())}"
     return None
 
 
 def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Path:
     """Lay out ``fig``, write it as PNG at ``path`` (folders made, the file replaced
-    atomically), close it; return the path."""
-    import matplotlib.pyplot as plt
-
+    atomically), close it if pyplot holds it; return the path."""
     if tight:
-        from matplotlib.layout_engine import TightLayoutEngine
+        from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
 
-        if fig.get_layout_engine() is None:
+        engine = fig.get_layout_engine()
+        if engine is None:
             # fig.tight_layout()'s own computation, without the placeholder layout engine
             # it leaves on the figure: with one, savefig lays the figure out once more
             # (~40 ms of a front plot's ~150 ms; the PNG is byte-identical).
             TightLayoutEngine(rect=None).execute(fig)
-        else:
+        elif not isinstance(engine, ConstrainedLayoutEngine):  # savefig runs that one
             fig.tight_layout()
     from optdesign.storage import atomic_output
 
@@ -80,5 +95,16 @@ def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Pa
     # output folder) is replaced, never followed, and a failed write leaves the old file.
     with atomic_output(path) as tmp:
         fig.savefig(tmp, dpi=dpi, format=path.suffix.lstrip(".").lower() or "png")
-    plt.close(fig)
+    if getattr(fig.canvas, "manager", None) is not None:  # a figure made through pyplot
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
     return path
+
+
+def _pyplot_figures() -> set[int] | None:
+    """The numbers of pyplot's open figures, None when pyplot is not imported (then none
+    can be open: importing it here would only cost time)."""
+    if "matplotlib.pyplot" not in sys.modules:
+        return None
+    return set(sys.modules["matplotlib.pyplot"].get_fignums())

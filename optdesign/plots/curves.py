@@ -5,10 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
-from optdesign.plots import plain, save_figure
+from optdesign.plots import new_figure, plain, save_figure
 
 
 def plot_curves(
@@ -20,7 +19,8 @@ def plot_curves(
     styles: Mapping[str, str] | None = None,
 ) -> Path:
     """Plot several curves against the deflection (degrees) into a PNG at ``path``."""
-    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=120)
+    fig = new_figure((6.4, 4.2))
+    ax = fig.subplots()
     for label, y in curves.items():
         ax.plot(phi_deg, y, (styles or {}).get(label, "-"), label=plain(label))
     ax.set_ylabel(plain(ylabel))

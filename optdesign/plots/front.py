@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from optdesign.plots import plain
+from optdesign.plots import new_figure, plain
 from optdesign.user_code import call_method
 
 _STYLE = {
@@ -94,8 +94,6 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
     """Objective space with every front overlaid, plus sketches of picked points of the
     first front (unless ``ax`` is given: then only the objective space, on ``ax``).
     Returns the Figure. Two objectives: a 2-D plot; three: a 3-D scatter."""
-    import matplotlib.pyplot as plt
-
     main = fronts[0]
     objectives = main.objectives
     picks = pick_points(main.F)
@@ -105,7 +103,7 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
     if ax is None:
         n_sk = len(picks)
         cols = max(1, (n_sk + 1) // 2)
-        fig = plt.figure(figsize=(6 + 3.0 * max(n_sk, 1) / 1.5, 5), dpi=120)
+        fig = new_figure((6 + 3.0 * max(n_sk, 1) / 1.5, 5), layout="constrained")
         gs = fig.add_gridspec(2, 1 + cols, width_ratios=[2.2] + [1] * cols)
         ax = fig.add_subplot(gs[:, 0], projection="3d" if three else None)
         sketches = True

@@ -24,13 +24,14 @@ def plot_profiles(
     gap_floor
         Floor used for the gap measure (the x axis of the gap panel is gap / floor).
     """
-    import matplotlib.pyplot as plt
+    import matplotlib
 
-    from optdesign.plots import plain
+    from optdesign.plots import new_figure, plain
 
     keys = [k for k in ("time", "gap") if k in profiles]
-    fig, axes = plt.subplots(1, len(keys), figsize=(6.0 * len(keys), 5.4), dpi=110, squeeze=False)
-    cmap = plt.get_cmap("tab20")
+    fig = new_figure((6.0 * len(keys), 5.4), dpi=110)
+    axes = fig.subplots(1, len(keys), squeeze=False)
+    cmap = matplotlib.colormaps["tab20"]
     styles = ["-", "--", "-.", ":"]
     for ax, key in zip(axes[0], keys, strict=True):
         taus, rho = profiles[key]

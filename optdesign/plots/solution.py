@@ -9,7 +9,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from optdesign.plots import plain
+from optdesign.plots import new_figure, plain
 from optdesign.problem.design_problem import DesignProblem
 
 
@@ -27,16 +27,14 @@ def plot_designs(
     last design's ratio curve. Returns the Figure; with ``ax`` the ratio is drawn on that
     axes (and the backlash, if any, on a twin axis) instead of a new figure.
     """
-    import matplotlib.pyplot as plt
-
     phi_deg = np.degrees(problem.phi)
     has_pin = problem.has("d")
     req = problem.spec.requirements
     if ax is None:
-        fig, axes = plt.subplots(
-            1, 2 if has_pin else 1, figsize=(11 if has_pin else 6, 4.6), dpi=120, squeeze=False
-        )
-        axes = list(axes[0])
+        # constrained: the footer (what limits the design) keeps its own room below the
+        # axes' labels in a notebook too, where no save_figure lays the figure out
+        fig = new_figure((11 if has_pin else 6, 4.6), layout="constrained")
+        axes = list(fig.subplots(1, 2 if has_pin else 1, squeeze=False)[0])
     else:
         fig = ax.figure
         axes = [ax, ax.twinx()] if has_pin else [ax]
@@ -94,7 +92,6 @@ def plot_designs(
         a.legend(fontsize=7)
     if limits:
         text = "what limits the design: " + "; ".join(lim.text() for lim in limits[:6])
-        # a figure x-label: tight_layout (save_figure) keeps room for it
         fig.supxlabel(_wrap(plain(text), 170), fontsize=7, x=0.01, ha="left")
     return fig
 

@@ -74,9 +74,17 @@ def front_summary(fronts: Sequence) -> str:
         cells.append(p.status)
         cells.append(", ".join(point_limits(problem, main.objectives, p))[:70])
         table.append(cells)
-    lines += ["", f"{printable(main.method)} front ({len(pts)} points, every {step}th shown):"]
+    lines += ["", f"{printable(main.method)} front ({len(pts)} points, {_shown(step)}):"]
     lines.append(format_table([*heads, "design", "status", "what limits it"], table))
     return printable("\n".join(lines), newlines=True)
+
+
+def _shown(step: int) -> str:
+    """Which points the table shows: "all shown", "every 2nd shown", "every 11th..."."""
+    if step <= 1:
+        return "all shown"
+    suffix = "th" if 10 <= step % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(step % 10, "th")
+    return f"every {step}{suffix} shown"
 
 
 def _design_cell(problem, var, value: float) -> str:

@@ -147,7 +147,7 @@ def solve_report(result: Any) -> str:
     data = {
         **_header(problem),
         "kind": "solve",
-        "status": result.status,
+        "status": result.status + _starts_text(result.multistart),
         "objective": f"{name} = {objective_shown(problem, name, objective_value(result)).text(8)}",
         "designs": [initial, best],
         "reference": 0,
@@ -155,6 +155,17 @@ def solve_report(result: Any) -> str:
         "front": None,
     }
     return render(data, title=f"optdesign: {problem.name}")
+
+
+def _starts_text(ms: Any) -> str:
+    """`` (5 of 8 starts converged; 3 failed: 2 restoration failed, 1 iteration limit)``:
+    the starts as the summary counts them; "" without a multistart."""
+    if ms is None:
+        return ""
+    failed = ms.failure_text()
+    return f" ({ms.n_converged} of {ms.n_starts} starts converged" + (
+        f"; {failed})" if failed else ")"
+    )
 
 
 def front_report(problem: Any, fronts: Sequence[Any]) -> str:

@@ -62,6 +62,8 @@ def result_summary(result: Result) -> str:
             f"multistart {ms.n_at_best} of {ms.n_starts} starts reached the best point "
             f"(within {ms.tolerance:g} relative; {ms.n_converged} converged; seed {ms.seed})"
         )
+        if ms.failed:  # the starts that cost time and gave nothing: how many and why
+            lines.append(f"          {ms.failure_text()}")
     for note in result.notes:
         lines.append(f"note      {note}")
     if problem is not None:

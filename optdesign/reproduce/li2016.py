@@ -134,12 +134,10 @@ def run(out: Path) -> int:
     print("conclusions use beta up to 90 deg and alpha around 5-15 deg, as plotted here.\n")
     print(comparison_table(rows))
 
-    # optdesign.plots selects the Agg back-end before pyplot loads
-    import matplotlib.pyplot as plt
+    from optdesign.plots import new_figure, save_figure
 
-    from optdesign.plots import save_figure
-
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
+    fig = new_figure((10, 3.8), dpi=100)
+    ax1, ax2 = fig.subplots(1, 2)
     for a in (2.0, 5.0, 10.0, 15.0, 20.0, 30.0):
         ax1.plot(betas, _eta(a, betas), label=f"alpha_s = {a:g} deg")
     ax1.set_xlabel("contact angle beta (deg)")

@@ -325,12 +325,10 @@ def run(out: Path) -> int:
 
 
 def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
-    # optdesign.plots selects the Agg back-end before pyplot loads
-    import matplotlib.pyplot as plt
+    from optdesign.plots import new_figure, save_figure
 
-    from optdesign.plots import save_figure
-
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = new_figure((6, 4), dpi=100)
+    ax = fig.subplots()
     for s in SIDES:
         ax.plot(np.degrees(PSI), np.degrees(om[s]), "o-", label=f"{s} side")
     ax.set(
@@ -341,7 +339,8 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
     ax.legend()
     save_figure(fig, out / "prsm_omega_position.png")
 
-    fig, axs = plt.subplots(1, 2, figsize=(10, 4))
+    fig = new_figure((10, 4), dpi=100)
+    axs = fig.subplots(1, 2)
     for s in SIDES:
         axs[0].plot(PITCHES, np.degrees(sp.omega[s]), "o-", label=f"{s}, spherical roller")
         axs[0].plot(
@@ -367,7 +366,8 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
         ("pitch", PITCHES, sp, "pitch (mm)"),
         ("beta", BETAS_DEG, sb, "flank half-angle (deg)"),
     ):
-        fig, ax = plt.subplots(figsize=(6, 4))
+        fig = new_figure((6, 4), dpi=100)
+        ax = fig.subplots()
         for s in SIDES:
             ax.plot(x, sw.e[s], "o-", label=f"{s}, with omega")
             ax.plot(x, sw.e0[s], "--", label=f"{s}, omega = 0")
@@ -375,7 +375,8 @@ def _plots(out: Path, om, sp, sb, spv, sbv, av) -> None:
         ax.legend(fontsize=8)
         save_figure(fig, out / f"prsm_eccentricity_{name}.png")
 
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = new_figure((6, 4), dpi=100)
+    ax = fig.subplots()
     for s in SIDES:
         ax.plot(LOADS, av[s][0], "-", label=f"{s}, with omega")
         ax.plot(LOADS, av[s][1], "--", label=f"{s}, omega = 0")

@@ -111,12 +111,10 @@ def run(out: Path) -> int:
     print(f"M_h = 500 N*m, ball screw eta' = {float(eta_back):.4f}, gear eta' = 0.98:")
     print(format_table(["lock", "max motor-shaft moment (N*m)", "magnet force (N)"], table))
 
-    # optdesign.plots selects the Agg back-end before pyplot loads
-    import matplotlib.pyplot as plt
+    from optdesign.plots import new_figure, save_figure
 
-    from optdesign.plots import save_figure
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
+    fig = new_figure((6, 3.5), dpi=100)
+    ax = fig.subplots()
     ax.plot(np.degrees(phi), np.asarray(load.moment) / 1e3)
     ax.set_xlabel("deflection phi (deg)")
     ax.set_ylabel("motor-shaft moment (N*m)")

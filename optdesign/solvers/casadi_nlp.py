@@ -32,6 +32,7 @@ from optdesign.interrupts import Interrupted, solver_call
 from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas
+from optdesign.solvers.deadline import passed as deadline_passed
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults: quiet, tight tolerances (the tests compare optima to 1e-4 relative and
@@ -248,6 +249,36 @@ def _try_ipopt_option(key: str, value: Any, where: str) -> None:
         raise InputError(where, f"Ipopt refuses {value!r} (out of the option's range)")
 
 
+class _DeadlineCallback(ca.Callback):
+    """Ipopt's iteration callback: stop (User_Requested_Stop) once the study's deadline
+    (:mod:`optdesign.solvers.deadline`) has passed. Its inputs are the solver's outputs
+    at the current iterate; only the clock is read."""
+
+    def __init__(self, nz: int, ng: int, n_p: int) -> None:
+        ca.Callback.__init__(self)
+        self._sizes = {"x": nz, "lam_x": nz, "g": ng, "lam_g": ng, "lam_p": n_p, "f": 1}
+        self.construct("optdesign_deadline", {})
+
+    def get_n_in(self) -> int:
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self) -> int:
+        return 1
+
+    def get_name_in(self, i: int) -> str:
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i: int) -> str:
+        return "ret"
+
+    def get_sparsity_in(self, i: int):
+        n = self._sizes.get(ca.nlpsol_out(i), 0)
+        return ca.Sparsity.dense(n, 1) if n else ca.Sparsity(0, 0)
+
+    def eval(self, arg):
+        return [1 if deadline_passed() else 0]
+
+
 class CasadiNLPSolver:
     """A reusable CasADi NLP solver for one :class:`NLP`.
 
@@ -263,9 +294,17 @@ class CasadiNLPSolver:
     """
 
     def __init__(self, nlp: NLP, plugin: str = "ipopt", options: Mapping[str, Any] | None = None):
+        from optdesign.solvers.deadline import DEADLINE_OPTION
+
         self.nlp = nlp
         self.plugin = plugin
+        options = dict(options or {})
+        watch = bool(options.pop(DEADLINE_OPTION, False))
         opts: dict[str, Any] = {"print_time": False}
+        if watch and plugin == "ipopt":
+            # stops the solve at its next iteration once the study's deadline has passed
+            self._watch = _DeadlineCallback(nlp.z.numel(), nlp.g.numel(), nlp.p.numel())
+            opts["iteration_callback"] = self._watch
         if plugin == "ipopt":
             check_ipopt_options(options or {})
             opts["ipopt"] = {**IPOPT_DEFAULTS, **(options or {})}
@@ -315,6 +354,8 @@ class CasadiNLPSolver:
         wall = time.perf_counter() - t0
         stats = self.solver.stats()
         return_status = str(stats.get("return_status", ""))
+        if return_status == "User_Requested_Stop" and deadline_passed():
+            return_status = "Maximum_WallTime_Exceeded"  # the study's time limit stopped it
         if return_status == "NonIpopt_Exception_Thrown":
             # a signal handler raised inside the call (one that solver_call does not know
             # of, e.g. the user's own): an interrupt all the same

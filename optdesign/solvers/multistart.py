@@ -14,7 +14,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from optdesign.solvers.blas import one_blas_thread
-from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.solvers.deadline import deadline, passed
+from optdesign.solvers.result import MultistartInfo, Result, TerminationCondition
 
 
 def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.ndarray:
@@ -54,6 +55,49 @@ def _tolerance(value: float, rel_tol: float) -> float:
     return rel_tol * max(abs(value), 1e-12) if math.isfinite(value) else 0.0
 
 
+#: The reason counted for the starts a time limit left unrun.
+NOT_STARTED = "not started (time limit)"
+
+
+def start_outcome(result: Result) -> str:
+    """How one start ended, in the summary's words: ``"converged"`` or why not.
+
+    ``"restoration failed"`` (Ipopt's feasibility restoration found no way back),
+    ``"iteration limit"``, ``"time limit"``, ``"not assembling"`` (a NaN or an infinity
+    in the model: a design where the linkage cannot be put together, such as a rod
+    shorter than the gap it must span), ``"locally infeasible"``, ``"evaluation error"``
+    (the back-end could not evaluate the model), else the result's status.
+    """
+    if result.success:
+        return "converged"
+    message = result.message or ""
+    term = result.termination
+    if "Restoration_Failed" in message:
+        return "restoration failed"
+    if term == TerminationCondition.MAX_ITERATIONS:
+        return "iteration limit"
+    if term == TerminationCondition.MAX_TIME:
+        return "time limit"
+    if "Invalid_Number" in message:
+        return "not assembling"
+    if term == TerminationCondition.INFEASIBLE:
+        return "locally infeasible"
+    if term == TerminationCondition.ERROR:
+        return "evaluation error"
+    return str(result.status or "failed")
+
+
+def outcome_counts(outcomes: Sequence[str]) -> dict[str, int]:
+    """The starts that did not converge, counted by reason: most frequent first, a tie
+    in the order the reasons first occur (never by timing)."""
+    counts: dict[str, int] = {}
+    for o in outcomes:
+        if o != "converged":
+            counts[o] = counts.get(o, 0) + 1
+    order = {o: k for k, o in enumerate(counts)}
+    return dict(sorted(counts.items(), key=lambda kv: (-kv[1], order[kv[0]])))
+
+
 def improves(value: float, best: float, rel_tol: float = 1e-6) -> bool:
     """Whether ``value`` is better than ``best`` by more than a tie (``rel_tol``
     relative): a search keeps its earlier incumbent on a tie, as :func:`best_of` does."""
@@ -67,6 +111,7 @@ def multistart(
     rel_tol: float = 1e-6,
     seed: int = 0,
     agree: int | None = None,
+    time_limit: float | None = None,
 ) -> Result:
     """Solve from every start and return the best result with its multistart record.
 
@@ -84,24 +129,39 @@ def multistart(
         shortest prefix of ``starts`` (in their order) on which that many agree, whatever
         the number of workers and whichever start finishes first: the same starts, the
         same winner (:func:`best_of`) and the same record as a run on one worker.
+    time_limit
+        Wall-clock seconds for the whole multistart (:mod:`optdesign.solvers.deadline`):
+        no start begins after it (the first start always runs), a solve built with
+        :data:`~optdesign.solvers.deadline.DEADLINE_OPTION` stops at it; the starts not
+        begun count as failed, "not started (time limit)", and a note says so.
     """
     t0 = time.perf_counter()
     starts = list(np.atleast_2d(starts))
     results: list[Result] = []
     # One BLAS thread in this process as in the workers (a back-end of the user's own
     # gets it too): the same arithmetic whatever the number of workers.
-    with one_blas_thread():
+    with one_blas_thread(), deadline(time_limit):
+        stop = _stop_rule(rel_tol, agree)
         if workers > 1 and len(starts) > 1:
             from optdesign.studies.runner import map_inherited
 
-            results = map_inherited(solve, starts, workers, stop=_stop_rule(rel_tol, agree))
+            results = map_inherited(solve, starts, workers, stop=stop)
         else:
-            stop = _stop_rule(rel_tol, agree)
             for x0 in starts:
                 results.append(solve(x0))
                 if stop(results):
                     break
+        timed_out = passed()
     best, n_at_best = best_of(results, rel_tol)
+    outcomes = [start_outcome(r) for r in results]
+    not_started = len(starts) - len(results) if timed_out else 0
+    failed = outcome_counts(outcomes + [NOT_STARTED] * not_started)
+    if timed_out:
+        stopped = sum(o == "time limit" for o in outcomes)
+        best.notes.append(
+            f"time limit of {time_limit:g} s reached: {len(results)} of {len(starts)} starts "
+            f"run ({stopped} stopped at the limit), {not_started} not started"
+        )
     best.multistart = MultistartInfo(
         n_starts=len(results),
         n_converged=sum(r.success for r in results),
@@ -112,6 +172,8 @@ def multistart(
         workers=workers,
         n_planned=len(starts),
         stopped_early=len(results) < len(starts),
+        outcomes=outcomes,
+        failed=failed,
     )
     best.wall_time_s = time.perf_counter() - t0
     return best
@@ -119,6 +181,8 @@ def multistart(
 
 def _stop_rule(rel_tol: float, agree: int | None) -> Callable[[list[Result]], bool]:
     def stop(results: list[Result]) -> bool:
+        if passed():  # the time limit: no further start
+            return True
         return bool(agree) and best_of(results, rel_tol)[1] >= agree
 
     return stop

@@ -79,6 +79,19 @@ class MultistartInfo:
     workers: int = 1
     n_planned: int | None = None
     stopped_early: bool = False
+    #: How each start ended, in start order: "converged" or why not ("restoration
+    #: failed", "iteration limit", "time limit", "not assembling", "locally
+    #: infeasible", ...: :func:`optdesign.solvers.multistart.start_outcome`).
+    outcomes: list[str] = field(default_factory=list)
+    #: The starts that did not converge, counted by reason (most frequent first).
+    failed: dict[str, int] = field(default_factory=dict)
+
+    def failure_text(self) -> str:
+        """``"5 failed: 3 restoration failed, 2 iteration limit"``; "" when none failed."""
+        n = sum(self.failed.values())
+        if not n:
+            return ""
+        return f"{n} failed: " + ", ".join(f"{k} {why}" for why, k in self.failed.items())
 
 
 @dataclass

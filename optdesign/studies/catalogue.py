@@ -35,7 +35,13 @@ from optdesign.formulations.discrete import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
-from optdesign.solvers.multistart import best_of, improves, sobol_starts
+from optdesign.solvers.multistart import (
+    best_of,
+    improves,
+    outcome_counts,
+    sobol_starts,
+    start_outcome,
+)
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.solve import _objective_set, finish, solver_for, solver_options
 
@@ -143,6 +149,7 @@ class NodeSolver:
             results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
         self.n_solves += len(results)
         best, n_at_best = best_of(results)
+        outcomes = [start_outcome(r) for r in results]
         best.multistart = MultistartInfo(
             len(results),
             sum(r.success for r in results),
@@ -150,6 +157,8 @@ class NodeSolver:
             1e-6,
             [r.objective for r in results],
             self.seed,
+            outcomes=outcomes,
+            failed=outcome_counts(outcomes),
         )
         return best
 

@@ -144,13 +144,11 @@ def run_monte_carlo(
 
 def plot_ranking(result: MonteCarloResult, path: Path, title: str = "") -> Path:
     """Bar plot of the sensitivity ranking in percent (like [L16] Fig. 6b)."""
-    # optdesign.plots selects the Agg back-end before pyplot loads
-    import matplotlib.pyplot as plt
-
-    from optdesign.plots import save_figure
+    from optdesign.plots import new_figure, save_figure
 
     ranked = result.ranking()
-    fig, ax = plt.subplots(figsize=(7, 3.5))
+    fig = new_figure((7, 3.5), dpi=100)
+    ax = fig.subplots()
     ax.bar([r[0] for r in ranked], [100 * r[1] for r in ranked], color="tab:blue")
     ax.set_ylabel("share of mean-square error (%)")
     ax.set_title(title or "Sensitivity ranking (Monte Carlo)")

@@ -120,6 +120,7 @@ def solve_nlp(
     options: Mapping[str, Any] | None = None,
     x0: np.ndarray | None = None,
     agree: int | None = None,
+    time_limit: float | None = None,
 ) -> Result:
     """Multistart NLP solve of ``problem``.
 
@@ -139,6 +140,10 @@ def solve_nlp(
         Stop once this many starts agree on the best value (default: the problem file's
         ``[solver] agree``, 3; 0: every start). On every shipped problem all 8 default
         starts reach the same optimum (benchmarks/README.md, "Overhead").
+    time_limit
+        Wall-clock seconds for the multistart: no start begins after it, and an Ipopt
+        solve stops at it (status ``time_limit``); other back-ends finish the start they
+        are in.
     """
     _no_catalogue(problem, "nlp")
     objective = objective or problem.objective_names[0]
@@ -146,11 +151,20 @@ def solve_nlp(
     n_starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
     agree = agree if agree is not None else problem.spec.solver.agree
+    if time_limit is not None and solver == "ipopt":
+        from optdesign.solvers.deadline import DEADLINE_OPTION
+
+        options = {**(options or {}), DEADLINE_OPTION: True}
     backend = solver_for(problem, solver, options, objectives)
     target = backend.nlp.target(objective)
     pts = start_points(problem, n_starts, seed, x0)
     result = multistart(
-        lambda x: backend.solve(x, target), pts, workers=workers, seed=seed, agree=agree or None
+        lambda x: backend.solve(x, target),
+        pts,
+        workers=workers,
+        seed=seed,
+        agree=agree or None,
+        time_limit=time_limit,
     )
     return finish(problem, result, objective)
 
@@ -328,7 +342,17 @@ def _solve_nlp_formulation(problem: DesignProblem, **options) -> Result:
     return attach_reference(problem, solve_nlp(problem, **_pick(options, _NLP_OPTIONS)))
 
 
-_NLP_OPTIONS = ("objective", "starts", "seed", "workers", "solver", "options", "x0", "agree")
+_NLP_OPTIONS = (
+    "objective",
+    "starts",
+    "seed",
+    "workers",
+    "solver",
+    "options",
+    "x0",
+    "agree",
+    "time_limit",
+)
 
 
 def _pick(options: Mapping[str, Any], names: tuple[str, ...]) -> dict[str, Any]:
@@ -400,6 +424,7 @@ def solve(
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
     diagnose: bool = True,
+    time_limit: float | None = None,
     **extra: Any,
 ) -> Result:
     """The optimal design of ``problem`` with its evidence (see :func:`optdesign.solve`).
@@ -407,12 +432,42 @@ def solve(
     A problem with no free variable is not optimised: its fixed design is checked
     (:func:`check_fixed_design`). ``diagnose``: on a result with no feasible design, the
     smallest relaxation of each conflicting requirement (:mod:`optdesign.studies.
-    diagnosis`)."""
+    diagnosis`). ``time_limit``: wall-clock seconds for the NLP multistart (a note says
+    when it stopped the solve); the diagnosis and the ranges, which come after, are
+    skipped with a note once it has passed."""
     from optdesign.safe_io import refuse_file_options
+    from optdesign.solvers.deadline import deadline, passed
 
     # Before any work and whatever the formulation: no option may read or write a file.
     refuse_file_options(options, "options")
     name = plan_solve(problem, formulation)
+    with deadline(time_limit):
+        result = _solve_within(
+            problem, name, objective, starts, seed, workers, solver, options, time_limit, extra
+        )
+        late = passed()
+    if late and ((diagnose and not result.success) or (ranges and result.success)):
+        what = "the diagnosis" if not result.success else "the ranges of the optimal set"
+        result.notes.append(f"{what} not computed: the time limit of {time_limit:g} s was reached")
+        return result
+    return _evidence(problem, result, solver, options, ranges, diagnose)
+
+
+def _solve_within(
+    problem: DesignProblem,
+    name: str,
+    objective: str | None,
+    starts: int | None,
+    seed: int | None,
+    workers: int,
+    solver: str,
+    options: Mapping[str, Any] | None,
+    time_limit: float | None,
+    extra: dict[str, Any],
+) -> Result:
+    """The formulation's solve (the fixed design's check without a free variable)."""
+    if time_limit is not None and name == "nlp":
+        extra = {**extra, "time_limit": time_limit}
     if not problem.free:
         result = check_fixed_design(problem, objective)
     else:
@@ -426,6 +481,15 @@ def solve(
             options=options,
             **extra,
         )
+        if time_limit is not None and name != "nlp":  # its solves are not watched
+            result.notes.append(
+                f"time_limit: not applied (the {name} formulation runs no NLP multistart)"
+            )
+    return result
+
+
+def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: bool) -> Result:
+    """The diagnosis of a result with no feasible design, the ranges of an optimum."""
     if diagnose and not result.success:
         from optdesign.studies.diagnosis import diagnose as diagnose_result
 

@@ -28,8 +28,15 @@ PARETO_TEXT = base("cs_min_ripple") + "\n[solver]\nstarts = 2\nipopt = { tol = 1
 PARETO = ["pareto", "@FILE@", "--objectives", "ripple,size", "--points", "4", "--workers", "1"]
 PARETO += ["--deterministic", "--no-progress", "--no-plot", "--no-report"]
 BENCH = ["bench", "--suite", "quick", "--solvers", "ipopt-exact", "--workers", "1", "--no-progress"]
-#: Bounds of cs_min_ripple's free variables (mm, rad).
-BOUNDS = {"R": (30, 120), "l": (40, 200), "n": (0, 150), "p": (2, 10), "phi0": (-0.6, 0.6)}
+#: Bounds of cs_min_ripple's free variables under front.csv's headings (in the file's
+#: units, as the summary shows them).
+BOUNDS = {
+    "R [mm]": (30, 120),
+    "l [mm]": (40, 200),
+    "n [mm]": (0, 150),
+    "p [mm]": (2, 10),
+    "phi0 [rad]": (-0.6, 0.6),
+}
 
 _BASES: dict[str, Path] = {}
 
@@ -128,7 +135,7 @@ def _front_inside(root: Path, stdout: str, stderr: str) -> list[str]:
                 continue
             if not lo - 1e-6 <= v <= hi + 1e-6:
                 out.append(f"front.csv {row.get('id')}: {k} = {v} outside [{lo}, {hi}] shown")
-        for k in ("ripple", "size"):
+        for k in ("ripple [%]", "size [mm]"):
             try:
                 ok = float(row[k]) == float(row[k]) and abs(float(row[k])) < 1e300
             except (KeyError, ValueError):

@@ -1,4 +1,5 @@
-"""Files of a front: ``front.csv`` (a row per point) and ``front.json`` (everything).
+"""Files of a front: ``front.csv`` (a row per point, in the summary's units with the unit
+in each heading: ``ripple [%]``) and ``front.json`` (everything, internal units).
 
 ``front.csv`` is written with :mod:`csv` (a name holding a comma, a quote or a newline
 is quoted) and is safe to open in a spreadsheet: a text cell or heading that starts
@@ -14,7 +15,6 @@ import io
 import json
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -25,20 +25,12 @@ from optdesign.text import csv_cell
 
 
 def front_rows(front: Front, problem: DesignProblem, rejected: bool = False) -> list[dict]:
-    """One dict per point: objectives, free design variables, status, method, active."""
-    rows = []
-    for p in front.points + (front.rejected if rejected else []):
-        row: dict[str, Any] = {"method": p.method, "id": p.id}
-        for k in front.objectives:
-            row[k] = p.objectives.get(k, float("nan"))
-        for v in problem.free:
-            row[v.name] = p.design.get(v.name, float("nan"))
-        row["status"] = p.status
-        row["verified"] = p.verified
-        row["on_front"] = not p.rejected
-        row["active"] = ";".join(p.active)
-        rows.append(row)
-    return rows
+    """One dict per point: method, id, objectives and free design variables in the
+    summary's units under ``"name [unit]"`` (:func:`optdesign.reports.frames.front_table`,
+    the rows of ``Front.to_frame()`` too), status, verified, on_front, active."""
+    from optdesign.reports.frames import front_table
+
+    return front_table(front, problem, rejected)
 
 
 def write_front_csv(
@@ -57,12 +49,42 @@ def write_front_csv(
         return atomic_write_text(Path(path), buf.getvalue())
 
 
-def read_front_csv(path: Path | str, objectives: Sequence[str]) -> np.ndarray:
-    """Objective values of the on-front rows of a ``front.csv`` (``objectives`` named as
-    the problem names them: a heading neutralised for spreadsheets is found too)."""
+def read_front_csv(
+    path: Path | str, objectives: Sequence[str], problem: DesignProblem | None = None
+) -> np.ndarray:
+    """Objective values of the on-front rows of a ``front.csv``.
+
+    ``objectives`` are named as the problem names them: the heading with its unit
+    (``"ripple [%]"``), or neutralised for spreadsheets, is found too. With ``problem``
+    the values are returned in internal units (a heading's unit must be the one the
+    problem shows that objective in; a heading without a unit, as written before units
+    were added, is taken as internal); without it, as the file writes them.
+    """
+    from optdesign.reports.frames import objective_column
+
     with Path(path).open(newline="") as fh:
-        rows = [r for r in csv.DictReader(fh) if r.get("on_front", "True") == "True"]
-    return np.array([[float(r[csv_cell(k)]) for k in objectives] for r in rows], dtype=float)
+        reader = csv.DictReader(fh)
+        heads = [_heading(reader.fieldnames or [], k) for k in objectives]
+        rows = [r for r in reader if r.get("on_front", "True") == "True"]
+    F = np.array([[float(r[h]) for h in heads] for r in rows], dtype=float).reshape(-1, len(heads))
+    if problem is not None:
+        for j, (k, h) in enumerate(zip(objectives, heads, strict=True)):
+            col = objective_column(problem, k)
+            if h == csv_cell(k):
+                continue  # no unit: internal
+            if h != csv_cell(col.header):
+                raise ValueError(f"{path}: column {h!r} is not in {col.unit or 'no unit'}")
+            F[:, j] /= col.scale
+    return F
+
+
+def _heading(fields: Sequence[str], name: str) -> str:
+    """The heading of column ``name`` (``name`` or ``name [unit]``, as csv_cell wrote it)."""
+    cell = csv_cell(name)
+    for f in fields:
+        if f == cell or (f.startswith(cell + " [") and f.endswith("]")):
+            return f
+    raise KeyError(name)
 
 
 def write_front_json(fronts: Sequence[Front], path: Path | str, **meta) -> Path:
