@@ -1,0 +1,199 @@
+"""Tests written from the survivors of the mutation run over the store, the units and the
+catalogue search (issue 21, `benchmarks/mutation/run.sh`): each pins a behaviour that a
+one-token change left unnoticed - the field and the reason of a refusal, a lock file's
+holder, a store changed in place through another hard link, the catalogue's tolerance."""
+
+from __future__ import annotations
+
+import math
+import os
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from optdesign import units
+from optdesign.errors import InputError
+from optdesign.formulations.discrete import discrete_variables
+from optdesign.problem.load import load
+from optdesign.safe_io import UnsafeFileError
+from optdesign.storage import _lock_holder, open_store
+from optdesign.studies.catalogue import is_on_catalogue, relaxation_bound
+from optdesign.studies.runner import run_tasks
+
+EXAMPLES = '(e.g. "N*mm", "rad/s"; "" for a plain number)'
+
+
+def _refusal(call, *args) -> str:
+    with pytest.raises(InputError) as caught:
+        call(*args)
+    return str(caught.value)
+
+
+# --- units: every refusal names its field and says why ----------------------------------
+@pytest.mark.parametrize(
+    ("unit", "message"),
+    [
+        (5, 'f.unit: a unit is a string such as "N*mm", got 5'),
+        ("m" * 101, "f.unit: too long for a unit (101 characters)"),
+        # 100 characters is not too long: the grammar reads it (and finds no such unit)
+        ("m" * 100, f"f.unit: cannot read '{'m' * 100}' as a unit: unknown unit '{'m' * 100}'"),
+        ("N*foo", f"f.unit: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+        ("N**", "f.unit: cannot read 'N**' as a unit: a power must be a whole number"),
+    ],
+)
+def test_parse_unit_refusals_name_the_field_and_the_reason(unit, message):
+    assert _refusal(units.parse_unit, unit, "f.unit").startswith(message)
+
+
+@pytest.mark.parametrize(
+    ("value", "unit", "message"),
+    [
+        (
+            "5 N*m",
+            "N*mm/rad",
+            "c.upper: '5 N*m' is a moment, expected a moment per angle ('N*mm/rad')",
+        ),
+        ("5 N*m", "", "c.upper: '5 N*m' is a moment, expected a plain number"),
+        (
+            "5 xyz",
+            "N",
+            "c.upper: cannot read '5 xyz' as a quantity: unknown unit 'xyz' (write a number "
+            'and a unit, e.g. "500 N*m"; no arithmetic)',
+        ),
+        ("1e308 kN", "N", "c.upper: '1e308 kN' is out of range"),
+        (float("nan"), "N", "c.upper: nan is not a finite number"),
+        (5, "N*foo", f"c.upper: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+    ],
+)
+def test_convert_refusals_name_the_field_and_the_reason(value, unit, message):
+    assert _refusal(units.convert, value, unit, "c.upper") == message
+
+
+def test_convert_reads_strings_and_pint_quantities_in_the_target_unit():
+    registry = units.registry()
+    assert units.convert("2 kN", "N", "c") == 2000.0
+    assert units.convert(registry.Quantity(3.0, "deg"), "rad", "c") == pytest.approx(
+        math.radians(3.0), rel=1e-15
+    )
+    assert units.convert(7, "N", "c") == 7.0  # a bare number: already in the unit
+
+
+def test_convert_refuses_pint_quantities_that_are_not_one_finite_number():
+    registry = units.registry()
+    vector = registry.Quantity(np.array([1.0, 2.0]), "N")
+    assert _refusal(units.convert, vector, "N", "c.upper") == (
+        f"c.upper: expected a scalar quantity, got {vector!r}"
+    )
+    infinite = registry.Quantity(float("inf"), "N")
+    assert _refusal(units.convert, infinite, "N", "c.upper") == (
+        f"c.upper: {infinite!r} is not a finite number"
+    )
+
+
+def test_an_object_with_units_that_is_not_pints_is_no_quantity():
+    class LooksLikeAQuantity:
+        units = "N"
+        magnitude = 1.0
+
+    value = LooksLikeAQuantity()
+    assert _refusal(units.convert, value, "N", "c.upper") == (
+        f"c.upper: expected a number or a quantity string, got {value!r}"
+    )
+
+
+@pytest.mark.parametrize(
+    ("unit", "to", "message"),
+    [
+        (
+            "N*mm",
+            "N*m/deg",
+            "d.unit: 'N*m/deg' is a moment per angle and 'N*mm' a moment: a unit of the "
+            "same dimension is needed",
+        ),
+        (
+            "",
+            "N",
+            "d.unit: 'N' is a force and no unit a plain number: a unit of the same dimension is needed",
+        ),
+        (
+            "N",
+            "",
+            "d.unit: no unit is a plain number and 'N' a force: a unit of the same dimension is needed",
+        ),
+        ("N", "N*foo", f"d.unit: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+        ("N*foo", "N", f"d.unit: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+    ],
+)
+def test_unit_factor_refusals_name_the_field(unit, to, message):
+    assert _refusal(units.unit_factor, unit, to, "d.unit") == message
+
+
+def test_unit_factor_values():
+    assert units.unit_factor("kN", "N", "d") == 1000.0
+    assert units.unit_factor("deg", "rad", "d") == pytest.approx(math.pi / 180, rel=1e-15)
+
+
+def test_parse_quantity_names_the_quantity():
+    assert _refusal(units.parse_quantity, "5 foo").startswith(
+        "quantity: cannot read '5 foo' as a quantity: unknown unit 'foo'"
+    )
+
+
+# --- store: the lock's holder, a store with another hard link ---------------------------
+@pytest.mark.parametrize(
+    ("content", "holder"),
+    [
+        (b"12345\n", "pid 12345"),
+        (b"not a pid", "pid unknown"),
+        (b"\xff\xfe", "pid unknown"),  # not UTF-8
+        (b"1" * 65, "pid unknown"),  # more than a pid: not read
+        (b"1" * 64, "pid " + "1" * 64),
+    ],
+)
+def test_lock_holder_reads_only_a_pid(tmp_path, content, holder):
+    lock = tmp_path / "lock"
+    lock.write_bytes(content)
+    assert _lock_holder(lock) == holder
+
+
+def test_lock_holder_of_a_missing_lock_is_unknown(tmp_path):
+    assert _lock_holder(tmp_path / "lock") == "pid unknown"
+
+
+def _double(task, deps):
+    return {"value": 2 * task["n"]}
+
+
+def test_a_torn_store_with_another_hard_link_is_not_repaired_in_place(tmp_path):
+    store = tmp_path / "s.jsonl"
+    run_tasks([{"id": f"t{i}", "n": i} for i in range(3)], _double, store, key="k")
+    torn = store.read_bytes()[:-3]
+    store.write_bytes(torn)
+    other = tmp_path / "elsewhere.jsonl"
+    os.link(store, other)
+    with pytest.raises(UnsafeFileError) as caught:
+        open_store(store, "k", resume=True)
+    assert str(caught.value).startswith(
+        f"the store {store} has 2 hard links (changing it would change another file too)"
+    )
+    assert other.read_bytes() == torn  # the file the other link names is untouched
+
+
+# --- catalogue search -----------------------------------------------------------------
+def test_relaxation_bound_without_a_bound_is_nan():
+    assert math.isnan(relaxation_bound(SimpleNamespace(bound=None)))
+    assert relaxation_bound(SimpleNamespace(bound=np.float64(0.25))) == 0.25
+
+
+def test_is_on_catalogue_takes_only_the_items_themselves():
+    problem = load("problems/fin_actuator.toml")
+    variables = discrete_variables(problem)
+    assert variables
+    design = {v.name: float(v.values[0]) for v in variables}
+    assert is_on_catalogue(problem, design)
+    first = variables[0]
+    nearly = dict(design, **{first.name: float(first.values[0]) * (1 + 1e-10)})
+    assert not is_on_catalogue(problem, nearly)  # 1e-10 off an item is off the catalogue
+    between = dict(design, **{first.name: float(first.values[0]) + 0.5})
+    assert not is_on_catalogue(problem, between)
