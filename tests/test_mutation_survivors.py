@@ -7,20 +7,26 @@ from __future__ import annotations
 
 import math
 import os
+import tomllib
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign import units
 from optdesign.errors import InputError
 from optdesign.formulations.discrete import discrete_variables
+from optdesign.problem import problem_from_dict
 from optdesign.problem.load import load
 from optdesign.safe_io import UnsafeFileError
 from optdesign.storage import _lock_holder, open_store
+from optdesign.studies import catalogue
 from optdesign.studies.catalogue import is_on_catalogue, relaxation_bound
 from optdesign.studies.runner import run_tasks
 
+ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = '(e.g. "N*mm", "rad/s"; "" for a plain number)'
 
 
@@ -187,7 +193,7 @@ def test_relaxation_bound_without_a_bound_is_nan():
 
 
 def test_is_on_catalogue_takes_only_the_items_themselves():
-    problem = load("problems/fin_actuator.toml")
+    problem = load(ROOT / "problems" / "fin_actuator.toml")
     variables = discrete_variables(problem)
     assert variables
     design = {v.name: float(v.values[0]) for v in variables}
@@ -197,3 +203,51 @@ def test_is_on_catalogue_takes_only_the_items_themselves():
     assert not is_on_catalogue(problem, nearly)  # 1e-10 off an item is off the catalogue
     between = dict(design, **{first.name: float(first.values[0]) + 0.5})
     assert not is_on_catalogue(problem, between)
+
+
+def _catalogue(leads, pins):
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": [f"{p} mm" for p in leads]}
+    data["variables"]["d"] = {"values": [f"{d} mm" for d in pins]}
+    return problem_from_dict(data)
+
+
+def test_branch_and_bound_counts_every_node_it_solves(monkeypatch):
+    """4 leads x 5 pins: branch and bound equals enumeration, and its counts are those of
+    the node solves it made (counted here by a wrapper around the node solver)."""
+    problem = _catalogue((4, 5, 6, 8), (4, 5, 6, 8, 10))
+    solves: list[bool] = []
+    original = catalogue.NodeSolver.solve
+
+    def counted(self, box, *args, **kwargs):
+        result = original(self, box, *args, **kwargs)
+        solves.append(bool(result.success))
+        return result
+
+    monkeypatch.setattr(catalogue.NodeSolver, "solve", counted)
+    bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
+    info = bnb.extra["catalogue"]
+    assert info["nodes"] == len(solves) == 8  # the relaxation and 7 boxes, of 20 items pairs
+    assert info["infeasible"] == solves.count(False) == 2
+    # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
+    assert (info["leaves"], info["pruned"]) == (1, 1)
+    solves.clear()
+    enum = catalogue.solve_catalogue(problem, method="enumerate", starts=2)
+    assert len(enum.extra["catalogue"]["enumerated"]) == 20
+    assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
+    assert bnb.extra["catalogue"]["items"] == enum.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+
+
+def test_the_catalogue_formulation_takes_the_callers_settings():
+    """od.solve(..., "catalogue", objective=, starts=, options=) reaches the search."""
+    problem = _catalogue((5, 6), (5, 6, 8))
+    ripple = od.solve(problem, "catalogue", objective="ripple", starts=2, ranges=False)
+    direct = catalogue.solve_catalogue(problem, objective="ripple", starts=2)
+    assert ripple.objective == pytest.approx(direct.objective, rel=1e-9)
+    assert ripple.extra["catalogue"]["items"] == {"p": 5, "d": 8}  # not backlash's 6 / 6
+    assert ripple.extra["catalogue"]["starts_per_node"] == 2
+    assert ripple.extra["catalogue"]["method"] == "enumerate"
+    # an iteration limit of 1 leaves even the relaxation unsolved: the options arrive
+    starved = od.solve(problem, "catalogue", options={"max_iter": 1}, ranges=False, diagnose=False)
+    assert starved.status == "infeasible"
+    assert "relaxation has no feasible design" in starved.message
