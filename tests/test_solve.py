@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import optdesign as od
 from optdesign.cli import main
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import build_nlp
@@ -300,3 +301,23 @@ def test_optimal_ranges_expose_non_unique_optima():
     ranges = optimal_ranges(ripple, res)
     assert ranges["R"][1] / ranges["R"][0] > 2  # ripple is scale-invariant in R, l, n, p
     assert ranges["phi0"][1] - ranges["phi0"][0] < 1e-3
+
+
+def test_sqpmethod_solves_quietly_and_takes_the_users_options(capfd):
+    """The sqpmethod back-end prints no iteration or QP table (its defaults, in the solver
+    registry), finds the Ipopt optimum, and a user's option still overrides a default."""
+    cs = PROBLEMS / "cs_min_backlash.toml"
+    result = od.solve(cs, solver="sqpmethod", starts=2, ranges=False, diagnose=False)
+    printed = capfd.readouterr().out
+    assert result.status == "optimal"
+    assert result.objective == pytest.approx(0.0362197, rel=1e-5)
+    assert "iter" not in printed and "QP NO." not in printed and "Input 0" not in printed
+    od.solve(
+        cs,
+        solver="sqpmethod",
+        starts=1,
+        ranges=False,
+        diagnose=False,
+        options={"print_iteration": True},
+    )
+    assert "iter" in capfd.readouterr().out

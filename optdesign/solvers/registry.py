@@ -93,10 +93,27 @@ def _ipopt(nlp, options):
     return CasadiNLPSolver(nlp, "ipopt", options)
 
 
+#: sqpmethod's defaults: its iterations, its default QP solver's (qpOASES) and the NaN
+#: of a trial step are not printed (a user's options override any of them; a QP solver
+#: the user names gets no option of qpOASES). qpOASES still prints its licence banner
+#: when it is built.
+SQPMETHOD_QUIET: dict[str, Any] = {
+    "show_eval_warnings": False,
+    "print_header": False,
+    "print_iteration": False,
+    "print_status": False,
+    "error_on_fail": False,
+}
+
+
 def _sqpmethod(nlp, options):
     from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 
-    return CasadiNLPSolver(nlp, "sqpmethod", options)
+    merged = {**SQPMETHOD_QUIET, **options}
+    if options.get("qpsol", "qpoases") == "qpoases":
+        qp = dict(options.get("qpsol_options") or {})
+        merged["qpsol_options"] = {"printLevel": "none", "error_on_fail": False, **qp}
+    return CasadiNLPSolver(nlp, "sqpmethod", merged)
 
 
 def _scipy(method: str):
