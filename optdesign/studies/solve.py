@@ -7,9 +7,10 @@ The best start is re-evaluated independently on the NumPy path
 solver converged *and* the check passes.
 
 Formulations register here (:func:`register_formulation`); ``formulation="auto"`` takes
-the first whose predicate holds, in order: catalogue (a variable takes catalogue
-values: never solved as continuous), robust (the file has tolerances: never ignored),
-gp (the problem is a geometric program), nlp.
+the first whose predicate holds for the problem *and the chosen objective*, in order:
+catalogue (a variable takes catalogue values: never solved as continuous), robust (the
+file has tolerances: never ignored), gp (the problem is a geometric program in that
+objective), nlp.
 """
 
 from __future__ import annotations
@@ -287,13 +288,14 @@ def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> 
 # --- formulation registry ---------------------------------------------------------------
 @dataclass(frozen=True)
 class Formulation:
-    """A way to solve a problem: ``solve(problem, **options) -> Result``; ``applies``
-    says whether ``auto`` should pick it. Both are import paths ("module:function") or
+    """A way to solve a problem: ``solve(problem, **options) -> Result``;
+    ``applies(problem, objective)`` says whether ``auto`` should pick it for that
+    objective (None: the problem's first). Both are import paths ("module:function") or
     callables, so that listing formulations imports no solver library."""
 
     name: str
     solve: str | Callable[..., Result]
-    applies: str | Callable[[DesignProblem], bool] | None = None
+    applies: str | Callable[[DesignProblem, str | None], bool] | None = None
     description: str = ""
 
     def _load(self, ref):
@@ -305,9 +307,9 @@ class Formulation:
     def run(self, problem: DesignProblem, **options) -> Result:
         return self._load(self.solve)(problem, **options)
 
-    def applies_to(self, problem: DesignProblem) -> bool:
+    def applies_to(self, problem: DesignProblem, objective: str | None = None) -> bool:
         fn = self._load(self.applies)
-        return bool(fn(problem)) if fn is not None else False
+        return bool(fn(problem, objective)) if fn is not None else False
 
 
 #: name -> formulation, in the order ``auto`` tries them.
@@ -345,7 +347,7 @@ for _f in (
     Formulation(
         "robust",
         "optdesign.studies.robust:solve_robust_formulation",
-        lambda problem: problem.spec.tolerances is not None,
+        lambda problem, objective=None: problem.spec.tolerances is not None,
         "risk measure (CVaR or mean + k std) of the objective under the tolerances",
     ),
     Formulation(
@@ -359,8 +361,11 @@ for _f in (
     register_formulation(_f)
 
 
-def choose_formulation(problem: DesignProblem, requested: str = "auto") -> str:
-    """The formulation to use: the requested one, or for ``auto`` the first that applies."""
+def choose_formulation(
+    problem: DesignProblem, requested: str = "auto", objective: str | None = None
+) -> str:
+    """The formulation to use: the requested one, or for ``auto`` the first that applies
+    to ``problem`` with ``objective`` (None: the problem's first objective)."""
     if requested != "auto":
         if requested not in FORMULATIONS:
             raise InputError(
@@ -369,16 +374,18 @@ def choose_formulation(problem: DesignProblem, requested: str = "auto") -> str:
             )
         return requested
     for name, f in FORMULATIONS.items():
-        if f.applies_to(problem):
+        if f.applies_to(problem, objective):
             return name
     return "nlp"
 
 
-def plan_solve(problem: DesignProblem, requested: str = "auto") -> str:
-    """The formulation :func:`solve` will use, after the checks that need no solve (the
-    file's Ipopt options, a combination no formulation honours), so that a caller can
-    refuse before any work."""
-    name = choose_formulation(problem, requested)
+def plan_solve(
+    problem: DesignProblem, requested: str = "auto", objective: str | None = None
+) -> str:
+    """The formulation :func:`solve` will use for ``objective``, after the checks that need
+    no solve (the file's Ipopt options, a combination no formulation honours), so that a
+    caller can refuse before any work."""
+    name = choose_formulation(problem, requested, objective)
     solver_options(problem, "ipopt")
     if name == "catalogue" and problem.spec.tolerances is not None and problem.free:
         disc = ", ".join(v.name for v in problem.free if v.discrete)
@@ -412,7 +419,7 @@ def solve(
 
     # Before any work and whatever the formulation: no option may read or write a file.
     refuse_file_options(options, "options")
-    name = plan_solve(problem, formulation)
+    name = plan_solve(problem, formulation, objective)
     if not problem.free:
         result = check_fixed_design(problem, objective)
     else:
