@@ -27,7 +27,7 @@ import pytest
 
 import optdesign as od
 from optdesign.cli import main
-from optdesign.reports.html import to_json
+from optdesign.reports.html_page import to_json
 from optdesign.text import csv_cell, printable
 
 PROBLEMS = Path(__file__).resolve().parent.parent / "problems"

@@ -119,9 +119,10 @@ def _load_entry_points() -> None:
 
 
 def get_mechanism(name: str) -> type[Mechanism]:
-    """The class registered as ``name``; InputError listing the registered ones if none."""
-    import optdesign.mechanisms  # noqa: F401  (registers the built-ins)
+    """The class registered as ``name``; InputError listing the registered ones if none.
 
+    The built-ins are registered already: importing this module runs the package's
+    ``__init__`` first, which imports them (and they register on import)."""
     cls = _REGISTRY.get(name)
     if cls is None:
         _load_entry_points()
@@ -135,7 +136,5 @@ def get_mechanism(name: str) -> type[Mechanism]:
 
 def registered() -> list[str]:
     """Names of the registered mechanisms (entry points included)."""
-    import optdesign.mechanisms  # noqa: F401
-
     _load_entry_points()
     return list(_REGISTRY)

@@ -32,6 +32,7 @@ from optdesign.problem.catalogue import (
 from optdesign.problem.quantities import Quantities
 from optdesign.problem.requirements import requirement_blocks
 from optdesign.problem.spec import ProblemSpec
+from optdesign.problem.spec_validation import validate_spec
 from optdesign.problem.variables import Variable
 from optdesign.user_code import UserCodeError, is_users, quantity_of
 
@@ -146,8 +147,6 @@ class DesignProblem:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         import pickle
-
-        from optdesign.problem.load import validate_spec
 
         mechanism, objectives, constraints = pickle.loads(state["blob"])
         self.mechanism = mechanism
@@ -376,8 +375,6 @@ class DesignProblem:
         self._revalidate({**data, "objective": {"minimize": list(names)}})
 
     def _revalidate(self, data: dict[str, Any]) -> None:
-        from optdesign.problem.load import validate_spec
-
         self.spec = validate_spec(data, self.mechanism, source=self.name)
         self._grid()
         self._check_consistency()

@@ -278,14 +278,6 @@ def _decreasing(f: Callable[[Any], Any], x: float) -> bool:
     return float(f(x + step)) < float(f(x))
 
 
-def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5, ev: Any = None):
-    """(active, violated) constraint reports of any design on the NumPy path (see
-    :func:`optdesign.studies.verify.constraint_rows`)."""
-    from optdesign.studies.verify import constraint_rows
-
-    return constraint_rows(problem, design, rel, ev)
-
-
 def binding_angles(rows: Iterable[Any]) -> dict[str, list[float]]:
     """Requirement name -> deflection angles (deg) where its rows bind (internal rows
     left out)."""

@@ -1,8 +1,9 @@
 """Multistart: seeded Sobol starts inside the bounds, solved locally, best kept.
 
 Reports how many starts reached the best objective (evidence of a global optimum). Starts
-run in-process, or on local worker processes that inherit the solver built once in this
-process (:mod:`optdesign.studies.runner`'s process engine).
+run in-process, or through the ``parallel_map`` a study passes (the studies' process
+engine, :func:`optdesign.studies.runner.map_inherited`: local worker processes that
+inherit the solver built once in this process). The solver layer knows no process pool.
 """
 
 from __future__ import annotations
@@ -67,6 +68,7 @@ def multistart(
     rel_tol: float = 1e-6,
     seed: int = 0,
     agree: int | None = None,
+    parallel_map: Callable[..., list[Result]] | None = None,
 ) -> Result:
     """Solve from every start and return the best result with its multistart record.
 
@@ -84,7 +86,13 @@ def multistart(
         shortest prefix of ``starts`` (in their order) on which that many agree, whatever
         the number of workers and whichever start finishes first: the same starts, the
         same winner (:func:`best_of`) and the same record as a run on one worker.
+    parallel_map
+        ``parallel_map(solve, starts, workers, stop=...)`` -> the results of the shortest
+        prefix of ``starts`` for which ``stop`` holds, in their order; needed when
+        ``workers > 1``.
     """
+    if workers > 1 and parallel_map is None:
+        raise ValueError("multistart: workers > 1 needs a parallel_map")
     t0 = time.perf_counter()
     starts = list(np.atleast_2d(starts))
     results: list[Result] = []
@@ -92,9 +100,7 @@ def multistart(
     # gets it too): the same arithmetic whatever the number of workers.
     with one_blas_thread():
         if workers > 1 and len(starts) > 1:
-            from optdesign.studies.runner import map_inherited
-
-            results = map_inherited(solve, starts, workers, stop=_stop_rule(rel_tol, agree))
+            results = parallel_map(solve, starts, workers, stop=_stop_rule(rel_tol, agree))
         else:
             stop = _stop_rule(rel_tol, agree)
             for x0 in starts:

@@ -37,7 +37,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
 from optdesign.solvers.multistart import best_of, improves, sobol_starts
 from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.studies.solve import _objective_set, finish, solver_for, solver_options
+from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
@@ -67,7 +67,7 @@ NODE_IPOPT_OPTIONS: dict[str, Any] = {"expect_infeasible_problem": "yes"}
 class NodeSolver:
     """Solve the problem's NLP on a sub-box of the catalogue variables.
 
-    One solver (:func:`optdesign.studies.solve.solver_for`) serves every node: a node
+    One solver (:func:`optdesign.studies.nlp_solve.solver_for`) serves every node: a node
     only passes its own variable bounds. A node whose starts all fail is tried again from
     :data:`RETRY_STARTS` more Sobol starts before it counts as infeasible, so a poor
     first start (e.g. a declared one) never makes a feasible problem look infeasible.

@@ -140,8 +140,8 @@ def _robust(problem: DesignProblem, result: Result, solver: str, relax: bool) ->
 
 
 def _gp(problem: DesignProblem, result: Result, relax: bool) -> Diagnosis:
+    from optdesign.studies.nlp_solve import solve_nlp
     from optdesign.studies.relaxation import relaxations
-    from optdesign.studies.solve import solve_nlp
 
     objective = result.objective_name or problem.objective_names[0]
     nlp = solve_nlp(problem, objective=objective)

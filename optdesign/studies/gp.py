@@ -17,7 +17,7 @@ from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
-from optdesign.studies.solve import finish, solve_nlp
+from optdesign.studies.nlp_solve import finish, solve_nlp
 
 
 def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:

@@ -64,7 +64,7 @@ def run_identity(
     options: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The identity components of a run of ``problem`` (see the module docstring)."""
-    from optdesign.studies.solve import formulation_for
+    from optdesign.studies.nlp_solve import formulation_for
 
     nlp = formulation_for(problem, tuple(sorted(objectives)))
     return {

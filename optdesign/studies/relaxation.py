@@ -70,7 +70,7 @@ def relaxations(
         e.g. the catalogue items nearest the design of the continuous relaxation's
         smallest one. A relaxation found at a site says where (:attr:`Relaxation.at`).
     """
-    from optdesign.studies.solve import _objective_set, solver_for
+    from optdesign.studies.nlp_solve import _objective_set, solver_for
 
     # The conflict is between the violated requirements and the ones binding at the best
     # infeasible point: each is a candidate.

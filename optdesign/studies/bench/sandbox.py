@@ -275,7 +275,7 @@ def _fix(inst: Instance, problem: DesignProblem, combo: Mapping[str, float]) -> 
         return problem_from_dict(data, source=inst.id)
     data = problem.spec.model_dump(mode="python")
     data["variables"] = {**data["variables"], **{k: float(v) for k, v in combo.items()}}
-    from optdesign.problem.load import validate_spec
+    from optdesign.problem.spec_validation import validate_spec
     from optdesign.problem.variables import parse_variable, variable_table
 
     spec = validate_spec(data, problem.mechanism, inst.id, internal=True)

@@ -20,6 +20,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord, record_from_result
+from optdesign.studies.pareto.run_setup import check_objectives, record_check, run_key, store_path
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 from optdesign.studies.runner import run_tasks
 
@@ -84,13 +85,6 @@ class CatalogueEpsilon:
     name: str = "epsilon-catalogue"
 
     def run(self, problem: DesignProblem, objectives: Sequence[str], run) -> Front:
-        from optdesign.studies.pareto.methods import (
-            _store,
-            check_objectives,
-            record_check,
-            run_key,
-        )
-
         objectives = check_objectives(problem, objectives)
         if len(objectives) != 2:
             raise InputError("objectives", "a catalogue front takes two objectives")
@@ -140,7 +134,7 @@ class CatalogueEpsilon:
             starts=starts,
             seed=seed,
         )
-        store = _store(run.out, self.name)
+        store = store_path(run.out, self.name)
         done = run_tasks(
             tasks + points,
             catalogue_task,

@@ -19,7 +19,7 @@ import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
 from optdesign.solvers.result import Result, clean_json
-from optdesign.studies.solve import finish
+from optdesign.studies.nlp_solve import finish
 from optdesign.studies.verify import VERIFY_TOL, verify_design
 
 
