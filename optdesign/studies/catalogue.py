@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.errors import ProblemError
 from optdesign.formulations.discrete import (
     ON_ITEM_TOL,
     branch,
@@ -38,6 +39,7 @@ from optdesign.problem.drive import box_has_item
 from optdesign.solvers.multistart import best_of, improves, sobol_starts
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
+from optdesign.studies.reference import attach_reference, reference_design
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
@@ -269,15 +271,11 @@ def solve_catalogue(
     t0 = time.perf_counter()
     dvars = discrete_variables(problem)
     if not dvars:
-        from optdesign.errors import ProblemError
-
         raise ProblemError("--formulation catalogue: no variable takes catalogue values")
     n_comb = n_combinations(problem)
     if method == "auto":
         method = "enumerate" if n_comb <= ENUMERATE_MAX else "bnb"
     if method not in ("enumerate", "bnb"):
-        from optdesign.errors import ProblemError
-
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate or bnb")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
@@ -392,8 +390,6 @@ def relaxation_bound(result: Result) -> float:
 
 def solve_catalogue_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="catalogue"``: the exact catalogue optimum and its relaxation bound."""
-    from optdesign.studies.reference import attach_reference, reference_design
-
     reference_design(problem)
     result = solve_catalogue(
         problem,

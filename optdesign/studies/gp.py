@@ -18,6 +18,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp
+from optdesign.studies.reference import attach_reference, reference_design
 
 
 def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
@@ -111,8 +112,6 @@ def solve_gp_problem(
 
 def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
-    from optdesign.studies.reference import attach_reference, reference_design
-
     reference_design(problem)  # validate [reference] before solving
     gp_solver = options.get("solver")
     result = solve_gp_problem(

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.solvers.result import Relaxation
+from optdesign.studies.nlp_solve import _objective_set, solver_for
 
 __all__ = ["Relaxation", "Site", "relaxations"]
 
@@ -70,8 +71,6 @@ def relaxations(
         e.g. the catalogue items nearest the design of the continuous relaxation's
         smallest one. A relaxation found at a site says where (:attr:`Relaxation.at`).
     """
-    from optdesign.studies.nlp_solve import _objective_set, solver_for
-
     # The conflict is between the violated requirements and the ones binding at the best
     # infeasible point: each is a candidate.
     names: dict[str, Any] = {}

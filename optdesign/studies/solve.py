@@ -17,6 +17,7 @@ objective), nlp.
 from __future__ import annotations
 
 import importlib
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -25,9 +26,12 @@ import numpy as np
 
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.safe_io import refuse_file_options
 from optdesign.solvers.result import Diagnosis, Result, SolutionStatus, TerminationCondition
+from optdesign.studies.diagnosis import diagnose as diagnose_result
 from optdesign.studies.nlp_solve import optimal_ranges, solve_nlp, solver_options
-from optdesign.studies.verify import verify_design
+from optdesign.studies.reference import attach_reference
+from optdesign.studies.verify import constraint_rows, verify_design
 
 
 def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> Result:
@@ -35,10 +39,6 @@ def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> 
     and objective evaluated on the NumPy path. Status ``optimal`` when it meets every
     requirement (the only feasible design is optimal), ``infeasible`` otherwise;
     formulation ``"fixed"``, solver ``"none"``."""
-    import time
-
-    from optdesign.studies.verify import constraint_rows
-
     t0 = time.perf_counter()
     objective = objective or problem.objective_names[0]
     if objective not in problem.objectives:
@@ -112,8 +112,6 @@ def register_formulation(formulation: Formulation) -> Formulation:
 
 
 def _solve_nlp_formulation(problem: DesignProblem, **options) -> Result:
-    from optdesign.studies.reference import attach_reference
-
     return attach_reference(problem, solve_nlp(problem, **_pick(options, _NLP_OPTIONS)))
 
 
@@ -202,8 +200,6 @@ def solve(
     (:func:`check_fixed_design`). ``diagnose``: on a result with no feasible design, the
     smallest relaxation of each conflicting requirement (:mod:`optdesign.studies.
     diagnosis`)."""
-    from optdesign.safe_io import refuse_file_options
-
     # Before any work and whatever the formulation: no option may read or write a file.
     refuse_file_options(options, "options")
     name = plan_solve(problem, formulation, objective)
@@ -221,8 +217,6 @@ def solve(
             **extra,
         )
     if diagnose and not result.success:
-        from optdesign.studies.diagnosis import diagnose as diagnose_result
-
         try:
             diagnose_result(problem, result, solver, options)
         except Exception as exc:  # a diagnosis, not the result: never lose the result

@@ -17,6 +17,8 @@ from typing import Any
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.catalogue import solve_catalogue
+from optdesign.studies.diagnosis import diagnose
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord, record_from_result
@@ -27,8 +29,6 @@ from optdesign.studies.runner import run_tasks
 
 def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
     """One catalogue solve: ``min target s.t. eps`` (an anchor, its tie-break, a point)."""
-    from optdesign.studies.catalogue import solve_catalogue
-
     problem: DesignProblem = task["problem"]
     t0 = time.perf_counter()
     eps = dict(task.get("eps") or {})
@@ -57,8 +57,6 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
         # An anchor with no catalogue design: its best point, for the error to name the
         # requirements it violates (no relaxations: the front stops here).
-        from optdesign.studies.diagnosis import diagnose
-
         diagnose(problem, result, relax=False)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
     rec.n_solves = int(result.extra.get("catalogue", {}).get("nlp_solves", 0))
