@@ -226,10 +226,6 @@ class DesignProblem:
                 design[v.name] = x[k]
         return design
 
-    def describe_variable(self, name: str) -> str:
-        v = self.by_name.get(name)
-        return v.description if v is not None else name
-
     def _check_consistency(self) -> None:
         table = self.mechanism.variable_table()
         missing = [k for k, info in table.items() if info.default is None and not self.has(k)]

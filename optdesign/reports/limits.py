@@ -209,18 +209,6 @@ def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> l
     return out
 
 
-def what_limits(result: Any) -> list[Limit]:
-    """Everything that limits the optimum of ``result``: active requirements, then the
-    variables at a bound."""
-    problem = result.problem_object
-    if problem is None:
-        return []
-    out = limits_of(problem, result.active)
-    if result.design:
-        out += bound_limits(problem, result.design)
-    return out
-
-
 def objective_where(rows: Iterable[Any]) -> list[str]:
     """Angles where the objective is attained (from its internal epigraph rows)."""
     return sorted({_label(r.name) for r in rows if is_internal(r.name) and _label(r.name)})
