@@ -11,7 +11,7 @@ import pytest
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import NotGP, Signomial, build_gp, is_gp
-from optdesign.models.fits import fit_clearance
+from optdesign.models.fit_formulas import fit_clearance
 from optdesign.problem import load_problem, problem_from_dict
 from optdesign.studies.gp import require_gp, solve_gp_problem
 

@@ -121,7 +121,7 @@ def import_graph() -> dict[str, dict[str, int]]:
 PRIMITIVES = {
     "optdesign": "the package root: a version and lazily exported names, no import",
     "optdesign.reports.tables": "plain-text tables",
-    "optdesign.reports.units": "a value in the user's units",
+    "optdesign.reports.display_units": "a value in the user's units",
     "optdesign.reports.limits": "a requirement's row in the user's units",
     "optdesign.plots": "a figure saved atomically",
     "optdesign.plots.profiles": "performance profiles drawn from arrays",

@@ -39,7 +39,7 @@ if [ ${#MODULES[@]} -eq 0 ]; then
     optdesign/studies/pareto/*.py
     optdesign/storage.py
     optdesign/units.py
-    optdesign/reports/units.py
+    optdesign/reports/display_units.py
   )
 fi
 # The tests a mutant faces: by default the whole fast suite (the README's test command,

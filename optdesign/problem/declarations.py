@@ -58,7 +58,7 @@ def objective_declaration(
 def _objective_arguments(
     problem, name_, fn, unit_, kind, description, formula, display_unit, display_scale, replace
 ) -> None:
-    from optdesign.problem.catalogue import BUILTIN_OBJECTIVES, KINDS
+    from optdesign.problem.objectives import BUILTIN_OBJECTIVES, KINDS
 
     where = "add_objective."
     function(where + "fn", fn)

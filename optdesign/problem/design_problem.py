@@ -4,9 +4,9 @@
 array broadcast against the grid, or a CasADi symbol) and returns the objective terms and
 constraint blocks computed from the design's quantities. The formulations (NLP, GP,
 robust, NSGA-II) and the independent checks all go through it, so each requirement is
-written once. Objectives come from the catalogue (:mod:`optdesign.problem.catalogue`) plus
-those a user adds; constraints from the requirements plus those a user adds. Nothing here
-knows a solver, nor names a mechanism.
+written once. Objectives come from the built-in declarations
+(:mod:`optdesign.problem.objectives`) plus those a user adds; constraints from the
+requirements plus those a user adds. Nothing here knows a solver, nor names a mechanism.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem import declarations, drive
-from optdesign.problem.catalogue import (
+from optdesign.problem.objectives import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
     ConstraintInfo,

@@ -33,7 +33,7 @@ from pydantic import (
 
 from optdesign.argument_checks import MAX_SEED, MAX_STARTS
 from optdesign.errors import InputError
-from optdesign.models.fits import Fit
+from optdesign.models.fit_formulas import Fit
 from optdesign.units import to_internal
 
 

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
-from optdesign.reports.units import Shown, objective_shown
+from optdesign.reports.display_units import Shown, objective_shown
 from optdesign.text import printable
 
 

@@ -23,16 +23,16 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.reports.facts import design_facts, objective_facts
-from optdesign.reports.html_page import render
-from optdesign.reports.limits import binding_angles, bound_limits, limits_of
-from optdesign.reports.solve_text import objective_value
-from optdesign.reports.units import (
+from optdesign.reports.display_units import (
     angle_unit,
     objective_shown,
     requirement_echo,
     variable_shown,
 )
+from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.html_page import render
+from optdesign.reports.limits import binding_angles, bound_limits, limits_of
+from optdesign.reports.solve_text import objective_value
 from optdesign.studies.verify import constraint_rows
 from optdesign.user_code import call_method
 

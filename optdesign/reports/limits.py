@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.reports.units import Shown, angle_unit, shown
+from optdesign.reports.display_units import Shown, angle_unit, shown
 from optdesign.text import printable
 
 #: Row names never shown as limits: the objective's epigraph rows, and membership checks
@@ -185,7 +185,7 @@ def symmetric(f: Callable[[Any], Any], lower: float | None, upper: float | None)
 
 def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> list[Limit]:
     """Free variables of ``design`` at a bound (within ``rel`` of the bound range)."""
-    from optdesign.reports.units import variable_shown
+    from optdesign.reports.display_units import variable_shown
 
     out = []
     for var in problem.free:
