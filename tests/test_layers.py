@@ -213,3 +213,19 @@ def test_the_entry_points_are_still_there():
     # an allowed arrow that no longer exists is a stale exception: remove it from the list
     graph = import_graph()
     assert sorted(e for e in ENTRY_POINTS if e[1] not in graph[e[0]]) == []
+
+
+def test_feasibility_and_ties_compare_with_the_named_tolerances():
+    """No comparison in the package against a bare 1e-6: the feasibility and tie
+    tolerances are optdesign.tolerances' (one name each, one value)."""
+    from optdesign import tolerances
+
+    assert tolerances.FEASIBILITY_TOL == 1e-6 and tolerances.OBJECTIVE_TIE_TOL == 1e-6
+    bare = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Compare):
+                for sub in ast.walk(node):
+                    if isinstance(sub, ast.Constant) and sub.value == 1e-6:
+                        bare.append(f"{path.relative_to(PACKAGE)}:{node.lineno}")
+    assert bare == []

@@ -16,6 +16,7 @@ import numpy as np
 
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 
 def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.ndarray:
@@ -27,7 +28,7 @@ def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.
     return lower + pts * (upper - lower)
 
 
-def best_of(results: Sequence[Result], rel_tol: float = 1e-6) -> tuple[Result, int]:
+def best_of(results: Sequence[Result], rel_tol: float = OBJECTIVE_TIE_TOL) -> tuple[Result, int]:
     """The best successful result and how many reached it within ``rel_tol``.
 
     Ties are decided by value, then by index, never by rounding: every successful result
@@ -55,7 +56,7 @@ def _tolerance(value: float, rel_tol: float) -> float:
     return rel_tol * max(abs(value), 1e-12) if math.isfinite(value) else 0.0
 
 
-def improves(value: float, best: float, rel_tol: float = 1e-6) -> bool:
+def improves(value: float, best: float, rel_tol: float = OBJECTIVE_TIE_TOL) -> bool:
     """Whether ``value`` is better than ``best`` by more than a tie (``rel_tol``
     relative): a search keeps its earlier incumbent on a tie, as :func:`best_of` does."""
     return value < best - _tolerance(best, rel_tol)
@@ -65,7 +66,7 @@ def multistart(
     solve: Callable[[np.ndarray], Result],
     starts: np.ndarray,
     workers: int = 1,
-    rel_tol: float = 1e-6,
+    rel_tol: float = OBJECTIVE_TIE_TOL,
     seed: int = 0,
     agree: int | None = None,
     parallel_map: Callable[..., list[Result]] | None = None,

@@ -40,11 +40,12 @@ from optdesign.solvers.multistart import best_of, improves, sobol_starts
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
 #: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
-PRUNE_TOL = 1e-6
+PRUNE_TOL = OBJECTIVE_TIE_TOL
 
 
 def cannot_improve(bound: float, incumbent: float) -> bool:
@@ -149,7 +150,7 @@ class NodeSolver:
             len(results),
             sum(r.success for r in results),
             n_at_best,
-            1e-6,
+            OBJECTIVE_TIE_TOL,
             [r.objective for r in results],
             self.seed,
         )

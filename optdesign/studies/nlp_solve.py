@@ -26,6 +26,7 @@ from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
 from optdesign.studies.runner import map_inherited
 from optdesign.studies.verify import nan_notes, verify_design
+from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 
 # --- formulation and solver caches ------------------------------------------------------
 _NLPS: OrderedDict[tuple, NLP] = OrderedDict()
@@ -172,7 +173,7 @@ def _no_catalogue(problem: DesignProblem, name: str) -> None:
 def optimal_ranges(
     problem: DesignProblem,
     result: Result,
-    rel: float = 1e-6,
+    rel: float = OBJECTIVE_TIE_TOL,
     solver: str = "ipopt",
     options: Mapping[str, Any] | None = None,
 ) -> dict[str, tuple[float, float]]:
@@ -209,7 +210,7 @@ def optimal_ranges(
         ends = []
         for sign in (1.0, -1.0):
             r = backend.solve(start, {VAR + var.name: sign}, bounds)
-            ok = r.success and r.max_violation <= 1e-6
+            ok = r.success and r.max_violation <= FEASIBILITY_TOL
             ends.append(r.design[var.name] if ok else result.design[var.name])
         opt = result.design[var.name]
         ranges[var.name] = (float(min(*ends, opt)), float(max(*ends, opt)))

@@ -40,6 +40,7 @@ from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp, solver_options, start_points
 from optdesign.studies.runner import map_inherited
+from optdesign.tolerances import FEASIBILITY_TOL
 
 #: Default independent Monte Carlo: sample count and seed (different from the SAA seed).
 MC_SAMPLES = 20_000
@@ -162,7 +163,7 @@ def monte_carlo(
         cvar=empirical_cvar(values, alpha),
         alpha=alpha,
         risk=risk_value(values, risk, alpha, k),
-        p_violation=float(np.mean(viol > 1e-6)),
+        p_violation=float(np.mean(viol > FEASIBILITY_TOL)),
         values=values,
     )
 

@@ -50,7 +50,7 @@ from optdesign.studies.pareto.run_setup import (
 )
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK, front_task
 from optdesign.studies.runner import forks_workers, process_pool, run_tasks
-from optdesign.studies.verify import VERIFY_TOL
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 def _common(
@@ -332,7 +332,7 @@ class NSGA2:
         if len(X):
             ev = problem.evaluate(X)
             for j, x in enumerate(X):
-                ok = bool(ev.violation[j] <= VERIFY_TOL)
+                ok = bool(ev.violation[j] <= FEASIBILITY_TOL)
                 design = {**problem.fixed_values, **problem.design_dict(x)}
                 pts.append(
                     FrontPoint(
