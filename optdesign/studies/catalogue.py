@@ -60,10 +60,10 @@ RETRY_STARTS = 4
 
 #: Ipopt options of the node NLPs. Many nodes of a catalogue search are infeasible boxes,
 #: and Ipopt's default filter spends ~120 iterations before its restoration phase proves
-#: it; ``expect_infeasible_problem`` enters restoration sooner: fin_actuator 5.5 -> 2.1 s,
-#: cs_min_backlash_catalogue 1.9 -> 1.4 s, the same nodes infeasible and the same optima
-#: (benchmarks/README.md, "Overhead"). A node still counts as infeasible only once all
-#: its starts and :data:`RETRY_STARTS` more say so.
+#: it; ``expect_infeasible_problem`` enters restoration sooner, with the same nodes
+#: infeasible and the same optima (figures: benchmarks/README.md, "Catalogue searches:
+#: infeasible nodes"). A node still counts as infeasible only once all its starts and
+#: :data:`RETRY_STARTS` more say so.
 NODE_IPOPT_OPTIONS: dict[str, Any] = {"expect_infeasible_problem": "yes"}
 
 

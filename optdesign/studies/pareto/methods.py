@@ -133,8 +133,8 @@ class EpsilonConstraint:
             seed=seed,
         )
         if run.workers > 1 and run.scheduler is None and forks_workers():
-            # Forked workers inherit the formulation built here (~0.03 s) instead of each
-            # building its own; their solvers they build side by side on first use.
+            # Forked workers inherit the formulation built here instead of each building
+            # its own; their solvers they build side by side on first use.
             formulation_for(problem, tuple(sorted(objectives)))
         label = f"{self.name}: points" if run.progress else False
         with process_pool(run.workers if run.scheduler is None else 1) as pool:
