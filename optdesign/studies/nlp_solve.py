@@ -22,7 +22,7 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.multistart import multistart, sobol_starts
-from optdesign.solvers.registry import make_solver
+from optdesign.solvers.registry import make_solver, solver_entry
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
 from optdesign.studies.runner import map_inherited
 from optdesign.studies.verify import nan_notes, verify_design
@@ -187,12 +187,11 @@ def optimal_ranges(
     scale together). A search that fails keeps the optimal value on its side.
     """
     objective = result.objective_name or problem.objective_names[0]
-    warm = solver == "ipopt" and "lam_g" in result.raw
+    warm_options = solver_entry(solver).warm_options
+    warm = warm_options is not None and "lam_g" in result.raw
     if warm:
         # Primal and dual start at the optimum (benchmarks/README.md, "Overhead").
-        from optdesign.solvers.casadi_nlp import IPOPT_WARM
-
-        options = {**IPOPT_WARM, **(options or {})}
+        options = {**warm_options, **(options or {})}
     backend = solver_for(problem, solver, options, _objective_set(problem, objective))
     nlp = backend.nlp
     limit = result.objective + rel * max(abs(result.objective), 1e-12)
