@@ -23,7 +23,7 @@ import numpy as np
 from optdesign.formulations.gp import build_gp
 from optdesign.problem import load_problem
 from optdesign.solvers import make_solver
-from optdesign.studies.solve import solve_nlp, solver_for
+from optdesign.studies.nlp_solve import solve_nlp, solver_for
 
 ROOT = Path(__file__).resolve().parents[1]
 

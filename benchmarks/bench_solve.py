@@ -25,8 +25,8 @@ from optdesign.problem import load_problem
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.global_check import penalised_objective
+from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.pareto.eps_solver import SLSQP_OPTIONS
-from optdesign.studies.solve import solve_nlp
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -116,7 +116,7 @@ def solve(
     spread = args.pop("contact_models")
     result = run(problem, **args, **({"agree": agree} if agree is not None else {}))
     if spread and result.design:
-        from optdesign.reports.facts import contact_model_spread
+        from optdesign.studies.contact_spread import contact_model_spread
 
         line = contact_model_spread(problem, result.design)
         result.notes.append(line or "backlash by pin contact model: no sized pin or no backlash")

@@ -16,7 +16,7 @@ smallest clearance of H7/g6 (table in :mod:`optdesign.models.iso286`).
 from __future__ import annotations
 
 from optdesign.models import iso286
-from optdesign.models.fits import (
+from optdesign.models.fit_formulas import (
     SMOOTH_GRADES,
     SMOOTH_HOLE_LETTERS,
     SMOOTH_SHAFT_LETTERS,

@@ -13,7 +13,7 @@ the output it reaches. Each output has one rule, applied where the text is writt
   ``@``, a tab or a carriage return gets a leading ``'`` (OWASP's rule against formula
   injection), numbers are written as numbers;
 - HTML and matplotlib have their own rules, next to the code that writes them
-  (:func:`optdesign.reports.html.to_json`, :func:`optdesign.plots.plain`).
+  (:func:`optdesign.reports.html_page.to_json`, :func:`optdesign.plots.plain`).
 
 The JSON outputs need no rule for text (JSON strings are safe by construction).
 """

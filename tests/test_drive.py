@@ -18,7 +18,7 @@ import pytest
 from scipy.optimize import brentq
 
 from optdesign.problem import load_problem, problem_from_dict
-from optdesign.studies.solve import solve_nlp
+from optdesign.studies.nlp_solve import solve_nlp
 
 ROOT = Path(__file__).resolve().parents[1]
 FIN = ROOT / "problems" / "fin_actuator.toml"

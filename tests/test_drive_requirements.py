@@ -9,7 +9,7 @@ from optdesign.mechanisms import CrankSlider
 from optdesign.models.lock import PinLock, motor_shaft_lock_load
 from optdesign.models.screw_sizing import buckling_load
 from optdesign.problem import problem_from_dict
-from optdesign.studies.solve import solve_nlp
+from optdesign.studies.nlp_solve import solve_nlp
 
 
 def _problem(**req):

@@ -555,7 +555,7 @@ def test_a_solution_stays_within_its_bounds():
     """Ipopt relaxes its bounds by ~1e-8 of the scaled variable: over a span of 1e12 mm a
     design came back 1e4 mm below its lower bound (a negative diameter); the design read
     from the solution is held within the declared bounds."""
-    from optdesign.studies.solve import formulation_for
+    from optdesign.studies.nlp_solve import formulation_for
 
     data = tomllib.loads(
         _text(
@@ -581,7 +581,7 @@ def test_report_of_a_design_with_overflowing_quantities(tmp_path, capsys):
     from drive_corpus import _set, bases
     from hostile_corpus import dumps
 
-    from optdesign.reports.html import to_json
+    from optdesign.reports.html_page import to_json
 
     assert to_json({"x": [1.0, math.inf, math.nan]}) == '{"x": [1.0, null, null]}'
     data, _ = bases()["cont"]

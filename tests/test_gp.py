@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import NotGP, Signomial, build_gp, is_gp
-from optdesign.models.fits import fit_clearance
+from optdesign.models.fit_formulas import fit_clearance
 from optdesign.problem import load_problem, problem_from_dict
 from optdesign.studies.gp import require_gp, solve_gp_problem
 
@@ -131,3 +132,40 @@ def test_auto_picks_gp_for_the_fork_and_nlp_for_the_crank_slider():
     _load_plugins()
     assert choose_formulation(load_problem(FORK), "auto") == "gp"
     assert choose_formulation(load_problem(ROOT / "problems/cs_min_backlash.toml"), "auto") == "nlp"
+
+
+def test_auto_decides_with_the_chosen_objective():
+    """The fork is a GP in backlash (worst case) but not in backlash_rss (a power of a
+    sum): ``auto`` with ``objective="backlash_rss"`` takes the NLP, where it used to
+    pick gp and refuse "not a geometric program"."""
+
+    import optdesign as od
+    from optdesign.studies.solve import choose_formulation
+
+    problem = od.load(FORK)
+    assert choose_formulation(problem, "auto") == "gp"
+    assert choose_formulation(problem, "auto", "backlash_rss") == "nlp"
+    result = od.solve(problem, "auto", objective="backlash_rss", ranges=False)
+    assert result.formulation == "nlp-epigraph" and result.status == "optimal"
+    assert result.objective_name == "backlash_rss"
+    assert result.objective == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-4)
+    # an explicit gp still refuses, naming the objective that breaks DGP form
+    with pytest.raises(ProblemError, match="objective backlash_rss: not DGP"):
+        od.solve(problem, "gp", objective="backlash_rss")
+
+
+def test_auto_decides_with_the_chosen_objective_on_the_command_line(tmp_path, capsys):
+    import json
+
+    from optdesign.cli import main
+
+    args = ["solve", str(FORK), "--objective", "backlash_rss", "--no-ranges"]
+    assert main([*args, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["formulation"] == "nlp-epigraph" and doc["status"] == "optimal"
+    assert doc["objective"]["name"] == "backlash_rss"
+    assert doc["objective"]["value"] == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-4)
+    assert main([*args, "--out", str(tmp_path / "out")]) == 0
+    text = capsys.readouterr().out
+    assert "nlp-epigraph" in text
+    assert re.search(r"objective +backlash_rss = 0\.019498", text)

@@ -33,8 +33,8 @@ from hypothesis import strategies as st
 from optdesign.errors import InputError
 from optdesign.fits import clearance, supported_fits
 from optdesign.models import iso286 as t
-from optdesign.models.fits import Fit, fit_clearance, it_tolerance, shaft_lower_deviation
-from optdesign.models.fits import shaft_upper_deviation as es_formula
+from optdesign.models.fit_formulas import Fit, fit_clearance, it_tolerance, shaft_lower_deviation
+from optdesign.models.fit_formulas import shaft_upper_deviation as es_formula
 
 # --------------------------------------------------------------------------------------
 # Printed values

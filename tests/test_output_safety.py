@@ -27,7 +27,7 @@ import pytest
 
 import optdesign as od
 from optdesign.cli import main
-from optdesign.reports.html import to_json
+from optdesign.reports.html_page import to_json
 from optdesign.text import csv_cell, printable
 
 PROBLEMS = Path(__file__).resolve().parent.parent / "problems"
@@ -284,7 +284,7 @@ def test_pareto_files_and_summary_with_a_hostile_name(hostile_file, tmp_path, ca
 def _hostile_objective_problem():
     """A problem whose own objective has a name a spreadsheet, plotly and mathtext would
     all read as markup, and whose values are negative numbers."""
-    from optdesign.problem.catalogue import ObjectiveInfo
+    from optdesign.problem.objectives import ObjectiveInfo
 
     problem = od.load(PROBLEMS / "cs_min_backlash.toml")
     # add_objective refuses such a name (names are identifiers: tests/test_user_code.py);

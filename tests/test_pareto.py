@@ -277,7 +277,7 @@ def threaded_blas():
     unset or 2 starts them), the counts restored after: the main process then differs
     from the one-thread workers unless the solves set their own count."""
     from optdesign.solvers.blas import blas_libraries
-    from optdesign.studies.solve import solver_for
+    from optdesign.studies.nlp_solve import solver_for
 
     solver_for(load_problem(PROBLEMS / "fork_min_backlash.toml"), "ipopt")  # CasADi's BLAS
     before = [(lib, lib.get_threads()) for lib in blas_libraries()]

@@ -28,7 +28,7 @@ from optdesign.models.loads import (
     pin_shear_stress,
 )
 from optdesign.problem import load_problem, problem_from_dict
-from optdesign.studies.solve import solve_nlp
+from optdesign.studies.nlp_solve import solve_nlp
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from optdesign.errors import InputError
 from optdesign.models import pin_contact as pc
-from optdesign.models.fits import fit_clearance
+from optdesign.models.fit_formulas import fit_clearance
 
 E, NU = 2.1e5, 0.3
 

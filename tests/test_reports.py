@@ -15,8 +15,8 @@ import pytest
 
 import optdesign as od
 from optdesign.problem.load import written_units
+from optdesign.reports.display_units import requirement_echo
 from optdesign.reports.result_json import SCHEMA, result_document
-from optdesign.reports.units import requirement_echo
 
 PROBLEMS = Path(__file__).resolve().parent.parent / "problems"
 

@@ -11,6 +11,7 @@ import pytest
 from optdesign.errors import ProblemError
 from optdesign.formulations.robust import Samples, draw_samples, sampled_objective
 from optdesign.problem.load import problem_from_dict
+from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.robust import (
     compare_nominal_robust,
     empirical_cvar,
@@ -18,7 +19,6 @@ from optdesign.studies.robust import (
     paired_bootstrap,
     solve_robust,
 )
-from optdesign.studies.solve import solve_nlp
 
 ROOT = Path(__file__).resolve().parents[1]
 FILE = ROOT / "problems" / "cs_min_backlash_robust.toml"

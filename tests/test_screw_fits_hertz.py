@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from optdesign.errors import InputError
 from optdesign.models import screw
-from optdesign.models.fits import Fit, fit_clearance, tolerance_unit
+from optdesign.models.fit_formulas import Fit, fit_clearance, tolerance_unit
 from optdesign.models.hertz_line import pin_flattening, pin_flattening_first_order
 
 

@@ -217,7 +217,7 @@ def test_catalogue_relaxation_takes_the_most_favourable_items_of_the_box():
 
 # --- NLP rows: both bounds scaled by the row's divisor -------------------------------------
 def test_nlp_rows_are_scaled_on_both_sides():
-    from optdesign.studies.solve import formulation_for
+    from optdesign.studies.nlp_solve import formulation_for
 
     problem = od.load(PROBLEMS / "cs_min_backlash.toml")
     nlp = formulation_for(problem)

@@ -557,7 +557,7 @@ def test_an_ipopt_solve_is_interrupted_not_returned_as_a_failed_start(capfd):
 
     import optdesign as od
     from optdesign.interrupts import Interrupted, interrupts_as_exceptions
-    from optdesign.studies.solve import solver_for
+    from optdesign.studies.nlp_solve import solver_for
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     backend = solver_for(problem, "ipopt", {**SLOW_IPOPT_OPTIONS, "max_iter": 20000})
@@ -579,7 +579,7 @@ def test_ctrl_c_in_a_solve_raises_keyboard_interrupt_without_the_cli():
     from test_cli_signals import SLOW_IPOPT_OPTIONS
 
     import optdesign as od
-    from optdesign.studies.solve import solver_for
+    from optdesign.studies.nlp_solve import solver_for
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     backend = solver_for(problem, "ipopt", {**SLOW_IPOPT_OPTIONS, "max_iter": 20000})

@@ -16,7 +16,7 @@ from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem, problem_from_dict
 from optdesign.solvers.casadi_nlp import IPOPT_WARM, CasadiNLPSolver
 from optdesign.studies.global_check import differential_evolution_optimum
-from optdesign.studies.solve import solve_nlp
+from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
@@ -284,7 +284,7 @@ def test_multistart_on_two_processes_matches_in_process():
 
 
 def test_optimal_ranges_expose_non_unique_optima():
-    from optdesign.studies.solve import optimal_ranges
+    from optdesign.studies.nlp_solve import optimal_ranges
 
     fork = load_problem(PROBLEMS / "fork_min_backlash.toml")
     res = solve_nlp(fork, starts=2)

@@ -82,7 +82,9 @@ def test_agree_stop_gives_the_same_record_for_one_two_three_workers(agree):
     starts = np.arange(len(OBJECTIVES), dtype=float).reshape(-1, 1)
     records = {}
     for workers in (1, 2, 3):
-        best = multistart(slow_solve, starts, workers=workers, agree=agree)
+        best = multistart(
+            slow_solve, starts, workers=workers, agree=agree, parallel_map=map_inherited
+        )
         ms = best.multistart
         records[workers] = (best.design["x"], ms.n_starts, ms.n_at_best, ms.objectives)
     # serial: agree=2 stops after starts 0, 1; agree=3 after 0, 1, 2, 3; None runs all 8

@@ -39,7 +39,7 @@ if [ ${#MODULES[@]} -eq 0 ]; then
     optdesign/studies/pareto/*.py
     optdesign/storage.py
     optdesign/units.py
-    optdesign/reports/units.py
+    optdesign/reports/display_units.py
   )
 fi
 # The tests a mutant faces: by default the whole fast suite (the README's test command,
@@ -79,7 +79,7 @@ cat >>"$WORK/tests/conftest.py" <<'PY'
 @pytest.fixture(autouse=True)
 def _empty_formulation_caches():
     from optdesign.studies import runner as _runner
-    from optdesign.studies import solve as _solve
+    from optdesign.studies import nlp_solve as _solve
 
     _solve._NLPS.clear()
     _solve._SOLVERS.clear()

@@ -84,7 +84,9 @@ def run_solve(args) -> int:
     problem = load_problem(args.file)
     with as_options(RENAMED):  # before the output folder is made
         check.objective_of(problem, args.objective)
-    plan_solve(problem, args.formulation)  # what needs no solve, before the folder is made
+    plan_solve(
+        problem, args.formulation, args.objective
+    )  # what needs no solve, before the folder is made
     write_files = args.out is not None or not args.json
     if not write_files:
         return _solve_and_report(args, problem, None)

@@ -25,8 +25,9 @@ def discrete_variables(problem: DesignProblem) -> list[Variable]:
     return [v for v in problem.free if v.discrete]
 
 
-def has_discrete(problem: DesignProblem) -> bool:
-    """True when some free variable takes catalogue values (``--formulation auto``)."""
+def has_discrete(problem: DesignProblem, objective: str | None = None) -> bool:
+    """True when some free variable takes catalogue values (``--formulation auto``; the
+    objective does not matter)."""
     return bool(discrete_variables(problem))
 
 

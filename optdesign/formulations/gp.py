@@ -4,7 +4,7 @@ A design problem is a GP when, after the change of variables ``y = log x``, ever
 objective and constraint row is a posynomial bounded above (or a monomial bounded on
 either side). Two things make that true for some of optdesign's problems: Hertz
 flattening taken to first order (b^2/D, a monomial) and the ISO 286 fit formulas
-(posynomials in D, :mod:`optdesign.models.fits`).
+(posynomials in D, :mod:`optdesign.models.fit_formulas`).
 
 **How the expressions are obtained.** The models are written once through
 :mod:`optdesign.math`, which dispatches CasADi symbols to CasADi and everything

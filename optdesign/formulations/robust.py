@@ -39,8 +39,8 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
-from optdesign.problem.catalogue import ObjectiveTerm
 from optdesign.problem.design_problem import DesignProblem, Expressions
+from optdesign.problem.objectives import ObjectiveTerm
 from optdesign.problem.spec import Tolerances
 
 #: Variance guard of the mean + k std measure (in scaled units, objective ~1).

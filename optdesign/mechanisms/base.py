@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import casadi as ca
@@ -381,11 +381,6 @@ def _short(v: Any) -> str:
         return "<symbolic>"
     a = np.asarray(v)
     return f"{float(a):g}" if a.ndim == 0 else f"<array {a.shape}>"
-
-
-def replace_joint(joint: Joint, **changes) -> Joint:
-    """A copy of ``joint`` with ``changes`` (dataclasses.replace, re-exported for plug-ins)."""
-    return replace(joint, **changes)
 
 
 # --- automatic derivative of the nut position ------------------------------------------

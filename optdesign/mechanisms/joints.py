@@ -21,7 +21,7 @@ from optdesign.errors import InputError
 from optdesign.models import pin_contact
 from optdesign.models._checks import require_positive
 from optdesign.models.clearance import root_sum_square, worst_case
-from optdesign.models.fits import Fit
+from optdesign.models.fit_formulas import Fit
 from optdesign.models.hertz_line import (
     contact_half_width,
     pin_flattening,

@@ -102,8 +102,8 @@ def _load_entry_points() -> None:
     if _ENTRY_POINTS_LOADED:
         return
     _ENTRY_POINTS_LOADED = True
-    # Imported here: importlib.metadata (with the email package) costs ~20 ms, and a
-    # shipped mechanism never needs it.
+    # Imported here: importlib.metadata (with the email package) is a measurable part of
+    # the CLI's start-up, and a shipped mechanism never needs it.
     from importlib.metadata import entry_points
 
     for ep in entry_points(group=ENTRY_POINT_GROUP):
@@ -119,9 +119,10 @@ def _load_entry_points() -> None:
 
 
 def get_mechanism(name: str) -> type[Mechanism]:
-    """The class registered as ``name``; InputError listing the registered ones if none."""
-    import optdesign.mechanisms  # noqa: F401  (registers the built-ins)
+    """The class registered as ``name``; InputError listing the registered ones if none.
 
+    The built-ins are registered already: importing this module runs the package's
+    ``__init__`` first, which imports them (and they register on import)."""
     cls = _REGISTRY.get(name)
     if cls is None:
         _load_entry_points()
@@ -135,7 +136,5 @@ def get_mechanism(name: str) -> type[Mechanism]:
 
 def registered() -> list[str]:
     """Names of the registered mechanisms (entry points included)."""
-    import optdesign.mechanisms  # noqa: F401
-
     _load_entry_points()
     return list(_REGISTRY)

@@ -31,12 +31,6 @@ def ratio(R, p, i_a, phi, phi0=0.0):
 
 
 @m.shareable
-def pin_distance(R, phi, phi0=0.0):
-    """Distance from O to the pin, R / cos(phi0 + phi) (mm)."""
-    return R / m.cos(phi0 + phi)
-
-
-@m.shareable
 def sensitivity_slot_normal(R, phi, phi0=0.0):
     """Output rotation per unit slot-normal clearance at the pin (rad/mm) = cos a / R."""
     return m.cos(phi0 + phi) / R

@@ -1,6 +1,6 @@
 """ISO 286 limits and fits as the standard prints them (stepped tables, nominal sizes <= 500 mm).
 
-:mod:`optdesign.models.fits` evaluates the ISO 286-1 *formulas* at the nominal size D
+:mod:`optdesign.models.fit_formulas` evaluates the ISO 286-1 *formulas* at the nominal size D
 itself, which an optimiser needs (smooth in D) but which is not what a drawing means:
 the standard evaluates the formulas once per size step (at the geometric mean of the
 step), rounds them, and prints the result as the value of the whole step. This module
@@ -28,7 +28,7 @@ Rules implemented (ISO 286-1:2010, its tables of fundamental deviations and thei
   (not -11).
 - IT14..IT18 are not used for sizes up to 1 mm.
 
-Smooth (formulas at D, :mod:`optdesign.models.fits`) against table (printed steps),
+Smooth (formulas at D, :mod:`optdesign.models.fit_formulas`) against table (printed steps),
 measured on 20 000 log-spaced sizes 1..500 mm and at every step edge (pinned by
 ``tests/test_iso286.py::test_smooth_vs_table_bounds_are_the_measured_ones``): smooth minus
 table, relative to |table| and in um ("n/a": the table value is zero or changes sign).

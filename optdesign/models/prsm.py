@@ -399,8 +399,3 @@ def _convex(sp: SurfacePoint, xi: int):
     k = -s * sp.kappa
     order = np.argsort(k)[::-1]
     return k[order], sp.directions[order], s * sp.normal
-
-
-def omega_at(geometry: PRSMGeometry, side: str, psi: float = 0.0) -> float:
-    """Principal-plane angle omega (rad) at the ``side`` contact, position psi."""
-    return PRSMContact(geometry).contact(side, psi).omega

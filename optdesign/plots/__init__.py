@@ -84,7 +84,7 @@ def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Pa
         if engine is None:
             # fig.tight_layout()'s own computation, without the placeholder layout engine
             # it leaves on the figure: with one, savefig lays the figure out once more
-            # (~40 ms of a front plot's ~150 ms; the PNG is byte-identical).
+            # (the PNG is byte-identical; figures: benchmarks/README.md).
             TightLayoutEngine(rect=None).execute(fig)
         elif not isinstance(engine, ConstrainedLayoutEngine):  # savefig runs that one
             fig.tight_layout()

@@ -11,6 +11,8 @@ import numpy as np
 
 from optdesign.plots import new_figure, plain
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.reports.limits import binding_angles, bound_limits, limits_of
+from optdesign.studies.verify import constraint_rows
 
 
 def plot_designs(
@@ -105,19 +107,17 @@ def _wrap(text: str, width: int) -> str:
 def plot_result(result, ax=None):
     """The optimum of ``result`` against the problem's initial design (a Figure); the
     initial design is labelled as violating the requirements when it does."""
-    from optdesign.reports.limits import binding_angles, bound_limits, limits_of, rows_at
-
     problem = result.problem_object
     if problem is None or not result.design:
         raise ValueError("plot: the result carries no problem or no design to draw")
     start = problem.design_dict(problem.start())
-    _, violated = rows_at(problem, start)
+    _, violated = constraint_rows(problem, start)
     n_bad = len(limits_of(problem, violated))
     initial = "initial design" + (
         f" (violates {n_bad} requirement{'s' if n_bad > 1 else ''})" if n_bad else ""
     )
     best = "optimum" if result.success else "best point found (infeasible)"
-    active, bad = rows_at(problem, result.design)
+    active, bad = constraint_rows(problem, result.design)
     # an infeasible point's violated requirements come first: they are the news
     limits = limits_of(problem, bad) + limits_of(problem, active)
     limits += bound_limits(problem, result.design)

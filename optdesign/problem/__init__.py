@@ -6,15 +6,15 @@ mechanism it names (:mod:`optdesign.problem.spec`) and turned into a
 design's quantities, on the CasADi path or the NumPy path alike.
 """
 
-from optdesign.problem.catalogue import (
+from optdesign.problem.design_problem import DesignProblem, Evaluation, Expressions
+from optdesign.problem.load import load, load_problem, problem_from_dict
+from optdesign.problem.objectives import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
     ConstraintInfo,
     ObjectiveInfo,
     ObjectiveTerm,
 )
-from optdesign.problem.design_problem import DesignProblem, Evaluation, Expressions
-from optdesign.problem.load import load, load_problem, problem_from_dict
 from optdesign.problem.quantities import Quantities
 from optdesign.problem.variables import Variable
 

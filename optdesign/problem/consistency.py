@@ -179,7 +179,7 @@ def _screw(problem: Any, screw: Any) -> None:
 def _fit(problem: Any) -> None:
     """The pin fit can be evaluated at every pin diameter the problem allows, and leaves
     a clearance (not an interference) there."""
-    from optdesign.models.fits import Fit
+    from optdesign.models.fit_formulas import Fit
     from optdesign.problem.drive import fit_values
 
     d = problem.by_name.get("d")

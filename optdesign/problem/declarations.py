@@ -1,6 +1,6 @@
 """The checks of what a user adds to a problem (:meth:`DesignProblem.add_objective`,
 :meth:`DesignProblem.add_constraint`), with the argument checks of
-:mod:`optdesign.validation`: refusals name ``add_objective.<argument>``.
+:mod:`optdesign.argument_checks`: refusals name ``add_objective.<argument>``.
 """
 
 from __future__ import annotations
@@ -10,8 +10,17 @@ import math
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from optdesign.argument_checks import (
+    ArgumentError,
+    choice,
+    flag,
+    function,
+    name,
+    number,
+    text,
+    unit,
+)
 from optdesign.errors import InputError
-from optdesign.validation import ArgumentError, choice, flag, function, name, number, text, unit
 
 
 def objective_declaration(
@@ -49,7 +58,7 @@ def objective_declaration(
 def _objective_arguments(
     problem, name_, fn, unit_, kind, description, formula, display_unit, display_scale, replace
 ) -> None:
-    from optdesign.problem.catalogue import BUILTIN_OBJECTIVES, KINDS
+    from optdesign.problem.objectives import BUILTIN_OBJECTIVES, KINDS
 
     where = "add_objective."
     function(where + "fn", fn)

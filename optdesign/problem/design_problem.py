@@ -4,9 +4,9 @@
 array broadcast against the grid, or a CasADi symbol) and returns the objective terms and
 constraint blocks computed from the design's quantities. The formulations (NLP, GP,
 robust, NSGA-II) and the independent checks all go through it, so each requirement is
-written once. Objectives come from the catalogue (:mod:`optdesign.problem.catalogue`) plus
-those a user adds; constraints from the requirements plus those a user adds. Nothing here
-knows a solver, nor names a mechanism.
+written once. Objectives come from the built-in declarations
+(:mod:`optdesign.problem.objectives`) plus those a user adds; constraints from the
+requirements plus those a user adds. Nothing here knows a solver, nor names a mechanism.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem import declarations, drive
-from optdesign.problem.catalogue import (
+from optdesign.problem.objectives import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
     ConstraintInfo,
@@ -32,6 +32,7 @@ from optdesign.problem.catalogue import (
 from optdesign.problem.quantities import Quantities
 from optdesign.problem.requirements import requirement_blocks
 from optdesign.problem.spec import ProblemSpec
+from optdesign.problem.spec_validation import validate_spec
 from optdesign.problem.variables import Variable
 from optdesign.user_code import UserCodeError, is_users, quantity_of
 
@@ -147,8 +148,6 @@ class DesignProblem:
     def __setstate__(self, state: dict[str, Any]) -> None:
         import pickle
 
-        from optdesign.problem.load import validate_spec
-
         mechanism, objectives, constraints = pickle.loads(state["blob"])
         self.mechanism = mechanism
         self.spec = validate_spec(state["spec"], mechanism, internal=True)
@@ -226,10 +225,6 @@ class DesignProblem:
             for k, v in enumerate(self.free):
                 design[v.name] = x[k]
         return design
-
-    def describe_variable(self, name: str) -> str:
-        v = self.by_name.get(name)
-        return v.description if v is not None else name
 
     def _check_consistency(self) -> None:
         table = self.mechanism.variable_table()
@@ -376,8 +371,6 @@ class DesignProblem:
         self._revalidate({**data, "objective": {"minimize": list(names)}})
 
     def _revalidate(self, data: dict[str, Any]) -> None:
-        from optdesign.problem.load import validate_spec
-
         self.spec = validate_spec(data, self.mechanism, source=self.name)
         self._grid()
         self._check_consistency()

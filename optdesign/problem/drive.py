@@ -192,7 +192,7 @@ def _items_in(values, lo, hi) -> list[float]:
 
 
 def _fit(problem):
-    from optdesign.models.fits import Fit
+    from optdesign.models.fit_formulas import Fit
 
     return Fit.parse(problem.spec.requirements.fit, "requirements.fit", values="table")
 

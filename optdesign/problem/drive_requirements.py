@@ -7,8 +7,8 @@ from __future__ import annotations
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import screw_sizing as sizing
-from optdesign.problem.catalogue import ConstraintBlock
 from optdesign.problem.drive import nut_stiffness_rule
+from optdesign.problem.objectives import ConstraintBlock
 
 
 def _need(value, what: str, field: str):

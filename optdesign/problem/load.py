@@ -13,14 +13,13 @@ import stat
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, get_args
+from typing import Any
 
-from pydantic import ValidationError
-
+from optdesign import argument_checks as validation
 from optdesign.errors import InputError, ProblemError
 from optdesign.mechanisms.registry import get_mechanism, registered
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.spec import ProblemSpec, spec_model
+from optdesign.problem.spec_validation import validate_spec
 from optdesign.problem.variables import parse_variable, variable_table
 from optdesign.units import Bare
 
@@ -139,8 +138,6 @@ def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProbl
         return problem
     if isinstance(problem, Mapping):
         return problem_from_dict(dict(problem))
-    from optdesign import validation
-
     try:
         path = validation.path("problem", problem)
     except validation.ArgumentError:
@@ -150,71 +147,6 @@ def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProbl
             + validation.shown(problem),
         ) from None
     return load_problem(path)
-
-
-def validate_spec(
-    data: dict[str, Any],
-    mechanism: type,
-    source: str = "problem",
-    internal: bool = False,
-    bare: Bare = "internal",
-) -> ProblemSpec:
-    """Validate ``data`` against the schema of ``mechanism``; ProblemError naming fields.
-
-    ``internal``: ``data`` is a validated spec's own dump (numbers in internal units).
-    ``bare``: a bare number for a dimensioned field is internal, or refused (files).
-    The error is one line: every invalid field with its reason, an unknown field with the
-    nearest valid name.
-    """
-    model = spec_model(mechanism)
-    context = {"internal": internal, "bare": "internal" if internal else bare}
-    try:
-        return model.model_validate(data, context=context)
-    except ValidationError as exc:
-        lines = []
-        for err in exc.errors():
-            parts = [str(p) for p in err["loc"] if not str(p).startswith("function-")]
-            # a list's item as in the file's arrays: duty_cycle[0].time, not duty_cycle.0.time
-            loc = ".".join(parts).replace(".[", "[")
-            loc = re.sub(r"\.(\d+)(?=\.|$)", r"[\1]", loc)
-            msg = err["msg"].removeprefix("Value error, ")
-            if err["type"] == "missing":
-                msg = "missing (a required field)"
-            if err["type"] == "extra_forbidden":
-                msg = "unknown field" + _did_you_mean(model, parts)
-            head = re.match(r"(\w+): ", msg)  # a table's check naming its own field
-            if head is not None:
-                loc, msg = f"{loc}.{head.group(1)}" if loc else head.group(1), msg[head.end() :]
-            lines.append(f"{loc}: {msg}")
-        more = f" (and {len(lines) - 3} more)" if len(lines) > 3 else ""
-        raise ProblemError(f"{source}: {'; '.join(lines[:3])}{more}") from None
-
-
-def _did_you_mean(model: type, parts: list[str]) -> str:
-    """`` (did you mean 'x'?; valid: ...)`` for the unknown last key of ``parts``."""
-    # Walk the schema to the table that holds the key.
-    for key in parts[:-1]:
-        field = getattr(model, "model_fields", {}).get(key)
-        if field is None:
-            return ""
-        model = _model_of(field.annotation)
-        if model is None:
-            return ""
-    names = list(getattr(model, "model_fields", {}))
-    close = difflib.get_close_matches(parts[-1], names, n=1, cutoff=0.6)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
-    return f"{hint} (valid: {', '.join(names)})" if len(names) <= 40 else hint
-
-
-def _model_of(annotation: Any) -> type | None:
-    """The pydantic model inside ``annotation`` (``X``, ``X | None``, ``Annotated[X, ...]``)."""
-    if isinstance(annotation, type) and hasattr(annotation, "model_fields"):
-        return annotation
-    for arg in get_args(annotation):
-        found = _model_of(arg)
-        if found is not None:
-            return found
-    return None
 
 
 def problem_from_dict(

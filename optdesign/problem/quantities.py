@@ -18,8 +18,6 @@ from collections.abc import Mapping, Sequence
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from optdesign.mechanisms.joints import (
     Backlash,
     Joint,
@@ -264,15 +262,6 @@ class Quantities:
             self.mechanism, self.phi, self.hinge_moment, eta_back, gear_back
         )
         return lock.force(load.moment)
-
-    def on_grid(self, value) -> bool:
-        """True when ``value`` varies over the deflection grid (a stroke quantity)."""
-        from optdesign import math as m
-
-        if m.is_symbolic(value):
-            return value.shape[0] == len(self.phi) and len(self.phi) > 1
-        shape = np.shape(value)
-        return bool(shape) and shape[-1] == len(self.phi) and len(self.phi) > 1
 
 
 def _defined(cls: type, item: str) -> bool:

@@ -16,8 +16,8 @@ import numpy as np
 from optdesign import math as m
 from optdesign.mechanisms.base import Rows
 from optdesign.models.loads import pin_bearing_pressure, pin_shear_stress
-from optdesign.problem.catalogue import ConstraintBlock, ConstraintInfo
 from optdesign.problem.drive_requirements import drive_blocks
+from optdesign.problem.objectives import ConstraintBlock, ConstraintInfo
 from optdesign.user_code import quantity_of
 
 

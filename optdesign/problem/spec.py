@@ -31,10 +31,10 @@ from pydantic import (
     model_validator,
 )
 
+from optdesign.argument_checks import MAX_SEED, MAX_STARTS
 from optdesign.errors import InputError
-from optdesign.models.fits import Fit
+from optdesign.models.fit_formulas import Fit
 from optdesign.units import to_internal
-from optdesign.validation import MAX_SEED, MAX_STARTS
 
 
 def _quantity(dimension: str):

@@ -10,8 +10,7 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import OptDesignError
-from optdesign.reports.units import Shown, objective_shown
+from optdesign.reports.display_units import Shown, objective_shown
 from optdesign.text import printable
 
 
@@ -74,35 +73,3 @@ def objective_facts(problem: Any, objectives: dict[str, float]) -> list[Fact]:
             desc = f"{desc}: {problem.mechanism.size_description}"
         out.append(Fact(name, objective_shown(problem, name, value), desc))
     return out
-
-
-def contact_model_spread(problem: Any, design: dict[str, float]) -> str | None:
-    """The worst-case backlash of ``design`` under each pin contact model (eq. 11 of
-    [D17], the conforming pin in its bore, Palmgren's empirical approach), as one line;
-    None when the problem has no backlash objective or no sized pin. The models differ
-    most in what they leave out (the bulk compression, the conformity), so the spread is
-    what a designer should read beside the one model the file chose."""
-    import copy
-
-    from optdesign.mechanisms.joints import CONTACT_MODELS
-
-    if problem is None or not design or "backlash" not in problem.objectives:
-        return None
-    if "d" not in problem.by_name:
-        return None
-    x = np.array([design[v.name] for v in problem.free], dtype=float)
-    chosen = problem.spec.requirements.pin_contact
-    parts = []
-    for model in CONTACT_MODELS:
-        other = problem if model == chosen else copy.copy(problem)
-        try:
-            if other is not problem:
-                other.set_requirement("pin_contact", model)
-            with np.errstate(all="ignore"):
-                value = float(np.ravel(other.evaluate(x).objectives["backlash"])[0])
-        except OptDesignError as exc:
-            parts.append(f"{model} n/a ({exc})")
-            continue
-        mark = " (the file's)" if model == chosen else ""
-        parts.append(f"{model} {objective_shown(problem, 'backlash', value).text(6)}{mark}")
-    return "backlash by pin contact model: " + ", ".join(parts)

@@ -10,29 +10,30 @@ The sketch comes from the mechanism's public :meth:`~optdesign.mechanisms.Mechan
 sketch`: no mechanism is named here.
 
 Any text in the data may come from a user (a problem's name, a label, a constraint's
-name): :func:`to_json` embeds it so that no string can end or re-open the ``<script>``
+name): :func:`~optdesign.reports.html_page.to_json` embeds it so that no string can end or re-open the ``<script>``
 element that carries it, and the page inserts every string as text (see
 :mod:`optdesign.reports.html_page`).
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-from optdesign.reports.facts import design_facts, objective_facts
-from optdesign.reports.limits import binding_angles, bound_limits, limits_of, rows_at
-from optdesign.reports.units import (
+from optdesign.reports.display_units import (
     angle_unit,
     objective_shown,
     requirement_echo,
     variable_shown,
 )
-from optdesign.solvers.result import clean_json
+from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.html_page import render
+from optdesign.reports.limits import binding_angles, bound_limits, limits_of
+from optdesign.reports.solve_text import objective_value
+from optdesign.studies.verify import constraint_rows
 from optdesign.user_code import call_method
 
 
@@ -41,7 +42,7 @@ def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str,
     with np.errstate(all="ignore"):
         ev = problem.evaluate(np.array([design[v.name] for v in problem.free], dtype=float))
         facts = design_facts(problem, design)
-    active, violated = rows_at(problem, design, ev=ev)  # one evaluation for both
+    active, violated = constraint_rows(problem, design, ev=ev)  # one evaluation for both
     objectives = ev.objectives
     rows = []
     for var in problem.variables:
@@ -132,9 +133,6 @@ def _header(problem: Any) -> dict[str, Any]:
 
 def solve_report(result: Any) -> str:
     """The report of a solve: the optimum against the initial design."""
-    from optdesign.reports.html_page import render
-    from optdesign.reports.solve_text import objective_value
-
     problem = result.problem_object
     if problem is None or not result.design:
         raise ValueError("report: the result carries no problem or no design")
@@ -171,7 +169,6 @@ def _starts_text(ms: Any) -> str:
 def front_report(problem: Any, fronts: Sequence[Any]) -> str:
     """The report of fronts: the objective space; hover or click a point for its design."""
     from optdesign.plots.front import pick_points
-    from optdesign.reports.html_page import render
 
     main = fronts[0]
     objectives = list(main.objectives)
@@ -203,29 +200,3 @@ def front_report(problem: Any, fronts: Sequence[Any]) -> str:
         "front": {"axes": axes, "traces": traces},
     }
     return render(data, title=f"optdesign: {problem.name} front")
-
-
-#: Characters written as JSON escapes inside the page's ``<script>`` element: ``<`` and
-#: ``>`` (no ``</script>``, ``<!--`` or ``<script`` can appear, in any case), ``&`` (no
-#: character reference), U+2028 and U+2029 (line ends to older JavaScript parsers). In
-#: JSON they can only occur inside strings, where the escape means the same character.
-_IN_SCRIPT = str.maketrans(
-    {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
-)
-
-
-def to_json(data: Any) -> str:
-    """JSON for embedding in a ``<script type="application/json">`` element.
-
-    Non-finite numbers become ``null`` (``NaN`` is not JSON); ``<``, ``>``, ``&``,
-    U+2028 and U+2029 are written as ``\\uXXXX`` escapes, so no text in the data can
-    close the element or start a comment in it (a ``<!--`` followed by ``<script`` would
-    swallow the rest of the page), and ``JSON.parse`` reads back the same strings."""
-    text = json.dumps(clean_json(data), allow_nan=False, default=_default)
-    return text.translate(_IN_SCRIPT)
-
-
-def _default(obj: Any) -> Any:
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"not JSON: {type(obj).__name__}")

@@ -13,8 +13,12 @@ as the characters).
 from __future__ import annotations
 
 import html
+import json
 from typing import Any
 
+import numpy as np
+
+from optdesign.solvers.result import clean_json
 from optdesign.text import printable
 
 _CSS = """
@@ -162,8 +166,6 @@ def render(data: dict[str, Any], title: str) -> str:
     """The whole page for ``data`` (see :mod:`optdesign.reports.html`)."""
     from plotly.offline import get_plotlyjs
 
-    from optdesign.reports.html import to_json
-
     def e(text: object) -> str:  # one line of text, escaped for element content
         return html.escape(printable(text), quote=True)
 
@@ -193,3 +195,29 @@ moments in N*m, ripple in %.</p>
 <script>{_SCRIPT}</script>
 </body></html>
 """
+
+
+#: Characters written as JSON escapes inside the page's ``<script>`` element: ``<`` and
+#: ``>`` (no ``</script>``, ``<!--`` or ``<script`` can appear, in any case), ``&`` (no
+#: character reference), U+2028 and U+2029 (line ends to older JavaScript parsers). In
+#: JSON they can only occur inside strings, where the escape means the same character.
+_IN_SCRIPT = str.maketrans(
+    {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+)
+
+
+def to_json(data: Any) -> str:
+    """JSON for embedding in a ``<script type="application/json">`` element.
+
+    Non-finite numbers become ``null`` (``NaN`` is not JSON); ``<``, ``>``, ``&``,
+    U+2028 and U+2029 are written as ``\\uXXXX`` escapes, so no text in the data can
+    close the element or start a comment in it (a ``<!--`` followed by ``<script`` would
+    swallow the rest of the page), and ``JSON.parse`` reads back the same strings."""
+    text = json.dumps(clean_json(data), allow_nan=False, default=_default)
+    return text.translate(_IN_SCRIPT)
+
+
+def _default(obj: Any) -> Any:
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"not JSON: {type(obj).__name__}")

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.reports.units import Shown, angle_unit, shown
+from optdesign.reports.display_units import Shown, angle_unit, shown
 from optdesign.text import printable
 
 #: Row names never shown as limits: the objective's epigraph rows, and membership checks
@@ -185,7 +185,7 @@ def symmetric(f: Callable[[Any], Any], lower: float | None, upper: float | None)
 
 def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> list[Limit]:
     """Free variables of ``design`` at a bound (within ``rel`` of the bound range)."""
-    from optdesign.reports.units import variable_shown
+    from optdesign.reports.display_units import variable_shown
 
     out = []
     for var in problem.free:
@@ -206,18 +206,6 @@ def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> l
                         variable_shown(problem, var, bound),
                     )
                 )
-    return out
-
-
-def what_limits(result: Any) -> list[Limit]:
-    """Everything that limits the optimum of ``result``: active requirements, then the
-    variables at a bound."""
-    problem = result.problem_object
-    if problem is None:
-        return []
-    out = limits_of(problem, result.active)
-    if result.design:
-        out += bound_limits(problem, result.design)
     return out
 
 
@@ -276,14 +264,6 @@ def _what(lim: Limit) -> str:
 def _decreasing(f: Callable[[Any], Any], x: float) -> bool:
     step = 1e-7 * max(1.0, abs(x))
     return float(f(x + step)) < float(f(x))
-
-
-def rows_at(problem: Any, design: dict[str, float], rel: float = 1e-5, ev: Any = None):
-    """(active, violated) constraint reports of any design on the NumPy path (see
-    :func:`optdesign.studies.verify.constraint_rows`)."""
-    from optdesign.studies.verify import constraint_rows
-
-    return constraint_rows(problem, design, rel, ev)
 
 
 def binding_angles(rows: Iterable[Any]) -> dict[str, list[float]]:

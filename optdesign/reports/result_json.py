@@ -13,6 +13,13 @@ import json
 from dataclasses import asdict
 from typing import Any
 
+from optdesign.reports.display_units import (
+    Shown,
+    json_value,
+    objective_shown,
+    requirement_values,
+    variable_shown,
+)
 from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.limits import (
     bound_limits,
@@ -21,13 +28,6 @@ from optdesign.reports.limits import (
     relaxation_limits,
 )
 from optdesign.reports.solve_text import objective_value
-from optdesign.reports.units import (
-    Shown,
-    json_value,
-    objective_shown,
-    requirement_values,
-    variable_shown,
-)
 from optdesign.solvers.result import Result, clean_json
 
 #: Name and version of the document's layout; bumped when a key changes meaning.

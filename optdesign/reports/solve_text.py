@@ -3,7 +3,7 @@ design table, what the design achieves, what limits the optimum, and for an infe
 problem the smallest change of each conflicting requirement that makes it feasible.
 
 Every number carries its unit, in the units the problem file wrote where that is
-unambiguous (:mod:`optdesign.reports.units`); the formulation's internal rows are never
+unambiguous (:mod:`optdesign.reports.display_units`); the formulation's internal rows are never
 shown (:mod:`optdesign.reports.limits`). Names from the user are shown one line each and
 the whole text is :func:`~optdesign.text.printable`: no control character of a problem
 file reaches the terminal.
@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+from optdesign.reports.display_units import objective_shown, requirement_echo, variable_shown
 from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.limits import (
     bound_limits,
@@ -22,7 +23,6 @@ from optdesign.reports.limits import (
     relaxation_text,
 )
 from optdesign.reports.tables import format_table
-from optdesign.reports.units import objective_shown, requirement_echo, variable_shown
 from optdesign.solvers.result import Result
 from optdesign.text import printable
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.mechanisms import CrankSlider, PinJoint, ShiftingFork
-from optdesign.models.fits import fit_clearance
+from optdesign.models.fit_formulas import fit_clearance
 from optdesign.models.hertz_line import contact_half_width, pin_flattening
 from optdesign.plots.curves import plot_curves
 from optdesign.reports.tables import Comparison, comparison_table

@@ -17,14 +17,13 @@ import numpy as np
 
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.result import (
+    SOLVED_STATUSES,
     ConstraintReport,
     Result,
     SolutionStatus,
     TerminationCondition,
 )
-
-#: Feasibility tolerance (scaled rows) for reports.
-FEAS_TOL = 1e-6
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 @runtime_checkable
@@ -49,13 +48,15 @@ def constraint_reports(
     g = np.asarray(g, dtype=float).ravel()
     lo_all = np.asarray(bounds.lbg, dtype=float)
     hi_all = np.asarray(bounds.ubg, dtype=float)
-    # Vectorised screening (a Python loop over the ~550 rows cost ~5 ms a solve); reports
-    # are built only for the violated and active rows, in row order.
+    # Vectorised screening (a Python loop over every row was a visible part of a solve);
+    # reports are built only for the violated and active rows, in row order.
     flo, fhi, fg = np.isfinite(lo_all), np.isfinite(hi_all), np.isfinite(g)
     with np.errstate(invalid="ignore"):
         amounts = np.maximum(np.where(flo, lo_all - g, 0.0), np.where(fhi, g - hi_all, 0.0))
-        is_viol = ~fg | (amounts > FEAS_TOL)
-        is_act = ~is_viol & ((flo & (g - lo_all < FEAS_TOL)) | (fhi & (hi_all - g < FEAS_TOL)))
+        is_viol = ~fg | (amounts > FEASIBILITY_TOL)
+        is_act = ~is_viol & (
+            (flo & (g - lo_all < FEASIBILITY_TOL)) | (fhi & (hi_all - g < FEASIBILITY_TOL))
+        )
     violated, active = [], []
     for k in np.flatnonzero(is_viol | is_act):
         s = nlp.g_scale[k]
@@ -66,7 +67,7 @@ def constraint_reports(
             float(g[k] * s),
             None if not np.isfinite(lo) else float(lo * s),
             None if not np.isfinite(hi) else float(hi * s),
-            float(max(amount, 0.0) * s) if amount > FEAS_TOL else 0.0,
+            float(max(amount, 0.0) * s) if amount > FEASIBILITY_TOL else 0.0,
             nlp.g_units[k],
         )
         if is_viol[k]:
@@ -110,7 +111,7 @@ def make_result(
     g = np.asarray(nlp.g_fun(z, theta), dtype=float).ravel()
     violated, active = constraint_reports(nlp, g, bounds)
     max_viol = max((r.amount / _bound_scale(r) for r in violated), default=0.0)
-    if status in ("optimal", "feasible") and violated:
+    if status in SOLVED_STATUSES and violated:
         status, termination = "infeasible", TerminationCondition.INFEASIBLE
     if status in ("max_iterations", "time_limit", "failed") and not violated:
         sol_status = SolutionStatus.FEASIBLE

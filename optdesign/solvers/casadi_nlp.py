@@ -33,6 +33,7 @@ from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.deadline import passed as deadline_passed
+from optdesign.solvers.ipopt_options import IPOPT_WARM  # noqa: F401 (its users import it here)
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults: quiet, tight tolerances (the tests compare optima to 1e-4 relative and
@@ -57,20 +58,6 @@ IPOPT_DEFAULTS: dict[str, Any] = {
     "mu_strategy": "adaptive",
     "mumps_pivot_order": 0,
     "bound_mult_init_method": "mu-based",
-}
-
-#: Ipopt options of a warm start from a nearby solution (primal and dual): take its
-#: multipliers and start close to the central path instead of pushing the point back
-#: into the interior. The ranges of the optimal set from the optimum: 179 iterations
-#: instead of 244 (cs_min_backlash), 135 instead of 257 (cs_min_ripple), same ranges.
-IPOPT_WARM: dict[str, Any] = {
-    "warm_start_init_point": "yes",
-    "warm_start_bound_push": 1e-9,
-    "warm_start_bound_frac": 1e-9,
-    "warm_start_slack_bound_push": 1e-9,
-    "warm_start_slack_bound_frac": 1e-9,
-    "warm_start_mult_bound_push": 1e-9,
-    "mu_init": 1e-6,
 }
 
 _IPOPT_STATUS = {

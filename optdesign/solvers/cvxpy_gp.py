@@ -94,7 +94,7 @@ def dual_bound(
     lo, hi = np.log(gp.lower), np.log(gp.upper)
     y0 = 0.5 * (lo + hi)
     # L is convex: one local minimisation from the box centre is the minimum. SLSQP
-    # (bounds) is used because L-BFGS-B was 10x slower per call here.
+    # (bounds) is used because L-BFGS-B was much slower per call here.
     with solver_call():
         best = minimize(
             L,

@@ -1,8 +1,9 @@
 """Multistart: seeded Sobol starts inside the bounds, solved locally, best kept.
 
 Reports how many starts reached the best objective (evidence of a global optimum). Starts
-run in-process, or on local worker processes that inherit the solver built once in this
-process (:mod:`optdesign.studies.runner`'s process engine).
+run in-process, or through the ``parallel_map`` a study passes (the studies' process
+engine, :func:`optdesign.studies.runner.map_inherited`: local worker processes that
+inherit the solver built once in this process). The solver layer knows no process pool.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.deadline import deadline, passed
 from optdesign.solvers.result import MultistartInfo, Result, TerminationCondition
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 
 def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.ndarray:
@@ -27,7 +29,7 @@ def sobol_starts(lower: np.ndarray, upper: np.ndarray, n: int, seed: int) -> np.
     return lower + pts * (upper - lower)
 
 
-def best_of(results: Sequence[Result], rel_tol: float = 1e-6) -> tuple[Result, int]:
+def best_of(results: Sequence[Result], rel_tol: float = OBJECTIVE_TIE_TOL) -> tuple[Result, int]:
     """The best successful result and how many reached it within ``rel_tol``.
 
     Ties are decided by value, then by index, never by rounding: every successful result
@@ -98,7 +100,7 @@ def outcome_counts(outcomes: Sequence[str]) -> dict[str, int]:
     return dict(sorted(counts.items(), key=lambda kv: (-kv[1], order[kv[0]])))
 
 
-def improves(value: float, best: float, rel_tol: float = 1e-6) -> bool:
+def improves(value: float, best: float, rel_tol: float = OBJECTIVE_TIE_TOL) -> bool:
     """Whether ``value`` is better than ``best`` by more than a tie (``rel_tol``
     relative): a search keeps its earlier incumbent on a tie, as :func:`best_of` does."""
     return value < best - _tolerance(best, rel_tol)
@@ -108,10 +110,11 @@ def multistart(
     solve: Callable[[np.ndarray], Result],
     starts: np.ndarray,
     workers: int = 1,
-    rel_tol: float = 1e-6,
+    rel_tol: float = OBJECTIVE_TIE_TOL,
     seed: int = 0,
     agree: int | None = None,
     time_limit: float | None = None,
+    parallel_map: Callable[..., list[Result]] | None = None,
 ) -> Result:
     """Solve from every start and return the best result with its multistart record.
 
@@ -134,7 +137,13 @@ def multistart(
         no start begins after it (the first start always runs), a solve built with
         :data:`~optdesign.solvers.deadline.DEADLINE_OPTION` stops at it; the starts not
         begun count as failed, "not started (time limit)", and a note says so.
+    parallel_map
+        ``parallel_map(solve, starts, workers, stop=...)`` -> the results of the shortest
+        prefix of ``starts`` for which ``stop`` holds, in their order; needed when
+        ``workers > 1``.
     """
+    if workers > 1 and parallel_map is None:
+        raise ValueError("multistart: workers > 1 needs a parallel_map")
     t0 = time.perf_counter()
     starts = list(np.atleast_2d(starts))
     results: list[Result] = []
@@ -143,9 +152,7 @@ def multistart(
     with one_blas_thread(), deadline(time_limit):
         stop = _stop_rule(rel_tol, agree)
         if workers > 1 and len(starts) > 1:
-            from optdesign.studies.runner import map_inherited
-
-            results = map_inherited(solve, starts, workers, stop=stop)
+            results = parallel_map(solve, starts, workers, stop=stop)
         else:
             for x0 in starts:
                 results.append(solve(x0))

@@ -15,16 +15,22 @@ from dataclasses import dataclass
 from typing import Any
 
 from optdesign.errors import InputError
+from optdesign.solvers.ipopt_options import IPOPT_WARM
 
 
 @dataclass(frozen=True)
 class SolverEntry:
-    """A registered back-end: ``factory(formulation, options) -> solver``."""
+    """A registered back-end: ``factory(formulation, options) -> solver``, and what a
+    study may ask of it without naming it."""
 
     name: str
     kind: str  # "nlp" or "gp": which formulation it solves
     factory: Callable[[Any, dict[str, Any]], Any]
     description: str = ""
+    #: options of a warm start from a nearby primal-dual solution (None: none)
+    warm_options: Mapping[str, Any] | None = None
+    #: the option that caps the iterations (None: none a study may set)
+    iteration_option: str | None = None
 
 
 _SOLVERS: dict[str, SolverEntry] = {}
@@ -36,8 +42,11 @@ def register_solver(
     kind: str = "nlp",
     description: str = "",
     replace: bool = False,
+    warm_options: Mapping[str, Any] | None = None,
+    iteration_option: str | None = None,
 ) -> SolverEntry:
-    """Register ``factory(formulation, options) -> solver`` as back-end ``name``."""
+    """Register ``factory(formulation, options) -> solver`` as back-end ``name``, with
+    its warm-start options and its iteration cap's option when it has them."""
     if not isinstance(name, str) or not name.strip() or not name.isprintable():
         raise InputError("register_solver.name", f"expected a name (a string), got {name!r}")
     if not callable(factory):
@@ -46,9 +55,13 @@ def register_solver(
         raise InputError("register_solver.kind", f"{kind!r}: use 'nlp' or 'gp'")
     if name in _SOLVERS and not replace:
         raise InputError("register_solver", f"a solver {name!r} is registered already")
-    entry = SolverEntry(name, kind, factory, description)
+    entry = SolverEntry(name, kind, factory, description, warm_options, iteration_option)
     _SOLVERS[name] = entry
     return entry
+
+
+#: The back-end of each formulation kind when the caller names none.
+DEFAULT_SOLVERS = {"nlp": "ipopt", "gp": "clarabel"}
 
 
 def solver_names(kind: str | None = None) -> list[str]:
@@ -78,7 +91,7 @@ def make_solver(
     from optdesign.safe_io import refuse_file_options
 
     kind = "nlp" if isinstance(formulation, NLP) else "gp"
-    name = name or ("ipopt" if kind == "nlp" else "clarabel")
+    name = name or DEFAULT_SOLVERS[kind]
     entry = solver_entry(name, kind)
     # No back-end option may read or write a file or load code (Ipopt's output_file,
     # CasADi's dump/jit, SCS's write_data_filename...), wherever it comes from.
@@ -145,8 +158,16 @@ def _builtins() -> None:
     if _BUILTINS_DONE:
         return
     _BUILTINS_DONE = True
+    if "ipopt" not in _SOLVERS:
+        register_solver(
+            "ipopt",
+            _ipopt,
+            "nlp",
+            "Ipopt interior point (CasADi), exact Hessian by default",
+            warm_options=IPOPT_WARM,
+            iteration_option="max_iter",
+        )
     for name, factory, kind, desc in (
-        ("ipopt", _ipopt, "nlp", "Ipopt interior point (CasADi), exact Hessian by default"),
         ("sqpmethod", _sqpmethod, "nlp", "CasADi SQP (sqpmethod) with a QP solver"),
         ("slsqp", _scipy("SLSQP"), "nlp", "SciPy SLSQP with CasADi exact derivatives"),
         ("trust-constr", _scipy("trust-constr"), "nlp", "SciPy trust-constr"),

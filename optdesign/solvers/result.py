@@ -162,6 +162,12 @@ class Diagnosis:
     note: str = ""
 
 
+#: The statuses of a solve that found a design meeting the requirements: the one success
+#: rule of a result, a front's record and a front's point (those two also drop a point
+#: the independent check refused, ``verified is False``).
+SOLVED_STATUSES = ("optimal", "feasible")
+
+
 @dataclass
 class Result:
     """Outcome of one optimisation, whatever the solver.
@@ -229,8 +235,8 @@ class Result:
 
     @property
     def success(self) -> bool:
-        """A feasible design was found (optimal or feasible)."""
-        return self.status in ("optimal", "feasible")
+        """A feasible design was found (a status of :data:`SOLVED_STATUSES`)."""
+        return self.status in SOLVED_STATUSES
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (enums as strings, NaN as None, no solver internals)."""

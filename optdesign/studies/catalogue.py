@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.errors import ProblemError
 from optdesign.formulations.discrete import (
     ON_ITEM_TOL,
     branch,
@@ -43,12 +44,14 @@ from optdesign.solvers.multistart import (
     start_outcome,
 )
 from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.studies.solve import _objective_set, finish, solver_for, solver_options
+from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
+from optdesign.studies.reference import attach_reference, reference_design
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
 #: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
-PRUNE_TOL = 1e-6
+PRUNE_TOL = OBJECTIVE_TIE_TOL
 
 
 def cannot_improve(bound: float, incumbent: float) -> bool:
@@ -63,17 +66,17 @@ RETRY_STARTS = 4
 
 #: Ipopt options of the node NLPs. Many nodes of a catalogue search are infeasible boxes,
 #: and Ipopt's default filter spends ~120 iterations before its restoration phase proves
-#: it; ``expect_infeasible_problem`` enters restoration sooner: fin_actuator 5.5 -> 2.1 s,
-#: cs_min_backlash_catalogue 1.9 -> 1.4 s, the same nodes infeasible and the same optima
-#: (benchmarks/README.md, "Overhead"). A node still counts as infeasible only once all
-#: its starts and :data:`RETRY_STARTS` more say so.
+#: it; ``expect_infeasible_problem`` enters restoration sooner, with the same nodes
+#: infeasible and the same optima (figures: benchmarks/README.md, "Catalogue searches:
+#: infeasible nodes"). A node still counts as infeasible only once all its starts and
+#: :data:`RETRY_STARTS` more say so.
 NODE_IPOPT_OPTIONS: dict[str, Any] = {"expect_infeasible_problem": "yes"}
 
 
 class NodeSolver:
     """Solve the problem's NLP on a sub-box of the catalogue variables.
 
-    One solver (:func:`optdesign.studies.solve.solver_for`) serves every node: a node
+    One solver (:func:`optdesign.studies.nlp_solve.solver_for`) serves every node: a node
     only passes its own variable bounds. A node whose starts all fail is tried again from
     :data:`RETRY_STARTS` more Sobol starts before it counts as infeasible, so a poor
     first start (e.g. a declared one) never makes a feasible problem look infeasible.
@@ -154,7 +157,7 @@ class NodeSolver:
             len(results),
             sum(r.success for r in results),
             n_at_best,
-            1e-6,
+            OBJECTIVE_TIE_TOL,
             [r.objective for r in results],
             self.seed,
             outcomes=outcomes,
@@ -278,15 +281,11 @@ def solve_catalogue(
     t0 = time.perf_counter()
     dvars = discrete_variables(problem)
     if not dvars:
-        from optdesign.errors import ProblemError
-
         raise ProblemError("--formulation catalogue: no variable takes catalogue values")
     n_comb = n_combinations(problem)
     if method == "auto":
         method = "enumerate" if n_comb <= ENUMERATE_MAX else "bnb"
     if method not in ("enumerate", "bnb"):
-        from optdesign.errors import ProblemError
-
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate or bnb")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
@@ -401,8 +400,6 @@ def relaxation_bound(result: Result) -> float:
 
 def solve_catalogue_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="catalogue"``: the exact catalogue optimum and its relaxation bound."""
-    from optdesign.studies.reference import attach_reference, reference_design
-
     reference_design(problem)
     result = solve_catalogue(
         problem,

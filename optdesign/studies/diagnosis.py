@@ -34,8 +34,14 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.formulations.discrete import discrete_variables, nearest_item
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.reports.limits import limits_of
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Result
+from optdesign.studies.catalogue import NodeSolver, first_feasible
+from optdesign.studies.nlp_solve import solve_nlp
+from optdesign.studies.relaxation import Site, relaxations
+from optdesign.studies.verify import constraint_rows
 
 #: Items of each catalogue variable tried around the continuous best point, and the most
 #: combinations of them solved (nearest first).
@@ -110,8 +116,6 @@ def _nothing_violated(result: Result) -> str:
 
 
 def _nlp(problem: DesignProblem, result: Result, solver: str, relax: bool) -> Diagnosis:
-    from optdesign.studies.relaxation import relaxations
-
     if not result.design:
         return Diagnosis(note="the solver returned no point to diagnose from")
     if not result.violated:
@@ -122,9 +126,6 @@ def _nlp(problem: DesignProblem, result: Result, solver: str, relax: bool) -> Di
 
 
 def _robust(problem: DesignProblem, result: Result, solver: str, relax: bool) -> Diagnosis:
-    from optdesign.studies.relaxation import relaxations
-    from optdesign.studies.verify import constraint_rows
-
     basis = "the nominal NLP"
     why = "the robust formulation imposes the nominal requirements (its statistic is the objective)"
     if not result.design:
@@ -140,9 +141,6 @@ def _robust(problem: DesignProblem, result: Result, solver: str, relax: bool) ->
 
 
 def _gp(problem: DesignProblem, result: Result, relax: bool) -> Diagnosis:
-    from optdesign.studies.relaxation import relaxations
-    from optdesign.studies.solve import solve_nlp
-
     objective = result.objective_name or problem.objective_names[0]
     nlp = solve_nlp(problem, objective=objective)
     basis = "the exact NLP"
@@ -175,11 +173,6 @@ def _catalogue(
     options: Mapping[str, Any] | None,
     relax: bool,
 ) -> Diagnosis:
-    from optdesign.formulations.discrete import discrete_variables, nearest_item
-    from optdesign.studies.catalogue import NodeSolver, first_feasible
-    from optdesign.studies.relaxation import Site, relaxations
-    from optdesign.studies.verify import constraint_rows
-
     dvars = discrete_variables(problem)
     objective = result.objective_name or problem.objective_names[0]
     info = result.extra.get("catalogue", {})
@@ -359,10 +352,5 @@ def _fixed(problem: DesignProblem, result: Result) -> Diagnosis:
 def violated_text(problem: DesignProblem, x: np.ndarray, limit: int = 8) -> str:
     """The requirements design ``x`` (free-variable vector) violates, by name and amount
     in the problem file's units, in one line ("" when it meets them all)."""
-    # The user's quantities and units are the reports' rendering of the rows (imported
-    # here only, as Result.summary does).
-    from optdesign.reports.limits import limits_of
-    from optdesign.studies.verify import constraint_rows
-
     _, violated = constraint_rows(problem, np.asarray(x, dtype=float))
     return "; ".join(lim.text() for lim in limits_of(problem, violated)[:limit])

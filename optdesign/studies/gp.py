@@ -15,9 +15,10 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.registry import make_solver
+from optdesign.solvers.registry import DEFAULT_SOLVERS, make_solver, solver_names
 from optdesign.solvers.result import Result
-from optdesign.studies.solve import finish, solve_nlp
+from optdesign.studies.nlp_solve import finish, solve_nlp
+from optdesign.studies.reference import attach_reference, reference_design
 
 
 def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
@@ -111,8 +112,6 @@ def solve_gp_problem(
 
 def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
-    from optdesign.studies.reference import attach_reference, reference_design
-
     reference_design(problem)  # validate [reference] before solving
     gp_solver = options.get("solver")
     result = solve_gp_problem(
@@ -120,6 +119,6 @@ def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
         objective=options.get("objective"),
         nlp_starts=options.get("starts"),
         seed=options.get("seed"),
-        solver=gp_solver if gp_solver in ("clarabel", "scs") else "clarabel",
+        solver=gp_solver if gp_solver in solver_names("gp") else DEFAULT_SOLVERS["gp"],
     )
     return attach_reference(problem, result)

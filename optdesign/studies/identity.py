@@ -21,6 +21,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from optdesign.store_identity import digest
+from optdesign.studies.nlp_solve import formulation_for
 
 #: Parts of a problem file that do not change what is computed (or that the ``solver``
 #: component holds).
@@ -64,8 +65,6 @@ def run_identity(
     options: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The identity components of a run of ``problem`` (see the module docstring)."""
-    from optdesign.studies.solve import formulation_for
-
     nlp = formulation_for(problem, tuple(sorted(objectives)))
     return {
         "problem": problem_digest(problem),

@@ -337,7 +337,7 @@ def _init_process() -> None:
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     # The environment variable is read when a BLAS library loads; forked workers inherit
     # NumPy's and SciPy's OpenBLAS already loaded with one thread per core. Two workers
-    # each running two BLAS threads (SLSQP's QP) on 2 cores ran ~3x slower per point.
+    # each running two BLAS threads (SLSQP's QP) on 2 cores oversubscribe the cores.
     # A library loaded later (CasADi's, with the first Ipopt solver) is set to one thread
     # by the solve itself (optdesign.solvers.blas.one_blas_thread), as in the main process.
     limit_blas_threads(1)

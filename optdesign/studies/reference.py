@@ -18,6 +18,7 @@ from optdesign.reports.tables import format_table
 from optdesign.solvers.result import Result
 from optdesign.studies.verify import verify_design
 from optdesign.text import printable
+from optdesign.tolerances import FEASIBILITY_TOL
 
 #: Quantities of the side-by-side table: (objective name, label, unit, scale).
 QUANTITIES = (
@@ -117,7 +118,7 @@ def comparison_text(problem: DesignProblem, comparison: dict[str, Any]) -> str:
         text, unit = texts[name]
         change = f"{100 * (b - a) / abs(a):+.1f} %" if a else "-"
         table.append([text, unit, a, b, change])
-    ok = comparison["reference_violation"] <= 1e-6
+    ok = comparison["reference_violation"] <= FEASIBILITY_TOL
     state = (
         "meets the requirements"
         if ok

@@ -18,7 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.solvers.registry import solver_entry
 from optdesign.solvers.result import Relaxation
+from optdesign.studies.nlp_solve import _objective_set, solver_for
 
 __all__ = ["Relaxation", "Site", "relaxations"]
 
@@ -70,8 +72,6 @@ def relaxations(
         e.g. the catalogue items nearest the design of the continuous relaxation's
         smallest one. A relaxation found at a site says where (:attr:`Relaxation.at`).
     """
-    from optdesign.studies.solve import _objective_set, solver_for
-
     # The conflict is between the violated requirements and the ones binding at the best
     # infeasible point: each is a candidate.
     names: dict[str, Any] = {}
@@ -86,7 +86,8 @@ def relaxations(
     # capped iteration count keeps the diagnosis cheap; a capped solve counts as
     # infeasible, so the reported relaxation stays a feasible one (at worst a little
     # larger than the smallest).
-    options = {"max_iter": max_iter} if solver == "ipopt" else None
+    cap = solver_entry(solver).iteration_option
+    options = {cap: max_iter} if cap is not None else None
     backend = solver_for(problem, solver, options, _objective_set(problem, objective))
     nlp = backend.nlp
     z_best = result.raw.get("z")

@@ -3,7 +3,7 @@ Monte Carlo.
 
 - :func:`solve_robust`: the robust NLP of :mod:`optdesign.formulations.robust` solved by
   Ipopt from the nominal optimum and scrambled-Sobol starts; the best point is checked on
-  the NumPy path (nominal requirements, :func:`optdesign.studies.solve.finish`) and its
+  the NumPy path (nominal requirements, :func:`optdesign.studies.nlp_solve.finish`) and its
   sample-average statistic recomputed there on the same fixed samples.
 - :func:`monte_carlo`: the objective of a design under freshly drawn scatter (its own seed,
   many samples), vectorised over the population of perturbed designs on the NumPy path of
@@ -38,7 +38,9 @@ from optdesign.reports.tables import format_table
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
-from optdesign.studies.solve import finish, solve_nlp, solver_options, start_points
+from optdesign.studies.nlp_solve import finish, solve_nlp, solver_options, start_points
+from optdesign.studies.runner import map_inherited
+from optdesign.tolerances import FEASIBILITY_TOL
 
 #: Default independent Monte Carlo: sample count and seed (different from the SAA seed).
 MC_SAMPLES = 20_000
@@ -161,7 +163,7 @@ def monte_carlo(
         cvar=empirical_cvar(values, alpha),
         alpha=alpha,
         risk=risk_value(values, risk, alpha, k),
-        p_violation=float(np.mean(viol > 1e-6)),
+        p_violation=float(np.mean(viol > FEASIBILITY_TOL)),
         values=values,
     )
 
@@ -228,7 +230,7 @@ def solve_robust(
         problem, objective, samples, plugin, options, risk, alpha, k, constrain_samples
     )
     build_s = time.perf_counter() - t0
-    result = multistart(solve, pts, workers=workers, seed=seed)
+    result = multistart(solve, pts, workers=workers, seed=seed, parallel_map=map_inherited)
     label = risk_label(risk, alpha, k, objective)
     result.formulation = "robust-saa"
     # Per-sample rows are the formulation's own; report the nominal requirements only.

@@ -329,7 +329,7 @@ def _run(
                         add(expand(t, record, done))
                         expand_replayed()
                 # The next tasks of the chains go out before the store writes (an fsync
-                # each, ~1 ms, was serial latency on every step of every chain); a run
+                # each was serial latency on every step of every chain); a run
                 # killed in between just recomputes the unstored records on resume.
                 submit_ready()
                 while pending:

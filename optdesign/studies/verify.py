@@ -6,13 +6,10 @@ import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
 from optdesign.solvers.result import ConstraintReport
-
-#: A design counts as feasible when no constraint is violated by more than this,
-#: relative to max(1, |bound|).
-VERIFY_TOL = 1e-6
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
-def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = VERIFY_TOL):
+def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = FEASIBILITY_TOL):
     """Re-evaluate every constraint of ``problem`` at free-variable vector ``x``.
 
     Returns

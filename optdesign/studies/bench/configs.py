@@ -127,7 +127,7 @@ def nlp_config(
 
     def run(problem: DesignProblem, objective: str, time_limit: float) -> Result:
         from optdesign.solvers.registry import make_solver
-        from optdesign.studies.solve import formulation_for
+        from optdesign.studies.nlp_solve import formulation_for
 
         nlp = formulation_for(problem, (objective,), form)
         opts = {**copy.deepcopy(options), **time_limit_options(solver, time_limit)}

@@ -26,7 +26,7 @@ import numpy as np
 
 from optdesign.problem import DesignProblem, problem_from_dict
 
-#: Fits drawn for the pin joints (all supported by :class:`optdesign.models.fits.Fit`).
+#: Fits drawn for the pin joints (all supported by :class:`optdesign.models.fit_formulas.Fit`).
 FITS = ("H7/g6", "H7/f7", "H8/f7", "H7/h6")
 
 #: Catalogue windows of the ISO 3408 leads (mm): three values each, so that enumerating

@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.solvers.result import SOLVED_STATUSES
+
 #: A run solved an instance when it succeeded and its gap is at most this (relative).
 SOLVED_GAP = 1e-4
 
@@ -130,7 +132,7 @@ def config_stats(
         for r in rs:
             if not r.get("success"):
                 st = str(r.get("status"))
-                if st in ("optimal", "feasible"):
+                if st in SOLVED_STATUSES:
                     st = "check failed"  # the solver claimed success, the NumPy check did not
                 reasons[st] = reasons.get(st, 0) + 1
         stats[c] = {

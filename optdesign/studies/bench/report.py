@@ -30,8 +30,8 @@ from optdesign.studies.bench.metrics import (
     paired_time_ratio,
     performance_profile,
 )
-from optdesign.studies.verify import VERIFY_TOL
 from optdesign.text import csv_cell, printable
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 def md_cell(text: object) -> str:
@@ -157,7 +157,7 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
         "Time = wall time of one run from the problem to the answer (formulation, solver "
         "set-up and solve; catalogue combinations summed), median over successful runs. "
         "Success = the solver reports success and the independent NumPy check passes "
-        f"(violation <= {VERIFY_TOL:g}); solved = success with gap <= {SOLVED_GAP:g} to the "
+        f"(violation <= {FEASIBILITY_TOL:g}); solved = success with gap <= {SOLVED_GAP:g} to the "
         "best value any configuration found. Best configuration (bold) = among those run "
         "on every instance of the table, the highest solved rate, then the lowest median "
         "time; 'time / best' = median over the instances both solved of the per-instance "

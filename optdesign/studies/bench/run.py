@@ -214,7 +214,7 @@ def bench_identity(
         "optdesign": version(),
     }
     if problems is not None:
-        from optdesign.studies.solve import formulation_for
+        from optdesign.studies.nlp_solve import formulation_for
 
         identity["problems"] = [
             {

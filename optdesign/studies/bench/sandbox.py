@@ -20,10 +20,11 @@ import numpy as np
 
 from optdesign.problem import DesignProblem, problem_from_dict
 from optdesign.solvers.blas import one_blas_thread
-from optdesign.solvers.result import Result
+from optdesign.solvers.result import SOLVED_STATUSES, Result
 from optdesign.studies.bench.configs import Config, NotApplicable, get_config
 from optdesign.studies.bench.instances import Instance, make_instance
-from optdesign.studies.verify import VERIFY_TOL, verify_design
+from optdesign.studies.verify import verify_design
+from optdesign.tolerances import FEASIBILITY_TOL
 
 #: After this many hard timeouts of one configuration on one mechanism in one worker
 #: process, its further runs on that mechanism are recorded as failures without running
@@ -144,7 +145,7 @@ def _solve_front(config: Config, inst: Instance, time_limit: float) -> dict[str,
         ev = problem.evaluate(x)
         worst = max(worst, float(ev.violation))
         F.append([float(ev.objectives[k]) for k in inst.objectives])
-    ok = len(F) >= 2 and worst <= VERIFY_TOL
+    ok = len(F) >= 2 and worst <= FEASIBILITY_TOL
     return {
         "time_s": elapsed,
         "status": "optimal" if ok else "failed",
@@ -178,8 +179,8 @@ def _execute(task: Mapping[str, Any]) -> dict[str, Any]:
         row["objective"] = float(objs[objective])
         row["violation"] = float(ev.violation)
         row["verified"] = bool(ok)
-        row["success"] = bool(row["status"] in ("optimal", "feasible") and ok)
-        if row["status"] in ("optimal", "feasible") and not ok:
+        row["success"] = bool(row["status"] in SOLVED_STATUSES and ok)
+        if row["status"] in SOLVED_STATUSES and not ok:
             row["reason"] = f"independent check failed: {violated[0].describe()}"
     else:
         row.update(objective=None, violation=None, verified=False, success=False)
@@ -275,7 +276,7 @@ def _fix(inst: Instance, problem: DesignProblem, combo: Mapping[str, float]) -> 
         return problem_from_dict(data, source=inst.id)
     data = problem.spec.model_dump(mode="python")
     data["variables"] = {**data["variables"], **{k: float(v) for k, v in combo.items()}}
-    from optdesign.problem.load import validate_spec
+    from optdesign.problem.spec_validation import validate_spec
     from optdesign.problem.variables import parse_variable, variable_table
 
     spec = validate_spec(data, problem.mechanism, inst.id, internal=True)
@@ -332,7 +333,7 @@ def row_problem(
         return "has an objective that is not a number"
     if not row["success"]:
         return None
-    if row["status"] not in ("optimal", "feasible"):
+    if row["status"] not in SOLVED_STATUSES:
         return f"counts as a success with status {row['status']!r}"
     if get_config(task["config"]).kind == "front":
         return _front_row_problem(row)
@@ -376,6 +377,6 @@ def _front_row_problem(row: Mapping[str, Any]) -> str | None:
     ):
         return "counts as a success without at least two finite front points"
     v = row.get("violation")
-    if not (_num(v) and 0 <= v <= VERIFY_TOL):
+    if not (_num(v) and 0 <= v <= FEASIBILITY_TOL):
         return f"counts as a success with violation {v!r}"
     return None

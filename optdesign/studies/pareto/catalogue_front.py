@@ -17,17 +17,18 @@ from typing import Any
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.catalogue import solve_catalogue
+from optdesign.studies.diagnosis import diagnose
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord, record_from_result
+from optdesign.studies.pareto.run_setup import check_objectives, record_check, run_key, store_path
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 from optdesign.studies.runner import run_tasks
 
 
 def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
     """One catalogue solve: ``min target s.t. eps`` (an anchor, its tie-break, a point)."""
-    from optdesign.studies.catalogue import solve_catalogue
-
     problem: DesignProblem = task["problem"]
     t0 = time.perf_counter()
     eps = dict(task.get("eps") or {})
@@ -56,8 +57,6 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
         # An anchor with no catalogue design: its best point, for the error to name the
         # requirements it violates (no relaxations: the front stops here).
-        from optdesign.studies.diagnosis import diagnose
-
         diagnose(problem, result, relax=False)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
     rec.n_solves = int(result.extra.get("catalogue", {}).get("nlp_solves", 0))
@@ -84,13 +83,6 @@ class CatalogueEpsilon:
     name: str = "epsilon-catalogue"
 
     def run(self, problem: DesignProblem, objectives: Sequence[str], run) -> Front:
-        from optdesign.studies.pareto.methods import (
-            _store,
-            check_objectives,
-            record_check,
-            run_key,
-        )
-
         objectives = check_objectives(problem, objectives)
         if len(objectives) != 2:
             raise InputError("objectives", "a catalogue front takes two objectives")
@@ -140,7 +132,7 @@ class CatalogueEpsilon:
             starts=starts,
             seed=seed,
         )
-        store = _store(run.out, self.name)
+        store = store_path(run.out, self.name)
         done = run_tasks(
             tasks + points,
             catalogue_task,

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import InfeasibleRequirementsError
+from optdesign.studies.diagnosis import violated_text
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 
@@ -70,8 +71,6 @@ def anchor_message(objective: str, rec: PointRecord, problem: Any = None) -> str
     free = [v.name for v in problem.free] if problem is not None else []
     if problem is None or not rec.design or any(k not in rec.design for k in free):
         return f"{head}; violated: {', '.join(rec.violated) or 'none reported'}"
-    from optdesign.studies.diagnosis import violated_text
-
     shown = violated_text(problem, np.array([rec.design[k] for k in free]))
     if not shown:
         return (

@@ -1,7 +1,7 @@
 """The epsilon-constraint solver of a front: ``min target s.t. others <= eps``.
 
 Every solve of a front - the anchors' multistarts, the tie-breaks, the sweep points, a
-weighted sum - is one formulation (:func:`optdesign.studies.solve.formulation_for` of the
+weighted sum - is one formulation (:func:`optdesign.studies.nlp_solve.formulation_for` of the
 front's objectives) with the target and the epsilon limits passed per solve, so each
 back-end is built once per process and any point's solution and multipliers can start
 any other solve.
@@ -25,8 +25,8 @@ from optdesign.formulations.nlp import NLP, Start
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.casadi_nlp import IPOPT_WARM
 from optdesign.solvers.result import Result
+from optdesign.studies.nlp_solve import formulation_for, solver_for
 from optdesign.studies.pareto.records import PointRecord
-from optdesign.studies.solve import formulation_for, solver_for
 
 #: Ipopt options of warm-started sweep points: take the neighbour's multipliers and start
 #: close to the central path instead of pushing the point back into the interior.

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.solvers.result import clean_json
+from optdesign.solvers.result import SOLVED_STATUSES, clean_json
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
@@ -55,7 +55,7 @@ class FrontPoint:
 
     @property
     def success(self) -> bool:
-        return self.status in ("optimal", "feasible") and self.verified is not False
+        return self.status in SOLVED_STATUSES and self.verified is not False
 
     @classmethod
     def from_record(cls, rec: PointRecord, method: str) -> FrontPoint:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import functools
 import math
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
@@ -31,8 +30,7 @@ import numpy as np
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.safe_io import slug
-from optdesign.studies.identity import run_identity
+from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, has_catalogue
 from optdesign.studies.pareto.chains import (
     TwoChains,
@@ -41,79 +39,18 @@ from optdesign.studies.pareto.chains import (
     three_objective_tasks,
 )
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
-from optdesign.studies.pareto.records import PointRecord, record_problem
+from optdesign.studies.pareto.records import PointRecord
+from optdesign.studies.pareto.run_setup import (
+    RunOptions,
+    check_front_problem,
+    check_objectives,
+    record_check,
+    run_key,
+    store_path,
+)
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK, front_task
 from optdesign.studies.runner import forks_workers, process_pool, run_tasks
-from optdesign.studies.solve import formulation_for
-from optdesign.studies.verify import VERIFY_TOL
-
-
-@dataclass
-class RunOptions:
-    """Where and how a front's tasks run (not what they compute)."""
-
-    out: Path | str | None = None
-    workers: int = 1
-    scheduler: str | Any | None = None
-    resume: bool = False
-    progress: bool = False
-    on_record: Callable | None = None
-    overwrite: bool = False  # start afresh over a store of an earlier run in ``out``
-
-
-def check_front_problem(problem: DesignProblem) -> None:
-    """Refuse, before any work, a problem no front can be traced on."""
-    if not problem.free:
-        raise InputError(
-            "variables",
-            "no free variable: a front trades objectives by moving the design, and this "
-            "problem's design is fixed (optdesign solve checks it)",
-        )
-
-
-def check_objectives(problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
-    """Two or three distinct objectives the problem can compute."""
-    check_front_problem(problem)
-    objectives = list(objectives)
-    if len(objectives) not in (2, 3):
-        raise InputError("objectives", f"give two or three objectives, got {objectives}")
-    if len(set(objectives)) != len(objectives):
-        raise InputError("objectives", f"repeated objective in {objectives}")
-    ex = problem.expressions(problem.design_dict(problem.midpoint()))
-    for k in objectives:
-        if k not in ex.objectives:
-            raise InputError(
-                "objectives",
-                f"{k!r} is not an objective of {problem.name} (available: {', '.join(ex.objectives)})",
-            )
-    return objectives
-
-
-def _store(out: Path | str | None, name: str) -> Path:
-    # The method's name names its store: a plain file name, never a path.
-    if not isinstance(name, str) or slug(name) != name:
-        raise InputError(
-            "name", f"{name!r}: a method's name names its store file: use letters, digits, ._-"
-        )
-    base = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-pareto-"))
-    base.mkdir(parents=True, exist_ok=True)
-    return base / f"{name}.jsonl"
-
-
-def run_key(
-    problem: DesignProblem, objectives: Sequence[str], back_end: str, /, **settings: Any
-) -> dict[str, Any]:
-    """Identity of a front's run (the components of
-    :func:`optdesign.studies.identity.run_identity`): problem, formulation, objectives,
-    the method's ``settings``, the solver ``back_end`` with every option, version."""
-    return run_identity(problem, objectives, back_end=back_end, method=settings)
-
-
-def record_check(problem: DesignProblem, objectives: Sequence[str]):
-    """``check(record)`` for :func:`run_tasks`: why a stored record of a front of
-    ``problem`` cannot be trusted (see :func:`record_problem`)."""
-    nlp = formulation_for(problem, tuple(sorted(objectives)))
-    return functools.partial(record_problem, problem, nlp=nlp)
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 def _common(
@@ -176,7 +113,7 @@ class EpsilonConstraint:
         if n_points < 2:
             raise InputError("points", f"a front needs at least 2 points, got {n_points}")
         t0 = time.perf_counter()
-        store = _store(run.out, self.name)
+        store = store_path(run.out, self.name)
         starts = self.starts if self.starts is not None else problem.spec.solver.starts
         seed = self.seed if self.seed is not None else problem.spec.solver.seed
         settings = {k: v for k, v in asdict(self).items() if k != "name"}
@@ -196,8 +133,8 @@ class EpsilonConstraint:
             seed=seed,
         )
         if run.workers > 1 and run.scheduler is None and forks_workers():
-            # Forked workers inherit the formulation built here (~0.03 s) instead of each
-            # building its own; their solvers they build side by side on first use.
+            # Forked workers inherit the formulation built here instead of each building
+            # its own; their solvers they build side by side on first use.
             formulation_for(problem, tuple(sorted(objectives)))
         label = f"{self.name}: points" if run.progress else False
         with process_pool(run.workers if run.scheduler is None else 1) as pool:
@@ -273,7 +210,7 @@ class WeightedSum:
                 "variables use 'epsilon' or 'nsga2'",
             )
         t0 = time.perf_counter()
-        store = _store(run.out, self.name)
+        store = store_path(run.out, self.name)
         starts = self.starts if self.starts is not None else problem.spec.solver.starts
         seed = self.seed if self.seed is not None else problem.spec.solver.seed
         key = run_key(
@@ -395,7 +332,7 @@ class NSGA2:
         if len(X):
             ev = problem.evaluate(X)
             for j, x in enumerate(X):
-                ok = bool(ev.violation[j] <= VERIFY_TOL)
+                ok = bool(ev.violation[j] <= FEASIBILITY_TOL)
                 design = {**problem.fixed_values, **problem.design_dict(x)}
                 pts.append(
                     FrontPoint(

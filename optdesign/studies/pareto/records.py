@@ -18,9 +18,10 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
-from optdesign.solvers.result import Result, clean_json
-from optdesign.studies.solve import finish
-from optdesign.studies.verify import VERIFY_TOL, verify_design
+from optdesign.solvers.result import SOLVED_STATUSES, Result, clean_json
+from optdesign.studies.nlp_solve import finish
+from optdesign.studies.verify import verify_design
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 @dataclass
@@ -92,7 +93,7 @@ class PointRecord:
     @property
     def ok(self) -> bool:
         """A verified, feasible point."""
-        return self.status in ("optimal", "feasible") and self.verified is True
+        return self.status in SOLVED_STATUSES and self.verified is True
 
     def to_dict(self) -> dict[str, Any]:
         d = {
@@ -132,7 +133,10 @@ def record_from_result(
     if result.design and result.objectives:
         # The epsilon bounds are constraints of this point: check them on the NumPy path too.
         for k, v in eps.items():
-            if np.isfinite(v) and relative_violation(result.objectives[k], None, v) > VERIFY_TOL:
+            if (
+                np.isfinite(v)
+                and relative_violation(result.objectives[k], None, v) > FEASIBILITY_TOL
+            ):
                 status = "infeasible"
                 result.verified = False
     active = sorted(
@@ -300,7 +304,7 @@ def record_problem(problem: DesignProblem, record: Mapping[str, Any], nlp=None) 
             return "holds a warm start of the wrong size"
         if not np.isfinite(rec.raw.z).all():
             return "holds a warm start that is not finite"
-    if rec.status not in ("optimal", "feasible") or rec.verified is False:
+    if rec.status not in SOLVED_STATUSES or rec.verified is False:
         return None  # shown as failed: never trusted as a design
     if rec.verified is not True:
         return f"has status {rec.status!r} without the independent check"
@@ -344,7 +348,7 @@ def _design_problem(problem: DesignProblem, rec: PointRecord) -> str | None:
     for name, bound in rec.eps.items():
         if (
             name in objectives
-            and relative_violation(float(objectives[name]), None, bound) > VERIFY_TOL
+            and relative_violation(float(objectives[name]), None, bound) > FEASIBILITY_TOL
         ):
             return f"has objective {name} above its epsilon bound {bound:.10g}"
     return None

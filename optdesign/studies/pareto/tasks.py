@@ -26,6 +26,7 @@ from optdesign.solvers.multistart import best_of, improves, sobol_starts
 from optdesign.solvers.result import Result
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_from_result
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: Relative slack on the anchor values in lexicographic tie-breaks and at the sweep ends.
 ANCHOR_SLACK = 1e-7
@@ -186,7 +187,7 @@ def eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
         looser = all(eps[k] >= nb.eps.get(k, -np.inf) for k in eps)
         t_nb, t = nb.objectives[target], rec.objectives[target]
         jump = task.get("jump", 0.2)
-        if looser and t > t_nb * (1 + 1e-6) + 1e-12:
+        if looser and t > t_nb * (1 + OBJECTIVE_TIE_TOL) + 1e-12:
             retry, why = True, "worse than its neighbour with a looser bound"
         elif jump is not None and _design_distance(problem, rec.x, nb.x) > jump:
             retry, why = True, "jump in design space"

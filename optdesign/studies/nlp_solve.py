@@ -1,0 +1,251 @@
+"""The NLP path of a solve: the problem's NLP and solver back-ends built once per process
+(thread-safe caches), the multistart from Sobol starts, the independent check of the
+best point on the NumPy path (:func:`finish`) and the ranges of the optimal set.
+
+Shared by every formulation and study that solves an NLP (the ``nlp`` formulation, the
+catalogue's nodes, the robust and GP formulations' exact NLP, the diagnosis, the fronts);
+the formulation registry and :func:`~optdesign.studies.solve.solve` sit above it in
+:mod:`optdesign.studies.solve`.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from optdesign.errors import ProblemError
+from optdesign.formulations.nlp import NLP, VAR, build_nlp
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.deadline import DEADLINE_OPTION
+from optdesign.solvers.multistart import multistart, sobol_starts
+from optdesign.solvers.registry import make_solver, solver_entry
+from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+from optdesign.studies.runner import map_inherited
+from optdesign.studies.verify import nan_notes, verify_design
+from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
+
+# --- formulation and solver caches ------------------------------------------------------
+_NLPS: OrderedDict[tuple, NLP] = OrderedDict()
+_SOLVERS: OrderedDict[tuple, Any] = OrderedDict()
+_CACHE_SIZE = 16
+
+#: CasADi's symbolic layer is not thread-safe and its solvers release the GIL: two threads
+#: of a threaded Dask worker building at once crashed the process. Every build holds this
+#: lock, and each thread gets its own solvers (a solver object is not re-entrant); the
+#: main thread's entries carry no thread id, so forked workers inherit them.
+_BUILD_LOCK = threading.RLock()
+
+
+def _remember(cache: OrderedDict, key: tuple, build: Callable[[], Any]) -> Any:
+    owner = (
+        "main" if threading.current_thread() is threading.main_thread() else threading.get_ident()
+    )
+    key = (owner, *key)
+    with _BUILD_LOCK:
+        if key in cache:
+            cache.move_to_end(key)
+            return cache[key]
+        value = build()
+        cache[key] = value
+        while len(cache) > _CACHE_SIZE:
+            cache.popitem(last=False)
+        return value
+
+
+def formulation_for(
+    problem: DesignProblem,
+    objectives: tuple[str, ...] | None = None,
+    form: str = "epigraph",
+    first_order: bool = False,
+) -> NLP:
+    """The NLP of ``problem`` for an objective set, built once per process and problem
+    state (the cache key is the problem's token, which changes with every edit)."""
+    objectives = tuple(objectives or problem.objective_names)
+    key = (problem.token, objectives, form, first_order)
+    return _remember(_NLPS, key, lambda: build_nlp(problem, objectives, form, first_order))
+
+
+def solver_for(
+    problem: DesignProblem,
+    name: str = "ipopt",
+    options: Mapping[str, Any] | None = None,
+    objectives: tuple[str, ...] | None = None,
+    form: str = "epigraph",
+):
+    """The back-end ``name`` of the problem's NLP, built once per process and problem
+    state, shared by every start, range and front point."""
+    nlp = formulation_for(problem, objectives, form)
+    opts = dict(solver_options(problem, name))
+    opts.update(options or {})
+    key = (problem.token, nlp.fingerprint, name, json.dumps(opts, sort_keys=True, default=str))
+    return _remember(_SOLVERS, key, lambda: make_solver(nlp, name, opts))
+
+
+def solver_options(problem: DesignProblem, name: str) -> dict[str, Any]:
+    """The problem file's own options of back-end ``name`` (``[solver] ipopt = {...}``)."""
+    if name != "ipopt":
+        return {}
+    from optdesign.solvers.casadi_nlp import check_ipopt_options
+
+    check_ipopt_options(problem.spec.solver.ipopt)  # before any work, naming the option
+    return dict(problem.spec.solver.ipopt)
+
+
+# --- the NLP path -----------------------------------------------------------------------
+def start_points(problem: DesignProblem, n_starts: int, seed: int, x0=None) -> np.ndarray:
+    """The multistart's starts: ``x0`` (or the declared start, else the middle of the
+    bounds) first, then scrambled-Sobol points of the whole box."""
+    first = problem.start() if x0 is None else np.asarray(x0, dtype=float)
+    pts = [first]
+    if n_starts > 1:
+        pts += list(sobol_starts(problem.lower(), problem.upper(), n_starts - 1, seed))
+    return np.array(pts)
+
+
+def solve_nlp(
+    problem: DesignProblem,
+    objective: str | None = None,
+    starts: int | None = None,
+    seed: int | None = None,
+    workers: int = 1,
+    solver: str = "ipopt",
+    options: Mapping[str, Any] | None = None,
+    x0: np.ndarray | None = None,
+    agree: int | None = None,
+    time_limit: float | None = None,
+) -> Result:
+    """Multistart NLP solve of ``problem``.
+
+    Parameters
+    ----------
+    objective
+        Objective to minimise (default: the problem's first).
+    starts, seed
+        Number of starts and Sobol seed (default: the problem file's ``[solver]``).
+    workers
+        Local processes for the starts.
+    solver, options
+        Registered back-end and its options.
+    x0
+        First start (default: the declared start, else the middle of the bounds).
+    agree
+        Stop once this many starts agree on the best value (default: the problem file's
+        ``[solver] agree``, 3; 0: every start). On every shipped problem all 8 default
+        starts reach the same optimum (benchmarks/README.md, "Overhead").
+    time_limit
+        Wall-clock seconds for the multistart: no start begins after it, and an Ipopt
+        solve stops at it (status ``time_limit``); other back-ends finish the start they
+        are in.
+    """
+    _no_catalogue(problem, "nlp")
+    objective = objective or problem.objective_names[0]
+    objectives = _objective_set(problem, objective)
+    n_starts = starts if starts is not None else problem.spec.solver.starts
+    seed = seed if seed is not None else problem.spec.solver.seed
+    agree = agree if agree is not None else problem.spec.solver.agree
+    if time_limit is not None and solver == "ipopt":
+        options = {**(options or {}), DEADLINE_OPTION: True}
+    backend = solver_for(problem, solver, options, objectives)
+    target = backend.nlp.target(objective)
+    pts = start_points(problem, n_starts, seed, x0)
+    result = multistart(
+        lambda x: backend.solve(x, target),
+        pts,
+        workers=workers,
+        seed=seed,
+        agree=agree or None,
+        time_limit=time_limit,
+        parallel_map=map_inherited,
+    )
+    return finish(problem, result, objective)
+
+
+def _objective_set(problem: DesignProblem, objective: str) -> tuple[str, ...]:
+    names = problem.objective_names
+    return tuple(names if objective in names else [objective, *names])
+
+
+def _no_catalogue(problem: DesignProblem, name: str) -> None:
+    disc = [v.name for v in problem.free if v.discrete]
+    if disc:
+        raise ProblemError(
+            f"--formulation {name}: variables {', '.join(disc)} take catalogue values; "
+            "use --formulation catalogue (or auto)"
+        )
+
+
+def optimal_ranges(
+    problem: DesignProblem,
+    result: Result,
+    rel: float = OBJECTIVE_TIE_TOL,
+    solver: str = "ipopt",
+    options: Mapping[str, Any] | None = None,
+) -> dict[str, tuple[float, float]]:
+    """Range of each free variable over the (near-)optimal set.
+
+    Minimises and maximises each variable subject to the requirements and to the
+    objective staying within ``rel`` of the optimum, with the same solver as the optimum
+    (the objective's epsilon row carries the limit), started at the optimum. A wide range
+    means the optimum does not fix that variable (e.g. the lead p in a backlash problem,
+    or the size of a ripple-optimal linkage, since ripple is invariant when R, l, n, p
+    scale together). A search that fails keeps the optimal value on its side.
+    """
+    objective = result.objective_name or problem.objective_names[0]
+    warm_options = solver_entry(solver).warm_options
+    warm = warm_options is not None and "lam_g" in result.raw
+    if warm:
+        # Primal and dual start at the optimum (benchmarks/README.md, "Overhead").
+        options = {**warm_options, **(options or {})}
+    backend = solver_for(problem, solver, options, _objective_set(problem, objective))
+    nlp = backend.nlp
+    limit = result.objective + rel * max(abs(result.objective), 1e-12)
+    bounds = nlp.bounds(eps={objective: limit})
+    x_opt = np.array([result.design[v.name] for v in problem.free])
+    if warm:
+        raw = result.raw
+        start = nlp.start(z0=raw["z"], lam_x0=raw["lam_x"], lam_g0=raw["lam_g"])
+    elif "z" in result.raw:
+        start = nlp.start(z0=result.raw["z"])
+    else:
+        start = nlp.start(x0=x_opt)
+    ranges = {}
+    for var in problem.free:
+        ends = []
+        for sign in (1.0, -1.0):
+            r = backend.solve(start, {VAR + var.name: sign}, bounds)
+            ok = r.success and r.max_violation <= FEASIBILITY_TOL
+            ends.append(r.design[var.name] if ok else result.design[var.name])
+        opt = result.design[var.name]
+        ranges[var.name] = (float(min(*ends, opt)), float(max(*ends, opt)))
+    return ranges
+
+
+def finish(problem: DesignProblem, result: Result, objective: str | None = None) -> Result:
+    """Check the result on the NumPy path, fill every objective and the full design."""
+    result.objective_name = result.objective_name or objective or problem.objective_names[0]
+    result.problem = problem.name
+    result.mechanism = problem.mechanism_name
+    result.problem_object = problem
+    if not result.design:
+        return result
+    x = np.array([result.design[v.name] for v in problem.free])
+    ok, violated, objectives = verify_design(problem, x)
+    result.verified = ok
+    result.notes += nan_notes(problem, objectives, violated)
+    result.objectives = {k: float(v) for k, v in objectives.items()}
+    result.design = {**problem.fixed_values, **result.design}
+    if result.success and not ok:
+        # The solver claims success but the independent check disagrees: not a design.
+        result.status = "infeasible"
+        result.termination = TerminationCondition.INFEASIBLE
+        result.solution_status = SolutionStatus.INFEASIBLE
+        result.violated = violated
+        result.message += " (independent check failed)"
+    elif not result.success and not result.violated:
+        result.violated = violated
+    return result
