@@ -25,6 +25,7 @@ from optdesign.storage import _lock_holder, open_store
 from optdesign.studies import catalogue
 from optdesign.studies.catalogue import is_on_catalogue, relaxation_bound
 from optdesign.studies.runner import run_tasks
+from optdesign.studies.verify import verify_design
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = '(e.g. "N*mm", "rad/s"; "" for a plain number)'
@@ -251,3 +252,28 @@ def test_the_catalogue_formulation_takes_the_callers_settings():
     starved = od.solve(problem, "catalogue", options={"max_iter": 1}, ranges=False, diagnose=False)
     assert starved.status == "infeasible"
     assert "relaxation has no feasible design" in starved.message
+
+
+def test_first_feasible_finds_a_feasible_catalogue_design_or_none():
+    """The diagnosis's depth-first search (reached only when no item combination near the
+    relaxation works, so no other fast test calls it): a leaf on the catalogue whose
+    design the independent check finds feasible; None when no item pair is feasible."""
+    problem = _catalogue((4, 5, 6, 8), (4, 5, 6, 8, 10))
+    found = catalogue.first_feasible(catalogue.NodeSolver(problem, starts=2))
+    assert found is not None and found.success
+    assert is_on_catalogue(problem, found.design)
+    x = np.array([found.design[v.name] for v in problem.free])
+    assert verify_design(problem, x)[0]
+    # the better child first: the leaf is no worse than the worst of the feasible items
+    enum = catalogue.solve_catalogue(problem, method="enumerate", starts=2)
+    feasible = {
+        (row["items"]["p"], row["items"]["d"]): row["objective"]
+        for row in enum.extra["catalogue"]["enumerated"]
+        if row["status"] == "optimal"
+    }
+    items = (found.design["p"], found.design["d"])
+    assert found.objective == pytest.approx(feasible[items], rel=1e-6)  # that item pair's optimum
+    assert found.objective <= max(feasible.values())
+    # pins of 4 mm only: too weak for the hinge moment whatever the lead (every pair fails)
+    weak = _catalogue((4, 5, 6, 8), (4,))
+    assert catalogue.first_feasible(catalogue.NodeSolver(weak, starts=2)) is None
