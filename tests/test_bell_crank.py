@@ -230,3 +230,53 @@ def test_bell_crank_problem_copies_are_independent():
     before = copy.deepcopy(MODULE["PROBLEM"])
     od.load(MODULE["PROBLEM"])
     assert before == MODULE["PROBLEM"]
+
+
+def _toml(data: dict) -> str:
+    """The example's problem dict as a problem file (inline tables one level down)."""
+
+    def value(v):
+        if isinstance(v, dict):
+            return "{" + ", ".join(f"{k} = {value(x)}" for k, x in v.items()) + "}"
+        return f'"{v}"' if isinstance(v, str) else repr(v)
+
+    lines = [f"{k} = {value(v)}" for k, v in data.items() if not isinstance(v, dict)]
+    for k, table in data.items():
+        if isinstance(table, dict):
+            lines += ["", f"[{k}]", *(f"{n} = {value(v)}" for n, v in table.items())]
+    return "\n".join(lines) + "\n"
+
+
+def test_the_bell_crank_by_entry_point_from_the_command_line_in_another_folder(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    problem = tmp_path / "bell_crank.toml"
+    problem.write_text(_toml(MODULE["PROBLEM"]))
+    dist = tmp_path / "bellcrank-1.0.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: bellcrank\nVersion: 1.0\n")
+    (dist / "entry_points.txt").write_text(
+        "[optdesign.mechanisms]\nbell_crank = bell_crank:BellCrank\n"
+    )
+    path = os.pathsep.join([str(tmp_path), str(EXAMPLE.parent), os.environ.get("PYTHONPATH", "")])
+    env = {**os.environ, "PYTHONPATH": path}
+
+    def run(*argv):
+        return subprocess.run(
+            [sys.executable, "-m", "optdesign", *argv],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            env=env,
+            cwd=tmp_path,
+        )
+
+    solve = run("solve", str(problem), "--out", "solved", "--workers", "1")
+    assert solve.returncode == 0, solve.stderr
+    assert "status    optimal" in solve.stdout and "independent check: passed" in solve.stdout
+    assert (tmp_path / "solved" / "report.html").is_file()
+    bench = run("bench", "--problem", str(problem), "--solvers", "slsqp-exact", "--workers", "1")
+    assert bench.returncode == 0, bench.stderr
+    assert "Suite `user`: 1 instances, 1 runs" in bench.stdout

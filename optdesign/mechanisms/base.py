@@ -170,13 +170,15 @@ class Sketch:
 class Mechanism:
     """Base of every mechanism plug-in.
 
-    Subclass, set :attr:`name` and :attr:`variables`, write :meth:`nut_position`, then
-    register the class with :func:`optdesign.register_mechanism`. Example::
+    Subclass, set :attr:`name` and :attr:`variables`, write :meth:`nut_position`, declare
+    the pins (:attr:`pin_joints` or :meth:`joints`), then register the class with
+    :func:`optdesign.register_mechanism` (the whole contract: docs/mechanisms.md). Example::
 
         @register_mechanism
         class Lever(Mechanism):
             name = "lever"
             variables = {"R": ("length", "lever arm")}
+            pin_joints = ("pin",)  # on the screw's line, loaded by the nut force
 
             def nut_position(self, phi):
                 return self.R * m.sin(phi)
