@@ -247,6 +247,7 @@ def _toml(data: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+@pytest.mark.slow  # two command-line runs in fresh processes (~20 s)
 def test_the_bell_crank_by_entry_point_from_the_command_line_in_another_folder(tmp_path):
     import os
     import subprocess
