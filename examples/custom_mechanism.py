@@ -13,6 +13,7 @@ class ScotchYoke(od.Mechanism):
         "R": od.VariableInfo("length", "crank radius"),
         "phi0": od.VariableInfo("angle", "neutral angle", positive=False, default=0.0),
     }
+    pin_joints = ("crank pin in the yoke's slot",)  # on the screw's line, the nut's force
     size_description = "crank radius R"  # the default size: the sum of the lengths
 
     def nut_position(self, phi):  # the nut follows the pin: x = R sin(phi0 + phi)

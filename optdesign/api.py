@@ -140,7 +140,10 @@ def pareto(
     (folder of the resumable store), ``workers``, ``scheduler`` (Dask), ``resume``,
     ``overwrite`` (start afresh over a stored run), ``progress``, ``starts``, ``seed``,
     ``solver``, ``agree``, ``spacing``, ``eps_values``, ``retry_starts``,
-    ``extra_starts``, ``deterministic``, NSGA-II's ``pop_size`` and ``generations``.
+    ``extra_starts``, ``deterministic``, ``time_limit`` (wall-clock seconds of an epsilon
+    front: no point begins after it, the points running finish; the front says how many
+    were left out and a resume in ``out`` computes them), NSGA-II's ``pop_size`` and
+    ``generations``.
 
     Returns
     -------

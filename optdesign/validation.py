@@ -161,7 +161,16 @@ def objective_of(problem: Any, objective: str | None, argument: str = "objective
 
 
 #: Options of :func:`optdesign.pareto` that say where and how a front runs (any method).
-RUN_OPTIONS = ("out", "workers", "scheduler", "resume", "overwrite", "progress", "on_record")
+RUN_OPTIONS = (
+    "out",
+    "workers",
+    "scheduler",
+    "resume",
+    "overwrite",
+    "progress",
+    "on_record",
+    "time_limit",
+)
 
 
 def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
@@ -180,6 +189,7 @@ def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
         "overwrite": (flag, ()),
         "progress": (flag, ()),
         "on_record": (_optional_function, ()),
+        "time_limit": (seconds, eps),
         "starts": (starts, (*eps, "weighted_sum")),
         "seed": (seed, ()),
         "agree": (agree, eps),

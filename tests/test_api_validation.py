@@ -299,8 +299,8 @@ def test_every_command_line_option_is_an_api_argument():
         (
             lambda: od.pareto(RIPPLE, "ripple,size", pointz=5),
             "pointz: unknown option of pareto() (did you mean 'points'? known: out, workers, "
-            "scheduler, resume, overwrite, progress, on_record, starts, seed, agree, solver, "
-            "spacing, eps_values, retry_starts, extra_starts, deterministic, pop_size, "
+            "scheduler, resume, overwrite, progress, on_record, time_limit, starts, seed, agree, "
+            "solver, spacing, eps_values, retry_starts, extra_starts, deterministic, pop_size, "
             "generations, name)",
         ),
         (

@@ -8,11 +8,13 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "custom_mechanism.py"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLE = EXAMPLES / "custom_mechanism.py"
 
 
-def test_example_imports_only_public_names():
-    tree = ast.parse(EXAMPLE.read_text())
+@pytest.mark.parametrize("name", ["custom_mechanism.py", "bell_crank.py"])
+def test_examples_use_only_public_names(name):
+    tree = ast.parse((EXAMPLES / name).read_text())
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             assert not (node.module or "").split(".")[-1].startswith("_")
@@ -20,6 +22,9 @@ def test_example_imports_only_public_names():
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
             if node.value.id in ("od", "m"):
                 assert not node.attr.startswith("_"), node.attr
+
+
+def test_scotch_yoke_example_is_short():
     assert len(EXAMPLE.read_text().splitlines()) <= 60
 
 

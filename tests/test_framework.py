@@ -189,6 +189,7 @@ def test_a_mechanism_from_a_separate_package_by_entry_point(tmp_path):
 
             class Yoke(od.Mechanism):
                 variables = {"R": od.VariableInfo("length", "crank radius")}
+                pin_joints = ("crank pin",)  # on the nut's line of action
 
                 def nut_position(self, phi):
                     return self.R * m.sin(phi)
@@ -281,6 +282,7 @@ def test_gp_diagnosis_of_a_user_mechanism_is_never_a_wrong_model():
     class AutoYoke(od.Mechanism):
         name = "auto_yoke"
         variables = {"R": od.VariableInfo("length", "crank radius")}  # noqa: RUF012
+        pin_joints = ("crank pin",)  # on the nut's line of action
 
         def nut_position(self, phi):
             return self.R * m.sin(phi)

@@ -39,6 +39,7 @@ def line_of(fn, offset: int = 1) -> str:
 # --- user mechanisms, one bug each ------------------------------------------------------
 class _Yoke(od.Mechanism):
     variables = {"R": od.VariableInfo("length", "crank radius")}  # noqa: RUF012
+    pin_joints = ("crank pin",)  # on the nut's line of action
 
 
 class AttrBug(_Yoke):
@@ -245,6 +246,7 @@ def test_a_user_mechanism_written_in_a_notebook_file(tmp_path):
             class CellYoke(od.Mechanism):
                 name = "t21_cell"
                 variables = {"R": od.VariableInfo("length", "crank radius")}
+                pin_joints = ("crank pin",)  # on the nut's line of action
 
                 def nut_position(self, phi):
                     return self.R * m.sin(phi) / self.undefined_in_cell
@@ -258,7 +260,7 @@ def test_a_user_mechanism_written_in_a_notebook_file(tmp_path):
     text = str(caught.value)
     assert "mechanism 't21_cell' (class notebook.CellYoke" in text
     assert "CellYoke.nut_position raised AttributeError" in text
-    assert f"at {cell}:11," in text
+    assert f"at {cell}:12," in text
 
 
 @pytest.mark.parametrize("mode", ["default", "json"])
@@ -294,6 +296,7 @@ def test_registering_a_mechanism_checks_its_declarations():
     class NoPosition(od.Mechanism):
         name = "t21_no_position"
         variables = {"R": ("length", "arm")}  # noqa: RUF012
+        pin_joints = ("crank pin",)  # on the nut's line of action
 
     with pytest.raises(OptDesignError, match=r"t21_no_position.*define nut_position\(self, phi\)"):
         od.register_mechanism(NoPosition)

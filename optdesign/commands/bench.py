@@ -1,7 +1,7 @@
 """``optdesign bench``: which solver and formulation to use, with evidence.
 
 Runs every solver configuration (:data:`optdesign.studies.bench.CONFIGS`) on a suite of
-seeded instances, streams one JSON row per run to ``OUT/bench_runs.jsonl`` (``--resume``
+seeded instances (or on the user's problem files, ``--problem FILE ...``), streams one JSON row per run to ``OUT/bench_runs.jsonl`` (``--resume``
 continues it), then writes ``bench_runs.csv``, ``bench_profiles.png`` (Dolan-More profiles of
 time and objective gap) and ``summary.md``, all under ``--out`` (default: a new folder).
 ``--update-readme FILE`` pastes the summary between the generated-block markers of FILE
@@ -21,7 +21,21 @@ from optdesign.errors import InputError
 @command("bench")
 def _bench(sub):
     p = sub.add_parser("bench", help="benchmark solver configurations on seeded instance families")
-    p.add_argument("--suite", type=checked(check.suite), default="default", help="default or quick")
+    p.add_argument(
+        "--suite",
+        type=checked(check.suite),
+        default=None,
+        help="default or quick (the default when no --problem is given)",
+    )
+    p.add_argument(
+        "--problem",
+        dest="problems",
+        nargs="+",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="benchmark these problem files (yours) instead of a suite",
+    )
     p.add_argument(
         "--solvers",
         nargs="+",
@@ -88,6 +102,13 @@ def run_bench_command(args) -> int:
     with as_options():  # the checks of optdesign.bench, before any work
         solvers = check.configs("solvers", args.solvers)
         check.run_folder(args.out, args.resume, args.overwrite)
+    if args.problems is not None and args.suite is not None:
+        raise InputError("--suite", "excludes --problem (run your problems or a suite)")
+    problems = None
+    if args.problems is not None:
+        from optdesign.api import load
+
+        problems = [load(path) for path in args.problems]  # refused naming the file
     if args.update_readme is not None:
         # Checked before the benchmark runs: a FIFO, /dev/zero, a folder or a file
         # without the markers is refused at once, not after an hour of runs.
@@ -100,13 +121,12 @@ def run_bench_command(args) -> int:
     out = args.out or default_out("bench")
     with storage.lock_folder(out):
         storage.ensure_writable(out)
-        return _run_locked(args, bench, solvers, out)
+        return _run_locked(args, bench, solvers, out, problems)
 
 
-def _run_locked(args, bench, solvers, out: Path) -> int:
-
+def _run_locked(args, bench, solvers, out: Path, problems) -> int:
     report = bench.run_bench(
-        args.suite,
+        None if problems is not None else args.suite or "default",
         solvers,
         out,
         workers=args.workers,
@@ -116,6 +136,7 @@ def _run_locked(args, bench, solvers, out: Path) -> int:
         time_limit=args.time_limit,
         hard_timeout=args.hard_timeout,
         overwrite=args.overwrite,
+        problems=problems,
     )
     from optdesign.text import printable
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from optdesign import validation as check
 from optdesign.cli import as_options, checked, command, default_out, literal
+from optdesign.errors import InputError
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
 #: Options spelt otherwise than their API argument (optdesign.pareto).
@@ -74,6 +75,13 @@ def _pareto(sub):
         help="NSGA-II generations",
     )
     p.add_argument(
+        "--time-limit",
+        type=checked(check.seconds, literal),
+        default=None,
+        help="epsilon fronts: wall-clock seconds of the whole front; no point begins after "
+        "it (the points left out are named; --resume computes them)",
+    )
+    p.add_argument(
         "--deterministic",
         action="store_true",
         help="epsilon fronts: the two chains meet in the middle, so the front is the same "
@@ -102,6 +110,16 @@ def run_pareto(args) -> int:
             check.method("method", m)
             check.method_for(problem, m)  # refused before the output folder is made
         check.run_folder(args.out, args.resume, args.overwrite)
+    if args.time_limit is not None:
+        from optdesign.studies.pareto.catalogue_front import has_catalogue
+
+        other = [m for m in methods if m not in ("epsilon", "uniform")]
+        if other or has_catalogue(problem):
+            what = f"the {other[0]} method" if other else "a catalogue front"
+            raise InputError(
+                "--time-limit",
+                f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
+            )
     out = args.out or default_out(f"pareto-{problem.name}")
     # One run per folder for the whole command (the runner re-enters the lock per store),
     # checked before any solving.
@@ -131,6 +149,8 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         overwrite=args.overwrite,
         progress=not args.no_progress,
     )
+    if args.time_limit is not None:
+        run["time_limit"] = args.time_limit
     fronts = []
     for m in methods:
         if m == "nsga2":
@@ -196,7 +216,11 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         print(f"note: {printable(note)}")
     print("\nwrote " + ", ".join(printable(w) for w in wrote))
     for front in fronts:
-        if not front.points:
+        if not front.points and front.notes and not front.rejected:
+            # the time limit left every point out: not an infeasible front
+            line = printable(f"{front.method}: {front.notes[0]}")
+            print(f"optdesign: {line}", file=sys.stderr)
+        elif not front.points:
             line = printable(_no_point(problem, front))
             print(f"optdesign: infeasible: {line}", file=sys.stderr)
     return 0 if all(f.points for f in fronts) else 1

@@ -117,8 +117,13 @@ class Rows:
     """``lower <= expr <= upper`` over the deflection grid (or one value), as a mechanism
     or a requirement states it; the problem turns these into named constraint blocks.
 
-    ``display`` maps the row's values back to the quantity a user reads (e.g. ``arcsin``
-    of a sine, in the unit ``display_unit``) for reports; None shows the value as is.
+    ``expr`` and the bounds are in ``unit`` (internal units: mm, N, MPa, N*mm, rad; ""
+    for a plain number). Reports show a row in ``display_unit``: ``display`` maps the
+    row's values to the quantity a user reads, already in ``display_unit`` (degrees of
+    the angle whose cosine the row bounds); without ``display``, the values are converted
+    from ``unit`` to ``display_unit`` (``unit="rad", display_unit="deg"`` shows degrees;
+    units of different dimensions are refused, naming the row). Without either, a row
+    is shown in its ``unit``.
     """
 
     name: str
@@ -129,6 +134,23 @@ class Rows:
     description: str = ""
     display: Callable[[Any], Any] | None = None
     display_unit: str = ""
+
+    def __post_init__(self):
+        if self.display is None and self.display_unit and self.display_unit != self.unit:
+            from optdesign.units import unit_factor
+
+            where = f"Rows({self.name!r}).display_unit"
+            self.display = Scaled(unit_factor(self.unit, self.display_unit, where))
+
+
+@dataclass(frozen=True)
+class Scaled:
+    """``value * factor``: a row shown in another unit of its dimension (picklable)."""
+
+    factor: float
+
+    def __call__(self, value):
+        return value * self.factor
 
 
 @dataclass
@@ -148,13 +170,15 @@ class Sketch:
 class Mechanism:
     """Base of every mechanism plug-in.
 
-    Subclass, set :attr:`name` and :attr:`variables`, write :meth:`nut_position`, then
-    register the class with :func:`optdesign.register_mechanism`. Example::
+    Subclass, set :attr:`name` and :attr:`variables`, write :meth:`nut_position`, declare
+    the pins (:attr:`pin_joints` or :meth:`joints`), then register the class with
+    :func:`optdesign.register_mechanism` (the whole contract: docs/mechanisms.md). Example::
 
         @register_mechanism
         class Lever(Mechanism):
             name = "lever"
             variables = {"R": ("length", "lever arm")}
+            pin_joints = ("pin",)  # on the screw's line, loaded by the nut force
 
             def nut_position(self, phi):
                 return self.R * m.sin(phi)
@@ -172,6 +196,12 @@ class Mechanism:
     fixed_clearances
         Keys of the clearance chain's fixed clearances (``[clearances]`` of a problem
         file): key -> (dimension, description).
+    pin_joints
+        Names of the sized pins of the default clearance chain, each on the screw's line
+        of action and carrying the nut force (a Scotch yoke's crank pin in the yoke's
+        slot: ``("crank pin",)``; ``()``: no pin). None: undeclared - a class that does
+        not write :meth:`joints` must declare it (refused when registered), so that the
+        chain never guesses a mechanism's pins.
     pin_shear_planes
         Shear planes of the sized pin (default of ``pin_shear_planes``).
     size_description
@@ -187,6 +217,7 @@ class Mechanism:
         "B": ("length", "screw/nut (axial)"),
         "O": ("angle", "output shaft"),
     }
+    pin_joints: ClassVar[tuple[str, ...] | None] = None
     pin_shear_planes: ClassVar[int] = 1
     size_description: ClassVar[str] = "sum of the mechanism's lengths"
 
@@ -292,9 +323,16 @@ class Mechanism:
         """The clearance chain (joints whose clearance reaches the output).
 
         Default: the screw's support bearings (A) and the screw/nut (B), axial; the
-        output shaft (O), angular; and, when the problem sizes a pin, one pin along the
-        screw's line of action loaded by the nut force (a screw pushing a pin).
+        output shaft (O), angular; and, when the problem sizes a pin, one joint per name
+        of :attr:`pin_joints`, each on the screw's line of action and loaded by the nut
+        force (its clearance moves the output as the nut's would: 1/(dx/dphi) rad/mm).
+        A linkage whose pins sit elsewhere (on a rod, a crank) writes its own chain.
         """
+        if type(self).pin_joints is None:
+            raise InputError(
+                "pin_joints",
+                f"a {self.label()} declares no pins: set pin_joints or write joints()",
+            )
         s = self.sensitivity_axial(phi)
         chain = [
             Joint("A screw bearings", "A", sensitivity=s),
@@ -302,17 +340,22 @@ class Mechanism:
             Joint("O output shaft", "O", angular=True),
         ]
         if pin is not None:
-            chain.append(Joint("pin", "", sensitivity=s, force=self.nut_force(phi, M_h), pin=pin))
+            F = self.nut_force(phi, M_h)
+            chain += [Joint(n, "", sensitivity=s, force=F, pin=pin) for n in self.pin_joints]
         return chain
 
     def pin_force(self, phi, M_h):
-        """Force on the sized pin(s) (N) for the bearing-pressure and shear requirements.
-        Default: the force of the first pin joint of :meth:`joints`."""
+        """Force on the sized pin(s) (N) for the bearing-pressure and shear requirements:
+        one pin size serves every pin joint of :meth:`joints`, so the default is the
+        largest magnitude of their forces at each angle."""
         marker = PinJoint.placeholder()
-        for joint in self.joints(phi, M_h, marker):
-            if joint.pin is marker:
-                return joint.force
-        raise InputError("pin", f"a {self.label()} has no sized pin joint")
+        forces = [j.force for j in self.joints(phi, M_h, marker) if j.pin is marker]
+        if not forces:
+            raise InputError("pin", f"a {self.label()} has no sized pin joint")
+        largest = m.fabs(forces[0])
+        for force in forces[1:]:
+            largest = m.fmax(largest, m.fabs(force))
+        return largest
 
     def backlash(self, phi, joints: Sequence[Joint]) -> Backlash:
         """Output backlash (degrees) at each angle of ``phi``: per joint, worst case, RSS."""

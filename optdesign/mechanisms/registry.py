@@ -95,6 +95,25 @@ def _check_declarations(cls: type[Mechanism], key: str) -> None:
         ) from exc
     if cls.nut_position is Mechanism.nut_position:
         raise UserCodeError(f"{subject}: define nut_position(self, phi)", subject)
+    pins = cls.pin_joints
+    if pins is None and cls.joints is Mechanism.joints:
+        # The default chain would have to guess where the pins are and what loads them;
+        # a wrong guess is a silently wrong backlash, so the class says it.
+        raise UserCodeError(
+            f"{subject}: its pins are undeclared: set pin_joints = ('crank pin',) for "
+            "pins on the screw's line of action carrying the nut force (a Scotch yoke's), "
+            "pin_joints = () for none, or write joints(self, phi, M_h, pin) "
+            "(docs/mechanisms.md)",
+            subject,
+        )
+    if pins is not None and (
+        not isinstance(pins, tuple)
+        or not all(isinstance(n, str) and n.strip() for n in pins)
+        or len(set(pins)) != len(pins)
+    ):
+        raise UserCodeError(
+            f"{subject}: pin_joints must be a tuple of distinct names, got {pins!r}", subject
+        )
 
 
 def _load_entry_points() -> None:

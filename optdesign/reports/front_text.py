@@ -54,6 +54,7 @@ def front_summary(fronts: Sequence) -> str:
         f"(hypervolume in {printable(hv_unit)}; reference points: nadir + 10 % of the range of the "
         "front itself (own) or of all fronts together (common))"
     )
+    lines += [f"note      {f.method}: {note}" for f in fronts for note in f.notes]
     pts = main.points
     if not pts:
         return printable("\n".join(lines), newlines=True)

@@ -136,6 +136,7 @@ def run_tasks(
     overwrite: bool = False,
     isolate: Isolation | None = None,
     check: Callable[[Record], str | None] | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> dict[str, Record]:
     """Run ``tasks`` through ``fn``, storing each record as it finishes.
 
@@ -189,6 +190,10 @@ def run_tasks(
         ``check(record) -> None`` or why a stored record cannot be trusted; on resume
         every stored record is checked before any is used, and one that fails refuses
         the resume naming the store, its line and the reason.
+    stop
+        ``stop() -> bool``: once true, no further task begins (a study's time limit);
+        the tasks running finish and are stored, the others are left out of the
+        returned records (a resume runs them).
 
     Returns
     -------
@@ -227,6 +232,7 @@ def run_tasks(
             pool,
             expand,
             isolate,
+            stop,
         )
 
 
@@ -244,6 +250,7 @@ def _run(
     pool,
     expand,
     isolate,
+    stop=None,
 ) -> dict[str, Record]:
     # run_tasks once the store is open: the scheduling loop.
     for k, rec in (known or {}).items():
@@ -307,7 +314,7 @@ def _run(
                 )
 
             def submit_ready() -> None:
-                while ex.has_room():
+                while ex.has_room() and not (stop is not None and stop()):
                     t = next((t for t in queue if ready(t)), None)
                     if t is None:
                         break
@@ -317,7 +324,7 @@ def _run(
             while True:
                 submit_ready()
                 if not ex.running():
-                    if queue:
+                    if queue and not (stop is not None and stop()):
                         raise ValueError("run_tasks: dependency cycle")
                     break
                 results = ex.wait()

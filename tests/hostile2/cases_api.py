@@ -273,6 +273,7 @@ from optdesign import math as m
 class {cls}(od.Mechanism):
     name = "{key}"
     variables = {variables}
+    pin_joints = ("crank pin",)  # on the nut's line of action
 {extra}
     def nut_position(self, phi):
         {body}

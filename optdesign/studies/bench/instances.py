@@ -40,9 +40,8 @@ P_CATALOGUE = 0.3
 SHIPPED = ("cs_min_ripple", "cs_min_backlash", "fork_min_backlash")
 
 
-def families() -> dict[str, tuple[str, tuple[str, ...]]]:
-    """family -> (mechanism, objectives), from every registered mechanism. A
-    two-objective family is a Pareto-front instance."""
+def _declared() -> dict[str, tuple[str, tuple[str, ...]]]:
+    """family -> (mechanism, objectives) as every registered mechanism declares them."""
     from optdesign.mechanisms.registry import get_mechanism, registered
 
     out: dict[str, tuple[str, tuple[str, ...]]] = {}
@@ -50,6 +49,66 @@ def families() -> dict[str, tuple[str, tuple[str, ...]]]:
         for family, objectives in get_mechanism(name).bench_families.items():
             out[family] = (name, tuple(objectives))
     return out
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Which registered mechanisms the seeded suites cover.
+
+    Attributes
+    ----------
+    families
+        mechanism -> its families (each builds a valid problem).
+    skipped
+        mechanism -> why it has no instances (no families declared, or the first family
+        whose instance its template cannot build, with the error).
+    """
+
+    families: dict[str, tuple[str, ...]]
+    skipped: dict[str, str]
+
+
+_COVERAGE: dict[tuple, Coverage] = {}
+
+
+def coverage() -> Coverage:
+    """Every registered mechanism with its families or the reason it has none (no
+    mechanism is left out silently); cached per set of registered classes."""
+    from optdesign.errors import OptDesignError
+    from optdesign.mechanisms.registry import get_mechanism, registered
+
+    classes = {name: get_mechanism(name) for name in registered()}
+    key = tuple((name, id(cls)) for name, cls in classes.items())
+    if key in _COVERAGE:
+        return _COVERAGE[key]
+    fams: dict[str, tuple[str, ...]] = {}
+    skipped: dict[str, str] = {}
+    for name, cls in classes.items():
+        if not cls.bench_families:
+            skipped[name] = (
+                "declares no bench_families (bench its problems with "
+                "optdesign bench --problem FILE, or declare bench_families and "
+                "bench_template)"
+            )
+            continue
+        for family in cls.bench_families:
+            try:
+                problem_from_dict(instance_dict(family, 0), source=f"{family}-000")
+            except (OptDesignError, ValueError, TypeError, KeyError) as exc:
+                skipped[name] = f"its family {family!r} builds no valid problem: {exc}"
+                break
+        else:
+            fams[name] = tuple(cls.bench_families)
+    _COVERAGE[key] = result = Coverage(fams, skipped)
+    return result
+
+
+def families() -> dict[str, tuple[str, tuple[str, ...]]]:
+    """family -> (mechanism, objectives), from every registered mechanism whose
+    families build valid problems (:func:`coverage` says why the others have none). A
+    two-objective family is a Pareto-front instance."""
+    covered = coverage().families
+    return {f: (mech, obj) for f, (mech, obj) in _declared().items() if mech in covered}
 
 
 def single_families() -> tuple[str, ...]:
@@ -129,7 +188,7 @@ def instance_dict(family: str, seed: int) -> dict[str, Any]:
     """
     if family == "shipped":
         return _shipped(seed)
-    fams = families()
+    fams = _declared()
     if family not in fams:
         raise KeyError(f"unknown instance family {family!r} (known: shipped, {', '.join(fams)})")
     mechanism, objectives = fams[family]

@@ -126,8 +126,11 @@ def eval_counts(n_evals: Mapping[str, int]) -> tuple[int | None, int | None, int
     return f, g, h
 
 
-def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) -> dict[str, Any]:
-    """bench_runs.csv, bench_profiles.png, summary.md, bench_stats.json in ``out``."""
+def write_outputs(
+    rows, out: Path, configs, suite_name, wall, time_limit, hard, skipped=None
+) -> dict[str, Any]:
+    """bench_runs.csv, bench_profiles.png, summary.md, bench_stats.json in ``out``;
+    ``skipped``: mechanism -> why the suite has no instances of it (listed last)."""
 
     out = Path(out)
     with io.StringIO() as fh:
@@ -185,6 +188,9 @@ def write_outputs(rows, out: Path, configs, suite_name, wall, time_limit, hard) 
             "",
             stats_table(st, desc, rows),
         ]
+    if skipped:
+        lines += ["", "### Registered mechanisms without instances", ""]
+        lines += [f"- {md_cell(name)}: {md_cell(why)}" for name, why in skipped.items()]
     text = "\n".join(lines) + "\n"
     atomic_write_text(out / "summary.md", text)
     atomic_write_text(

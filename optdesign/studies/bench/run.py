@@ -18,7 +18,7 @@ from optdesign.safe_io import read_file
 from optdesign.storage import atomic_write_text
 from optdesign.store_identity import identity_key
 from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
-from optdesign.studies.bench.instances import Instance, user_instances
+from optdesign.studies.bench.instances import Instance, coverage, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
 from optdesign.studies.bench.metrics import add_gaps, config_stats
 from optdesign.studies.bench.sandbox import run_task
@@ -42,6 +42,9 @@ class BenchReport:
         Files written (CSV, profiles PNG, summary).
     wall_time_s
         Wall time of the whole benchmark (resumed runs included).
+    skipped
+        Registered mechanisms the seeded suite has no instances of, with the reason
+        (empty for the caller's own problems).
     """
 
     rows: list[dict[str, Any]]
@@ -50,6 +53,7 @@ class BenchReport:
     summary_markdown: str = ""
     paths: dict[str, Any] = field(default_factory=dict)
     wall_time_s: float = 0.0
+    skipped: dict[str, str] = field(default_factory=dict)
 
     def summary(self) -> str:
         return self.summary_markdown
@@ -140,10 +144,12 @@ def run_bench(
     if workers < 1:
         raise InputError("workers", f"need at least 1 worker, got {workers}")
     hard = hard_timeout if hard_timeout is not None else time_limit + 3.0
+    skipped: dict[str, str] = {}
     if problems is not None:
         instances = user_instances(problems)
         suite_name = "user"
     elif instances is None:
+        skipped = coverage().skipped
         suite_name = suite or "default"
         wants_fronts = any(get_config(c).kind == "front" for c in names)
         try:
@@ -182,7 +188,7 @@ def run_bench(
         wall += _stored_wall(meta_path, key_text)
     atomic_write_text(meta_path, json.dumps({"key": key_text, "wall_time_s": wall}))
     rows = add_gaps([dict(records[t["id"]]) for t in tasks if t["id"] in records])
-    paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard)
+    paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard, skipped)
     single = [c for c in names if get_config(c).kind not in ("front", "debug")]
     return BenchReport(
         rows=rows,
@@ -191,6 +197,7 @@ def run_bench(
         summary_markdown=paths["summary_text"],
         paths=paths,
         wall_time_s=wall,
+        skipped=skipped,
     )
 
 

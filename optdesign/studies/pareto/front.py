@@ -102,6 +102,8 @@ class Front:
         The resumable store of the run, if any.
     n_solves
         NLP solves behind the front.
+    notes
+        What the reader must know about the run (a time limit that left points out).
     """
 
     objectives: list[str]
@@ -114,6 +116,7 @@ class Front:
     store: str = ""
     n_solves: int = 0
     settings: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
     problem_object: Any = field(default=None, repr=False, compare=False)
 
     @property
@@ -139,6 +142,7 @@ class Front:
                 "store": self.store,
                 "n_solves": self.n_solves,
                 "settings": self.settings,
+                "notes": self.notes,
                 "points": [p.to_dict() for p in self.points],
                 "rejected": [p.to_dict() for p in self.rejected],
             }

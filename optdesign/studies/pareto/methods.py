@@ -150,6 +150,7 @@ class EpsilonConstraint:
                 on_record=run.on_record,
                 pool=pool,
                 check=record_check(problem, objectives),
+                stop=_deadline_passed if run.time_limit is not None else None,
             )
             anchor_list = anchor_tasks(common, objectives, starts, seed, self.agree)
             if len(objectives) == 2:
@@ -158,13 +159,13 @@ class EpsilonConstraint:
                     objectives, n_points, self.name, common, self.spacing, self.eps_values, split
                 )
                 done = phase(anchor_list, resume=run.resume, expand=sweep)
-                anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+                anchors = _anchors(done, objectives, run)
                 tasks = sweep.tasks
             else:
                 # Three objectives: the rows need every anchor (the nadir of B), so the
                 # anchors run first, then the rows in parallel.
                 done = phase(anchor_list, resume=run.resume)
-                anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
+                anchors = _anchors(done, objectives, run)
                 for k, rec in anchors.items():
                     check_anchor(rec, k, problem)
                 tasks = three_objective_tasks(anchors, objectives, n_points, self.name, common)
@@ -174,9 +175,18 @@ class EpsilonConstraint:
         for k, rec in anchors.items():
             check_anchor(rec, k, problem)
         recs = [
-            PointRecord.from_dict(done[t["id"]]) for t in sorted(tasks, key=lambda t: t["index"])
+            PointRecord.from_dict(done[t["id"]])
+            for t in sorted(tasks, key=lambda t: t["index"])
+            if t["id"] in done  # a time limit leaves the points not begun out
         ]
         pts = [FrontPoint.from_record(r, self.name) for r in recs]
+        notes = []
+        if len(recs) < n_points:
+            notes.append(
+                f"time limit of {run.time_limit:g} s reached: {n_points - len(recs)} of "
+                f"{n_points} points not computed (no point begins after the limit; "
+                f"{_resume_hint(run)} computes them)"
+            )
         return make_front(
             pts,
             objectives,
@@ -187,7 +197,31 @@ class EpsilonConstraint:
             store=str(store),
             n_solves=sum(r.n_solves for r in recs) + sum(r.n_solves for r in anchors.values()),
             settings={**settings, "starts": starts, "seed": seed},
+            notes=notes,
         )
+
+
+def _deadline_passed() -> bool:
+    from optdesign.solvers import deadline
+
+    return deadline.passed()
+
+
+def _resume_hint(run: RunOptions) -> str:
+    return "resuming the run in its folder" if run.out is not None else "a run with an out folder"
+
+
+def _anchors(done, objectives: Sequence[str], run: RunOptions) -> dict[str, PointRecord]:
+    """The anchors' records; a time limit that passed before they were all computed is
+    said so (a front needs both ends)."""
+    missing = [k for k in objectives if f"anchor-{k}" not in done]
+    if missing:
+        raise InputError(
+            "time_limit",
+            f"{run.time_limit:g} s passed before the anchors ({', '.join(missing)}) were "
+            f"computed: give more time, or {_resume_hint(run)} continues",
+        )
+    return {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
 
 
 @dataclass
@@ -409,7 +443,16 @@ METHODS: dict[str, Callable[..., Any]] = {
     "nsga2": NSGA2,
 }
 
-_RUN_FIELDS = ("out", "workers", "scheduler", "resume", "progress", "on_record", "overwrite")
+_RUN_FIELDS = (
+    "out",
+    "workers",
+    "scheduler",
+    "resume",
+    "progress",
+    "on_record",
+    "overwrite",
+    "time_limit",
+)
 
 
 def compute_front(
@@ -452,13 +495,22 @@ def compute_front(
             raise InputError("pareto", f"option not understood by {method!r}: {exc}") from None
     elif options:
         raise ProblemError(f"options {sorted(options)} go into the method object, not pareto()")
+    if run.time_limit is not None and not isinstance(method, EpsilonConstraint):
+        raise InputError(
+            "time_limit",
+            f"not applied by the {getattr(method, 'name', type(method).__name__)!r} method: "
+            "only a continuous epsilon sweep ('epsilon', 'uniform') stops at a time limit",
+        )
     store_name = getattr(method, "name", None)
     if run.overwrite and run.out is not None and not run.resume and store_name:
         from optdesign import storage
 
         with storage.lock_folder(run.out):
             storage.discard_store(Path(run.out) / f"{store_name}.jsonl")
-    return method.run(problem, objectives, run)
+    from optdesign.solvers.deadline import deadline
+
+    with deadline(run.time_limit):
+        return method.run(problem, objectives, run)
 
 
 __all__ = [

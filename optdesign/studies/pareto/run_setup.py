@@ -32,6 +32,8 @@ class RunOptions:
     progress: bool = False
     on_record: Callable | None = None
     overwrite: bool = False  # start afresh over a store of an earlier run in ``out``
+    # wall-clock seconds of the study: no point begins after it (epsilon sweeps)
+    time_limit: float | None = None
 
 
 def check_front_problem(problem: DesignProblem) -> None:
