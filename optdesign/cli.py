@@ -86,6 +86,28 @@ def default_out(prefix: str) -> Path:
     return path
 
 
+@contextlib.contextmanager
+def output_folder(out: Path | None, prefix: str):
+    """``out``, or a new default folder (:func:`default_out`) that is removed again if the
+    command leaves nothing in it but its lock: a run refused or stopped before it wrote a
+    file leaves no empty folder behind. A folder the user named is never removed."""
+    if out is not None:
+        yield out
+        return
+    path = default_out(prefix)
+    try:
+        yield path
+    finally:
+        from optdesign.storage import LOCK_NAME
+
+        with contextlib.suppress(OSError):
+            if {e.name for e in os.scandir(path)} <= {LOCK_NAME}:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(path / LOCK_NAME)
+                os.rmdir(path)
+                os.rmdir(path.parent)  # optdesign-out itself, when nothing else is in it
+
+
 @command("reproduce")
 def _reproduce(sub):
     from optdesign.reproduce import REPRODUCTIONS

@@ -609,3 +609,33 @@ def test_read_file_caps_and_refuses_special_files(tmp_path):
     (tmp_path / "s.jsonl").mkdir()
     with pytest.raises(UnsafeFileError, match="is a folder"):
         scan_store(tmp_path / "s.jsonl")
+
+
+def test_a_refused_run_leaves_no_default_output_folder(tmp_path, monkeypatch, capsys):
+    """A run refused after its default folder was made (the GP check needs the model)
+    removes the folder again: nothing in the working directory; one line names why."""
+    monkeypatch.chdir(tmp_path)
+    code = main(["solve", str(ROOT / "problems" / "cs_min_backlash.toml"), "--formulation", "gp"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert list(tmp_path.iterdir()) == []
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "\\n" not in lines[0]
+    assert "not a geometric program: variable n: not DGP" in lines[0]
+    # a folder the user named is kept, empty or not
+    code = main(
+        [
+            "solve",
+            str(ROOT / "problems" / "cs_min_backlash.toml"),
+            "--formulation",
+            "gp",
+            "--out",
+            "mine",
+        ]
+    )
+    assert code == 2 and (tmp_path / "mine").is_dir()
+    # a run that writes keeps its default folder
+    problem = ROOT / "problems" / "fork_min_backlash.toml"
+    assert main(["solve", str(problem), *QUICK, "--no-plot", "--no-report"]) == 0
+    [made] = (tmp_path / "optdesign-out").iterdir()
+    assert (made / "result.json").is_file()

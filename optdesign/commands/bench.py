@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, default_out, literal
+from optdesign.cli import as_options, checked, command, literal, output_folder
 from optdesign.errors import InputError
 
 
@@ -118,8 +118,7 @@ def run_bench_command(args) -> int:
             raise InputError(
                 "--update-readme", f"{args.update_readme} has no generated-block markers"
             )
-    out = args.out or default_out("bench")
-    with storage.lock_folder(out):
+    with output_folder(args.out, "bench") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         return _run_locked(args, bench, solvers, out, problems)
 

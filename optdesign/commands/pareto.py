@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, default_out, literal
+from optdesign.cli import as_options, checked, command, literal, output_folder
 from optdesign.errors import InputError
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
@@ -120,10 +120,9 @@ def run_pareto(args) -> int:
                 "--time-limit",
                 f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
             )
-    out = args.out or default_out(f"pareto-{problem.name}")
     # One run per folder for the whole command (the runner re-enters the lock per store),
     # checked before any solving.
-    with storage.lock_folder(out):
+    with output_folder(args.out, f"pareto-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         for m in methods:
             if m == "nsga2":

@@ -6,7 +6,7 @@ import contextlib
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, default_out, literal
+from optdesign.cli import as_options, checked, command, literal, output_folder
 
 #: Options spelt otherwise than their API argument (optdesign.solve).
 RENAMED = {"ranges": "--no-ranges", "problem": "file"}
@@ -90,9 +90,8 @@ def run_solve(args) -> int:
     write_files = args.out is not None or not args.json
     if not write_files:
         return _solve_and_report(args, problem, None)
-    out = args.out or default_out(f"solve-{problem.name}")
     # One writer per folder, and a folder we cannot write to is refused before solving.
-    with storage.lock_folder(out):
+    with output_folder(args.out, f"solve-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         return _solve_and_report(args, problem, out)
 

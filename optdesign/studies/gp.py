@@ -26,8 +26,8 @@ def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
     gp = build_gp(problem, objective)
     if not gp.is_gp:
         raise ProblemError(
-            f"--formulation gp: problem {problem.name!r} is not a geometric program:\n  "
-            + gp.explain().replace("\n", "\n  ")
+            f"--formulation gp: problem {problem.name!r} is not a geometric program: "
+            + "; ".join(gp.explain().splitlines())
         )
     return gp
 
