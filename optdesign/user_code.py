@@ -165,6 +165,11 @@ def hint(exc: BaseException) -> str:
             "od.math.grid_max / grid_min / grid_sum over the stroke and od.math.fmax / "
             "fmin of two values, not Python's max, min, sum or a loop"
         )
+    if "bad operand type for abs()" in text:
+        return (
+            "; the quantities are CasADi expressions while the model is built, and this "
+            "CasADi release has no abs() for them: use od.math.fabs"
+        )
     if "truth value" in text:
         return (
             "; a CasADi expression has no truth value: use od.math.where(cond, a, b) or "

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -127,12 +128,20 @@ def test_python_builtins_on_casadi_get_the_od_math_hint(kind, role):
     assert "not Python's max, min, sum or a loop" in text
 
 
-def test_abs_of_a_quantity_is_fine_on_the_solvers_path():
-    """Python's abs works on CasADi expressions: no refusal, the same run as fabs (the
-    peak force is not smooth: the solve's status is whatever fabs gives too)."""
+def test_abs_of_a_quantity_on_the_solvers_path():
+    """Python's abs works on CasADi expressions where CasADi defines it (3.8.2): no
+    refusal, the same run as fabs (the peak force is not smooth: the solve's status is
+    whatever fabs gives too). Where it does not (3.6.1, the oldest allowed), the refusal
+    points at od.math.fabs."""
     problem = od.load(PROBLEM)
     problem.add_objective("peak", lambda q: od.math.grid_max(abs(q.nut_force)), unit="N")
     problem.add_objective("peak2", lambda q: od.math.grid_max(od.math.fabs(q.nut_force)), unit="N")
+    if not hasattr(ca.SX, "__abs__"):
+        with pytest.raises(UserCodeError) as caught:
+            od.solve(problem, objective="peak", starts=1, ranges=False)
+        text = str(caught.value)
+        assert "bad operand type for abs()" in text and text.endswith("use od.math.fabs")
+        return
     a = od.solve(problem, objective="peak", starts=1, ranges=False)
     b = od.solve(problem, objective="peak2", starts=1, ranges=False)
     assert a.status == b.status
