@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import inspect
 import os
+import re
 import sys
 import sysconfig
 import traceback
@@ -149,8 +150,12 @@ def stage(values: Any) -> str:
     return "while evaluating a design"
 
 
+#: CasADi's own source location at the head of its messages (".../casadi/core/x.cpp:166: ")
+_CASADI_SOURCE = re.compile(r"(?:\.\.\./|/)?casadi/core/[\w/]+\.(?:cpp|hpp):\d+:\s*")
+
+
 def _exception_text(exc: BaseException) -> str:
-    text = " ".join(str(exc).split())
+    text = _CASADI_SOURCE.sub("", " ".join(str(exc).split()))
     if "not iterable by design" in text:  # CasADi's own text goes on about m.nz
         text = "CasADi matrices are not iterable"
     return text if len(text) <= 300 else text[:297] + "..."
@@ -164,6 +169,12 @@ def hint(exc: BaseException) -> str:
             "; the quantities are CasADi expressions while the model is built: use "
             "od.math.grid_max / grid_min / grid_sum over the stroke and od.math.fmax / "
             "fmin of two values, not Python's max, min, sum or a loop"
+        )
+    if "__round__" in text:
+        return (
+            "; the quantities are arrays over the stroke (CasADi expressions while the model"
+            " is built): Python's round() does not apply to them, and a rounded value gives"
+            " the solver no gradient"
         )
     if "bad operand type for abs()" in text:
         return (

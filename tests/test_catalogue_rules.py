@@ -312,3 +312,16 @@ def test_design_efficiency_sizes_the_motor_torque_with_the_catalogue_value():
 
     with pytest.raises(OptDesignError, match="efficiency_design"):
         problem_from_dict(data)
+
+
+@pytest.mark.parametrize("value", ["69000 mm/min", "fast", ""])
+def test_dn_max_that_is_neither_a_number_nor_a_grade_is_refused_in_one_message(value):
+    from optdesign.errors import OptDesignError
+
+    data = tomllib.loads(FIN.read_text())
+    data["requirements"]["dn_max"] = value
+    with pytest.raises(OptDesignError) as caught:
+        problem_from_dict(data)
+    text = str(caught.value)
+    assert "requirements.dn_max: a number (d x n in mm x 1/min, e.g. 70000) or a grade " in text
+    assert f"got {value!r}" in text and "literal" not in text and "float" not in text

@@ -586,3 +586,30 @@ def test_a_user_sketch_bug_names_its_line_where_the_linkage_is_drawn(tmp_path, c
     printed = capsys.readouterr().out
     assert "report.html not written: mechanism 't21_sketch'" in printed
     assert (out / "result.json").exists() and not (out / "report.html").exists()
+
+
+def test_builtins_on_quantities_get_a_hint_and_no_casadi_source_path():
+    """max() of two CasADi scalars asks for their truth value: the message says so without
+    CasADi's C++ file and line; round() of the stroke's array is named as such."""
+    problem = od.load(BACKLASH)
+
+    def larger_end(q):
+        return max(q.nut_force[0], q.nut_force[1])
+
+    problem.add_objective("ends", larger_end, unit="N")
+    with pytest.raises(UserCodeError) as caught:
+        od.solve(problem, objective="ends", starts=1, ranges=False)
+    text = str(caught.value)
+    assert "Cannot compute the truth value of a CasADi" in text and ".cpp" not in text
+    assert f"at {line_of(larger_end)}, while building the solver's model" in text
+    assert "od.math.where(cond, a, b) or od.math.fmax / fmin" in text
+
+    def rounded(q):
+        return round(q.nut_force)
+
+    with pytest.raises(UserCodeError) as caught:  # tried when declared, on NumPy arrays
+        problem.add_objective("rounded", rounded, unit="N")
+    assert str(caught.value).endswith(
+        "Python's round() does not apply to them, and a rounded value gives the solver no "
+        "gradient"
+    )

@@ -370,6 +370,18 @@ class Requirements(_Model):
             )
         return self
 
+    @field_validator("dn_max", mode="before")
+    @classmethod
+    def _dn_max(cls, value: Any) -> Any:
+        # One message for both forms (pydantic would list each branch of the union).
+        grades = ("rolled", "peeled", "ground", "high-speed")
+        if isinstance(value, str) and value not in grades:
+            raise ValueError(
+                f"a number (d x n in mm x 1/min, e.g. 70000) or a grade ({', '.join(grades)}),"
+                f" got {value!r}"
+            )
+        return value
+
     @field_validator("fit")
     @classmethod
     def _fit(cls, value: str) -> str:
