@@ -610,6 +610,5 @@ def test_builtins_on_quantities_get_a_hint_and_no_casadi_source_path():
     with pytest.raises(UserCodeError) as caught:  # tried when declared, on NumPy arrays
         problem.add_objective("rounded", rounded, unit="N")
     assert str(caught.value).endswith(
-        "Python's round() does not apply to them, and a rounded value gives the solver no "
-        "gradient"
+        "Python's round() does not apply to them, and a rounded value gives the solver no gradient"
     )
