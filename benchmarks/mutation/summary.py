@@ -5,11 +5,28 @@ Usage: python benchmarks/mutation/summary.py mutmut-results.txt
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 from collections import Counter, defaultdict
 
 LINE = re.compile(r"^\s*(?P<name>[\w.]+)__mutmut_\d+: (?P<status>.+?)\s*$")
+
+
+def module_of(name: str) -> str:
+    """The module of a mutated function's name:
+    optdesign.models.loads.x_motor_torque / ...crank_slider.xǁCrankSliderǁjoints."""
+    return re.sub(r"\.(x[ΛǁŁ_].*|[A-Za-z_]+ǁ.*)$", "", name)
+
+
+def wilson(killed: int, tried: int, z: float = 1.96) -> tuple[float, float]:
+    """The 95 % Wilson score interval of a kill rate (for a sampled run)."""
+    if tried == 0:
+        return (0.0, 1.0)
+    p = killed / tried
+    centre = (p + z * z / (2 * tried)) / (1 + z * z / tried)
+    half = z * math.sqrt(p * (1 - p) / tried + z * z / (4 * tried * tried)) / (1 + z * z / tried)
+    return (centre - half, centre + half)
 
 
 def main(path: str) -> int:
@@ -21,8 +38,7 @@ def main(path: str) -> int:
             if not match:
                 continue
             name, status = match["name"], match["status"]
-            # optdesign.models.loads.x_motor_torque / ...crank_slider.xǁCrankSliderǁjoints
-            module = re.sub(r"\.(x[ΛǁŁ_].*|[A-Za-z_]+ǁ.*)$", "", name)
+            module = module_of(name)
             per_module[module][status] += 1
             if status == "survived":
                 survivors.append(line.strip().split(":")[0])
@@ -43,8 +59,11 @@ def main(path: str) -> int:
         f"{total['timeout']:8d} {other}"
     )
     if tried:
+        killed = total["killed"] + total["timeout"]
+        low, high = wilson(killed, tried)
         print(
-            f"killed (timeouts count as killed): {100 * (total['killed'] + total['timeout']) / tried:.1f} %"
+            f"killed (timeouts count as killed): {100 * killed / tried:.1f} % "
+            f"(95 % interval if sampled: {100 * low:.1f}-{100 * high:.1f} %)"
         )
     print(
         "other statuses:",
