@@ -105,7 +105,7 @@ cp "$ROOT/pyproject.toml" "$WORK/"
   printf '    --ignore\n    tests/test_hostile2.py\n'
   printf '    --ignore\n    tests/hostile2\n'
   printf "also_copy =\n"
-  for f in problems examples docs benchmarks README.md setup.py; do printf '    %s\n' "$f"; done
+  for f in problems examples docs benchmarks README.md setup.py .ci; do printf '    %s\n' "$f"; done
   echo "use_git_change_detection = false"
 } >"$WORK/setup.cfg"
 cd "$WORK"
