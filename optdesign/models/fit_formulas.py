@@ -78,30 +78,19 @@ SHAFT_DEVIATIONS: dict[str, tuple[float, float]] = {
     "h": (0.0, 0.0),
 }
 
-#: Shaft letters with a smooth (formula) value.
-SMOOTH_SHAFT_LETTERS: tuple[str, ...] = (
-    "c",
-    "d",
-    "e",
-    "f",
-    "g",
-    "h",
-    "js",
-    "k",
-    "m",
-    "n",
-    "p",
-    "u",
-)
-#: Hole letters with a smooth (formula) value.
-SMOOTH_HOLE_LETTERS: tuple[str, ...] = tuple(x.upper() for x in SMOOTH_SHAFT_LETTERS)
-#: IT grades with a smooth value (ISO 286-1 gives IT1..IT4 no multiple of i).
-SMOOTH_GRADES: tuple[int, ...] = tuple(sorted(IT_FACTORS))
 #: Why a table letter has no smooth value.
 _NO_FORMULA = {
     "r": "ISO 286-1 defines r only as the geometric mean of the p and s values",
     "s": "ISO 286-1 gives s only as IT8 + '1 to 4' um up to 50 mm",
 }
+#: Shaft letters with a smooth (formula) value: the table's, but r and s.
+SMOOTH_SHAFT_LETTERS: tuple[str, ...] = tuple(
+    x for x in iso286.SHAFT_LETTERS if x not in _NO_FORMULA
+)
+#: Hole letters with a smooth (formula) value.
+SMOOTH_HOLE_LETTERS: tuple[str, ...] = tuple(x.upper() for x in SMOOTH_SHAFT_LETTERS)
+#: IT grades with a smooth value (ISO 286-1 gives IT1..IT4 no multiple of i).
+SMOOTH_GRADES: tuple[int, ...] = tuple(sorted(IT_FACTORS))
 _DELTA_8 = ("K", "M", "N")  # ES = -ei + Delta up to IT8
 _DELTA_7 = ("P", "U")  # ES = -ei + Delta up to IT7
 _VALUES = ("smooth", "table")
