@@ -190,6 +190,21 @@ def _part_params(g: PRSMGeometry, part: str) -> tuple[float, float]:
     return {"screw": (g.r_s, g.lead_s), "roller": (g.r_r, g.lead_r), "nut": (g.r_n, g.lead_n)}[part]
 
 
+def _roller_flank(g: PRSMGeometry, rho, theta, xi):
+    """A point of the roller's arc-profiled flank ``xi`` at (rho, theta), roller frame."""
+    return thread_flank(
+        rho,
+        theta,
+        kind="roller",
+        xi=xi,
+        r0=g.r_r,
+        pitch=g.pitch,
+        lead=g.lead_r,
+        beta=g.beta,
+        arc_radius=g.roller_profile_radius,
+    )
+
+
 @dataclass(frozen=True)
 class ThreadContact:
     """A matched contact between a screw or nut flank (body 1) and a roller flank (body 2)."""
@@ -285,17 +300,7 @@ class PRSMContact:
         pa = thread_flank(
             x[0], x[1], kind=part, xi=xi_a, r0=r0a, pitch=g.pitch, lead=lead_a, beta=g.beta
         )
-        pb = centre + thread_flank(
-            x[2],
-            x[3],
-            kind="roller",
-            xi=xi_b,
-            r0=g.r_r,
-            pitch=g.pitch,
-            lead=g.lead_r,
-            beta=g.beta,
-            arc_radius=g.roller_profile_radius,
-        )
+        pb = centre + _roller_flank(g, x[2], x[3], xi_b)
         Ja = ca.jacobian(pa, x[0:2])
         Jb = ca.jacobian(pb, x[2:4])
         ta_u = Ja[:, 0] / ca.norm_2(Ja[:, 0])
@@ -317,17 +322,7 @@ class PRSMContact:
         za = thread_flank(
             r0a, psi, kind=part, xi=xi_a, r0=r0a, pitch=g.pitch, lead=lead_a, beta=g.beta
         )[2]
-        zb = thread_flank(
-            g.r_r,
-            theta_b,
-            kind="roller",
-            xi=xi_b,
-            r0=g.r_r,
-            pitch=g.pitch,
-            lead=g.lead_r,
-            beta=g.beta,
-            arc_radius=g.roller_profile_radius,
-        )[2]
+        zb = _roller_flank(g, g.r_r, theta_b, xi_b)[2]
         return np.array([r0a, psi, g.r_r, theta_b, za - zb])
 
     def contact(self, side: str, psi: float = 0.0, tol: float = 1e-12) -> ThreadContact:
