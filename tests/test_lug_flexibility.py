@@ -5,7 +5,11 @@ contact models (file, NLP, GP, the ``--contact-models`` spread)."""
 from __future__ import annotations
 
 import copy
+import json
 import math
+import re
+import subprocess
+import sys
 import tomllib
 from pathlib import Path
 
@@ -257,3 +261,23 @@ def test_gp_form_with_fixed_thicknesses_and_its_refusal():
 def test_contact_model_is_refused_by_name():
     with pytest.raises(OptDesignError, match=r"requirements\.pin_contact"):
         problem_from_dict(_fin("tate", None))
+
+
+@pytest.mark.parametrize("json_mode", [False, True])
+def test_spread_on_the_command_line(tmp_path, json_mode):
+    """A file with [materials.lug] (units as a user writes them): Huth's backlash in the
+    summary's note, in the default output and in --json."""
+    text = FIN.read_text().replace(
+        "[screw]", '[materials.lug]\ncheek_thickness = "5 mm"\n\n[screw]', 1
+    )
+    path = tmp_path / "fin_lug.toml"
+    path.write_text(text)
+    args = [sys.executable, "-m", "optdesign", "solve", str(path), "--contact-models"]
+    args += ["--no-ranges"] + (["--json"] if json_mode else [])
+    run = subprocess.run(args, capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    notes = json.loads(run.stdout)["notes"] if json_mode else [run.stdout]
+    line = next(n for n in notes if "backlash by pin contact model" in n)
+    value = float(re.search(r"huth ([0-9.]+) deg", line).group(1))
+    assert value == pytest.approx(0.0422825, rel=1e-5)
+    assert "palmgren 0.0441218 deg" in line
