@@ -181,12 +181,11 @@ class Lug(_Model):
 
     @model_validator(mode="after")
     def _positive(self):
-        for name, unit in (("cheek_thickness", "mm"), ("thickness", "mm"), ("E", "MPa")):
+        for name in ("cheek_thickness", "thickness", "E", "cheek_E"):
             value = getattr(self, name)
             if value is not None and not value > 0:
+                unit = "mm" if name.endswith("thickness") else "MPa"
                 raise ValueError(f"{name}: must be positive, got {value:g} {unit}")
-        if self.cheek_E is not None and not self.cheek_E > 0:
-            raise ValueError(f"cheek_E: must be positive, got {self.cheek_E:g} MPa")
         return self
 
 
