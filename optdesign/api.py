@@ -79,8 +79,10 @@ def solve(
         fixed design is checked (formulation ``"fixed"``).
     contact_models
         Also the worst-case backlash of the optimum under each pin contact model
-        (``duan2017``, ``conforming``, ``palmgren``), as a note of the result: the
-        spread of the models a designer should read beside the file's choice.
+        (``duan2017``, ``conforming``, ``palmgren``, ``huth``; ``n/a`` with the reason
+        where a model lacks its inputs, e.g. Huth's without ``[materials.lug]``), as a
+        note of the result: the spread of the models a designer should read beside the
+        file's choice.
     time_limit
         Wall-clock seconds for the NLP multistart (at most a day; None: no limit): no
         start begins after it, an Ipopt solve stops at it, and the result says so (a

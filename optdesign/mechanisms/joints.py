@@ -27,9 +27,10 @@ from optdesign.models.hertz_line import (
     pin_flattening,
     pin_flattening_first_order,
 )
+from optdesign.models.lug_flexibility import Lug
 
 #: Contact models of a loaded pin (``requirements.pin_contact``).
-CONTACT_MODELS = ("duan2017", "conforming", "palmgren")
+CONTACT_MODELS = ("duan2017", "conforming", "palmgren", "huth")
 
 
 def _numeric(value) -> bool:
@@ -64,11 +65,17 @@ class PinJoint:
         ``"conforming"``: the pin in its bore with the fit's clearance
         (:mod:`optdesign.models.pin_contact`), the elastic approach of the pair;
         ``"palmgren"``: Palmgren's empirical approach of a steel line contact,
-        3.84e-5 F^0.9 / L^0.8 ([P59]; the bulk compression included, steel only).
+        3.84e-5 F^0.9 / L^0.8 ([P59]; the bulk compression included, steel only);
+        ``"huth"``: Huth's flexibility of the pin in its lug or clevis, C F
+        (:mod:`optdesign.models.lug_flexibility`; pin bending and shear and the lugs'
+        bearing deformation included), which needs ``lug``.
     values
         ISO 286 values: ``"smooth"`` (the formulas at D) or ``"table"`` (as ISO 286-2
         prints them; a symbolic D takes the smooth value times ``ratio_max`` /
         ``ratio_min``, the table's ratio that the catalogue search sets per solve).
+    lug
+        The members around the pin (thicknesses, moduli, shear planes), for
+        ``contact = "huth"``.
     """
 
     d: Any
@@ -84,6 +91,7 @@ class PinJoint:
     values: str = "smooth"
     ratio_max: Any = 1.0
     ratio_min: Any = 1.0
+    lug: Lug | None = None
 
     def __post_init__(self):
         require_positive("pin.d", self.d)
@@ -101,6 +109,12 @@ class PinJoint:
                     f"Palmgren's approach is an empirical law of steel (E about 2.1e5 MPa), "
                     f"got {float(self.E):g} MPa; use pin_contact duan2017 or conforming",
                 )
+        if self.contact == "huth" and self.lug is None:
+            raise InputError(
+                "materials.lug",
+                'pin_contact "huth" needs the lug around the pin: give [materials.lug] '
+                "cheek_thickness (and thickness, E where they differ from the pin's L, E)",
+            )
 
     @staticmethod
     @cache
@@ -132,6 +146,8 @@ class PinJoint:
             return self.extra + c + approach
         if self.contact == "palmgren":
             return self.extra + c + pin_contact.palmgren_approach(F, self.L)
+        if self.contact == "huth":
+            return self.extra + c + self.lug_compliance() * F
         flat = pin_flattening_first_order if self.first_order else pin_flattening
         return self.extra + c + self.surfaces * flat(self.d, F, self.L, self.E, self.nu)
 
@@ -142,6 +158,8 @@ class PinJoint:
             return pin_contact.contact_stiffness(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
         if self.contact == "palmgren":
             return pin_contact.palmgren_stiffness(F, self.L)
+        if self.contact == "huth":
+            return 1.0 / self.lug_compliance() + 0.0 * F
         # Delta = D/2 - sqrt(D^2/4 - k F) (eq. 11): dDelta/dF = k / (2 sqrt(D^2/4 - k F))
         k = 4.0 * self.d * (1.0 - self.nu**2) / (np.pi * self.E * self.L)
         root = m.sqrt_domain(0.25 * self.d**2 - k * F)
@@ -149,12 +167,19 @@ class PinJoint:
 
     def contact_pressure(self, F):
         """Largest contact pressure (MPa) under F: Hertz line contact (eq. 10; also for
-        Palmgren's approach, which gives no pressure) or the conforming solution."""
+        Palmgren's and Huth's approaches, which give no pressure) or the conforming
+        solution."""
         if self.contact == "conforming":
             c = self.fit_clearance()
             return pin_contact.max_pressure(F, self.L, 0.5 * self.d, 0.5 * c, self.E, self.nu)
         b = contact_half_width(self.d, F, self.L, self.E, self.nu)
         return 2.0 * F / (np.pi * b * self.L)
+
+    def lug_compliance(self):
+        """Huth's compliance of the pin in its lug (mm/N; needs ``lug``)."""
+        if self.lug is None:
+            raise InputError("materials.lug", "Huth's model needs the lug around the pin")
+        return self.lug.compliance(self.d, self.L, self.E)
 
     def fit_band(self):
         """(smallest, largest) fit clearance (mm) of this pin's diameter."""

@@ -103,8 +103,9 @@ DN_LIMIT = {"rolled": 70_000.0, "peeled": 90_000.0, "ground": 90_000.0, "high-sp
 #: A DN rule: which diameter it multiplies by the speed and its limit for each grade.
 #: ``"HIWIN"``: the nominal diameter d0 (HIWIN's ds), :data:`DN_LIMIT`. ``"ball-centre"``
 #: (the default, the conservative one): the ball-centre diameter d_m and 70 000 whatever
-#: the grade - the rule of the makers that rate DN on the ball circle ([CAT]), at or
-#: below HIWIN's limit for every grade.
+#: the grade - the rule of the makers that rate DN on the ball circle ([CAT]; THK's
+#: selection example checks N2 = 70 000 / D, D the ball center-to-center diameter,
+#: [THK-EX] in docs/references.md), at or below HIWIN's limit for every grade.
 DN_RULES: dict[str, tuple[str, dict[str, float]]] = {
     "HIWIN": ("nominal", DN_LIMIT),
     "ball-centre": ("ball-centre", {grade: 70_000.0 for grade in DN_LIMIT}),

@@ -20,6 +20,8 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
 - a pin fit the chosen ISO 286 values cannot evaluate (``fit_values``), at a pin diameter
   outside the tables, or whose clearance is negative (an interference: a pin joint needs a
   clearance, and the backlash model would subtract it);
+- ``pin_contact = "huth"`` without ``[materials.lug]`` (Huth's model needs the lug's
+  thicknesses);
 - a plain number of the file (a factor, a share of time) with a nonzero magnitude below
   :data:`~optdesign.units.MIN_MAGNITUDE` or above :data:`~optdesign.units.MAX_MAGNITUDE`
   (quantities with units are checked when they are read).
@@ -55,6 +57,7 @@ def check_problem(problem: Any) -> None:
     if spec.screw is not None:
         _screw(problem, spec.screw)
     _fit(problem)
+    _lug(problem)
 
 
 def _magnitudes(data: Any, path: str) -> None:
@@ -230,3 +233,13 @@ def _fit(problem: Any) -> None:
                 "clearance fit (e.g. H7/g6)"
                 + (' or fit_clearance = "max"' if side == "min" else "")
             )
+
+
+def _lug(problem: Any) -> None:
+    spec = problem.spec
+    if spec.requirements.pin_contact == "huth" and spec.materials.lug is None:
+        raise ProblemError(
+            'materials.lug: pin_contact "huth" needs the lug around the pin: give '
+            "[materials.lug] cheek_thickness (and thickness, E where they differ from the "
+            "pin's loaded length and modulus)"
+        )

@@ -25,6 +25,7 @@ from optdesign.mechanisms.joints import (
     with_fixed_clearances,
     with_sampled_fits,
 )
+from optdesign.models.lug_flexibility import Lug
 from optdesign.problem import drive
 from optdesign.user_code import call_method, stage
 
@@ -215,8 +216,18 @@ class Quantities:
             self.first_order,
             contact=req.pin_contact,
             values=values,
+            lug=self._lug(),
             **ratios,
         )
+
+    def _lug(self) -> Lug | None:
+        """The lug around the sized pin (``[materials.lug]``), in single or double shear
+        as the pin's shear check counts it (``pin_shear_planes``, else the mechanism's)."""
+        lug = self.problem.spec.materials.lug
+        if lug is None:
+            return None
+        planes = self.requirements.pin_shear_planes or self.problem.mechanism.pin_shear_planes
+        return Lug(lug.cheek_thickness, lug.thickness, lug.E, lug.cheek_E, planes, lug.fastener)
 
     @cached_property
     def pin_force(self):

@@ -168,8 +168,30 @@ class Material(_Model):
         return self
 
 
+class Lug(_Model):
+    """The lug (or clevis) around the sized pin, for ``pin_contact = "huth"`` (Huth's
+    flexibility, :mod:`optdesign.models.lug_flexibility`). Single or double shear is the
+    problem's ``pin_shear_planes`` (the mechanism's default unless the file sets it)."""
+
+    cheek_thickness: Length
+    thickness: Length | None = None
+    E: Pressure | None = None
+    cheek_E: Pressure | None = None
+    fastener: Literal["bolted", "riveted"] = "bolted"
+
+    @model_validator(mode="after")
+    def _positive(self):
+        for name in ("cheek_thickness", "thickness", "E", "cheek_E"):
+            value = getattr(self, name)
+            if value is not None and not value > 0:
+                unit = "mm" if name.endswith("thickness") else "MPa"
+                raise ValueError(f"{name}: must be positive, got {value:g} {unit}")
+        return self
+
+
 class Materials(_Model):
     pin: Material = Material()
+    lug: Lug | None = None
 
 
 class ScrewSizing(_Model):
@@ -320,7 +342,7 @@ class Requirements(_Model):
     screw: ScrewSizing | None = None
     lock: MotorLock | None = None
     fit_values: Literal["table", "smooth"] | None = None
-    pin_contact: Literal["duan2017", "conforming", "palmgren"] = "duan2017"
+    pin_contact: Literal["duan2017", "conforming", "palmgren", "huth"] = "duan2017"
     pin_contact_pressure_max: Pressure | None = None
     efficiency_min: Dimensionless | None = Field(None, gt=0.0, le=1.0)
     back_drive: Literal["required", "forbidden"] | None = None

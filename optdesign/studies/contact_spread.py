@@ -1,6 +1,6 @@
 """The spread of a design's backlash over the pin contact models ([D17]'s eq. 11, the
-conforming pin in its bore, Palmgren's empirical approach): ``od.solve(...,
-contact_models=True)`` and ``optdesign solve --contact-models``."""
+conforming pin in its bore, Palmgren's empirical approach, Huth's pin in its lug):
+``od.solve(..., contact_models=True)`` and ``optdesign solve --contact-models``."""
 
 from __future__ import annotations
 
@@ -16,10 +16,12 @@ from optdesign.reports.display_units import objective_shown
 
 def contact_model_spread(problem: Any, design: dict[str, float]) -> str | None:
     """The worst-case backlash of ``design`` under each pin contact model (eq. 11 of
-    [D17], the conforming pin in its bore, Palmgren's empirical approach), as one line;
-    None when the problem has no backlash objective or no sized pin. The models differ
-    most in what they leave out (the bulk compression, the conformity), so the spread is
-    what a designer should read beside the one model the file chose."""
+    [D17], the conforming pin in its bore, Palmgren's empirical approach, Huth's pin in
+    its lug), as one line; None when the problem has no backlash objective or no sized
+    pin. A model the problem cannot evaluate (Huth's without ``[materials.lug]``) shows
+    ``n/a`` and the reason. The models differ most in what they leave out (the bulk
+    compression, the pin's bending, the conformity), so the spread is what a designer
+    should read beside the one model the file chose."""
     if problem is None or not design or "backlash" not in problem.objectives:
         return None
     if "d" not in problem.by_name:
