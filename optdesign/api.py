@@ -39,7 +39,7 @@ def solve(
     starts: int | None = None,
     seed: int | None = None,
     workers: int = 1,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
     agree: int | None = None,
@@ -65,8 +65,11 @@ def solve(
     workers
         Local processes for the starts (1..256).
     solver, options
-        Registered solver back-end (:func:`optdesign.solver_names`) and its options
-        (Ipopt's are checked by Ipopt before the solve).
+        Registered solver back-end (:func:`optdesign.solver_names`; None: the
+        formulation's default, :func:`optdesign.solvers.registry.default_solver` - Ipopt
+        for an NLP, Clarabel for a GP) and its options (checked as the back-end declares
+        before the solve: Ipopt's by Ipopt). A GP formulation given an NLP back-end
+        solves the GP with the default GP back-end and says so in a note.
     ranges
         Also compute the range of each variable over the optimal set (NLP optima).
     agree

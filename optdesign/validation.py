@@ -57,6 +57,7 @@ from optdesign.argument_checks import (  # noqa: F401
     unit,
     workers,
 )
+from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints, solver_names
 
 
 def formulation(argument: str, value: Any) -> str:
@@ -66,11 +67,9 @@ def formulation(argument: str, value: Any) -> str:
     return choice(argument, value, ["auto", *FORMULATIONS], "formulation")
 
 
-def solver(argument: str, value: Any) -> str:
-    """A registered solver back-end (NLP or GP)."""
-    from optdesign.solvers.registry import solver_names
-
-    return choice(argument, value, solver_names(), "solver")
+def solver(argument: str, value: Any) -> str | None:
+    """A registered solver back-end (NLP or GP); None: the formulation's default."""
+    return None if value is None else choice(argument, value, solver_names(), "solver")
 
 
 def method(argument: str, value: Any) -> str:
@@ -138,8 +137,9 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
 
 
 def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] | None:
-    """Options of a solver back-end: a mapping with string keys; Ipopt's are checked by
-    Ipopt itself (the check the problem file's ``[solver] ipopt`` gets)."""
+    """Options of a solver back-end (None: the registry's default for an NLP): a mapping
+    with string keys, checked as the back-end declares (Ipopt's by Ipopt itself, the
+    check the problem file's ``[solver] ipopt`` gets)."""
     if options is None:
         return None
     if not isinstance(options, Mapping):
@@ -147,10 +147,7 @@ def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] |
     for key in options:
         if not isinstance(key, str):
             raise ArgumentError(argument, f"option names are strings, got {shown(key)}")
-    if solver == "ipopt" and options:
-        from optdesign.solvers.casadi_nlp import check_ipopt_options
-
-        check_ipopt_options(dict(options), field=argument)
+    solver_hints(solver).check_options(options, argument)
     return dict(options)
 
 
@@ -193,7 +190,7 @@ def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
         "starts": (starts, (*eps, "weighted_sum")),
         "seed": (seed, ()),
         "agree": (agree, eps),
-        "solver": (lambda a, v: choice(a, v, ("slsqp", "ipopt"), "front solver"), eps),
+        "solver": (lambda a, v: choice(a, v, FRONT_SOLVERS.choices, "front solver"), eps),
         "spacing": (lambda a, v: choice(a, v, ("arc", "uniform"), "spacing"), ("epsilon",)),
         "eps_values": (_eps_values, eps),
         "retry_starts": (retries, eps),
@@ -389,7 +386,6 @@ def configs(argument: str, value: Any) -> list[str] | None:
     items = [s.strip() for item in names(argument, value) for s in item.split(",") if s.strip()]
     if not items:
         raise ArgumentError(argument, "give at least one configuration (or None for all)")
-    from optdesign.solvers.registry import solver_names
     from optdesign.studies.bench.configs import default_configs
 
     known = default_configs(include_hidden=True)

@@ -102,7 +102,7 @@ def run_pareto(args) -> int:
 
     problem = load_problem(args.file)
     check_front_problem(problem)  # before the output folder is made
-    solver_options(problem, "ipopt")
+    solver_options(problem)
     with as_options(RENAMED):  # the checks of optdesign.pareto, before any work
         objectives = check.front_objectives(problem, args.objectives)
         methods = list(METHOD_NAMES) if args.method == "all" else check.names("method", args.method)

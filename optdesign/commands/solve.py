@@ -27,8 +27,8 @@ def _solve(sub):
     p.add_argument(
         "--solver",
         type=checked(check.solver),
-        default="ipopt",
-        help="solver back-end (default ipopt)",
+        default=None,
+        help="solver back-end (default: the formulation's, ipopt for an NLP, clarabel for a GP)",
     )
     p.add_argument("--objective", default=None, help="objective to minimise (default: file's)")
     p.add_argument(
