@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers import SolverHints
+from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 
 #: What the back-end declares: the studies use these without naming it.
 HINTS = SolverHints(
