@@ -36,6 +36,7 @@ _EXPORTS: dict[str, str] = {
     "solve": "optdesign.api:solve",
     "pareto": "optdesign.api:pareto",
     "bench": "optdesign.api:bench",
+    "bench_configurations": "optdesign.api:bench_configurations",
     "report": "optdesign.api:report",
     "DesignProblem": "optdesign.problem.design_problem:DesignProblem",
     "Quantities": "optdesign.problem.quantities:Quantities",

@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 # The checks of one argument, re-exported: the CLI and the API call them as validation.X.
@@ -57,6 +58,7 @@ from optdesign.argument_checks import (  # noqa: F401
     unit,
     workers,
 )
+from optdesign.errors import InputError
 from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints, solver_names
 
 
@@ -186,7 +188,7 @@ def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
         "overwrite": (flag, ()),
         "progress": (flag, ()),
         "on_record": (_optional_function, ()),
-        "time_limit": (seconds, eps),
+        "time_limit": (seconds, ()),  # refused by front_time_limit where not applied
         "starts": (starts, (*eps, "weighted_sum")),
         "seed": (seed, ()),
         "agree": (agree, eps),
@@ -321,6 +323,64 @@ def method_for(problem: Any, method_: Any, argument: str = "method") -> None:
                 "weighted_sum would leave the catalogue: with catalogue variables use "
                 "epsilon or nsga2",
             )
+
+
+def front_problem(problem: Any) -> None:
+    """A problem a front can be traced on (a free variable), whose file's solver options
+    its back-ends accept: refused before any work."""
+    from optdesign.studies.nlp_solve import solver_options
+    from optdesign.studies.pareto.run_setup import check_front_problem
+
+    check_front_problem(problem)
+    solver_options(problem)
+
+
+def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> None:
+    """A front's time limit (``time_limit``, None: none) is applied by every method
+    named in ``methods``: only a continuous epsilon sweep stops at one (a method object
+    is checked when it runs)."""
+    if time_limit is None:
+        return
+    from optdesign.studies.pareto.catalogue_front import has_catalogue
+
+    named = [m for m in methods if isinstance(m, str)]
+    other = [m for m in named if m not in ("epsilon", "uniform")]
+    if other or (named and has_catalogue(problem)):
+        what = f"the {other[0]} method" if other else "a catalogue front"
+        raise ArgumentError(
+            "time_limit",
+            f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
+        )
+
+
+def solve_plan(problem: Any, formulation_: str = "auto", objective: str | None = None) -> str:
+    """The formulation :func:`optdesign.solve` will use for ``objective``, after the
+    checks that need no solve (the file's solver options, a combination no formulation
+    honours), so that a caller refuses before any work."""
+    from optdesign.studies.solve import plan_solve
+
+    return plan_solve(problem, formulation_, objective)
+
+
+def readme_file(argument: str, path: Any) -> Path | None:
+    """A file whose generated block a benchmark's summary replaces (None: none): a
+    regular UTF-8 text file with the markers, checked before any run (a FIFO,
+    /dev/zero, a folder or a file without the markers is refused at once, not after an
+    hour of runs)."""
+    if path is None:
+        return None
+    from optdesign.studies.bench.report import has_readme_markers, read_readme
+
+    path = Path(_optional_path(argument, path))
+    try:
+        text = read_readme(path, option=argument)
+    except ArgumentError:
+        raise
+    except InputError as exc:
+        raise ArgumentError(argument, exc.reason) from None
+    if not has_readme_markers(text):
+        raise ArgumentError(argument, f"{path} has no generated-block markers")
+    return path
 
 
 def front_objectives(problem: Any, objectives: Any, argument: str = "objectives") -> list[str]:
