@@ -169,6 +169,14 @@ def checked(check: Callable[[str, Any], Any], parse: Callable[[str], Any] = str)
     return convert
 
 
+def time_limit_option(parser: argparse.ArgumentParser, help: str, default: float | None = None):
+    """The ``--time-limit`` option of a command: seconds, checked as the API checks its
+    ``time_limit``."""
+    parser.add_argument(
+        "--time-limit", type=checked(validation.seconds, literal), default=default, help=help
+    )
+
+
 def bounded_int(lo: int, hi: int) -> Callable[[str], int]:
     """An argparse type: an integer from ``lo`` to ``hi`` (sizes are capped, so that a
     typo cannot start unbounded work)."""

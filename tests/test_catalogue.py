@@ -86,9 +86,10 @@ def test_catalogue_problem_is_never_solved_as_continuous():
 def test_node_solver_ipopt_options_file_wins_over_node_defaults():
     # Nodes enter Ipopt's restoration phase early (many boxes are infeasible); a problem
     # file's own [solver] ipopt options still decide, and a caller's override both.
-    from optdesign.studies.catalogue import NODE_IPOPT_OPTIONS, NodeSolver
+    from optdesign.solvers.registry import solver_hints
+    from optdesign.studies.catalogue import NodeSolver
 
-    assert NODE_IPOPT_OPTIONS["expect_infeasible_problem"] == "yes"
+    assert solver_hints("ipopt").node_options["expect_infeasible_problem"] == "yes"
     default = NodeSolver(_small_catalogue())
     assert default.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
     data = tomllib.loads(CATALOGUE.read_text())

@@ -213,6 +213,24 @@ def test_no_import_points_up_the_layers():
     assert upward == [], "upward imports:\n" + "\n".join(upward)
 
 
+def test_the_commands_enter_through_the_public_api():
+    """A command (optdesign/commands/*, cli.py) reaches the studies through optdesign.api
+    and optdesign.validation only (the checks and the computations ``od.solve``,
+    ``od.pareto``, ``od.bench`` run), never by importing a study itself; the reports and
+    plots it writes read the results."""
+    graph = import_graph()
+    direct = [
+        f"{m}:{line} imports {t}"
+        for m, arrows in sorted(graph.items())
+        if m == "optdesign.cli" or m.startswith("optdesign.commands")
+        for t, line in sorted(arrows.items())
+        if t.startswith("optdesign.studies")
+    ]
+    assert direct == [], "commands importing a study:\n" + "\n".join(direct)
+    assert "optdesign.api" in graph["optdesign.commands.pareto"]
+    assert "optdesign.api" in graph["optdesign.commands.bench"]
+
+
 def test_the_entry_points_are_still_there():
     # an allowed arrow that no longer exists is a stale exception: remove it from the list
     graph = import_graph()

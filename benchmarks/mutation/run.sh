@@ -38,7 +38,7 @@ if [ ${#MODULES[@]} -eq 0 ]; then
     optdesign/studies/relaxation.py
     optdesign/studies/catalogue.py
     optdesign/studies/pareto/*.py
-    optdesign/storage.py
+    optdesign/storage/*.py
     optdesign/units.py
     optdesign/reports/display_units.py
   )

@@ -43,6 +43,7 @@ from optdesign.solvers.multistart import (
     sobol_starts,
     start_outcome,
 )
+from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
@@ -64,15 +65,6 @@ def cannot_improve(bound: float, incumbent: float) -> bool:
 RETRY_STARTS = 4
 
 
-#: Ipopt options of the node NLPs. Many nodes of a catalogue search are infeasible boxes,
-#: and Ipopt's default filter spends ~120 iterations before its restoration phase proves
-#: it; ``expect_infeasible_problem`` enters restoration sooner, with the same nodes
-#: infeasible and the same optima (figures: benchmarks/README.md, "Catalogue searches:
-#: infeasible nodes"). A node still counts as infeasible only once all its starts and
-#: :data:`RETRY_STARTS` more say so.
-NODE_IPOPT_OPTIONS: dict[str, Any] = {"expect_infeasible_problem": "yes"}
-
-
 class NodeSolver:
     """Solve the problem's NLP on a sub-box of the catalogue variables.
 
@@ -88,7 +80,7 @@ class NodeSolver:
         objective: str | None = None,
         starts: int = 3,
         seed: int = 0,
-        plugin: str = "ipopt",
+        solver: str | None = None,
         options: Mapping[str, Any] | None = None,
         eps: Mapping[str, float] | None = None,
         free_rows: tuple[int, ...] = (),
@@ -101,10 +93,14 @@ class NodeSolver:
         self.eps = dict(eps or {})
         names = _objective_set(problem, self.objective)
         names = tuple(dict.fromkeys([*names, *sorted(self.eps)]))
-        if plugin == "ipopt":
-            # the node defaults, then the problem file's own Ipopt options, then the caller's
-            options = {**NODE_IPOPT_OPTIONS, **solver_options(problem, plugin), **(options or {})}
-        self.backend = solver_for(problem, plugin, options, names)
+        solver = self.solver = solver or default_solver("nlp")
+        node = solver_hints(solver).node_options
+        if node is not None:
+            # The back-end's node options (infeasible boxes are common; a node still
+            # counts as infeasible only once all its starts and RETRY_STARTS more say
+            # so), then the problem file's own options, then the caller's.
+            options = {**node, **solver_options(problem, solver), **(options or {})}
+        self.backend = solver_for(problem, solver, options, names)
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
         self.starts = max(1, starts)
@@ -254,7 +250,7 @@ def solve_catalogue(
     starts: int | None = None,
     seed: int | None = None,
     objective: str | None = None,
-    plugin: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     eps: Mapping[str, float] | None = None,
 ) -> Result:
@@ -289,7 +285,7 @@ def solve_catalogue(
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate or bnb")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
-    ns = NodeSolver(problem, objective, n_starts, seed, plugin, options, eps)
+    ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
     root = ns.solve({})
     info: dict[str, Any] = {
         "method": method,
@@ -316,7 +312,7 @@ def solve_catalogue(
             "failed" if relaxed_ok else "infeasible",
             float("nan"),
             {},
-            plugin,
+            ns.solver,
             f"catalogue-{method}",
             wall,
             message=(
@@ -407,7 +403,7 @@ def solve_catalogue_formulation(problem: DesignProblem, **options: Any) -> Resul
         starts=options.get("starts"),
         seed=options.get("seed"),
         objective=options.get("objective"),
-        plugin=options.get("solver") or "ipopt",
+        solver=options.get("solver"),
         options=options.get("options"),
     )
     return attach_reference(problem, result)

@@ -15,7 +15,7 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.registry import DEFAULT_SOLVERS, make_solver, solver_names
+from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp
 from optdesign.studies.reference import attach_reference, reference_design
@@ -38,7 +38,7 @@ def solve_gp_problem(
     compare_nlp: bool = True,
     nlp_starts: int | None = None,
     seed: int | None = None,
-    solver: str = "clarabel",
+    solver: str | None = None,
 ) -> Result:
     """GP solve of ``problem`` with certificate, exact check and exact-NLP comparison.
 
@@ -52,13 +52,14 @@ def solve_gp_problem(
     nlp_starts, seed
         Multistart of that NLP (default: the problem file's).
     solver
-        Registered GP back-end (``clarabel``, ``scs``).
+        Registered GP back-end (:func:`optdesign.solver_names` ``("gp")``; None: the
+        registry's default for a GP).
     """
     objective = objective or problem.objective_names[0]
     t0 = time.perf_counter()
     gp = require_gp(problem, objective)
     t_trace = time.perf_counter() - t0
-    backend = make_solver(gp, solver.lower())
+    backend = make_solver(gp, solver.lower() if solver else default_solver("gp"))
     if gp.infeasible:
         result = Result(
             "infeasible",
@@ -113,12 +114,15 @@ def solve_gp_problem(
 def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
     reference_design(problem)  # validate [reference] before solving
-    gp_solver = options.get("solver")
+    named = options.get("solver")
+    solver = solver_for_kind(named, "gp")
     result = solve_gp_problem(
         problem,
         objective=options.get("objective"),
         nlp_starts=options.get("starts"),
         seed=options.get("seed"),
-        solver=gp_solver if gp_solver in solver_names("gp") else DEFAULT_SOLVERS["gp"],
+        solver=solver,
     )
+    if named and named != solver:
+        result.notes.append(f"solver {named} solves NLPs: the GP was solved by {solver}")
     return attach_reference(problem, result)

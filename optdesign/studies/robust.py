@@ -172,7 +172,7 @@ def make_robust_solve(
     problem: DesignProblem,
     objective: str | None = None,
     samples: Samples | None = None,
-    plugin: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     risk: str | None = None,
     alpha: float | None = None,
@@ -181,8 +181,8 @@ def make_robust_solve(
 ):
     """Build the robust NLP and its solver once; return x0 -> Result."""
     nlp = build_robust_nlp(problem, objective, samples, risk, alpha, k, constrain_samples)
-    merged = {**solver_options(problem, plugin), **(options or {})}
-    return make_solver(nlp, plugin, merged).solve
+    merged = {**solver_options(problem, solver), **(options or {})}
+    return make_solver(nlp, solver, merged).solve
 
 
 def solve_robust(
@@ -196,11 +196,11 @@ def solve_robust(
     alpha: float | None = None,
     k: float | None = None,
     constrain_samples: bool = False,
-    plugin: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     workers: int = 1,
 ) -> Result:
-    """Robust optimum of ``problem`` (SAA of the ``[tolerances]``), multistart Ipopt.
+    """Robust optimum of ``problem`` (SAA of the ``[tolerances]``), multistart NLP.
 
     Parameters
     ----------
@@ -210,6 +210,8 @@ def solve_robust(
         Number of starts; the others are scrambled-Sobol points (``seed``).
     samples
         Fixed scatter samples (default: the file's ``tolerances.samples`` and ``seed``).
+    solver, options
+        Registered NLP back-end (None: the registry's default) and its options.
 
     Returns
     -------
@@ -227,7 +229,7 @@ def solve_robust(
     pts = start_points(problem, starts, seed, x0)
     t0 = time.perf_counter()
     solve = make_robust_solve(
-        problem, objective, samples, plugin, options, risk, alpha, k, constrain_samples
+        problem, objective, samples, solver, options, risk, alpha, k, constrain_samples
     )
     build_s = time.perf_counter() - t0
     result = multistart(solve, pts, workers=workers, seed=seed, parallel_map=map_inherited)
@@ -259,19 +261,19 @@ def solve_robust_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="robust"``: the nominal optimum (multistart), then the robust optimum
     started from it."""
     objective = options.get("objective") or problem.objective_names[0]
-    plugin = options.get("solver") or "ipopt"
+    solver = options.get("solver")
     nominal = solve_nlp(
         problem,
         objective=objective,
         starts=options.get("starts"),
         seed=options.get("seed"),
         workers=options.get("workers") or 1,
-        solver=plugin,
+        solver=solver,
         options=options.get("options"),
     )
     x0 = np.array([nominal.design[v.name] for v in problem.free]) if nominal.design else None
     result = solve_robust(
-        problem, x0=x0, objective=objective, plugin=plugin, options=options.get("options")
+        problem, x0=x0, objective=objective, solver=solver, options=options.get("options")
     )
     result.extra["nominal_optimum"] = {
         "status": nominal.status,

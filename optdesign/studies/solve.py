@@ -182,7 +182,7 @@ def plan_solve(
     no solve (the file's Ipopt options, a combination no formulation honours), so that a
     caller can refuse before any work."""
     name = choose_formulation(problem, requested, objective)
-    solver_options(problem, "ipopt")
+    solver_options(problem)  # the file's options of the default NLP back-end, checked
     if name == "catalogue" and problem.spec.tolerances is not None and problem.free:
         disc = ", ".join(v.name for v in problem.free if v.discrete)
         raise ProblemError(
@@ -199,7 +199,7 @@ def solve(
     starts: int | None = None,
     seed: int | None = None,
     workers: int = 1,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
     diagnose: bool = True,
@@ -236,7 +236,7 @@ def _solve_within(
     starts: int | None,
     seed: int | None,
     workers: int,
-    solver: str,
+    solver: str | None,
     options: Mapping[str, Any] | None,
     time_limit: float | None,
     extra: dict[str, Any],

@@ -17,6 +17,7 @@ from typing import Any
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.diagnosis import diagnose
 from optdesign.studies.pareto.chains import check_anchor
@@ -126,7 +127,7 @@ class CatalogueEpsilon:
         key = run_key(
             problem,
             objectives,
-            "ipopt",
+            FRONT_SOLVERS.fallback,
             method=self.name,
             points=self.points,
             starts=starts,

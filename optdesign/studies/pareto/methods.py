@@ -30,6 +30,7 @@ import numpy as np
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, has_catalogue
 from optdesign.studies.pareto.chains import (
@@ -78,7 +79,10 @@ class EpsilonConstraint:
     agree
         An anchor's multistart stops once this many starts agree (None: all starts).
     solver
-        ``"slsqp"`` (SLSQP sweep, Ipopt fallback and tie-breaks) or ``"ipopt"``.
+        The sweep's back-end, one of the registry's
+        :data:`~optdesign.solvers.registry.FRONT_SOLVERS` choices: its primary (default,
+        ``"slsqp"``: SLSQP sweep, Ipopt fallback and tie-breaks) or its fallback
+        (``"ipopt"`` throughout).
     retry_starts, extra_starts
         Sobol starts for a point that fails, worsens or jumps; at every point.
     deterministic
@@ -93,7 +97,7 @@ class EpsilonConstraint:
     starts: int | None = None
     seed: int | None = None
     agree: int | None = 3
-    solver: str = "slsqp"
+    solver: str = FRONT_SOLVERS.primary
     retry_starts: int = 4
     extra_starts: int = 0
     deterministic: bool = False
@@ -250,14 +254,14 @@ class WeightedSum:
         key = run_key(
             problem,
             objectives,
-            "ipopt",
+            FRONT_SOLVERS.fallback,
             method="weighted_sum",
             n=self.points,
             starts=starts,
             seed=seed,
         )
         check = record_check(problem, objectives)
-        common = _common(problem, objectives, "ipopt")
+        common = _common(problem, objectives, FRONT_SOLVERS.fallback)
         done = run_tasks(
             anchor_tasks(common, objectives, starts, seed, 3),
             front_task,

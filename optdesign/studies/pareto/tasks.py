@@ -33,7 +33,7 @@ ANCHOR_SLACK = 1e-7
 
 
 def _solver(task: Mapping[str, Any]) -> EpsSolver:
-    return EpsSolver(task["problem"], task["objectives"], task.get("solver", "slsqp"))
+    return EpsSolver(task["problem"], task["objectives"], task.get("solver"))
 
 
 def _records(deps: Mapping[str, Any]) -> dict[str, PointRecord]:
@@ -73,7 +73,7 @@ def multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
     # No per-start Ipopt fallback first: a start that fails is just a failed start.
     results, n_at_best = run(False)
     n_solves = len(results)
-    if n_at_best == 0 and solver.method == "slsqp":
+    if n_at_best == 0 and solver.has_fallback:
         results, n_at_best = run(True)
         n_solves += len(results)
     best, n_at_best = best_of(results)
@@ -229,7 +229,7 @@ def weighted_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str,
     coefs = {k: w / max(normalise[k][1] - normalise[k][0], 1e-300) for k, w in weights.items()}
     start = solver.start_from(nb if nb is not None and nb.ok else None, task["x0"])
     target = solver.nlp.target(coefs)
-    res = solver.backend("ipopt").solve(start, target, solver.nlp.bounds())
+    res = solver.backend("fallback").solve(start, target, solver.nlp.bounds())
     rec = _record(task, solver, res, "weighted_sum", next(iter(weights)), {})
     rec.weights = dict(weights)
     rec.wall_time_s = time.perf_counter() - t0
