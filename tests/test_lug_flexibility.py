@@ -273,8 +273,8 @@ def test_spread_on_the_command_line(tmp_path, json_mode):
     path = tmp_path / "fin_lug.toml"
     path.write_text(text)
     args = [sys.executable, "-m", "optdesign", "solve", str(path), "--contact-models"]
-    args += ["--no-ranges"] + (["--json"] if json_mode else [])
-    run = subprocess.run(args, capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    args += ["--no-ranges", "--out", str(tmp_path / "out")] + (["--json"] if json_mode else [])
+    run = subprocess.run(args, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     notes = json.loads(run.stdout)["notes"] if json_mode else [run.stdout]
     line = next(n for n in notes if "backlash by pin contact model" in n)
