@@ -101,6 +101,14 @@ def solve_gp_problem(
             "starts": nlp.multistart.n_starts if nlp.multistart else 1,
         }
         result.extra["gap_gp_nlp_rel"] = gap
+        if nlp.success and nlp.solver == "ipopt":
+            from optdesign.studies.sensitivity import nlp_sensitivities
+
+            result.sensitivities = nlp_sensitivities(problem, nlp)
+            if result.sensitivities:
+                result.notes.append(
+                    "sensitivities: of the exact NLP's optimum, from Ipopt's multipliers"
+                )
         exact_at_gp = result.objectives.get(objective, float("nan"))
         result.notes.append(
             f"exact NLP (exact Hertz) optimum {nlp.objective:.8g} ({nlp.status}, "

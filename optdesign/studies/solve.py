@@ -273,6 +273,13 @@ def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: 
             text = " ".join(str(exc).split())[:300]
             result.diagnosis = Diagnosis(note=f"not computed: {type(exc).__name__}: {text}")
     continuous = result.formulation.startswith("nlp") and not any(v.discrete for v in problem.free)
+    if result.success and continuous and result.solver == "ipopt" and "lam_g" in result.raw:
+        try:  # what each requirement costs, from Ipopt's multipliers
+            from optdesign.studies.sensitivity import nlp_sensitivities
+
+            result.sensitivities = nlp_sensitivities(problem, result)
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.notes.append(f"sensitivities not computed: {exc}")
     if ranges and result.success and continuous and result.design and "z" in result.raw:
         try:
             result.ranges = optimal_ranges(problem, result, solver=solver, options=options)
