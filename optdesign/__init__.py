@@ -37,6 +37,8 @@ _EXPORTS: dict[str, str] = {
     "pareto": "optdesign.api:pareto",
     "bench": "optdesign.api:bench",
     "report": "optdesign.api:report",
+    "sweep": "optdesign.api:sweep",
+    "Sweep": "optdesign.studies.sweep:Sweep",
     "DesignProblem": "optdesign.problem.design_problem:DesignProblem",
     "Quantities": "optdesign.problem.quantities:Quantities",
     "Result": "optdesign.solvers.result:Result",
