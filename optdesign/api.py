@@ -267,6 +267,7 @@ def sweep(
     resume: bool = False,
     overwrite: bool = False,
     progress: bool = False,
+    sensitivities: bool = False,
 ):
     """How the optimum of ``problem`` moves when one or two parameters change.
 
@@ -281,6 +282,8 @@ def sweep(
     set changes (``starts``, ``seed``: that multistart, default the file's). The points
     go to ``out/sweep.jsonl`` as they finish (a new temporary folder by default);
     ``resume`` continues a stored sweep, ``overwrite`` starts afresh over one.
+    ``sensitivities``: also each point's log-sensitivities to every binding requirement
+    (``point.sensitivities``, :attr:`optdesign.Result.sensitivities`).
 
     Returns
     -------
@@ -297,6 +300,7 @@ def sweep(
     resume = validation.flag("resume", resume)
     overwrite = validation.flag("overwrite", overwrite)
     progress = validation.flag("progress", progress)
+    sensitivities = validation.flag("sensitivities", sensitivities)
     validation.run_folder(out, resume, overwrite)
     problem = load(problem)
     validation.objective_of(problem, objective)
@@ -311,4 +315,5 @@ def sweep(
         resume=resume,
         overwrite=overwrite,
         progress=progress,
+        sensitivities=sensitivities,
     )

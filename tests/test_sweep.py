@@ -21,7 +21,8 @@ HINGE = "requirements.hinge_moment"
 @pytest.fixture(scope="module")
 def fork_sweep(tmp_path_factory):
     out = tmp_path_factory.mktemp("sweep")
-    return od.sweep(FORK, {HINGE: ("200 N*m", "1000 N*m", 5)}, out=out, check_every=3), out
+    vary = {HINGE: ("200 N*m", "1000 N*m", 5)}
+    return od.sweep(FORK, vary, out=out, check_every=3, sensitivities=True), out
 
 
 def test_every_point_equals_an_independent_multistart(fork_sweep):
@@ -72,7 +73,8 @@ def test_resume_reuses_the_stored_points(fork_sweep):
     sweep, out = fork_sweep
     store = out / "sweep.jsonl"
     lines = store.read_text().splitlines()
-    again = od.sweep(FORK, {HINGE: ("200 N*m", "1000 N*m", 5)}, out=out, check_every=3, resume=True)
+    vary = {HINGE: ("200 N*m", "1000 N*m", 5)}
+    again = od.sweep(FORK, vary, out=out, check_every=3, resume=True, sensitivities=True)
     assert store.read_text().splitlines() == lines  # nothing solved again
     assert [p.objective for p in again.points] == [p.objective for p in sweep.points]
     # another range is another run: refused, naming what changed
@@ -89,12 +91,12 @@ def test_an_infeasible_point_says_what_fails(tmp_path):
     )
     ok, bad = sweep.points
     assert ok.success and ok.active == ["d.upper", "nut_travel"]
-    assert bad.status == "infeasible" and not bad.success
+    assert not bad.success  # the best design found violates the requirements
     assert any("pin_bearing_pressure" in v for v in bad.violated)
     text = sweep.summary()
     assert "infeasible points (what fails at the best design found):" in text
     row = next(line for line in text.splitlines() if line.startswith("1 "))
-    assert row.split()[:4] == ["1", "15000", "-", "-"] and "infeasible" in row
+    assert row.split()[:4] == ["1", "15000", "-", "-"] and bad.status in row
     y = sweep.plot().axes[0].lines[0].get_ydata()
     assert np.isnan(y[1]) and np.isfinite(y[0])  # nothing drawn where nothing is feasible
 
@@ -205,3 +207,30 @@ def test_cli_writes_the_table_chart_and_json(tmp_path, capsys):
     assert [p["status"] for p in doc["points"]] == ["optimal"] * 3
     assert main(["sweep", str(FORK), "--vary", "requirements.hinge_moment=1..2mm:3"]) == 2
     assert "--vary.requirements.hinge_moment start: '1 mm' is a length" in capsys.readouterr().err
+
+
+def test_one_nlp_for_loads_and_limits_its_own_for_the_rest(tmp_path):
+    from optdesign.studies.sweep_solver import sweep_mode
+
+    problem = od.load(FORK)
+    assert sweep_mode(problem, [HINGE], [(2e5, 1e6)]) == "shared"  # a parameter of the NLP
+    assert sweep_mode(problem, ["requirements.nut_travel_max"], [(100.0, 120.0)]) == "shared"
+    # the stroke moves the grid, a bound the variables' scaling: each point its own NLP
+    assert sweep_mode(problem, ["requirements.deflection.max"], [(0.4, 0.6)]) == "rebuild"
+    assert sweep_mode(problem, ["variables.R.upper"], [(90.0, 110.0)]) == "rebuild"
+    # the hinge moment also sets the pin's load in the contact model: not a limit
+    assert (
+        sweep_mode(
+            problem,
+            ["requirements.hinge_moment", "requirements.nut_travel_max"],
+            [(2e5, 1e6), (100.0, 120.0)],
+        )
+        == "shared"
+    )
+    sweep = od.sweep(
+        problem, {"requirements.nut_travel_max": ("100 mm", "120 mm", 3)}, out=tmp_path
+    )
+    for p in sweep.points:
+        alone = solve_nlp(at_values(problem, {"requirements.nut_travel_max": p.values[0]}))
+        assert p.objective == pytest.approx(alone.objective, rel=1e-6)
+        assert "nut_travel" in p.active

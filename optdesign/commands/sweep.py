@@ -80,6 +80,11 @@ def _sweep(sub):
     p.add_argument(
         "--overwrite", action="store_true", help="start afresh over a stored sweep in --out"
     )
+    p.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="also each point's log-sensitivity to every binding requirement (in sweep.json)",
+    )
     p.add_argument("--json", action="store_true", help="print sweep.json to stdout")
     p.add_argument("--no-plot", action="store_true", help="skip the design chart sweep.png")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -118,6 +123,7 @@ def run_sweep_command(args) -> int:
                 resume=args.resume,
                 overwrite=args.overwrite,
                 progress=not args.no_progress and not args.json,
+                sensitivities=args.sensitivities,
             )
         return _write(args, sweep, out)
 
@@ -137,6 +143,9 @@ def sweep_document(sweep) -> dict:
             "axes": [{"path": a.path, "unit": a.unit, "values": list(a.shown)} for a in sweep.axes],
             "units": {c[0]: c[1] for c in sweep_columns(sweep) if c[1]},
             "points": [dict(zip(headers, r, strict=True)) for r in rows],
+            "sensitivities": [p.sensitivities for p in sweep.points]
+            if any(p.sensitivities for p in sweep.points)
+            else None,
             "wall_time": {"value": sweep.wall_time_s, "unit": "s"},
             "notes": sweep.notes,
         }

@@ -83,17 +83,19 @@ def with_requirement(problem: DesignProblem, path: str, value: float) -> DesignP
     return new
 
 
-def nlp_sensitivities(problem: DesignProblem, result: Result) -> list[Sensitivity]:
+def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[Sensitivity]:
     """The sensitivities of an NLP optimum (``result`` of :func:`solve_nlp` with Ipopt's
     multipliers in ``result.raw``), ranked by the size of their log-sensitivity (what
-    costs most first); empty when the result carries no multipliers."""
+    costs most first); empty when the result carries no multipliers. ``nlp``: the
+    formulation that solved it (default: the problem's own)."""
     from optdesign.studies.nlp_solve import _objective_set, formulation_for
 
     raw = result.raw
     if not result.success or "lam_g" not in raw or "lam_x" not in raw:
         return []
     objective = result.objective_name or problem.objective_names[0]
-    nlp = formulation_for(problem, _objective_set(problem, objective))
+    if nlp is None:
+        nlp = formulation_for(problem, _objective_set(problem, objective))
     lam_g = np.asarray(raw["lam_g"], dtype=float)
     lam_x = np.asarray(raw["lam_x"], dtype=float)
     if len(lam_g) != len(nlp.g_names) or len(lam_x) != len(nlp.lbz):

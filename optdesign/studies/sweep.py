@@ -325,9 +325,13 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         )
         solves, checked = 1, True
     else:
+        shared = _shared_solver(task)
         if prev is not None and prev.get("design"):
             x0 = np.array([prev["design"][v.name] for v in problem.free])
-            warm = solve_nlp(problem, objective, starts=1, x0=x0)
+            if shared is not None:
+                warm = shared.warm(problem, x0)
+            else:
+                warm = solve_nlp(problem, objective, starts=1, x0=x0)
             solves += 1
         best = warm
         changed = (
@@ -337,7 +341,10 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         )
         checked = changed or task["index"] % task["check_every"] == 0 or task["last"]
         if checked:
-            full = solve_nlp(problem, objective, starts=task["starts"], seed=task["seed"])
+            if shared is not None:
+                full = shared.multistart(problem, task["starts"], task["seed"])
+            else:
+                full = solve_nlp(problem, objective, starts=task["starts"], seed=task["seed"])
             solves += full.multistart.n_starts if full.multistart else 1
             if best is None or _better(full, best):
                 best = full
@@ -369,11 +376,12 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         "warm_objective": None if warm is None else float(warm.objective),
         "sensitivities": {},
     }
-    if best.success and best.solver == "ipopt" and "lam_g" in best.raw:
+    if task["sensitivities"] and best.success and best.solver == "ipopt" and "lam_g" in best.raw:
         from optdesign.studies.sensitivity import nlp_sensitivities
 
+        nlp = shared.nlp if task["continuation"] and shared is not None else None
         try:
-            sens = nlp_sensitivities(problem, best)
+            sens = nlp_sensitivities(problem, best, nlp=nlp)
         except Exception:  # a report: never lose the point
             sens = []
         record["sensitivities"] = {
@@ -381,6 +389,19 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         }
     record["time_s"] = time.perf_counter() - t0
     return record
+
+
+def _shared_solver(task: Mapping[str, Any]):
+    """The sweep's one NLP (:mod:`optdesign.studies.sweep_solver`), built once per
+    process; None when each point builds its own (mode ``"rebuild"``)."""
+    if task["mode"] != "shared":
+        return None
+    from optdesign.studies.runner import cached
+    from optdesign.studies.sweep_solver import SweepSolver
+
+    base = task["problem"]
+    key = ("sweep-solver", base.token, tuple(task["paths"]), task["objective"])
+    return cached(key, lambda: SweepSolver(base, task["paths"], task["objective"]))
 
 
 def _better(a, b) -> bool:
@@ -415,6 +436,7 @@ def run_sweep(
     resume: bool = False,
     overwrite: bool = False,
     progress: bool = False,
+    sensitivities: bool = False,
 ) -> Sweep:
     """The sweep of :func:`optdesign.sweep` (arguments checked there)."""
     from optdesign.studies.identity import problem_digest, solver_identity, version
@@ -426,10 +448,14 @@ def run_sweep(
     if isinstance(check_every, bool) or not isinstance(check_every, int) or check_every < 1:
         raise InputError("check_every", f"a positive integer, got {check_every!r}")
     cont = continuable(problem)
+    from optdesign.studies.sweep_solver import sweep_mode
+
+    paths = [a.path for a in axes]
+    mode = sweep_mode(problem, paths, [(a.values[0], a.values[-1]) for a in axes])
+    mode = mode if cont else "formulation"
     starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
     order = grid_order(axes)
-    paths = [a.path for a in axes]
     tasks = []
     for k, idx in enumerate(order):
         tasks.append(
@@ -443,6 +469,8 @@ def run_sweep(
                 "last": k == len(order) - 1,
                 "objective": objective,
                 "continuation": cont,
+                "mode": mode,
+                "sensitivities": bool(sensitivities),
                 "check_every": check_every,
                 "starts": starts,
                 "seed": seed,
@@ -455,6 +483,8 @@ def run_sweep(
             "sweep": {a.path: list(a.values) for a in axes},
             "check_every": check_every,
             "continuation": cont,
+            "mode": mode,
+            "sensitivities": bool(sensitivities),
             "starts": starts,
             "seed": seed,
         },
@@ -501,6 +531,8 @@ def run_sweep(
             "catalogue variables or tolerances: every point solved by its formulation, "
             "no continuation"
         )
+    if mode == "rebuild":
+        notes.append("each point builds its own NLP (the swept parameter changes the model)")
     return Sweep(problem, objective, axes, points, time.perf_counter() - t0, cont, store, notes)
 
 
