@@ -124,3 +124,27 @@ def test_every_shipped_problem_every_objective(name):
         _check_against_resolves(problem, result)
         checked += 1
     assert checked >= 3
+
+
+def test_the_gps_own_duals_agree(fork):
+    # A GP in log space: the dual of the row posy(x)/L <= 1 is -d log(optimum)/d log(L),
+    # the log-sensitivity, computed by cvxpy from the GP alone (first-order Hertz, where
+    # the NLP's is exact: 0.5 % apart on the pin's pressure, 2e-5 on the travel)
+    import numpy as np
+
+    from optdesign.formulations.gp import build_gp, to_cvxpy
+
+    problem, result = fork
+    prob, _, _, cons = to_cvxpy(build_gp(problem, "backlash"))
+    prob.solve(gp=True, solver="CLARABEL")
+    duals: dict[str, float] = {}
+    for row, con in cons:
+        if row.kind == "upper" and con.dual_value is not None:
+            duals[row.name] = duals.get(row.name, 0.0) + float(np.asarray(con.dual_value))
+    ours = {s.name: s.log_sensitivity for s in result.sensitivities}
+    assert ours["requirements.nut_travel_max"] == pytest.approx(-duals["nut_travel"], rel=1e-3)
+    assert ours["requirements.pin_bearing_pressure_max"] == pytest.approx(
+        -duals["pin_bearing_pressure"], rel=0.01
+    )
+    assert duals["pin_shear_stress"] < 1e-6  # not binding: no cost in either
+    assert "requirements.pin_shear_stress_max" not in ours

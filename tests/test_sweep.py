@@ -234,3 +234,16 @@ def test_one_nlp_for_loads_and_limits_its_own_for_the_rest(tmp_path):
         alone = solve_nlp(at_values(problem, {"requirements.nut_travel_max": p.values[0]}))
         assert p.objective == pytest.approx(alone.objective, rel=1e-6)
         assert "nut_travel" in p.active
+
+
+def test_a_catalogue_problem_is_swept_point_by_point_and_item_changes_marked(tmp_path):
+    problem = od.load(PROBLEMS / "cs_min_backlash_catalogue.toml")
+    sweep = od.sweep(problem, {HINGE: ("400 N*m", "600 N*m", 2)}, starts=1, out=tmp_path)
+    assert not sweep.continuation and "no continuation" in sweep.notes[0]
+    first, second = sweep.points
+    # the pin steps up one catalogue size (ISO 2338: 6 -> 8 mm); the binding set is the same
+    assert (first.design["d"], second.design["d"]) == (6.0, 8.0)
+    assert first.active == second.active == ["nut_travel"]
+    assert (first.active_change, second.active_change) == (False, True)
+    at_600 = od.solve(at_values(problem, {HINGE: 600e3}), starts=1, ranges=False)
+    assert second.objective == pytest.approx(at_600.objective, rel=1e-9)

@@ -60,7 +60,7 @@ def plot_sweep(sweep: Any):
     fig.suptitle(
         plain(
             f"{problem.name}: optimum against {axis.label} "
-            f"(dotted: binding set changes ({changes}); grey: infeasible)"
+            f"(dotted: binding set or item changes ({changes}); grey: infeasible)"
         ),
         fontsize=9,
     )

@@ -96,7 +96,7 @@ def sweep_summary(sweep: Any) -> str:
     # an infeasible point's numbers are of the best design found, not an optimum: "-"
     first = 1 + len(sweep.axes)  # the point and the parameters are shown for every point
     cells = [
-        [_cell(r[i]) if p.success or i < first or headers[i] == "status" else "-" for i in keep]
+        [_cell(r[i]) if p.success or i < first or headers[i] in _ALWAYS else "-" for i in keep]
         for r, p in zip(rows, sweep.points, strict=True)
     ]
     lines += ["", format_table([headers[i] for i in keep], cells)]
@@ -116,6 +116,10 @@ def sweep_summary(sweep: Any) -> str:
     if sweep.store is not None:
         lines += ["", f"store     {printable(sweep.store)}"]
     return "\n".join(lines)
+
+
+#: Columns shown for an infeasible point too.
+_ALWAYS = ("status", "multistart_check")
 
 
 def _cell(v: Any) -> str:

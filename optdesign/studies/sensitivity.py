@@ -28,11 +28,12 @@ multiplier in the problem's units is ``lam_x * T / x_span`` and ``dv*/d(bound) =
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
 
+from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.result import Result, Sensitivity
 
@@ -232,6 +233,25 @@ def with_bound(problem: DesignProblem, name: str, side: str, value: float) -> De
     new.by_name = {v.name: v for v in new.variables}
     new._touch()
     return new
+
+
+def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProblem:
+    """A copy of ``problem`` with each parameter path at its value (internal units)."""
+    for path, value in values.items():
+        head, _, rest = path.partition(".")
+        if head == "requirements":
+            problem = with_requirement(problem, rest, value)
+        else:
+            name, _, side = rest.partition(".")
+            problem = with_bound(problem, name, side or "value", value)
+            var = problem.by_name[name]
+            if var.free and not var.lower < var.upper:
+                raise InputError(
+                    f"vary.{path}",
+                    f"{name}'s lower bound {var.lower:g} is not below its upper "
+                    f"bound {var.upper:g} {var.unit}",
+                )
+    return problem
 
 
 def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:

@@ -33,7 +33,7 @@ import numpy as np
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.studies.sensitivity import with_bound, with_requirement
+from optdesign.studies.sensitivity import at_values
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: Most parameters of one sweep, and most points along one parameter.
@@ -69,7 +69,11 @@ class Axis:
 
 @dataclass
 class SweepPoint:
-    """One point of a sweep (see the record written by :func:`sweep_point`)."""
+    """One point of a sweep (see the record written by :func:`sweep_point`).
+
+    ``active_change``: the binding set or a catalogue item differs from the point before
+    it in the sweep's order (both solved); ``checked``: a full multistart checked it;
+    ``jump``: that multistart found a better optimum than the warm start."""
 
     index: int
     values: tuple[float, ...]
@@ -192,25 +196,6 @@ def _known(problem: DesignProblem) -> str:
     return "known: " + ", ".join(v.name for v in problem.variables)
 
 
-def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProblem:
-    """A copy of ``problem`` with each parameter path at its value (internal units)."""
-    for path, value in values.items():
-        head, _, rest = path.partition(".")
-        if head == "requirements":
-            problem = with_requirement(problem, rest, value)
-        else:
-            name, _, side = rest.partition(".")
-            problem = with_bound(problem, name, side or "value", value)
-            var = problem.by_name[name]
-            if var.free and not var.lower < var.upper:
-                raise InputError(
-                    f"vary.{path}",
-                    f"{name}'s lower bound {var.lower:g} is not below its upper "
-                    f"bound {var.upper:g} {var.unit}",
-                )
-    return problem
-
-
 def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
     """The axes of ``vary`` (``{path: (start, stop, count)}``), checked: a known parameter
     path, quantities of its dimension (a bare number only for a plain number), a range
@@ -321,7 +306,7 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
             starts=task["starts"],
             seed=task["seed"],
             ranges=False,
-            diagnose=False,
+            diagnose=True,  # an infeasible point: what to relax (no design to show)
         )
         solves, checked = 1, True
     else:
@@ -365,12 +350,6 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         "violated": [] if best.success else _violated(problem, best),
         "checked": bool(checked),
         "jump": jump,
-        "active_change": bool(
-            prev is not None
-            and best.success
-            and prev.get("success")
-            and active != prev.get("active")
-        ),
         "success": best.success,
         "solves": solves,
         "warm_objective": None if warm is None else float(warm.objective),
@@ -414,8 +393,12 @@ def _better(a, b) -> bool:
 
 def _violated(problem: DesignProblem, result) -> list[str]:
     """What fails at the best design found: the violated requirements as read."""
-    from optdesign.reports.limits import limits_of
+    from optdesign.reports.limits import limits_of, relaxation_limits, relaxation_text
 
+    diagnosis = result.diagnosis
+    if not result.violated and diagnosis is not None and diagnosis.relaxations:
+        relax = relaxation_limits(problem, diagnosis.relaxations)
+        return ["relax one of: " + "; ".join(relaxation_text(lim) for lim in relax)]
     if not result.violated:
         return [f"no design found ({result.status})"]
     return [lim.text() for lim in limits_of(problem, result.violated)][:10] or [
@@ -460,7 +443,7 @@ def run_sweep(
     for k, idx in enumerate(order):
         tasks.append(
             {
-                "id": "p" + "-".join(f"{i:04d}" for i in idx),
+                "id": _point_id(idx),
                 "after": [tasks[-1]["id"]] if tasks and cont else [],
                 "problem": problem,
                 "paths": paths,
@@ -507,7 +490,7 @@ def run_sweep(
     by_grid = sorted(order, key=lambda idx: tuple(reversed(idx)))
     points = []
     for idx in by_grid:
-        rec = records["p" + "-".join(f"{i:04d}" for i in idx)]
+        rec = records[_point_id(idx)]
         points.append(
             SweepPoint(
                 index=rec["index"],
@@ -519,7 +502,7 @@ def run_sweep(
                 violated=list(rec["violated"]),
                 checked=rec["checked"],
                 jump=rec["jump"],
-                active_change=rec["active_change"],
+                active_change=_changed(problem, records, order, idx),
                 solves=rec["solves"],
                 time_s=rec["time_s"],
                 sensitivities=dict(rec.get("sensitivities") or {}),
@@ -534,6 +517,26 @@ def run_sweep(
     if mode == "rebuild":
         notes.append("each point builds its own NLP (the swept parameter changes the model)")
     return Sweep(problem, objective, axes, points, time.perf_counter() - t0, cont, store, notes)
+
+
+def _changed(problem: DesignProblem, records, order, idx) -> bool:
+    """The binding set or a catalogue item differs from the point before in the sweep's
+    order (both solved)."""
+    k = order.index(idx)
+    if k == 0:
+        return False
+    rec = records[_point_id(idx)]
+    prev = records[_point_id(order[k - 1])]
+    if not (rec["success"] and prev["success"]):
+        return False
+    items = [v.name for v in problem.free if v.discrete]
+    return rec["active"] != prev["active"] or any(
+        rec["design"].get(n) != prev["design"].get(n) for n in items
+    )
+
+
+def _point_id(idx) -> str:
+    return "p" + "-".join(f"{i:04d}" for i in idx)
 
 
 def _float(v: Any) -> float:
