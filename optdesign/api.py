@@ -268,6 +268,8 @@ def sweep(
     overwrite: bool = False,
     progress: bool = False,
     sensitivities: bool = False,
+    workers: int = 1,
+    scheduler: str | None = None,
 ):
     """How the optimum of ``problem`` moves when one or two parameters change.
 
@@ -282,6 +284,9 @@ def sweep(
     set changes (``starts``, ``seed``: that multistart, default the file's). The points
     go to ``out/sweep.jsonl`` as they finish (a new temporary folder by default);
     ``resume`` continues a stored sweep, ``overwrite`` starts afresh over one.
+    ``workers`` (local processes) or ``scheduler`` (a Dask scheduler's address): the
+    rows of a two-parameter sweep, or the points of a catalogue problem, side by side
+    (one row is one chain of warm starts; the records are the same for any number).
     ``sensitivities``: also each point's log-sensitivities to every binding requirement
     (``point.sensitivities``, :attr:`optdesign.Result.sensitivities`).
 
@@ -301,6 +306,8 @@ def sweep(
     overwrite = validation.flag("overwrite", overwrite)
     progress = validation.flag("progress", progress)
     sensitivities = validation.flag("sensitivities", sensitivities)
+    workers = validation.workers("workers", workers)
+    scheduler = validation.text("scheduler", scheduler, optional=True)
     validation.run_folder(out, resume, overwrite)
     problem = load(problem)
     validation.objective_of(problem, objective)
@@ -316,4 +323,6 @@ def sweep(
         overwrite=overwrite,
         progress=progress,
         sensitivities=sensitivities,
+        workers=workers,
+        scheduler=scheduler,
     )

@@ -11,7 +11,7 @@ import optdesign as od
 from optdesign.cli import main
 from optdesign.commands.sweep import parse_vary
 from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.sweep import at_values, grid_order, sweep_axes
+from optdesign.studies.sweep import at_values, grid_order, neighbour, sweep_axes
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 FORK = PROBLEMS / "fork_min_backlash.toml"
@@ -111,8 +111,16 @@ def test_two_parameters_snake_through_the_grid(tmp_path):
     # R's upper bound of 90 mm binds (the free optimum has R = 95.3 mm), 110 mm does not
     assert "R.upper" in sweep.points[0].active and "R.upper" not in sweep.points[2].active
     assert sweep.points[0].objective > sweep.points[2].objective
-    assert grid_order(sweep.axes) == [(0, 0), (1, 0), (1, 1), (0, 1)]
+    assert grid_order(sweep.axes) == [(0, 0), (1, 0), (0, 1), (1, 1)]
+    # each row a chain; a row's first point continues from the row before's first point
+    assert [neighbour(i) for i in grid_order(sweep.axes)] == [None, (0, 0), (0, 0), (0, 1)]
     assert sweep.plot().axes[0].get_xlabel() == "hinge_moment [N*m]"
+    # two workers run the rows side by side: the same records, whatever the timing
+    vary = {HINGE: ("400 N*m", "600 N*m", 2), "variables.R.upper": ("90 mm", "110 mm", 2)}
+    again = od.sweep(FORK, vary, out=tmp_path / "w2", workers=2)
+    assert [(p.objective, p.design, p.active) for p in again.points] == [
+        (p.objective, p.design, p.active) for p in sweep.points
+    ]
 
 
 @pytest.mark.parametrize(
@@ -247,3 +255,28 @@ def test_a_catalogue_problem_is_swept_point_by_point_and_item_changes_marked(tmp
     assert (first.active_change, second.active_change) == (False, True)
     at_600 = od.solve(at_values(problem, {HINGE: 600e3}), starts=1, ranges=False)
     assert second.objective == pytest.approx(at_600.objective, rel=1e-9)
+
+
+def test_a_worse_warm_start_is_caught_as_a_jump(tmp_path, monkeypatch):
+    # The warm start made to end 1 % above the optimum (as if the chain had followed a
+    # local optimum): the multistart check of every point finds the better one, marks
+    # the jump and the chain goes on from it.
+    import dataclasses
+
+    from optdesign.studies.sweep_solver import SweepSolver
+
+    original = SweepSolver.warm
+
+    def worse(self, point, x0):
+        r = original(self, point, x0)
+        return dataclasses.replace(r, objective=r.objective * 1.01)
+
+    monkeypatch.setattr(SweepSolver, "warm", worse)
+    sweep = od.sweep(FORK, {HINGE: ("400 N*m", "600 N*m", 3)}, check_every=1, out=tmp_path)
+    assert [p.jump for p in sweep.points] == [False, True, True]  # the first has no neighbour
+    assert all(p.checked for p in sweep.points)
+    problem = od.load(FORK)
+    for p in sweep.points:
+        alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}))
+        assert p.objective == pytest.approx(alone.objective, rel=1e-9)
+    assert "the multistart check found a better optimum" in sweep.summary()

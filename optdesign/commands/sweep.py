@@ -75,6 +75,14 @@ def _sweep(sub):
     p.add_argument(
         "--seed", type=checked(check.seed, literal), default=None, help="seed (default: file's)"
     )
+    p.add_argument(
+        "--workers",
+        type=checked(check.workers, literal),
+        default=1,
+        help="local processes: the rows of a two-parameter sweep (or a catalogue problem's "
+        "points) side by side (default 1)",
+    )
+    p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
     p.add_argument("--resume", action="store_true", help="continue the sweep stored in --out")
     p.add_argument(
@@ -124,6 +132,8 @@ def run_sweep_command(args) -> int:
                 overwrite=args.overwrite,
                 progress=not args.no_progress and not args.json,
                 sensitivities=args.sensitivities,
+                workers=args.workers,
+                scheduler=args.scheduler,
             )
         return _write(args, sweep, out)
 

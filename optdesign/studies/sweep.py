@@ -2,10 +2,11 @@
 variable changes (``od.sweep``, ``optdesign sweep``).
 
 One or two parameters, each over an evenly spaced range. The points are solved by
-*continuation*: in a snake order through the grid (each point next to the one before it),
-every point is warm-started from its neighbour's design (one Ipopt solve), and a full
-multistart checks the point - independently of the neighbour - every ``check_every``
-points, at the ends, wherever the warm start fails and wherever the binding set differs
+*continuation*: every point is warm-started from its neighbour's design (one Ipopt solve;
+the point before it along the first parameter, the first point of a row from the first
+point of the row before: every row a chain, :func:`neighbour`), and a full multistart
+checks the point - independently of the neighbour - every ``check_every`` points, at
+the ends of every row, wherever the warm start fails and wherever the binding set differs
 from the neighbour's. A multistart that finds a better optimum than the warm start marks a
 *jump* (the chain had followed a local optimum), and the chain goes on from the better one.
 
@@ -252,15 +253,21 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
 
 
 def grid_order(axes: Sequence[Axis]) -> list[tuple[int, ...]]:
-    """Index tuples of the grid in snake order (each point next to the one before it)."""
+    """Index tuples of the grid, the first parameter fastest."""
     if len(axes) == 1:
         return [(i,) for i in range(len(axes[0].values))]
-    n0, n1 = len(axes[0].values), len(axes[1].values)
-    out = []
-    for j in range(n1):
-        row = range(n0) if j % 2 == 0 else range(n0 - 1, -1, -1)
-        out += [(i, j) for i in row]
-    return out
+    return [(i, j) for j in range(len(axes[1].values)) for i in range(len(axes[0].values))]
+
+
+def neighbour(idx: tuple[int, ...]) -> tuple[int, ...] | None:
+    """The point a point continues from: the one before it along the first parameter;
+    the first point of a row continues from the first point of the row before. Every
+    row is so a chain of its own (rows run side by side with several workers)."""
+    if idx[0] > 0:
+        return (idx[0] - 1, *idx[1:])
+    if len(idx) == 2 and idx[1] > 0:
+        return (0, idx[1] - 1)
+    return None
 
 
 # --- one point -------------------------------------------------------------------------
@@ -324,7 +331,7 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
             or not warm.success
             or (prev is not None and active_names(problem, warm) != prev.get("active"))
         )
-        checked = changed or task["index"] % task["check_every"] == 0 or task["last"]
+        checked = changed or task["scheduled_check"]
         if checked:
             if shared is not None:
                 full = shared.multistart(problem, task["starts"], task["seed"])
@@ -420,6 +427,8 @@ def run_sweep(
     overwrite: bool = False,
     progress: bool = False,
     sensitivities: bool = False,
+    workers: int = 1,
+    scheduler: str | None = None,
 ) -> Sweep:
     """The sweep of :func:`optdesign.sweep` (arguments checked there)."""
     from optdesign.studies.identity import problem_digest, solver_identity, version
@@ -440,16 +449,19 @@ def run_sweep(
     seed = seed if seed is not None else problem.spec.solver.seed
     order = grid_order(axes)
     tasks = []
+    n0 = len(axes[0].values)
     for k, idx in enumerate(order):
+        before = neighbour(idx)
         tasks.append(
             {
                 "id": _point_id(idx),
-                "after": [tasks[-1]["id"]] if tasks and cont else [],
+                "after": [_point_id(before)] if before is not None and cont else [],
                 "problem": problem,
                 "paths": paths,
                 "values": [a.values[i] for a, i in zip(axes, idx, strict=True)],
                 "index": k,
-                "last": k == len(order) - 1,
+                # the ends of every row and every check_every-th point along it
+                "scheduled_check": idx[0] % check_every == 0 or idx[0] == n0 - 1,
                 "objective": objective,
                 "continuation": cont,
                 "mode": mode,
@@ -486,6 +498,8 @@ def run_sweep(
         progress="sweep" if progress else False,
         key=key,
         check=sweep_store_check,
+        workers=workers,
+        scheduler=scheduler,
     )
     by_grid = sorted(order, key=lambda idx: tuple(reversed(idx)))
     points = []
@@ -502,7 +516,7 @@ def run_sweep(
                 violated=list(rec["violated"]),
                 checked=rec["checked"],
                 jump=rec["jump"],
-                active_change=_changed(problem, records, order, idx),
+                active_change=_changed(problem, records, idx),
                 solves=rec["solves"],
                 time_s=rec["time_s"],
                 sensitivities=dict(rec.get("sensitivities") or {}),
@@ -519,14 +533,12 @@ def run_sweep(
     return Sweep(problem, objective, axes, points, time.perf_counter() - t0, cont, store, notes)
 
 
-def _changed(problem: DesignProblem, records, order, idx) -> bool:
-    """The binding set or a catalogue item differs from the point before in the sweep's
-    order (both solved)."""
-    k = order.index(idx)
-    if k == 0:
+def _changed(problem: DesignProblem, records, idx) -> bool:
+    """The binding set or a catalogue item differs from the neighbour's (both solved)."""
+    before = neighbour(idx)
+    if before is None:
         return False
-    rec = records[_point_id(idx)]
-    prev = records[_point_id(order[k - 1])]
+    rec, prev = records[_point_id(idx)], records[_point_id(before)]
     if not (rec["success"] and prev["success"]):
         return False
     items = [v.name for v in problem.free if v.discrete]
