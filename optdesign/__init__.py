@@ -38,6 +38,8 @@ _EXPORTS: dict[str, str] = {
     "bench": "optdesign.api:bench",
     "bench_configurations": "optdesign.api:bench_configurations",
     "report": "optdesign.api:report",
+    "sweep": "optdesign.api:sweep",
+    "Sweep": "optdesign.studies.sweep:Sweep",
     "DesignProblem": "optdesign.problem.design_problem:DesignProblem",
     "Quantities": "optdesign.problem.quantities:Quantities",
     "Result": "optdesign.solvers.result:Result",

@@ -28,7 +28,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
 from optdesign.solvers.result import Result
 
-__all__ = ["bench", "bench_configurations", "load", "pareto", "report", "solve"]
+__all__ = ["bench", "bench_configurations", "load", "pareto", "report", "solve", "sweep"]
 
 
 def solve(
@@ -285,3 +285,76 @@ def report(result: Any, path: str | Path) -> Path:
     problem, fronts, target = validation.report_arguments(result, path)
     page = front_report(problem, fronts) if fronts else solve_report(result)
     return atomic_write_text(target, page)
+
+
+def sweep(
+    problem: DesignProblem | str | Path | Mapping[str, Any],
+    vary: Mapping[str, Any],
+    *,
+    objective: str | None = None,
+    check_every: int = 10,
+    starts: int | None = None,
+    seed: int | None = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    progress: bool = False,
+    sensitivities: bool = False,
+    workers: int = 1,
+    scheduler: str | None = None,
+):
+    """How the optimum of ``problem`` moves when one or two parameters change.
+
+    ``vary``: ``{path: (start, stop, count)}`` for one or two parameters, e.g.
+    ``{"requirements.hinge_moment": ("200 N*m", "1000 N*m", 20)}``; a path is
+    ``requirements.NAME`` (``requirements.mean_ratio.min`` inside a band),
+    ``variables.NAME.lower`` / ``.upper`` (a free variable's bound) or ``variables.NAME``
+    (a fixed variable); start and stop are quantities of the parameter's dimension
+    (a bare number only for a plain number), count 2..1000. Points are solved by
+    continuation (warm-started from the neighbour) with a full multistart every
+    ``check_every`` points, at the ends and wherever the warm start fails or the binding
+    set changes (``starts``, ``seed``: that multistart, default the file's). The points
+    go to ``out/sweep.jsonl`` as they finish (a new temporary folder by default);
+    ``resume`` continues a stored sweep, ``overwrite`` starts afresh over one.
+    ``workers`` (local processes) or ``scheduler`` (a Dask scheduler's address): the
+    rows of a two-parameter sweep, or the points of a catalogue problem, side by side
+    (one row is one chain of warm starts; the records are the same for any number).
+    ``sensitivities``: also each point's log-sensitivities to every binding requirement
+    (``point.sensitivities``, :attr:`optdesign.Result.sensitivities`).
+
+    Returns
+    -------
+    Sweep
+        The points (parameters, status, objective, design, binding set, the multistart
+        checks and jumps, what fails at an infeasible point); ``.summary()``,
+        ``.to_frame()`` (columns ``"name [unit]"``), ``.plot()`` (the design chart).
+    """
+    from optdesign.studies.sweep import run_sweep
+
+    starts = validation.starts("starts", starts)
+    seed = validation.seed("seed", seed)
+    check_every = validation.integer("check_every", check_every, 1, 10_000)
+    resume = validation.flag("resume", resume)
+    overwrite = validation.flag("overwrite", overwrite)
+    progress = validation.flag("progress", progress)
+    sensitivities = validation.flag("sensitivities", sensitivities)
+    workers = validation.workers("workers", workers)
+    scheduler = validation.text("scheduler", scheduler, optional=True)
+    validation.run_folder(out, resume, overwrite)
+    problem = load(problem)
+    validation.objective_of(problem, objective)
+    return run_sweep(
+        problem,
+        vary,
+        objective=objective,
+        check_every=check_every,
+        starts=starts,
+        seed=seed,
+        out=out,
+        resume=resume,
+        overwrite=overwrite,
+        progress=progress,
+        sensitivities=sensitivities,
+        workers=workers,
+        scheduler=scheduler,
+    )

@@ -139,6 +139,7 @@ def _load_plugins() -> None:
 PLUGIN_MODULES: list[str] = [
     "optdesign.commands.solve",
     "optdesign.commands.pareto",
+    "optdesign.commands.sweep",
     "optdesign.commands.bench",
 ]
 

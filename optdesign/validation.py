@@ -335,6 +335,17 @@ def front_problem(problem: Any) -> None:
     solver_options(problem)
 
 
+def sweep_parameters(problem: Any, vary: Mapping[str, Any], field: str = "vary") -> None:
+    """The parameters of a sweep (``{path: (start, stop, count)}``) of ``problem``:
+    refused, naming ``field`` and the path, before any work."""
+    from optdesign.studies.sweep import sweep_axes
+
+    try:
+        sweep_axes(problem, vary)
+    except InputError as exc:
+        raise InputError(exc.field.replace("vary", field, 1), exc.reason) from None
+
+
 def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> None:
     """A front's time limit (``time_limit``, None: none) is applied by every method
     named in ``methods``: only a continuous epsilon sweep stops at one (a method object

@@ -54,6 +54,8 @@ ENTRY_POINTS = {
     ("optdesign.studies.pareto.front", "optdesign.reports.front_text"),
     ("optdesign.studies.pareto.front", "optdesign.reports.frames"),
     ("optdesign.studies.pareto.front", "optdesign.plots.front"),
+    ("optdesign.studies.sweep", "optdesign.reports.sweep"),
+    ("optdesign.studies.sweep", "optdesign.plots.sweep"),
     # od.report(result_or_front, path): the public API's entry point to the report page
     ("optdesign.api", "optdesign.reports.html"),
 }

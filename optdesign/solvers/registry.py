@@ -56,6 +56,10 @@ class SolverHints:
     options_check: str | None = None
     #: modules a benchmark imports before timing (the back-end's lazy imports)
     preload: tuple[str, ...] = ()
+    #: the result carries the constraint and bound multipliers of the NLP it solved
+    #: (``raw["lam_g"]``, ``raw["lam_x"]``, in the formulation's scaling), which the
+    #: sensitivities of :mod:`optdesign.studies.sensitivity` read
+    multipliers: bool = False
 
     def time_limit(self, seconds: float) -> dict[str, float]:
         """The back-end's own options for a wall-time limit of ``seconds``."""
@@ -278,6 +282,7 @@ def _builtins() -> None:
         deadline_options={DEADLINE_OPTION: True},
         time_limit_options=("max_wall_time", "max_cpu_time"),
         file_options="ipopt",
+        multipliers=True,
         options_check="optdesign.solvers.casadi_nlp:check_ipopt_options",
     )
     scipy = ("optdesign.solvers.scipy_nlp",)

@@ -162,6 +162,44 @@ class Diagnosis:
     note: str = ""
 
 
+@dataclass
+class Sensitivity:
+    """What one requirement (or active variable bound) costs at an optimum.
+
+    Attributes
+    ----------
+    name
+        ``"requirements.hinge_moment"``, ``"requirements.mean_ratio.min"`` or
+        ``"variables.R.upper"``: where the file states it.
+    objective
+        The objective whose optimum it moves.
+    limit, unit
+        The requirement's (bound's) value as the user reads it.
+    d_objective_d_limit, objective_unit
+        d(optimal objective)/d(limit), in ``objective_unit`` per ``unit``.
+    log_sensitivity
+        % change of the optimal objective per % change of the limit (None when the
+        objective is 0).
+    """
+
+    name: str
+    objective: str
+    limit: float
+    unit: str
+    d_objective_d_limit: float
+    objective_unit: str = ""
+    log_sensitivity: float | None = None
+
+    def text(self) -> str:
+        """``"hinge_moment 500 N*m: +1 % -> backlash +0.62 %"``."""
+        what = self.name.split(".", 1)[1] if self.name.startswith("requirements.") else self.name
+        limit = f"{self.limit:.6g} {self.unit}".rstrip()
+        if self.log_sensitivity is not None:
+            return f"{what} {limit}: +1 % -> {self.objective} {self.log_sensitivity:+.3g} %"
+        per = f"{self.objective_unit}/{self.unit}" if self.unit else self.objective_unit
+        return f"{what} {limit}: d{self.objective}/d{what} = {self.d_objective_d_limit:+.3g} {per}"
+
+
 #: The statuses of a solve that found a design meeting the requirements: the one success
 #: rule of a result, a front's record and a front's point (those two also drop a point
 #: the independent check refused, ``verified is False``).
@@ -198,6 +236,9 @@ class Result:
     diagnosis
         For a result with no feasible design: the relaxations of the conflicting
         requirements (:class:`Diagnosis`), when computed.
+    sensitivities
+        What each binding requirement and active bound costs (:class:`Sensitivity`),
+        most costly first; empty when not computed.
     notes
         Plain-language remarks for the summary.
     """
@@ -224,6 +265,7 @@ class Result:
     multistart: MultistartInfo | None = None
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
     diagnosis: Diagnosis | None = None
+    sensitivities: list[Sensitivity] = field(default_factory=list)
     problem: str = ""
     mechanism: str = ""
     notes: list[str] = field(default_factory=list)

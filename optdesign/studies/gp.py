@@ -15,7 +15,7 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind
+from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp
 from optdesign.studies.reference import attach_reference, reference_design
@@ -102,6 +102,14 @@ def solve_gp_problem(
             "starts": nlp.multistart.n_starts if nlp.multistart else 1,
         }
         result.extra["gap_gp_nlp_rel"] = gap
+        if nlp.success and solver_hints(nlp.solver).multipliers:
+            from optdesign.studies.sensitivity import nlp_sensitivities
+
+            result.sensitivities = nlp_sensitivities(problem, nlp)
+            if result.sensitivities:
+                result.notes.append(
+                    "sensitivities: of the exact NLP's optimum, from Ipopt's multipliers"
+                )
         exact_at_gp = result.objectives.get(objective, float("nan"))
         result.notes.append(
             f"exact NLP (exact Hertz) optimum {nlp.objective:.8g} ({nlp.status}, "
