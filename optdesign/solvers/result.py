@@ -14,6 +14,8 @@ from dataclasses import asdict, dataclass, field
 from enum import Enum, StrEnum
 from typing import Any
 
+from optdesign.solvers.details import Details
+
 
 class TerminationCondition(StrEnum):
     """Why the solver stopped."""
@@ -200,6 +202,10 @@ class Result:
         requirements (:class:`Diagnosis`), when computed.
     notes
         Plain-language remarks for the summary.
+    details
+        What a catalogue search, a GP solve, a robust solve or a reference comparison
+        adds (:class:`~optdesign.solvers.details.Details`, typed); ``result.json`` writes
+        it as ``"extra"``.
     """
 
     status: str
@@ -227,7 +233,7 @@ class Result:
     problem: str = ""
     mechanism: str = ""
     notes: list[str] = field(default_factory=list)
-    extra: dict[str, Any] = field(default_factory=dict)
+    details: Details = field(default_factory=Details)
     # solver internals kept for warm starts (not written to JSON)
     raw: dict[str, Any] = field(default_factory=dict, repr=False)
     # the DesignProblem solved (for plots and tables; not written to JSON)
@@ -247,6 +253,11 @@ class Result:
             self.problem_object = problem
         d.pop("raw", None)
         d.pop("problem_object", None)
+        # The details keep the key and layout result files have always had.
+        d = {
+            ("extra" if k == "details" else k): (self.details.to_json() if k == "details" else v)
+            for k, v in d.items()
+        }
         d["termination"] = self.termination.value
         d["solution_status"] = self.solution_status.value
         return clean_json(d)

@@ -59,7 +59,8 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         # requirements it violates (no relaxations: the front stops here).
         diagnose(problem, result, relax=False)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
-    rec.n_solves = int(result.extra.get("catalogue", {}).get("nlp_solves", 0))
+    info = result.details.catalogue
+    rec.n_solves = info.nlp_solves if info is not None else 0
     rec.wall_time_s = time.perf_counter() - t0
     return rec.to_dict()
 

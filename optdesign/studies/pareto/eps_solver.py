@@ -107,7 +107,7 @@ class EpsSolver:
         """``min target s.t. eps`` from ``start``.
 
         With SLSQP as primary back-end and ``fallback``, a start SLSQP does not solve is
-        solved again by Ipopt from the same primal start; ``result.extra["fallback"]``
+        solved again by Ipopt from the same primal start; ``result.details.fallback``
         then holds SLSQP's message. ``use="ipopt"`` or ``"tie"`` picks Ipopt directly.
         """
         bounds = self.nlp.bounds(eps={k: v for k, v in eps.items() if np.isfinite(v)})
@@ -120,7 +120,7 @@ class EpsSolver:
         if fallback and use is None and self.method == "slsqp" and not result.success:
             first = result
             result = self.backend("ipopt").solve(Start(start.z0), target, bounds)
-            result.extra["fallback"] = f"{first.status}: {first.message}"
+            result.details.fallback = f"{first.status}: {first.message}"
             result.wall_time_s += first.wall_time_s
         return result
 

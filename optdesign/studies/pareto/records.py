@@ -167,7 +167,7 @@ def record_from_result(
         wall_time_s=result.wall_time_s,
         iterations=result.iterations,
         solver=result.solver,
-        fallback=str(result.extra.get("fallback", "")),
+        fallback=result.details.fallback,
         raw=raw,
     )
 
