@@ -164,10 +164,18 @@ class Diagnosis:
     note: str = ""
 
 
-#: The statuses of a solve that found a design meeting the requirements: the one success
-#: rule of a result, a front's record and a front's point (those two also drop a point
-#: the independent check refused, ``verified is False``).
+#: The statuses of a solve that found a design meeting the requirements.
 SOLVED_STATUSES = ("optimal", "feasible")
+
+
+def is_success(status: str, verified: bool | None = None) -> bool:
+    """The one success rule of a solved point (a result, a front's record or point, a
+    bench run): a status of :data:`SOLVED_STATUSES` that the independent check on the
+    NumPy path did not refuse (``verified`` False). ``verified`` None means not checked
+    (yet): a result before :func:`optdesign.studies.nlp_solve.finish`; a stored front
+    record that claims success unchecked is refused before it is read
+    (:func:`optdesign.studies.pareto.records.record_problem`)."""
+    return status in SOLVED_STATUSES and verified is not False
 
 
 @dataclass
@@ -241,8 +249,8 @@ class Result:
 
     @property
     def success(self) -> bool:
-        """A feasible design was found (a status of :data:`SOLVED_STATUSES`)."""
-        return self.status in SOLVED_STATUSES
+        """A feasible design was found (:func:`is_success`)."""
+        return is_success(self.status, self.verified)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (enums as strings, NaN as None, no solver internals)."""

@@ -34,7 +34,7 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     eps = dict(task.get("eps") or {})
     if "tie_of" in task:  # lexicographic tie-break: the first objective held at its optimum
         first = PointRecord.from_dict(deps[task["tie_of"]])
-        if not first.ok:
+        if not first.success:
             first.id, first.kind = task["id"], "anchor"
             return first.to_dict()
         name = task["fixed"]
@@ -43,8 +43,8 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         a, b = task["eps_name"], task["target"]
         lo_rec = PointRecord.from_dict(deps[f"anchor-{a}"])
         hi_rec = PointRecord.from_dict(deps[f"anchor-{b}"])
-        if not (lo_rec.ok and hi_rec.ok):  # no frame: the run stops at check_anchor
-            failed = a if not lo_rec.ok else b
+        if not (lo_rec.success and hi_rec.success):  # no frame: the run stops at check_anchor
+            failed = a if not lo_rec.success else b
             return PointRecord(
                 task["id"], task["kind"], "failed", None, b, f"anchor {failed} has no design"
             ).to_dict()

@@ -8,74 +8,108 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.solvers.result import SOLVED_STATUSES, clean_json
+from optdesign.solvers.result import clean_json
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
 
-@dataclass
+@dataclass(eq=False)
 class FrontPoint:
-    """One point of a front.
+    """One point of a front: the solved point's record (:class:`PointRecord`, the one
+    record of a solved point) seen from the front, with the method that made it and why
+    it is left off the front.
 
     Attributes
     ----------
-    objectives
-        Every objective of the problem at the design (NumPy path).
-    design
-        The full design (fixed and free variables).
-    status
-        Solver status after the independent check.
-    active
-        Names of the active constraint rows (requirements and epsilon bounds).
+    record
+        The point as solved and stored: objectives (every objective at the design, NumPy
+        path), design (fixed and free variables), status after the independent check,
+        ``verified``, active rows, epsilon bounds or weights, task id, solves, time.
     method
         The front method that produced it.
-    verified
-        Result of the independent NumPy check (None if not checked).
-    eps
-        The epsilon bounds (or weights) that defined the point.
-    id
-        Task id in the store.
     rejected
         Why the point is not on the front ("" when it is).
     """
 
-    objectives: dict[str, float]
-    design: dict[str, float]
-    status: str
-    active: list[str]
+    record: PointRecord
     method: str
-    verified: bool | None = None
-    eps: dict[str, float] = field(default_factory=dict)
-    id: str = ""
     rejected: str = ""
-    n_solves: int = 0
-    wall_time_s: float = 0.0
-    message: str = ""
-    retried: str = ""
+
+    @property
+    def objectives(self) -> dict[str, float]:
+        return self.record.objectives
+
+    @property
+    def design(self) -> dict[str, float]:
+        return self.record.design
+
+    @property
+    def status(self) -> str:
+        return self.record.status
+
+    @property
+    def active(self) -> list[str]:
+        """Names of the active constraint rows (requirements and epsilon bounds)."""
+        return self.record.active
+
+    @property
+    def verified(self) -> bool | None:
+        return self.record.verified
+
+    @property
+    def eps(self) -> dict[str, float]:
+        """The epsilon bounds (or weights) that defined the point."""
+        return self.record.eps or self.record.weights
+
+    @property
+    def id(self) -> str:
+        return self.record.id
+
+    @property
+    def n_solves(self) -> int:
+        return self.record.n_solves
+
+    @property
+    def wall_time_s(self) -> float:
+        return self.record.wall_time_s
+
+    @property
+    def message(self) -> str:
+        return self.record.message
+
+    @property
+    def retried(self) -> str:
+        return self.record.retried
 
     @property
     def success(self) -> bool:
-        return self.status in SOLVED_STATUSES and self.verified is not False
+        """The record's success (the one rule, :func:`~optdesign.solvers.result.
+        is_success`)."""
+        return self.record.success
 
     @classmethod
     def from_record(cls, rec: PointRecord, method: str) -> FrontPoint:
-        return cls(
-            objectives=dict(rec.objectives),
-            design=dict(rec.design),
-            status=rec.status,
-            active=list(rec.active),
-            method=method,
-            verified=rec.verified,
-            eps=dict(rec.eps or rec.weights),
-            id=rec.id,
-            n_solves=rec.n_solves,
-            wall_time_s=rec.wall_time_s,
-            message=rec.message,
-            retried=rec.retried,
-        )
+        return cls(rec, method)
 
     def to_dict(self) -> dict[str, Any]:
-        return clean_json(dict(self.__dict__))
+        """The point as ``front.json`` writes it."""
+        return clean_json(
+            {
+                "objectives": dict(self.objectives),
+                "design": dict(self.design),
+                "status": self.status,
+                "active": list(self.active),
+                "method": self.method,
+                "verified": self.verified,
+                "eps": dict(self.eps),
+                "id": self.id,
+                "rejected": self.rejected,
+                "n_solves": self.n_solves,
+                "wall_time_s": self.wall_time_s,
+                "message": self.message,
+                "retried": self.retried,
+            }
+        )
 
 
 @dataclass

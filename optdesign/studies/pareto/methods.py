@@ -368,17 +368,18 @@ class NSGA2:
             for j, x in enumerate(X):
                 ok = bool(ev.violation[j] <= FEASIBILITY_TOL)
                 design = {**problem.fixed_values, **problem.design_dict(x)}
-                pts.append(
-                    FrontPoint(
-                        objectives={k: float(v[j]) for k, v in ev.objectives.items()},
-                        design={k: float(v) for k, v in design.items()},
-                        status="feasible" if ok else "infeasible",
-                        active=[],
-                        method=self.name,
-                        verified=ok,
-                        id=f"nsga2-{j:04d}",
-                    )
+                rec = PointRecord(
+                    id=f"nsga2-{j:04d}",
+                    kind="nsga2",
+                    status="feasible" if ok else "infeasible",
+                    verified=ok,
+                    target="",
+                    design={k: float(v) for k, v in design.items()},
+                    objectives={k: float(v[j]) for k, v in ev.objectives.items()},
+                    wall_time_s=0.0,
+                    n_solves=0,
                 )
+                pts.append(FrontPoint(rec, self.name))
         return make_front(
             pts,
             objectives,
