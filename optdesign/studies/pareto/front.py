@@ -13,6 +13,11 @@ from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
 
+def _of_record(name: str, doc: str) -> property:
+    """A read-only attribute of a front's point that is its record's."""
+    return property(lambda self: getattr(self.record, name), doc=doc)
+
+
 @dataclass(eq=False)
 class FrontPoint:
     """One point of a front: the solved point's record (:class:`PointRecord`, the one
@@ -35,51 +40,21 @@ class FrontPoint:
     method: str
     rejected: str = ""
 
-    @property
-    def objectives(self) -> dict[str, float]:
-        return self.record.objectives
-
-    @property
-    def design(self) -> dict[str, float]:
-        return self.record.design
-
-    @property
-    def status(self) -> str:
-        return self.record.status
-
-    @property
-    def active(self) -> list[str]:
-        """Names of the active constraint rows (requirements and epsilon bounds)."""
-        return self.record.active
-
-    @property
-    def verified(self) -> bool | None:
-        return self.record.verified
+    objectives = _of_record("objectives", "Every objective at the design (NumPy path).")
+    design = _of_record("design", "The full design (fixed and free variables).")
+    status = _of_record("status", "Solver status after the independent check.")
+    active = _of_record("active", "Active constraint rows (requirements, epsilon bounds).")
+    verified = _of_record("verified", "The independent check (None: not checked).")
+    id = _of_record("id", "Task id in the store.")
+    n_solves = _of_record("n_solves", "Solves spent on the point.")
+    wall_time_s = _of_record("wall_time_s", "Its wall time.")
+    message = _of_record("message", "The solver's message.")
+    retried = _of_record("retried", "Why it was solved again from Sobol starts (or '').")
 
     @property
     def eps(self) -> dict[str, float]:
         """The epsilon bounds (or weights) that defined the point."""
         return self.record.eps or self.record.weights
-
-    @property
-    def id(self) -> str:
-        return self.record.id
-
-    @property
-    def n_solves(self) -> int:
-        return self.record.n_solves
-
-    @property
-    def wall_time_s(self) -> float:
-        return self.record.wall_time_s
-
-    @property
-    def message(self) -> str:
-        return self.record.message
-
-    @property
-    def retried(self) -> str:
-        return self.record.retried
 
     @property
     def success(self) -> bool:
