@@ -33,12 +33,12 @@ from optdesign.studies.pareto.records import PointRecord
 def test_result_record_and_front_point_share_one_success_rule(status, verified, expected):
     result = Result(status, 1.0, {"x": 1.0}, "ipopt", "nlp", 0.0, verified=verified)
     rec = PointRecord(id="p", kind="eps", status=status, verified=verified, target="a")
-    point = FrontPoint(rec, "epsilon")
+    point = FrontPoint.from_record(rec, "epsilon")
     assert is_success(status, verified) is expected
     assert (result.success, rec.success, point.success) == (expected, expected, expected)
 
 
-def test_front_point_is_a_view_of_its_record_and_writes_front_json_keys():
+def test_front_point_is_its_record_and_writes_front_json_keys():
     rec = PointRecord(
         id="eps-0001",
         kind="eps",
@@ -69,7 +69,8 @@ def test_front_point_is_a_view_of_its_record_and_writes_front_json_keys():
         "retried",
     ]
     assert point.to_dict()["n_solves"] == 3
-    failed = FrontPoint(
+    assert isinstance(point, PointRecord) and point.kind == "eps" and point.raw is None
+    failed = FrontPoint.from_record(
         PointRecord(id="eps-0002", kind="eps", status="optimal", verified=False, target="a"),
         "weighted_sum",
     )

@@ -31,6 +31,7 @@ from optdesign.interrupts import solver_call
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.details import Details, GPDetails, GPDual, GPTiming
 from optdesign.solvers.result import (
+    SOLVED_STATUSES,
     Certificate,
     ConstraintReport,
     Result,
@@ -148,7 +149,7 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
         solver_s=float(stats.solve_time) if stats and stats.solve_time else float("nan"),
         total_s=wall,
     )
-    if status not in ("optimal", "feasible") or xs[0].value is None:
+    if status not in SOLVED_STATUSES or xs[0].value is None:
         return Result(
             status=status,
             objective=float("nan"),

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -13,58 +13,35 @@ from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
 
-def _of_record(name: str, doc: str) -> property:
-    """A read-only attribute of a front's point that is its record's."""
-    return property(lambda self: getattr(self.record, name), doc=doc)
-
-
-@dataclass(eq=False)
-class FrontPoint:
+@dataclass
+class FrontPoint(PointRecord):
     """One point of a front: the solved point's record (:class:`PointRecord`, the one
-    record of a solved point) seen from the front, with the method that made it and why
-    it is left off the front.
+    record of a solved point, whose success rule it keeps) with the method that made it
+    and why it is left off the front. Its ``eps`` holds the epsilon bounds, or the
+    weights, that defined it; it carries no warm start (``raw``).
 
     Attributes
     ----------
-    record
-        The point as solved and stored: objectives (every objective at the design, NumPy
-        path), design (fixed and free variables), status after the independent check,
-        ``verified``, active rows, epsilon bounds or weights, task id, solves, time.
     method
         The front method that produced it.
     rejected
         Why the point is not on the front ("" when it is).
     """
 
-    record: PointRecord
-    method: str
+    method: str = ""
     rejected: str = ""
-
-    objectives = _of_record("objectives", "Every objective at the design (NumPy path).")
-    design = _of_record("design", "The full design (fixed and free variables).")
-    status = _of_record("status", "Solver status after the independent check.")
-    active = _of_record("active", "Active constraint rows (requirements, epsilon bounds).")
-    verified = _of_record("verified", "The independent check (None: not checked).")
-    id = _of_record("id", "Task id in the store.")
-    n_solves = _of_record("n_solves", "Solves spent on the point.")
-    wall_time_s = _of_record("wall_time_s", "Its wall time.")
-    message = _of_record("message", "The solver's message.")
-    retried = _of_record("retried", "Why it was solved again from Sobol starts (or '').")
-
-    @property
-    def eps(self) -> dict[str, float]:
-        """The epsilon bounds (or weights) that defined the point."""
-        return self.record.eps or self.record.weights
-
-    @property
-    def success(self) -> bool:
-        """The record's success (the one rule, :func:`~optdesign.solvers.result.
-        is_success`)."""
-        return self.record.success
 
     @classmethod
     def from_record(cls, rec: PointRecord, method: str) -> FrontPoint:
-        return cls(rec, method)
+        kw = {f.name: getattr(rec, f.name) for f in fields(PointRecord)}
+        kw.update(
+            objectives=dict(rec.objectives),
+            design=dict(rec.design),
+            active=list(rec.active),
+            eps=dict(rec.eps or rec.weights),
+            raw=None,
+        )
+        return cls(**kw, method=method)
 
     def to_dict(self) -> dict[str, Any]:
         """The point as ``front.json`` writes it."""

@@ -145,7 +145,11 @@ class FrontMethod:
             counts = " or ".join(_COUNTS[n] for n in self.n_objectives)
             raise InputError("objectives", f"{self.what} takes {counts} objectives")
         if self.designs == "continuous" and has_catalogue(problem):
-            raise InputError("method", leaves_catalogue(f"{type(self).__name__} {self.name!r}"))
+            raise InputError(
+                "method",
+                leaves_catalogue(f"{type(self).__name__} {self.name!r}")
+                + " (the name 'epsilon' picks CatalogueEpsilon there)",
+            )
         if self.designs == "catalogue" and not has_catalogue(problem):
             raise InputError("method", f"{self.name}: no variable takes catalogue values")
         self.check_settings()
