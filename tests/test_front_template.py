@@ -1,20 +1,17 @@
 """One front-method template (studies/pareto/template.py): a new method is a small
 subclass giving its step; the command line and od.pareto build methods by one function."""
 
-import argparse
 from dataclasses import dataclass
 
 import pytest
 
 import optdesign as od
-from optdesign.commands.pareto import _method
 from optdesign.errors import InputError
 from optdesign.studies.pareto import (
     CatalogueEpsilon,
     EpsilonConstraint,
     FrontMethod,
     PointRecord,
-    WeightedSum,
     make_method,
 )
 from optdesign.studies.pareto.chains import anchor_tasks
@@ -73,27 +70,32 @@ def test_a_new_front_method_is_a_small_subclass_of_the_template(tmp_path):
         od.pareto(problem, ["backlash", "size"], method=AnchorsOnly(), time_limit=5)
 
 
-def _args(**kw):
-    base = dict(
-        points=7, starts=2, seed=None, deterministic=True, pop=20, generations=10, time_limit=None
-    )
-    return argparse.Namespace(**{**base, **kw})
+def test_the_command_line_builds_methods_as_od_pareto_does(tmp_path):
+    """The same front, point for point, from ``optdesign pareto`` and from od.pareto with
+    the same settings (both build the method by make_method)."""
+    import json
 
+    from optdesign.cli import main
 
-def test_the_command_line_builds_methods_as_od_pareto_does():
+    out = tmp_path / "cli"
+    argv = ["pareto", FORK, "--objectives", "backlash,size", "--points", "4", "--method"]
+    more = ["--starts", "2", "--workers", "1", "--deterministic", "--out", str(out)]
+    quiet = ["--no-plot", "--no-report", "--no-progress"]
+    assert main([*argv, "uniform,weighted_sum", *more, *quiet]) == 0
+    stored = json.loads((out / "front.json").read_text())["fronts"]
     problem = od.load(FORK)
-    seed = problem.spec.solver.seed
-    uniform = _method(_args(), problem, "uniform")
-    assert uniform == make_method(problem, "uniform", 7, starts=2, seed=seed, deterministic=True)
-    assert uniform == EpsilonConstraint(
-        points=7, spacing="uniform", name="uniform", starts=2, seed=seed, deterministic=True
-    )
-    assert _method(_args(), problem, "weighted_sum") == WeightedSum(points=7, starts=2, seed=seed)
-    # with catalogue variables "epsilon" is the catalogue front (settings it has no use
-    # for, like deterministic, are left)
+    for method, cli in zip(("uniform", "weighted_sum"), stored, strict=True):
+        extra = {"deterministic": True} if method == "uniform" else {}
+        front = od.pareto(problem, ["backlash", "size"], 4, method, starts=2, **extra)
+        assert cli["method"] == front.method == method
+        assert cli["settings"] == json.loads(json.dumps(front.settings))
+        assert [p["objectives"] for p in cli["points"]] == [p.objectives for p in front.points]
     catalogue = od.load(CATALOGUE)
-    assert _method(_args(seed=5), catalogue, "epsilon") == CatalogueEpsilon(
-        points=7, starts=2, seed=5
+    assert make_method(catalogue, "epsilon", 7, starts=2, seed=5, deterministic=True) == (
+        CatalogueEpsilon(points=7, starts=2, seed=5)
+    )
+    assert make_method(problem, "uniform", 7, starts=2) == EpsilonConstraint(
+        points=7, spacing="uniform", name="uniform", starts=2
     )
     with pytest.raises(InputError, match="weighted_sum would leave the catalogue"):
         make_method(catalogue, "weighted_sum", 7)

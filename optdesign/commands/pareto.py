@@ -13,6 +13,7 @@ from pathlib import Path
 
 from optdesign import validation as check
 from optdesign.cli import as_options, checked, command, literal, output_folder
+from optdesign.errors import InputError
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
 #: Options spelt otherwise than their API argument (optdesign.pareto).
@@ -96,7 +97,7 @@ def _pareto(sub):
 def run_pareto(args) -> int:
     from optdesign import storage
     from optdesign.problem import load_problem
-    from optdesign.studies.pareto.methods import check_front_problem, check_time_limit
+    from optdesign.studies.pareto.methods import check_front_problem
     from optdesign.studies.solve import solver_options
 
     problem = load_problem(args.file)
@@ -109,42 +110,36 @@ def run_pareto(args) -> int:
             check.method("method", m)
             check.method_for(problem, m)  # refused before the output folder is made
         check.run_folder(args.out, args.resume, args.overwrite)
-    built = [_method(args, problem, m) for m in methods]  # as optdesign.pareto builds them
-    for method in built:
-        check_time_limit(method, args.time_limit, "--time-limit")
+    if args.time_limit is not None:
+        from optdesign.studies.pareto.catalogue_front import has_catalogue
+
+        other = [m for m in methods if m not in ("epsilon", "uniform")]
+        if other or has_catalogue(problem):
+            what = f"the {other[0]} method" if other else "a catalogue front"
+            raise InputError(
+                "--time-limit",
+                f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
+            )
     # One run per folder for the whole command (the runner re-enters the lock per store),
     # checked before any solving.
     with output_folder(args.out, f"pareto-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
-        for method in built:
-            if not method.stored:
+        for m in methods:
+            if m == "nsga2":
                 continue
-            store = out / f"{method.name}.jsonl"
+            store = out / f"{m}.jsonl"
             if args.overwrite:
                 storage.discard_store(store)
             elif not args.resume:
                 storage.check_new_store(store)
-        return _run_locked(args, problem, objectives, built, out)
-
-
-def _method(args, problem, name: str):
-    """The method object of ``--method`` ``name`` with the command line's settings
-    (:func:`optdesign.studies.pareto.make_method`, as :func:`optdesign.pareto` does)."""
-    from optdesign.studies.pareto import make_method
-
-    seed = args.seed if args.seed is not None else problem.spec.solver.seed
-    if name == "nsga2":
-        settings = dict(pop_size=args.pop, generations=args.generations, seed=seed)
-    elif name == "weighted_sum":
-        settings = dict(starts=args.starts, seed=seed)
-    else:
-        settings = dict(starts=args.starts, seed=seed, deterministic=args.deterministic)
-    return make_method(problem, name, args.points, **settings)
+        return _run_locked(args, problem, objectives, methods, out)
 
 
 def _run_locked(args, problem, objectives, methods, out: Path) -> int:
     from optdesign.studies import pareto as pa
+    from optdesign.studies.pareto.catalogue_front import has_catalogue
 
+    seed = args.seed if args.seed is not None else problem.spec.solver.seed
     run = dict(
         out=out,
         workers=args.workers,
@@ -155,7 +150,28 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
     )
     if args.time_limit is not None:
         run["time_limit"] = args.time_limit
-    fronts = [pa.compute_front(problem, objectives, method=m, **run) for m in methods]
+    fronts = []
+    for m in methods:
+        if m == "nsga2":
+            method = pa.NSGA2(pop_size=args.pop, generations=args.generations, seed=seed)
+        elif m == "weighted_sum":
+            method = pa.WeightedSum(points=args.points, starts=args.starts, seed=seed)
+        elif has_catalogue(problem):
+            # the name: compute_front turns it into the catalogue front (every point a
+            # catalogue design)
+            method = m
+        else:
+            method = pa.EpsilonConstraint(
+                points=args.points,
+                spacing="arc" if m == "epsilon" else "uniform",
+                name=m,
+                starts=args.starts,
+                seed=seed,
+                deterministic=args.deterministic,
+            )
+        named = {"points": args.points, "starts": args.starts, "seed": seed}
+        extra = named if isinstance(method, str) else {}
+        fronts.append(pa.compute_front(problem, objectives, method=method, **extra, **run))
     if len(fronts) > 1:
         # Hypervolumes of different methods are comparable only with one reference point.
         pa.common_hypervolumes(fronts)
