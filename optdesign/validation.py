@@ -315,14 +315,10 @@ def method_for(problem: Any, method_: Any, argument: str = "method") -> None:
     """A front method that keeps the problem's designs valid: a weighted sum of
     continuous NLPs would leave a catalogue."""
     if method_ == "weighted_sum" or type(method_).__name__ == "WeightedSum":
-        from optdesign.studies.pareto.catalogue_front import has_catalogue
+        from optdesign.studies.pareto.template import has_catalogue, leaves_catalogue
 
         if has_catalogue(problem):
-            raise ArgumentError(
-                argument,
-                "weighted_sum would leave the catalogue: with catalogue variables use "
-                "epsilon or nsga2",
-            )
+            raise ArgumentError(argument, leaves_catalogue("weighted_sum"))
 
 
 def front_problem(problem: Any) -> None:

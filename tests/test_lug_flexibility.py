@@ -250,7 +250,7 @@ def test_gp_form_with_fixed_thicknesses_and_its_refusal():
     assert gp.is_gp, gp.explain()
     r = solve_gp_problem(problem, nlp_starts=2)
     assert r.status == "optimal"
-    assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
+    assert abs(r.details.gp.gap_gp_nlp_rel) < 1e-3
     data["materials"] = {"lug": {"cheek_thickness": "6 mm"}}
     gp = build_gp(problem_from_dict(data))
     assert not gp.is_gp

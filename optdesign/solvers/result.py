@@ -14,6 +14,8 @@ from dataclasses import asdict, dataclass, field
 from enum import Enum, StrEnum
 from typing import Any
 
+from optdesign.solvers.details import Details
+
 
 class TerminationCondition(StrEnum):
     """Why the solver stopped."""
@@ -206,6 +208,16 @@ class Sensitivity:
 SOLVED_STATUSES = ("optimal", "feasible")
 
 
+def is_success(status: str, verified: bool | None = None) -> bool:
+    """The one success rule of a solved point (a result, a front's record or point, a
+    bench run): a status of :data:`SOLVED_STATUSES` that the independent check on the
+    NumPy path did not refuse (``verified`` False). ``verified`` None means not checked
+    (yet): a result before :func:`optdesign.studies.nlp_solve.finish`; a stored front
+    record that claims success unchecked is refused before it is read
+    (:func:`optdesign.studies.pareto.records.record_problem`)."""
+    return status in SOLVED_STATUSES and verified is not False
+
+
 @dataclass
 class Result:
     """Outcome of one optimisation, whatever the solver.
@@ -241,6 +253,10 @@ class Result:
         most costly first; empty when not computed.
     notes
         Plain-language remarks for the summary.
+    details
+        What a catalogue search, a GP solve, a robust solve or a reference comparison
+        adds (:class:`~optdesign.solvers.details.Details`, typed); ``result.json`` writes
+        it as ``"extra"``.
     """
 
     status: str
@@ -269,7 +285,7 @@ class Result:
     problem: str = ""
     mechanism: str = ""
     notes: list[str] = field(default_factory=list)
-    extra: dict[str, Any] = field(default_factory=dict)
+    details: Details = field(default_factory=Details)
     # solver internals kept for warm starts (not written to JSON)
     raw: dict[str, Any] = field(default_factory=dict, repr=False)
     # the DesignProblem solved (for plots and tables; not written to JSON)
@@ -277,8 +293,8 @@ class Result:
 
     @property
     def success(self) -> bool:
-        """A feasible design was found (a status of :data:`SOLVED_STATUSES`)."""
-        return self.status in SOLVED_STATUSES
+        """A feasible design was found (:func:`is_success`)."""
+        return is_success(self.status, self.verified)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (enums as strings, NaN as None, no solver internals)."""
@@ -289,6 +305,11 @@ class Result:
             self.problem_object = problem
         d.pop("raw", None)
         d.pop("problem_object", None)
+        # The details keep the key and layout result files have always had.
+        d = {
+            ("extra" if k == "details" else k): (self.details.to_json() if k == "details" else v)
+            for k, v in d.items()
+        }
         d["termination"] = self.termination.value
         d["solution_status"] = self.solution_status.value
         return clean_json(d)

@@ -36,6 +36,7 @@ from optdesign.formulations.discrete import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
+from optdesign.solvers.details import CatalogueCombination, CatalogueDetails
 from optdesign.solvers.multistart import (
     best_of,
     improves,
@@ -171,22 +172,25 @@ def _fixed(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
     return {k: (v, v) for k, v in values.items()}
 
 
-def enumerate_catalogue(ns: NodeSolver, x_hint=None) -> tuple[Result | None, list[dict]]:
+def enumerate_catalogue(
+    ns: NodeSolver, x_hint=None
+) -> tuple[Result | None, list[CatalogueCombination]]:
     """Solve every combination of catalogue items; the best and the table of all."""
     dvars = discrete_variables(ns.problem)
     table, best = [], None
     for combo in itertools.product(*(v.values for v in dvars)):
         items = {v.name: float(c) for v, c in zip(dvars, combo, strict=True)}
         r = ns.solve(_fixed(items), x_hint)
-        table.append({"items": items, "status": r.status, "objective": r.objective})
+        table.append(CatalogueCombination(items, r.status, r.objective))
         # a tie (within PRUNE_TOL) keeps the earlier combination, as branch and bound does
         if r.success and (best is None or improves(r.objective, best.objective, PRUNE_TOL)):
             best = r
     return best, table
 
 
-def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict]:
-    """Best-first branch and bound from the relaxation ``root``."""
+def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict[str, int]]:
+    """Best-first branch and bound from the relaxation ``root``; the best leaf and the
+    node counts (nodes, pruned, infeasible, leaves)."""
     dvars = discrete_variables(ns.problem)
     full = {v.name: (v.lower, v.upper) for v in dvars}
     counter = itertools.count()
@@ -271,7 +275,7 @@ def solve_catalogue(
     Returns
     -------
     Result
-        ``extra["catalogue"]``: method, items chosen, relaxation bound and design, node
+        ``details.catalogue``: method, items chosen, relaxation bound and design, node
         counts (and the table of every combination when enumerating).
     """
     t0 = time.perf_counter()
@@ -287,22 +291,22 @@ def solve_catalogue(
     seed = seed if seed is not None else problem.spec.solver.seed
     ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
     root = ns.solve({})
-    info: dict[str, Any] = {
-        "method": method,
-        "combinations": n_comb,
-        "variables": {v.name: list(v.values) for v in dvars},
-        "relaxation_bound": root.objective if root.success else None,
-        "relaxation_status": root.status,
-        "relaxation_design": {k: root.design.get(k) for k in ns.names} if root.design else {},
-        "starts_per_node": n_starts,
-    }
+    info = CatalogueDetails(
+        method=method,
+        combinations=n_comb,
+        variables={v.name: list(v.values) for v in dvars},
+        relaxation_bound=root.objective if root.success else None,
+        relaxation_status=root.status,
+        relaxation_design={k: root.design.get(k) for k in ns.names} if root.design else {},
+        starts_per_node=n_starts,
+    )
     if method == "enumerate":
-        best, table = enumerate_catalogue(ns, ns.x_of(root))
-        info["enumerated"] = table
+        best, info.enumerated = enumerate_catalogue(ns, ns.x_of(root))
     else:
         best, stats = branch_and_bound(ns, root)
-        info.update(stats)
-    info["nlp_solves"] = ns.n_solves
+        info.nodes, info.pruned = stats["nodes"], stats["pruned"]
+        info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
+    info.nlp_solves = ns.n_solves
     wall = time.perf_counter() - t0
     if best is None:
         # Infeasible only when the continuous relaxation (every catalogue range at once)
@@ -322,27 +326,27 @@ def solve_catalogue(
                 else "the continuous relaxation has no feasible design"
             ),
         )
-        result.extra["catalogue"] = info
+        result.details.catalogue = info
         return finish(problem, result, objective)
     best.formulation = f"catalogue-{method}"
     best.wall_time_s = wall
     # Snap to the exact items (the NLP holds them within its bound tolerance).
     for v in dvars:
         best.design[v.name] = nearest_item(best.design[v.name], v.values)[0]
-    info["items"] = {v.name: best.design[v.name] for v in dvars}
+    info.items = {v.name: best.design[v.name] for v in dvars}
     if root.success:
-        info["gap_to_relaxation_rel"] = (best.objective - root.objective) / abs(root.objective)
-    best.extra["catalogue"] = info
+        info.gap_to_relaxation_rel = (best.objective - root.objective) / abs(root.objective)
+    best.details.catalogue = info
     best.bound = root.objective if root.success else None
     items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
     bound = (
         f"continuous relaxation bound {root.objective:.8g} (discrete optimum "
-        f"{100 * info['gap_to_relaxation_rel']:+.3f} % above it)"
+        f"{100 * (info.gap_to_relaxation_rel or 0.0):+.3f} % above it)"
         if root.success
         else f"continuous relaxation: {root.status}"
     )
     best.notes.append(
-        f"catalogue items chosen: {items}; {bound}; {method}, {info['nlp_solves']} NLP solves"
+        f"catalogue items chosen: {items}; {bound}; {method}, {info.nlp_solves} NLP solves"
     )
     return finish(problem, best, objective)
 

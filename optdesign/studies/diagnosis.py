@@ -164,8 +164,8 @@ def _catalogue(
 ) -> Diagnosis:
     dvars = discrete_variables(problem)
     objective = result.objective_name or problem.objective_names[0]
-    info = result.extra.get("catalogue", {})
-    root = info.get("relaxation_design") or {}
+    info = result.details.catalogue
+    root = (info.relaxation_design if info else None) or {}
     x0 = problem.start()
     for k, v in enumerate(problem.free):
         value = root.get(v.name)

@@ -15,6 +15,7 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.details import ExactNLP, GPDetails, GPRows, GPTiming
 from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp
@@ -48,7 +49,7 @@ def solve_gp_problem(
         Objective to minimise (default: the problem's first).
     compare_nlp
         Also solve the exact NLP (exact Hertz), warm-started from the GP design, and
-        report its optimum and the gap (``extra["nlp_exact"]``, ``extra["gap_gp_nlp_rel"]``).
+        report its optimum and the gap (``details.gp.nlp_exact``, ``details.gp.gap_gp_nlp_rel``).
     nlp_starts, seed
         Multistart of that NLP (default: the problem file's).
     solver
@@ -72,12 +73,10 @@ def solve_gp_problem(
         )
         return finish(problem, result, objective)
     result = backend.solve()
-    result.extra.setdefault("gp_timing", {})["trace_s"] = t_trace
-    result.extra["gp_rows"] = {
-        "objective": len(gp.objective_rows),
-        "constraints": len(gp.rows),
-        "before_pruning": gp.n_rows_before_pruning,
-    }
+    details = result.details.gp = result.details.gp or GPDetails()
+    details.timing = details.timing or GPTiming()
+    details.timing.trace_s = t_trace
+    details.rows = GPRows(len(gp.objective_rows), len(gp.rows), gp.n_rows_before_pruning)
     result.notes.append(
         "GP model: first-order Hertz flattening b^2/D and ISO 286 formulas (posynomials); "
         "the independent check and 'objectives at this design' use the exact model"
@@ -94,14 +93,14 @@ def solve_gp_problem(
         x0 = np.array([result.design[v.name] for v in problem.free])
         nlp = solve_nlp(problem, objective=objective, starts=nlp_starts, seed=seed, x0=x0)
         gap = (gp_objective - nlp.objective) / abs(nlp.objective) if nlp.success else float("nan")
-        result.extra["nlp_exact"] = {
-            "status": nlp.status,
-            "objective": nlp.objective,
-            "design": {v.name: nlp.design.get(v.name) for v in problem.free},
-            "wall_time_s": nlp.wall_time_s,
-            "starts": nlp.multistart.n_starts if nlp.multistart else 1,
-        }
-        result.extra["gap_gp_nlp_rel"] = gap
+        details.nlp_exact = ExactNLP(
+            status=nlp.status,
+            objective=nlp.objective,
+            design={v.name: nlp.design.get(v.name) for v in problem.free},
+            wall_time_s=nlp.wall_time_s,
+            starts=nlp.multistart.n_starts if nlp.multistart else 1,
+        )
+        details.gap_gp_nlp_rel = gap
         if nlp.success and solver_hints(nlp.solver).multipliers:
             from optdesign.studies.sensitivity import nlp_sensitivities
 

@@ -23,7 +23,12 @@ from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.multistart import multistart, sobol_starts
 from optdesign.solvers.registry import default_solver, make_solver, solver_hints
-from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+from optdesign.solvers.result import (
+    SOLVED_STATUSES,
+    Result,
+    SolutionStatus,
+    TerminationCondition,
+)
 from optdesign.studies.runner import map_inherited
 from optdesign.studies.verify import nan_notes, verify_design
 from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
@@ -238,18 +243,19 @@ def finish(problem: DesignProblem, result: Result, objective: str | None = None)
     if not result.design:
         return result
     x = np.array([result.design[v.name] for v in problem.free])
+    claimed = result.status in SOLVED_STATUSES  # the solver's word, checked below
     ok, violated, objectives = verify_design(problem, x)
     result.verified = ok
     result.notes += nan_notes(problem, objectives, violated)
     result.objectives = {k: float(v) for k, v in objectives.items()}
     result.design = {**problem.fixed_values, **result.design}
-    if result.success and not ok:
+    if claimed and not ok:
         # The solver claims success but the independent check disagrees: not a design.
         result.status = "infeasible"
         result.termination = TerminationCondition.INFEASIBLE
         result.solution_status = SolutionStatus.INFEASIBLE
         result.violated = violated
         result.message += " (independent check failed)"
-    elif not result.success and not result.violated:
+    elif not claimed and not result.violated:
         result.violated = violated
     return result

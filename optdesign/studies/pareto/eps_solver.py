@@ -111,7 +111,7 @@ class EpsSolver:
 
         With a primary back-end other than the fallback and ``fallback``, a start the
         primary does not solve is solved again by the fallback from the same primal
-        start; ``result.extra["fallback"]`` then holds the primary's message.
+        start; ``result.details.fallback`` then holds the primary's message.
         ``use="fallback"`` or ``"tie"`` picks that back-end directly.
         """
         bounds = self.nlp.bounds(eps={k: v for k, v in eps.items() if np.isfinite(v)})
@@ -125,7 +125,7 @@ class EpsSolver:
         if fallback and use is None and self.has_fallback and not result.success:
             first = result
             result = self.backend("fallback").solve(Start(start.z0), target, bounds)
-            result.extra["fallback"] = f"{first.status}: {first.message}"
+            result.details.fallback = f"{first.status}: {first.message}"
             result.wall_time_s += first.wall_time_s
         return result
 
