@@ -342,6 +342,16 @@ def sweep_parameters(problem: Any, vary: Mapping[str, Any], field: str = "vary")
         raise InputError(exc.field.replace("vary", field, 1), exc.reason) from None
 
 
+def front_store(problem: Any, method: str) -> str | None:
+    """The file name of the resumable store of front method ``method`` on ``problem``
+    (``"epsilon-catalogue.jsonl"`` for an epsilon front of a catalogue problem), or None
+    when the method keeps none (NSGA-II): what a command checks before any front runs."""
+    from optdesign.studies.pareto.methods import make_method
+
+    built = make_method(problem, method)
+    return f"{built.name}.jsonl" if getattr(built, "stored", False) else None
+
+
 def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> None:
     """A front's time limit (``time_limit``, None: none) is applied by every method
     named in ``methods``: only a continuous epsilon sweep stops at one (a method object

@@ -110,9 +110,10 @@ def run_pareto(args) -> int:
     with output_folder(args.out, f"pareto-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         for m in methods:
-            if m == "nsga2":
+            name = check.front_store(problem, m)
+            if name is None:
                 continue
-            store = out / f"{m}.jsonl"
+            store = out / name
             if args.overwrite:
                 storage.discard_store(store)
             elif not args.resume:
