@@ -286,6 +286,20 @@ def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: 
             result.sensitivities = nlp_sensitivities(problem, result)
         except Exception as exc:  # a report, not the result: never lose the optimum
             result.notes.append(f"sensitivities not computed: {exc}")
+    if (
+        result.success
+        and result.formulation.startswith("catalogue")
+        and solver_hints(result.solver).multipliers
+        and "lam_g" in result.raw
+    ):
+        try:  # the continuous part at the chosen items, and the neighbouring items
+            from optdesign.studies.catalogue_sensitivity import catalogue_sensitivities
+
+            result.sensitivities, result.item_steps = catalogue_sensitivities(
+                problem, result, solver, options
+            )
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.notes.append(f"sensitivities not computed: {exc}")
     if ranges and result.success and continuous and result.design and "z" in result.raw:
         try:
             result.ranges = optimal_ranges(problem, result, solver=solver, options=options)
