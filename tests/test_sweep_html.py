@@ -13,6 +13,7 @@ from optdesign.cli import main
 from optdesign.errors import InputError
 from optdesign.reports.display_units import objective_shown
 from optdesign.reports.sweep import _cell, sweep_rows
+from optdesign.reports.sweep_html import NOT_COMPUTED
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 NASTY = '<!--<script>x</script>"><b>%{x}</b>'
@@ -56,6 +57,7 @@ def test_the_page_carries_the_chart_the_table_and_each_points_design(nasty):
         assert R["value"] == pytest.approx(p.design["R"])
         # the point's design checked on the point's problem: it meets its requirements
         assert view["violated"] == []
+        assert view["sensitivities"] == [NOT_COMPUTED]  # not "none": nothing was asked
 
 
 def test_od_report_refuses_a_sweep_without_a_design(nasty, tmp_path):

@@ -20,6 +20,10 @@ from optdesign.reports.html import _header, design_view
 from optdesign.reports.html_page import render
 from optdesign.reports.sweep import _cell, sweep_rows
 
+#: What the page says of a point's sensitivities when the sweep did not compute them
+#: (an empty list would read "none": nothing binds).
+NOT_COMPUTED = "not computed (od.sweep(..., sensitivities=True), optdesign sweep --sensitivities)"
+
 
 def _shown_value(axis: Any, value: float) -> float:
     table = dict(zip(axis.values, axis.shown, strict=True))
@@ -48,7 +52,7 @@ def sweep_report(sweep: Any) -> str:
         view["sensitivities"] = [
             f"{name}: +1 % -> {sweep.objective} {value:+.3g} %"
             for name, value in sorted(p.sensitivities.items(), key=lambda kv: -abs(kv[1]))
-        ]
+        ] or [NOT_COMPUTED]
         of_point[p.index] = len(designs)
         designs.append(view)
     groups: dict[tuple[float, ...], list[Any]] = {}
