@@ -117,3 +117,14 @@ def test_cli_json_carries_item_steps(capsys):
     doc = json.loads(capsys.readouterr().out)
     assert {s["variable"] for s in doc["item_steps"]} == {"p", "d"}
     assert any(s["name"] == "requirements.nut_travel_max" for s in doc["sensitivities"])
+
+
+@pytest.mark.slow
+def test_a_catalogue_sweep_records_them_only_when_asked(catalogue):
+    # a catalogue point is solved by its formulation: its sensitivities are the solve's
+    problem, result = catalogue
+    vary = {"requirements.hinge_moment": ("400 N*m", "500 N*m", 2)}
+    sweep = od.sweep(problem, vary, sensitivities=True)
+    at_500 = sweep.points[1].sensitivities
+    assert at_500 == pytest.approx({s.name: s.log_sensitivity for s in result.sensitivities})
+    assert all(p.sensitivities == {} for p in od.sweep(problem, vary).points)
