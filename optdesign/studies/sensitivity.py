@@ -120,7 +120,7 @@ def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[
         out.append(_record(problem, objective, f"requirements.{path}", p, (up - down) / (2 * h), v))
     for k, var in enumerate(problem.free):
         lam = float(lam_x[k])
-        if lam == 0.0:
+        if lam == 0.0 or var.discrete:  # a catalogue variable is held at its item, not a bound
             continue
         side = "upper" if lam > 0 else "lower"
         bound = var.upper if lam > 0 else var.lower
@@ -264,6 +264,15 @@ def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:
     return with_requirement(problem, rest, value)
 
 
+def limit_value(problem: DesignProblem, name: str) -> float:
+    """The internal value of the limit ``name`` of a :class:`Sensitivity`."""
+    head, _, rest = name.partition(".")
+    if head == "variables":
+        var, _, side = rest.partition(".")
+        return float(getattr(problem.by_name[var], side))
+    return dict(requirement_paths(problem))[rest]
+
+
 def finite_difference(
     problem: DesignProblem, result: Result, name: str, rel: float = 1e-3
 ) -> tuple[float, float]:
@@ -273,12 +282,7 @@ def finite_difference(
     value). The check of :func:`nlp_sensitivities` (tests, benchmarks)."""
     from optdesign.studies.nlp_solve import solve_nlp
 
-    head, _, rest = name.partition(".")
-    if head == "variables":
-        var, _, side = rest.partition(".")
-        p = float(getattr(problem.by_name[var], side))
-    else:
-        p = dict(requirement_paths(problem))[rest]
+    p = limit_value(problem, name)
     h = rel * max(abs(p), 1e-9)
     x0 = np.array([result.design[v.name] for v in problem.free])
     values = []
