@@ -94,47 +94,12 @@ def robust_sensitivities(
     ``objective`` over ``samples``, with the solver's multipliers in ``result.raw``), ranked as
     :func:`~optdesign.studies.sensitivity.nlp_sensitivities` ranks them; empty without
     multipliers or for a one-value objective."""
-    from optdesign.studies.sensitivity import (
-        NEGLIGIBLE,
-        STEP,
-        _record,
-        requirement_paths,
-        with_requirement,
-    )
+    from optdesign.studies.sensitivity import from_multipliers
 
     raw = result.raw
     if not result.success or "lam_g" not in raw or "lam_x" not in raw:
         return []
-    lam_g = np.asarray(raw["lam_g"], dtype=float)
-    lam_x = np.asarray(raw["lam_x"], dtype=float)
-    if len(lam_g) != len(nlp.g_names):
-        return []
     label = nlp.default_target
-    T = nlp.target_scales[nlp.targets.index(label)]
-    mu = lam_g * T / nlp.g_scale
-    x = np.array([result.design[v.name] for v in problem.free])
-    v = float(result.objective)
-    rows = _SampleRows(nlp, mu, samples, objective)
-    base = rows.value(problem, x)
-    out = []
-    for path, p in requirement_paths(problem):
-        h = STEP * max(abs(p), 1e-9)
-        try:
-            up = rows.value(with_requirement(problem, path, p + h), x)
-            down = rows.value(with_requirement(problem, path, p - h), x)
-        except Exception:  # a step the schema refuses (a band's min at its max): skip it
-            continue
-        if not (math.isfinite(up) and math.isfinite(down) and math.isfinite(base)):
-            continue
-        out.append(_record(problem, label, f"requirements.{path}", p, (up - down) / (2 * h), v))
-    for k, var in enumerate(problem.free):
-        lam = float(lam_x[k])
-        if lam == 0.0 or var.discrete:
-            continue
-        side = "upper" if lam > 0 else "lower"
-        bound = var.upper if lam > 0 else var.lower
-        d = -lam * T / nlp.x_span[k]
-        out.append(_record(problem, label, f"variables.{var.name}.{side}", bound, d, v))
-    kept = [s for s, effect in out if abs(effect) > NEGLIGIBLE * max(abs(v), 1e-300)]
-    kept.sort(key=lambda s: (-abs(s.log_sensitivity or 0.0), s.name))
-    return kept
+    return from_multipliers(
+        problem, result, nlp, label, label, lambda mu: _SampleRows(nlp, mu, samples, objective)
+    )
