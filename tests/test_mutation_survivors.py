@@ -310,3 +310,16 @@ def test_three_objective_weights_are_the_smallest_triangle_holding_the_points():
         assert all(min(w) >= 0 and math.isclose(sum(w), 1.0) for w in grid)
         assert len({tuple(round(x, 12) for x in w) for w in grid}) == len(grid)
     assert _weight_grid(2, 5) == [(w, 1 - w) for w in np.linspace(0.0, 1.0, 5)]
+
+
+def test_an_objective_without_a_problem_or_a_declaration_is_shown_bare():
+    """An objective value shown with no problem (a record read alone) or under a name the
+    problem does not declare: the number as it is, with no unit."""
+    from optdesign.reports.display_units import Shown, objective_shown
+
+    assert objective_shown(None, "backlash", 0.5) == Shown(0.5, "")
+    assert objective_shown(None, "backlash", 0.5).text() == "0.5"
+    problem = load(Path(__file__).resolve().parents[1] / "problems" / "cs_min_backlash.toml")
+    assert objective_shown(problem, "not_an_objective", 2.0) == Shown(2.0, "")
+    shown = objective_shown(problem, "CVaR_0.9(backlash)", 0.03)  # a statistic of it
+    assert shown.unit == "deg" and shown.value == pytest.approx(0.03)
