@@ -15,11 +15,10 @@ on the shipped catalogue problem.
 
 from __future__ import annotations
 
-import heapq
 import itertools
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from functools import partial
 from typing import Any
 
@@ -44,6 +43,8 @@ from optdesign.solvers.multistart import (
     start_outcome,
 )
 from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -111,10 +112,30 @@ class NodeSolver:
         self.seed = seed
         self.names = [v.name for v in problem.free]
         self.n_solves = 0
+        #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
+        self.n_cold = 0
+        self.n_implied = 0
+        #: boxes proved infeasible (shared by the searches of one front); None: no memo
+        self.memo = None
 
-    def solve(self, bounds: Mapping[str, tuple[float, float]], x_hint=None) -> Result:
+    def solve(
+        self,
+        bounds: Mapping[str, tuple[float, float]],
+        x_hint=None,
+        warm: bool = False,
+        cutoff: float | None = None,
+    ) -> Result:
         """Best of the multistart on the box where ``bounds`` replace the catalogue
-        variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start."""
+        variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
+
+        ``warm``: the hint alone decides when its solve succeeds with a value that
+        ``cutoff`` (the incumbent's objective) would not prune; a failed hint, or a value
+        that would prune the node, runs the rest of the multistart (and its retries) as
+        a cold node does, so infeasibility and pruning rest on the same starts as before.
+        """
+        if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
+            self.n_implied += 1
+            return _no_item(self.backend.name, "infeasible: a wider box was at looser limits")
         lo, hi = self.problem.lower().copy(), self.problem.upper().copy()
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
@@ -124,15 +145,7 @@ class NodeSolver:
         }
         if not box_has_item(self.problem, node):
             # e.g. a (d0, p) box that holds no screw of the catalogue: nothing to solve
-            return Result(
-                "infeasible",
-                float("nan"),
-                {},
-                self.backend.name,
-                "catalogue",
-                0.0,
-                message="no catalogue item in this box",
-            )
+            return _no_item(self.backend.name, "no catalogue item in this box")
         params = self.problem.parameter_values(node)
         box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
         if self.free_rows.size:
@@ -146,10 +159,22 @@ class NodeSolver:
         if self.starts > 1:
             pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
         start = partial(self.nlp.start, parameters=box.parameters)
-        results = [self.backend.solve(start(x0=p), self.target, box) for p in pts]
+        results = []
+        if warm and x_hint is not None:
+            results.append(self.backend.solve(start(x0=pts.pop(0)), self.target, box))
+            first_ok = results[0]
+            if first_ok.success and (
+                cutoff is None or not cannot_improve(first_ok.objective, cutoff)
+            ):
+                pts = []  # the warm start decides this node
+            else:
+                self.n_cold += 1
+        results += [self.backend.solve(start(x0=p), self.target, box) for p in pts]
         if not any(r.success for r in results):
             retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
             results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
+            if self.memo is not None and not any(r.success for r in results):
+                self.memo.add_infeasible(bounds, self.eps)
         self.n_solves += len(results)
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
@@ -171,6 +196,10 @@ class NodeSolver:
         return np.array([result.design[n] for n in self.names])
 
 
+def _no_item(solver: str, message: str) -> Result:
+    return Result("infeasible", float("nan"), {}, solver, "catalogue", 0.0, message=message)
+
+
 def _fixed(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
     return {k: (v, v) for k, v in values.items()}
 
@@ -189,65 +218,6 @@ def enumerate_catalogue(ns: NodeSolver, x_hint=None) -> tuple[Result | None, lis
     return best, table
 
 
-def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict]:
-    """Best-first branch and bound from the relaxation ``root``."""
-    dvars = discrete_variables(ns.problem)
-    full = {v.name: (v.lower, v.upper) for v in dvars}
-    counter = itertools.count()
-    heap: list = []
-    stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0}
-    if root.success:
-        heapq.heappush(heap, (root.objective, next(counter), full, root))
-    incumbent: Result | None = None
-    while heap:
-        bound, _, box, res = heapq.heappop(heap)
-        if incumbent is not None and cannot_improve(bound, incumbent.objective):
-            stats["pruned"] += 1
-            continue
-        x = ns.x_of(res)
-        # the catalogue variable farthest (relatively) from an item in its range
-        worst, worst_d = None, ON_ITEM_TOL
-        for v in dvars:
-            allowed = items_within(v.values, *box[v.name])
-            _item, dist = nearest_item(res.design[v.name], tuple(allowed))
-            if dist > worst_d:
-                worst, worst_d = v, dist
-        if worst is None:  # every catalogue variable sits on an item: a leaf
-            items = {
-                v.name: nearest_item(
-                    res.design[v.name], tuple(items_within(v.values, *box[v.name]))
-                )[0]
-                for v in dvars
-            }
-            if all(box[v.name][0] == box[v.name][1] for v in dvars):
-                leaf = res  # already solved with every catalogue variable fixed
-            else:
-                leaf = ns.solve(_fixed(items), x)
-                stats["nodes"] += 1
-            stats["leaves"] += 1
-            if leaf.success and (
-                incumbent is None or improves(leaf.objective, incumbent.objective, PRUNE_TOL)
-            ):
-                incumbent = leaf  # a tie keeps the incumbent found first
-            continue
-        allowed = items_within(worst.values, *box[worst.name])
-        for side in branch(res.design[worst.name], allowed):
-            if not side:
-                continue
-            child = dict(box)
-            child[worst.name] = (side[0], side[-1])
-            r = ns.solve(child, x)
-            stats["nodes"] += 1
-            if not r.success:
-                stats["infeasible"] += 1
-                continue
-            if incumbent is not None and cannot_improve(r.objective, incumbent.objective):
-                stats["pruned"] += 1
-                continue
-            heapq.heappush(heap, (r.objective, next(counter), child, r))
-    return incumbent, stats
-
-
 def solve_catalogue(
     problem: DesignProblem,
     method: str = "auto",
@@ -257,6 +227,8 @@ def solve_catalogue(
     plugin: str = "ipopt",
     options: Mapping[str, Any] | None = None,
     eps: Mapping[str, float] | None = None,
+    incumbents: Sequence[Mapping[str, float]] = (),
+    memo: InfeasibleBoxes | None = None,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -271,6 +243,12 @@ def solve_catalogue(
     eps
         Upper limits on other objectives (name -> limit): a point of an
         epsilon-constraint front over catalogue designs.
+    incumbents
+        Designs (name -> value) whose catalogue items are tried first, the best feasible
+        one being the search's first incumbent (e.g. a front's neighbouring optima).
+    memo
+        Boxes proved infeasible by earlier searches of the same problem and node
+        settings (shared by a front's points; see :mod:`optdesign.studies.catalogue_bnb`).
 
     Returns
     -------
@@ -290,6 +268,7 @@ def solve_catalogue(
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
     ns = NodeSolver(problem, objective, n_starts, seed, plugin, options, eps)
+    ns.memo = memo
     root = ns.solve({})
     info: dict[str, Any] = {
         "method": method,
@@ -304,8 +283,8 @@ def solve_catalogue(
         best, table = enumerate_catalogue(ns, ns.x_of(root))
         info["enumerated"] = table
     else:
-        best, stats = branch_and_bound(ns, root)
-        info.update(stats)
+        best, stats = branch_and_bound(ns, root, incumbents)
+        info.update(stats, warm_fallbacks=ns.n_cold, implied_infeasible=ns.n_implied)
     info["nlp_solves"] = ns.n_solves
     wall = time.perf_counter() - t0
     if best is None:

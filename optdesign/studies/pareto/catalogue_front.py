@@ -19,6 +19,7 @@ from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.diagnosis import diagnose
+from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord, record_from_result
@@ -52,7 +53,12 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         hi = max(hi_rec.objectives[a], lo)
         eps = {a: float(lo + task["eps_frac"] * (hi - lo))}
     result = solve_catalogue(
-        problem, starts=task["starts"], seed=task["seed"], objective=task["target"], eps=eps
+        problem,
+        starts=task["starts"],
+        seed=task["seed"],
+        objective=task["target"],
+        eps=eps,
+        **front_knowledge(task, deps),
     )
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
         # An anchor with no catalogue design: its best point, for the error to name the
@@ -123,6 +129,7 @@ class CatalogueEpsilon:
                     "after": [f"anchor-{a}", f"anchor-{b}"],
                 }
             )
+        chain_points(tasks, points, sequential=run.workers == 1 and not run.scheduler)
         key = run_key(
             problem,
             objectives,
