@@ -129,6 +129,14 @@ def _sqpmethod(nlp, options):
     return CasadiNLPSolver(nlp, "sqpmethod", merged)
 
 
+def _bonmin(nlp, options):
+    # a continuous NLP: Bonmin with no integer variable (its Ipopt); catalogue problems
+    # reach Bonmin through the catalogue search (optdesign.studies.catalogue_minlp)
+    from optdesign.solvers.bonmin import bonmin_nlp_solver
+
+    return bonmin_nlp_solver(nlp, options)
+
+
 def _scipy(method: str):
     def make(nlp, options):
         from optdesign.solvers.scipy_nlp import ScipyNLPSolver
@@ -171,6 +179,7 @@ def _builtins() -> None:
         ("sqpmethod", _sqpmethod, "nlp", "CasADi SQP (sqpmethod) with a QP solver"),
         ("slsqp", _scipy("SLSQP"), "nlp", "SciPy SLSQP with CasADi exact derivatives"),
         ("trust-constr", _scipy("trust-constr"), "nlp", "SciPy trust-constr"),
+        ("bonmin", _bonmin, "nlp", "Bonmin (CasADi): MINLP on catalogue items, else an NLP"),
         ("clarabel", _cvxpy("CLARABEL"), "gp", "cvxpy GP, Clarabel interior point"),
         ("scs", _cvxpy("SCS"), "gp", "cvxpy GP, SCS first-order conic"),
     ):

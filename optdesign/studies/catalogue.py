@@ -263,8 +263,13 @@ def solve_catalogue(
     n_comb = n_combinations(problem)
     if method == "auto":
         method = "enumerate" if n_comb <= ENUMERATE_MAX else "bnb"
-    if method not in ("enumerate", "bnb"):
-        raise ProblemError(f"catalogue method {method!r}: use auto, enumerate or bnb")
+    minlp_options = None
+    if plugin == "bonmin" or method == "bonmin":
+        # Bonmin picks the items (its options: Bonmin's); Ipopt solves the relaxation
+        # bound and the chosen items' NLP
+        method, plugin, minlp_options, options = "bonmin", "ipopt", options, None
+    if method not in ("enumerate", "bnb", "bonmin"):
+        raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or bonmin")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
     ns = NodeSolver(problem, objective, n_starts, seed, plugin, options, eps)
@@ -282,6 +287,10 @@ def solve_catalogue(
     if method == "enumerate":
         best, table = enumerate_catalogue(ns, ns.x_of(root))
         info["enumerated"] = table
+    elif method == "bonmin":
+        from optdesign.studies.catalogue_minlp import solve_bonmin
+
+        best, info["bonmin"] = solve_bonmin(ns, minlp_options)
     else:
         best, stats = branch_and_bound(ns, root, incumbents)
         info.update(stats, warm_fallbacks=ns.n_cold, implied_infeasible=ns.n_implied)

@@ -1,0 +1,86 @@
+"""Catalogue searches (issue 25): the warm branch and bound and Bonmin against
+enumeration on a small catalogue instance; the one-hot encoding; the infeasibility memo."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+import optdesign as od
+from optdesign.errors import InputError
+from optdesign.formulations.catalogue_minlp import item_groups
+from optdesign.problem import problem_from_dict
+from optdesign.studies.catalogue import NodeSolver, solve_catalogue
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _small(leads=("5 mm", "6 mm"), pins=("5 mm", "6 mm", "8 mm")):
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": list(leads)}
+    data["variables"]["d"] = {"values": list(pins)}
+    return problem_from_dict(data)
+
+
+@pytest.fixture(scope="module")
+def enumerated():
+    return solve_catalogue(_small(), method="enumerate", starts=2)
+
+
+def test_warm_branch_and_bound_equals_enumeration(enumerated):
+    bnb = solve_catalogue(_small(), method="bnb", starts=2)
+    assert bnb.extra["catalogue"]["items"] == enumerated.extra["catalogue"]["items"]
+    assert bnb.objective == pytest.approx(enumerated.objective, rel=1e-9)
+    assert bnb.objective == pytest.approx(0.0340646, rel=1e-5)  # p = 6, d = 6
+
+
+def test_bonmin_equals_enumeration(enumerated):
+    """od.solve(..., solver="bonmin"): Bonmin's B-BB picks the items, their NLP is the
+    design; the same optimum as enumeration, with the relaxation bound below it."""
+    res = od.solve(_small(), solver="bonmin", starts=2, ranges=False)
+    info = res.extra["catalogue"]
+    assert info["method"] == "bonmin" and info["bonmin"]["algorithm"] == "B-BB"
+    assert info["bonmin"]["status"] == "SUCCESS"
+    assert info["items"] == enumerated.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    assert res.objective == pytest.approx(enumerated.objective, rel=1e-9)
+    assert res.bound < res.objective and res.verified
+
+
+def test_bonmin_refuses_an_unknown_algorithm():
+    with pytest.raises(InputError, match=r"algorithm.*'B-XX' is not a Bonmin algorithm"):
+        solve_catalogue(_small(), method="bonmin", starts=1, options={"algorithm": "B-XX"})
+
+
+def test_one_hot_groups_follow_the_item_data():
+    """Leads and pins carry their own data (none for an ISO 3408 lead, the table fit for
+    a pin): two groups of 2 and 3 items, the pin's group holding the fit ratios."""
+    groups = item_groups(_small())
+    assert [g.names for g in groups] == [("p",), ("d",)]
+    assert [len(g.items) for g in groups] == [2, 3]
+    assert set(groups[1].data) == {"fit_ratio_max", "fit_ratio_min"}
+    assert not groups[0].data
+
+
+def test_infeasible_boxes_imply_sub_boxes_under_tighter_limits():
+    memo = InfeasibleBoxes({"p": (2.0, 10.0), "d": (4.0, 25.0)})
+    memo.add_infeasible({"d": (4.0, 5.0)}, {"motor_torque": 3.0})
+    assert memo.known_infeasible({"d": (4.0, 4.0), "p": (5.0, 6.0)}, {"motor_torque": 2.5})
+    assert memo.known_infeasible({"d": (5.0, 5.0)}, {"motor_torque": 3.0})
+    # a looser limit, no limit, or a box reaching outside: not implied
+    assert not memo.known_infeasible({"d": (4.0, 5.0)}, {"motor_torque": 3.5})
+    assert not memo.known_infeasible({"d": (4.0, 5.0)}, {})
+    assert not memo.known_infeasible({"d": (4.0, 6.0)}, {"motor_torque": 2.0})
+
+
+def test_a_memo_proof_skips_the_nlp():
+    """A node solver with a memo answers an implied box without a solve."""
+    problem = _small()
+    ns = NodeSolver(problem, starts=1)
+    ns.memo = InfeasibleBoxes({"p": (5.0, 6.0), "d": (5.0, 8.0)})
+    ns.memo.add_infeasible({"d": (5.0, 5.0)}, {})
+    r = ns.solve({"d": (5.0, 5.0), "p": (6.0, 6.0)})
+    assert r.status == "infeasible" and "wider box" in r.message
+    assert (ns.n_solves, ns.n_implied) == (0, 1)
