@@ -18,7 +18,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 from typing import Any
 
@@ -123,13 +123,13 @@ class NodeSolver:
         bounds: Mapping[str, tuple[float, float]],
         x_hint=None,
         warm: bool = False,
-        cutoff: float | None = None,
+        prunes: Callable[[float], bool] | None = None,
     ) -> Result:
         """Best of the multistart on the box where ``bounds`` replace the catalogue
         variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
 
         ``warm``: the hint alone decides when its solve succeeds with a value that
-        ``cutoff`` (the incumbent's objective) would not prune; a failed hint, or a value
+        ``prunes`` (the search's pruning test) would not prune; a failed hint, or a value
         that would prune the node, runs the rest of the multistart (and its retries) as
         a cold node does, so infeasibility and pruning rest on the same starts as before.
         """
@@ -164,7 +164,7 @@ class NodeSolver:
             results.append(self.backend.solve(start(x0=pts.pop(0)), self.target, box))
             first_ok = results[0]
             if first_ok.success and (
-                cutoff is None or not cannot_improve(first_ok.objective, cutoff)
+                prunes is None or not prunes(first_ok.objective)
             ):
                 pts = []  # the warm start decides this node
             else:

@@ -8,9 +8,10 @@ sub-boxes of the catalogue variables) with three savings:
   would prune the node (:meth:`NodeSolver.solve` with ``warm=True``). The relaxation at
   the root and every leaf (a combination of items: the values reported) keep the full
   multistart;
-- **a first incumbent**: combinations known to be good (a front's anchors: the
-  neighbours' discrete optima) are solved first, each as a leaf with the full
-  multistart, and the best feasible one is the incumbent the search starts with;
+- **a first incumbent**: combinations known to be good (a front's anchors and previous
+  point: the neighbours' discrete optima) are solved first, each as a leaf with the full
+  multistart; the best feasible one prunes every node whose bound is worse than it
+  beyond the tie tolerance;
 - **infeasible boxes implied** (:class:`InfeasibleBoxes`): a box proved infeasible under
   some epsilon limits proves every sub-box infeasible under limits at least as tight,
   with no NLP; the points of one catalogue front share these proofs.
@@ -25,8 +26,11 @@ is pruned, or called infeasible, only on the same starts as the cold search (the
 start plus the multistart and its retries); what the warm start changes is the bound of
 a node it does not prune (one start instead of several), which steers the order of the
 search and the branching variable, not which node may be discarded. A first incumbent
-changes which of two tied combinations (within the pruning tolerance) is reported:
-the incumbent, solved first, keeps a tie.
+prunes only nodes that cannot hold a combination tied with it, and a combination the
+search finds keeps a tie with it: it is reported only when the search finds nothing as
+good, so it does not decide between tied combinations. Which of two tied combinations
+(within the pruning tolerance) the search finds first still depends on its order, which
+the warm bounds steer.
 """
 
 from __future__ import annotations
@@ -170,13 +174,23 @@ def branch_and_bound_warm(
     counter = itertools.count()
     heap: list = []
     stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
-    incumbent: Result | None = None
+    incumbent: Result | None = None  # the best leaf the search itself found
+    seed: Result | None = None  # the best candidate's leaf
     if root.success:
-        incumbent, _ = first_incumbent(ns, candidates, stats)
+        seed, _ = first_incumbent(ns, candidates, stats)
         heapq.heappush(heap, (root.objective, next(counter), full, root, None))
+
+    def prunes(bound: float) -> bool:
+        # the search's own incumbent prunes ties too (the leaf found first is kept), as
+        # before; a candidate prunes only what is worse beyond the tie tolerance, so that
+        # the search still reaches the combination it would report without the candidate
+        if incumbent is not None and cannot_improve(bound, incumbent.objective):
+            return True
+        return seed is not None and bound > seed.objective + _prune_tol() * abs(seed.objective)
+
     while heap:
         bound, _, box, res, warm_from = heapq.heappop(heap)
-        if incumbent is not None and cannot_improve(bound, incumbent.objective):
+        if prunes(bound):
             if warm_from is not None:
                 # a bound from the warm start alone: pruned only on the full multistart
                 res = ns.solve(box, warm_from)
@@ -184,7 +198,7 @@ def branch_and_bound_warm(
                 if not res.success:
                     stats["infeasible"] += 1
                     continue
-                if not cannot_improve(res.objective, incumbent.objective):
+                if not prunes(res.objective):
                     heapq.heappush(heap, (res.objective, next(counter), box, res, None))
                     continue
             stats["pruned"] += 1
@@ -210,17 +224,20 @@ def branch_and_bound_warm(
             child = dict(box)
             child[worst.name] = (side[0], side[-1])
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
-            cutoff = None if incumbent is None else incumbent.objective
             # a box of one combination is a leaf: its value is reported, full multistart
-            r = ns.solve(child, x) if fixed else ns.solve(child, x, warm=True, cutoff=cutoff)
+            r = ns.solve(child, x) if fixed else ns.solve(child, x, warm=True, prunes=prunes)
             stats["nodes"] += 1
             if not r.success:
                 stats["infeasible"] += 1
                 continue
-            if incumbent is not None and cannot_improve(r.objective, incumbent.objective):
+            if prunes(r.objective):
                 stats["pruned"] += 1
                 continue
             warm_only = not fixed and r.multistart is not None and r.multistart.n_starts < ns.starts
             entry = (r.objective, next(counter), child, r, x if warm_only else None)
             heapq.heappush(heap, entry)
+    if seed is not None and (
+        incumbent is None or improves(seed.objective, incumbent.objective, _prune_tol())
+    ):
+        incumbent = seed  # no leaf of the search ties with the candidate
     return incumbent, stats
