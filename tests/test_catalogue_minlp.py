@@ -84,3 +84,19 @@ def test_a_memo_proof_skips_the_nlp():
     r = ns.solve({"d": (5.0, 5.0), "p": (6.0, 6.0)})
     assert r.status == "infeasible" and "wider box" in r.message
     assert (ns.n_solves, ns.n_implied) == (0, 1)
+
+
+@pytest.mark.slow
+def test_bench_configurations_of_the_catalogue_searches(tmp_path):
+    """`optdesign bench --solvers catalogue-bnb,bonmin-b-bb` on a small catalogue
+    instance: both are configurations of the bench and reach the same optimum."""
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["5 mm", "6 mm", "8 mm"]}
+    rep = od.bench(problems=[data], solvers=["catalogue-bnb", "bonmin-b-bb"], out=tmp_path)
+    frame = rep.to_frame().set_index("config")
+    assert set(frame.index) == {"catalogue-bnb", "bonmin-b-bb"}
+    assert frame.loc["catalogue-bnb", "objective"] == pytest.approx(0.0340646, rel=1e-5)
+    assert frame.loc["bonmin-b-bb", "objective"] == pytest.approx(
+        frame.loc["catalogue-bnb", "objective"], rel=1e-9
+    )

@@ -360,3 +360,12 @@ def default_configs(include_hidden: bool = False) -> list[str]:
 # Registered at import so that every process (forked, spawned or a Dask worker) sees the
 # same registry.
 _register_defaults()
+
+
+def _register_catalogue() -> None:
+    from optdesign.studies.bench.catalogue_configs import register_catalogue_configs
+
+    register_catalogue_configs(register_config, Config)
+
+
+_register_catalogue()
