@@ -100,3 +100,29 @@ def test_bench_configurations_of_the_catalogue_searches(tmp_path):
     assert frame.loc["bonmin-b-bb", "objective"] == pytest.approx(
         frame.loc["catalogue-bnb", "objective"], rel=1e-9
     )
+
+
+def _relaxation_on_an_item():
+    """A catalogue whose node relaxation sits on an item (d = 8 mm) with the fit data
+    of the box's most favourable pin, while the best pin is the next one (10 mm)."""
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["8 mm", "10 mm", "12 mm", "16 mm"]}
+    req = data["requirements"]
+    req["hinge_moment"] = "585.9 N*m"
+    req["deflection"] = {"min": "-28.38 deg", "max": "28.38 deg", "points": 61}
+    req["mean_ratio"] = {"min": 200, "max": 245.6}
+    return problem_from_dict(data)
+
+
+def test_a_relaxation_on_an_item_still_branches_the_rest_of_its_box():
+    """The box p = 6, d in [8, 16] relaxes to d = 8 (its fit data the best of 8..16 mm);
+    the leaf d = 8 is worse, and the search goes on to d = 10 (0.0352439 deg,
+    enumeration's optimum) instead of taking the leaf for the box."""
+    problem = _relaxation_on_an_item()
+    bnb = solve_catalogue(problem, method="bnb", starts=2)
+    enum = solve_catalogue(problem, method="enumerate", starts=2)
+    assert enum.extra["catalogue"]["items"] == {"p": 6, "d": 10}
+    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 10}
+    assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
+    assert bnb.objective == pytest.approx(0.0352439, rel=1e-5)

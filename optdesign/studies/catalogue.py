@@ -124,6 +124,7 @@ class NodeSolver:
         x_hint=None,
         warm: bool = False,
         prunes: Callable[[float], bool] | None = None,
+        fallback: bool = True,
     ) -> Result:
         """Best of the multistart on the box where ``bounds`` replace the catalogue
         variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
@@ -132,6 +133,8 @@ class NodeSolver:
         ``prunes`` (the search's pruning test) would not prune; a failed hint, or a value
         that would prune the node, runs the rest of the multistart (and its retries) as
         a cold node does, so infeasibility and pruning rest on the same starts as before.
+        ``fallback=False``: the warm start's result whatever it is (a first incumbent's
+        value, which only needs to be feasible).
         """
         if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
             self.n_implied += 1
@@ -163,10 +166,11 @@ class NodeSolver:
         if warm and x_hint is not None:
             results.append(self.backend.solve(start(x0=pts.pop(0)), self.target, box))
             first_ok = results[0]
-            if first_ok.success and (
-                prunes is None or not prunes(first_ok.objective)
-            ):
+            if first_ok.success and (prunes is None or not prunes(first_ok.objective)):
                 pts = []  # the warm start decides this node
+            elif not fallback:
+                self.n_solves += 1
+                return first_ok
             else:
                 self.n_cold += 1
         results += [self.backend.solve(start(x0=p), self.target, box) for p in pts]

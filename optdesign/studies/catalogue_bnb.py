@@ -9,9 +9,11 @@ sub-boxes of the catalogue variables) with three savings:
   the root and every leaf (a combination of items: the values reported) keep the full
   multistart;
 - **a first incumbent**: combinations known to be good (a front's anchors and previous
-  point: the neighbours' discrete optima) are solved first, each as a leaf with the full
-  multistart; the best feasible one prunes every node whose bound is worse than it
-  beyond the tie tolerance;
+  point: the neighbours' discrete optima) are solved first, each as a leaf from the
+  neighbour's design alone (one start: a feasible value bounds the optimum from above
+  whatever start found it); the best feasible one prunes every node whose bound is
+  worse than it beyond the tie tolerance, and is reported (after the full multistart)
+  only when the search finds no leaf as good;
 - **infeasible boxes implied** (:class:`InfeasibleBoxes`): a box proved infeasible under
   some epsilon limits proves every sub-box infeasible under limits at least as tight,
   with no NLP; the points of one catalogue front share these proofs.
@@ -126,7 +128,8 @@ def first_incumbent(
     ns, candidates: Sequence[Mapping[str, float]], stats: dict
 ) -> tuple[Result | None, dict | None]:
     """The best feasible of ``candidates`` (item combinations), each solved as a leaf
-    with the full multistart; a tie keeps the earlier candidate."""
+    from the candidate's design alone (one start: its value only bounds the optimum from
+    above); a tie keeps the earlier candidate."""
     from optdesign.studies.catalogue import _fixed
 
     dvars = discrete_variables(ns.problem)
@@ -141,7 +144,10 @@ def first_incumbent(
         if key in seen:
             continue
         seen.add(key)
-        r = ns.solve(_fixed(items), _x_of_design(ns, cand))
+        x0 = _x_of_design(ns, cand)
+        if x0 is None:
+            continue
+        r = ns.solve(_fixed(items), x0, warm=True, fallback=False)
         stats["nodes"] += 1
         stats["seeded"] += 1
         if r.success and (best is None or improves(r.objective, best.objective, _prune_tol())):
@@ -176,8 +182,9 @@ def branch_and_bound_warm(
     stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
     incumbent: Result | None = None  # the best leaf the search itself found
     seed: Result | None = None  # the best candidate's leaf
+    seed_items: dict | None = None
     if root.success:
-        seed, _ = first_incumbent(ns, candidates, stats)
+        seed, seed_items = first_incumbent(ns, candidates, stats)
         heapq.heappush(heap, (root.objective, next(counter), full, root, None))
 
     def prunes(bound: float) -> bool:
@@ -205,8 +212,10 @@ def branch_and_bound_warm(
             continue
         x = ns.x_of(res)
         worst, items = _on_items(ns, dvars, box, res)
+        sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
-            if all(box[v.name][0] == box[v.name][1] for v in dvars):
+            fixed_box = all(box[v.name][0] == box[v.name][1] for v in dvars)
+            if fixed_box:
                 leaf = res  # already solved with every catalogue variable fixed
             else:
                 leaf = ns.solve(_fixed(items), x)
@@ -216,13 +225,27 @@ def branch_and_bound_warm(
                 incumbent is None or improves(leaf.objective, incumbent.objective, _prune_tol())
             ):
                 incumbent = leaf  # a tie keeps the incumbent found first
-            continue
-        allowed = items_within(worst.values, *box[worst.name])
-        for side in branch(res.design[worst.name], allowed):
+            if fixed_box or prunes(bound):
+                continue
+            # The node's relaxation sits on items, but its item data (fit ratios, screw
+            # ratings) are the most favourable over the box's items, not those of the
+            # items it sits on: the box's other combinations may still beat this leaf.
+            # Split the first wide variable at its item: below it, at it, above it.
+            var = next(v for v in dvars if box[v.name][0] != box[v.name][1])
+            allowed = items_within(var.values, *box[var.name])
+            at = items[var.name]
+            sides = [(var, [a for a in allowed if a < at]), (var, [at])]
+            sides.append((var, [a for a in allowed if a > at]))
+        else:
+            allowed = items_within(worst.values, *box[worst.name])
+            sides = [(worst, side) for side in branch(res.design[worst.name], allowed)]
+        for var, side in sides:
             if not side:
                 continue
             child = dict(box)
-            child[worst.name] = (side[0], side[-1])
+            child[var.name] = (side[0], side[-1])
+            if child == _fixed(items):
+                continue  # the leaf just solved
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
             # a box of one combination is a leaf: its value is reported, full multistart
             r = ns.solve(child, x) if fixed else ns.solve(child, x, warm=True, prunes=prunes)
@@ -239,5 +262,9 @@ def branch_and_bound_warm(
     if seed is not None and (
         incumbent is None or improves(seed.objective, incumbent.objective, _prune_tol())
     ):
-        incumbent = seed  # no leaf of the search ties with the candidate
+        # no leaf of the search ties with the candidate: it is the optimum, and as a
+        # reported leaf it gets the full multistart (its own start first)
+        full = ns.solve(_fixed(seed_items), ns.x_of(seed))
+        stats["nodes"] += 1
+        incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats
