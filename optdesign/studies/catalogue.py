@@ -10,7 +10,9 @@ What "exact" rests on: the node NLPs are non-convex and solved locally (multista
 the bound of a node is the best local optimum found, not a proven global one. A node
 whose relaxation is under-estimated (missed global optimum) can be pruned wrongly;
 enumeration has the same dependence on each fixed-item solve. The test compares the two
-on the shipped catalogue problem.
+on the shipped catalogue problem. The branch and bound itself (warm nodes, first
+incumbents, implied infeasible boxes) is :mod:`optdesign.studies.catalogue_bnb`; Bonmin
+as the other search, :mod:`optdesign.studies.catalogue_minlp`.
 """
 
 from __future__ import annotations
