@@ -45,22 +45,17 @@ from optdesign.solvers.multistart import (
     start_outcome,
 )
 from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
 from optdesign.studies.catalogue_bnb import InfeasibleBoxes
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
+from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
+from optdesign.studies.catalogue_bnb import fixed_box as _fixed
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
-#: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
-PRUNE_TOL = OBJECTIVE_TIE_TOL
-
-
-def cannot_improve(bound: float, incumbent: float) -> bool:
-    """Whether a node whose relaxation gives ``bound`` can be pruned: it cannot beat the
-    incumbent's objective by more than ``PRUNE_TOL`` (relative)."""
-    return bound >= incumbent - PRUNE_TOL * abs(incumbent)
 
 
 #: Sobol starts a node tries before it is called infeasible, when its own starts fail.
@@ -204,10 +199,6 @@ class NodeSolver:
 
 def _no_item(solver: str, message: str) -> Result:
     return Result("infeasible", float("nan"), {}, solver, "catalogue", 0.0, message=message)
-
-
-def _fixed(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
-    return {k: (v, v) for k, v in values.items()}
 
 
 def enumerate_catalogue(ns: NodeSolver, x_hint=None) -> tuple[Result | None, list[dict]]:

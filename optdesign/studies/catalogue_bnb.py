@@ -53,8 +53,23 @@ from optdesign.formulations.discrete import (
 )
 from optdesign.solvers.multistart import improves
 from optdesign.solvers.result import Result
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 Box = Mapping[str, tuple[float, float]]
+
+#: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
+PRUNE_TOL = OBJECTIVE_TIE_TOL
+
+
+def cannot_improve(bound: float, incumbent: float) -> bool:
+    """Whether a node whose relaxation gives ``bound`` can be pruned: it cannot beat the
+    incumbent's objective by more than ``PRUNE_TOL`` (relative)."""
+    return bound >= incumbent - PRUNE_TOL * abs(incumbent)
+
+
+def fixed_box(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
+    """The box of one item combination (each variable fixed to its item)."""
+    return {k: (v, v) for k, v in values.items()}
 
 
 class InfeasibleBoxes:
@@ -130,8 +145,6 @@ def first_incumbent(
     """The best feasible of ``candidates`` (item combinations), each solved as a leaf
     from the candidate's design alone (one start: its value only bounds the optimum from
     above); a tie keeps the earlier candidate."""
-    from optdesign.studies.catalogue import _fixed
-
     dvars = discrete_variables(ns.problem)
     best, best_items, seen = None, None, set()
     for cand in candidates:
@@ -147,7 +160,7 @@ def first_incumbent(
         x0 = _x_of_design(ns, cand)
         if x0 is None:
             continue
-        r = ns.solve(_fixed(items), x0, warm=True, fallback=False)
+        r = ns.solve(fixed_box(items), x0, warm=True, fallback=False)
         stats["nodes"] += 1
         stats["seeded"] += 1
         if r.success and (best is None or improves(r.objective, best.objective, _prune_tol())):
@@ -163,8 +176,6 @@ def _x_of_design(ns, design: Mapping[str, float]):
 
 
 def _prune_tol() -> float:
-    from optdesign.studies.catalogue import PRUNE_TOL
-
     return PRUNE_TOL
 
 
@@ -173,8 +184,6 @@ def branch_and_bound_warm(
 ) -> tuple[Result | None, dict]:
     """Best-first branch and bound from the relaxation ``root`` with warm child nodes and
     the best of ``candidates`` (item combinations) as its first incumbent."""
-    from optdesign.studies.catalogue import _fixed, cannot_improve
-
     dvars = discrete_variables(ns.problem)
     full = {v.name: (v.lower, v.upper) for v in dvars}
     counter = itertools.count()
@@ -214,18 +223,18 @@ def branch_and_bound_warm(
         worst, items = _on_items(ns, dvars, box, res)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
-            fixed_box = all(box[v.name][0] == box[v.name][1] for v in dvars)
-            if fixed_box:
+            one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
+            if one_combination:
                 leaf = res  # already solved with every catalogue variable fixed
             else:
-                leaf = ns.solve(_fixed(items), x)
+                leaf = ns.solve(fixed_box(items), x)
                 stats["nodes"] += 1
             stats["leaves"] += 1
             if leaf.success and (
                 incumbent is None or improves(leaf.objective, incumbent.objective, _prune_tol())
             ):
                 incumbent = leaf  # a tie keeps the incumbent found first
-            if fixed_box or prunes(bound):
+            if one_combination or prunes(bound):
                 continue
             # The node's relaxation sits on items, but its item data (fit ratios, screw
             # ratings) are the most favourable over the box's items, not those of the
@@ -244,7 +253,7 @@ def branch_and_bound_warm(
                 continue
             child = dict(box)
             child[var.name] = (side[0], side[-1])
-            if child == _fixed(items):
+            if child == fixed_box(items):
                 continue  # the leaf just solved
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
             # a box of one combination is a leaf: its value is reported, full multistart
@@ -264,7 +273,7 @@ def branch_and_bound_warm(
     ):
         # no leaf of the search ties with the candidate: it is the optimum, and as a
         # reported leaf it gets the full multistart (its own start first)
-        full = ns.solve(_fixed(seed_items), ns.x_of(seed))
+        full = ns.solve(fixed_box(seed_items), ns.x_of(seed))
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats

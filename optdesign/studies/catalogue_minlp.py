@@ -35,7 +35,7 @@ def solve_bonmin(ns, options: Mapping[str, Any] | None = None) -> tuple[Result |
     import casadi as ca
 
     from optdesign.formulations.catalogue_minlp import build_catalogue_minlp
-    from optdesign.studies.catalogue import _fixed
+    from optdesign.studies.catalogue_bnb import fixed_box
 
     opts = bonmin_options(options)
     problem = ns.problem
@@ -68,5 +68,5 @@ def solve_bonmin(ns, options: Mapping[str, Any] | None = None) -> tuple[Result |
     info["items"] = items
     info["objective_scaled"] = float(sol["f"])
     design = ns.nlp.x_from_z(x[: minlp.n_z])
-    leaf = ns.solve(_fixed(items), design, warm=True)
+    leaf = ns.solve(fixed_box(items), design, warm=True)
     return (leaf if leaf.success else None), info
