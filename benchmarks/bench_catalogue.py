@@ -47,8 +47,19 @@ def _write(path: Path, row: dict) -> None:
     print(json.dumps(row), flush=True)
 
 
+def catalogue_record(result) -> dict:
+    """The catalogue search's record of ``result`` as a dict: ``result.extra["catalogue"]``,
+    or the typed ``result.details.catalogue`` where the result carries typed details."""
+    details = getattr(getattr(result, "details", None), "catalogue", None)
+    if details is not None:
+        from dataclasses import asdict, is_dataclass
+
+        return asdict(details) if is_dataclass(details) else dict(details)
+    return dict(getattr(result, "extra", {}).get("catalogue", {}))
+
+
 def _catalogue_info(result) -> dict:
-    info = result.extra.get("catalogue", {})
+    info = catalogue_record(result)
     return {
         k: info.get(k)
         for k in ("method", "nlp_solves", "nodes", "pruned", "infeasible", "leaves", "items")

@@ -31,6 +31,7 @@ import argparse
 import json
 import math
 import os
+import sys
 import time
 import tomllib
 from pathlib import Path
@@ -42,6 +43,9 @@ import numpy as np
 
 from optdesign.problem import problem_from_dict
 from optdesign.studies.catalogue import solve_catalogue
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_catalogue import catalogue_record
 
 ROOT = Path(__file__).resolve().parents[1]
 ISO_2338 = (4, 5, 6, 8, 10, 12, 16)
@@ -100,7 +104,7 @@ def run(contender: str, problem, de_limit: float):
 
         res = get_config("de").run(problem, problem.objective_names[0], de_limit)
     wall = time.perf_counter() - t0
-    info = res.extra.get("catalogue", {})
+    info = catalogue_record(res)
     items = {v.name: res.design.get(v.name) for v in problem.free if v.discrete}
     return {
         "status": res.status,
