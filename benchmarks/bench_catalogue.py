@@ -47,23 +47,19 @@ def _write(path: Path, row: dict) -> None:
     print(json.dumps(row), flush=True)
 
 
-def catalogue_record(result) -> dict:
-    """The catalogue search's record of ``result`` as a dict: ``result.extra["catalogue"]``,
-    or the typed ``result.details.catalogue`` where the result carries typed details."""
-    details = getattr(getattr(result, "details", None), "catalogue", None)
-    if details is not None:
-        from dataclasses import asdict, is_dataclass
-
-        return asdict(details) if is_dataclass(details) else dict(details)
-    return dict(getattr(result, "extra", {}).get("catalogue", {}))
-
-
 def _catalogue_info(result) -> dict:
-    info = catalogue_record(result)
+    """The catalogue search's counts of ``result`` (its typed ``details.catalogue``)."""
+    info = result.details.catalogue
+    if info is None:
+        return {}
     return {
-        k: info.get(k)
-        for k in ("method", "nlp_solves", "nodes", "pruned", "infeasible", "leaves", "items")
-        if k in info
+        "method": info.method,
+        "nlp_solves": info.nlp_solves,
+        "nodes": info.nodes,
+        "pruned": info.pruned,
+        "infeasible": info.infeasible,
+        "leaves": info.leaves,
+        "items": info.items,
     }
 
 

@@ -31,7 +31,6 @@ import argparse
 import json
 import math
 import os
-import sys
 import time
 import tomllib
 from pathlib import Path
@@ -43,9 +42,6 @@ import numpy as np
 
 from optdesign.problem import problem_from_dict
 from optdesign.studies.catalogue import solve_catalogue
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_catalogue import catalogue_record
 
 ROOT = Path(__file__).resolve().parents[1]
 ISO_2338 = (4, 5, 6, 8, 10, 12, 16)
@@ -98,21 +94,22 @@ def run(contender: str, problem, de_limit: float):
         res = solve_catalogue(problem, method="bnb")
     elif contender.startswith("bonmin-"):
         algorithm = contender.removeprefix("bonmin-")
-        res = solve_catalogue(problem, method="bonmin", options={"algorithm": algorithm})
+        res = solve_catalogue(problem, solver="bonmin", options={"algorithm": algorithm})
     else:
         from optdesign.studies.bench.configs import get_config
 
         res = get_config("de").run(problem, problem.objective_names[0], de_limit)
     wall = time.perf_counter() - t0
-    info = catalogue_record(res)
+    info = res.details.catalogue
+    minlp = info.minlp if info is not None else None
     items = {v.name: res.design.get(v.name) for v in problem.free if v.discrete}
     return {
         "status": res.status,
         "success": bool(res.success),
         "objective": float(res.objective) if res.success else None,
         "items": items if res.success else None,
-        "nlp_solves": info.get("nlp_solves"),
-        "bonmin_status": (info.get("bonmin") or {}).get("status"),
+        "nlp_solves": info.nlp_solves if info is not None else None,
+        "bonmin_status": minlp.status if minlp is not None else None,
         "wall_s": round(wall, 3),
     }
 

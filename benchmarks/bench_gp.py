@@ -43,10 +43,10 @@ def main() -> None:
         t_trace = time.perf_counter() - t0
         r = make_solver(gp, "clarabel").solve()
         gp_all.append(time.perf_counter() - t0)
-        timing = r.extra["gp_timing"]
-        gp_total.append(t_trace + timing["total_s"])  # without the certificate
-        gp_solver.append(timing["solver_s"])
-        gp_cert.append(timing["certificate_s"])
+        timing = r.details.gp.timing
+        gp_total.append(t_trace + timing.total_s)  # without the certificate
+        gp_solver.append(timing.solver_s)
+        gp_cert.append(timing.certificate_s)
         gp_obj, cert = r.objective, r.certificate
 
     backend = solver_for(problem)

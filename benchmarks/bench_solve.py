@@ -23,10 +23,10 @@ from scipy.optimize import differential_evolution
 from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.global_check import penalised_objective
 from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.pareto.eps_solver import SLSQP_OPTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -66,7 +66,8 @@ def main() -> None:
         results.append(r)
     one_solve = float(np.median(times))
     # the same NLP by SLSQP with exact CasADi derivatives (the Pareto sweeps' solver)
-    slsqp = ScipyNLPSolver(solver.nlp, "SLSQP", "exact", SLSQP_OPTIONS)
+    sweep = dict(solver_hints("slsqp").sweep_options or {})
+    slsqp = ScipyNLPSolver(solver.nlp, "SLSQP", "exact", sweep)
     slsqp_runs = [slsqp.solve(problem.start()) for _ in range(args.repeats)]
     one_slsqp = float(np.median([r.wall_time_s for r in slsqp_runs]))
 

@@ -28,7 +28,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
 from optdesign.solvers.result import Result
 
-__all__ = ["bench", "load", "pareto", "report", "solve"]
+__all__ = ["bench", "bench_configurations", "load", "pareto", "report", "solve", "sweep"]
 
 
 def solve(
@@ -39,7 +39,7 @@ def solve(
     starts: int | None = None,
     seed: int | None = None,
     workers: int = 1,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
     agree: int | None = None,
@@ -65,8 +65,11 @@ def solve(
     workers
         Local processes for the starts (1..256).
     solver, options
-        Registered solver back-end (:func:`optdesign.solver_names`) and its options
-        (Ipopt's are checked by Ipopt before the solve).
+        Registered solver back-end (:func:`optdesign.solver_names`; None: the
+        formulation's default, :func:`optdesign.solvers.registry.default_solver` - Ipopt
+        for an NLP, Clarabel for a GP) and its options (checked as the back-end declares
+        before the solve: Ipopt's by Ipopt). A GP formulation given an NLP back-end
+        solves the GP with the default GP back-end and says so in a note.
     ranges
         Also compute the range of each variable over the optimal set (NLP optima).
     agree
@@ -142,10 +145,11 @@ def pareto(
     (folder of the resumable store), ``workers``, ``scheduler`` (Dask), ``resume``,
     ``overwrite`` (start afresh over a stored run), ``progress``, ``starts``, ``seed``,
     ``solver``, ``agree``, ``spacing``, ``eps_values``, ``retry_starts``,
-    ``extra_starts``, ``deterministic``, ``time_limit`` (wall-clock seconds of an epsilon
-    front: no point begins after it, the points running finish; the front says how many
-    were left out and a resume in ``out`` computes them), NSGA-II's ``pop_size`` and
-    ``generations``.
+    ``extra_starts``, ``deterministic``, ``time_limit`` (wall-clock seconds of a
+    continuous epsilon front, refused by any other method: no point begins after it, the
+    points running finish; the front says how many were left out and a resume in
+    ``out`` computes them), NSGA-II's ``pop_size`` and ``generations``. ``optdesign
+    pareto`` runs each of its methods through this function.
 
     Returns
     -------
@@ -161,6 +165,7 @@ def pareto(
     problem = load(problem)
     validation.front_objectives(problem, objectives)
     validation.method_for(problem, method)
+    validation.front_time_limit(problem, [method], options.get("time_limit"))
     return compute_front(problem, objectives, points, method, **options)
 
 
@@ -177,6 +182,7 @@ def bench(
     hard_timeout: float | None = None,
     progress: bool = False,
     scheduler: str | None = None,
+    update_readme: str | Path | None = None,
 ):
     """Benchmark solver configurations on problems (yours) or on a seeded suite.
 
@@ -187,6 +193,9 @@ def bench(
     (``resume``) or started afresh (``overwrite``). ``time_limit``: soft wall-time limit
     of each solver call (s, at most a day); ``hard_timeout``: a run is killed after it
     (default ``time_limit + 3``). ``scheduler``: address of a Dask scheduler.
+    ``update_readme``: a text file whose generated block (between the markers of
+    ``benchmarks/README.md``) gets the summary; checked before any run. ``optdesign
+    bench`` runs through this function.
 
     Returns
     -------
@@ -209,8 +218,9 @@ def bench(
         progress=progress,
         scheduler=scheduler,
     )
+    readme = validation.readme_file("update_readme", update_readme)
     loaded = None if args["problems"] is None else [load(p) for p in args["problems"]]
-    return run_bench(
+    report = run_bench(
         suite=args["suite"],
         problems=loaded,
         configs=args["solvers"],
@@ -223,6 +233,26 @@ def bench(
         hard_timeout=args["hard_timeout"],
         progress=args["progress"],
     )
+    if readme is not None:
+        from optdesign.studies.bench.report import update_readme as paste
+
+        if not paste(readme, report.summary()):  # its markers gone during the runs
+            raise validation.ArgumentError(
+                "update_readme", f"{readme} has no generated-block markers"
+            )
+    return report
+
+
+def bench_configurations(hidden: bool = False) -> list[tuple[str, str, str]]:
+    """The benchmark's configurations ``(name, kind, description)``, the names
+    :func:`bench` takes as ``solvers`` (a registered solver back-end is one too, by its
+    name); ``hidden``: also the ones kept for the tests."""
+    from optdesign.studies.bench import default_configs, get_config
+
+    return [
+        (name, (c := get_config(name)).kind, c.description)
+        for name in default_configs(include_hidden=hidden)
+    ]
 
 
 def report(result: Any, path: str | Path) -> Path:
@@ -255,3 +285,76 @@ def report(result: Any, path: str | Path) -> Path:
     problem, fronts, target = validation.report_arguments(result, path)
     page = front_report(problem, fronts) if fronts else solve_report(result)
     return atomic_write_text(target, page)
+
+
+def sweep(
+    problem: DesignProblem | str | Path | Mapping[str, Any],
+    vary: Mapping[str, Any],
+    *,
+    objective: str | None = None,
+    check_every: int = 10,
+    starts: int | None = None,
+    seed: int | None = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    progress: bool = False,
+    sensitivities: bool = False,
+    workers: int = 1,
+    scheduler: str | None = None,
+):
+    """How the optimum of ``problem`` moves when one or two parameters change.
+
+    ``vary``: ``{path: (start, stop, count)}`` for one or two parameters, e.g.
+    ``{"requirements.hinge_moment": ("200 N*m", "1000 N*m", 20)}``; a path is
+    ``requirements.NAME`` (``requirements.mean_ratio.min`` inside a band),
+    ``variables.NAME.lower`` / ``.upper`` (a free variable's bound) or ``variables.NAME``
+    (a fixed variable); start and stop are quantities of the parameter's dimension
+    (a bare number only for a plain number), count 2..1000. Points are solved by
+    continuation (warm-started from the neighbour) with a full multistart every
+    ``check_every`` points, at the ends and wherever the warm start fails or the binding
+    set changes (``starts``, ``seed``: that multistart, default the file's). The points
+    go to ``out/sweep.jsonl`` as they finish (a new temporary folder by default);
+    ``resume`` continues a stored sweep, ``overwrite`` starts afresh over one.
+    ``workers`` (local processes) or ``scheduler`` (a Dask scheduler's address): the
+    rows of a two-parameter sweep, or the points of a catalogue problem, side by side
+    (one row is one chain of warm starts; the records are the same for any number).
+    ``sensitivities``: also each point's log-sensitivities to every binding requirement
+    (``point.sensitivities``, :attr:`optdesign.Result.sensitivities`).
+
+    Returns
+    -------
+    Sweep
+        The points (parameters, status, objective, design, binding set, the multistart
+        checks and jumps, what fails at an infeasible point); ``.summary()``,
+        ``.to_frame()`` (columns ``"name [unit]"``), ``.plot()`` (the design chart).
+    """
+    from optdesign.studies.sweep import run_sweep
+
+    starts = validation.starts("starts", starts)
+    seed = validation.seed("seed", seed)
+    check_every = validation.integer("check_every", check_every, 1, 10_000)
+    resume = validation.flag("resume", resume)
+    overwrite = validation.flag("overwrite", overwrite)
+    progress = validation.flag("progress", progress)
+    sensitivities = validation.flag("sensitivities", sensitivities)
+    workers = validation.workers("workers", workers)
+    scheduler = validation.text("scheduler", scheduler, optional=True)
+    validation.run_folder(out, resume, overwrite)
+    problem = load(problem)
+    validation.objective_of(problem, objective)
+    return run_sweep(
+        problem,
+        vary,
+        objective=objective,
+        check_every=check_every,
+        starts=starts,
+        seed=seed,
+        out=out,
+        resume=resume,
+        overwrite=overwrite,
+        progress=progress,
+        sensitivities=sensitivities,
+        workers=workers,
+        scheduler=scheduler,
+    )

@@ -139,6 +139,7 @@ def _load_plugins() -> None:
 PLUGIN_MODULES: list[str] = [
     "optdesign.commands.solve",
     "optdesign.commands.pareto",
+    "optdesign.commands.sweep",
     "optdesign.commands.bench",
 ]
 
@@ -167,6 +168,14 @@ def checked(check: Callable[[str, Any], Any], parse: Callable[[str], Any] = str)
             raise argparse.ArgumentTypeError(exc.reason) from None
 
     return convert
+
+
+def time_limit_option(parser: argparse.ArgumentParser, help: str, default: float | None = None):
+    """The ``--time-limit`` option of a command: seconds, checked as the API checks its
+    ``time_limit``."""
+    parser.add_argument(
+        "--time-limit", type=checked(validation.seconds, literal), default=default, help=help
+    )
 
 
 def bounded_int(lo: int, hi: int) -> Callable[[str], int]:

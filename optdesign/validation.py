@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 # The checks of one argument, re-exported: the CLI and the API call them as validation.X.
@@ -57,6 +58,8 @@ from optdesign.argument_checks import (  # noqa: F401
     unit,
     workers,
 )
+from optdesign.errors import InputError
+from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints, solver_names
 
 
 def formulation(argument: str, value: Any) -> str:
@@ -66,11 +69,9 @@ def formulation(argument: str, value: Any) -> str:
     return choice(argument, value, ["auto", *FORMULATIONS], "formulation")
 
 
-def solver(argument: str, value: Any) -> str:
-    """A registered solver back-end (NLP or GP)."""
-    from optdesign.solvers.registry import solver_names
-
-    return choice(argument, value, solver_names(), "solver")
+def solver(argument: str, value: Any) -> str | None:
+    """A registered solver back-end (NLP or GP); None: the formulation's default."""
+    return None if value is None else choice(argument, value, solver_names(), "solver")
 
 
 def method(argument: str, value: Any) -> str:
@@ -138,8 +139,9 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
 
 
 def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] | None:
-    """Options of a solver back-end: a mapping with string keys; Ipopt's are checked by
-    Ipopt itself (the check the problem file's ``[solver] ipopt`` gets)."""
+    """Options of a solver back-end (None: the registry's default for an NLP): a mapping
+    with string keys, checked as the back-end declares (Ipopt's by Ipopt itself, the
+    check the problem file's ``[solver] ipopt`` gets)."""
     if options is None:
         return None
     if not isinstance(options, Mapping):
@@ -147,10 +149,7 @@ def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] |
     for key in options:
         if not isinstance(key, str):
             raise ArgumentError(argument, f"option names are strings, got {shown(key)}")
-    if solver == "ipopt" and options:
-        from optdesign.solvers.casadi_nlp import check_ipopt_options
-
-        check_ipopt_options(dict(options), field=argument)
+    solver_hints(solver).check_options(options, argument)
     return dict(options)
 
 
@@ -189,11 +188,11 @@ def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
         "overwrite": (flag, ()),
         "progress": (flag, ()),
         "on_record": (_optional_function, ()),
-        "time_limit": (seconds, eps),
+        "time_limit": (seconds, ()),  # refused by front_time_limit where not applied
         "starts": (starts, (*eps, "weighted_sum")),
         "seed": (seed, ()),
         "agree": (agree, eps),
-        "solver": (lambda a, v: choice(a, v, ("slsqp", "ipopt"), "front solver"), eps),
+        "solver": (lambda a, v: choice(a, v, FRONT_SOLVERS.choices, "front solver"), eps),
         "spacing": (lambda a, v: choice(a, v, ("arc", "uniform"), "spacing"), ("epsilon",)),
         "eps_values": (_eps_values, eps),
         "retry_starts": (retries, eps),
@@ -316,14 +315,89 @@ def method_for(problem: Any, method_: Any, argument: str = "method") -> None:
     """A front method that keeps the problem's designs valid: a weighted sum of
     continuous NLPs would leave a catalogue."""
     if method_ == "weighted_sum" or type(method_).__name__ == "WeightedSum":
-        from optdesign.studies.pareto.catalogue_front import has_catalogue
+        from optdesign.studies.pareto.template import has_catalogue, leaves_catalogue
 
         if has_catalogue(problem):
-            raise ArgumentError(
-                argument,
-                "weighted_sum would leave the catalogue: with catalogue variables use "
-                "epsilon or nsga2",
-            )
+            raise ArgumentError(argument, leaves_catalogue("weighted_sum"))
+
+
+def front_problem(problem: Any) -> None:
+    """A problem a front can be traced on (a free variable), whose file's solver options
+    its back-ends accept: refused before any work."""
+    from optdesign.studies.nlp_solve import solver_options
+    from optdesign.studies.pareto.run_setup import check_front_problem
+
+    check_front_problem(problem)
+    solver_options(problem)
+
+
+def sweep_parameters(problem: Any, vary: Mapping[str, Any], field: str = "vary") -> None:
+    """The parameters of a sweep (``{path: (start, stop, count)}``) of ``problem``:
+    refused, naming ``field`` and the path, before any work."""
+    from optdesign.studies.sweep import sweep_axes
+
+    try:
+        sweep_axes(problem, vary)
+    except InputError as exc:
+        raise InputError(exc.field.replace("vary", field, 1), exc.reason) from None
+
+
+def front_store(problem: Any, method: str) -> str | None:
+    """The file name of the resumable store of front method ``method`` on ``problem``
+    (``"epsilon-catalogue.jsonl"`` for an epsilon front of a catalogue problem), or None
+    when the method keeps none (NSGA-II): what a command checks before any front runs."""
+    from optdesign.studies.pareto.methods import make_method
+
+    built = make_method(problem, method)
+    return f"{built.name}.jsonl" if getattr(built, "stored", False) else None
+
+
+def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> None:
+    """A front's time limit (``time_limit``, None: none) is applied by every method
+    named in ``methods``: only a continuous epsilon sweep stops at one (a method object
+    is checked when it runs)."""
+    if time_limit is None:
+        return
+    from optdesign.studies.pareto.catalogue_front import has_catalogue
+
+    named = [m for m in methods if isinstance(m, str)]
+    other = [m for m in named if m not in ("epsilon", "uniform")]
+    if other or (named and has_catalogue(problem)):
+        what = f"the {other[0]} method" if other else "a catalogue front"
+        raise ArgumentError(
+            "time_limit",
+            f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
+        )
+
+
+def solve_plan(problem: Any, formulation_: str = "auto", objective: str | None = None) -> str:
+    """The formulation :func:`optdesign.solve` will use for ``objective``, after the
+    checks that need no solve (the file's solver options, a combination no formulation
+    honours), so that a caller refuses before any work."""
+    from optdesign.studies.solve import plan_solve
+
+    return plan_solve(problem, formulation_, objective)
+
+
+def readme_file(argument: str, path: Any) -> Path | None:
+    """A file whose generated block a benchmark's summary replaces (None: none): a
+    regular UTF-8 text file with the markers, checked before any run (a FIFO,
+    /dev/zero, a folder or a file without the markers is refused at once, not after an
+    hour of runs)."""
+    if path is None:
+        return None
+    from optdesign.studies.bench.report import has_readme_markers, read_readme
+
+    path = Path(_optional_path(argument, path))
+    try:
+        text = read_readme(path, option=argument)
+    except ArgumentError:
+        raise
+    except InputError as exc:
+        raise ArgumentError(argument, exc.reason) from None
+    if not has_readme_markers(text):
+        raise ArgumentError(argument, f"{path} has no generated-block markers")
+    return path
 
 
 def front_objectives(problem: Any, objectives: Any, argument: str = "objectives") -> list[str]:
@@ -389,7 +463,6 @@ def configs(argument: str, value: Any) -> list[str] | None:
     items = [s.strip() for item in names(argument, value) for s in item.split(",") if s.strip()]
     if not items:
         raise ArgumentError(argument, "give at least one configuration (or None for all)")
-    from optdesign.solvers.registry import solver_names
     from optdesign.studies.bench.configs import default_configs
 
     known = default_configs(include_hidden=True)

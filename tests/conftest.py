@@ -1,10 +1,18 @@
 import os
+import signal
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+# A run started in the background by a non-interactive shell (`pytest &`, nohup, a
+# mutation run) inherits SIGINT ignored, and so would the commands it starts; the signal
+# tests check what a user at a terminal gets, Python's own handler, so the run starts
+# from it (a handled signal is reset to its default in a child, which Python then takes).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 # Property tests find a bug every run or never, not by luck: by default (the README's test
 # command, CI) Hypothesis draws the same examples on every run - seeded from each test's

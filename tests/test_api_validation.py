@@ -181,6 +181,21 @@ CASES = [
         problem=CATALOGUE,
         objectives="backlash,ripple",
     ),
+    pareto(
+        "time_limit",
+        5,
+        "5",
+        "not applied by the nsga2 method: only a continuous epsilon sweep stops at a time limit",
+        method="nsga2",
+    ),
+    pareto(
+        "time_limit",
+        5,
+        "5",
+        "not applied by a catalogue front: only a continuous epsilon sweep stops at a time limit",
+        problem=CATALOGUE,
+        objectives="backlash,ripple",
+    ),
     pareto("resume", True, None, "give the {out} folder of the run to resume"),
     pareto("overwrite", True, None, "excludes {resume} (start over, or continue)", resume=True),
     # --- bench ---------------------------------------------------------------------
@@ -209,6 +224,18 @@ CASES = [
         10**400,
         ["1" + "0" * 400],
         "an integer of more than 100 digits is outside (0, 86400]",
+    ),
+    bench(
+        "update_readme",
+        str(ROOT / "pyproject.toml"),
+        [str(ROOT / "pyproject.toml")],
+        f"{ROOT / 'pyproject.toml'} has no generated-block markers",
+    ),
+    bench(
+        "update_readme",
+        str(ROOT / "no-such-readme.md"),
+        [str(ROOT / "no-such-readme.md")],
+        f"{ROOT / 'no-such-readme.md'} does not exist",
     ),
     bench("resume", True, [], "give the {out} folder of the run to resume"),
     bench("overwrite", True, [], "excludes {resume} (start over, or continue)", resume=True),
@@ -260,7 +287,7 @@ def test_every_command_line_option_is_an_api_argument():
 
     parser = build_parser()
     subparsers = next(a for a in parser._actions if a.dest == "command").choices
-    outputs = {"json", "no_plot", "no_report", "no_diagnosis", "list", "update_readme", "out"}
+    outputs = {"json", "no_plot", "no_report", "no_diagnosis", "list", "out"}
     api = {
         "solve": set(inspect.signature(od.solve).parameters) | {"file"},
         "pareto": set(inspect.signature(od.pareto).parameters) | set(_pareto_options()) | {"file"},
@@ -398,3 +425,15 @@ def test_an_out_that_is_a_file_is_refused_before_any_work(tmp_path, capsys, unde
     assert main(argv) == 2
     assert "--out: " in capsys.readouterr().err
     assert sentinel.read_text() == "a file, not a folder\n"
+
+
+def test_bench_configurations_are_the_command_lines_list(capsys):
+    # optdesign bench --list prints od.bench_configurations(), the names od.bench takes
+    configs = od.bench_configurations()
+    assert [c[0] for c in configs][:2] == ["ipopt-exact", "ipopt-lbfgs"]
+    assert ("gp-clarabel", "gp", "cvxpy GP (first-order Hertz), Clarabel") in configs
+    assert "debug-crash" not in {c[0] for c in configs}
+    assert "debug-crash" in {c[0] for c in od.bench_configurations(hidden=True)}
+    assert main(["bench", "--list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in lines] == [c[0] for c in configs]

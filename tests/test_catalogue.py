@@ -42,14 +42,14 @@ def test_branch_and_bound_equals_enumeration_small_catalogue():
     assert enum.status == "optimal" and bnb.status == "optimal"
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-6)
     # p = 6, d = 6 is the best pair (p = 5 with d = 6 gives 0.03703 deg)
-    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    assert bnb.details.catalogue.items == {"p": 6, "d": 6}
     # ISO 286-2 table H7/g6 at 6 mm: 12 + 12 = 24 um largest clearance (the 0.034065)
     assert bnb.objective == pytest.approx(0.0340646, rel=1e-5)
     assert is_on_catalogue(problem, bnb.design) and bnb.verified
     # the relaxation (p in [5, 6], d in [5, 8] continuous) bounds the discrete optimum
     assert relaxation_bound(bnb) < bnb.objective
-    assert len(enum.extra["catalogue"]["enumerated"]) == 6
-    assert bnb.extra["catalogue"]["nlp_solves"] < enum.extra["catalogue"]["nlp_solves"]
+    assert len(enum.details.catalogue.enumerated) == 6
+    assert bnb.details.catalogue.nlp_solves < enum.details.catalogue.nlp_solves
 
 
 def test_smooth_fit_values_give_the_formula_optimum():
@@ -57,7 +57,7 @@ def test_smooth_fit_values_give_the_formula_optimum():
     problem = _small_catalogue("smooth")
     bnb = solve_catalogue(problem, method="bnb", starts=2)
     assert bnb.status == "optimal"
-    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    assert bnb.details.catalogue.items == {"p": 6, "d": 6}
     assert bnb.objective == pytest.approx(0.0363462, rel=1e-5)
 
 
@@ -69,7 +69,7 @@ def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-6)
     assert relaxation_bound(bnb) == pytest.approx(RELAXED, rel=1e-5)
     assert relaxation_bound(bnb) < bnb.objective
-    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    assert bnb.details.catalogue.items == {"p": 6, "d": 6}
 
 
 def test_catalogue_problem_is_never_solved_as_continuous():
@@ -86,9 +86,10 @@ def test_catalogue_problem_is_never_solved_as_continuous():
 def test_node_solver_ipopt_options_file_wins_over_node_defaults():
     # Nodes enter Ipopt's restoration phase early (many boxes are infeasible); a problem
     # file's own [solver] ipopt options still decide, and a caller's override both.
-    from optdesign.studies.catalogue import NODE_IPOPT_OPTIONS, NodeSolver
+    from optdesign.solvers.registry import solver_hints
+    from optdesign.studies.catalogue import NodeSolver
 
-    assert NODE_IPOPT_OPTIONS["expect_infeasible_problem"] == "yes"
+    assert solver_hints("ipopt").node_options["expect_infeasible_problem"] == "yes"
     default = NodeSolver(_small_catalogue())
     assert default.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
     data = tomllib.loads(CATALOGUE.read_text())

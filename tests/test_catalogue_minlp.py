@@ -9,9 +9,10 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
-from optdesign.errors import InputError
+from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.catalogue_minlp import item_groups
 from optdesign.problem import problem_from_dict
+from optdesign.solvers.registry import solver_hints
 from optdesign.studies.catalogue import NodeSolver, solve_catalogue
 from optdesign.studies.catalogue_bnb import InfeasibleBoxes
 
@@ -32,26 +33,51 @@ def enumerated():
 
 def test_warm_branch_and_bound_equals_enumeration(enumerated):
     bnb = solve_catalogue(_small(), method="bnb", starts=2)
-    assert bnb.extra["catalogue"]["items"] == enumerated.extra["catalogue"]["items"]
+    assert bnb.details.catalogue.items == enumerated.details.catalogue.items
     assert bnb.objective == pytest.approx(enumerated.objective, rel=1e-9)
     assert bnb.objective == pytest.approx(0.0340646, rel=1e-5)  # p = 6, d = 6
+    # the typed counts are written to result.json under the catalogue record's names
+    extra = bnb.to_dict()["extra"]["catalogue"]
+    info = bnb.details.catalogue
+    assert (extra["nodes"], extra["leaves"]) == (info.nodes, info.leaves)
+    assert extra["seeded"] == info.seeded == 0  # no first incumbent outside a front
+    assert extra["warm_fallbacks"] == info.warm_fallbacks
+    assert extra["implied_infeasible"] == info.implied_infeasible == 0  # no memo
+    assert "minlp" not in extra
 
 
 def test_bonmin_equals_enumeration(enumerated):
     """od.solve(..., solver="bonmin"): Bonmin's B-BB picks the items, their NLP is the
     design; the same optimum as enumeration, with the relaxation bound below it."""
     res = od.solve(_small(), solver="bonmin", starts=2, ranges=False)
-    info = res.extra["catalogue"]
-    assert info["method"] == "bonmin" and info["bonmin"]["algorithm"] == "B-BB"
-    assert info["bonmin"]["status"] == "SUCCESS"
-    assert info["items"] == enumerated.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    info = res.details.catalogue
+    assert info.method == "minlp" and res.formulation == "catalogue-minlp"
+    assert (info.minlp.solver, info.minlp.algorithm) == ("bonmin", "B-BB")
+    assert info.minlp.status == "SUCCESS" and info.minlp.items == {"p": 6, "d": 6}
+    assert info.items == enumerated.details.catalogue.items == {"p": 6, "d": 6}
     assert res.objective == pytest.approx(enumerated.objective, rel=1e-9)
     assert res.bound < res.objective and res.verified
+    minlp = res.to_dict()["extra"]["catalogue"]["minlp"]
+    assert (minlp["solver"], minlp["status"], minlp["binaries"]) == ("bonmin", "SUCCESS", 5)
 
 
 def test_bonmin_refuses_an_unknown_algorithm():
     with pytest.raises(InputError, match=r"algorithm.*'B-XX' is not a Bonmin algorithm"):
-        solve_catalogue(_small(), method="bonmin", starts=1, options={"algorithm": "B-XX"})
+        solve_catalogue(_small(), solver="bonmin", starts=1, options={"algorithm": "B-XX"})
+    # through the API: refused before any solve, naming the argument
+    with pytest.raises(InputError, match=r"options\.algorithm: 'B-XX' is not a Bonmin"):
+        od.solve(_small(), solver="bonmin", options={"algorithm": "B-XX"})
+
+
+def test_the_registry_routes_a_catalogue_problem_to_its_minlp_back_end():
+    """Bonmin declares a MINLP solve and its time-limit option; method "minlp" with an
+    NLP-only back-end is refused, naming the back-ends that solve MINLPs."""
+    hints = solver_hints("bonmin")
+    assert hints.minlp == "optdesign.solvers.bonmin:solve_minlp"
+    assert hints.time_limit(30) == {"time_limit": 30.0} and not hints.multipliers
+    assert solver_hints("ipopt").minlp is None
+    with pytest.raises(ProblemError, match=r"back-end 'ipopt' solves no MINLP .*: bonmin\)"):
+        solve_catalogue(_small(), method="minlp", solver="ipopt", starts=1)
 
 
 def test_one_hot_groups_follow_the_item_data():
@@ -122,7 +148,7 @@ def test_a_relaxation_on_an_item_still_branches_the_rest_of_its_box():
     problem = _relaxation_on_an_item()
     bnb = solve_catalogue(problem, method="bnb", starts=2)
     enum = solve_catalogue(problem, method="enumerate", starts=2)
-    assert enum.extra["catalogue"]["items"] == {"p": 6, "d": 10}
-    assert bnb.extra["catalogue"]["items"] == {"p": 6, "d": 10}
+    assert enum.details.catalogue.items == {"p": 6, "d": 10}
+    assert bnb.details.catalogue.items == {"p": 6, "d": 10}
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
     assert bnb.objective == pytest.approx(0.0352439, rel=1e-5)

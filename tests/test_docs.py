@@ -16,6 +16,7 @@ PAGES = [
     ROOT / "README.md",
     *sorted((ROOT / "docs").glob("*.md")),
     ROOT / "benchmarks" / "README.md",
+    ROOT / "tests" / "README.md",
 ]
 #: How docs/README.md spells a test reference in general: not a name to check.
 PLACEHOLDERS = {"tests/FILE.py", "test_function"}

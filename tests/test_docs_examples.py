@@ -40,6 +40,9 @@ def test_the_readmes_python_examples_run_as_written(tmp_path, monkeypatch, mecha
     assert result.objective == pytest.approx(0.0362197, rel=1e-5)  # cs_min_backlash's optimum
     assert len(front.points) == 30
     assert (tmp_path / "out" / "front.html").stat().st_size > 10_000
+    sweep = namespace["sweep"]  # continuation over the hinge moment, the user's rows too
+    assert [p.success for p in sweep.points] == [True] * 9
+    assert sweep.points[4].objective == pytest.approx(result.objective, rel=1e-6)  # 500 N*m
     bench = namespace["report"]
     assert bench.configs == ["ipopt-exact", "slsqp-exact", "de"]
     assert len(bench.rows) >= 3 and {row["config"] for row in bench.rows} == set(bench.configs)

@@ -75,8 +75,8 @@ def test_fork_gp_agrees_with_exact_nlp_and_is_certified():
     r = solve_gp_problem(problem, nlp_starts=2)
     assert r.status == "optimal" and r.verified
     # GP (first-order Hertz) vs exact NLP: within 0.1 % (acceptance), here ~0.01 %
-    assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
-    assert r.extra["nlp_exact"]["objective"] == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-5)
+    assert abs(r.details.gp.gap_gp_nlp_rel) < 1e-3
+    assert r.details.gp.nlp_exact.objective == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-5)
     assert r.objective == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-3)
     # the exact model at the GP design is the exact optimum too (same active set)
     assert r.objectives["backlash"] == pytest.approx(FORK_NLP_OPTIMUM, rel=1e-5)
@@ -96,7 +96,7 @@ def test_fixed_linkage_crank_slider_is_a_gp():
     assert len(gp.rows) < gp.n_rows_before_pruning
     r = solve_gp_problem(problem, nlp_starts=2)
     assert r.status == "optimal"
-    assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
+    assert abs(r.details.gp.gap_gp_nlp_rel) < 1e-3
     assert r.certificate.gap_rel < 1e-6
 
 

@@ -54,6 +54,8 @@ ENTRY_POINTS = {
     ("optdesign.studies.pareto.front", "optdesign.reports.front_text"),
     ("optdesign.studies.pareto.front", "optdesign.reports.frames"),
     ("optdesign.studies.pareto.front", "optdesign.plots.front"),
+    ("optdesign.studies.sweep", "optdesign.reports.sweep"),
+    ("optdesign.studies.sweep", "optdesign.plots.sweep"),
     # od.report(result_or_front, path): the public API's entry point to the report page
     ("optdesign.api", "optdesign.reports.html"),
 }
@@ -211,6 +213,24 @@ def test_no_import_points_up_the_layers():
         if layer(t) > layer(m) and (m, t) not in ENTRY_POINTS
     ]
     assert upward == [], "upward imports:\n" + "\n".join(upward)
+
+
+def test_the_commands_enter_through_the_public_api():
+    """A command (optdesign/commands/*, cli.py) reaches the studies through optdesign.api
+    and optdesign.validation only (the checks and the computations ``od.solve``,
+    ``od.pareto``, ``od.bench`` run), never by importing a study itself; the reports and
+    plots it writes read the results."""
+    graph = import_graph()
+    direct = [
+        f"{m}:{line} imports {t}"
+        for m, arrows in sorted(graph.items())
+        if m == "optdesign.cli" or m.startswith("optdesign.commands")
+        for t, line in sorted(arrows.items())
+        if t.startswith("optdesign.studies")
+    ]
+    assert direct == [], "commands importing a study:\n" + "\n".join(direct)
+    assert "optdesign.api" in graph["optdesign.commands.pareto"]
+    assert "optdesign.api" in graph["optdesign.commands.bench"]
 
 
 def test_the_entry_points_are_still_there():

@@ -250,7 +250,7 @@ def test_gp_form_with_fixed_thicknesses_and_its_refusal():
     assert gp.is_gp, gp.explain()
     r = solve_gp_problem(problem, nlp_starts=2)
     assert r.status == "optimal"
-    assert abs(r.extra["gap_gp_nlp_rel"]) < 1e-3
+    assert abs(r.details.gp.gap_gp_nlp_rel) < 1e-3
     data["materials"] = {"lug": {"cheek_thickness": "6 mm"}}
     gp = build_gp(problem_from_dict(data))
     assert not gp.is_gp
@@ -273,8 +273,8 @@ def test_spread_on_the_command_line(tmp_path, json_mode):
     path = tmp_path / "fin_lug.toml"
     path.write_text(text)
     args = [sys.executable, "-m", "optdesign", "solve", str(path), "--contact-models"]
-    args += ["--no-ranges"] + (["--json"] if json_mode else [])
-    run = subprocess.run(args, capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    args += ["--no-ranges", "--out", str(tmp_path / "out")] + (["--json"] if json_mode else [])
+    run = subprocess.run(args, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     notes = json.loads(run.stdout)["notes"] if json_mode else [run.stdout]
     line = next(n for n in notes if "backlash by pin contact model" in n)

@@ -227,18 +227,18 @@ def test_branch_and_bound_counts_every_node_it_solves(monkeypatch):
 
     monkeypatch.setattr(catalogue.NodeSolver, "solve", counted)
     bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
-    info = bnb.extra["catalogue"]
+    info = bnb.details.catalogue
     # the relaxation, 7 boxes of 20 item pairs, and the box whose warm bound (one start)
     # would prune it, solved again with the full multistart before it is pruned
-    assert info["nodes"] == len(solves) == 9
-    assert info["infeasible"] == solves.count(False) == 2
+    assert info.nodes == len(solves) == 9
+    assert info.infeasible == solves.count(False) == 2
     # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
-    assert (info["leaves"], info["pruned"]) == (1, 1)
+    assert (info.leaves, info.pruned) == (1, 1)
     solves.clear()
     enum = catalogue.solve_catalogue(problem, method="enumerate", starts=2)
-    assert len(enum.extra["catalogue"]["enumerated"]) == 20
+    assert len(enum.details.catalogue.enumerated) == 20
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
-    assert bnb.extra["catalogue"]["items"] == enum.extra["catalogue"]["items"] == {"p": 6, "d": 6}
+    assert bnb.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
 
 
 def test_the_catalogue_formulation_takes_the_callers_settings():
@@ -247,9 +247,9 @@ def test_the_catalogue_formulation_takes_the_callers_settings():
     ripple = od.solve(problem, "catalogue", objective="ripple", starts=2, ranges=False)
     direct = catalogue.solve_catalogue(problem, objective="ripple", starts=2)
     assert ripple.objective == pytest.approx(direct.objective, rel=1e-9)
-    assert ripple.extra["catalogue"]["items"] == {"p": 5, "d": 8}  # not backlash's 6 / 6
-    assert ripple.extra["catalogue"]["starts_per_node"] == 2
-    assert ripple.extra["catalogue"]["method"] == "enumerate"
+    assert ripple.details.catalogue.items == {"p": 5, "d": 8}  # not backlash's 6 / 6
+    assert ripple.details.catalogue.starts_per_node == 2
+    assert ripple.details.catalogue.method == "enumerate"
     # an iteration limit of 1 leaves even the relaxation unsolved: the options arrive
     starved = od.solve(problem, "catalogue", options={"max_iter": 1}, ranges=False, diagnose=False)
     assert starved.status == "infeasible"
@@ -269,9 +269,9 @@ def test_first_feasible_finds_a_feasible_catalogue_design_or_none():
     # the better child first: the leaf is no worse than the worst of the feasible items
     enum = catalogue.solve_catalogue(problem, method="enumerate", starts=2)
     feasible = {
-        (row["items"]["p"], row["items"]["d"]): row["objective"]
-        for row in enum.extra["catalogue"]["enumerated"]
-        if row["status"] == "optimal"
+        (row.items["p"], row.items["d"]): row.objective
+        for row in enum.details.catalogue.enumerated
+        if row.status == "optimal"
     }
     items = (found.design["p"], found.design["d"])
     assert found.objective == pytest.approx(feasible[items], rel=1e-6)  # that item pair's optimum

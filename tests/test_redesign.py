@@ -72,7 +72,7 @@ def test_redesign_beats_the_paper_on_ripple_and_backlash(fit_values, paper, opti
     problem = problem_from_dict(data)
     result = attach_reference(problem, solve_catalogue(problem, starts=2))
     assert result.status == "optimal" and result.verified
-    q = result.extra["reference"]["quantities"]
+    q = result.details.reference.quantities
     ripple_paper, ripple_opt = q["ripple"]
     backlash_paper, backlash_opt = q["backlash"]
     # the paper's design on the same models (seed 000: 23.8 % exact-derivative ripple)
@@ -81,6 +81,6 @@ def test_redesign_beats_the_paper_on_ripple_and_backlash(fit_values, paper, opti
     # the re-design meets ripple <= 10 % and cuts the backlash by about 30 %
     assert ripple_opt <= 10.0 + 1e-6
     assert backlash_opt == pytest.approx(optimum, rel=1e-4)
-    assert result.extra["catalogue"]["items"] == {"d": 6}
-    assert result.extra["reference"]["reference_violated"] == ["ripple_max"]
+    assert result.details.catalogue.items == {"d": 6}
+    assert result.details.reference.reference_violated == ["ripple_max"]
     assert any("Duan 2017" in note for note in result.notes)

@@ -111,8 +111,8 @@ def test_robust_beats_nominal_in_an_independent_monte_carlo(problem, nominal):
     rob = cmp.robust
     assert rob.status == "optimal" and rob.verified  # nominal requirements hold (NumPy check)
     # The SAA statistic recomputed on the NumPy path from the same samples equals Ipopt's.
-    assert rob.extra["saa_check"] == pytest.approx(rob.objective, rel=1e-7)
-    assert rob.objective < cmp.nominal.extra["saa_value"]  # in-sample: better by construction
+    assert rob.details.robust.saa_check == pytest.approx(rob.objective, rel=1e-7)
+    assert rob.objective < cmp.nominal_saa  # in-sample: better by construction
     # Out of sample (different seed, 1250x the samples, same draws for both designs):
     # The optimised statistic, CVaR_0.9, is lower for the robust design, and the paired
     # bootstrap interval of the difference excludes 0. (The plain 95 % quantile is not

@@ -38,7 +38,7 @@ if [ ${#MODULES[@]} -eq 0 ]; then
     optdesign/studies/relaxation.py
     optdesign/studies/catalogue.py
     optdesign/studies/pareto/*.py
-    optdesign/storage.py
+    optdesign/storage/*.py
     optdesign/units.py
     optdesign/reports/display_units.py
   )
@@ -127,8 +127,9 @@ else
   "$MUTMUT" run --max-children "${JOBS:-2}" "no-such-mutant" >mutmut-generate.log 2>&1 || true
   "$MUTMUT" results --all true >mutmut-all.txt 2>&1 || true
   "$PY" "$ROOT/benchmarks/mutation/sample.py" mutmut-all.txt "$SAMPLE" "${SEED:-0}" >sample.txt
-  # mutmut takes the names as arguments: in chunks, so the command line stays short
-  xargs -a sample.txt -n 200 "$MUTMUT" run --max-children "${JOBS:-2}" >mutmut-run.log 2>&1 || true
+  # mutmut takes the names as arguments: in chunks of the shuffled sample, so that the
+  # command line stays short and a run stopped early still leaves a random sample
+  xargs -a sample.txt -n 40 "$MUTMUT" run --max-children "${JOBS:-2}" >mutmut-run.log 2>&1 || true
   "$MUTMUT" results --all true >mutmut-results-all.txt 2>&1 || true
   grep -F -f sample.txt mutmut-results-all.txt >mutmut-results.txt || true
   "$PY" "$ROOT/benchmarks/mutation/summary.py" mutmut-results.txt

@@ -3,7 +3,8 @@
 Usage: python benchmarks/mutation/sample.py mutmut-all.txt FRACTION SEED > sample.txt
 
 Each module contributes ``ceil(FRACTION * n)`` of its ``n`` mutants, drawn without
-replacement by a generator seeded with SEED, so the same tree gives the same sample.
+replacement by a generator seeded with SEED, so the same tree gives the same sample,
+printed in a seeded random order.
 """
 
 from __future__ import annotations
@@ -27,10 +28,14 @@ def main(path: str, fraction: float, seed: int) -> int:
                 full = line.strip().split(":")[0]
                 by_module[module_of(match["name"])].append(full)
     rng = random.Random(seed)
+    sample = []
     for module in sorted(by_module):
         names = sorted(by_module[module])
-        for name in sorted(rng.sample(names, math.ceil(fraction * len(names)))):
-            print(name)
+        sample += rng.sample(names, math.ceil(fraction * len(names)))
+    # in a seeded random order: the mutants run in chunks, so the part of the sample a
+    # stopped run got through is itself a random sample
+    rng.shuffle(sample)
+    print("\n".join(sample))
     return 0
 
 

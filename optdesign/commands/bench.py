@@ -1,6 +1,6 @@
 """``optdesign bench``: which solver and formulation to use, with evidence.
 
-Runs every solver configuration (:data:`optdesign.studies.bench.CONFIGS`) on a suite of
+Runs every solver configuration (:func:`optdesign.bench_configurations`) on a suite of
 seeded instances (or on the user's problem files, ``--problem FILE ...``), streams one JSON row per run to ``OUT/bench_runs.jsonl`` (``--resume``
 continues it), then writes ``bench_runs.csv``, ``bench_profiles.png`` (Dolan-More profiles of
 time and objective gap) and ``summary.md``, all under ``--out`` (default: a new folder).
@@ -14,8 +14,10 @@ import os
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder
-from optdesign.errors import InputError
+from optdesign.cli import as_options, checked, command, literal, output_folder, time_limit_option
+
+#: Options spelt otherwise than their API argument (optdesign.bench).
+RENAMED = {"problems": "--problem"}
 
 
 @command("bench")
@@ -67,11 +69,8 @@ def _bench(sub):
         action="store_true",
         help="start afresh in an --out folder that holds a previous run's store",
     )
-    p.add_argument(
-        "--time-limit",
-        type=checked(check.seconds, literal),
-        default=1.0,
-        help="soft wall-time limit of each solver call, s (default 1; set-up not included)",
+    time_limit_option(
+        p, "soft wall-time limit of each solver call, s (default 1; set-up not included)", 1.0
     )
     p.add_argument(
         "--hard-timeout",
@@ -91,65 +90,51 @@ def _bench(sub):
 
 
 def run_bench_command(args) -> int:
-    from optdesign import storage
-    from optdesign.studies import bench
+    from optdesign import api, storage
 
     if args.list:
-        for name in bench.default_configs():
-            c = bench.get_config(name)
-            print(f"{name:20s} {c.kind:7s} {c.description}")
+        for name, kind, description in api.bench_configurations():
+            print(f"{name:20s} {kind:7s} {description}")
         return 0
-    with as_options():  # the checks of optdesign.bench, before any work
-        solvers = check.configs("solvers", args.solvers)
+    with as_options(RENAMED):  # the checks of optdesign.bench, before the folder is made
+        check.configs("solvers", args.solvers)
         check.run_folder(args.out, args.resume, args.overwrite)
-    if args.problems is not None and args.suite is not None:
-        raise InputError("--suite", "excludes --problem (run your problems or a suite)")
+        if args.problems is not None and args.suite is not None:
+            raise check.ArgumentError(
+                "suite", "excludes {problems} (run your problems or a suite)", ("problems",)
+            )
+        check.readme_file("update_readme", args.update_readme)
     problems = None
     if args.problems is not None:
-        from optdesign.api import load
-
-        problems = [load(path) for path in args.problems]  # refused naming the file
-    if args.update_readme is not None:
-        # Checked before the benchmark runs: a FIFO, /dev/zero, a folder or a file
-        # without the markers is refused at once, not after an hour of runs.
-        from optdesign.studies.bench.report import has_readme_markers, read_readme
-
-        if not has_readme_markers(read_readme(args.update_readme)):
-            raise InputError(
-                "--update-readme", f"{args.update_readme} has no generated-block markers"
-            )
+        problems = [api.load(path) for path in args.problems]  # refused naming the file
     with output_folder(args.out, "bench") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
-        return _run_locked(args, bench, solvers, out, problems)
+        return _run_locked(args, problems, out)
 
 
-def _run_locked(args, bench, solvers, out: Path, problems) -> int:
-    report = bench.run_bench(
-        None if problems is not None else args.suite or "default",
-        solvers,
-        out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        resume=args.resume,
-        progress=not args.no_progress,
-        time_limit=args.time_limit,
-        hard_timeout=args.hard_timeout,
-        overwrite=args.overwrite,
-        problems=problems,
-    )
+def _run_locked(args, problems, out: Path) -> int:
+    from optdesign import api
     from optdesign.text import printable
 
+    with as_options(RENAMED):
+        report = api.bench(
+            problems,
+            suite=args.suite,
+            solvers=args.solvers,
+            out=out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            progress=not args.no_progress,
+            time_limit=args.time_limit,
+            hard_timeout=args.hard_timeout,
+            overwrite=args.overwrite,
+            update_readme=args.update_readme,
+        )
     print(printable(report.summary(), newlines=True))
     paths = report.paths
     written = [out / "bench_runs.jsonl", paths["csv"], paths["profiles"], paths["summary"]]
     print("wrote " + ", ".join(printable(p) for p in written))
     if args.update_readme is not None:
-        from optdesign.studies.bench.report import update_readme
-
-        if update_readme(args.update_readme, report.summary()):
-            print(f"updated the generated block of {printable(args.update_readme)}")
-        else:
-            raise InputError(
-                "--update-readme", f"{args.update_readme} has no generated-block markers"
-            )
+        print(f"updated the generated block of {printable(args.update_readme)}")
     return 0

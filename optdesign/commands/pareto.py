@@ -12,8 +12,7 @@ import time
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder
-from optdesign.errors import InputError
+from optdesign.cli import as_options, checked, command, literal, output_folder, time_limit_option
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
 #: Options spelt otherwise than their API argument (optdesign.pareto).
@@ -74,12 +73,10 @@ def _pareto(sub):
         default=500,
         help="NSGA-II generations",
     )
-    p.add_argument(
-        "--time-limit",
-        type=checked(check.seconds, literal),
-        default=None,
-        help="epsilon fronts: wall-clock seconds of the whole front; no point begins after "
-        "it (the points left out are named; --resume computes them)",
+    time_limit_option(
+        p,
+        "epsilon fronts: wall-clock seconds of the whole front; no point begins after it "
+        "(the points left out are named; --resume computes them)",
     )
     p.add_argument(
         "--deterministic",
@@ -97,37 +94,26 @@ def _pareto(sub):
 def run_pareto(args) -> int:
     from optdesign import storage
     from optdesign.problem import load_problem
-    from optdesign.studies.pareto.methods import check_front_problem
-    from optdesign.studies.solve import solver_options
 
     problem = load_problem(args.file)
-    check_front_problem(problem)  # before the output folder is made
-    solver_options(problem, "ipopt")
     with as_options(RENAMED):  # the checks of optdesign.pareto, before any work
+        check.front_problem(problem)  # before the output folder is made
         objectives = check.front_objectives(problem, args.objectives)
         methods = list(METHOD_NAMES) if args.method == "all" else check.names("method", args.method)
         for m in methods:
             check.method("method", m)
             check.method_for(problem, m)  # refused before the output folder is made
+        check.front_time_limit(problem, methods, args.time_limit)
         check.run_folder(args.out, args.resume, args.overwrite)
-    if args.time_limit is not None:
-        from optdesign.studies.pareto.catalogue_front import has_catalogue
-
-        other = [m for m in methods if m not in ("epsilon", "uniform")]
-        if other or has_catalogue(problem):
-            what = f"the {other[0]} method" if other else "a catalogue front"
-            raise InputError(
-                "--time-limit",
-                f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
-            )
     # One run per folder for the whole command (the runner re-enters the lock per store),
     # checked before any solving.
     with output_folder(args.out, f"pareto-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         for m in methods:
-            if m == "nsga2":
+            name = check.front_store(problem, m)
+            if name is None:
                 continue
-            store = out / f"{m}.jsonl"
+            store = out / name
             if args.overwrite:
                 storage.discard_store(store)
             elif not args.resume:
@@ -135,9 +121,19 @@ def run_pareto(args) -> int:
         return _run_locked(args, problem, objectives, methods, out)
 
 
+def _method_options(args, method: str, seed: int) -> dict:
+    """The options of ``optdesign.pareto`` for ``method`` from the command's arguments."""
+    if method == "nsga2":
+        return {"pop_size": args.pop, "generations": args.generations, "seed": seed}
+    if method == "weighted_sum":
+        return {"starts": args.starts, "seed": seed}
+    # an epsilon front; on a catalogue problem the catalogue front (every point a
+    # catalogue design), which takes the starts and the seed
+    return {"starts": args.starts, "seed": seed, "deterministic": args.deterministic}
+
+
 def _run_locked(args, problem, objectives, methods, out: Path) -> int:
-    from optdesign.studies import pareto as pa
-    from optdesign.studies.pareto.catalogue_front import has_catalogue
+    from optdesign.api import pareto
 
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
     run = dict(
@@ -152,39 +148,21 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         run["time_limit"] = args.time_limit
     fronts = []
     for m in methods:
-        if m == "nsga2":
-            method = pa.NSGA2(pop_size=args.pop, generations=args.generations, seed=seed)
-        elif m == "weighted_sum":
-            method = pa.WeightedSum(points=args.points, starts=args.starts, seed=seed)
-        elif has_catalogue(problem):
-            # the name: compute_front turns it into the catalogue front (every point a
-            # catalogue design)
-            method = m
-        else:
-            method = pa.EpsilonConstraint(
-                points=args.points,
-                spacing="arc" if m == "epsilon" else "uniform",
-                name=m,
-                starts=args.starts,
-                seed=seed,
-                deterministic=args.deterministic,
+        with as_options(RENAMED):
+            front = pareto(
+                problem, objectives, args.points, m, **run, **_method_options(args, m, seed)
             )
-        named = {"points": args.points, "starts": args.starts, "seed": seed}
-        extra = named if isinstance(method, str) else {}
-        fronts.append(pa.compute_front(problem, objectives, method=method, **extra, **run))
-    if len(fronts) > 1:
-        # Hypervolumes of different methods are comparable only with one reference point.
-        pa.common_hypervolumes(fronts)
-    pa.write_front_csv(fronts, problem, out / "front.csv")
-    pa.write_front_json(
+        fronts.append(front)
+    from optdesign.reports.front_files import no_point_text, write_front_files
+
+    wrote = write_front_files(
         fronts,
-        out / "front.json",
-        problem=problem.name,
+        problem,
+        out,
         objectives=objectives,
         points=args.points,
         created=time.strftime("%Y-%m-%d %H:%M:%S"),
     )
-    wrote = [out / "front.csv", out / "front.json"]
     notes = []
     if not args.no_plot:
         from optdesign.plots import write_figure
@@ -220,23 +198,6 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
             line = printable(f"{front.method}: {front.notes[0]}")
             print(f"optdesign: {line}", file=sys.stderr)
         elif not front.points:
-            line = printable(_no_point(problem, front))
+            line = printable(no_point_text(problem, front))
             print(f"optdesign: infeasible: {line}", file=sys.stderr)
     return 0 if all(f.points for f in fronts) else 1
-
-
-def _no_point(problem, front) -> str:
-    """Why a front has no point: the requirements its least violating design violates."""
-    import numpy as np
-
-    from optdesign.studies.diagnosis import violated_text
-
-    head = f"{front.method}: no feasible design"
-    designs = [p.design for p in front.rejected if p.design]
-    if not designs:
-        return head
-    X = np.array([[d[v.name] for v in problem.free] for d in designs])
-    worst = np.asarray(problem.evaluate(X).violation, dtype=float)
-    best = X[int(np.argmin(np.where(np.isfinite(worst), worst, np.inf)))]
-    shown = violated_text(problem, best)
-    return f"{head} among {len(designs)} designs; the least violating one: {shown or 'none'}"

@@ -6,7 +6,7 @@ import contextlib
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder
+from optdesign.cli import as_options, checked, command, literal, output_folder, time_limit_option
 
 #: Options spelt otherwise than their API argument (optdesign.solve).
 RENAMED = {"ranges": "--no-ranges", "problem": "file"}
@@ -27,8 +27,8 @@ def _solve(sub):
     p.add_argument(
         "--solver",
         type=checked(check.solver),
-        default="ipopt",
-        help="solver back-end (default ipopt)",
+        default=None,
+        help="solver back-end (default: the formulation's, ipopt for an NLP, clarabel for a GP)",
     )
     p.add_argument("--objective", default=None, help="objective to minimise (default: file's)")
     p.add_argument(
@@ -49,12 +49,10 @@ def _solve(sub):
         default=1,
         help="local processes for the starts",
     )
-    p.add_argument(
-        "--time-limit",
-        type=checked(check.seconds, literal),
-        default=None,
-        help="wall-clock limit of the multistart, s (default: none); the summary says "
-        "when it stopped the solve",
+    time_limit_option(
+        p,
+        "wall-clock limit of the multistart, s (default: none); the summary says when it "
+        "stopped the solve",
     )
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.add_argument("--no-report", action="store_true", help="skip the interactive report.html")
@@ -79,14 +77,12 @@ def _solve(sub):
 def run_solve(args) -> int:
     from optdesign import storage
     from optdesign.problem import load_problem
-    from optdesign.studies.solve import plan_solve
 
     problem = load_problem(args.file)
     with as_options(RENAMED):  # before the output folder is made
         check.objective_of(problem, args.objective)
-    plan_solve(
-        problem, args.formulation, args.objective
-    )  # what needs no solve, before the folder is made
+        # what needs no solve, before the folder is made
+        check.solve_plan(problem, args.formulation, args.objective)
     write_files = args.out is not None or not args.json
     if not write_files:
         return _solve_and_report(args, problem, None)

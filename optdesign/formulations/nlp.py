@@ -127,7 +127,6 @@ class NLP:
     param_names: list[str] = field(default_factory=list)
     param_defaults: np.ndarray = field(default_factory=lambda: np.zeros(0))
     limits: dict[str, float] = field(default_factory=dict)
-    extra: dict[str, Any] = field(default_factory=dict)
 
     # --- targets -------------------------------------------------------------------------
     def target(self, spec: str | Mapping[str, float] | Target | None = None) -> Target:

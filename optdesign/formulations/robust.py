@@ -195,7 +195,7 @@ def build_robust_nlp(
     NLP
         Decision vector: scaled design, then the per-sample epigraph variables and the
         risk variables. ``objective_values``: the risk measure and the nominal objective
-        (for reports). ``extra``: risk settings and the samples.
+        (for reports).
     """
     tol = tolerances_of(problem)
     objective = objective or problem.objective_names[0]
@@ -354,12 +354,4 @@ def build_robust_nlp(
         aux_init=aux_init_fun,
         param_names=base.param_names,
         param_defaults=base.param_defaults,
-        extra={
-            "objective": objective,
-            "risk": risk,
-            "alpha": alpha,
-            "k": k,
-            "samples": samples,
-            "constrain_samples": constrain_samples,
-        },
     )

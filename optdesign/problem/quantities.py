@@ -67,7 +67,11 @@ class Quantities:
         self.phi = problem.phi
         self.labels = problem.phi_labels
         self.requirements = problem.spec.requirements
-        self.hinge_moment = self.requirements.hinge_moment
+        # a parameter of the solver's model when a sweep varies it (one NLP for every
+        # point, optdesign.studies.sweep_solver), else the requirement's value
+        self.hinge_moment = self.design.get(
+            drive.PARAM + "hinge_moment", self.requirements.hinge_moment
+        )
 
     def __getattr__(self, item: str) -> Any:
         design = self.__dict__.get("design")

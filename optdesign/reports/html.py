@@ -141,6 +141,7 @@ def solve_report(result: Any) -> str:
     if initial["violated"]:
         initial["label"] = "initial design (violates the requirements)"
     best = design_view(problem, result.design, "optimum" if result.success else "best point found")
+    best["sensitivities"] = [s.text() for s in result.sensitivities]
     name = result.objective_name
     data = {
         **_header(problem),

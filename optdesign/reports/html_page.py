@@ -119,6 +119,7 @@ _SCRIPT = r"""
     el('design').innerHTML = table(d, ref && ref !== d ? ref : null);
     el('objectives').innerHTML = list(d.objectives.map((o) => o.text).concat(d.facts.map((f) => f.text)));
     el('limits').innerHTML = list(d.limits);
+    el('costs').innerHTML = list(d.sensitivities || []);
     el('violated').innerHTML = list(d.violated, 'violated');
     el('reference').innerHTML = ref && ref !== d
       ? '<h3>' + esc(ref.label) + ': violated requirements</h3>' + list(ref.violated, 'violated') : '';
@@ -187,6 +188,7 @@ moments in N*m, ripple in %.</p>
 <div class="grid">
 <div><div id="design"></div><h3>at this design</h3><div id="objectives"></div></div>
 <div><h3>what limits it (binding requirements and bounds)</h3><div id="limits"></div>
+<h3>what each limit costs (sensitivity of the optimum)</h3><div id="costs"></div>
 <h3>violated requirements</h3><div id="violated"></div><div id="reference"></div></div>
 <div id="sketch" class="plot"></div>
 <div id="curves" class="plot"></div>

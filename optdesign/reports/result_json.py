@@ -85,6 +85,19 @@ def result_document(result: Result) -> dict[str, Any]:
         if relax:
             doc["relaxations"] = relax
         doc["diagnosis"] = {"basis": diagnosis.basis, "note": diagnosis.note, "relaxations": relax}
+    doc["sensitivities"] = [
+        {
+            "name": sen.name,
+            "objective": sen.objective,
+            "limit": {"value": sen.limit, "unit": sen.unit},
+            "d_objective_d_limit": {
+                "value": sen.d_objective_d_limit,
+                "unit": f"{sen.objective_unit}/{sen.unit}" if sen.unit else sen.objective_unit,
+            },
+            "log_sensitivity": sen.log_sensitivity,
+        }
+        for sen in result.sensitivities
+    ]
     if result.bound is not None:
         doc["bound"] = objective_shown(problem, name, result.bound).to_json()
     if result.certificate is not None:

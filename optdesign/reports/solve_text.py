@@ -89,6 +89,9 @@ def result_summary(result: Result) -> str:
         head = "what limits the optimum" if result.success else "binding at the best point found"
         lines += ["", f"{head} (active requirements and bounds):"]
         lines += [f"  {lim.text()}" for lim in (limits + bounds)[:30]]
+    if result.sensitivities:
+        lines += ["", "what each limit costs (sensitivity of the optimum, most costly first):"]
+        lines += [f"  {printable(s.text())}" for s in result.sensitivities[:30]]
     violated = limits_of(problem, result.violated) if problem is not None else []
     if violated:
         lines += ["", "violated requirements:"]

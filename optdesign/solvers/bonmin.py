@@ -1,4 +1,5 @@
-"""Bonmin's options as optdesign uses it (no CasADi import: the registry lists it).
+"""Bonmin as optdesign uses it: its options, its MINLP solve, and the back-end of a
+continuous NLP (no CasADi import at module level: the registry lists it).
 
 Bonmin (in CasADi's wheel) solves MINLPs by its algorithms ``B-BB`` (NLP-based branch
 and bound), ``B-OA`` (outer approximation) and ``B-Hyb`` (hybrid); the last two are
@@ -58,12 +59,48 @@ def bonmin_options(options: Mapping[str, Any] | None) -> dict[str, Any]:
     """Bonmin's options: quiet, ``B-BB`` unless ``algorithm`` names another of
     :data:`BONMIN_ALGORITHMS`, then the caller's (Bonmin's own names)."""
     opts = {**BONMIN_QUIET, "algorithm": "B-BB", **dict(options or {})}
-    if opts["algorithm"] not in BONMIN_ALGORITHMS:
-        raise InputError(
-            "options.algorithm",
-            f"{opts['algorithm']!r} is not a Bonmin algorithm (use {', '.join(BONMIN_ALGORITHMS)})",
-        )
+    check_bonmin_options(opts)
     return opts
+
+
+def check_bonmin_options(options: Mapping[str, Any], field: str = "options") -> None:
+    """Refuse an unknown ``algorithm`` before any work, naming ``field``."""
+    algorithm = options.get("algorithm", "B-BB")
+    if algorithm not in BONMIN_ALGORITHMS:
+        raise InputError(
+            f"{field}.algorithm",
+            f"{algorithm!r} is not a Bonmin algorithm (use {', '.join(BONMIN_ALGORITHMS)})",
+        )
+
+
+def solve_minlp(minlp: Any, x0: Any, options: Mapping[str, Any] | None = None):
+    """Bonmin on a mixed-integer NLP (``minlp``: x, f, g, its bounds and ``discrete``
+    flags, e.g. :class:`~optdesign.formulations.catalogue_minlp.CatalogueMINLP`) from
+    ``x0``; a :class:`~optdesign.solvers.base.MINLPSolution` (an evaluation error Bonmin
+    cannot recover from is a status ``"error: ..."``, no point)."""
+    import casadi as ca
+    import numpy as np
+
+    from optdesign.interrupts import solver_call
+    from optdesign.solvers.base import MINLPSolution
+
+    opts = bonmin_options(options)
+    solver = ca.nlpsol(
+        "optdesign_bonmin",
+        "bonmin",
+        {"x": minlp.x, "f": minlp.f, "g": minlp.g},
+        {"discrete": minlp.discrete, "print_time": False, "bonmin": opts},
+    )
+    with solver_call(), quiet_stdout():
+        try:
+            sol = solver(x0=x0, lbx=minlp.lbx, ubx=minlp.ubx, lbg=minlp.lbg, ubg=minlp.ubg)
+            status = str(solver.stats().get("return_status", ""))
+        except RuntimeError as exc:
+            sol, status = None, f"error: {str(exc).splitlines()[-1]}"
+    if sol is None or status not in BONMIN_FOUND:
+        return MINLPSolution(status, False, None, None, opts["algorithm"])
+    x = np.asarray(sol["x"], dtype=float).ravel()
+    return MINLPSolution(status, True, x, float(sol["f"]), opts["algorithm"])
 
 
 def bonmin_nlp_solver(nlp, options: Mapping[str, Any] | None = None):

@@ -29,7 +29,9 @@ from scipy.special import logsumexp
 from optdesign.formulations.gp import GPData, GPRow, to_cvxpy
 from optdesign.interrupts import solver_call
 from optdesign.solvers.blas import one_blas_thread
+from optdesign.solvers.details import Details, GPDetails, GPDual, GPTiming
 from optdesign.solvers.result import (
+    SOLVED_STATUSES,
     Certificate,
     ConstraintReport,
     Result,
@@ -141,13 +143,13 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
         "termination": term,
         "message": error or status_text,
     }
-    timing = {
-        "build_s": t_build,
-        "compile_s": float(getattr(prob, "compilation_time", None) or float("nan")),
-        "solver_s": float(stats.solve_time) if stats and stats.solve_time else float("nan"),
-        "total_s": wall,
-    }
-    if status not in ("optimal", "feasible") or xs[0].value is None:
+    timing = GPTiming(
+        build_s=t_build,
+        compile_s=float(getattr(prob, "compilation_time", None) or float("nan")),
+        solver_s=float(stats.solve_time) if stats and stats.solve_time else float("nan"),
+        total_s=wall,
+    )
+    if status not in SOLVED_STATUSES or xs[0].value is None:
         return Result(
             status=status,
             objective=float("nan"),
@@ -155,7 +157,7 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
             solution_status=SolutionStatus.INFEASIBLE
             if status == "infeasible"
             else SolutionStatus.NO_SOLUTION,
-            extra={"gp_timing": timing},
+            details=Details(gp=GPDetails(timing=timing)),
             **common,
         )
     t_cert = time.perf_counter()
@@ -172,7 +174,7 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
     g, conv = dual_bound(
         gp, np.array(duals[:n_obj]), [duals[n_obj + k] for k in keep], [rows[k] for k in keep]
     )
-    timing["certificate_s"] = time.perf_counter() - t_cert
+    timing.certificate_s = time.perf_counter() - t_cert
     log_p = float(np.log(objective))
     gap_log = log_p - g
     lower = float(np.exp(g))
@@ -182,14 +184,14 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
         objective,
         float(1.0 - np.exp(-gap_log)),
     )
-    dual_info = {
-        "dual_bound_converged": conv,
-        "multipliers": {
+    dual_info = GPDual(
+        dual_bound_converged=conv,
+        multipliers={
             f"{r.name}[{r.label}]" if r.label else r.name: d
             for (r, _), d in zip(cons, duals, strict=True)
             if d > ACTIVE_DUAL
         },
-    }
+    )
     active = []
     for (r, _c), d in zip(cons[n_obj:], duals[n_obj:], strict=True):
         if d <= ACTIVE_DUAL:
@@ -212,7 +214,7 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
         max_violation=0.0,
         bound=lower,
         certificate=certificate,
-        extra={"gp_dual": dual_info, "gp_timing": timing},
+        details=Details(gp=GPDetails(dual=dual_info, timing=timing)),
         **common,
     )
 

@@ -18,3 +18,17 @@ IPOPT_WARM: dict[str, Any] = {
     "warm_start_mult_bound_push": 1e-9,
     "mu_init": 1e-6,
 }
+
+#: Ipopt options of a solve started at a feasible point close to its optimum (a front's
+#: lexicographic tie-breaks, started at an optimum of the objective fixed before): a
+#: small initial barrier parameter and bound push keep Ipopt there instead of pushing it
+#: back into the interior (cs_min_backlash, backlash anchor: 25-48 iterations instead of
+#: 62-101, and no failure from any of 6 multistart optima).
+IPOPT_TIE: dict[str, Any] = {"mu_init": 1e-5, "bound_push": 1e-6, "bound_frac": 1e-6}
+
+#: Ipopt options of a catalogue node. Many nodes of a catalogue search are infeasible
+#: boxes, and Ipopt's default filter spends ~120 iterations before its restoration phase
+#: proves it; ``expect_infeasible_problem`` enters restoration sooner, with the same nodes
+#: infeasible and the same optima (figures: benchmarks/README.md, "Catalogue searches:
+#: infeasible nodes").
+IPOPT_NODE: dict[str, Any] = {"expect_infeasible_problem": "yes"}

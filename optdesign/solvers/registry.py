@@ -1,4 +1,5 @@
-"""One factory for every solver back-end, and the registry behind it.
+"""One factory for every solver back-end, the registry behind it, and what each back-end
+declares of itself.
 
 ``make_solver(formulation, name, options)`` builds the back-end registered as ``name`` for
 a formulation (an :class:`~optdesign.formulations.nlp.NLP`, or a GP's
@@ -6,16 +7,75 @@ a formulation (an :class:`~optdesign.formulations.nlp.NLP`, or a GP's
 all go through it. Adding a back-end is one module with a class that follows
 :class:`~optdesign.solvers.base.NLPSolver` and one :func:`register_solver` line, from
 inside the package or from a user's own code.
+
+No study names a back-end: a study asks the registry. :func:`default_solver` gives the
+back-end of a formulation kind when the caller names none, :func:`solver_hints` what a
+back-end declares (:class:`SolverHints`: its warm-start options, the options of a solve
+that may meet infeasible sub-problems, its iteration and time-limit options, the problem
+file's table of its options), and :data:`FRONT_SOLVERS` the back-ends of a Pareto
+sweep's roles (:class:`FrontSolvers`).
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from optdesign.errors import InputError
-from optdesign.solvers.ipopt_options import IPOPT_WARM
+from optdesign.solvers.deadline import DEADLINE_OPTION
+from optdesign.solvers.ipopt_options import IPOPT_NODE, IPOPT_TIE, IPOPT_WARM
+
+
+@dataclass(frozen=True)
+class SolverHints:
+    """What a back-end declares, so that a study can use it without naming it (every
+    field empty: the back-end is used with the caller's options only)."""
+
+    #: options of a warm start from a nearby primal-dual solution (None: takes none)
+    warm_start_options: Mapping[str, Any] | None = None
+    #: options of a solve started at a feasible point close to its optimum (a front's
+    #: lexicographic tie-breaks)
+    restart_options: Mapping[str, Any] | None = None
+    #: options of a solve that may meet an infeasible sub-problem (a catalogue node)
+    node_options: Mapping[str, Any] | None = None
+    #: options of the back-end as the primary solver of a front's sweep
+    sweep_options: Mapping[str, Any] | None = None
+    #: the option that caps the iterations (None: none a study may set)
+    iteration_option: str | None = None
+    #: options that make a solve stop at the multistart's deadline
+    #: (:mod:`optdesign.solvers.deadline`; None: it finishes the start it is in)
+    deadline_options: Mapping[str, Any] | None = None
+    #: options that take a wall-time limit in seconds (the benchmark's soft limit)
+    time_limit_options: tuple[str, ...] = ()
+    #: the problem file's table of this back-end's options (``[solver] ipopt = {...}``)
+    file_options: str | None = None
+    #: "module:function" checking the back-end's options before any work
+    #: (``check(options, field=...)``; None: the back-end checks them when it is built)
+    options_check: str | None = None
+    #: modules a benchmark imports before timing (the back-end's lazy imports)
+    preload: tuple[str, ...] = ()
+    #: the result carries the constraint and bound multipliers of the NLP it solved
+    #: (``raw["lam_g"]``, ``raw["lam_x"]``, in the formulation's scaling), which the
+    #: sensitivities of :mod:`optdesign.studies.sensitivity` read
+    multipliers: bool = False
+    #: "module:function" solving a catalogue problem as one mixed-integer NLP
+    #: (``solve(minlp, x0, options) ->`` :class:`~optdesign.solvers.base.MINLPSolution`;
+    #: ``minlp``: a :class:`~optdesign.formulations.catalogue_minlp.CatalogueMINLP`); a
+    #: catalogue search given this back-end hands it the whole problem (method
+    #: ``"minlp"``) instead of solving its nodes with it. None: an NLP back-end only.
+    minlp: str | None = None
+
+    def time_limit(self, seconds: float) -> dict[str, float]:
+        """The back-end's own options for a wall-time limit of ``seconds``."""
+        return {name: float(seconds) for name in self.time_limit_options}
+
+    def check_options(self, options: Mapping[str, Any], field_name: str) -> None:
+        """Refuse options the back-end would refuse, naming ``field_name``."""
+        if self.options_check is not None and options:
+            module, _, attr = self.options_check.partition(":")
+            getattr(importlib.import_module(module), attr)(dict(options), field=field_name)
 
 
 @dataclass(frozen=True)
@@ -27,11 +87,34 @@ class SolverEntry:
     kind: str  # "nlp" or "gp": which formulation it solves
     factory: Callable[[Any, dict[str, Any]], Any]
     description: str = ""
-    #: options of a warm start from a nearby primal-dual solution (None: none)
-    warm_options: Mapping[str, Any] | None = None
-    #: the option that caps the iterations (None: none a study may set)
-    iteration_option: str | None = None
+    hints: SolverHints = field(default_factory=SolverHints)
 
+    @property
+    def warm_options(self) -> Mapping[str, Any] | None:
+        """Its warm-start options (:attr:`SolverHints.warm_start_options`)."""
+        return self.hints.warm_start_options
+
+    @property
+    def iteration_option(self) -> str | None:
+        """Its iteration cap's option (:attr:`SolverHints.iteration_option`)."""
+        return self.hints.iteration_option
+
+
+@dataclass(frozen=True)
+class FrontSolvers:
+    """The back-ends of a Pareto front's roles: the sweep's ``primary`` (the default of
+    ``solver=``), the ``fallback`` that solves again a start the primary fails (and, used
+    throughout, the weighted sums and the catalogue fronts' nodes), the ``tie`` of the
+    lexicographic tie-breaks; ``choices``: the sweep back-ends a caller may name."""
+
+    primary: str = "slsqp"
+    fallback: str = "ipopt"
+    tie: str = "ipopt"
+    choices: tuple[str, ...] = ("slsqp", "ipopt")
+
+
+#: The roles of a front's back-ends (:mod:`optdesign.studies.pareto.eps_solver`).
+FRONT_SOLVERS = FrontSolvers()
 
 _SOLVERS: dict[str, SolverEntry] = {}
 
@@ -44,24 +127,63 @@ def register_solver(
     replace: bool = False,
     warm_options: Mapping[str, Any] | None = None,
     iteration_option: str | None = None,
+    hints: SolverHints | None = None,
 ) -> SolverEntry:
     """Register ``factory(formulation, options) -> solver`` as back-end ``name``, with
-    its warm-start options and its iteration cap's option when it has them."""
+    what it declares of itself (``hints``; ``warm_options`` and ``iteration_option``
+    fill those two fields of it)."""
     if not isinstance(name, str) or not name.strip() or not name.isprintable():
         raise InputError("register_solver.name", f"expected a name (a string), got {name!r}")
     if not callable(factory):
         raise InputError("register_solver.factory", f"expected a function, got {factory!r}")
     if kind not in ("nlp", "gp"):
         raise InputError("register_solver.kind", f"{kind!r}: use 'nlp' or 'gp'")
+    if hints is not None and not isinstance(hints, SolverHints):
+        raise InputError("register_solver.hints", f"expected a SolverHints, got {hints!r}")
     if name in _SOLVERS and not replace:
         raise InputError("register_solver", f"a solver {name!r} is registered already")
-    entry = SolverEntry(name, kind, factory, description, warm_options, iteration_option)
+    hints = hints or SolverHints()
+    if warm_options is not None or iteration_option is not None:
+        hints = SolverHints(
+            **{
+                **hints.__dict__,
+                "warm_start_options": warm_options or hints.warm_start_options,
+                "iteration_option": iteration_option or hints.iteration_option,
+            }
+        )
+    entry = SolverEntry(name, kind, factory, description, hints)
     _SOLVERS[name] = entry
     return entry
 
 
 #: The back-end of each formulation kind when the caller names none.
 DEFAULT_SOLVERS = {"nlp": "ipopt", "gp": "clarabel"}
+
+
+def default_solver(kind: str = "nlp") -> str:
+    """The back-end of formulation kind ``kind`` (``"nlp"`` or ``"gp"``) when the caller
+    names none."""
+    if kind not in DEFAULT_SOLVERS:
+        raise InputError("kind", f"{kind!r}: use 'nlp' or 'gp'")
+    return DEFAULT_SOLVERS[kind]
+
+
+def solver_for_kind(name: str | None, kind: str = "nlp") -> str:
+    """``name`` when it is a registered back-end of ``kind``, else the kind's default (a
+    study that needs an NLP solve for a GP result, or a GP for a solve that named an NLP
+    back-end)."""
+    return name if name in solver_names(kind) else default_solver(kind)
+
+
+def solver_hints(name: str | None, kind: str | None = None) -> SolverHints:
+    """What back-end ``name`` (None: the default of ``kind``, else of an NLP) declares;
+    InputError listing the registered ones for an unknown name."""
+    name = name or default_solver(kind or "nlp")
+    _builtins()
+    entry = _SOLVERS.get(name)
+    if entry is None or (kind is not None and entry.kind != kind):
+        entry = solver_entry(name, kind or "nlp")  # the refusal naming the known ones
+    return entry.hints
 
 
 def solver_names(kind: str | None = None) -> list[str]:
@@ -91,7 +213,7 @@ def make_solver(
     from optdesign.safe_io import refuse_file_options
 
     kind = "nlp" if isinstance(formulation, NLP) else "gp"
-    name = name or DEFAULT_SOLVERS[kind]
+    name = name or default_solver(kind)
     entry = solver_entry(name, kind)
     # No back-end option may read or write a file or load code (Ipopt's output_file,
     # CasADi's dump/jit, SCS's write_data_filename...), wherever it comes from.
@@ -166,22 +288,58 @@ def _builtins() -> None:
     if _BUILTINS_DONE:
         return
     _BUILTINS_DONE = True
-    if "ipopt" not in _SOLVERS:
-        register_solver(
-            "ipopt",
-            _ipopt,
+    ipopt = SolverHints(
+        warm_start_options=IPOPT_WARM,
+        restart_options=IPOPT_TIE,
+        node_options=IPOPT_NODE,
+        iteration_option="max_iter",
+        deadline_options={DEADLINE_OPTION: True},
+        time_limit_options=("max_wall_time", "max_cpu_time"),
+        file_options="ipopt",
+        multipliers=True,
+        options_check="optdesign.solvers.casadi_nlp:check_ipopt_options",
+    )
+    scipy = ("optdesign.solvers.scipy_nlp",)
+    slsqp = SolverHints(
+        sweep_options={"maxiter": 200}, time_limit_options=("time_limit",), preload=scipy
+    )
+    cvxpy = ("cvxpy", "optdesign.solvers.cvxpy_gp", "optdesign.formulations.gp")
+    for name, factory, kind, desc, hints in (
+        ("ipopt", _ipopt, "nlp", "Ipopt interior point (CasADi), exact Hessian by default", ipopt),
+        ("sqpmethod", _sqpmethod, "nlp", "CasADi SQP (sqpmethod) with a QP solver", None),
+        ("slsqp", _scipy("SLSQP"), "nlp", "SciPy SLSQP with CasADi exact derivatives", slsqp),
+        (
+            "trust-constr",
+            _scipy("trust-constr"),
             "nlp",
-            "Ipopt interior point (CasADi), exact Hessian by default",
-            warm_options=IPOPT_WARM,
-            iteration_option="max_iter",
-        )
-    for name, factory, kind, desc in (
-        ("sqpmethod", _sqpmethod, "nlp", "CasADi SQP (sqpmethod) with a QP solver"),
-        ("slsqp", _scipy("SLSQP"), "nlp", "SciPy SLSQP with CasADi exact derivatives"),
-        ("trust-constr", _scipy("trust-constr"), "nlp", "SciPy trust-constr"),
-        ("bonmin", _bonmin, "nlp", "Bonmin (CasADi): MINLP on catalogue items, else an NLP"),
-        ("clarabel", _cvxpy("CLARABEL"), "gp", "cvxpy GP, Clarabel interior point"),
-        ("scs", _cvxpy("SCS"), "gp", "cvxpy GP, SCS first-order conic"),
+            "SciPy trust-constr",
+            SolverHints(time_limit_options=("time_limit",), preload=scipy),
+        ),
+        (
+            "bonmin",
+            _bonmin,
+            "nlp",
+            "Bonmin (CasADi): MINLP on catalogue items, else an NLP",
+            SolverHints(
+                time_limit_options=("time_limit",),
+                options_check="optdesign.solvers.bonmin:check_bonmin_options",
+                minlp="optdesign.solvers.bonmin:solve_minlp",
+            ),
+        ),
+        (
+            "clarabel",
+            _cvxpy("CLARABEL"),
+            "gp",
+            "cvxpy GP, Clarabel interior point",
+            SolverHints(time_limit_options=("time_limit",), preload=cvxpy),
+        ),
+        (
+            "scs",
+            _cvxpy("SCS"),
+            "gp",
+            "cvxpy GP, SCS first-order conic",
+            SolverHints(time_limit_options=("time_limit_secs",), preload=cvxpy),
+        ),
     ):
         if name not in _SOLVERS:
-            register_solver(name, factory, kind, desc)
+            register_solver(name, factory, kind, desc, hints=hints)

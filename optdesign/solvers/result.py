@@ -14,6 +14,8 @@ from dataclasses import asdict, dataclass, field
 from enum import Enum, StrEnum
 from typing import Any
 
+from optdesign.solvers.details import Details
+
 
 class TerminationCondition(StrEnum):
     """Why the solver stopped."""
@@ -162,10 +164,58 @@ class Diagnosis:
     note: str = ""
 
 
+@dataclass
+class Sensitivity:
+    """What one requirement (or active variable bound) costs at an optimum.
+
+    Attributes
+    ----------
+    name
+        ``"requirements.hinge_moment"``, ``"requirements.mean_ratio.min"`` or
+        ``"variables.R.upper"``: where the file states it.
+    objective
+        The objective whose optimum it moves.
+    limit, unit
+        The requirement's (bound's) value as the user reads it.
+    d_objective_d_limit, objective_unit
+        d(optimal objective)/d(limit), in ``objective_unit`` per ``unit``.
+    log_sensitivity
+        % change of the optimal objective per % change of the limit (None when the
+        objective is 0).
+    """
+
+    name: str
+    objective: str
+    limit: float
+    unit: str
+    d_objective_d_limit: float
+    objective_unit: str = ""
+    log_sensitivity: float | None = None
+
+    def text(self) -> str:
+        """``"hinge_moment 500 N*m: +1 % -> backlash +0.62 %"``."""
+        what = self.name.split(".", 1)[1] if self.name.startswith("requirements.") else self.name
+        limit = f"{self.limit:.6g} {self.unit}".rstrip()
+        if self.log_sensitivity is not None:
+            return f"{what} {limit}: +1 % -> {self.objective} {self.log_sensitivity:+.3g} %"
+        per = f"{self.objective_unit}/{self.unit}" if self.unit else self.objective_unit
+        return f"{what} {limit}: d{self.objective}/d{what} = {self.d_objective_d_limit:+.3g} {per}"
+
+
 #: The statuses of a solve that found a design meeting the requirements: the one success
 #: rule of a result, a front's record and a front's point (those two also drop a point
 #: the independent check refused, ``verified is False``).
 SOLVED_STATUSES = ("optimal", "feasible")
+
+
+def is_success(status: str, verified: bool | None = None) -> bool:
+    """The one success rule of a solved point (a result, a front's record or point, a
+    bench run): a status of :data:`SOLVED_STATUSES` that the independent check on the
+    NumPy path did not refuse (``verified`` False). ``verified`` None means not checked
+    (yet): a result before :func:`optdesign.studies.nlp_solve.finish`; a stored front
+    record that claims success unchecked is refused before it is read
+    (:func:`optdesign.studies.pareto.records.record_problem`)."""
+    return status in SOLVED_STATUSES and verified is not False
 
 
 @dataclass
@@ -198,8 +248,15 @@ class Result:
     diagnosis
         For a result with no feasible design: the relaxations of the conflicting
         requirements (:class:`Diagnosis`), when computed.
+    sensitivities
+        What each binding requirement and active bound costs (:class:`Sensitivity`),
+        most costly first; empty when not computed.
     notes
         Plain-language remarks for the summary.
+    details
+        What a catalogue search, a GP solve, a robust solve or a reference comparison
+        adds (:class:`~optdesign.solvers.details.Details`, typed); ``result.json`` writes
+        it as ``"extra"``.
     """
 
     status: str
@@ -224,10 +281,11 @@ class Result:
     multistart: MultistartInfo | None = None
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
     diagnosis: Diagnosis | None = None
+    sensitivities: list[Sensitivity] = field(default_factory=list)
     problem: str = ""
     mechanism: str = ""
     notes: list[str] = field(default_factory=list)
-    extra: dict[str, Any] = field(default_factory=dict)
+    details: Details = field(default_factory=Details)
     # solver internals kept for warm starts (not written to JSON)
     raw: dict[str, Any] = field(default_factory=dict, repr=False)
     # the DesignProblem solved (for plots and tables; not written to JSON)
@@ -235,8 +293,8 @@ class Result:
 
     @property
     def success(self) -> bool:
-        """A feasible design was found (a status of :data:`SOLVED_STATUSES`)."""
-        return self.status in SOLVED_STATUSES
+        """A feasible design was found (:func:`is_success`)."""
+        return is_success(self.status, self.verified)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (enums as strings, NaN as None, no solver internals)."""
@@ -247,6 +305,11 @@ class Result:
             self.problem_object = problem
         d.pop("raw", None)
         d.pop("problem_object", None)
+        # The details keep the key and layout result files have always had.
+        d = {
+            ("extra" if k == "details" else k): (self.details.to_json() if k == "details" else v)
+            for k, v in d.items()
+        }
         d["termination"] = self.termination.value
         d["solution_status"] = self.solution_status.value
         return clean_json(d)

@@ -37,6 +37,7 @@ from optdesign.formulations.discrete import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
+from optdesign.solvers.details import CatalogueCombination, CatalogueDetails
 from optdesign.solvers.multistart import (
     best_of,
     improves,
@@ -44,6 +45,7 @@ from optdesign.solvers.multistart import (
     sobol_starts,
     start_outcome,
 )
+from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
 from optdesign.studies.catalogue_bnb import InfeasibleBoxes
@@ -62,15 +64,6 @@ ENUMERATE_MAX = 16
 RETRY_STARTS = 4
 
 
-#: Ipopt options of the node NLPs. Many nodes of a catalogue search are infeasible boxes,
-#: and Ipopt's default filter spends ~120 iterations before its restoration phase proves
-#: it; ``expect_infeasible_problem`` enters restoration sooner, with the same nodes
-#: infeasible and the same optima (figures: benchmarks/README.md, "Catalogue searches:
-#: infeasible nodes"). A node still counts as infeasible only once all its starts and
-#: :data:`RETRY_STARTS` more say so.
-NODE_IPOPT_OPTIONS: dict[str, Any] = {"expect_infeasible_problem": "yes"}
-
-
 class NodeSolver:
     """Solve the problem's NLP on a sub-box of the catalogue variables.
 
@@ -86,7 +79,7 @@ class NodeSolver:
         objective: str | None = None,
         starts: int = 3,
         seed: int = 0,
-        plugin: str = "ipopt",
+        solver: str | None = None,
         options: Mapping[str, Any] | None = None,
         eps: Mapping[str, float] | None = None,
         free_rows: tuple[int, ...] = (),
@@ -99,10 +92,14 @@ class NodeSolver:
         self.eps = dict(eps or {})
         names = _objective_set(problem, self.objective)
         names = tuple(dict.fromkeys([*names, *sorted(self.eps)]))
-        if plugin == "ipopt":
-            # the node defaults, then the problem file's own Ipopt options, then the caller's
-            options = {**NODE_IPOPT_OPTIONS, **solver_options(problem, plugin), **(options or {})}
-        self.backend = solver_for(problem, plugin, options, names)
+        solver = self.solver = solver or default_solver("nlp")
+        node = solver_hints(solver).node_options
+        if node is not None:
+            # The back-end's node options (infeasible boxes are common; a node still
+            # counts as infeasible only once all its starts and RETRY_STARTS more say
+            # so), then the problem file's own options, then the caller's.
+            options = {**node, **solver_options(problem, solver), **(options or {})}
+        self.backend = solver_for(problem, solver, options, names)
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
         self.starts = max(1, starts)
@@ -201,18 +198,35 @@ def _no_item(solver: str, message: str) -> Result:
     return Result("infeasible", float("nan"), {}, solver, "catalogue", 0.0, message=message)
 
 
-def enumerate_catalogue(ns: NodeSolver, x_hint=None) -> tuple[Result | None, list[dict]]:
+def enumerate_catalogue(
+    ns: NodeSolver, x_hint=None
+) -> tuple[Result | None, list[CatalogueCombination]]:
     """Solve every combination of catalogue items; the best and the table of all."""
     dvars = discrete_variables(ns.problem)
     table, best = [], None
     for combo in itertools.product(*(v.values for v in dvars)):
         items = {v.name: float(c) for v, c in zip(dvars, combo, strict=True)}
         r = ns.solve(_fixed(items), x_hint)
-        table.append({"items": items, "status": r.status, "objective": r.objective})
+        table.append(CatalogueCombination(items, r.status, r.objective))
         # a tie (within PRUNE_TOL) keeps the earlier combination, as branch and bound does
         if r.success and (best is None or improves(r.objective, best.objective, PRUNE_TOL)):
             best = r
     return best, table
+
+
+def minlp_back_end(solver: str | None) -> str:
+    """The MINLP back-end of method ``"minlp"``: ``solver`` when it declares a MINLP
+    solve (:attr:`~optdesign.solvers.registry.SolverHints.minlp`), the first registered
+    one when ``solver`` is None; ProblemError naming them otherwise."""
+    known = [n for n in solver_names("nlp") if solver_hints(n).minlp]
+    if solver is None and known:
+        return known[0]
+    if solver in known:
+        return solver
+    raise ProblemError(
+        f"catalogue method minlp: back-end {solver!r} solves no MINLP "
+        f"(those that do: {', '.join(known) or 'none registered'})"
+    )
 
 
 def solve_catalogue(
@@ -221,7 +235,7 @@ def solve_catalogue(
     starts: int | None = None,
     seed: int | None = None,
     objective: str | None = None,
-    plugin: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     eps: Mapping[str, float] | None = None,
     incumbents: Sequence[Mapping[str, float]] = (),
@@ -232,8 +246,14 @@ def solve_catalogue(
     Parameters
     ----------
     method
-        ``"enumerate"``, ``"bnb"`` or ``"auto"`` (enumerate up to
-        :data:`ENUMERATE_MAX` combinations, branch and bound above).
+        ``"enumerate"``, ``"bnb"``, ``"minlp"`` or ``"auto"`` (enumerate up to
+        :data:`ENUMERATE_MAX` combinations, branch and bound above; ``"minlp"`` when
+        ``solver`` is a MINLP back-end). ``"minlp"``: the MINLP back-end (``solver``, or
+        the first registered one) picks the items, with ``options`` its own
+        (:mod:`optdesign.studies.catalogue_minlp`); the default NLP back-end solves the
+        relaxation and the items' node NLP.
+    solver, options
+        The NLP back-end of every node and its options (default: the registry's).
     starts, seed
         Multistart of each node NLP (default: the problem file's ``solver``; ``starts``
         at most 4 per node, the first start being the parent's optimum).
@@ -250,7 +270,7 @@ def solve_catalogue(
     Returns
     -------
     Result
-        ``extra["catalogue"]``: method, items chosen, relaxation bound and design, node
+        ``details.catalogue``: method, items chosen, relaxation bound and design, node
         counts (and the table of every combination when enumerating).
     """
     t0 = time.perf_counter()
@@ -258,40 +278,43 @@ def solve_catalogue(
     if not dvars:
         raise ProblemError("--formulation catalogue: no variable takes catalogue values")
     n_comb = n_combinations(problem)
-    if method == "auto":
+    minlp_solver, minlp_options = None, None
+    if method == "minlp" or (method == "auto" and solver_hints(solver).minlp):
+        # A MINLP back-end picks the items (its options: its own); the default NLP
+        # back-end solves the relaxation bound and the chosen items' node NLP.
+        minlp_solver, minlp_options = minlp_back_end(solver), options
+        method, solver, options = "minlp", None, None
+    elif method == "auto":
         method = "enumerate" if n_comb <= ENUMERATE_MAX else "bnb"
-    minlp_options = None
-    if plugin == "bonmin" or method == "bonmin":
-        # Bonmin picks the items (its options: Bonmin's); Ipopt solves the relaxation
-        # bound and the chosen items' NLP
-        method, plugin, minlp_options, options = "bonmin", "ipopt", options, None
-    if method not in ("enumerate", "bnb", "bonmin"):
-        raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or bonmin")
+    if method not in ("enumerate", "bnb", "minlp"):
+        raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or minlp")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
-    ns = NodeSolver(problem, objective, n_starts, seed, plugin, options, eps)
+    ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
     ns.memo = memo
     root = ns.solve({})
-    info: dict[str, Any] = {
-        "method": method,
-        "combinations": n_comb,
-        "variables": {v.name: list(v.values) for v in dvars},
-        "relaxation_bound": root.objective if root.success else None,
-        "relaxation_status": root.status,
-        "relaxation_design": {k: root.design.get(k) for k in ns.names} if root.design else {},
-        "starts_per_node": n_starts,
-    }
+    info = CatalogueDetails(
+        method=method,
+        combinations=n_comb,
+        variables={v.name: list(v.values) for v in dvars},
+        relaxation_bound=root.objective if root.success else None,
+        relaxation_status=root.status,
+        relaxation_design={k: root.design.get(k) for k in ns.names} if root.design else {},
+        starts_per_node=n_starts,
+    )
     if method == "enumerate":
-        best, table = enumerate_catalogue(ns, ns.x_of(root))
-        info["enumerated"] = table
-    elif method == "bonmin":
-        from optdesign.studies.catalogue_minlp import solve_bonmin
+        best, info.enumerated = enumerate_catalogue(ns, ns.x_of(root))
+    elif method == "minlp":
+        from optdesign.studies.catalogue_minlp import solve_minlp
 
-        best, info["bonmin"] = solve_bonmin(ns, minlp_options)
+        best, info.minlp = solve_minlp(ns, minlp_solver, minlp_options)
     else:
         best, stats = branch_and_bound(ns, root, incumbents)
-        info.update(stats, warm_fallbacks=ns.n_cold, implied_infeasible=ns.n_implied)
-    info["nlp_solves"] = ns.n_solves
+        info.nodes, info.pruned = stats["nodes"], stats["pruned"]
+        info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
+        info.seeded = stats["seeded"]
+        info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
+    info.nlp_solves = ns.n_solves
     wall = time.perf_counter() - t0
     if best is None:
         # Infeasible only when the continuous relaxation (every catalogue range at once)
@@ -301,7 +324,7 @@ def solve_catalogue(
             "failed" if relaxed_ok else "infeasible",
             float("nan"),
             {},
-            plugin,
+            ns.solver,
             f"catalogue-{method}",
             wall,
             message=(
@@ -311,27 +334,28 @@ def solve_catalogue(
                 else "the continuous relaxation has no feasible design"
             ),
         )
-        result.extra["catalogue"] = info
+        result.details.catalogue = info
         return finish(problem, result, objective)
     best.formulation = f"catalogue-{method}"
     best.wall_time_s = wall
     # Snap to the exact items (the NLP holds them within its bound tolerance).
     for v in dvars:
         best.design[v.name] = nearest_item(best.design[v.name], v.values)[0]
-    info["items"] = {v.name: best.design[v.name] for v in dvars}
+    info.items = {v.name: best.design[v.name] for v in dvars}
     if root.success:
-        info["gap_to_relaxation_rel"] = (best.objective - root.objective) / abs(root.objective)
-    best.extra["catalogue"] = info
+        info.gap_to_relaxation_rel = (best.objective - root.objective) / abs(root.objective)
+    best.details.catalogue = info
     best.bound = root.objective if root.success else None
     items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
     bound = (
         f"continuous relaxation bound {root.objective:.8g} (discrete optimum "
-        f"{100 * info['gap_to_relaxation_rel']:+.3f} % above it)"
+        f"{100 * (info.gap_to_relaxation_rel or 0.0):+.3f} % above it)"
         if root.success
         else f"continuous relaxation: {root.status}"
     )
+    how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
     best.notes.append(
-        f"catalogue items chosen: {items}; {bound}; {method}, {info['nlp_solves']} NLP solves"
+        f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
     )
     return finish(problem, best, objective)
 
@@ -392,7 +416,7 @@ def solve_catalogue_formulation(problem: DesignProblem, **options: Any) -> Resul
         starts=options.get("starts"),
         seed=options.get("seed"),
         objective=options.get("objective"),
-        plugin=options.get("solver") or "ipopt",
+        solver=options.get("solver"),
         options=options.get("options"),
     )
     return attach_reference(problem, result)

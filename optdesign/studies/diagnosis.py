@@ -37,6 +37,7 @@ import numpy as np
 from optdesign.formulations.discrete import discrete_variables, nearest_item
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.reports.limits import limits_of
+from optdesign.solvers.registry import solver_for_kind, solver_hints
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Result
 from optdesign.studies.catalogue import NodeSolver, first_feasible
 from optdesign.studies.nlp_solve import solve_nlp
@@ -47,7 +48,8 @@ from optdesign.studies.verify import constraint_rows
 #: combinations of them solved (nearest first).
 NEAREST_ITEMS = 3
 MAX_ITEM_COMBINATIONS = 4
-#: Ipopt iteration cap of the solve at each combination (the relaxations' own cap is 80).
+#: Iteration cap of the solve at each combination (the relaxations' own cap is 80), for a
+#: back-end that declares its iteration option.
 NODE_MAX_ITER = 150
 #: Combinations tried for each requirement beyond the nearest one.
 MAX_ALTERNATIVES = 3
@@ -56,17 +58,30 @@ MAX_ALTERNATIVES = 3
 def diagnose(
     problem: DesignProblem,
     result: Result,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     relax: bool = True,
 ) -> Result:
     """Fill ``result.diagnosis`` (and, when the formulation returned no point, the best
     point found) of a result that is not a success; returns ``result``.
 
-    ``relax=False``: the best point only, no relaxation (e.g. for an error message)."""
+    ``solver``, ``options``: the NLP back-end of the relaxations and its options (a GP
+    back-end, or None: the registry's default for an NLP). ``relax=False``: the best
+    point only, no relaxation (e.g. for an error message)."""
     if result.success:
         return result
-    result.diagnosis = _diagnosis(problem, result, solver, options, relax)
+    nlp_solver = solver_for_kind(solver, "nlp")
+    kind = result.formulation
+    if kind == "fixed":
+        result.diagnosis = _fixed(problem, result)
+    elif kind.startswith("catalogue"):
+        result.diagnosis = _catalogue(problem, result, nlp_solver, options, relax)
+    elif kind == "gp":
+        result.diagnosis = _gp(problem, result, relax)
+    elif kind.startswith("robust"):
+        result.diagnosis = _robust(problem, result, nlp_solver, relax)
+    else:
+        result.diagnosis = _nlp(problem, result, nlp_solver, relax)
     missed = [r for r in result.diagnosis.relaxations if r.needed == r.written]
     if missed:
         # a relaxation of nothing: the diagnosis met every requirement as written
@@ -79,32 +94,6 @@ def diagnose(
         old = result.diagnosis.note
         result.diagnosis.note = f"{found}; {old}" if old else found
     return result
-
-
-def _diagnosis(
-    problem: DesignProblem,
-    result: Result,
-    solver: str,
-    options: Mapping[str, Any] | None,
-    relax: bool,
-) -> Diagnosis:
-    nlp_solver = _nlp_solver(solver)
-    kind = result.formulation
-    if kind == "fixed":
-        return _fixed(problem, result)
-    if kind.startswith("catalogue"):
-        return _catalogue(problem, result, nlp_solver, options, relax)
-    if kind == "gp":
-        return _gp(problem, result, relax)
-    if kind.startswith("robust"):
-        return _robust(problem, result, nlp_solver, relax)
-    return _nlp(problem, result, nlp_solver, relax)
-
-
-def _nlp_solver(solver: str) -> str:
-    from optdesign.solvers.registry import solver_names
-
-    return solver if solver in solver_names("nlp") else "ipopt"
 
 
 def _nothing_violated(result: Result) -> str:
@@ -163,7 +152,7 @@ def _gp(problem: DesignProblem, result: Result, relax: bool) -> Diagnosis:
         return Diagnosis(basis=basis, note=_nothing_violated(nlp))
     if not relax:
         return Diagnosis(basis=basis, note=why)
-    return Diagnosis(relaxations(problem, nlp, solver="ipopt"), basis, why)
+    return Diagnosis(relaxations(problem, nlp), basis, why)
 
 
 def _catalogue(
@@ -175,8 +164,8 @@ def _catalogue(
 ) -> Diagnosis:
     dvars = discrete_variables(problem)
     objective = result.objective_name or problem.objective_names[0]
-    info = result.extra.get("catalogue", {})
-    root = info.get("relaxation_design") or {}
+    info = result.details.catalogue
+    root = (info.relaxation_design if info else None) or {}
     x0 = problem.start()
     for k, v in enumerate(problem.free):
         value = root.get(v.name)
@@ -184,7 +173,8 @@ def _catalogue(
             x0[k] = value
     # Each combination is solved once, capped like the relaxations' solves: a best point
     # to report, not an optimum (its infeasible solves are where Ipopt spends its time).
-    capped = {**(options or {}), "max_iter": NODE_MAX_ITER} if solver == "ipopt" else options
+    cap = solver_hints(solver).iteration_option
+    capped = {**(options or {}), cap: NODE_MAX_ITER} if cap is not None else options
     ns = NodeSolver(problem, objective, 1, problem.spec.solver.seed, solver, capped)
     tried: list[tuple[float, int, dict[str, float], Result]] = []
     for k, items in enumerate(_item_combinations(problem, dvars, x0)):

@@ -15,7 +15,8 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.registry import DEFAULT_SOLVERS, make_solver, solver_names
+from optdesign.solvers.details import ExactNLP, GPDetails, GPRows, GPTiming
+from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp
 from optdesign.studies.reference import attach_reference, reference_design
@@ -38,7 +39,7 @@ def solve_gp_problem(
     compare_nlp: bool = True,
     nlp_starts: int | None = None,
     seed: int | None = None,
-    solver: str = "clarabel",
+    solver: str | None = None,
 ) -> Result:
     """GP solve of ``problem`` with certificate, exact check and exact-NLP comparison.
 
@@ -48,17 +49,18 @@ def solve_gp_problem(
         Objective to minimise (default: the problem's first).
     compare_nlp
         Also solve the exact NLP (exact Hertz), warm-started from the GP design, and
-        report its optimum and the gap (``extra["nlp_exact"]``, ``extra["gap_gp_nlp_rel"]``).
+        report its optimum and the gap (``details.gp.nlp_exact``, ``details.gp.gap_gp_nlp_rel``).
     nlp_starts, seed
         Multistart of that NLP (default: the problem file's).
     solver
-        Registered GP back-end (``clarabel``, ``scs``).
+        Registered GP back-end (:func:`optdesign.solver_names` ``("gp")``; None: the
+        registry's default for a GP).
     """
     objective = objective or problem.objective_names[0]
     t0 = time.perf_counter()
     gp = require_gp(problem, objective)
     t_trace = time.perf_counter() - t0
-    backend = make_solver(gp, solver.lower())
+    backend = make_solver(gp, solver.lower() if solver else default_solver("gp"))
     if gp.infeasible:
         result = Result(
             "infeasible",
@@ -71,12 +73,10 @@ def solve_gp_problem(
         )
         return finish(problem, result, objective)
     result = backend.solve()
-    result.extra.setdefault("gp_timing", {})["trace_s"] = t_trace
-    result.extra["gp_rows"] = {
-        "objective": len(gp.objective_rows),
-        "constraints": len(gp.rows),
-        "before_pruning": gp.n_rows_before_pruning,
-    }
+    details = result.details.gp = result.details.gp or GPDetails()
+    details.timing = details.timing or GPTiming()
+    details.timing.trace_s = t_trace
+    details.rows = GPRows(len(gp.objective_rows), len(gp.rows), gp.n_rows_before_pruning)
     result.notes.append(
         "GP model: first-order Hertz flattening b^2/D and ISO 286 formulas (posynomials); "
         "the independent check and 'objectives at this design' use the exact model"
@@ -93,14 +93,22 @@ def solve_gp_problem(
         x0 = np.array([result.design[v.name] for v in problem.free])
         nlp = solve_nlp(problem, objective=objective, starts=nlp_starts, seed=seed, x0=x0)
         gap = (gp_objective - nlp.objective) / abs(nlp.objective) if nlp.success else float("nan")
-        result.extra["nlp_exact"] = {
-            "status": nlp.status,
-            "objective": nlp.objective,
-            "design": {v.name: nlp.design.get(v.name) for v in problem.free},
-            "wall_time_s": nlp.wall_time_s,
-            "starts": nlp.multistart.n_starts if nlp.multistart else 1,
-        }
-        result.extra["gap_gp_nlp_rel"] = gap
+        details.nlp_exact = ExactNLP(
+            status=nlp.status,
+            objective=nlp.objective,
+            design={v.name: nlp.design.get(v.name) for v in problem.free},
+            wall_time_s=nlp.wall_time_s,
+            starts=nlp.multistart.n_starts if nlp.multistart else 1,
+        )
+        details.gap_gp_nlp_rel = gap
+        if nlp.success and solver_hints(nlp.solver).multipliers:
+            from optdesign.studies.sensitivity import nlp_sensitivities
+
+            result.sensitivities = nlp_sensitivities(problem, nlp)
+            if result.sensitivities:
+                result.notes.append(
+                    "sensitivities: of the exact NLP's optimum, from Ipopt's multipliers"
+                )
         exact_at_gp = result.objectives.get(objective, float("nan"))
         result.notes.append(
             f"exact NLP (exact Hertz) optimum {nlp.objective:.8g} ({nlp.status}, "
@@ -113,12 +121,15 @@ def solve_gp_problem(
 def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
     reference_design(problem)  # validate [reference] before solving
-    gp_solver = options.get("solver")
+    named = options.get("solver")
+    solver = solver_for_kind(named, "gp")
     result = solve_gp_problem(
         problem,
         objective=options.get("objective"),
         nlp_starts=options.get("starts"),
         seed=options.get("seed"),
-        solver=gp_solver if gp_solver in solver_names("gp") else DEFAULT_SOLVERS["gp"],
+        solver=solver,
     )
+    if named and named != solver:
+        result.notes.append(f"solver {named} solves NLPs: the GP was solved by {solver}")
     return attach_reference(problem, result)

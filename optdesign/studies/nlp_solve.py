@@ -21,10 +21,14 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.deadline import DEADLINE_OPTION
 from optdesign.solvers.multistart import multistart, sobol_starts
-from optdesign.solvers.registry import make_solver, solver_entry
-from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+from optdesign.solvers.registry import default_solver, make_solver, solver_hints
+from optdesign.solvers.result import (
+    SOLVED_STATUSES,
+    Result,
+    SolutionStatus,
+    TerminationCondition,
+)
 from optdesign.studies.runner import map_inherited
 from optdesign.studies.verify import nan_notes, verify_design
 from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
@@ -72,13 +76,15 @@ def formulation_for(
 
 def solver_for(
     problem: DesignProblem,
-    name: str = "ipopt",
+    name: str | None = None,
     options: Mapping[str, Any] | None = None,
     objectives: tuple[str, ...] | None = None,
     form: str = "epigraph",
 ):
-    """The back-end ``name`` of the problem's NLP, built once per process and problem
-    state, shared by every start, range and front point."""
+    """The back-end ``name`` (None: the registry's default for an NLP) of the problem's
+    NLP, built once per process and problem state, shared by every start, range and
+    front point."""
+    name = name or default_solver("nlp")
     nlp = formulation_for(problem, objectives, form)
     opts = dict(solver_options(problem, name))
     opts.update(options or {})
@@ -86,14 +92,16 @@ def solver_for(
     return _remember(_SOLVERS, key, lambda: make_solver(nlp, name, opts))
 
 
-def solver_options(problem: DesignProblem, name: str) -> dict[str, Any]:
-    """The problem file's own options of back-end ``name`` (``[solver] ipopt = {...}``)."""
-    if name != "ipopt":
+def solver_options(problem: DesignProblem, name: str | None = None) -> dict[str, Any]:
+    """The problem file's own options of back-end ``name`` (None: the default NLP
+    back-end), from the table its registry entry declares (``[solver] ipopt = {...}``),
+    checked as the back-end checks them, before any work."""
+    hints = solver_hints(name)
+    if hints.file_options is None:
         return {}
-    from optdesign.solvers.casadi_nlp import check_ipopt_options
-
-    check_ipopt_options(problem.spec.solver.ipopt)  # before any work, naming the option
-    return dict(problem.spec.solver.ipopt)
+    options = dict(getattr(problem.spec.solver, hints.file_options) or {})
+    hints.check_options(options, f"solver.{hints.file_options}")
+    return options
 
 
 # --- the NLP path -----------------------------------------------------------------------
@@ -113,7 +121,7 @@ def solve_nlp(
     starts: int | None = None,
     seed: int | None = None,
     workers: int = 1,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     x0: np.ndarray | None = None,
     agree: int | None = None,
@@ -130,7 +138,7 @@ def solve_nlp(
     workers
         Local processes for the starts.
     solver, options
-        Registered back-end and its options.
+        Registered back-end (None: the registry's default for an NLP) and its options.
     x0
         First start (default: the declared start, else the middle of the bounds).
     agree
@@ -138,9 +146,9 @@ def solve_nlp(
         ``[solver] agree``, 3; 0: every start). On every shipped problem all 8 default
         starts reach the same optimum (benchmarks/README.md, "Overhead").
     time_limit
-        Wall-clock seconds for the multistart: no start begins after it, and an Ipopt
-        solve stops at it (status ``time_limit``); other back-ends finish the start they
-        are in.
+        Wall-clock seconds for the multistart: no start begins after it, and a solve of
+        a back-end that declares deadline options (Ipopt) stops at it (status
+        ``time_limit``); other back-ends finish the start they are in.
     """
     _no_catalogue(problem, "nlp")
     objective = objective or problem.objective_names[0]
@@ -148,8 +156,9 @@ def solve_nlp(
     n_starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
     agree = agree if agree is not None else problem.spec.solver.agree
-    if time_limit is not None and solver == "ipopt":
-        options = {**(options or {}), DEADLINE_OPTION: True}
+    watch = solver_hints(solver).deadline_options
+    if time_limit is not None and watch:
+        options = {**(options or {}), **watch}
     backend = solver_for(problem, solver, options, objectives)
     target = backend.nlp.target(objective)
     pts = start_points(problem, n_starts, seed, x0)
@@ -183,7 +192,7 @@ def optimal_ranges(
     problem: DesignProblem,
     result: Result,
     rel: float = OBJECTIVE_TIE_TOL,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
 ) -> dict[str, tuple[float, float]]:
     """Range of each free variable over the (near-)optimal set.
@@ -196,7 +205,7 @@ def optimal_ranges(
     scale together). A search that fails keeps the optimal value on its side.
     """
     objective = result.objective_name or problem.objective_names[0]
-    warm_options = solver_entry(solver).warm_options
+    warm_options = solver_hints(solver).warm_start_options
     warm = warm_options is not None and "lam_g" in result.raw
     if warm:
         # Primal and dual start at the optimum (benchmarks/README.md, "Overhead").
@@ -234,18 +243,19 @@ def finish(problem: DesignProblem, result: Result, objective: str | None = None)
     if not result.design:
         return result
     x = np.array([result.design[v.name] for v in problem.free])
+    claimed = result.status in SOLVED_STATUSES  # the solver's word, checked below
     ok, violated, objectives = verify_design(problem, x)
     result.verified = ok
     result.notes += nan_notes(problem, objectives, violated)
     result.objectives = {k: float(v) for k, v in objectives.items()}
     result.design = {**problem.fixed_values, **result.design}
-    if result.success and not ok:
+    if claimed and not ok:
         # The solver claims success but the independent check disagrees: not a design.
         result.status = "infeasible"
         result.termination = TerminationCondition.INFEASIBLE
         result.solution_status = SolutionStatus.INFEASIBLE
         result.violated = violated
         result.message += " (independent check failed)"
-    elif not result.success and not result.violated:
+    elif not claimed and not result.violated:
         result.violated = violated
     return result

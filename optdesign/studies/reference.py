@@ -8,13 +8,12 @@ reference meets the problem's requirements.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.reports.tables import format_table
+from optdesign.solvers.details import ReferenceComparison
 from optdesign.solvers.result import Result
 from optdesign.studies.verify import verify_design
 from optdesign.text import printable
@@ -57,12 +56,13 @@ def reference_design(problem: DesignProblem) -> tuple[str, dict[str, float]] | N
     return ref.label, design
 
 
-def compare_reference(problem: DesignProblem, result: Result) -> dict[str, Any] | None:
-    """Evaluate reference and optimum; None when the problem has no reference.
+def compare_reference(problem: DesignProblem, result: Result) -> ReferenceComparison | None:
+    """Evaluate reference and optimum; None when the problem has no reference (or the
+    result no design).
 
     Returns
     -------
-    dict
+    ReferenceComparison
         label, reference design, and per quantity (reference, optimum); also whether
         the reference meets the requirements (its largest relative violation).
     """
@@ -84,56 +84,55 @@ def compare_reference(problem: DesignProblem, result: Result) -> dict[str, Any] 
     ratio_opt = np.atleast_1d(ev_opt.constraints["ratio_positive"].values)
     rows["ratio_min"] = (float(ratio_ref.min()), float(ratio_opt.min()))
     rows["ratio_max"] = (float(ratio_ref.max()), float(ratio_opt.max()))
-    return {
-        "label": label,
-        "design": {v.name: design[v.name] for v in problem.free},
-        "quantities": rows,
-        "reference_violation": float(ev_ref.violation),
-        "reference_violated": sorted(
-            {r.name.split("[")[0] for r in verify_design(problem, x_ref)[1]}
-        ),
-        "optimum_violation": float(ev_opt.violation),
-    }
+    return ReferenceComparison(
+        label=label,
+        design={v.name: design[v.name] for v in problem.free},
+        quantities=rows,
+        reference_violation=float(ev_ref.violation),
+        reference_violated=sorted({r.name.split("[")[0] for r in verify_design(problem, x_ref)[1]}),
+        optimum_violation=float(ev_opt.violation),
+        optimum_design={v.name: result.design[v.name] for v in problem.free},
+    )
 
 
-def comparison_text(problem: DesignProblem, comparison: dict[str, Any]) -> str:
+def comparison_text(problem: DesignProblem, comparison: ReferenceComparison) -> str:
     """Side-by-side table of a :func:`compare_reference` result."""
-    label = printable(comparison["label"])  # one line: it heads the table
+    label = printable(comparison.label)  # one line: it heads the table
     texts = {name: (text, unit) for name, text, unit, _ in QUANTITIES}
     texts["ratio_min"] = ("ratio min", "")
     texts["ratio_max"] = ("ratio max", "")
-    opt_design = comparison.get("optimum_design", {})
+    opt_design = comparison.optimum_design
     table = []
     for v in problem.free:
         table.append(
             [
                 f"{v.name} ({v.description})",
                 v.unit,
-                comparison["design"][v.name],
+                comparison.design[v.name],
                 opt_design.get(v.name, float("nan")),
                 "",
             ]
         )
-    for name, (a, b) in comparison["quantities"].items():
+    for name, (a, b) in comparison.quantities.items():
         text, unit = texts[name]
         change = f"{100 * (b - a) / abs(a):+.1f} %" if a else "-"
         table.append([text, unit, a, b, change])
-    ok = comparison["reference_violation"] <= FEASIBILITY_TOL
+    ok = comparison.reference_violation <= FEASIBILITY_TOL
     state = (
         "meets the requirements"
         if ok
-        else "violates " + printable(", ".join(comparison["reference_violated"]))
+        else "violates " + printable(", ".join(comparison.reference_violated))
     )
     head = f"{label} vs optimum, same models ({label} {state}):"
     return head + "\n" + format_table(["quantity", "unit", label, "optimum", "change"], table)
 
 
 def attach_reference(problem: DesignProblem, result: Result) -> Result:
-    """Add the reference comparison to ``result`` (extra["reference"] and a summary note)."""
+    """Add the reference comparison to ``result`` (``details.reference`` and a summary
+    note)."""
     comparison = compare_reference(problem, result)
     if comparison is None:
         return result
-    comparison["optimum_design"] = {v.name: result.design[v.name] for v in problem.free}
-    result.extra["reference"] = comparison
+    result.details.reference = comparison
     result.notes.append(comparison_text(problem, comparison))
     return result

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.solvers.registry import solver_entry
+from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Relaxation
 from optdesign.studies.nlp_solve import _objective_set, solver_for
 
@@ -28,7 +28,7 @@ __all__ = ["Relaxation", "Site", "relaxations"]
 def relaxations(
     problem: Any,
     result: Any,
-    solver: str = "ipopt",
+    solver: str | None = None,
     iterations: int = 8,
     max_requirements: int = 6,
     max_iter: int = 80,
@@ -49,14 +49,15 @@ def relaxations(
         candidates; its best point starts each solve (the NLP's own point ``raw["z"]``
         when ``result`` is a solve of this NLP, else ``x_start``).
     solver
-        The back-end of the solve.
+        The back-end of the solve (None: the registry's default for an NLP).
     iterations
         Bisection steps on each relaxation (the answer is feasible and within
         ``2**-iterations`` of the bracket above the smallest one).
     max_requirements
         At most this many requirements are diagnosed (the largest violations first).
     max_iter
-        Iteration cap of each Ipopt solve.
+        Iteration cap of each solve (for a back-end that declares its iteration
+        option).
     objective
         The objective of the NLP (default: the result's, if the problem has it).
     box, parameters
@@ -82,11 +83,11 @@ def relaxations(
     if objective is None:
         own = result.objective_name
         objective = own if own in problem.objectives else problem.objective_names[0]
-    # Infeasible sub-problems are where Ipopt spends its time (restoration phase): a
+    # Infeasible sub-problems are where an interior point spends its time (restoration phase): a
     # capped iteration count keeps the diagnosis cheap; a capped solve counts as
     # infeasible, so the reported relaxation stays a feasible one (at worst a little
     # larger than the smallest).
-    cap = solver_entry(solver).iteration_option
+    cap = solver_hints(solver).iteration_option
     options = {cap: max_iter} if cap is not None else None
     backend = solver_for(problem, solver, options, _objective_set(problem, objective))
     nlp = backend.nlp

@@ -35,6 +35,7 @@ from optdesign.formulations.robust import (
 )
 from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
 from optdesign.reports.tables import format_table
+from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Result
@@ -172,7 +173,7 @@ def make_robust_solve(
     problem: DesignProblem,
     objective: str | None = None,
     samples: Samples | None = None,
-    plugin: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     risk: str | None = None,
     alpha: float | None = None,
@@ -181,8 +182,8 @@ def make_robust_solve(
 ):
     """Build the robust NLP and its solver once; return x0 -> Result."""
     nlp = build_robust_nlp(problem, objective, samples, risk, alpha, k, constrain_samples)
-    merged = {**solver_options(problem, plugin), **(options or {})}
-    return make_solver(nlp, plugin, merged).solve
+    merged = {**solver_options(problem, solver), **(options or {})}
+    return make_solver(nlp, solver, merged).solve
 
 
 def solve_robust(
@@ -196,11 +197,11 @@ def solve_robust(
     alpha: float | None = None,
     k: float | None = None,
     constrain_samples: bool = False,
-    plugin: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     workers: int = 1,
 ) -> Result:
-    """Robust optimum of ``problem`` (SAA of the ``[tolerances]``), multistart Ipopt.
+    """Robust optimum of ``problem`` (SAA of the ``[tolerances]``), multistart NLP.
 
     Parameters
     ----------
@@ -210,13 +211,15 @@ def solve_robust(
         Number of starts; the others are scrambled-Sobol points (``seed``).
     samples
         Fixed scatter samples (default: the file's ``tolerances.samples`` and ``seed``).
+    solver, options
+        Registered NLP back-end (None: the registry's default) and its options.
 
     Returns
     -------
     Result
         ``objective``: the risk measure (SAA); ``objectives``: nominal objective values
-        (NumPy check); ``extra``: ``risk_label``, ``saa_check`` (the statistic recomputed
-        on the NumPy path from the same samples), ``saa_samples``, ``saa_seed``.
+        (NumPy check); ``details.robust``: ``risk_label``, ``saa_check`` (the statistic
+        recomputed on the NumPy path from the same samples), ``saa_samples``, ``saa_seed``.
     """
     tol = tolerances_of(problem)
     objective = objective or problem.objective_names[0]
@@ -227,7 +230,7 @@ def solve_robust(
     pts = start_points(problem, starts, seed, x0)
     t0 = time.perf_counter()
     solve = make_robust_solve(
-        problem, objective, samples, plugin, options, risk, alpha, k, constrain_samples
+        problem, objective, samples, solver, options, risk, alpha, k, constrain_samples
     )
     build_s = time.perf_counter() - t0
     result = multistart(solve, pts, workers=workers, seed=seed, parallel_map=map_inherited)
@@ -236,7 +239,7 @@ def solve_robust(
     # Per-sample rows are the formulation's own; report the nominal requirements only.
     result.active = [r for r in result.active if "[s" not in r.name and "cvar" not in r.name]
     result = finish(problem, result, objective)
-    result.extra.update(
+    details = result.details.robust = RobustDetails(
         risk_label=label,
         saa_samples=samples.n,
         saa_seed=samples.seed,
@@ -251,7 +254,7 @@ def solve_robust(
     if result.design:
         free = {v.name: result.design[v.name] for v in problem.free}
         values, _ = sample_values(problem, free, samples, objective)
-        result.extra["saa_check"] = risk_value(values, risk, alpha, k)
+        details.saa_check = risk_value(values, risk, alpha, k)
     return result
 
 
@@ -259,25 +262,26 @@ def solve_robust_formulation(problem: DesignProblem, **options: Any) -> Result:
     """``formulation="robust"``: the nominal optimum (multistart), then the robust optimum
     started from it."""
     objective = options.get("objective") or problem.objective_names[0]
-    plugin = options.get("solver") or "ipopt"
+    solver = options.get("solver")
     nominal = solve_nlp(
         problem,
         objective=objective,
         starts=options.get("starts"),
         seed=options.get("seed"),
         workers=options.get("workers") or 1,
-        solver=plugin,
+        solver=solver,
         options=options.get("options"),
     )
     x0 = np.array([nominal.design[v.name] for v in problem.free]) if nominal.design else None
     result = solve_robust(
-        problem, x0=x0, objective=objective, plugin=plugin, options=options.get("options")
+        problem, x0=x0, objective=objective, solver=solver, options=options.get("options")
     )
-    result.extra["nominal_optimum"] = {
-        "status": nominal.status,
-        objective: nominal.objectives.get(objective, nominal.objective),
-        "design": nominal.design,
-    }
+    result.details.robust.nominal_optimum = NominalOptimum(
+        nominal.status,
+        objective,
+        nominal.objectives.get(objective, nominal.objective),
+        nominal.design,
+    )
     return result
 
 
@@ -304,6 +308,8 @@ class RobustComparison:
     mc_robust: MonteCarloSummary
     objective: str
     risk_label: str
+    #: The robust statistic (the SAA's) at the nominal optimum, on the same samples.
+    nominal_saa: float = float("nan")
 
     def table(self) -> str:
         """Readable comparison table."""
@@ -321,8 +327,8 @@ class RobustComparison:
                 self.robust.objectives[self.objective],
             ),
             row(
-                f"SAA {self.risk_label} (S={self.robust.extra.get('saa_samples')})",
-                self.nominal.extra.get("saa_value", float("nan")),
+                f"SAA {self.risk_label} (S={self.robust.details.robust.saa_samples})",
+                self.nominal_saa,
                 self.robust.objective,
             ),
             row("MC mean", a.mean, b.mean),
@@ -383,7 +389,7 @@ def compare_nominal_robust(
     values, _ = sample_values(
         problem, {v.name: nominal.design[v.name] for v in problem.free}, samples, objective
     )
-    nominal.extra["saa_value"] = risk_value(values, tol.risk, tol.alpha, tol.k)
+    nominal_saa = risk_value(values, tol.risk, tol.alpha, tol.k)
     mc = draw_samples(problem, n_mc, mc_seed, tol)
     free = [v.name for v in problem.free]
     mc_nom = monte_carlo(
@@ -392,7 +398,8 @@ def compare_nominal_robust(
     mc_rob = monte_carlo(
         problem, {v: robust.design[v] for v in free}, objective=objective, q=q, samples=mc
     )
-    return RobustComparison(nominal, robust, mc_nom, mc_rob, objective, robust.extra["risk_label"])
+    label = robust.details.robust.risk_label
+    return RobustComparison(nominal, robust, mc_nom, mc_rob, objective, label, nominal_saa)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -416,7 +423,7 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"\nnominal {cmp.nominal.status}, robust {cmp.robust.status} "
         f"(independent check {'passed' if cmp.robust.verified else 'FAILED'}); "
-        f"SAA statistic recomputed on the NumPy path: {cmp.robust.extra.get('saa_check'):.6g}; "
+        f"SAA statistic recomputed on the NumPy path: {cmp.robust.details.robust.saa_check:.6g}; "
         f"total {time.perf_counter() - t0:.1f} s"
     )
     return 0 if cmp.robust.success else 1

@@ -28,6 +28,7 @@ from optdesign.errors import InputError, ProblemError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.safe_io import refuse_file_options
 from optdesign.solvers.deadline import deadline, passed
+from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Diagnosis, Result, SolutionStatus, TerminationCondition
 from optdesign.studies.diagnosis import diagnose as diagnose_result
 from optdesign.studies.nlp_solve import optimal_ranges, solve_nlp, solver_options
@@ -182,7 +183,7 @@ def plan_solve(
     no solve (the file's Ipopt options, a combination no formulation honours), so that a
     caller can refuse before any work."""
     name = choose_formulation(problem, requested, objective)
-    solver_options(problem, "ipopt")
+    solver_options(problem)  # the file's options of the default NLP back-end, checked
     if name == "catalogue" and problem.spec.tolerances is not None and problem.free:
         disc = ", ".join(v.name for v in problem.free if v.discrete)
         raise ProblemError(
@@ -199,7 +200,7 @@ def solve(
     starts: int | None = None,
     seed: int | None = None,
     workers: int = 1,
-    solver: str = "ipopt",
+    solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     ranges: bool = True,
     diagnose: bool = True,
@@ -236,7 +237,7 @@ def _solve_within(
     starts: int | None,
     seed: int | None,
     workers: int,
-    solver: str,
+    solver: str | None,
     options: Mapping[str, Any] | None,
     time_limit: float | None,
     extra: dict[str, Any],
@@ -273,6 +274,18 @@ def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: 
             text = " ".join(str(exc).split())[:300]
             result.diagnosis = Diagnosis(note=f"not computed: {type(exc).__name__}: {text}")
     continuous = result.formulation.startswith("nlp") and not any(v.discrete for v in problem.free)
+    if (
+        result.success
+        and continuous
+        and solver_hints(result.solver).multipliers
+        and "lam_g" in result.raw
+    ):
+        try:  # what each requirement costs, from Ipopt's multipliers
+            from optdesign.studies.sensitivity import nlp_sensitivities
+
+            result.sensitivities = nlp_sensitivities(problem, result)
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.notes.append(f"sensitivities not computed: {exc}")
     if ranges and result.success and continuous and result.design and "z" in result.raw:
         try:
             result.ranges = optimal_ranges(problem, result, solver=solver, options=options)

@@ -14,14 +14,17 @@ import copy
 import os
 import signal
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.bonmin import BONMIN_ALGORITHMS
+from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Result
+from optdesign.studies.bench.catalogue_configs import register_catalogue_configs
 
 
 class NotApplicable(Exception):
@@ -71,7 +74,6 @@ class Config:
 
 #: Modules of the built-in back-ends' libraries (see ``Config.preload``).
 SCIPY_MODULES = ("optdesign.solvers.scipy_nlp",)
-CVXPY_MODULES = ("cvxpy", "optdesign.solvers.cvxpy_gp", "optdesign.formulations.gp")
 PYMOO_MODULES = ("pymoo.algorithms.moo.nsga2", "pymoo.optimize", "pymoo.core.problem")
 
 
@@ -111,15 +113,6 @@ def get_config(name: str) -> Config:
     )
 
 
-def time_limit_options(solver: str, time_limit: float) -> dict[str, Any]:
-    """Each back-end's own wall-time option (sqpmethod has none: the hard timeout covers it)."""
-    if solver == "ipopt":
-        return {"max_wall_time": float(time_limit), "max_cpu_time": float(time_limit)}
-    if solver in ("slsqp", "trust-constr"):
-        return {"time_limit": float(time_limit)}
-    return {}
-
-
 def nlp_config(
     name: str, solver: str, options: dict[str, Any], form: str = "epigraph", description: str = ""
 ) -> Config:
@@ -130,10 +123,12 @@ def nlp_config(
         from optdesign.studies.nlp_solve import formulation_for
 
         nlp = formulation_for(problem, (objective,), form)
-        opts = {**copy.deepcopy(options), **time_limit_options(solver, time_limit)}
+        # Each back-end's own wall-time options, as it declares them (sqpmethod has
+        # none: the hard timeout covers it).
+        opts = {**copy.deepcopy(options), **solver_hints(solver).time_limit(time_limit)}
         return make_solver(nlp, solver, opts).solve(problem.start(), objective)
 
-    preload = SCIPY_MODULES if solver in ("slsqp", "trust-constr") else ()
+    preload = solver_hints(solver).preload
     return Config(
         name,
         "nlp",
@@ -201,7 +196,7 @@ def _de_run(problem: DesignProblem, objective: str, time_limit: float) -> Result
     )
 
 
-def _gp_config(solver: str, description: str) -> Config:
+def _gp_config(solver: str, description: str, options: Mapping[str, Any] | None = None) -> Config:
     def run(problem: DesignProblem, objective: str, time_limit: float) -> Result:
         from optdesign.formulations.gp import build_gp
         from optdesign.solvers.registry import make_solver
@@ -209,14 +204,11 @@ def _gp_config(solver: str, description: str) -> Config:
         gp = build_gp(problem, objective)
         if not gp.is_gp:
             raise NotApplicable("not a GP: " + gp.explain().splitlines()[0])
-        options: dict[str, Any] = {}
-        if solver == "scs":
-            options = {"max_iters": 100_000, "time_limit_secs": float(time_limit)}
-        elif solver == "clarabel":
-            options = {"time_limit": float(time_limit)}
-        return make_solver(gp, solver, options).solve()
+        opts = {**(options or {}), **solver_hints(solver, "gp").time_limit(time_limit)}
+        return make_solver(gp, solver, opts).solve()
 
-    return Config(f"gp-{solver}", "gp", run, description, applies=gp_applies, preload=CVXPY_MODULES)
+    preload = solver_hints(solver, "gp").preload
+    return Config(f"gp-{solver}", "gp", run, description, applies=gp_applies, preload=preload)
 
 
 def gp_applies(problem: DesignProblem) -> bool:
@@ -327,7 +319,7 @@ def _register_defaults() -> None:
         Config("debug-abort", "debug", _debug_abort, "kills its own process (tests)", hidden=True)
     )
     register_config(_gp_config("clarabel", "cvxpy GP (first-order Hertz), Clarabel"))
-    register_config(_gp_config("scs", "cvxpy GP (first-order Hertz), SCS"))
+    register_config(_gp_config("scs", "cvxpy GP (first-order Hertz), SCS", {"max_iters": 100_000}))
     register_config(
         Config(
             "front-epsilon",
@@ -350,6 +342,22 @@ def _register_defaults() -> None:
             preload=PYMOO_MODULES,
         )
     )
+    # the catalogue searches (issue 25): optdesign's own, and Bonmin's algorithms
+    catalogue: list[tuple[str, str, str | None, dict[str, Any] | None, str]] = [
+        ("catalogue-bnb", "bnb", None, None, "optdesign catalogue branch and bound (warm nodes)"),
+        ("catalogue-enumerate", "enumerate", None, None, "every catalogue combination's NLP"),
+    ]
+    for alg in BONMIN_ALGORITHMS:
+        catalogue.append(
+            (
+                f"bonmin-{alg.lower()}",
+                "minlp",
+                "bonmin",
+                {"algorithm": alg},
+                f"Bonmin {alg} (CasADi), one-hot catalogue items",
+            )
+        )
+    register_catalogue_configs(register_config, Config, catalogue)
 
 
 def default_configs(include_hidden: bool = False) -> list[str]:
@@ -360,12 +368,3 @@ def default_configs(include_hidden: bool = False) -> list[str]:
 # Registered at import so that every process (forked, spawned or a Dask worker) sees the
 # same registry.
 _register_defaults()
-
-
-def _register_catalogue() -> None:
-    from optdesign.studies.bench.catalogue_configs import register_catalogue_configs
-
-    register_catalogue_configs(register_config, Config)
-
-
-_register_catalogue()

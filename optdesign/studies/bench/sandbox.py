@@ -20,7 +20,7 @@ import numpy as np
 
 from optdesign.problem import DesignProblem, problem_from_dict
 from optdesign.solvers.blas import one_blas_thread
-from optdesign.solvers.result import SOLVED_STATUSES, Result
+from optdesign.solvers.result import SOLVED_STATUSES, Result, is_success
 from optdesign.studies.bench.configs import Config, NotApplicable, get_config
 from optdesign.studies.bench.instances import Instance, make_instance
 from optdesign.studies.verify import verify_design
@@ -179,7 +179,7 @@ def _execute(task: Mapping[str, Any]) -> dict[str, Any]:
         row["objective"] = float(objs[objective])
         row["violation"] = float(ev.violation)
         row["verified"] = bool(ok)
-        row["success"] = bool(row["status"] in SOLVED_STATUSES and ok)
+        row["success"] = is_success(row["status"], bool(ok))
         if row["status"] in SOLVED_STATUSES and not ok:
             row["reason"] = f"independent check failed: {violated[0].describe()}"
     else:

@@ -1,7 +1,10 @@
 """Pareto fronts of a design problem.
 
-- :mod:`.methods`: the methods as objects (:class:`EpsilonConstraint`,
-  :class:`WeightedSum`, :class:`NSGA2`) and :func:`compute_front`;
+- :mod:`.template`: what every front method does, written once (:class:`FrontMethod`);
+- :mod:`.methods`: the methods as its subclasses (:class:`EpsilonConstraint`,
+  :class:`WeightedSum`, :class:`NSGA2`; :mod:`.catalogue_front`: :class:`CatalogueEpsilon`),
+  :func:`make_method` (a method from its name, for the API and the command line) and
+  :func:`compute_front`;
 - :mod:`.chains` and :mod:`.tasks`: the epsilon method's task graph (anchors, chains);
 - :mod:`.eps_solver`: every solve of a front on one formulation;
 - :mod:`.records`: typed records as stored; :mod:`.front`: the :class:`Front`;
@@ -15,9 +18,11 @@ from optdesign.studies.pareto.methods import (
     NSGA2,
     CatalogueEpsilon,
     EpsilonConstraint,
+    FrontMethod,
     RunOptions,
     WeightedSum,
     compute_front,
+    make_method,
 )
 from optdesign.studies.pareto.records import PointRecord
 
@@ -27,6 +32,7 @@ __all__ = [
     "CatalogueEpsilon",
     "EpsilonConstraint",
     "Front",
+    "FrontMethod",
     "FrontPoint",
     "PointRecord",
     "RunOptions",
@@ -34,6 +40,7 @@ __all__ = [
     "common_hypervolumes",
     "compute_front",
     "make_front",
+    "make_method",
     "read_front_csv",
     "write_front_csv",
     "write_front_json",

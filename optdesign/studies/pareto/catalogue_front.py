@@ -13,19 +13,20 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.diagnosis import diagnose
 from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
-from optdesign.studies.pareto.chains import check_anchor
-from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord, record_from_result
-from optdesign.studies.pareto.run_setup import check_objectives, record_check, run_key, store_path
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
-from optdesign.studies.runner import run_tasks
+from optdesign.studies.pareto.template import FrontMethod, FrontRun, Traced, has_catalogue
+
+#: ``has_catalogue`` is defined with the template; importers here keep working.
+__all__ = ["CatalogueEpsilon", "catalogue_task", "has_catalogue"]
 
 
 def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
@@ -35,7 +36,7 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     eps = dict(task.get("eps") or {})
     if "tie_of" in task:  # lexicographic tie-break: the first objective held at its optimum
         first = PointRecord.from_dict(deps[task["tie_of"]])
-        if not first.ok:
+        if not first.success:
             first.id, first.kind = task["id"], "anchor"
             return first.to_dict()
         name = task["fixed"]
@@ -44,8 +45,8 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         a, b = task["eps_name"], task["target"]
         lo_rec = PointRecord.from_dict(deps[f"anchor-{a}"])
         hi_rec = PointRecord.from_dict(deps[f"anchor-{b}"])
-        if not (lo_rec.ok and hi_rec.ok):  # no frame: the run stops at check_anchor
-            failed = a if not lo_rec.ok else b
+        if not (lo_rec.success and hi_rec.success):  # no frame: the run stops at check_anchor
+            failed = a if not lo_rec.success else b
             return PointRecord(
                 task["id"], task["kind"], "failed", None, b, f"anchor {failed} has no design"
             ).to_dict()
@@ -65,13 +66,14 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         # requirements it violates (no relaxations: the front stops here).
         diagnose(problem, result, relax=False)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
-    rec.n_solves = int(result.extra.get("catalogue", {}).get("nlp_solves", 0))
+    info = result.details.catalogue
+    rec.n_solves = info.nlp_solves if info is not None else 0
     rec.wall_time_s = time.perf_counter() - t0
     return rec.to_dict()
 
 
 @dataclass
-class CatalogueEpsilon:
+class CatalogueEpsilon(FrontMethod):
     """Epsilon-constraint front of two objectives over catalogue designs.
 
     Attributes
@@ -88,17 +90,30 @@ class CatalogueEpsilon:
     seed: int | None = None
     name: str = "epsilon-catalogue"
 
-    def run(self, problem: DesignProblem, objectives: Sequence[str], run) -> Front:
-        objectives = check_objectives(problem, objectives)
-        if len(objectives) != 2:
-            raise InputError("objectives", "a catalogue front takes two objectives")
+    designs: ClassVar[str] = "any"
+    n_objectives: ClassVar[tuple[int, ...]] = (2,)
+    what: ClassVar[str] = "a catalogue front"
+    max_default_starts: ClassVar[int | None] = 4
+
+    def check_settings(self) -> None:
         if self.points < 2:
             raise InputError("points", f"a front needs at least 2 points, got {self.points}")
-        t0 = time.perf_counter()
-        a, b = objectives
-        starts = self.starts if self.starts is not None else min(problem.spec.solver.starts, 4)
-        seed = self.seed if self.seed is not None else problem.spec.solver.seed
-        common = {"problem": problem, "starts": starts, "seed": seed}
+
+    def identity(self, starts: int, seed: int, objectives: Sequence[str]) -> tuple[str, dict]:
+        settings = {"points": self.points, "starts": starts, "seed": seed}
+        return FRONT_SOLVERS.fallback, {"method": self.name, **settings}
+
+    def settings(self, starts: int, seed: int, objectives: Sequence[str]) -> dict[str, Any]:
+        return {
+            "points": self.points,
+            "starts": starts,
+            "seed": seed,
+            "spacing": "uniform in " + objectives[0],
+        }
+
+    def trace(self, ctx: FrontRun) -> Traced:
+        a, b = ctx.objectives
+        common = {"problem": ctx.problem, "starts": ctx.starts, "seed": ctx.seed}
         tasks = []
         for first, second in ((a, b), (b, a)):
             tasks.append(
@@ -129,52 +144,13 @@ class CatalogueEpsilon:
                     "after": [f"anchor-{a}", f"anchor-{b}"],
                 }
             )
-        chain_points(tasks, points, sequential=run.workers == 1 and not run.scheduler)
-        key = run_key(
-            problem,
-            objectives,
-            "ipopt",
-            method=self.name,
-            points=self.points,
-            starts=starts,
-            seed=seed,
-        )
-        store = store_path(run.out, self.name)
-        done = run_tasks(
+        chain_points(tasks, points, sequential=ctx.run.workers == 1 and not ctx.run.scheduler)
+        done = ctx.tasks(
             tasks + points,
             catalogue_task,
-            store,
-            run.workers,
-            run.scheduler,
-            run.resume,
-            f"{self.name}: points" if run.progress else False,
-            key,
-            run.on_record,
-            check=record_check(problem, objectives),
+            progress=f"{self.name}: points" if ctx.run.progress else False,
         )
-        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
-        for k, rec in anchors.items():
-            check_anchor(rec, k, problem)
+        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in ctx.objectives}
         recs = [PointRecord.from_dict(done[t["id"]]) for t in points]
-        pts = [FrontPoint.from_record(r, self.name) for r in recs]
         n_solves = sum(PointRecord.from_dict(r).n_solves for r in done.values())
-        return make_front(
-            pts,
-            objectives,
-            self.name,
-            time.perf_counter() - t0,
-            problem,
-            anchors=anchors_of(anchors),
-            store=str(store),
-            n_solves=n_solves,
-            settings={
-                "points": self.points,
-                "starts": starts,
-                "seed": seed,
-                "spacing": "uniform in " + a,
-            },
-        )
-
-
-def has_catalogue(problem: DesignProblem) -> bool:
-    return any(v.discrete for v in problem.free)
+        return Traced(recs, anchors, n_solves)

@@ -46,7 +46,7 @@ def _design(deps: Mapping[str, Any], key: str | None) -> dict[str, float] | None
     if key is None or key not in deps:
         return None
     rec = PointRecord.from_dict(deps[key])
-    return dict(rec.design) if rec.ok and rec.design else None
+    return dict(rec.design) if rec.success and rec.design else None
 
 
 def front_knowledge(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:

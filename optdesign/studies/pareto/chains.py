@@ -85,7 +85,7 @@ def anchor_message(objective: str, rec: PointRecord, problem: Any = None) -> str
 
 def check_anchor(rec: PointRecord, name: str, problem: Any = None) -> None:
     """Raise :class:`NoFeasibleAnchor` unless ``rec`` is a verified feasible anchor."""
-    if not rec.ok:
+    if not rec.success:
         raise NoFeasibleAnchor(name, rec, problem)
 
 

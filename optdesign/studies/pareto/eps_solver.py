@@ -6,43 +6,33 @@ front's objectives) with the target and the epsilon limits passed per solve, so 
 back-end is built once per process and any point's solution and multipliers can start
 any other solve.
 
-The primary back-end is SLSQP with exact CasADi first derivatives (~0.03 s to build,
-3-6x faster per solve than Ipopt on these NLPs); a start it does not solve (failure, or
-an iterate that violates a row) is solved again by Ipopt (exact Hessian) from the same
-start. The lexicographic tie-breaks use Ipopt with :data:`TIE_OPTIONS`. ``method="ipopt"``
-uses Ipopt throughout, warm-started primal and dual with :data:`WARM_OPTIONS`.
+The back-ends of each role are the solver registry's
+(:data:`~optdesign.solvers.registry.FRONT_SOLVERS`), with the options each back-end
+declares (:class:`~optdesign.solvers.registry.SolverHints`). The primary back-end is SLSQP
+with exact CasADi first derivatives and its sweep options (~0.03 s to build, 3-6x faster
+per solve than Ipopt on these NLPs); a start it does not solve (failure, or an iterate
+that violates a row) is solved again by the fallback, Ipopt (exact Hessian), from the same
+start. The lexicographic tie-breaks use the tie back-end (Ipopt) with its restart options.
+``method`` = the fallback (``"ipopt"``) uses it throughout, warm-started primal and dual
+with its warm-start options.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
 
 import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, Start
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.casadi_nlp import IPOPT_WARM
+from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import formulation_for, solver_for
 from optdesign.studies.pareto.records import PointRecord
 
-#: Ipopt options of warm-started sweep points: take the neighbour's multipliers and start
-#: close to the central path instead of pushing the point back into the interior.
-WARM_OPTIONS: dict[str, Any] = IPOPT_WARM
-
-#: Ipopt options of the lexicographic tie-breaks. Their start is an optimum of the
-#: objective fixed before, so it is feasible (to the slack) and close to the tie-break's
-#: optimum: a small initial barrier parameter and bound push keep Ipopt there instead of
-#: pushing it back into the interior (cs_min_backlash, backlash anchor: 25-48 iterations
-#: instead of 62-101, and no failure from any of 6 multistart optima).
-TIE_OPTIONS: dict[str, Any] = {"mu_init": 1e-5, "bound_push": 1e-6, "bound_frac": 1e-6}
-
-#: SLSQP options of the sweeps: a start still running at 200 iterations goes to Ipopt.
-SLSQP_OPTIONS: dict[str, Any] = {"maxiter": 200}
-
-METHODS = ("slsqp", "ipopt")
+#: The sweep back-ends a caller may name (``solver=``).
+METHODS = FRONT_SOLVERS.choices
 
 
 class EpsSolver:
@@ -55,15 +45,21 @@ class EpsSolver:
     objectives
         The front's objectives: the formulation's objective set.
     method
-        ``"slsqp"`` (SLSQP, Ipopt fallback) or ``"ipopt"``.
+        The primary back-end (default: the registry's front primary, SLSQP, with the
+        fallback's solves behind it), or the fallback (Ipopt) throughout.
     """
 
-    def __init__(self, problem: DesignProblem, objectives: Sequence[str], method: str = "slsqp"):
+    def __init__(
+        self, problem: DesignProblem, objectives: Sequence[str], method: str | None = None
+    ):
+        method = method or FRONT_SOLVERS.primary
         if method not in METHODS:
             raise ProblemError(f"solver {method!r}: use one of {', '.join(METHODS)}")
         self.problem = problem
         self.objectives = tuple(sorted(objectives))
         self.method = method
+        #: a start the primary does not solve goes to the fallback
+        self.has_fallback = method != FRONT_SOLVERS.fallback
         self.nlp: NLP = formulation_for(problem, self.objectives)
 
     @property
@@ -71,15 +67,22 @@ class EpsSolver:
         return self.nlp.fingerprint
 
     def backend(self, use: str = "primary"):
-        """The back-end for ``use``: ``"primary"``, ``"ipopt"``, ``"tie"`` or ``"warm"``."""
-        p = self.problem
-        if use == "primary" and self.method == "slsqp":
-            return solver_for(p, "slsqp", SLSQP_OPTIONS, self.objectives)
+        """The back-end for ``use``: ``"primary"`` (with its sweep options; the fallback
+        as primary is warm-started), ``"fallback"``, ``"tie"`` (with its restart options)
+        or ``"warm"`` (the fallback with its warm-start options)."""
+        p, roles = self.problem, FRONT_SOLVERS
+        if use == "primary" and self.has_fallback:
+            return solver_for(
+                p, self.method, solver_hints(self.method).sweep_options, self.objectives
+            )
         if use == "tie":
-            return solver_for(p, "ipopt", TIE_OPTIONS, self.objectives)
-        if use == "warm" or (use == "primary" and self.method == "ipopt"):
-            return solver_for(p, "ipopt", WARM_OPTIONS, self.objectives)
-        return solver_for(p, "ipopt", None, self.objectives)
+            return solver_for(
+                p, roles.tie, solver_hints(roles.tie).restart_options, self.objectives
+            )
+        if use == "warm" or use == "primary":
+            warm = solver_hints(roles.fallback).warm_start_options
+            return solver_for(p, roles.fallback, warm, self.objectives)
+        return solver_for(p, roles.fallback, None, self.objectives)
 
     def start_from(self, neighbour: PointRecord | None, x=None) -> Start:
         """A start from a neighbour's record: primal and dual when it solved this same
@@ -106,21 +109,23 @@ class EpsSolver:
     ) -> Result:
         """``min target s.t. eps`` from ``start``.
 
-        With SLSQP as primary back-end and ``fallback``, a start SLSQP does not solve is
-        solved again by Ipopt from the same primal start; ``result.extra["fallback"]``
-        then holds SLSQP's message. ``use="ipopt"`` or ``"tie"`` picks Ipopt directly.
+        With a primary back-end other than the fallback and ``fallback``, a start the
+        primary does not solve is solved again by the fallback from the same primal
+        start; ``result.details.fallback`` then holds the primary's message.
+        ``use="fallback"`` or ``"tie"`` picks that back-end directly.
         """
         bounds = self.nlp.bounds(eps={k: v for k, v in eps.items() if np.isfinite(v)})
-        warm = use is None and self.method == "ipopt"
+        warm = use is None and not self.has_fallback
         backend = self.backend(use or ("warm" if warm else "primary"))
-        if self.method == "slsqp" or use is not None:
-            # SLSQP takes no dual start, and a tie-break's duals belong to another target.
+        if self.has_fallback or use is not None:
+            # The primary takes no dual start (SLSQP), and a tie-break's duals belong to
+            # another target.
             start = Start(start.z0)
         result = backend.solve(start, target, bounds)
-        if fallback and use is None and self.method == "slsqp" and not result.success:
+        if fallback and use is None and self.has_fallback and not result.success:
             first = result
-            result = self.backend("ipopt").solve(Start(start.z0), target, bounds)
-            result.extra["fallback"] = f"{first.status}: {first.message}"
+            result = self.backend("fallback").solve(Start(start.z0), target, bounds)
+            result.details.fallback = f"{first.status}: {first.message}"
             result.wall_time_s += first.wall_time_s
         return result
 

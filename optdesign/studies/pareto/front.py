@@ -3,79 +3,65 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
-from optdesign.solvers.result import SOLVED_STATUSES, clean_json
+from optdesign.solvers.result import clean_json
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
 
 @dataclass
-class FrontPoint:
-    """One point of a front.
+class FrontPoint(PointRecord):
+    """One point of a front: the solved point's record (:class:`PointRecord`, the one
+    record of a solved point, whose success rule it keeps) with the method that made it
+    and why it is left off the front. Its ``eps`` holds the epsilon bounds, or the
+    weights, that defined it; it carries no warm start (``raw``).
 
     Attributes
     ----------
-    objectives
-        Every objective of the problem at the design (NumPy path).
-    design
-        The full design (fixed and free variables).
-    status
-        Solver status after the independent check.
-    active
-        Names of the active constraint rows (requirements and epsilon bounds).
     method
         The front method that produced it.
-    verified
-        Result of the independent NumPy check (None if not checked).
-    eps
-        The epsilon bounds (or weights) that defined the point.
-    id
-        Task id in the store.
     rejected
         Why the point is not on the front ("" when it is).
     """
 
-    objectives: dict[str, float]
-    design: dict[str, float]
-    status: str
-    active: list[str]
-    method: str
-    verified: bool | None = None
-    eps: dict[str, float] = field(default_factory=dict)
-    id: str = ""
+    method: str = ""
     rejected: str = ""
-    n_solves: int = 0
-    wall_time_s: float = 0.0
-    message: str = ""
-    retried: str = ""
-
-    @property
-    def success(self) -> bool:
-        return self.status in SOLVED_STATUSES and self.verified is not False
 
     @classmethod
     def from_record(cls, rec: PointRecord, method: str) -> FrontPoint:
-        return cls(
+        kw = {f.name: getattr(rec, f.name) for f in fields(PointRecord)}
+        kw.update(
             objectives=dict(rec.objectives),
             design=dict(rec.design),
-            status=rec.status,
             active=list(rec.active),
-            method=method,
-            verified=rec.verified,
             eps=dict(rec.eps or rec.weights),
-            id=rec.id,
-            n_solves=rec.n_solves,
-            wall_time_s=rec.wall_time_s,
-            message=rec.message,
-            retried=rec.retried,
+            raw=None,
         )
+        return cls(**kw, method=method)
 
     def to_dict(self) -> dict[str, Any]:
-        return clean_json(dict(self.__dict__))
+        """The point as ``front.json`` writes it."""
+        return clean_json(
+            {
+                "objectives": dict(self.objectives),
+                "design": dict(self.design),
+                "status": self.status,
+                "active": list(self.active),
+                "method": self.method,
+                "verified": self.verified,
+                "eps": dict(self.eps),
+                "id": self.id,
+                "rejected": self.rejected,
+                "n_solves": self.n_solves,
+                "wall_time_s": self.wall_time_s,
+                "message": self.message,
+                "retried": self.retried,
+            }
+        )
 
 
 @dataclass

@@ -19,37 +19,40 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.nlp_solve import formulation_for
-from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, has_catalogue
+from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
 from optdesign.studies.pareto.chains import (
     TwoChains,
     anchor_tasks,
     check_anchor,
     three_objective_tasks,
 )
-from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
+from optdesign.studies.pareto.front import Front
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.run_setup import (
     RunOptions,
     check_front_problem,
-    check_objectives,
-    record_check,
-    run_key,
-    store_path,
 )
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK, front_task
-from optdesign.studies.runner import forks_workers, process_pool, run_tasks
+from optdesign.studies.pareto.template import (
+    FrontMethod,
+    FrontRun,
+    Traced,
+    has_catalogue,
+    leaves_catalogue,
+)
+from optdesign.studies.runner import forks_workers, process_pool
 from optdesign.tolerances import FEASIBILITY_TOL
 
 
@@ -60,7 +63,7 @@ def _common(
 
 
 @dataclass
-class EpsilonConstraint:
+class EpsilonConstraint(FrontMethod):
     """Epsilon-constraint fronts of two or three objectives.
 
     Attributes
@@ -78,7 +81,10 @@ class EpsilonConstraint:
     agree
         An anchor's multistart stops once this many starts agree (None: all starts).
     solver
-        ``"slsqp"`` (SLSQP sweep, Ipopt fallback and tie-breaks) or ``"ipopt"``.
+        The sweep's back-end, one of the registry's
+        :data:`~optdesign.solvers.registry.FRONT_SOLVERS` choices: its primary (default,
+        ``"slsqp"``: SLSQP sweep, Ipopt fallback and tie-breaks) or its fallback
+        (``"ipopt"`` throughout).
     retry_starts, extra_starts
         Sobol starts for a point that fails, worsens or jumps; at every point.
     deterministic
@@ -93,44 +99,41 @@ class EpsilonConstraint:
     starts: int | None = None
     seed: int | None = None
     agree: int | None = 3
-    solver: str = "slsqp"
+    solver: str = FRONT_SOLVERS.primary
     retry_starts: int = 4
     extra_starts: int = 0
     deterministic: bool = False
     name: str = "epsilon"
 
-    def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
-        objectives = check_objectives(problem, objectives)
-        if has_catalogue(problem):
-            raise InputError(
-                "method",
-                "continuous sweeps would leave the catalogue: use CatalogueEpsilon (or "
-                "method='epsilon', which picks it)",
-            )
+    honours_time_limit: ClassVar[bool] = True
+
+    @property
+    def n_points(self) -> int:
+        return len(self.eps_values) if self.eps_values is not None else self.points
+
+    def check_settings(self) -> None:
         if self.spacing not in ("arc", "uniform"):
             raise InputError("spacing", f"{self.spacing!r}: use 'arc' or 'uniform'")
-        n_points = len(self.eps_values) if self.eps_values is not None else self.points
-        if n_points < 2:
-            raise InputError("points", f"a front needs at least 2 points, got {n_points}")
-        t0 = time.perf_counter()
-        store = store_path(run.out, self.name)
-        starts = self.starts if self.starts is not None else problem.spec.solver.starts
-        seed = self.seed if self.seed is not None else problem.spec.solver.seed
-        settings = {k: v for k, v in asdict(self).items() if k != "name"}
-        key = run_key(
-            problem,
-            objectives,
-            self.solver,
-            method="epsilon",
-            **{**settings, "starts": starts, "seed": seed},
-        )
+        if self.n_points < 2:
+            raise InputError("points", f"a front needs at least 2 points, got {self.n_points}")
+
+    def settings(self, starts: int, seed: int, objectives: Sequence[str]) -> dict[str, Any]:
+        mine = {k: v for k, v in asdict(self).items() if k != "name"}
+        return {**mine, "starts": starts, "seed": seed}
+
+    def identity(self, starts: int, seed: int, objectives: Sequence[str]) -> tuple[str, dict]:
+        return self.solver, {"method": "epsilon", **self.settings(starts, seed, objectives)}
+
+    def trace(self, ctx: FrontRun) -> Traced:
+        problem, objectives, run = ctx.problem, ctx.objectives, ctx.run
+        n_points = self.n_points
         common = _common(
             problem,
             objectives,
             self.solver,
             retry_starts=self.retry_starts,
             extra_starts=self.extra_starts,
-            seed=seed,
+            seed=ctx.seed,
         )
         if run.workers > 1 and run.scheduler is None and forks_workers():
             # Forked workers inherit the formulation built here instead of each building
@@ -140,19 +143,13 @@ class EpsilonConstraint:
         with process_pool(run.workers if run.scheduler is None else 1) as pool:
             # Every phase of the front shares the store, the identity and the workers.
             phase = functools.partial(
-                run_tasks,
+                ctx.tasks,
                 fn=front_task,
-                store_path=store,
-                workers=run.workers,
-                scheduler=run.scheduler,
                 progress=label,
-                key=key,
-                on_record=run.on_record,
                 pool=pool,
-                check=record_check(problem, objectives),
                 stop=_deadline_passed if run.time_limit is not None else None,
             )
-            anchor_list = anchor_tasks(common, objectives, starts, seed, self.agree)
+            anchor_list = anchor_tasks(common, objectives, ctx.starts, ctx.seed, self.agree)
             if len(objectives) == 2:
                 split = n_points // 2 if self.deterministic else None
                 sweep = TwoChains(
@@ -172,14 +169,11 @@ class EpsilonConstraint:
                 known = {f"anchor-{k}": done[f"anchor-{k}"] for k in objectives}
                 # the anchors are in the store already: resume over them
                 done = phase(tasks, resume=True, known=known)
-        for k, rec in anchors.items():
-            check_anchor(rec, k, problem)
         recs = [
             PointRecord.from_dict(done[t["id"]])
             for t in sorted(tasks, key=lambda t: t["index"])
             if t["id"] in done  # a time limit leaves the points not begun out
         ]
-        pts = [FrontPoint.from_record(r, self.name) for r in recs]
         notes = []
         if len(recs) < n_points:
             notes.append(
@@ -187,18 +181,8 @@ class EpsilonConstraint:
                 f"{n_points} points not computed (no point begins after the limit; "
                 f"{_resume_hint(run)} computes them)"
             )
-        return make_front(
-            pts,
-            objectives,
-            self.name,
-            time.perf_counter() - t0,
-            problem,
-            anchors=anchors_of(anchors),
-            store=str(store),
-            n_solves=sum(r.n_solves for r in recs) + sum(r.n_solves for r in anchors.values()),
-            settings={**settings, "starts": starts, "seed": seed},
-            notes=notes,
-        )
+        n_solves = sum(r.n_solves for r in recs) + sum(r.n_solves for r in anchors.values())
+        return Traced(recs, anchors, n_solves, notes)
 
 
 def _deadline_passed() -> bool:
@@ -225,7 +209,7 @@ def _anchors(done, objectives: Sequence[str], run: RunOptions) -> dict[str, Poin
 
 
 @dataclass
-class WeightedSum:
+class WeightedSum(FrontMethod):
     """Weighted sum of the normalised objectives (ideal 0, nadir 1), weights evenly
     spaced. It finds only the convex hull of the front: points in non-convex parts are
     missed whatever the weights."""
@@ -235,44 +219,21 @@ class WeightedSum:
     seed: int | None = None
     name: str = "weighted_sum"
 
-    def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
-        objectives = check_objectives(problem, objectives)
-        if has_catalogue(problem):
-            raise InputError(
-                "method",
-                "weighted sums of continuous NLPs would leave the catalogue: with catalogue "
-                "variables use 'epsilon' or 'nsga2'",
-            )
-        t0 = time.perf_counter()
-        store = store_path(run.out, self.name)
-        starts = self.starts if self.starts is not None else problem.spec.solver.starts
-        seed = self.seed if self.seed is not None else problem.spec.solver.seed
-        key = run_key(
-            problem,
-            objectives,
-            "ipopt",
-            method="weighted_sum",
-            n=self.points,
-            starts=starts,
-            seed=seed,
-        )
-        check = record_check(problem, objectives)
-        common = _common(problem, objectives, "ipopt")
-        done = run_tasks(
-            anchor_tasks(common, objectives, starts, seed, 3),
-            front_task,
-            store,
-            run.workers,
-            run.scheduler,
-            run.resume,
-            False,
-            key,
-            run.on_record,
-            check=check,
-        )
+    def identity(self, starts: int, seed: int, objectives: Sequence[str]) -> tuple[str, dict]:
+        return FRONT_SOLVERS.fallback, {
+            "method": "weighted_sum",
+            "n": self.points,
+            "starts": starts,
+            "seed": seed,
+        }
+
+    def trace(self, ctx: FrontRun) -> Traced:
+        problem, objectives, run = ctx.problem, ctx.objectives, ctx.run
+        common = _common(problem, objectives, FRONT_SOLVERS.fallback)
+        done = ctx.tasks(anchor_tasks(common, objectives, ctx.starts, ctx.seed, 3), front_task)
         anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in objectives}
         for k, rec in anchors.items():
-            check_anchor(rec, k, problem)
+            check_anchor(rec, k, problem)  # the weights are normalised between them
         F = np.array([[r.objectives[k] for k in objectives] for r in anchors.values()])
         ideal, nadir = F.min(axis=0), F.max(axis=0)
         normalise = {k: (float(ideal[j]), float(nadir[j])) for j, k in enumerate(objectives)}
@@ -293,31 +254,17 @@ class WeightedSum:
                 }
             )
             prev = tasks[-1]["id"]
-        done = run_tasks(
+        done = ctx.tasks(
             tasks,
             front_task,
-            store,
-            1,
-            None,
-            True,
-            "weighted sum" if run.progress else False,
-            key,
-            run.on_record,
+            workers=1,
+            scheduler=None,
+            resume=True,
+            progress="weighted sum" if run.progress else False,
             known={f"anchor-{objectives[-1]}": done[f"anchor-{objectives[-1]}"]},
-            check=check,
         )
         recs = [PointRecord.from_dict(done[t["id"]]) for t in tasks]
-        pts = [FrontPoint.from_record(r, self.name) for r in recs]
-        return make_front(
-            pts,
-            objectives,
-            self.name,
-            time.perf_counter() - t0,
-            problem,
-            anchors=anchors_of(anchors),
-            store=str(store),
-            n_solves=len(recs) + sum(r.n_solves for r in anchors.values()),
-        )
+        return Traced(recs, anchors, len(recs) + sum(r.n_solves for r in anchors.values()))
 
 
 def _weight_grid(m: int, n_points: int) -> list[tuple[float, ...]]:
@@ -332,7 +279,7 @@ def _weight_grid(m: int, n_points: int) -> list[tuple[float, ...]]:
 
 
 @dataclass
-class NSGA2:
+class NSGA2(FrontMethod):
     """NSGA-II (pymoo) on the NumPy path of the same problem: its final non-dominated
     feasible population, each point checked with the same independent check."""
 
@@ -341,12 +288,17 @@ class NSGA2:
     seed: int = 0
     name: str = "nsga2"
 
-    def run(self, problem: DesignProblem, objectives: Sequence[str], run: RunOptions) -> Front:
+    designs: ClassVar[str] = "any"  # searched as indices of the catalogue items
+    stored: ClassVar[bool] = False
+
+    def settings(self, starts: int, seed: int, objectives: Sequence[str]) -> dict[str, Any]:
+        return {"pop_size": self.pop_size, "generations": self.generations, "seed": self.seed}
+
+    def trace(self, ctx: FrontRun) -> Traced:
         from pymoo.algorithms.moo.nsga2 import NSGA2 as PymooNSGA2
         from pymoo.optimize import minimize
 
-        objectives = check_objectives(problem, objectives)
-        t0 = time.perf_counter()
+        problem, objectives = ctx.problem, ctx.objectives
         res = minimize(
             pymoo_problem(problem, objectives),
             PymooNSGA2(pop_size=self.pop_size),
@@ -354,8 +306,7 @@ class NSGA2:
             seed=self.seed,
             verbose=False,
         )
-        wall = time.perf_counter() - t0
-        pts = []
+        recs = []
         X = np.atleast_2d(res.X) if res.X is not None else np.zeros((0, len(problem.free)))
         if res.X is None and res.pop is not None and len(res.pop):
             # no feasible design: keep the least violating one, for the report to name
@@ -368,29 +319,20 @@ class NSGA2:
             for j, x in enumerate(X):
                 ok = bool(ev.violation[j] <= FEASIBILITY_TOL)
                 design = {**problem.fixed_values, **problem.design_dict(x)}
-                pts.append(
-                    FrontPoint(
-                        objectives={k: float(v[j]) for k, v in ev.objectives.items()},
-                        design={k: float(v) for k, v in design.items()},
-                        status="feasible" if ok else "infeasible",
-                        active=[],
-                        method=self.name,
-                        verified=ok,
+                recs.append(
+                    PointRecord(
                         id=f"nsga2-{j:04d}",
+                        kind="nsga2",
+                        status="feasible" if ok else "infeasible",
+                        verified=ok,
+                        target="",
+                        design={k: float(v) for k, v in design.items()},
+                        objectives={k: float(v[j]) for k, v in ev.objectives.items()},
+                        wall_time_s=0.0,
+                        n_solves=0,
                     )
                 )
-        return make_front(
-            pts,
-            objectives,
-            self.name,
-            wall,
-            problem,
-            settings={
-                "pop_size": self.pop_size,
-                "generations": self.generations,
-                "seed": self.seed,
-            },
-        )
+        return Traced(recs)
 
 
 def pymoo_problem(problem: DesignProblem, objectives: Sequence[str]):
@@ -455,6 +397,50 @@ _RUN_FIELDS = (
 )
 
 
+def make_method(
+    problem: DesignProblem, method: str | Any = "epsilon", points: int = 50, **settings: Any
+) -> Any:
+    """The method object of ``method`` (a name of :data:`METHODS` with its ``settings``,
+    or a method object, returned as given): the one way the command line and
+    :func:`optdesign.pareto` build a front method. On a problem with catalogue variables,
+    ``"epsilon"`` and ``"uniform"`` are the catalogue front (:class:`CatalogueEpsilon`,
+    every point a catalogue design; it takes ``points``, ``starts`` and ``seed``)."""
+    if not isinstance(method, str):
+        if settings:
+            raise ProblemError(
+                f"options {sorted(settings)} go into the method object, not pareto()"
+            )
+        return method
+    if method not in METHODS:
+        raise InputError("method", f"unknown method {method!r} (known: {', '.join(METHODS)})")
+    if has_catalogue(problem):
+        # every point a catalogue design: each one solved by the catalogue search
+        if method not in ("epsilon", "uniform", "nsga2"):
+            raise InputError("method", leaves_catalogue(method))
+        if method != "nsga2":
+            keep = {k: settings[k] for k in ("starts", "seed") if k in settings}
+            return CatalogueEpsilon(points=settings.get("points", points), **keep)
+    if method == "nsga2":
+        settings.pop("solver", None)
+    else:
+        settings.setdefault("points", points)
+    try:
+        return METHODS[method](**settings)
+    except TypeError as exc:
+        raise InputError("pareto", f"option not understood by {method!r}: {exc}") from None
+
+
+def check_time_limit(method: Any, time_limit: float | None, field: str = "time_limit") -> None:
+    """Refuse a time limit the method does not apply (only continuous epsilon sweeps stop
+    at one)."""
+    if time_limit is not None and not getattr(method, "honours_time_limit", False):
+        raise InputError(
+            field,
+            f"not applied by the {getattr(method, 'name', type(method).__name__)} method: "
+            "only a continuous epsilon sweep ('epsilon', 'uniform') stops at a time limit",
+        )
+
+
 def compute_front(
     problem: DesignProblem,
     objectives: Sequence[str],
@@ -463,44 +449,16 @@ def compute_front(
     **options: Any,
 ) -> Front:
     """The front of ``objectives`` by ``method`` (a name of :data:`METHODS` or a method
-    object with ``run(problem, objectives, RunOptions)``). ``options`` holds the run's
-    options (``out``, ``workers``, ``scheduler``, ``resume``, ``progress``,
-    ``on_record``) and the method's settings (see the method classes)."""
+    object with ``run(problem, objectives, RunOptions)``, see :func:`make_method`).
+    ``options`` holds the run's options (``out``, ``workers``, ``scheduler``, ``resume``,
+    ``progress``, ``on_record``, ``overwrite``, ``time_limit``) and the method's settings
+    (see the method classes)."""
     check_front_problem(problem)
     run = RunOptions(**{k: options.pop(k) for k in _RUN_FIELDS if k in options})
     if run.workers < 1:
         raise InputError("workers", f"need at least 1 worker, got {run.workers}")
-    if isinstance(method, str) and has_catalogue(problem):
-        # every point a catalogue design: each one solved by the catalogue search
-        if method not in ("epsilon", "uniform", "nsga2"):
-            raise InputError(
-                "method",
-                f"{method!r} would leave the catalogue: with catalogue variables use "
-                "'epsilon' or 'nsga2'",
-            )
-        if method != "nsga2":
-            keep = {k: options[k] for k in ("starts", "seed") if k in options}
-            method = CatalogueEpsilon(points=options.get("points", points), **keep)
-            options = {}
-    if isinstance(method, str):
-        if method not in METHODS:
-            raise InputError("method", f"unknown method {method!r} (known: {', '.join(METHODS)})")
-        if method in ("nsga2",):
-            options.pop("solver", None)
-        else:
-            options.setdefault("points", points)
-        try:
-            method = METHODS[method](**options)
-        except TypeError as exc:
-            raise InputError("pareto", f"option not understood by {method!r}: {exc}") from None
-    elif options:
-        raise ProblemError(f"options {sorted(options)} go into the method object, not pareto()")
-    if run.time_limit is not None and not isinstance(method, EpsilonConstraint):
-        raise InputError(
-            "time_limit",
-            f"not applied by the {getattr(method, 'name', type(method).__name__)!r} method: "
-            "only a continuous epsilon sweep ('epsilon', 'uniform') stops at a time limit",
-        )
+    method = make_method(problem, method, points, **options)
+    check_time_limit(method, run.time_limit)
     store_name = getattr(method, "name", None)
     if run.overwrite and run.out is not None and not run.resume and store_name:
         from optdesign import storage
@@ -519,8 +477,11 @@ __all__ = [
     "NSGA2",
     "CatalogueEpsilon",
     "EpsilonConstraint",
+    "FrontMethod",
     "RunOptions",
     "WeightedSum",
     "check_front_problem",
+    "check_time_limit",
     "compute_front",
+    "make_method",
 ]

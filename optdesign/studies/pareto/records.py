@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
-from optdesign.solvers.result import SOLVED_STATUSES, Result, clean_json
+from optdesign.solvers.result import Result, clean_json, is_success
 from optdesign.studies.nlp_solve import finish
 from optdesign.studies.verify import verify_design
 from optdesign.tolerances import FEASIBILITY_TOL
@@ -91,9 +91,10 @@ class PointRecord:
     retried: str = ""
 
     @property
-    def ok(self) -> bool:
-        """A verified, feasible point."""
-        return self.status in SOLVED_STATUSES and self.verified is True
+    def success(self) -> bool:
+        """A feasible point the independent check did not refuse (the one rule,
+        :func:`~optdesign.solvers.result.is_success`)."""
+        return is_success(self.status, self.verified)
 
     def to_dict(self) -> dict[str, Any]:
         d = {
@@ -167,7 +168,7 @@ def record_from_result(
         wall_time_s=result.wall_time_s,
         iterations=result.iterations,
         solver=result.solver,
-        fallback=str(result.extra.get("fallback", "")),
+        fallback=result.details.fallback,
         raw=raw,
     )
 
@@ -304,7 +305,7 @@ def record_problem(problem: DesignProblem, record: Mapping[str, Any], nlp=None) 
             return "holds a warm start of the wrong size"
         if not np.isfinite(rec.raw.z).all():
             return "holds a warm start that is not finite"
-    if rec.status not in SOLVED_STATUSES or rec.verified is False:
+    if not rec.success:
         return None  # shown as failed: never trusted as a design
     if rec.verified is not True:
         return f"has status {rec.status!r} without the independent check"

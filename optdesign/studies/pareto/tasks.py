@@ -33,7 +33,7 @@ ANCHOR_SLACK = 1e-7
 
 
 def _solver(task: Mapping[str, Any]) -> EpsSolver:
-    return EpsSolver(task["problem"], task["objectives"], task.get("solver", "slsqp"))
+    return EpsSolver(task["problem"], task["objectives"], task.get("solver"))
 
 
 def _records(deps: Mapping[str, Any]) -> dict[str, PointRecord]:
@@ -73,7 +73,7 @@ def multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
     # No per-start Ipopt fallback first: a start that fails is just a failed start.
     results, n_at_best = run(False)
     n_solves = len(results)
-    if n_at_best == 0 and solver.method == "slsqp":
+    if n_at_best == 0 and solver.has_fallback:
         results, n_at_best = run(True)
         n_solves += len(results)
     best, n_at_best = best_of(results)
@@ -96,7 +96,7 @@ def tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
     solver = _solver(task)
     fixed: dict[str, float] = {}
     for k, name in enumerate(order[1:], start=1):
-        if not rec.ok:
+        if not rec.success:
             break
         prev = order[k - 1]
         fixed[prev] = rec.objectives[prev] * (1 + ANCHOR_SLACK) + 1e-12
@@ -111,7 +111,7 @@ def tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
         # The start is feasible for the tie-break (the bound is its own value plus slack):
         # a result worse than the start is a solver failure, not a tie-break (default
         # Ipopt once returned ripple 0.99996 "optimal" from a start at 0.0555).
-        if cand.ok and cand.objectives[name] <= rec.objectives[name] * (1 + 1e-9) + 1e-15:
+        if cand.success and cand.objectives[name] <= rec.objectives[name] * (1 + 1e-9) + 1e-15:
             cand.multistart = rec.multistart
             rec = cand
     rec.id = task["id"]
@@ -139,7 +139,7 @@ def arc_eps(task: Mapping[str, Any], nb: PointRecord | None) -> dict[str, float]
     f = task["frame"]
     a, b = task["eps_name"], task["target"]
     lo, hi = f["a_lo"], f["a_hi"]
-    if nb is None or not nb.ok:
+    if nb is None or not nb.success:
         return {a: float(task["fallback_eps"])}
     a1, b1 = nb.objectives[a], nb.objectives[b]
     s1 = (a1 - f["a0"]) / f["ra"] + (f["b0"] - b1) / f["rb"]
@@ -156,7 +156,7 @@ def row_eps(task: Mapping[str, Any], head: PointRecord | None) -> dict[str, floa
     b = task["b_name"]
     lo = (
         head.objectives[b] * (1 + ANCHOR_SLACK) + 1e-12
-        if head is not None and head.ok
+        if head is not None and head.success
         else task["b_hi"]
     )
     lo = min(lo, task["b_hi"])
@@ -178,12 +178,12 @@ def eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
         eps = arc_eps(task, nb)
     solver = _solver(task)
     n_solves = 1
-    start = solver.start_from(nb if nb is not None and nb.ok else None)
+    start = solver.start_from(nb if nb is not None and nb.success else None)
     rec = _record(task, solver, solver.solve(target, eps, start), "eps", target, eps)
     retry, why = False, ""
-    if not rec.ok:
+    if not rec.success:
         retry, why = True, "failed"
-    elif nb is not None and nb.ok:
+    elif nb is not None and nb.success:
         looser = all(eps[k] >= nb.eps.get(k, -np.inf) for k in eps)
         t_nb, t = nb.objectives[target], rec.objectives[target]
         jump = task.get("jump", 0.2)
@@ -205,11 +205,11 @@ def eps_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
             n_solves += 1
             # a tie (1e-6 relative) keeps the earlier point: the warm start's, else the
             # first start's - decided by value and order, not by rounding
-            if cand.ok and (
-                not rec.ok or improves(cand.objectives[target], rec.objectives[target])
+            if cand.success and (
+                not rec.success or improves(cand.objectives[target], rec.objectives[target])
             ):
                 rec = cand
-    if rec.ok and len(eps) == 1:
+    if rec.success and len(eps) == 1:
         rec.slope = solver.slope(target, next(iter(eps)), rec)
     rec.warm = task.get("warm")  # the neighbour it started from (which chain computed it)
     rec.retried = why
@@ -227,9 +227,9 @@ def weighted_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str,
     solver = _solver(task)
     nb = _records(deps).get(task.get("warm") or "")
     coefs = {k: w / max(normalise[k][1] - normalise[k][0], 1e-300) for k, w in weights.items()}
-    start = solver.start_from(nb if nb is not None and nb.ok else None, task["x0"])
+    start = solver.start_from(nb if nb is not None and nb.success else None, task["x0"])
     target = solver.nlp.target(coefs)
-    res = solver.backend("ipopt").solve(start, target, solver.nlp.bounds())
+    res = solver.backend("fallback").solve(start, target, solver.nlp.bounds())
     rec = _record(task, solver, res, "weighted_sum", next(iter(weights)), {})
     rec.weights = dict(weights)
     rec.wall_time_s = time.perf_counter() - t0

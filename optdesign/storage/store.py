@@ -1,30 +1,12 @@
-"""Safe output: atomic result files, one writer per output folder, the JSONL task store.
+"""The append-only JSON Lines store of :func:`optdesign.studies.runner.run_tasks`
+(:mod:`optdesign.storage`).
 
-Long runs write into an output folder that a user may reuse, interrupt, share between
-two runs by mistake, or receive from someone else. This module makes each of those safe:
-
-- :func:`atomic_write_text` / :func:`atomic_write_bytes` / :func:`atomic_output`: a
-  result file is either the old one or the complete new one, never a partial file (a
-  new temporary file in the same folder, created with ``O_EXCL``, fsynced, then
-  ``os.replace``: a link planted at the result's name is replaced, never followed);
-- :func:`lock_folder`: an advisory lock (``flock`` on ``.optdesign.lock`` in the folder),
-  non-blocking, so a second run into the same folder is refused at once with the pid of
-  the first. The kernel drops the lock with the process, whatever ends it: no stale
-  locks. The lock is re-entrant within a process (a command holds it for the whole run,
-  the task runner takes it again for each store);
-- :func:`open_store` / :class:`StoreWriter` / :func:`read_store`: the append-only JSON
-  Lines store of :func:`optdesign.studies.runner.run_tasks`. Its first line is the run's
-  identity ``{"__store__": 2, "key": ..., "identity": {...}}``, written with the file's
-  creation (the file appears complete with it, atomically), so a store without its
-  identity is never ours. Resuming checks the format version, the identity (naming the
-  component that changed, :mod:`optdesign.store_identity`) and every record, refuses
-  damaged or foreign stores, and cuts a torn last line (a run killed while writing)
-  before appending.
-
-The lock file and the stores are opened without following links, and must be regular
-files with one link (:mod:`optdesign.safe_io`): nothing outside the folder is truncated,
-appended to or read through them. An ``--out`` that is itself a link, given on the
-command line, is the user's choice and is used as given.
+Its first line is the run's identity ``{"__store__": 2, "key": ..., "identity": {...}}``,
+written with the file's creation (the file appears complete with it, atomically), so a
+store without its identity is never ours. Resuming checks the format version, the
+identity (naming the component that changed, :mod:`optdesign.store_identity`) and every
+record, refuses damaged or foreign stores, and cuts a torn last line (a run killed while
+writing) before appending.
 """
 
 from __future__ import annotations
@@ -32,276 +14,23 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import tempfile
 import threading
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from optdesign.errors import OptDesignError
 from optdesign.interrupts import deferred
-from optdesign.safe_io import CLOEXEC, NOFOLLOW, open_file, read_file
-
-try:  # POSIX; elsewhere folders are not locked
-    import fcntl
-except ImportError:  # pragma: no cover - Windows
-    fcntl = None  # type: ignore[assignment]
+from optdesign.safe_io import open_file, read_file
+from optdesign.storage.files import StoreError, atomic_write_text
 
 Record = dict[str, Any]
-
-#: Name of the lock file in a locked output folder.
-LOCK_NAME = ".optdesign.lock"
 
 #: Store format version (the identity line's ``__store__``): 2 stores the identity's
 #: components; a store of another format is refused, naming its version.
 STORE_VERSION = 2
 
 _EMPTY = "it is empty (no identity line)"
-
-
-class StoreError(OptDesignError):
-    """An output folder or store that cannot be used safely (damaged, foreign, busy)."""
-
-
-class FolderInUseError(StoreError):
-    """Another process holds the lock of an output folder."""
-
-
-# --- atomic files ------------------------------------------------------------------------
-def _umask() -> int:
-    # os.umask can only be read by setting it; do it once (at first use, not at import).
-    global _UMASK
-    if _UMASK is None:
-        old = os.umask(0o022)
-        os.umask(old)
-        _UMASK = old
-    return _UMASK
-
-
-_UMASK: int | None = None
-
-
-def _fsync_dir(folder: Path) -> None:
-    # The rename itself is durable only once the directory entry is on disk.
-    try:
-        fd = os.open(folder, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
-def _temp_file(path: Path) -> tuple[int, Path]:
-    # Hidden, in the same folder (os.replace must not cross file systems), keeping the
-    # suffix so that writers choosing the format by extension (matplotlib) still work.
-    # mkstemp creates it with O_EXCL | O_NOFOLLOW: a new file, never a planted one.
-    try:
-        fd, tmp = tempfile.mkstemp(
-            prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent
-        )
-    except OSError as exc:
-        raise StoreError(f"cannot write {path}: {exc.strerror}") from None
-    return fd, Path(tmp)
-
-
-def _commit(fd: int, tmp: Path, path: Path) -> None:
-    # The temporary file's content is complete: make it durable and put it in place.
-    # os.replace swaps the directory entry: a link planted at ``path`` is replaced, its
-    # target never opened.
-    os.fchmod(fd, 0o666 & ~_umask())  # mkstemp made it 0600
-    os.fsync(fd)
-    os.replace(tmp, path)
-
-
-@contextlib.contextmanager
-def atomic_output(path: Path | str) -> Iterator[Path]:
-    """A temporary path to write ``path``'s new content to; it replaces ``path`` on exit.
-
-    For writers that want a file name (``savefig``). On an exception (an interrupt too)
-    the temporary file is removed and ``path`` is unchanged. A symbolic link at ``path``
-    is replaced by the new file, never followed.
-
-    Examples
-    --------
-    >>> with atomic_output(out / "front.png") as tmp:  # doctest: +SKIP
-    ...     fig.savefig(tmp)
-    """
-    path = Path(path)
-    _make_folder(path.parent)
-    fd, tmp = _temp_file(path)
-    os.close(fd)
-    try:
-        yield tmp
-        # The writer wrote by name (it may even have replaced the file, atomically):
-        # reopened without following a link, made durable, put in place.
-        fd = os.open(tmp, os.O_RDWR | NOFOLLOW | CLOEXEC)
-        try:
-            _commit(fd, tmp, path)
-        finally:
-            os.close(fd)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    _fsync_dir(path.parent)
-
-
-def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically: readers see the old file or the whole new one.
-
-    The data goes through the descriptor of the new temporary file (created with
-    ``O_EXCL``), never through a name: a link at ``path`` is replaced, not followed.
-
-    Returns
-    -------
-    Path
-        ``path``.
-    """
-    path = Path(path)
-    _make_folder(path.parent)
-    fd, tmp = _temp_file(path)
-    try:
-        view = memoryview(data)
-        while view:
-            view = view[os.write(fd, view) :]
-        _commit(fd, tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    finally:
-        os.close(fd)
-    _fsync_dir(path.parent)
-    return path
-
-
-def atomic_write_text(path: Path | str, text: str, encoding: str = "utf-8") -> Path:
-    """Write ``text`` to ``path`` atomically (see :func:`atomic_write_bytes`)."""
-    return atomic_write_bytes(path, text.encode(encoding))
-
-
-def _make_folder(folder: Path) -> None:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise StoreError(f"cannot create the output folder {folder}: {exc.strerror}") from None
-
-
-def ensure_writable(folder: Path | str) -> Path:
-    """Create ``folder`` if needed and check that files can be created in it.
-
-    Done before a long computation, so that a read-only or full output folder is
-    reported at once rather than after an hour of solving.
-
-    Raises
-    ------
-    StoreError
-        Naming the folder and the reason.
-    """
-    folder = Path(folder)
-    _make_folder(folder)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".optdesign-write-test.", dir=folder)
-        os.close(fd)
-        os.unlink(tmp)
-    except OSError as exc:
-        raise StoreError(f"cannot write to the output folder {folder}: {exc.strerror}") from None
-    return folder
-
-
-# --- one writer per folder ------------------------------------------------------------------
-#: realpath of a folder -> [lock file descriptor, depth] for the locks this process holds.
-_HELD: dict[str, list[int]] = {}
-_HELD_LOCK = threading.Lock()
-
-
-def _forget_locks_in_child() -> None:
-    # A forked child (worker, isolated task) inherits the lock's file descriptor; it
-    # must not keep the lock alive after the parent is gone, nor believe it holds it.
-    # Closing the inherited descriptor leaves the parent's lock in place (flock locks
-    # belong to the open file, which the parent still has open).
-    global _HELD_LOCK
-    _HELD_LOCK = threading.Lock()
-    for fd, _ in _HELD.values():
-        with contextlib.suppress(OSError):
-            os.close(fd)
-    _HELD.clear()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_forget_locks_in_child)
-
-
-def _lock_holder(path: Path) -> str:
-    try:
-        pid = (read_file(path, what="the lock file", limit=64) or b"").decode().strip()
-    except (OSError, OptDesignError, UnicodeDecodeError):
-        pid = ""
-    return f"pid {pid}" if pid.isdigit() else "pid unknown"
-
-
-def _acquire(folder: Path) -> int:
-    path = folder / LOCK_NAME
-    # A lock file planted as a link (to ~/.bashrc) is refused, never truncated; so is
-    # a hard link, a FIFO or a device.
-    try:
-        fd = open_file(path, os.O_RDWR | os.O_CREAT, 0o644, what="the lock file", single_link=True)
-    except OSError as exc:
-        raise StoreError(f"cannot write to the output folder {folder}: {exc.strerror}") from None
-    if fcntl is None:  # pragma: no cover - no advisory locks on this platform
-        return fd
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        os.close(fd)
-        raise FolderInUseError(
-            f"folder {folder} is in use by another optdesign run ({_lock_holder(path)}); "
-            "wait for it to finish or use another output folder"
-        ) from None
-    # The pid is for the message of a run refused by this one.
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-    return fd
-
-
-@contextlib.contextmanager
-def lock_folder(folder: Path | str) -> Iterator[Path]:
-    """Hold the output folder ``folder`` (created if needed) for this process.
-
-    Non-blocking: if another process holds it, :class:`FolderInUseError` says so with
-    its pid. Re-entrant within a process. The lock is released on exit, or by the kernel
-    when the process ends, however it ends.
-    """
-    folder = Path(folder)
-    _make_folder(folder)
-    key = os.path.realpath(folder)
-    with _HELD_LOCK:
-        entry = _HELD.get(key)
-        if entry is not None:
-            entry[1] += 1
-        else:
-            _HELD[key] = [_acquire(folder), 1]
-    try:
-        yield folder
-    finally:
-        with _HELD_LOCK:
-            entry = _HELD.get(key)
-            if entry is not None:  # absent in a forked child: nothing to release
-                entry[1] -= 1
-                if entry[1] == 0:
-                    del _HELD[key]
-                    with contextlib.suppress(OSError):
-                        os.close(entry[0])  # closing releases the flock
-
-
-def holds_lock(folder: Path | str) -> bool:
-    """Whether this process holds the lock of ``folder``."""
-    return os.path.realpath(folder) in _HELD
 
 
 # --- the JSONL store --------------------------------------------------------------------

@@ -1,0 +1,187 @@
+"""``optdesign sweep FILE --vary PATH=START..STOP UNIT:COUNT [--vary ...]``: how the
+optimum moves when one or two parameters change (:func:`optdesign.sweep`).
+
+Writes ``sweep.csv`` (units in the headers), ``sweep.json``, the design chart
+``sweep.png`` and the JSONL store ``sweep.jsonl`` (the points as they finish;
+``--resume`` continues from them) to the output folder.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import re
+from pathlib import Path
+
+from optdesign import validation as check
+from optdesign.cli import as_options, checked, command, literal, output_folder
+from optdesign.errors import InputError
+
+_RANGE = re.compile(
+    r"^\s*(?P<start>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<u0>[^.\s][^.]*?)?\s*"
+    r"\.\.\s*(?P<stop>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<u1>.*?)\s*"
+    r":\s*(?P<count>\d+)\s*$"
+)
+
+
+def parse_vary(text: str) -> tuple[str, tuple[str, str, int]]:
+    """``"requirements.hinge_moment=200..1000N*m:20"`` -> (path, ("200 N*m", "1000 N*m",
+    20)); the unit after the stop applies to a start written without one."""
+    path, sep, rng = text.partition("=")
+    if not sep or not path.strip():
+        raise InputError(
+            "--vary",
+            f"{text!r}: write PATH=START..STOP UNIT:COUNT, e.g. "
+            "requirements.hinge_moment=200..1000N*m:20",
+        )
+    m = _RANGE.match(rng)
+    if m is None:
+        raise InputError(
+            "--vary",
+            f"{path.strip()}: {rng!r} is not START..STOP UNIT:COUNT (e.g. 200..1000N*m:20)",
+        )
+    u1 = (m["u1"] or "").strip()
+    u0 = (m["u0"] or "").strip() or u1
+    start = f"{m['start']} {u0}".strip()
+    stop = f"{m['stop']} {u1}".strip()
+    return path.strip(), (start, stop, int(m["count"]))
+
+
+@command("sweep")
+def _sweep(sub):
+    p = sub.add_parser("sweep", help="the optimum against one or two parameters (continuation)")
+    p.add_argument("file", type=Path, help="problem file (TOML)")
+    p.add_argument(
+        "--vary",
+        action="append",
+        required=True,
+        help="PATH=START..STOP UNIT:COUNT, e.g. requirements.hinge_moment=200..1000N*m:20 "
+        "(once or twice; PATH: requirements.NAME, variables.NAME.lower|upper, variables.NAME)",
+    )
+    p.add_argument("--objective", default=None, help="objective (default: the file's first)")
+    p.add_argument(
+        "--check-every",
+        type=checked(lambda a, v: check.integer(a, v, 1, 10_000), literal),
+        default=10,
+        help="a full multistart every this many points (default 10), and at the ends, "
+        "where the warm start fails and where the binding set changes",
+    )
+    p.add_argument(
+        "--starts",
+        type=checked(check.starts, literal),
+        default=None,
+        help="starts of the multistart checks (default: the file's)",
+    )
+    p.add_argument(
+        "--seed", type=checked(check.seed, literal), default=None, help="seed (default: file's)"
+    )
+    p.add_argument(
+        "--workers",
+        type=checked(check.workers, literal),
+        default=1,
+        help="local processes: the rows of a two-parameter sweep (or a catalogue problem's "
+        "points) side by side (default 1)",
+    )
+    p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument("--resume", action="store_true", help="continue the sweep stored in --out")
+    p.add_argument(
+        "--overwrite", action="store_true", help="start afresh over a stored sweep in --out"
+    )
+    p.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="also each point's log-sensitivity to every binding requirement (in sweep.json)",
+    )
+    p.add_argument("--json", action="store_true", help="print sweep.json to stdout")
+    p.add_argument("--no-plot", action="store_true", help="skip the design chart sweep.png")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run_sweep_command)
+
+
+def run_sweep_command(args) -> int:
+    import optdesign as od
+    from optdesign import storage
+    from optdesign.cli import stdout_to_stderr
+    from optdesign.problem import load_problem
+
+    vary = dict(parse_vary(t) for t in args.vary)
+    if len(vary) < len(args.vary):
+        raise InputError("--vary", "the same parameter twice")
+    problem = load_problem(args.file)
+    with as_options():
+        check.objective_of(problem, args.objective)
+        check.run_folder(args.out, args.resume, args.overwrite)
+        check.sweep_parameters(problem, vary, "--vary")  # before the output folder is made
+    with output_folder(args.out, f"sweep-{problem.name}") as out, storage.lock_folder(out):
+        storage.ensure_writable(out)
+        quiet = stdout_to_stderr() if args.json else contextlib.nullcontext()
+        with quiet:
+            sweep = od.sweep(
+                problem,
+                vary,
+                objective=args.objective,
+                check_every=args.check_every,
+                starts=args.starts,
+                seed=args.seed,
+                out=out,
+                resume=args.resume,
+                overwrite=args.overwrite,
+                progress=not args.no_progress and not args.json,
+                sensitivities=args.sensitivities,
+                workers=args.workers,
+                scheduler=args.scheduler,
+            )
+        return _write(args, sweep, out)
+
+
+def sweep_document(sweep) -> dict:
+    """``sweep.json``: the axes, the table's columns with their units, the rows."""
+    from optdesign.reports.sweep import sweep_columns, sweep_rows
+    from optdesign.solvers.result import clean_json
+
+    headers, rows = sweep_rows(sweep)
+    return clean_json(
+        {
+            "schema": "optdesign.sweep/1",
+            "problem": sweep.problem.name,
+            "objective": sweep.objective,
+            "continuation": sweep.continuation,
+            "axes": [{"path": a.path, "unit": a.unit, "values": list(a.shown)} for a in sweep.axes],
+            "units": {c[0]: c[1] for c in sweep_columns(sweep) if c[1]},
+            "points": [dict(zip(headers, r, strict=True)) for r in rows],
+            "sensitivities": [p.sensitivities for p in sweep.points]
+            if any(p.sensitivities for p in sweep.points)
+            else None,
+            "wall_time": {"value": sweep.wall_time_s, "unit": "s"},
+            "notes": sweep.notes,
+        }
+    )
+
+
+def _write(args, sweep, out: Path) -> int:
+    from optdesign.reports.sweep import sweep_csv
+    from optdesign.storage import atomic_write_text
+    from optdesign.text import printable
+
+    text = json.dumps(sweep_document(sweep), indent=2)
+    atomic_write_text(out / "sweep.csv", sweep_csv(sweep))
+    atomic_write_text(out / "sweep.json", text)
+    wrote = [out / "sweep.csv", out / "sweep.json"]
+    notes = []
+    if not args.no_plot:
+        from optdesign.plots import write_figure
+
+        failed = write_figure(sweep.plot, out / "sweep.png")
+        if failed is None:
+            wrote.append(out / "sweep.png")
+        else:
+            notes.append(failed)
+    if args.json:
+        print(text)
+    else:
+        print(sweep.summary())
+        for note in notes:
+            print(f"note: {printable(note)}")
+        print("\nwrote " + ", ".join(printable(w) for w in wrote))
+    return 0 if any(p.success for p in sweep.points) else 1

@@ -1,0 +1,291 @@
+"""What each requirement costs: sensitivities of an NLP optimum to every requirement and
+every active variable bound, from the solver's multipliers.
+
+At a KKT point of ``min v(x; p) s.t. lo(p) <= g(x; p) <= hi(p)`` the envelope theorem
+gives the derivative of the optimal value with respect to any parameter ``p`` of the
+problem (a requirement's limit, a load, the stroke):
+
+    dv*/dp = dv/dp + sum_i mu_i * (dg_i/dp - db_i/dp)
+
+with ``b_i`` the bound of row ``i`` that binds (upper when ``mu_i > 0``, lower when
+``mu_i < 0``: CasADi's sign convention) and ``mu_i`` the multiplier of the row *in the
+problem's own units*. The NLP (:mod:`optdesign.formulations.nlp`) divides the objective
+by its typical value ``T`` and each row by its scale ``s_i``; Ipopt's ``lam_g`` belongs to
+that scaled problem, so ``mu_i = lam_g_i * T / s_i`` (the scaling changes neither the
+feasible set nor the optimum, so the multipliers of the unscaled problem are these).
+
+The partial derivatives ``dg/dp`` are central differences of the model on the NumPy path
+at the fixed optimum (no re-solve): a requirement can enter the rows as a limit, as a
+load (the hinge moment scales every force) or through the grid (the stroke), and the
+difference of the model covers all of them alike. The epigraph rows that carry a
+``max``/``spread`` objective (``t - theta_k >= 0``) contribute through their model part
+only: the auxiliary ``t`` is the same on both sides of the difference.
+
+A bound of a design variable ``x_k = x_lo + x_span * z_k`` binds with ``lam_x``; its
+multiplier in the problem's units is ``lam_x * T / x_span`` and ``dv*/d(bound) = -mu``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+import numpy as np
+
+from optdesign.errors import InputError
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.result import Result, Sensitivity
+
+#: Relative step of the central differences of the model (a smooth function evaluated,
+#: not solved: the error is O(step^2) and roundoff ~1e-16/step).
+STEP = 1e-5
+
+#: Sensitivities whose log-sensitivity (or, for a zero limit or objective, whose effect
+#: of a 1 % change relative to the objective) is below this are left out: not binding.
+NEGLIGIBLE = 1e-6
+
+
+def requirement_paths(problem: DesignProblem) -> Iterator[tuple[str, float]]:
+    """Every numeric requirement of ``problem`` (path below ``requirements``, internal
+    value): plain numbers and quantities, inside bands (``mean_ratio.min``) and tables
+    (``lock.force_max``); counts, switches, texts and lists are not limits."""
+
+    def walk(model: Any, prefix: str) -> Iterator[tuple[str, float]]:
+        for name in type(model).model_fields:
+            value = getattr(model, name)
+            path = f"{prefix}{name}"
+            if hasattr(type(value), "model_fields"):
+                yield from walk(value, path + ".")
+            elif isinstance(value, float) and math.isfinite(value):
+                yield path, value
+
+    yield from walk(problem.spec.requirements, "")
+
+
+def with_requirement(problem: DesignProblem, path: str, value: float) -> DesignProblem:
+    """A copy of ``problem`` whose requirement ``path`` (``"hinge_moment"``,
+    ``"mean_ratio.min"``) is ``value`` (internal units), validated like a file; the
+    original is left as it was (its solver caches stay valid)."""
+    from optdesign.problem.spec_validation import validate_spec
+
+    data = problem.spec.model_dump(mode="python")
+    node = data["requirements"]
+    keys = path.split(".")
+    for key in keys[:-1]:
+        node = node[key]
+    node[keys[-1]] = value
+    new = object.__new__(type(problem))
+    new.__dict__.update(problem.__dict__)
+    new.spec = validate_spec(data, problem.mechanism, source=problem.name, internal=True)
+    new._grid()
+    new._check_consistency()
+    new._touch()
+    return new
+
+
+def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[Sensitivity]:
+    """The sensitivities of an NLP optimum (``result`` of :func:`solve_nlp` with Ipopt's
+    multipliers in ``result.raw``), ranked by the size of their log-sensitivity (what
+    costs most first); empty when the result carries no multipliers. ``nlp``: the
+    formulation that solved it (default: the problem's own)."""
+    from optdesign.studies.nlp_solve import _objective_set, formulation_for
+
+    raw = result.raw
+    if not result.success or "lam_g" not in raw or "lam_x" not in raw:
+        return []
+    objective = result.objective_name or problem.objective_names[0]
+    if nlp is None:
+        nlp = formulation_for(problem, _objective_set(problem, objective))
+    lam_g = np.asarray(raw["lam_g"], dtype=float)
+    lam_x = np.asarray(raw["lam_x"], dtype=float)
+    if len(lam_g) != len(nlp.g_names) or len(lam_x) != len(nlp.lbz):
+        return []
+    T = nlp.target_scales[nlp.targets.index(objective)]
+    mu = lam_g * T / nlp.g_scale
+    x = np.array([result.design[v.name] for v in problem.free])
+    v = float(result.objective)
+    rows = _RowModel(nlp, objective, mu)
+    base = rows.value(problem, x)
+    out: list[tuple[Sensitivity, float]] = []  # with the effect of +1 % (or +1 unit at 0)
+    for path, p in requirement_paths(problem):
+        h = STEP * max(abs(p), 1e-9)
+        try:
+            up = rows.value(with_requirement(problem, path, p + h), x)
+            down = rows.value(with_requirement(problem, path, p - h), x)
+        except Exception:  # a step the schema refuses (a band's min at its max): skip it
+            continue
+        if not (math.isfinite(up) and math.isfinite(down) and math.isfinite(base)):
+            continue
+        out.append(_record(problem, objective, f"requirements.{path}", p, (up - down) / (2 * h), v))
+    for k, var in enumerate(problem.free):
+        lam = float(lam_x[k])
+        if lam == 0.0:
+            continue
+        side = "upper" if lam > 0 else "lower"
+        bound = var.upper if lam > 0 else var.lower
+        d = -lam * T / nlp.x_span[k]
+        out.append(_record(problem, objective, f"variables.{var.name}.{side}", bound, d, v))
+    kept = [s for s, effect in out if abs(effect) > NEGLIGIBLE * max(abs(v), 1e-300)]
+    kept.sort(key=lambda s: (-abs(s.log_sensitivity or 0.0), s.name))
+    return kept
+
+
+def _record(
+    problem: DesignProblem, objective: str, path: str, p: float, dvdp: float, v: float
+) -> tuple[Sensitivity, float]:
+    """The record of ``dv*/dp`` at limit ``p`` (both internal), in the user's units."""
+    from optdesign.reports.display_units import (
+        Shown,
+        objective_shown,
+        requirement_values,
+        variable_shown,
+    )
+
+    if path.startswith("variables."):
+        var = problem.by_name[path.split(".")[1]]
+        limit = variable_shown(problem, var, p)
+    else:
+        node: Any = requirement_values(problem)
+        for key in path.split(".")[1:]:
+            node = node.get(key) if isinstance(node, dict) else None
+        limit = node if isinstance(node, Shown) else Shown(p, "")
+    factor = limit.value / p if p != 0 and limit.value else 1.0
+    obj = objective_shown(problem, objective, v)
+    obj_factor = obj.value / v if v != 0 else objective_shown(problem, objective, 1.0).value
+    log = dvdp * p / v if v != 0 else None
+    record = Sensitivity(
+        name=path,
+        objective=objective,
+        limit=float(limit.value),
+        unit=limit.unit,
+        d_objective_d_limit=float(dvdp * obj_factor / factor),
+        objective_unit=obj.unit,
+        log_sensitivity=None if log is None else float(log),
+    )
+    return record, float(dvdp * p * 0.01) if p != 0 else float(dvdp)
+
+
+class _RowModel:
+    """The Lagrangian's parameter-dependent part at a fixed design: ``v(p)`` for a
+    scalar objective plus ``sum mu_i (g_i(p) - b_i(p))`` over the NLP's rows, from the
+    NumPy path (rows matched to the NLP's by block name and order)."""
+
+    def __init__(self, nlp, objective: str, mu: np.ndarray):
+        self.nlp = nlp
+        self.objective = objective
+        self.mu = mu
+        self.rows = np.flatnonzero(mu != 0.0)
+        eps = set(nlp.eps_rows.values())
+        self.eps_name = {row: name for name, row in nlp.eps_rows.items()}
+        # (block name, index within the block) of every row the NLP has, in its order
+        self.where: list[tuple[str, int]] = []
+        seen: dict[str, int] = {}
+        for i, name in enumerate(nlp.g_names):
+            base = name.split("[", 1)[0] if i not in eps else name
+            k = seen.get(base, 0)
+            seen[base] = k + 1
+            self.where.append((base, k))
+
+    def value(self, problem: DesignProblem, x: np.ndarray) -> float:
+        with np.errstate(all="ignore"):
+            ex = problem.expressions(problem.design_dict(x))
+            blocks: dict[str, tuple[np.ndarray, float | None, float | None]] = {}
+            for name, term in ex.objectives.items():
+                e = np.ravel(np.asarray(term.expr, dtype=float))
+                blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
+                blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
+                blocks[f"{name}_envelope"] = (-e, 0.0, None)
+            for block in ex.constraints:
+                e = np.ravel(np.asarray(block.expr, dtype=float))
+                blocks[block.name] = (e, block.lower, block.upper)
+            limits = problem.objective_limits()
+            total = 0.0
+            term = ex.objectives.get(self.objective)
+            if term is not None and term.kind == "scalar":
+                total += float(np.ravel(np.asarray(term.expr, dtype=float))[0])
+            for i in self.rows:
+                mu = float(self.mu[i])
+                if i in self.eps_name:
+                    name = self.eps_name[i]
+                    t = ex.objectives[name]
+                    g = float(np.ravel(np.asarray(t.expr, float))[0]) if t.kind == "scalar" else 0.0
+                    lo, hi = None, limits.get(name)
+                else:
+                    base, k = self.where[i]
+                    values, lo, hi = blocks[base]
+                    g = float(values[k] if values.size > 1 else values[0])
+                b = hi if mu > 0 else lo
+                total += mu * (g - (b if b is not None and math.isfinite(b) else 0.0))
+        return total
+
+
+def with_bound(problem: DesignProblem, name: str, side: str, value: float) -> DesignProblem:
+    """A copy of ``problem`` whose free variable ``name`` has its ``side`` ("lower" or
+    "upper") bound at ``value`` (internal units)."""
+    import dataclasses
+
+    new = object.__new__(type(problem))
+    new.__dict__.update(problem.__dict__)
+    new.variables = [
+        dataclasses.replace(v, **{side: value}) if v.name == name else v for v in problem.variables
+    ]
+    new.by_name = {v.name: v for v in new.variables}
+    new._touch()
+    return new
+
+
+def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProblem:
+    """A copy of ``problem`` with each parameter path at its value (internal units)."""
+    for path, value in values.items():
+        head, _, rest = path.partition(".")
+        if head == "requirements":
+            problem = with_requirement(problem, rest, value)
+        else:
+            name, _, side = rest.partition(".")
+            problem = with_bound(problem, name, side or "value", value)
+            var = problem.by_name[name]
+            if var.free and not var.lower < var.upper:
+                raise InputError(
+                    f"vary.{path}",
+                    f"{name}'s lower bound {var.lower:g} is not below its upper "
+                    f"bound {var.upper:g} {var.unit}",
+                )
+    return problem
+
+
+def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:
+    """``problem`` with the limit ``name`` of a :class:`Sensitivity` at ``value``
+    (internal units)."""
+    head, _, rest = name.partition(".")
+    if head == "variables":
+        var, _, side = rest.partition(".")
+        return with_bound(problem, var, side, value)
+    return with_requirement(problem, rest, value)
+
+
+def finite_difference(
+    problem: DesignProblem, result: Result, name: str, rel: float = 1e-3
+) -> tuple[float, float]:
+    """d(optimal objective)/d(limit) of ``result`` by re-solves: the limit ``name`` moved
+    by ``rel`` (relative) to both sides, each re-solved from the optimum (one start),
+    central difference; returns (derivative in internal units, the limit's internal
+    value). The check of :func:`nlp_sensitivities` (tests, benchmarks)."""
+    from optdesign.studies.nlp_solve import solve_nlp
+
+    head, _, rest = name.partition(".")
+    if head == "variables":
+        var, _, side = rest.partition(".")
+        p = float(getattr(problem.by_name[var], side))
+    else:
+        p = dict(requirement_paths(problem))[rest]
+    h = rel * max(abs(p), 1e-9)
+    x0 = np.array([result.design[v.name] for v in problem.free])
+    values = []
+    for q in (p + h, p - h):
+        other = perturbed(problem, name, q)
+        r = solve_nlp(other, result.objective_name or None, starts=1, x0=x0)
+        if not r.success:
+            raise RuntimeError(f"{name} = {q:g}: the re-solve ended {r.status}")
+        values.append(r.objective)
+    return (values[0] - values[1]) / (2 * h), p

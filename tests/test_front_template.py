@@ -1,0 +1,101 @@
+"""One front-method template (studies/pareto/template.py): a new method is a small
+subclass giving its step; the command line and od.pareto build methods by one function."""
+
+from dataclasses import dataclass
+
+import pytest
+
+import optdesign as od
+from optdesign.errors import InputError
+from optdesign.studies.pareto import (
+    CatalogueEpsilon,
+    EpsilonConstraint,
+    FrontMethod,
+    PointRecord,
+    make_method,
+)
+from optdesign.studies.pareto.chains import anchor_tasks
+from optdesign.studies.pareto.tasks import front_task
+from optdesign.studies.pareto.template import FrontRun, Traced
+
+FORK = "problems/fork_min_backlash.toml"
+CATALOGUE = "problems/cs_min_backlash_catalogue.toml"
+
+
+@dataclass
+class AnchorsOnly(FrontMethod):
+    """The two ends of a front and nothing between: the smallest method the template
+    runs (store, identity, resume, anchors' check and wrap-up come from the template)."""
+
+    starts: int | None = 2
+    seed: int | None = None
+    name: str = "anchors"
+
+    def identity(self, starts, seed, objectives):
+        return "ipopt", {"method": "anchors", "starts": starts, "seed": seed}
+
+    def trace(self, ctx: FrontRun) -> Traced:
+        common = {"problem": ctx.problem, "objectives": sorted(ctx.objectives), "solver": "ipopt"}
+        done = ctx.tasks(anchor_tasks(common, ctx.objectives, ctx.starts, ctx.seed, 3), front_task)
+        anchors = {k: PointRecord.from_dict(done[f"anchor-{k}"]) for k in ctx.objectives}
+        return Traced(list(anchors.values()), anchors, sum(r.n_solves for r in anchors.values()))
+
+
+def test_a_new_front_method_is_a_small_subclass_of_the_template(tmp_path):
+    problem = od.load(FORK)
+    front = od.pareto(problem, ["backlash", "size"], method=AnchorsOnly(), out=tmp_path)
+    assert front.store == str(tmp_path / "anchors.jsonl")
+    assert sorted(p.id for p in front.points) == ["anchor-backlash", "anchor-size"]
+    # each end is the optimum of its objective: the other end is worse in it
+    ends = {p.id: p.objectives for p in front.points}
+    assert ends["anchor-backlash"]["backlash"] < ends["anchor-size"]["backlash"]
+    assert ends["anchor-size"]["size"] < ends["anchor-backlash"]["size"]
+    assert front.anchors == {k: ends[f"anchor-{k}"] for k in ("backlash", "size")}
+    # a resume reads the store the template wrote: no solve runs again
+    seen = []
+    again = od.pareto(
+        problem,
+        ["backlash", "size"],
+        method=AnchorsOnly(),
+        out=tmp_path,
+        resume=True,
+        on_record=seen.append,
+    )
+    assert seen == []
+    assert [p.objectives for p in again.points] == [p.objectives for p in front.points]
+    # the template's refusals hold for it too
+    with pytest.raises(InputError, match="would leave the catalogue"):
+        od.pareto(CATALOGUE, ["ripple", "backlash"], method=AnchorsOnly())
+    with pytest.raises(InputError, match="time_limit: not applied by the anchors method"):
+        od.pareto(problem, ["backlash", "size"], method=AnchorsOnly(), time_limit=5)
+
+
+def test_the_command_line_builds_methods_as_od_pareto_does(tmp_path):
+    """The same front, point for point, from ``optdesign pareto`` and from od.pareto with
+    the same settings (both build the method by make_method)."""
+    import json
+
+    from optdesign.cli import main
+
+    out = tmp_path / "cli"
+    argv = ["pareto", FORK, "--objectives", "backlash,size", "--points", "4", "--method"]
+    more = ["--starts", "2", "--workers", "1", "--deterministic", "--out", str(out)]
+    quiet = ["--no-plot", "--no-report", "--no-progress"]
+    assert main([*argv, "uniform,weighted_sum", *more, *quiet]) == 0
+    stored = json.loads((out / "front.json").read_text())["fronts"]
+    problem = od.load(FORK)
+    for method, cli in zip(("uniform", "weighted_sum"), stored, strict=True):
+        extra = {"deterministic": True} if method == "uniform" else {}
+        front = od.pareto(problem, ["backlash", "size"], 4, method, starts=2, **extra)
+        assert cli["method"] == front.method == method
+        assert cli["settings"] == json.loads(json.dumps(front.settings))
+        assert [p["objectives"] for p in cli["points"]] == [p.objectives for p in front.points]
+    catalogue = od.load(CATALOGUE)
+    assert make_method(catalogue, "epsilon", 7, starts=2, seed=5, deterministic=True) == (
+        CatalogueEpsilon(points=7, starts=2, seed=5)
+    )
+    assert make_method(problem, "uniform", 7, starts=2) == EpsilonConstraint(
+        points=7, spacing="uniform", name="uniform", starts=2
+    )
+    with pytest.raises(InputError, match="weighted_sum would leave the catalogue"):
+        make_method(catalogue, "weighted_sum", 7)

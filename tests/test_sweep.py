@@ -1,0 +1,284 @@
+"""Issue 24: parametric sweeps by continuation (od.sweep, optdesign sweep), the store and
+its resume, infeasible points, the design chart, and the refusals of bad input."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import optdesign as od
+from optdesign.cli import main
+from optdesign.commands.sweep import parse_vary
+from optdesign.studies.nlp_solve import solve_nlp
+from optdesign.studies.sweep import at_values, grid_order, neighbour, sweep_axes
+
+PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
+FORK = PROBLEMS / "fork_min_backlash.toml"
+HINGE = "requirements.hinge_moment"
+
+
+@pytest.fixture(scope="module")
+def fork_sweep(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep")
+    vary = {HINGE: ("200 N*m", "1000 N*m", 5)}
+    return od.sweep(FORK, vary, out=out, check_every=3, sensitivities=True), out
+
+
+def test_every_point_equals_an_independent_multistart(fork_sweep):
+    sweep, _ = fork_sweep
+    problem = od.load(FORK)
+    assert [p.values[0] for p in sweep.points] == pytest.approx([200e3, 400e3, 600e3, 800e3, 1e6])
+    for p in sweep.points:
+        alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}), starts=8, seed=5)
+        assert p.success and alone.success
+        assert p.objective == pytest.approx(alone.objective, rel=1e-6)
+    # the checks: the ends, every third point, and where the binding set changed
+    assert [p.checked for p in sweep.points] == [True, True, False, True, True]
+    assert sweep.points[0].active == ["d.lower", "nut_travel"]  # a light load: the smallest pin
+    assert sweep.points[1].active == ["nut_travel", "pin_bearing_pressure"]
+    assert [p.active_change for p in sweep.points] == [False, True, False, False, False]
+    assert not any(p.jump for p in sweep.points)
+    # the backlash grows with the load (the pin grows with it)
+    objectives = [p.objective for p in sweep.points]
+    assert objectives == sorted(objectives)
+    # each point carries its sensitivities: +1 % hinge moment costs about 0.24 % at 500 N*m
+    assert 0.1 < sweep.points[2].sensitivities[HINGE] < 0.4
+
+
+def test_frame_csv_and_chart_in_the_users_units(fork_sweep):
+    sweep, _ = fork_sweep
+    frame = sweep.to_frame()
+    assert list(frame.columns[:6]) == [
+        "point",
+        "hinge_moment [N*m]",
+        "backlash [deg]",
+        "R [mm]",
+        "p [mm]",
+        "d [mm]",
+    ]
+    assert frame["hinge_moment [N*m]"].tolist() == pytest.approx([200, 400, 600, 800, 1000])
+    assert frame.attrs["units"]["backlash [deg]"] == "deg"
+    fig = sweep.plot()
+    labels = [ax.get_ylabel() for ax in fig.axes if ax.get_visible()]
+    assert labels == ["backlash [deg]", "R [mm]", "p [mm]", "d [mm]"]
+    # the binding-set change is marked on every panel (a dotted line at 400 N*m)
+    first = fig.axes[0]
+    assert any(line.get_xdata()[0] == 400 for line in first.lines if line.get_linestyle() == ":")
+    text = sweep.summary()
+    assert "binding set changes at:" in text and "point 1: nut_travel;pin_bearing_pressure" in text
+
+
+def test_resume_reuses_the_stored_points(fork_sweep):
+    sweep, out = fork_sweep
+    store = out / "sweep.jsonl"
+    lines = store.read_text().splitlines()
+    vary = {HINGE: ("200 N*m", "1000 N*m", 5)}
+    again = od.sweep(FORK, vary, out=out, check_every=3, resume=True, sensitivities=True)
+    assert store.read_text().splitlines() == lines  # nothing solved again
+    assert [p.objective for p in again.points] == [p.objective for p in sweep.points]
+    # another range is another run: refused, naming what changed
+    with pytest.raises(od.OptDesignError, match="method"):
+        od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out, check_every=3, resume=True)
+    # and a new run does not silently replace the stored one
+    with pytest.raises(od.OptDesignError, match="--resume"):
+        od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out)
+
+
+def test_an_infeasible_point_says_what_fails(tmp_path):
+    sweep = od.sweep(
+        PROBLEMS / "cs_min_backlash.toml", {HINGE: ("10 kN*m", "15 kN*m", 2)}, out=tmp_path
+    )
+    ok, bad = sweep.points
+    assert ok.success and ok.active == ["d.upper", "nut_travel"]
+    assert not bad.success  # the best design found violates the requirements
+    assert any("pin_bearing_pressure" in v for v in bad.violated)
+    text = sweep.summary()
+    assert "infeasible points (what fails at the best design found):" in text
+    row = next(line for line in text.splitlines() if line.startswith("1 "))
+    assert row.split()[:4] == ["1", "15000", "-", "-"] and bad.status in row
+    y = sweep.plot().axes[0].lines[0].get_ydata()
+    assert np.isnan(y[1]) and np.isfinite(y[0])  # nothing drawn where nothing is feasible
+
+
+def test_two_parameters_snake_through_the_grid(tmp_path):
+    sweep = od.sweep(
+        FORK,
+        {HINGE: ("400 N*m", "600 N*m", 2), "variables.R.upper": ("90 mm", "110 mm", 2)},
+        out=tmp_path,
+    )
+    assert len(sweep.points) == 4 and all(p.success for p in sweep.points)
+    # R's upper bound of 90 mm binds (the free optimum has R = 95.3 mm), 110 mm does not
+    assert "R.upper" in sweep.points[0].active and "R.upper" not in sweep.points[2].active
+    assert sweep.points[0].objective > sweep.points[2].objective
+    assert grid_order(sweep.axes) == [(0, 0), (1, 0), (0, 1), (1, 1)]
+    # each row a chain; a row's first point continues from the row before's first point
+    assert [neighbour(i) for i in grid_order(sweep.axes)] == [None, (0, 0), (0, 0), (0, 1)]
+    assert sweep.plot().axes[0].get_xlabel() == "hinge_moment [N*m]"
+    # two workers run the rows side by side: the same records, whatever the timing
+    vary = {HINGE: ("400 N*m", "600 N*m", 2), "variables.R.upper": ("90 mm", "110 mm", 2)}
+    again = od.sweep(FORK, vary, out=tmp_path / "w2", workers=2)
+    assert [(p.objective, p.design, p.active) for p in again.points] == [
+        (p.objective, p.design, p.active) for p in sweep.points
+    ]
+
+
+@pytest.mark.parametrize(
+    ("vary", "field", "reason"),
+    [
+        (
+            {"requirements.hinge_momnet": ("1 N*m", "2 N*m", 3)},
+            "vary",
+            "did you mean 'hinge_moment'",
+        ),
+        ({HINGE: ("200 mm", "2 N*m", 3)}, "vary.requirements.hinge_moment start", "a length"),
+        ({HINGE: ("200", "1000 N*m", 3)}, "vary.requirements.hinge_moment start", "no unit"),
+        ({HINGE: ("2 N*m", "2 N*m", 3)}, "vary.requirements.hinge_moment", "an empty range"),
+        ({HINGE: ("1 N*m", "2 N*m", 1)}, "vary.requirements.hinge_moment", "outside 2..1000"),
+        ({HINGE: ("1 N*m", "2 N*m", 2.5)}, "vary.requirements.hinge_moment", "an integer"),
+        ({HINGE: ("1 N*m", "2 N*m")}, "vary.requirements.hinge_moment", "(start, stop, count)"),
+        ({"variables.d": ("1 mm", "2 mm", 3)}, "vary", "sweep variables.d.lower or d.upper"),
+        ({"requirements.fit": (1, 2, 3)}, "vary", "not a number"),
+        ({}, "vary", "give {parameter path"),
+        (
+            {
+                HINGE: ("1 N*m", "2 N*m", 2),
+                "variables.R.upper": ("90 mm", "91 mm", 2),
+                "variables.p.upper": ("9 mm", "10 mm", 2),
+            },
+            "vary",
+            "at most 2",
+        ),
+        ({"variables.R.lower": ("100 mm", "130 mm", 2)}, "vary.variables.R.lower", "not below"),
+    ],
+)
+def test_bad_sweeps_are_refused_naming_the_field(vary, field, reason):
+    problem = od.load(FORK)
+    with pytest.raises(od.InputError) as err:
+        sweep_axes(problem, vary)
+    assert err.value.field == field
+    assert reason in err.value.reason
+
+
+def test_api_arguments_are_checked_before_any_work():
+    with pytest.raises(od.InputError, match="resume: give the out folder"):
+        od.sweep(FORK, {HINGE: ("1 N*m", "2 N*m", 2)}, resume=True)
+    with pytest.raises(od.InputError, match="starts: 0 is outside"):
+        od.sweep(FORK, {HINGE: ("1 N*m", "2 N*m", 2)}, starts=0)
+    with pytest.raises(od.InputError, match="objective"):
+        od.sweep(FORK, {HINGE: ("1 N*m", "2 N*m", 2)}, objective="nope")
+
+
+def test_vary_text_of_the_command_line():
+    assert parse_vary("requirements.hinge_moment=200..1000N*m:20") == (
+        HINGE,
+        ("200 N*m", "1000 N*m", 20),
+    )
+    assert parse_vary("requirements.mean_ratio.min=180..220:5") == (
+        "requirements.mean_ratio.min",
+        ("180", "220", 5),
+    )
+    assert parse_vary("variables.R.upper=0.09 m..0.11 m:3")[1] == ("0.09 m", "0.11 m", 3)
+    with pytest.raises(od.InputError, match=r"--vary: requirements.hinge_moment: '200:3'"):
+        parse_vary("requirements.hinge_moment=200:3")
+
+
+def test_cli_writes_the_table_chart_and_json(tmp_path, capsys):
+    out = tmp_path / "o"
+    args = [
+        "sweep",
+        str(FORK),
+        "--vary",
+        "requirements.mean_ratio.min=180..220:3",
+        "--out",
+        str(out),
+        "--no-progress",
+    ]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "sweep     mean_ratio.min 180..220 (3 points)" in text
+    assert {p.name for p in out.iterdir()} >= {
+        "sweep.csv",
+        "sweep.json",
+        "sweep.png",
+        "sweep.jsonl",
+    }
+    header = (out / "sweep.csv").read_text().splitlines()[0]
+    assert header.startswith("point,mean_ratio.min,backlash [deg],R [mm],p [mm],d [mm],status")
+    assert main([*args, "--resume", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["axes"][0] == {
+        "path": "requirements.mean_ratio.min",
+        "unit": "",
+        "values": [180.0, 200.0, 220.0],
+    }
+    assert [p["status"] for p in doc["points"]] == ["optimal"] * 3
+    assert main(["sweep", str(FORK), "--vary", "requirements.hinge_moment=1..2mm:3"]) == 2
+    assert "--vary.requirements.hinge_moment start: '1 mm' is a length" in capsys.readouterr().err
+
+
+def test_one_nlp_for_loads_and_limits_its_own_for_the_rest(tmp_path):
+    from optdesign.studies.sweep_solver import sweep_mode
+
+    problem = od.load(FORK)
+    assert sweep_mode(problem, [HINGE], [(2e5, 1e6)]) == "shared"  # a parameter of the NLP
+    assert sweep_mode(problem, ["requirements.nut_travel_max"], [(100.0, 120.0)]) == "shared"
+    # the stroke moves the grid, a bound the variables' scaling: each point its own NLP
+    assert sweep_mode(problem, ["requirements.deflection.max"], [(0.4, 0.6)]) == "rebuild"
+    assert sweep_mode(problem, ["variables.R.upper"], [(90.0, 110.0)]) == "rebuild"
+    # the hinge moment also sets the pin's load in the contact model: not a limit
+    assert (
+        sweep_mode(
+            problem,
+            ["requirements.hinge_moment", "requirements.nut_travel_max"],
+            [(2e5, 1e6), (100.0, 120.0)],
+        )
+        == "shared"
+    )
+    sweep = od.sweep(
+        problem, {"requirements.nut_travel_max": ("100 mm", "120 mm", 3)}, out=tmp_path
+    )
+    for p in sweep.points:
+        alone = solve_nlp(at_values(problem, {"requirements.nut_travel_max": p.values[0]}))
+        assert p.objective == pytest.approx(alone.objective, rel=1e-6)
+        assert "nut_travel" in p.active
+
+
+def test_a_catalogue_problem_is_swept_point_by_point_and_item_changes_marked(tmp_path):
+    problem = od.load(PROBLEMS / "cs_min_backlash_catalogue.toml")
+    sweep = od.sweep(problem, {HINGE: ("400 N*m", "600 N*m", 2)}, starts=1, out=tmp_path)
+    assert not sweep.continuation and "no continuation" in sweep.notes[0]
+    first, second = sweep.points
+    # the pin steps up two catalogue sizes (ISO 2338: 6 -> 10 mm, as enumeration finds:
+    # d = 8 mm gives 0.0390417 deg at 600 N*m); the binding set is the same
+    assert (first.design["d"], second.design["d"]) == (6.0, 10.0)
+    assert second.objective == pytest.approx(0.0378044, rel=1e-5)
+    assert first.active == second.active == ["nut_travel"]
+    assert (first.active_change, second.active_change) == (False, True)
+    at_600 = od.solve(at_values(problem, {HINGE: 600e3}), starts=1, ranges=False)
+    assert second.objective == pytest.approx(at_600.objective, rel=1e-9)
+
+
+def test_a_worse_warm_start_is_caught_as_a_jump(tmp_path, monkeypatch):
+    # The warm start made to end 1 % above the optimum (as if the chain had followed a
+    # local optimum): the multistart check of every point finds the better one, marks
+    # the jump and the chain goes on from it.
+    import dataclasses
+
+    from optdesign.studies.sweep_solver import SweepSolver
+
+    original = SweepSolver.warm
+
+    def worse(self, point, x0):
+        r = original(self, point, x0)
+        return dataclasses.replace(r, objective=r.objective * 1.01)
+
+    monkeypatch.setattr(SweepSolver, "warm", worse)
+    sweep = od.sweep(FORK, {HINGE: ("400 N*m", "600 N*m", 3)}, check_every=1, out=tmp_path)
+    assert [p.jump for p in sweep.points] == [False, True, True]  # the first has no neighbour
+    assert all(p.checked for p in sweep.points)
+    problem = od.load(FORK)
+    for p in sweep.points:
+        alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}))
+        assert p.objective == pytest.approx(alone.objective, rel=1e-9)
+    assert "the multistart check found a better optimum" in sweep.summary()
