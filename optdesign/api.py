@@ -263,7 +263,9 @@ def report(result: Any, path: str | Path) -> Path:
     ----------
     result
         A :class:`Result` with a design (:func:`solve`), a :class:`Front` with points
-        (:func:`pareto`), or a list of fronts of one problem (drawn together).
+        (:func:`pareto`), a list of fronts of one problem (drawn together), or a
+        :class:`Sweep` (:func:`sweep`: its design chart and table, hover a point for its
+        design; the command line's ``sweep.html``).
     path
         The page's file; or an existing folder, to write ``report.html`` in it. Written
         as the command line writes it: atomically, through a new file (a link planted at
@@ -281,9 +283,15 @@ def report(result: Any, path: str | Path) -> Path:
     """
     from optdesign.reports.html import front_report, solve_report
     from optdesign.storage import atomic_write_text
+    from optdesign.studies.sweep import Sweep
 
     problem, fronts, target = validation.report_arguments(result, path)
-    page = front_report(problem, fronts) if fronts else solve_report(result)
+    if isinstance(result, Sweep):
+        from optdesign.reports.sweep_html import sweep_report
+
+        page = sweep_report(result)
+    else:
+        page = front_report(problem, fronts) if fronts else solve_report(result)
     return atomic_write_text(target, page)
 
 

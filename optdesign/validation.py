@@ -278,11 +278,12 @@ def folder(argument: str, out: Any) -> None:
 def report_arguments(subject: Any, path_: Any) -> tuple[Any, list[Any], Any]:
     """The checked arguments of :func:`optdesign.report`: (problem, fronts or [],
     the page's path). ``subject`` is a :class:`~optdesign.Result` with a design, a
-    :class:`~optdesign.Front` with points, or a list of fronts of one problem (drawn
-    together, as ``optdesign pareto --method all`` does); ``path_`` the page's file,
+    :class:`~optdesign.Front` with points, a list of fronts of one problem (drawn
+    together, as ``optdesign pareto --method all`` does) or a :class:`~optdesign.Sweep`; ``path_`` the page's file,
     or a folder to write ``report.html`` in (as the command line's ``--out``)."""
     from optdesign.solvers.result import Result
     from optdesign.studies.pareto.front import Front
+    from optdesign.studies.sweep import Sweep
 
     target = path("path", path_)
     if target.is_dir():
@@ -291,6 +292,10 @@ def report_arguments(subject: Any, path_: Any) -> tuple[Any, list[Any], Any]:
         raise ArgumentError("path", f"{shown(str(target))} is not a regular file")
     folder("path", target.parent)
     items = list(subject) if isinstance(subject, list | tuple) else [subject]
+    if isinstance(subject, Sweep):
+        if not any(p.design for p in subject.points):
+            raise ArgumentError("result", "the sweep has no point with a design to report")
+        return subject.problem, [], target
     if isinstance(subject, Result):
         problem = subject.problem_object
         if problem is None:
@@ -301,7 +306,8 @@ def report_arguments(subject: Any, path_: Any) -> tuple[Any, list[Any], Any]:
     if not items or not all(isinstance(f, Front) for f in items):
         raise ArgumentError(
             "result",
-            f"expected a Result (od.solve) or a Front (od.pareto), got {shown(subject)}",
+            f"expected a Result (od.solve), a Front (od.pareto) or a Sweep (od.sweep), "
+            f"got {shown(subject)}",
         )
     problem = items[0].problem_object
     if problem is None or any(f.problem_object is not problem for f in items):

@@ -59,6 +59,10 @@ def test_bonmin_equals_enumeration(enumerated):
     assert res.bound < res.objective and res.verified
     minlp = res.to_dict()["extra"]["catalogue"]["minlp"]
     assert (minlp["solver"], minlp["status"], minlp["binaries"]) == ("bonmin", "SUCCESS", 5)
+    # the neighbouring items, re-solved by the nodes' NLP back-end (Bonmin only picks)
+    steps = {(s.variable, s.item): s.objective for s in res.item_steps}
+    assert steps[("d", 5.0)] is None
+    assert steps[("p", 5.0)] == pytest.approx(0.0347087, rel=1e-5)
 
 
 def test_bonmin_refuses_an_unknown_algorithm():

@@ -56,8 +56,9 @@ ENTRY_POINTS = {
     ("optdesign.studies.pareto.front", "optdesign.plots.front"),
     ("optdesign.studies.sweep", "optdesign.reports.sweep"),
     ("optdesign.studies.sweep", "optdesign.plots.sweep"),
-    # od.report(result_or_front, path): the public API's entry point to the report page
+    # od.report(result_or_front_or_sweep, path): the public API's entry point to the pages
     ("optdesign.api", "optdesign.reports.html"),
+    ("optdesign.api", "optdesign.reports.sweep_html"),
 }
 
 

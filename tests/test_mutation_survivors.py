@@ -279,3 +279,36 @@ def test_first_feasible_finds_a_feasible_catalogue_design_or_none():
     # pins of 4 mm only: too weak for the hinge moment whatever the lead (every pair fails)
     weak = _catalogue((4, 5, 6, 8), (4,))
     assert catalogue.first_feasible(catalogue.NodeSolver(weak, starts=2)) is None
+
+
+# --- survivors of the sampled mutation run of issue 21 (docs/testing.md) -----------------
+def test_a_gp_objective_with_a_negative_term_is_not_a_gp():
+    """A user objective that is a signomial (12 mm - p): the GP diagnosis refuses it,
+    names the term, and cvxpy agrees; the problem's own objective stays a GP."""
+    import copy
+
+    from test_gp import CS_FIXED
+
+    from optdesign.formulations.gp import build_gp
+
+    problem = problem_from_dict(copy.deepcopy(CS_FIXED))
+    problem.add_objective("lead_margin", lambda q: 12.0 - q.design["p"], unit="mm")
+    gp = build_gp(problem, "lead_margin")
+    check = {c.name: c for c in gp.checks}["lead_margin"]
+    assert not gp.is_gp and check in gp.failures()
+    assert check.reason == "lead_margin[] has a negative term: -p + 12 (a signomial)"
+    assert check.cvxpy_is_dgp is False
+    assert build_gp(problem, "backlash").is_gp
+
+
+def test_three_objective_weights_are_the_smallest_triangle_holding_the_points():
+    """A 3-objective weighted sum: the weights lie on a triangular grid of side s, the
+    smallest with s (s + 1) / 2 >= points, and sum to 1."""
+    from optdesign.studies.pareto.methods import _weight_grid
+
+    for points, side in ((3, 2), (6, 3), (10, 4), (11, 5), (15, 5)):
+        grid = _weight_grid(3, points)
+        assert len(grid) == side * (side + 1) // 2
+        assert all(min(w) >= 0 and math.isclose(sum(w), 1.0) for w in grid)
+        assert len({tuple(round(x, 12) for x in w) for w in grid}) == len(grid)
+    assert _weight_grid(2, 5) == [(w, 1 - w) for w in np.linspace(0.0, 1.0, 5)]

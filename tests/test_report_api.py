@@ -61,8 +61,16 @@ def test_report_replaces_a_planted_link_without_following_it(tmp_path):
 @pytest.mark.parametrize(
     ("subject", "path", "expected"),
     [
-        ("text", "r.html", "result: expected a Result (od.solve) or a Front (od.pareto)"),
-        ([], "r.html", "result: expected a Result (od.solve) or a Front (od.pareto)"),
+        (
+            "text",
+            "r.html",
+            "result: expected a Result (od.solve), a Front (od.pareto) or a Sweep (od.sweep)",
+        ),
+        (
+            [],
+            "r.html",
+            "result: expected a Result (od.solve), a Front (od.pareto) or a Sweep (od.sweep)",
+        ),
         (None, 42, "path: expected a folder or file path, got 42"),
         (None, "", "path: '' is not a usable path"),
         (None, "file.txt/r.html", "path: "),

@@ -299,3 +299,45 @@ def test_hostile_names_are_shown_as_text_and_run_nothing(browser, hostile_dir):
     axis = browser.execute_script("return document.querySelector('#front .xtitle').textContent")
     assert axis == data["front"]["axes"][0]
     assert _not_blank(browser) > 10.0
+
+
+@pytest.fixture(scope="module")
+def sweep_dir(tmp_path_factory):
+    _need_browser()
+    out = tmp_path_factory.mktemp("sweep")
+    src = (PROBLEMS / "cs_min_backlash.toml").read_text()
+    path = out / "hostile.toml"
+    path.write_text(src.replace('name = "cs_min_backlash"', "name = " + json.dumps(HOSTILE)))
+    args = ["sweep", str(path), "--vary", "requirements.hinge_moment=300..700N*m:3"]
+    assert main([*args, "--starts", "1", "--no-progress", "--out", str(out / "s")]) == 0
+    return out / "s"
+
+
+def test_sweep_page_hover_a_point_or_a_row_shows_its_design(browser, sweep_dir):
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    from optdesign.text import printable
+
+    points = json.loads((sweep_dir / "sweep.json").read_text())["points"]
+    _open(browser, sweep_dir / "sweep.html")
+    _nothing_injected(browser)
+    assert browser.find_element(By.TAG_NAME, "h1").text == f"{printable(HOSTILE)} (crank-slider)"
+    attributes = browser.execute_script(
+        "return Array.from(document.querySelectorAll('#sweep-table *'),"
+        " (e) => Array.from(e.attributes, (a) => a.name)).flat()"
+    )
+    assert set(attributes) <= {"data-design"}
+    rows = browser.find_elements(By.CSS_SELECTOR, "#sweep-table tr[data-design]")
+    markers = browser.find_elements(By.CSS_SELECTOR, "#front .scatterlayer .trace .points path")
+    assert len(rows) == len(markers) == len(points) == 3
+    selected = "return document.body.dataset.selected"
+    text_of = "return document.getElementById(arguments[0]).textContent"
+    for k, target in ((2, rows[2]), (0, markers[0])):
+        ActionChains(browser).move_to_element(target).click().perform()
+        assert int(browser.execute_script(selected)) == k
+        label = browser.execute_script(text_of, "selected-label")
+        assert label == f"point {k}: hinge_moment [N*m] = {300 + 200 * k:g}"
+        cell = browser.find_element(By.CSS_SELECTOR, '#design td[data-var="R"]')
+        assert float(cell.text) == pytest.approx(points[k]["R [mm]"], rel=1e-5)
+    _nothing_injected(browser)

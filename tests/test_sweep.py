@@ -201,6 +201,7 @@ def test_cli_writes_the_table_chart_and_json(tmp_path, capsys):
         "sweep.csv",
         "sweep.json",
         "sweep.png",
+        "sweep.html",
         "sweep.jsonl",
     }
     header = (out / "sweep.csv").read_text().splitlines()[0]

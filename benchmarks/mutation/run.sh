@@ -115,6 +115,11 @@ mkdir -p mutants
 # Tests that start `python -m optdesign` (signals, CLI) import the mutated tree too, not
 # an installed optdesign.
 export PYTHONPATH="$WORK/mutants${PYTHONPATH:+:$PYTHONPATH}"
+# A mutant's test process that hangs at no CPU (a lock held at mutmut's fork) is stopped
+# after IDLE seconds and counted apart ("suspicious"), never as killed.
+"$PY" "$ROOT/benchmarks/mutation/watchdog.py" "$WORK/hung.log" "${IDLE:-120}" &
+WATCHDOG=$!
+trap 'kill $WATCHDOG 2>/dev/null || true' EXIT
 if [ -z "${SAMPLE:-}" ]; then
   "$MUTMUT" run --max-children "${JOBS:-2}" >mutmut-run.log 2>&1 || true
   "$MUTMUT" results --all true >mutmut-results.txt 2>&1 || true
@@ -131,6 +136,7 @@ else
   # command line stays short and a run stopped early still leaves a random sample
   xargs -a sample.txt -n 40 "$MUTMUT" run --max-children "${JOBS:-2}" >mutmut-run.log 2>&1 || true
   "$MUTMUT" results --all true >mutmut-results-all.txt 2>&1 || true
-  grep -F -f sample.txt mutmut-results-all.txt >mutmut-results.txt || true
+  sed "s/$/:/" sample.txt >sample-keys.txt  # "name:" so that _mutmut_1 is not _mutmut_12
+  grep -F -f sample-keys.txt mutmut-results-all.txt >mutmut-results.txt || true
   "$PY" "$ROOT/benchmarks/mutation/summary.py" mutmut-results.txt
 fi

@@ -58,12 +58,17 @@ def main(path: str) -> int:
         f"{'total':45s} {tried:6d} {total['killed']:7d} {total['survived']:9d} "
         f"{total['timeout']:8d} {other}"
     )
-    if tried:
+    # a mutant not run, or whose tests hung (stopped by watchdog.py: "suspicious"), is
+    # neither killed nor survived: left out of the rate, and counted on its own line
+    unjudged = total["suspicious"] + total["not checked"]
+    judged = tried - unjudged
+    if judged:
         killed = total["killed"] + total["timeout"]
-        low, high = wilson(killed, tried)
+        low, high = wilson(killed, judged)
         print(
-            f"killed (timeouts count as killed): {100 * killed / tried:.1f} % "
-            f"(95 % interval if sampled: {100 * low:.1f}-{100 * high:.1f} %)"
+            f"killed (timeouts count as killed): {killed} of {judged} judged, "
+            f"{100 * killed / judged:.1f} % (95 % interval if sampled: "
+            f"{100 * low:.1f}-{100 * high:.1f} %); not judged: {unjudged}"
         )
     print(
         "other statuses:",

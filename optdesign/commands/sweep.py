@@ -15,7 +15,7 @@ from pathlib import Path
 
 from optdesign import validation as check
 from optdesign.cli import as_options, checked, command, literal, output_folder
-from optdesign.errors import InputError
+from optdesign.errors import InputError, OptDesignError
 
 _RANGE = re.compile(
     r"^\s*(?P<start>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<u0>[^.\s][^.]*?)?\s*"
@@ -94,7 +94,9 @@ def _sweep(sub):
         help="also each point's log-sensitivity to every binding requirement (in sweep.json)",
     )
     p.add_argument("--json", action="store_true", help="print sweep.json to stdout")
-    p.add_argument("--no-plot", action="store_true", help="skip the design chart sweep.png")
+    p.add_argument(
+        "--no-plot", action="store_true", help="skip the design charts sweep.png and sweep.html"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run_sweep_command)
 
@@ -177,6 +179,13 @@ def _write(args, sweep, out: Path) -> int:
             wrote.append(out / "sweep.png")
         else:
             notes.append(failed)
+        if any(p.design for p in sweep.points):
+            import optdesign as od
+
+            try:  # a user's mechanism that cannot draw itself: a note, not the sweep lost
+                wrote.append(od.report(sweep, out / "sweep.html"))
+            except OptDesignError as exc:
+                notes.append(f"sweep.html not written: {exc}")
     if args.json:
         print(text)
     else:

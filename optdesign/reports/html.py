@@ -142,6 +142,7 @@ def solve_report(result: Any) -> str:
         initial["label"] = "initial design (violates the requirements)"
     best = design_view(problem, result.design, "optimum" if result.success else "best point found")
     best["sensitivities"] = [s.text() for s in result.sensitivities]
+    best["item_steps"] = [s.text() for s in result.item_steps]
     name = result.objective_name
     data = {
         **_header(problem),

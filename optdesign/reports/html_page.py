@@ -27,6 +27,7 @@ h1 { font-size: 1.3em; margin-bottom: 0.2em; }
 .meta { color: #555; margin: 0.2em 0; }
 .grid { display: grid; grid-template-columns: minmax(420px, 1fr) minmax(420px, 1fr); gap: 1em; }
 .plot { width: 100%; height: 480px; }
+#sweep-table { max-height: 420px; overflow: auto; }
 table { border-collapse: collapse; font-size: 0.9em; }
 td, th { padding: 2px 8px; border-bottom: 1px solid #ddd; text-align: left; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
@@ -120,6 +121,8 @@ _SCRIPT = r"""
     el('objectives').innerHTML = list(d.objectives.map((o) => o.text).concat(d.facts.map((f) => f.text)));
     el('limits').innerHTML = list(d.limits);
     el('costs').innerHTML = list(d.sensitivities || []);
+    el('steps').innerHTML = (d.item_steps || []).length
+      ? '<h3>the neighbouring catalogue items (the rest re-solved)</h3>' + list(d.item_steps) : '';
     el('violated').innerHTML = list(d.violated, 'violated');
     el('reference').innerHTML = ref && ref !== d
       ? '<h3>' + esc(ref.label) + ': violated requirements</h3>' + list(ref.violated, 'violated') : '';
@@ -144,10 +147,10 @@ _SCRIPT = r"""
     const f = DATA.front, three = f.axes.length === 3, axes = f.axes.map(ptext);
     const traces = f.traces.map((t) => ({
       x: t.coords[0], y: t.coords[1], z: three ? t.coords[2] : undefined,
-      customdata: t.index, type: three ? 'scatter3d' : 'scatter', mode: 'markers' + (three ? '' : '+lines'),
+      customdata: t.index, type: three ? 'scatter3d' : 'scatter', mode: t.mode || ('markers' + (three ? '' : '+lines')),
       marker: { size: three ? 4 : 8 }, name: ptext(t.method + ' (' + t.index.length + ' points)'),
       hovertemplate: axes[0] + ' %{x}<br>' + axes[1] + ' %{y}' + (three ? '<br>' + axes[2] + ' %{z}' : '') + '<extra>%{fullData.name}</extra>' }));
-    const layout = { title: { text: 'Pareto front: hover or click a point' }, hovermode: 'closest', margin: { t: 40 },
+    const layout = { title: { text: ptext(f.title || 'Pareto front: hover or click a point') }, hovermode: 'closest', margin: { t: 40 },
       legend: { font: { size: 10 } } };
     if (three) layout.scene = { xaxis: { title: { text: axes[0] } }, yaxis: { title: { text: axes[1] } }, zaxis: { title: { text: axes[2] } } };
     else { layout.xaxis = { title: { text: axes[0] } }; layout.yaxis = { title: { text: axes[1] } }; }
@@ -157,6 +160,23 @@ _SCRIPT = r"""
       gd.on('plotly_hover', pick);
     });
   }
+  function drawTable() {
+    // the sweep's table: a row with a design shows it on hover or click
+    const t = DATA.table;
+    let h = '<table><tr>' + t.headers.map((x) => '<th>' + esc(x) + '</th>').join('') + '</tr>';
+    t.rows.forEach((row, i) => {
+      const d = t.design[i];
+      h += '<tr' + (d === null ? '' : ' data-design="' + Number(d) + '"') + '>';
+      h += row.map((c) => '<td>' + esc(c) + '</td>').join('') + '</tr>';
+    });
+    el('sweep-table').innerHTML = h + '</table>';
+    el('sweep-table').querySelectorAll('tr[data-design]').forEach((tr) => {
+      const pick = () => show(Number(tr.dataset.design));
+      tr.addEventListener('mouseenter', pick);
+      tr.addEventListener('click', pick);
+    });
+  }
+  if (DATA.table) drawTable();
   const ready = DATA.front ? drawFront() : Promise.resolve();
   ready.then(() => { if (DATA.selected !== null) show(DATA.selected); document.body.dataset.ready = '1'; });
 })();
@@ -172,6 +192,8 @@ def render(data: dict[str, Any], title: str) -> str:
 
     reqs = "".join(f"<li>{e(r)}</li>" for r in data["requirements"])
     front = '<div id="front" class="plot"></div>' if data.get("front") else ""
+    if data.get("table"):
+        front += '<h2>the sweep</h2><div id="sweep-table"></div>'
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <title>{e(title)}</title>
@@ -188,7 +210,7 @@ moments in N*m, ripple in %.</p>
 <div class="grid">
 <div><div id="design"></div><h3>at this design</h3><div id="objectives"></div></div>
 <div><h3>what limits it (binding requirements and bounds)</h3><div id="limits"></div>
-<h3>what each limit costs (sensitivity of the optimum)</h3><div id="costs"></div>
+<h3>what each limit costs (sensitivity of the optimum)</h3><div id="costs"></div><div id="steps"></div>
 <h3>violated requirements</h3><div id="violated"></div><div id="reference"></div></div>
 <div id="sketch" class="plot"></div>
 <div id="curves" class="plot"></div>

@@ -98,6 +98,21 @@ def result_document(result: Result) -> dict[str, Any]:
         }
         for sen in result.sensitivities
     ]
+    if result.item_steps:
+        doc["item_steps"] = [
+            {
+                "variable": step.variable,
+                "item": {"value": step.item, "unit": step.unit},
+                "chosen": {"value": step.chosen, "unit": step.unit},
+                "status": step.status,
+                "objective": step.objective_name,
+                "value": None
+                if step.objective is None
+                else {"value": step.objective, "unit": step.objective_unit},
+                "change_percent": step.change_percent,
+            }
+            for step in result.item_steps
+        ]
     if result.bound is not None:
         doc["bound"] = objective_shown(problem, name, result.bound).to_json()
     if result.certificate is not None:

@@ -92,6 +92,9 @@ def result_summary(result: Result) -> str:
     if result.sensitivities:
         lines += ["", "what each limit costs (sensitivity of the optimum, most costly first):"]
         lines += [f"  {printable(s.text())}" for s in result.sensitivities[:30]]
+    if result.item_steps:
+        lines += ["", "the neighbouring catalogue items (other items kept, the rest re-solved):"]
+        lines += [f"  {printable(s.text())}" for s in result.item_steps]
     violated = limits_of(problem, result.violated) if problem is not None else []
     if violated:
         lines += ["", "violated requirements:"]

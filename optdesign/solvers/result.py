@@ -202,6 +202,43 @@ class Sensitivity:
         return f"{what} {limit}: d{self.objective}/d{what} = {self.d_objective_d_limit:+.3g} {per}"
 
 
+@dataclass
+class ItemStep:
+    """A catalogue optimum's neighbouring item: one catalogue variable moved one item up
+    or down, the other items kept and the continuous part re-solved warm.
+
+    Attributes
+    ----------
+    variable, item, chosen, unit
+        The catalogue variable, the neighbouring item and the chosen one (user's unit).
+    status
+        The re-solve's status (``"infeasible"``: no design with this item).
+    objective, objective_name, objective_unit, change_percent
+        The optimum with this item (None when infeasible) and its change from the
+        catalogue optimum in %.
+    """
+
+    variable: str
+    item: float
+    chosen: float
+    unit: str
+    status: str
+    objective_name: str
+    objective: float | None = None
+    objective_unit: str = ""
+    change_percent: float | None = None
+
+    def text(self) -> str:
+        """``"p 6 mm -> 8 mm: backlash 0.0351 deg (+3.2 %)"`` or ``"... : infeasible"``."""
+        unit = f" {self.unit}" if self.unit else ""
+        step = f"{self.variable} {self.chosen:g}{unit} -> {self.item:g}{unit}"
+        if self.objective is None:
+            return f"{step}: {self.status}"
+        value = f"{self.objective:.6g} {self.objective_unit}".rstrip()
+        change = "" if self.change_percent is None else f" ({self.change_percent:+.3g} %)"
+        return f"{step}: {self.objective_name} {value}{change}"
+
+
 #: The statuses of a solve that found a design meeting the requirements: the one success
 #: rule of a result, a front's record and a front's point (those two also drop a point
 #: the independent check refused, ``verified is False``).
@@ -251,6 +288,8 @@ class Result:
     sensitivities
         What each binding requirement and active bound costs (:class:`Sensitivity`),
         most costly first; empty when not computed.
+    item_steps
+        A catalogue optimum's neighbouring items (:class:`ItemStep`); empty otherwise.
     notes
         Plain-language remarks for the summary.
     details
@@ -282,6 +321,7 @@ class Result:
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
     diagnosis: Diagnosis | None = None
     sensitivities: list[Sensitivity] = field(default_factory=list)
+    item_steps: list[ItemStep] = field(default_factory=list)
     problem: str = ""
     mechanism: str = ""
     notes: list[str] = field(default_factory=list)

@@ -37,7 +37,7 @@ from optdesign.problem.design_problem import DesignProblem, relative_violation, 
 from optdesign.reports.tables import format_table
 from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
-from optdesign.solvers.registry import make_solver
+from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Result
 from optdesign.studies.nlp_solve import finish, solve_nlp, solver_options, start_points
 from optdesign.studies.runner import map_inherited
@@ -200,6 +200,7 @@ def solve_robust(
     solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     workers: int = 1,
+    sensitivities: bool = False,
 ) -> Result:
     """Robust optimum of ``problem`` (SAA of the ``[tolerances]``), multistart NLP.
 
@@ -213,6 +214,9 @@ def solve_robust(
         Fixed scatter samples (default: the file's ``tolerances.samples`` and ``seed``).
     solver, options
         Registered NLP back-end (None: the registry's default) and its options.
+    sensitivities
+        Also what each requirement costs at the optimum (``result.sensitivities``, from
+        the multipliers of the sample-average NLP: :mod:`optdesign.studies.robust_sensitivity`).
 
     Returns
     -------
@@ -229,9 +233,9 @@ def solve_robust(
     samples = samples if samples is not None else draw_samples(problem, tol.samples, tol.seed, tol)
     pts = start_points(problem, starts, seed, x0)
     t0 = time.perf_counter()
-    solve = make_robust_solve(
-        problem, objective, samples, solver, options, risk, alpha, k, constrain_samples
-    )
+    nlp = build_robust_nlp(problem, objective, samples, risk, alpha, k, constrain_samples)
+    merged = {**solver_options(problem, solver), **(options or {})}
+    solve = make_solver(nlp, solver, merged).solve
     build_s = time.perf_counter() - t0
     result = multistart(solve, pts, workers=workers, seed=seed, parallel_map=map_inherited)
     label = risk_label(risk, alpha, k, objective)
@@ -255,7 +259,28 @@ def solve_robust(
         free = {v.name: result.design[v.name] for v in problem.free}
         values, _ = sample_values(problem, free, samples, objective)
         details.saa_check = risk_value(values, risk, alpha, k)
+    if sensitivities and result.success and solver_hints(result.solver).multipliers:
+        _attach_sensitivities(problem, result, nlp, samples, objective)
     return result
+
+
+def _attach_sensitivities(
+    problem: DesignProblem, result: Result, nlp, samples: Samples, objective: str
+) -> None:
+    """What each requirement costs at the robust optimum (a report: never loses it)."""
+    from optdesign.studies.robust_sensitivity import robust_sensitivities
+
+    kind = sampled_objective(problem, problem.design_dict(problem.midpoint()), objective)
+    if kind[0].kind not in ("max", "spread"):
+        result.notes.append(
+            "sensitivities not computed: a one-value objective enters the risk measure "
+            "directly (only worst-case and spread objectives are covered)"
+        )
+        return
+    try:
+        result.sensitivities = robust_sensitivities(problem, result, nlp, samples, objective)
+    except Exception as exc:
+        result.notes.append(f"sensitivities not computed: {exc}")
 
 
 def solve_robust_formulation(problem: DesignProblem, **options: Any) -> Result:
@@ -274,7 +299,12 @@ def solve_robust_formulation(problem: DesignProblem, **options: Any) -> Result:
     )
     x0 = np.array([nominal.design[v.name] for v in problem.free]) if nominal.design else None
     result = solve_robust(
-        problem, x0=x0, objective=objective, solver=solver, options=options.get("options")
+        problem,
+        x0=x0,
+        objective=objective,
+        solver=solver,
+        options=options.get("options"),
+        sensitivities=True,
     )
     result.details.robust.nominal_optimum = NominalOptimum(
         nominal.status,

@@ -97,15 +97,35 @@ def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[
     objective = result.objective_name or problem.objective_names[0]
     if nlp is None:
         nlp = formulation_for(problem, _objective_set(problem, objective))
+    return from_multipliers(
+        problem, result, nlp, objective, objective, lambda mu: _RowModel(nlp, objective, mu)
+    )
+
+
+def from_multipliers(
+    problem: DesignProblem,
+    result: Result,
+    nlp: Any,
+    target: str,
+    objective: str,
+    row_model: Any,
+) -> list[Sensitivity]:
+    """The envelope theorem at an optimum of ``nlp`` (its multipliers in ``result.raw``):
+    d(optimum)/d(limit) = the multipliers times the rows' derivative in the limit at the
+    fixed optimum. ``target``: the NLP's objective target whose scale undoes Ipopt's
+    scaling; ``objective``: the name the records carry; ``row_model(mu)``: the rows'
+    value (``.value(problem, x)``) weighted by the unscaled multipliers ``mu``. Ranked by
+    the size of the log-sensitivity (what costs most first); empty without multipliers."""
+    raw = result.raw
     lam_g = np.asarray(raw["lam_g"], dtype=float)
     lam_x = np.asarray(raw["lam_x"], dtype=float)
     if len(lam_g) != len(nlp.g_names) or len(lam_x) != len(nlp.lbz):
         return []
-    T = nlp.target_scales[nlp.targets.index(objective)]
+    T = nlp.target_scales[nlp.targets.index(target)]
     mu = lam_g * T / nlp.g_scale
     x = np.array([result.design[v.name] for v in problem.free])
     v = float(result.objective)
-    rows = _RowModel(nlp, objective, mu)
+    rows = row_model(mu)
     base = rows.value(problem, x)
     out: list[tuple[Sensitivity, float]] = []  # with the effect of +1 % (or +1 unit at 0)
     for path, p in requirement_paths(problem):
@@ -120,7 +140,7 @@ def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[
         out.append(_record(problem, objective, f"requirements.{path}", p, (up - down) / (2 * h), v))
     for k, var in enumerate(problem.free):
         lam = float(lam_x[k])
-        if lam == 0.0:
+        if lam == 0.0 or var.discrete:  # a catalogue variable is held at its item, not a bound
             continue
         side = "upper" if lam > 0 else "lower"
         bound = var.upper if lam > 0 else var.lower
@@ -264,6 +284,15 @@ def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:
     return with_requirement(problem, rest, value)
 
 
+def limit_value(problem: DesignProblem, name: str) -> float:
+    """The internal value of the limit ``name`` of a :class:`Sensitivity`."""
+    head, _, rest = name.partition(".")
+    if head == "variables":
+        var, _, side = rest.partition(".")
+        return float(getattr(problem.by_name[var], side))
+    return dict(requirement_paths(problem))[rest]
+
+
 def finite_difference(
     problem: DesignProblem, result: Result, name: str, rel: float = 1e-3
 ) -> tuple[float, float]:
@@ -273,12 +302,7 @@ def finite_difference(
     value). The check of :func:`nlp_sensitivities` (tests, benchmarks)."""
     from optdesign.studies.nlp_solve import solve_nlp
 
-    head, _, rest = name.partition(".")
-    if head == "variables":
-        var, _, side = rest.partition(".")
-        p = float(getattr(problem.by_name[var], side))
-    else:
-        p = dict(requirement_paths(problem))[rest]
+    p = limit_value(problem, name)
     h = rel * max(abs(p), 1e-9)
     x0 = np.array([result.design[v.name] for v in problem.free])
     values = []

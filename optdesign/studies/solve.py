@@ -205,6 +205,7 @@ def solve(
     ranges: bool = True,
     diagnose: bool = True,
     time_limit: float | None = None,
+    sensitivities: bool = True,
     **extra: Any,
 ) -> Result:
     """The optimal design of ``problem`` with its evidence (see :func:`optdesign.solve`).
@@ -214,7 +215,9 @@ def solve(
     smallest relaxation of each conflicting requirement (:mod:`optdesign.studies.
     diagnosis`). ``time_limit``: wall-clock seconds for the NLP multistart (a note says
     when it stopped the solve); the diagnosis and the ranges, which come after, are
-    skipped with a note once it has passed."""
+    skipped with a note once it has passed. ``sensitivities``: what each requirement costs
+    at an NLP or catalogue optimum (and a catalogue optimum's neighbouring items; a sweep
+    asks for them only when its caller does)."""
     # Before any work and whatever the formulation: no option may read or write a file.
     refuse_file_options(options, "options")
     name = plan_solve(problem, formulation, objective)
@@ -227,7 +230,7 @@ def solve(
         what = "the diagnosis" if not result.success else "the ranges of the optimal set"
         result.notes.append(f"{what} not computed: the time limit of {time_limit:g} s was reached")
         return result
-    return _evidence(problem, result, solver, options, ranges, diagnose)
+    return _evidence(problem, result, solver, options, ranges, diagnose, sensitivities)
 
 
 def _solve_within(
@@ -265,7 +268,9 @@ def _solve_within(
     return result
 
 
-def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: bool) -> Result:
+def _evidence(
+    problem, result: Result, solver, options, ranges: bool, diagnose: bool, sensitivities: bool
+) -> Result:
     """The diagnosis of a result with no feasible design, the ranges of an optimum."""
     if diagnose and not result.success:
         try:
@@ -275,7 +280,8 @@ def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: 
             result.diagnosis = Diagnosis(note=f"not computed: {type(exc).__name__}: {text}")
     continuous = result.formulation.startswith("nlp") and not any(v.discrete for v in problem.free)
     if (
-        result.success
+        sensitivities
+        and result.success
         and continuous
         and solver_hints(result.solver).multipliers
         and "lam_g" in result.raw
@@ -284,6 +290,24 @@ def _evidence(problem, result: Result, solver, options, ranges: bool, diagnose: 
             from optdesign.studies.sensitivity import nlp_sensitivities
 
             result.sensitivities = nlp_sensitivities(problem, result)
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.notes.append(f"sensitivities not computed: {exc}")
+    if (
+        sensitivities
+        and result.success
+        and result.formulation.startswith("catalogue")
+        and solver_hints(result.solver).multipliers
+        and "lam_g" in result.raw
+    ):
+        try:  # the continuous part at the chosen items, and the neighbouring items
+            from optdesign.studies.catalogue_sensitivity import catalogue_sensitivities
+
+            # a MINLP back-end only picked the items: the default NLP back-end solved
+            # them (optdesign.studies.catalogue_minlp), and re-solves their neighbours
+            minlp = solver_hints(solver).minlp is not None
+            result.sensitivities, result.item_steps = catalogue_sensitivities(
+                problem, result, None if minlp else solver, None if minlp else options
+            )
         except Exception as exc:  # a report, not the result: never lose the optimum
             result.notes.append(f"sensitivities not computed: {exc}")
     if ranges and result.success and continuous and result.design and "z" in result.raw:

@@ -315,6 +315,7 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
             seed=task["seed"],
             ranges=False,
             diagnose=True,  # an infeasible point: what to relax (no design to show)
+            sensitivities=task["sensitivities"],  # a catalogue's: with its neighbouring items
         )
         solves, checked = 1, True
     else:
@@ -372,10 +373,11 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         from optdesign.studies.sensitivity import nlp_sensitivities
 
         nlp = shared.nlp if task["continuation"] and shared is not None else None
-        try:
-            sens = nlp_sensitivities(problem, best, nlp=nlp)
+        try:  # a point solved by its formulation has its own (a catalogue's, a robust one's)
+            sens = nlp_sensitivities(problem, best, nlp=nlp) if task["continuation"] else []
         except Exception:  # a report: never lose the point
             sens = []
+        sens = sens or best.sensitivities
         record["sensitivities"] = {
             s.name: s.log_sensitivity for s in sens if s.log_sensitivity is not None
         }

@@ -1,0 +1,105 @@
+"""``sweep.html``: the design chart of a sweep in the interactive page of ``report.html``.
+
+The chart is the objective against the (first) parameter, one trace per value of a
+second one, the points where the binding set or a catalogue item changes marked; the
+table below it is the sweep's (:func:`~optdesign.reports.sweep.sweep_rows`, in the
+summary's units). Hovering or clicking a point of the chart, or a row of the table,
+shows that point's design as ``report.html`` shows a front's: its values, sketch, curves
+and what binds, evaluated on the point's own problem (the swept requirement at the
+point's value). The page is :mod:`optdesign.reports.html_page`'s: every string of the
+data (a problem's or a variable's name, a binding row's label) is embedded by
+:func:`~optdesign.reports.html_page.to_json` and inserted as text.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from optdesign.reports.display_units import objective_shown
+from optdesign.reports.html import _header, design_view
+from optdesign.reports.html_page import render
+from optdesign.reports.sweep import _cell, sweep_rows
+
+#: What the page says of a point's sensitivities when the sweep did not compute them
+#: (an empty list would read "none": nothing binds).
+NOT_COMPUTED = "not computed (od.sweep(..., sensitivities=True), optdesign sweep --sensitivities)"
+
+
+def _shown_value(axis: Any, value: float) -> float:
+    table = dict(zip(axis.values, axis.shown, strict=True))
+    return float(table.get(value, value))
+
+
+def sweep_report(sweep: Any) -> str:
+    """The page of ``sweep``: the design chart, the table, the design of each point."""
+    from optdesign.studies.sensitivity import at_values
+
+    problem = sweep.problem
+    paths = [a.path for a in sweep.axes]
+    first = sweep.axes[0]
+    designs: list[dict[str, Any]] = []
+    of_point: dict[int, int] = {}
+    for p in sweep.points:
+        if not p.design:
+            continue
+        at = at_values(problem, dict(zip(paths, p.values, strict=True)))
+        where = ", ".join(
+            f"{a.label} = {_shown_value(a, v):.6g}"
+            for a, v in zip(sweep.axes, p.values, strict=True)
+        )
+        label = f"point {p.index}: {where}" + ("" if p.success else f" ({p.status}, best found)")
+        view = design_view(at, {**p.design, **at.fixed_values}, label)
+        view["sensitivities"] = [
+            f"{name}: +1 % -> {sweep.objective} {value:+.3g} %"
+            for name, value in sorted(p.sensitivities.items(), key=lambda kv: -abs(kv[1]))
+        ] or [NOT_COMPUTED]
+        of_point[p.index] = len(designs)
+        designs.append(view)
+    groups: dict[tuple[float, ...], list[Any]] = {}
+    for p in sweep.points:
+        groups.setdefault(tuple(p.values[1:]), []).append(p)
+
+    def trace(name: str, points: list[Any], mode: str | None = None) -> dict[str, Any]:
+        shown = [p for p in points if p.success and p.index in of_point]
+        coords = [
+            [_shown_value(first, p.values[0]) for p in shown],
+            [objective_shown(problem, sweep.objective, p.objective).value for p in shown],
+        ]
+        out = {"method": name, "coords": coords, "index": [of_point[p.index] for p in shown]}
+        if mode:
+            out["mode"] = mode
+        return out
+
+    traces = []
+    for key, points in groups.items():
+        if len(sweep.axes) > 1:
+            name = f"{sweep.axes[1].label} = {_shown_value(sweep.axes[1], key[0]):.6g}"
+        else:
+            name = "optimum"
+        traces.append(trace(name, points))
+    changes = [p for p in sweep.points if p.active_change]
+    if changes:
+        traces.append(trace("binding set or item changes", changes, "markers"))
+    unit = objective_shown(problem, sweep.objective, 1.0).unit
+    headers, rows = sweep_rows(sweep)
+    solved = sum(p.success for p in sweep.points)
+    data = {
+        **_header(problem),
+        "kind": "sweep",
+        "status": f"{solved} of {len(sweep.points)} points solved",
+        "objective": sweep.objective,
+        "designs": designs,
+        "reference": None,
+        "selected": next(iter(of_point.values()), None),
+        "front": {
+            "axes": [first.label, f"{sweep.objective} ({unit})" if unit else sweep.objective],
+            "traces": traces,
+            "title": "design chart: hover or click a point (or a row of the table)",
+        },
+        "table": {
+            "headers": headers,
+            "rows": [[_cell(v) for v in row] for row in rows],
+            "design": [of_point.get(p.index) for p in sweep.points],
+        },
+    }
+    return render(data, f"optdesign sweep: {problem.name}")
