@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 BACKLASH = str(ROOT / "problems" / "cs_min_backlash.toml")
 RIPPLE = str(ROOT / "problems" / "cs_min_ripple.toml")
 CATALOGUE = str(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
-SOLVERS = "ipopt, sqpmethod, slsqp, trust-constr, clarabel, scs"
+SOLVERS = "ipopt, sqpmethod, slsqp, trust-constr, bonmin, clarabel, scs"
 
 
 @dataclass

@@ -250,8 +250,10 @@ def test_a_catalogue_problem_is_swept_point_by_point_and_item_changes_marked(tmp
     sweep = od.sweep(problem, {HINGE: ("400 N*m", "600 N*m", 2)}, starts=1, out=tmp_path)
     assert not sweep.continuation and "no continuation" in sweep.notes[0]
     first, second = sweep.points
-    # the pin steps up one catalogue size (ISO 2338: 6 -> 8 mm); the binding set is the same
-    assert (first.design["d"], second.design["d"]) == (6.0, 8.0)
+    # the pin steps up two catalogue sizes (ISO 2338: 6 -> 10 mm, as enumeration finds:
+    # d = 8 mm gives 0.0390417 deg at 600 N*m); the binding set is the same
+    assert (first.design["d"], second.design["d"]) == (6.0, 10.0)
+    assert second.objective == pytest.approx(0.0378044, rel=1e-5)
     assert first.active == second.active == ["nut_travel"]
     assert (first.active_change, second.active_change) == (False, True)
     at_600 = od.solve(at_values(problem, {HINGE: 600e3}), starts=1, ranges=False)

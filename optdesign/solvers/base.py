@@ -11,6 +11,7 @@ the final point and multipliers.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -24,6 +25,20 @@ from optdesign.solvers.result import (
     TerminationCondition,
 )
 from optdesign.tolerances import FEASIBILITY_TOL
+
+
+@dataclass
+class MINLPSolution:
+    """What a MINLP back-end returns (:attr:`~optdesign.solvers.registry.SolverHints.
+    minlp`): its return status, whether it found an integer-feasible point, the point
+    (None when not) and its objective (in the formulation's scaling), the algorithm it ran.
+    """
+
+    status: str
+    found: bool
+    x: np.ndarray | None
+    objective: float | None
+    algorithm: str
 
 
 @runtime_checkable

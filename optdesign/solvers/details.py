@@ -36,6 +36,36 @@ class CatalogueCombination:
 
 
 @dataclass
+class MINLPDetails:
+    """What a MINLP back-end did with a catalogue problem (method ``"minlp"``).
+
+    Attributes
+    ----------
+    solver, algorithm, status
+        The back-end (``"bonmin"``), its algorithm and its return status.
+    binaries, groups
+        One-hot binaries of the encoding, and the catalogue variables of each group.
+    seconds
+        Time of the encoding and the MINLP solve.
+    items, objective_scaled
+        The items it chose and its objective (the NLP's scaled one); None when it found
+        no integer-feasible point.
+    """
+
+    solver: str
+    algorithm: str
+    status: str
+    binaries: int
+    groups: list[list[str]]
+    seconds: float
+    items: dict[str, float] | None = None
+    objective_scaled: float | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return _fields_json(self, ("items", "objective_scaled"))
+
+
+@dataclass
 class CatalogueDetails:
     """How the exact catalogue optimum was found (:func:`optdesign.studies.catalogue.
     solve_catalogue`).
@@ -43,7 +73,7 @@ class CatalogueDetails:
     Attributes
     ----------
     method
-        ``"enumerate"`` or ``"bnb"``.
+        ``"enumerate"``, ``"bnb"`` or ``"minlp"`` (a MINLP back-end picked the items).
     combinations
         Number of item combinations.
     variables
@@ -57,6 +87,15 @@ class CatalogueDetails:
         Every combination and its solve (enumeration only).
     nodes, pruned, infeasible, leaves
         Branch-and-bound counts (branch and bound only).
+    seeded
+        Nodes solved for the first incumbents (a front's neighbouring optima).
+    warm_fallbacks
+        Warm nodes that fell back to the full multistart.
+    implied_infeasible
+        Boxes proved infeasible with no NLP (:class:`~optdesign.studies.catalogue_bnb.
+        InfeasibleBoxes`).
+    minlp
+        What the MINLP back-end did (method ``"minlp"`` only).
     nlp_solves
         NLP solves spent.
     items
@@ -77,6 +116,10 @@ class CatalogueDetails:
     pruned: int | None = None
     infeasible: int | None = None
     leaves: int | None = None
+    seeded: int | None = None
+    warm_fallbacks: int | None = None
+    implied_infeasible: int | None = None
+    minlp: MINLPDetails | None = None
     nlp_solves: int = 0
     items: dict[str, float] | None = None
     gap_to_relaxation_rel: float | None = None
@@ -90,12 +133,18 @@ class CatalogueDetails:
                 "pruned",
                 "infeasible",
                 "leaves",
+                "seeded",
+                "warm_fallbacks",
+                "implied_infeasible",
+                "minlp",
                 "items",
                 "gap_to_relaxation_rel",
             ),
         )
         if self.enumerated is not None:
             out["enumerated"] = [asdict(row) for row in self.enumerated]
+        if self.minlp is not None:
+            out["minlp"] = self.minlp.to_json()
         return out
 
 

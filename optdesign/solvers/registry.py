@@ -60,6 +60,12 @@ class SolverHints:
     #: (``raw["lam_g"]``, ``raw["lam_x"]``, in the formulation's scaling), which the
     #: sensitivities of :mod:`optdesign.studies.sensitivity` read
     multipliers: bool = False
+    #: "module:function" solving a catalogue problem as one mixed-integer NLP
+    #: (``solve(minlp, x0, options) ->`` :class:`~optdesign.solvers.base.MINLPSolution`;
+    #: ``minlp``: a :class:`~optdesign.formulations.catalogue_minlp.CatalogueMINLP`); a
+    #: catalogue search given this back-end hands it the whole problem (method
+    #: ``"minlp"``) instead of solving its nodes with it. None: an NLP back-end only.
+    minlp: str | None = None
 
     def time_limit(self, seconds: float) -> dict[str, float]:
         """The back-end's own options for a wall-time limit of ``seconds``."""
@@ -245,6 +251,14 @@ def _sqpmethod(nlp, options):
     return CasadiNLPSolver(nlp, "sqpmethod", merged)
 
 
+def _bonmin(nlp, options):
+    # a continuous NLP: Bonmin with no integer variable (its Ipopt); catalogue problems
+    # reach Bonmin through the catalogue search (optdesign.studies.catalogue_minlp)
+    from optdesign.solvers.bonmin import bonmin_nlp_solver
+
+    return bonmin_nlp_solver(nlp, options)
+
+
 def _scipy(method: str):
     def make(nlp, options):
         from optdesign.solvers.scipy_nlp import ScipyNLPSolver
@@ -300,6 +314,17 @@ def _builtins() -> None:
             "nlp",
             "SciPy trust-constr",
             SolverHints(time_limit_options=("time_limit",), preload=scipy),
+        ),
+        (
+            "bonmin",
+            _bonmin,
+            "nlp",
+            "Bonmin (CasADi): MINLP on catalogue items, else an NLP",
+            SolverHints(
+                time_limit_options=("time_limit",),
+                options_check="optdesign.solvers.bonmin:check_bonmin_options",
+                minlp="optdesign.solvers.bonmin:solve_minlp",
+            ),
         ),
         (
             "clarabel",

@@ -10,16 +10,17 @@ What "exact" rests on: the node NLPs are non-convex and solved locally (multista
 the bound of a node is the best local optimum found, not a proven global one. A node
 whose relaxation is under-estimated (missed global optimum) can be pruned wrongly;
 enumeration has the same dependence on each fixed-item solve. The test compares the two
-on the shipped catalogue problem.
+on the shipped catalogue problem. The branch and bound itself (warm nodes, first
+incumbents, implied infeasible boxes) is :mod:`optdesign.studies.catalogue_bnb`; Bonmin
+as the other search, :mod:`optdesign.studies.catalogue_minlp`.
 """
 
 from __future__ import annotations
 
-import heapq
 import itertools
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 from typing import Any
 
@@ -44,22 +45,19 @@ from optdesign.solvers.multistart import (
     sobol_starts,
     start_outcome,
 )
-from optdesign.solvers.registry import default_solver, solver_hints
+from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
+from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
+from optdesign.studies.catalogue_bnb import fixed_box as _fixed
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
-#: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
-PRUNE_TOL = OBJECTIVE_TIE_TOL
-
-
-def cannot_improve(bound: float, incumbent: float) -> bool:
-    """Whether a node whose relaxation gives ``bound`` can be pruned: it cannot beat the
-    incumbent's objective by more than ``PRUNE_TOL`` (relative)."""
-    return bound >= incumbent - PRUNE_TOL * abs(incumbent)
 
 
 #: Sobol starts a node tries before it is called infeasible, when its own starts fail.
@@ -108,10 +106,33 @@ class NodeSolver:
         self.seed = seed
         self.names = [v.name for v in problem.free]
         self.n_solves = 0
+        #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
+        self.n_cold = 0
+        self.n_implied = 0
+        #: boxes proved infeasible (shared by the searches of one front); None: no memo
+        self.memo = None
 
-    def solve(self, bounds: Mapping[str, tuple[float, float]], x_hint=None) -> Result:
+    def solve(
+        self,
+        bounds: Mapping[str, tuple[float, float]],
+        x_hint=None,
+        warm: bool = False,
+        prunes: Callable[[float], bool] | None = None,
+        fallback: bool = True,
+    ) -> Result:
         """Best of the multistart on the box where ``bounds`` replace the catalogue
-        variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start."""
+        variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
+
+        ``warm``: the hint alone decides when its solve succeeds with a value that
+        ``prunes`` (the search's pruning test) would not prune; a failed hint, or a value
+        that would prune the node, runs the rest of the multistart (and its retries) as
+        a cold node does, so infeasibility and pruning rest on the same starts as before.
+        ``fallback=False``: the warm start's result whatever it is (a first incumbent's
+        value, which only needs to be feasible).
+        """
+        if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
+            self.n_implied += 1
+            return _no_item(self.backend.name, "infeasible: a wider box was at looser limits")
         lo, hi = self.problem.lower().copy(), self.problem.upper().copy()
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
@@ -121,15 +142,7 @@ class NodeSolver:
         }
         if not box_has_item(self.problem, node):
             # e.g. a (d0, p) box that holds no screw of the catalogue: nothing to solve
-            return Result(
-                "infeasible",
-                float("nan"),
-                {},
-                self.backend.name,
-                "catalogue",
-                0.0,
-                message="no catalogue item in this box",
-            )
+            return _no_item(self.backend.name, "no catalogue item in this box")
         params = self.problem.parameter_values(node)
         box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
         if self.free_rows.size:
@@ -143,10 +156,23 @@ class NodeSolver:
         if self.starts > 1:
             pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
         start = partial(self.nlp.start, parameters=box.parameters)
-        results = [self.backend.solve(start(x0=p), self.target, box) for p in pts]
+        results = []
+        if warm and x_hint is not None:
+            results.append(self.backend.solve(start(x0=pts.pop(0)), self.target, box))
+            first_ok = results[0]
+            if first_ok.success and (prunes is None or not prunes(first_ok.objective)):
+                pts = []  # the warm start decides this node
+            elif not fallback:
+                self.n_solves += 1
+                return first_ok
+            else:
+                self.n_cold += 1
+        results += [self.backend.solve(start(x0=p), self.target, box) for p in pts]
         if not any(r.success for r in results):
             retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
             results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
+            if self.memo is not None and not any(r.success for r in results):
+                self.memo.add_infeasible(bounds, self.eps)
         self.n_solves += len(results)
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
@@ -168,8 +194,8 @@ class NodeSolver:
         return np.array([result.design[n] for n in self.names])
 
 
-def _fixed(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
-    return {k: (v, v) for k, v in values.items()}
+def _no_item(solver: str, message: str) -> Result:
+    return Result("infeasible", float("nan"), {}, solver, "catalogue", 0.0, message=message)
 
 
 def enumerate_catalogue(
@@ -188,64 +214,19 @@ def enumerate_catalogue(
     return best, table
 
 
-def branch_and_bound(ns: NodeSolver, root: Result) -> tuple[Result | None, dict[str, int]]:
-    """Best-first branch and bound from the relaxation ``root``; the best leaf and the
-    node counts (nodes, pruned, infeasible, leaves)."""
-    dvars = discrete_variables(ns.problem)
-    full = {v.name: (v.lower, v.upper) for v in dvars}
-    counter = itertools.count()
-    heap: list = []
-    stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0}
-    if root.success:
-        heapq.heappush(heap, (root.objective, next(counter), full, root))
-    incumbent: Result | None = None
-    while heap:
-        bound, _, box, res = heapq.heappop(heap)
-        if incumbent is not None and cannot_improve(bound, incumbent.objective):
-            stats["pruned"] += 1
-            continue
-        x = ns.x_of(res)
-        # the catalogue variable farthest (relatively) from an item in its range
-        worst, worst_d = None, ON_ITEM_TOL
-        for v in dvars:
-            allowed = items_within(v.values, *box[v.name])
-            _item, dist = nearest_item(res.design[v.name], tuple(allowed))
-            if dist > worst_d:
-                worst, worst_d = v, dist
-        if worst is None:  # every catalogue variable sits on an item: a leaf
-            items = {
-                v.name: nearest_item(
-                    res.design[v.name], tuple(items_within(v.values, *box[v.name]))
-                )[0]
-                for v in dvars
-            }
-            if all(box[v.name][0] == box[v.name][1] for v in dvars):
-                leaf = res  # already solved with every catalogue variable fixed
-            else:
-                leaf = ns.solve(_fixed(items), x)
-                stats["nodes"] += 1
-            stats["leaves"] += 1
-            if leaf.success and (
-                incumbent is None or improves(leaf.objective, incumbent.objective, PRUNE_TOL)
-            ):
-                incumbent = leaf  # a tie keeps the incumbent found first
-            continue
-        allowed = items_within(worst.values, *box[worst.name])
-        for side in branch(res.design[worst.name], allowed):
-            if not side:
-                continue
-            child = dict(box)
-            child[worst.name] = (side[0], side[-1])
-            r = ns.solve(child, x)
-            stats["nodes"] += 1
-            if not r.success:
-                stats["infeasible"] += 1
-                continue
-            if incumbent is not None and cannot_improve(r.objective, incumbent.objective):
-                stats["pruned"] += 1
-                continue
-            heapq.heappush(heap, (r.objective, next(counter), child, r))
-    return incumbent, stats
+def minlp_back_end(solver: str | None) -> str:
+    """The MINLP back-end of method ``"minlp"``: ``solver`` when it declares a MINLP
+    solve (:attr:`~optdesign.solvers.registry.SolverHints.minlp`), the first registered
+    one when ``solver`` is None; ProblemError naming them otherwise."""
+    known = [n for n in solver_names("nlp") if solver_hints(n).minlp]
+    if solver is None and known:
+        return known[0]
+    if solver in known:
+        return solver
+    raise ProblemError(
+        f"catalogue method minlp: back-end {solver!r} solves no MINLP "
+        f"(those that do: {', '.join(known) or 'none registered'})"
+    )
 
 
 def solve_catalogue(
@@ -257,20 +238,34 @@ def solve_catalogue(
     solver: str | None = None,
     options: Mapping[str, Any] | None = None,
     eps: Mapping[str, float] | None = None,
+    incumbents: Sequence[Mapping[str, float]] = (),
+    memo: InfeasibleBoxes | None = None,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
     Parameters
     ----------
     method
-        ``"enumerate"``, ``"bnb"`` or ``"auto"`` (enumerate up to
-        :data:`ENUMERATE_MAX` combinations, branch and bound above).
+        ``"enumerate"``, ``"bnb"``, ``"minlp"`` or ``"auto"`` (enumerate up to
+        :data:`ENUMERATE_MAX` combinations, branch and bound above; ``"minlp"`` when
+        ``solver`` is a MINLP back-end). ``"minlp"``: the MINLP back-end (``solver``, or
+        the first registered one) picks the items, with ``options`` its own
+        (:mod:`optdesign.studies.catalogue_minlp`); the default NLP back-end solves the
+        relaxation and the items' node NLP.
+    solver, options
+        The NLP back-end of every node and its options (default: the registry's).
     starts, seed
         Multistart of each node NLP (default: the problem file's ``solver``; ``starts``
         at most 4 per node, the first start being the parent's optimum).
     eps
         Upper limits on other objectives (name -> limit): a point of an
         epsilon-constraint front over catalogue designs.
+    incumbents
+        Designs (name -> value) whose catalogue items are tried first, the best feasible
+        one being the search's first incumbent (e.g. a front's neighbouring optima).
+    memo
+        Boxes proved infeasible by earlier searches of the same problem and node
+        settings (shared by a front's points; see :mod:`optdesign.studies.catalogue_bnb`).
 
     Returns
     -------
@@ -283,13 +278,20 @@ def solve_catalogue(
     if not dvars:
         raise ProblemError("--formulation catalogue: no variable takes catalogue values")
     n_comb = n_combinations(problem)
-    if method == "auto":
+    minlp_solver, minlp_options = None, None
+    if method == "minlp" or (method == "auto" and solver_hints(solver).minlp):
+        # A MINLP back-end picks the items (its options: its own); the default NLP
+        # back-end solves the relaxation bound and the chosen items' node NLP.
+        minlp_solver, minlp_options = minlp_back_end(solver), options
+        method, solver, options = "minlp", None, None
+    elif method == "auto":
         method = "enumerate" if n_comb <= ENUMERATE_MAX else "bnb"
-    if method not in ("enumerate", "bnb"):
-        raise ProblemError(f"catalogue method {method!r}: use auto, enumerate or bnb")
+    if method not in ("enumerate", "bnb", "minlp"):
+        raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or minlp")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
     ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
+    ns.memo = memo
     root = ns.solve({})
     info = CatalogueDetails(
         method=method,
@@ -302,10 +304,16 @@ def solve_catalogue(
     )
     if method == "enumerate":
         best, info.enumerated = enumerate_catalogue(ns, ns.x_of(root))
+    elif method == "minlp":
+        from optdesign.studies.catalogue_minlp import solve_minlp
+
+        best, info.minlp = solve_minlp(ns, minlp_solver, minlp_options)
     else:
-        best, stats = branch_and_bound(ns, root)
+        best, stats = branch_and_bound(ns, root, incumbents)
         info.nodes, info.pruned = stats["nodes"], stats["pruned"]
         info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
+        info.seeded = stats["seeded"]
+        info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
     info.nlp_solves = ns.n_solves
     wall = time.perf_counter() - t0
     if best is None:
@@ -345,8 +353,9 @@ def solve_catalogue(
         if root.success
         else f"continuous relaxation: {root.status}"
     )
+    how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
     best.notes.append(
-        f"catalogue items chosen: {items}; {bound}; {method}, {info.nlp_solves} NLP solves"
+        f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
     )
     return finish(problem, best, objective)
 

@@ -302,8 +302,11 @@ def _evidence(
         try:  # the continuous part at the chosen items, and the neighbouring items
             from optdesign.studies.catalogue_sensitivity import catalogue_sensitivities
 
+            # a MINLP back-end only picked the items: the default NLP back-end solved
+            # them (optdesign.studies.catalogue_minlp), and re-solves their neighbours
+            minlp = solver_hints(solver).minlp is not None
             result.sensitivities, result.item_steps = catalogue_sensitivities(
-                problem, result, solver, options
+                problem, result, None if minlp else solver, None if minlp else options
             )
         except Exception as exc:  # a report, not the result: never lose the optimum
             result.notes.append(f"sensitivities not computed: {exc}")

@@ -21,8 +21,10 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.bonmin import BONMIN_ALGORITHMS
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Result
+from optdesign.studies.bench.catalogue_configs import register_catalogue_configs
 
 
 class NotApplicable(Exception):
@@ -340,6 +342,22 @@ def _register_defaults() -> None:
             preload=PYMOO_MODULES,
         )
     )
+    # the catalogue searches (issue 25): optdesign's own, and Bonmin's algorithms
+    catalogue: list[tuple[str, str, str | None, dict[str, Any] | None, str]] = [
+        ("catalogue-bnb", "bnb", None, None, "optdesign catalogue branch and bound (warm nodes)"),
+        ("catalogue-enumerate", "enumerate", None, None, "every catalogue combination's NLP"),
+    ]
+    for alg in BONMIN_ALGORITHMS:
+        catalogue.append(
+            (
+                f"bonmin-{alg.lower()}",
+                "minlp",
+                "bonmin",
+                {"algorithm": alg},
+                f"Bonmin {alg} (CasADi), one-hot catalogue items",
+            )
+        )
+    register_catalogue_configs(register_config, Config, catalogue)
 
 
 def default_configs(include_hidden: bool = False) -> list[str]:

@@ -20,6 +20,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.diagnosis import diagnose
+from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
 from optdesign.studies.pareto.records import PointRecord, record_from_result
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 from optdesign.studies.pareto.template import FrontMethod, FrontRun, Traced, has_catalogue
@@ -53,7 +54,12 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         hi = max(hi_rec.objectives[a], lo)
         eps = {a: float(lo + task["eps_frac"] * (hi - lo))}
     result = solve_catalogue(
-        problem, starts=task["starts"], seed=task["seed"], objective=task["target"], eps=eps
+        problem,
+        starts=task["starts"],
+        seed=task["seed"],
+        objective=task["target"],
+        eps=eps,
+        **front_knowledge(task, deps),
     )
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
         # An anchor with no catalogue design: its best point, for the error to name the
@@ -138,6 +144,7 @@ class CatalogueEpsilon(FrontMethod):
                     "after": [f"anchor-{a}", f"anchor-{b}"],
                 }
             )
+        chain_points(tasks, points, sequential=ctx.run.workers == 1 and not ctx.run.scheduler)
         done = ctx.tasks(
             tasks + points,
             catalogue_task,

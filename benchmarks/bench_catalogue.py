@@ -1,0 +1,157 @@
+"""Catalogue searches of fin_actuator: the single solve and the 6-point front, in one run.
+
+- (a) the shipped ``problems/fin_actuator.toml`` solved as users solve it
+  (``od.solve(problem)``: the catalogue branch and bound with its relaxation bound),
+  ``--repeats`` times: the first from an empty solver cache (formulation and Ipopt
+  builds included), the others with the built solver;
+- (b) the catalogue front backlash vs motor torque of docs/drive.md
+  (``optdesign pareto problems/fin_actuator.toml --objectives backlash,motor_torque
+  --points 6 --workers 1``), in-process with 1 worker from an empty solver cache: its
+  wall time, the NLP solves of every anchor and point, and the points themselves.
+
+Every figure is written as one JSON line to ``--out`` as soon as it is measured, so a
+killed run keeps what it measured. Seconds are wall-clock on a shared machine: read them
+beside the NLP solve counts, which do not depend on the load.
+
+    .venv/bin/python benchmarks/bench_catalogue.py [--repeats 2] [--points 6]
+        [--out benchmarks/results/bench_catalogue.jsonl] [--tag before]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import optdesign as od
+from optdesign.studies import nlp_solve as solve_study
+
+ROOT = Path(__file__).resolve().parents[1]
+FIN = ROOT / "problems" / "fin_actuator.toml"
+
+
+def _clear_caches() -> None:
+    solve_study._NLPS.clear()
+    solve_study._SOLVERS.clear()
+
+
+def _write(path: Path, row: dict) -> None:
+    with path.open("a") as fh:
+        fh.write(json.dumps(row) + "\n")
+    print(json.dumps(row), flush=True)
+
+
+def _catalogue_info(result) -> dict:
+    """The catalogue search's counts of ``result`` (its typed ``details.catalogue``)."""
+    info = result.details.catalogue
+    if info is None:
+        return {}
+    return {
+        "method": info.method,
+        "nlp_solves": info.nlp_solves,
+        "nodes": info.nodes,
+        "pruned": info.pruned,
+        "infeasible": info.infeasible,
+        "leaves": info.leaves,
+        "items": info.items,
+    }
+
+
+def single(path: Path, tag: str, repeats: int) -> None:
+    problem = od.load(FIN)
+    _clear_caches()
+    for i in range(repeats):
+        t0 = time.perf_counter()
+        res = od.solve(problem)
+        wall = time.perf_counter() - t0
+        _write(
+            path,
+            {
+                "tag": tag,
+                "case": "single",
+                "repeat": i,
+                "cold": i == 0,
+                "wall_s": round(wall, 3),
+                "status": res.status,
+                "objective": res.objective,
+                "bound": res.bound,
+                **_catalogue_info(res),
+            },
+        )
+
+
+def front(path: Path, tag: str, points: int) -> None:
+    problem = od.load(FIN)
+    _clear_caches()
+    t0 = time.perf_counter()
+
+    def on_record(rec) -> None:
+        rec = rec if isinstance(rec, dict) else rec.to_dict()
+        _write(
+            path,
+            {
+                "tag": tag,
+                "case": "front-record",
+                "id": rec.get("id"),
+                "kind": rec.get("kind"),
+                "status": rec.get("status"),
+                "objectives": rec.get("objectives"),
+                "n_solves": rec.get("n_solves"),
+                "wall_s": rec.get("wall_time_s"),
+                "elapsed_s": round(time.perf_counter() - t0, 3),
+            },
+        )
+
+    out = Path(tempfile.mkdtemp(prefix="bench-catalogue-"))
+    fr = od.pareto(
+        problem,
+        ["backlash", "motor_torque"],
+        points=points,
+        workers=1,
+        out=out,
+        on_record=on_record,
+    )
+    wall = time.perf_counter() - t0
+    frame = fr.to_frame()
+    cols = [
+        c for c in frame.columns if c.split(" ")[0] in ("backlash", "motor_torque", "d0", "p", "d")
+    ]
+    _write(
+        path,
+        {
+            "tag": tag,
+            "case": "front",
+            "points": points,
+            "wall_s": round(wall, 3),
+            "nlp_solves": fr.n_solves,
+            "front": frame[cols].to_dict(orient="records"),
+        },
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=2, help="single solves (first one cold)")
+    ap.add_argument("--points", type=int, default=6)
+    ap.add_argument("--tag", default="run", help="label written on every line")
+    ap.add_argument(
+        "--out", type=Path, default=ROOT / "benchmarks" / "results" / "bench_catalogue.jsonl"
+    )
+    ap.add_argument("--only", choices=("single", "front"), default=None)
+    args = ap.parse_args()
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    _write(args.out, {"tag": args.tag, "case": "start", "load": os.getloadavg()})
+    if args.only in (None, "single"):
+        single(args.out, args.tag, args.repeats)
+    if args.only in (None, "front"):
+        front(args.out, args.tag, args.points)
+
+
+if __name__ == "__main__":
+    main()

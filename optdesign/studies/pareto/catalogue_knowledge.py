@@ -1,0 +1,70 @@
+"""What one point of a catalogue front passes to the next (see
+:mod:`optdesign.studies.catalogue_bnb`).
+
+- First incumbents: a point's search starts from the best feasible of its neighbours'
+  discrete optima - the previous point (when the points run one after another), then the
+  nearer anchor, then the other; the anchor's tie-break starts from the anchor's items.
+  The candidates come from the task's declared dependencies only, so a point computes
+  the same with any number of workers except where two combinations tie within the
+  pruning tolerance (then the candidate tried first is kept).
+- Infeasible boxes: with one local worker the tasks run in order in one process - the
+  anchors, then the points from the loosest epsilon limit to the tightest - and they
+  share one :class:`~optdesign.studies.catalogue_bnb.InfeasibleBoxes` memo (a box proved
+  infeasible under looser limits is not solved again).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Mapping
+from typing import Any
+
+from optdesign.formulations.discrete import discrete_variables
+from optdesign.studies.catalogue_bnb import shared_memo
+from optdesign.studies.identity import problem_digest
+from optdesign.studies.pareto.records import PointRecord
+
+
+def chain_points(tasks: list[dict], points: list[dict], sequential: bool) -> None:
+    """Mark the tasks of a front that share a memo, and chain the points (each after the
+    previous one) when they run one after another anyway."""
+    if not sequential:
+        return
+    for t in tasks:
+        t["memo"] = True
+    # from the loosest limit to the tightest: a box proved infeasible at one point is
+    # then implied infeasible at every later one (InfeasibleBoxes)
+    loose_first = sorted(points, key=lambda t: -t["eps_frac"])
+    for prev, pt in itertools.pairwise(loose_first):
+        pt["previous"] = prev["id"]
+        pt["after"] = [*pt["after"], prev["id"]]
+    for pt in points:
+        pt["memo"] = True
+
+
+def _design(deps: Mapping[str, Any], key: str | None) -> dict[str, float] | None:
+    if key is None or key not in deps:
+        return None
+    rec = PointRecord.from_dict(deps[key])
+    return dict(rec.design) if rec.success and rec.design else None
+
+
+def front_knowledge(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """``incumbents`` and ``memo`` arguments of the catalogue search of ``task``."""
+    if "tie_of" in task:
+        keys = [task["tie_of"]]
+    elif "eps_frac" in task:
+        near, far = f"anchor-{task['eps_name']}", f"anchor-{task['target']}"
+        if task["eps_frac"] > 0.5:
+            near, far = far, near
+        keys = [task.get("previous"), near, far]
+    else:
+        keys = []
+    found = [_design(deps, k) for k in keys]
+    incumbents = [d for d in found if d is not None]
+    memo = None
+    if task.get("memo"):
+        problem = task["problem"]
+        full = {v.name: (v.lower, v.upper) for v in discrete_variables(problem)}
+        memo = shared_memo((problem_digest(problem), task["starts"], task["seed"]), full)
+    return {"incumbents": incumbents, "memo": memo}
