@@ -28,11 +28,15 @@ is pruned, or called infeasible, only on the same starts as the cold search (the
 start plus the multistart and its retries); what the warm start changes is the bound of
 a node it does not prune (one start instead of several), which steers the order of the
 search and the branching variable, not which node may be discarded. A first incumbent
-prunes only nodes that cannot hold a combination tied with it, and a combination the
-search finds keeps a tie with it: it is reported only when the search finds nothing as
-good, so it does not decide between tied combinations. Which of two tied combinations
-(within the pruning tolerance) the search finds first still depends on its order, which
-the warm bounds steer.
+prunes only what the search itself would prune, so it changes the work, not the answer.
+
+Ties are decided by value, then by the items: of two combinations whose objectives tie
+(within :data:`PRUNE_TOL`), the one with the smaller items in the order the catalogue
+variables are declared (lexicographic, :func:`combination_key`) is reported, whatever
+order the search meets them in. A node whose bound ties with the incumbent is pruned only
+when its box holds no combination smaller than the incumbent's, so the answer does not
+depend on the warm bounds, the first incumbent or the number of workers. (Enumeration
+visits the combinations in that order and keeps the first of a tie: the same rule.)
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from __future__ import annotations
 import heapq
 import itertools
 from collections.abc import Mapping, Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -65,6 +70,41 @@ def cannot_improve(bound: float, incumbent: float) -> bool:
     """Whether a node whose relaxation gives ``bound`` can be pruned: it cannot beat the
     incumbent's objective by more than ``PRUNE_TOL`` (relative)."""
     return bound >= incumbent - PRUNE_TOL * abs(incumbent)
+
+
+def combination_key(values: Mapping[str, float], names: Sequence[str]) -> tuple[float, ...]:
+    """The order of item combinations that decides a tie: the items of ``names`` (the
+    catalogue variables, in their declared order), compared lexicographically."""
+    return tuple(float(values[n]) for n in names)
+
+
+def box_key(box: Box, names: Sequence[str]) -> tuple[float, ...]:
+    """The smallest :func:`combination_key` of a box's combinations (its lower ends)."""
+    return tuple(float(box[n][0]) for n in names)
+
+
+def wins(
+    value: float, key: tuple[float, ...], best: float | None, best_key: tuple[float, ...] | None
+) -> bool:
+    """Whether a combination of objective ``value`` and items ``key`` replaces the best
+    so far: a better value beyond the tie tolerance, or a tie with smaller items."""
+    if best is None or best_key is None:
+        return True
+    if improves(value, best, PRUNE_TOL):
+        return True
+    return not improves(best, value, PRUNE_TOL) and key < best_key
+
+
+def box_cannot_win(
+    bound: float, box: Box, names: Sequence[str], best: float, best_key: tuple[float, ...]
+) -> bool:
+    """Whether a node (relaxation ``bound`` over ``box``) can be pruned against the best
+    combination so far: its bound is worse beyond the tie tolerance, or ties and the box
+    holds no combination with smaller items."""
+    if not cannot_improve(bound, best):
+        return False  # it may beat the best by more than the tolerance
+    worse = bound > best + PRUNE_TOL * abs(best)
+    return worse or box_key(box, names) >= best_key
 
 
 def fixed_box(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
@@ -144,8 +184,9 @@ def first_incumbent(
 ) -> tuple[Result | None, dict | None]:
     """The best feasible of ``candidates`` (item combinations), each solved as a leaf
     from the candidate's design alone (one start: its value only bounds the optimum from
-    above); a tie keeps the earlier candidate."""
+    above); a tie is decided by the items (:func:`wins`), not by the candidates' order."""
     dvars = discrete_variables(ns.problem)
+    names = [v.name for v in dvars]
     best, best_items, seen = None, None, set()
     for cand in candidates:
         try:
@@ -163,7 +204,8 @@ def first_incumbent(
         r = ns.solve(fixed_box(items), x0, warm=True, fallback=False)
         stats["nodes"] += 1
         stats["seeded"] += 1
-        if r.success and (best is None or improves(r.objective, best.objective, _prune_tol())):
+        best_key = None if best_items is None else combination_key(best_items, names)
+        if r.success and wins(r.objective, combination_key(items, names), _value(best), best_key):
             best, best_items = r, items
     return best, best_items
 
@@ -173,10 +215,6 @@ def _x_of_design(ns, design: Mapping[str, float]):
     if not all(n in design for n in ns.names):
         return None
     return np.array([float(design[n]) for n in ns.names])
-
-
-def _prune_tol() -> float:
-    return PRUNE_TOL
 
 
 def branch_and_bound_warm(
@@ -189,24 +227,29 @@ def branch_and_bound_warm(
     counter = itertools.count()
     heap: list = []
     stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
+    names = [v.name for v in dvars]
     incumbent: Result | None = None  # the best leaf the search itself found
+    inc_key: tuple[float, ...] | None = None
     seed: Result | None = None  # the best candidate's leaf
     seed_items: dict | None = None
+    seed_key: tuple[float, ...] | None = None
     if root.success:
         seed, seed_items = first_incumbent(ns, candidates, stats)
+        if seed_items is not None:
+            seed_key = combination_key(seed_items, names)
         heapq.heappush(heap, (root.objective, next(counter), full, root, None))
 
-    def prunes(bound: float) -> bool:
-        # the search's own incumbent prunes ties too (the leaf found first is kept), as
-        # before; a candidate prunes only what is worse beyond the tie tolerance, so that
-        # the search still reaches the combination it would report without the candidate
-        if incumbent is not None and cannot_improve(bound, incumbent.objective):
-            return True
-        return seed is not None and bound > seed.objective + _prune_tol() * abs(seed.objective)
+    def prunes(bound: float, box: Box) -> bool:
+        # the same rule against the search's incumbent and the candidate: worse beyond
+        # the tie tolerance, or a tie that no combination of the box can win on its items
+        for best, key in ((incumbent, inc_key), (seed, seed_key)):
+            if best is not None and box_cannot_win(bound, box, names, best.objective, key):
+                return True
+        return False
 
     while heap:
         bound, _, box, res, warm_from = heapq.heappop(heap)
-        if prunes(bound):
+        if prunes(bound, box):
             if warm_from is not None:
                 # a bound from the warm start alone: pruned only on the full multistart
                 res = ns.solve(box, warm_from)
@@ -214,7 +257,7 @@ def branch_and_bound_warm(
                 if not res.success:
                     stats["infeasible"] += 1
                     continue
-                if not prunes(res.objective):
+                if not prunes(res.objective, box):
                     heapq.heappush(heap, (res.objective, next(counter), box, res, None))
                     continue
             stats["pruned"] += 1
@@ -230,11 +273,10 @@ def branch_and_bound_warm(
                 leaf = ns.solve(fixed_box(items), x)
                 stats["nodes"] += 1
             stats["leaves"] += 1
-            if leaf.success and (
-                incumbent is None or improves(leaf.objective, incumbent.objective, _prune_tol())
-            ):
-                incumbent = leaf  # a tie keeps the incumbent found first
-            if one_combination or prunes(bound):
+            key = combination_key(items, names)
+            if leaf.success and wins(leaf.objective, key, _value(incumbent), inc_key):
+                incumbent, inc_key = leaf, key
+            if one_combination or prunes(bound, box):
                 continue
             # The node's relaxation sits on items, but its item data (fit ratios, screw
             # ratings) are the most favourable over the box's items, not those of the
@@ -257,23 +299,33 @@ def branch_and_bound_warm(
                 continue  # the leaf just solved
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
             # a box of one combination is a leaf: its value is reported, full multistart
-            r = ns.solve(child, x) if fixed else ns.solve(child, x, warm=True, prunes=prunes)
+            if fixed:
+                r = ns.solve(child, x)
+            else:
+                r = ns.solve(child, x, warm=True, prunes=partial(_prunes_box, prunes, child))
             stats["nodes"] += 1
             if not r.success:
                 stats["infeasible"] += 1
                 continue
-            if prunes(r.objective):
+            if prunes(r.objective, child):
                 stats["pruned"] += 1
                 continue
             warm_only = not fixed and r.multistart is not None and r.multistart.n_starts < ns.starts
             entry = (r.objective, next(counter), child, r, x if warm_only else None)
             heapq.heappush(heap, entry)
-    if seed is not None and (
-        incumbent is None or improves(seed.objective, incumbent.objective, _prune_tol())
-    ):
-        # no leaf of the search ties with the candidate: it is the optimum, and as a
-        # reported leaf it gets the full multistart (its own start first)
+    if seed is not None and wins(seed.objective, seed_key, _value(incumbent), inc_key):
+        # the candidate beats every leaf of the search (or ties with smaller items): it
+        # is the optimum, and as a reported leaf it gets the full multistart (its own
+        # start first)
         full = ns.solve(fixed_box(seed_items), ns.x_of(seed))
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats
+
+
+def _value(result: Result | None) -> float | None:
+    return None if result is None else result.objective
+
+
+def _prunes_box(prunes, box: Box, value: float) -> bool:
+    return prunes(value, box)

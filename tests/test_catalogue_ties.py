@@ -1,0 +1,129 @@
+"""Ties between catalogue combinations are decided by value, then by the items.
+
+A catalogue optimum where one variable does not change the objective (the fin actuator's
+screw diameter when the pin decides the backlash) has tied combinations. Which one is
+reported must not depend on the order the search meets them in (the warm bounds, a
+front's or sweep's first incumbent, the number of workers): the smallest items, in the
+declared order of the catalogue variables, win a tie.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from optdesign.solvers.result import Result
+from optdesign.studies.catalogue import enumerate_catalogue
+from optdesign.studies.catalogue_bnb import (
+    box_cannot_win,
+    branch_and_bound_warm,
+    combination_key,
+    wins,
+)
+
+A_ITEMS = (1.0, 2.0, 3.0)
+B_ITEMS = (1.0, 2.0, 3.0, 4.0)
+
+
+@dataclass
+class _Var:
+    name: str
+    values: tuple[float, ...]
+    discrete: bool = True
+
+    @property
+    def lower(self) -> float:
+        return self.values[0]
+
+    @property
+    def upper(self) -> float:
+        return self.values[-1]
+
+
+@dataclass
+class _Problem:
+    free: list[_Var]
+
+
+class TiedNodes:
+    """A node solver whose objective, (a - 2)^2 + 1, ignores b; each relaxation sits at
+    the top of b's range, so the search meets the largest b first."""
+
+    def __init__(self):
+        self.problem = _Problem([_Var("a", A_ITEMS), _Var("b", B_ITEMS)])
+        self.names = ["a", "b"]
+        self.starts = 1
+        self.boxes: list[dict] = []
+
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True):
+        self.boxes.append(dict(box))
+        lo_a, hi_a = box.get("a", (A_ITEMS[0], A_ITEMS[-1]))
+        _, hi_b = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
+        a = min(max(2.0, lo_a), hi_a)
+        return Result("optimal", (a - 2.0) ** 2 + 1.0, {"a": a, "b": hi_b}, "fake", "nlp", 0.0)
+
+    def x_of(self, result):
+        return np.array([result.design[n] for n in self.names])
+
+
+def _search(candidates=()):
+    ns = TiedNodes()
+    best, stats = branch_and_bound_warm(ns, ns.solve({}), candidates)
+    return best, stats
+
+
+def test_the_smallest_tied_items_win_whatever_the_search_meets_first():
+    best, stats = _search()
+    assert best.objective == pytest.approx(1.0)
+    # b ties at every item: b = 1 is reported, although the search met b = 4 first
+    assert (best.design["a"], best.design["b"]) == (2.0, 1.0)
+    assert stats["leaves"] >= 2
+
+
+@pytest.mark.parametrize(
+    "candidates",
+    [
+        [{"a": 2.0, "b": 4.0}],
+        [{"a": 2.0, "b": 3.0}, {"a": 2.0, "b": 2.0}],
+        [{"a": 3.0, "b": 1.0}, {"a": 2.0, "b": 4.0}],
+        [{"a": 2.0, "b": 1.0}],
+    ],
+)
+def test_a_first_incumbent_changes_the_work_not_the_tie(candidates):
+    best, _ = _search(candidates)
+    assert (best.design["a"], best.design["b"]) == (2.0, 1.0)
+
+
+def test_enumeration_decides_the_tie_the_same_way():
+    best, table = enumerate_catalogue(TiedNodes())
+    assert len(table) == len(A_ITEMS) * len(B_ITEMS)
+    assert (best.design["a"], best.design["b"]) == (2.0, 1.0)
+
+
+def test_wins_is_value_first_then_items():
+    small, large = (2.0, 1.0), (2.0, 4.0)
+    assert wins(1.0, large, None, None)
+    # better beyond the tolerance wins whatever the items
+    assert wins(1.0, large, 1.001, small)
+    assert not wins(1.001, small, 1.0, large)
+    # within the tolerance (1e-6 relative) the smaller items win, either way round
+    assert wins(1.0 + 5e-7, small, 1.0, large)
+    assert wins(1.0 - 5e-7, small, 1.0, large)
+    assert not wins(1.0 - 5e-7, large, 1.0, small)
+    assert not wins(1.0, small, 1.0, small)
+
+
+def test_a_tied_box_is_pruned_only_when_it_holds_no_smaller_combination():
+    names = ["a", "b"]
+    best_key = combination_key({"b": 3.0, "a": 2.0}, names)
+    assert best_key == (2.0, 3.0)
+    holds_smaller = {"a": (2.0, 3.0), "b": (1.0, 4.0)}
+    holds_none = {"a": (2.0, 3.0), "b": (3.0, 4.0)}
+    assert not box_cannot_win(1.0, holds_smaller, names, 1.0, best_key)
+    assert box_cannot_win(1.0, holds_none, names, 1.0, best_key)
+    # worse beyond the tolerance: pruned whatever it holds
+    assert box_cannot_win(1.01, holds_smaller, names, 1.0, best_key)
+    # better beyond the tolerance: never pruned
+    assert not box_cannot_win(0.99, holds_none, names, 1.0, best_key)
