@@ -60,3 +60,20 @@ def _registries_restored():
     registry._SOLVERS.update(solvers)
     configs.CONFIGS.clear()
     configs.CONFIGS.update(bench)
+
+
+@pytest.fixture(scope="session")
+def fin_lug_optimum():
+    """The shipped fin_actuator with 5 mm lug cheeks (the inputs of Huth's model; its
+    optimum is the file's, the lug entering no objective) solved once with the pin contact
+    models' spread: (problem, result), shared by the tests that read the spread there."""
+    import tomllib
+    from pathlib import Path
+
+    import optdesign as od
+
+    path = Path(__file__).resolve().parents[1] / "problems" / "fin_actuator.toml"
+    data = tomllib.loads(path.read_text())
+    data.setdefault("materials", {})["lug"] = {"cheek_thickness": "5 mm"}
+    problem = od.load(data)
+    return problem, od.solve(problem, contact_models=True, ranges=False)

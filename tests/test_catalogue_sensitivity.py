@@ -64,8 +64,10 @@ def test_steps_to_the_neighbouring_items(catalogue):
             assert step.status == "infeasible", step.text()
             continue
         feasible += 1
-        # an independent re-solve of this item (four starts, not warm)
-        independent = NodeSolver(problem, None, 4, 7).solve(_fixed({**chosen, name: item}))
+        # an independent re-solve of this item (four starts, not warm; with seed 7 one
+        # start of p = 5 mm sits 34 s in Ipopt 3.14.11's emergency restoration (CasADi
+        # 3.6-3.7, the oldest allowed) where later releases converge)
+        independent = NodeSolver(problem, None, 4, 3).solve(_fixed({**chosen, name: item}))
         shown = objective_shown(problem, "backlash", independent.objective)
         assert (step.objective_unit, step.objective_name) == (shown.unit, "backlash")
         assert step.objective == pytest.approx(shown.value, rel=1e-6)

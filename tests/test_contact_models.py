@@ -4,11 +4,8 @@ selectable model, and the backlash of an optimum under each model (``--contact-m
 
 from __future__ import annotations
 
-import json
 import math
 import re
-import subprocess
-import sys
 import tomllib
 from pathlib import Path
 
@@ -18,7 +15,7 @@ import pytest
 import optdesign as od
 from optdesign.errors import InputError, OptDesignError
 from optdesign.mechanisms.joints import PinJoint
-from optdesign.problem import load_problem, problem_from_dict
+from optdesign.problem import problem_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 FIN = ROOT / "problems" / "fin_actuator.toml"
@@ -52,9 +49,8 @@ def _at_optimum(model: str) -> float:
     return float(np.ravel(problem.evaluate(x).objectives["backlash"])[0])
 
 
-def test_backlash_spread_over_the_contact_models_at_the_fin_optimum():
-    problem = load_problem(FIN)
-    result = od.solve(problem, contact_models=True, ranges=False)
+def test_backlash_spread_over_the_contact_models_at_the_fin_optimum(fin_lug_optimum):
+    problem, result = fin_lug_optimum
     line = next(n for n in result.notes if n.startswith("backlash by pin contact model"))
     values = {
         name: float(v)
@@ -72,25 +68,3 @@ def test_backlash_spread_over_the_contact_models_at_the_fin_optimum():
     assert line in result.summary()
     with pytest.raises(OptDesignError, match="contact_models"):
         od.solve(problem, contact_models="yes")
-
-
-def test_contact_models_on_the_command_line_json():
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "optdesign",
-            "solve",
-            str(FIN),
-            "--contact-models",
-            "--no-ranges",
-            "--json",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=ROOT,
-    )
-    assert run.returncode == 0, run.stderr
-    notes = json.loads(run.stdout)["notes"]
-    assert any("palmgren 0.0441218 deg" in n for n in notes)

@@ -213,10 +213,17 @@ def _catalogue(leads, pins):
     return problem_from_dict(data)
 
 
-def test_branch_and_bound_counts_every_node_it_solves(monkeypatch):
+@pytest.fixture(scope="module")
+def enumerated_4x5():
+    """4 leads x 5 pins and the enumeration of its 20 item pairs (two starts a node)."""
+    problem = _catalogue((4, 5, 6, 8), (4, 5, 6, 8, 10))
+    return problem, catalogue.solve_catalogue(problem, method="enumerate", starts=2)
+
+
+def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x5):
     """4 leads x 5 pins: branch and bound equals enumeration, and its counts are those of
     the node solves it made (counted here by a wrapper around the node solver)."""
-    problem = _catalogue((4, 5, 6, 8), (4, 5, 6, 8, 10))
+    problem, enum = enumerated_4x5
     solves: list[bool] = []
     original = catalogue.NodeSolver.solve
 
@@ -234,8 +241,6 @@ def test_branch_and_bound_counts_every_node_it_solves(monkeypatch):
     assert info.infeasible == solves.count(False) == 2
     # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
     assert (info.leaves, info.pruned) == (1, 1)
-    solves.clear()
-    enum = catalogue.solve_catalogue(problem, method="enumerate", starts=2)
     assert len(enum.details.catalogue.enumerated) == 20
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
     assert bnb.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
@@ -256,18 +261,17 @@ def test_the_catalogue_formulation_takes_the_callers_settings():
     assert "relaxation has no feasible design" in starved.message
 
 
-def test_first_feasible_finds_a_feasible_catalogue_design_or_none():
+def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5):
     """The diagnosis's depth-first search (reached only when no item combination near the
     relaxation works, so no other fast test calls it): a leaf on the catalogue whose
     design the independent check finds feasible; None when no item pair is feasible."""
-    problem = _catalogue((4, 5, 6, 8), (4, 5, 6, 8, 10))
+    problem, enum = enumerated_4x5
     found = catalogue.first_feasible(catalogue.NodeSolver(problem, starts=2))
     assert found is not None and found.success
     assert is_on_catalogue(problem, found.design)
     x = np.array([found.design[v.name] for v in problem.free])
     assert verify_design(problem, x)[0]
     # the better child first: the leaf is no worse than the worst of the feasible items
-    enum = catalogue.solve_catalogue(problem, method="enumerate", starts=2)
     feasible = {
         (row.items["p"], row.items["d"]): row.objective
         for row in enum.details.catalogue.enumerated

@@ -123,6 +123,12 @@ class CatalogueDetails:
     nlp_solves: int = 0
     items: dict[str, float] | None = None
     gap_to_relaxation_rel: float | None = None
+    #: The boxes the search proved infeasible, with the epsilon limits of each proof
+    #: (:class:`~optdesign.studies.catalogue_bnb.InfeasibleBoxes`): the neighbouring
+    #: items of the optimum read them before solving. In memory only (not in result.json).
+    infeasible_boxes: list[tuple[dict[str, tuple[float, float]], dict[str, float]]] = field(
+        default_factory=list, repr=False
+    )
 
     def to_json(self) -> dict[str, Any]:
         out = _fields_json(
@@ -145,6 +151,7 @@ class CatalogueDetails:
             out["enumerated"] = [asdict(row) for row in self.enumerated]
         if self.minlp is not None:
             out["minlp"] = self.minlp.to_json()
+        out.pop("infeasible_boxes")
         return out
 
 

@@ -291,7 +291,10 @@ def solve_catalogue(
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
     ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
-    ns.memo = memo
+    # the search's own proofs when no front shares a memo: a box inside one proved
+    # infeasible is skipped, and the optimum's neighbouring items read them afterwards
+    full = {v.name: (v.lower, v.upper) for v in dvars}
+    ns.memo = memo if memo is not None else InfeasibleBoxes(full)
     root = ns.solve({})
     info = CatalogueDetails(
         method=method,
@@ -315,6 +318,7 @@ def solve_catalogue(
         info.seeded = stats["seeded"]
         info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
     info.nlp_solves = ns.n_solves
+    info.infeasible_boxes = ns.memo.proofs
     wall = time.perf_counter() - t0
     if best is None:
         # Infeasible only when the continuous relaxation (every catalogue range at once)

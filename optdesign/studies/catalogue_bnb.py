@@ -129,6 +129,19 @@ class InfeasibleBoxes:
     def __len__(self) -> int:
         return len(self._proofs)
 
+    @property
+    def proofs(self) -> list[tuple[dict[str, tuple[float, float]], dict[str, float]]]:
+        """The stored proofs: (box, epsilon limits) pairs, oldest first."""
+        return [(dict(box), dict(eps)) for box, eps in self._proofs]
+
+    @classmethod
+    def from_proofs(cls, full: Box, proofs) -> InfeasibleBoxes:
+        """A memo holding ``proofs`` (as :attr:`proofs` gives them)."""
+        memo = cls(full)
+        for box, eps in proofs:
+            memo.add_infeasible(box, eps)
+        return memo
+
     def add_infeasible(self, box: Box, eps: Mapping[str, float]) -> None:
         self._proofs.append(({**self.full, **box}, dict(eps)))
 

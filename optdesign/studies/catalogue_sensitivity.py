@@ -20,6 +20,7 @@ import numpy as np
 from optdesign.formulations.discrete import discrete_variables
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.result import ItemStep, Result, Sensitivity
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes
 
 
 def neighbour_items(values: tuple[float, ...] | list[float], item: float) -> list[float]:
@@ -59,6 +60,11 @@ def catalogue_sensitivities(
     dvars = discrete_variables(problem)
     items = {v.name: float(result.design[v.name]) for v in dvars}
     ns = NodeSolver(problem, objective, 1, problem.spec.solver.seed, solver, options)
+    searched = result.details.catalogue
+    if searched is not None and searched.infeasible_boxes:
+        # an item inside a box the search proved infeasible is infeasible, with no NLP
+        full = {v.name: (v.lower, v.upper) for v in dvars}
+        ns.memo = InfeasibleBoxes.from_proofs(full, searched.infeasible_boxes)
     x0 = np.array([result.design[v.name] for v in problem.free])
     v0 = float(result.objective)
     shown0 = objective_shown(problem, objective, v0)
