@@ -109,8 +109,12 @@ class NodeSolver:
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
         self.n_implied = 0
-        #: boxes proved infeasible (shared by the searches of one front); None: no memo
+        #: boxes proved infeasible (shared by the searches of one front), read before a
+        #: node is solved and written when one is proved; None: no memo
         self.memo = None
+        #: where this search's own proofs are recorded besides (never read by it: a
+        #: single search keeps its nodes; the optimum's neighbouring items read them)
+        self.proofs = None
 
     def solve(
         self,
@@ -171,8 +175,11 @@ class NodeSolver:
         if not any(r.success for r in results):
             retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
             results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
-            if self.memo is not None and not any(r.success for r in results):
-                self.memo.add_infeasible(bounds, self.eps)
+            if not any(r.success for r in results):
+                if self.memo is not None:
+                    self.memo.add_infeasible(bounds, self.eps)
+                if self.proofs is not None and self.proofs is not self.memo:
+                    self.proofs.add_infeasible(bounds, self.eps)
         self.n_solves += len(results)
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
@@ -291,10 +298,13 @@ def solve_catalogue(
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
     ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
-    # the search's own proofs when no front shares a memo: a box inside one proved
-    # infeasible is skipped, and the optimum's neighbouring items read them afterwards
-    full = {v.name: (v.lower, v.upper) for v in dvars}
-    ns.memo = memo if memo is not None else InfeasibleBoxes(full)
+    ns.memo = memo
+    # the proofs of this search (a front's memo, or this search's own, which it does not
+    # read: a single search solves the nodes it always did), for the optimum's
+    # neighbouring items (studies.catalogue_sensitivity)
+    ns.proofs = (
+        memo if memo is not None else InfeasibleBoxes({v.name: (v.lower, v.upper) for v in dvars})
+    )
     root = ns.solve({})
     info = CatalogueDetails(
         method=method,
@@ -318,7 +328,7 @@ def solve_catalogue(
         info.seeded = stats["seeded"]
         info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
     info.nlp_solves = ns.n_solves
-    info.infeasible_boxes = ns.memo.proofs
+    info.infeasible_boxes = ns.proofs.proofs
     wall = time.perf_counter() - t0
     if best is None:
         # Infeasible only when the continuous relaxation (every catalogue range at once)
