@@ -5,6 +5,9 @@ screw diameter when the pin decides the backlash) has tied combinations. Which o
 reported must not depend on the order the search meets them in (the warm bounds, a
 front's or sweep's first incumbent, the number of workers): the smallest items, in the
 declared order of the catalogue variables, win a tie.
+
+The same fake node solvers check the diagnosis's depth-first search (``first_feasible``):
+a relaxation sitting on items does not settle its box, whose other combinations may work.
 """
 
 from __future__ import annotations
@@ -127,3 +130,26 @@ def test_a_tied_box_is_pruned_only_when_it_holds_no_smaller_combination():
     assert box_cannot_win(1.01, holds_smaller, names, 1.0, best_key)
     # better beyond the tolerance: never pruned
     assert not box_cannot_win(0.99, holds_none, names, 1.0, best_key)
+
+
+class TrapNodes(TiedNodes):
+    """The relaxation of every wide box sits on (2, top of b), but the combination
+    (2, 4) is infeasible with its own items (its box's data were the most favourable)."""
+
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True):
+        result = super().solve(box, x_hint, warm, prunes, fallback)
+        fixed = all(box.get(n, (0, 1))[0] == box.get(n, (0, 1))[1] for n in self.names)
+        if fixed and (box["a"][0], box["b"][0]) == (2.0, 4.0):
+            return Result("infeasible", float("nan"), {}, "fake", "nlp", 0.0)
+        return result
+
+
+def test_first_feasible_searches_the_rest_of_a_box_whose_relaxation_sat_on_items():
+    from optdesign.studies.catalogue import first_feasible
+
+    ns = TrapNodes()
+    found = first_feasible(ns)
+    # the leaf (2, 4) fails; the rest of its box still holds feasible combinations
+    assert found is not None and found.success
+    assert (found.design["a"], found.design["b"]) == (2.0, 3.0)
+    assert {"a": (2.0, 2.0), "b": (4.0, 4.0)} in ns.boxes  # the failed leaf was tried

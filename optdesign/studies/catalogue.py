@@ -48,7 +48,7 @@ from optdesign.solvers.multistart import (
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes, split_at_items
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
@@ -400,13 +400,23 @@ def first_feasible(ns: NodeSolver) -> Result | None:
             leaf = ns.solve(_fixed(items), ns.x_of(res))
             if leaf.success:
                 return leaf
-            continue
-        allowed = items_within(worst.values, *box[worst.name])
-        sides = [side for side in branch(res.design[worst.name], allowed) if side]
+            # The relaxation's item data are the most favourable over the box's items,
+            # not those of the items it sits on: the box's other combinations may still
+            # work (split as the branch and bound does).
+            if all(box[v.name][0] == box[v.name][1] for v in dvars):
+                continue
+            splits = split_at_items(dvars, box, items)
+        else:
+            allowed = items_within(worst.values, *box[worst.name])
+            splits = [(worst, side) for side in branch(res.design[worst.name], allowed)]
         children = []
-        for side in sides:
+        for var, side in splits:
+            if not side:
+                continue
             child = dict(box)
-            child[worst.name] = (side[0], side[-1])
+            child[var.name] = (side[0], side[-1])
+            if worst is None and child == _fixed(items):
+                continue  # the leaf just solved
             r = ns.solve(child, ns.x_of(res))
             if r.success:
                 children.append((r.objective, child, r))

@@ -294,12 +294,7 @@ def branch_and_bound_warm(
             # The node's relaxation sits on items, but its item data (fit ratios, screw
             # ratings) are the most favourable over the box's items, not those of the
             # items it sits on: the box's other combinations may still beat this leaf.
-            # Split the first wide variable at its item: below it, at it, above it.
-            var = next(v for v in dvars if box[v.name][0] != box[v.name][1])
-            allowed = items_within(var.values, *box[var.name])
-            at = items[var.name]
-            sides = [(var, [a for a in allowed if a < at]), (var, [at])]
-            sides.append((var, [a for a in allowed if a > at]))
+            sides = split_at_items(dvars, box, items)
         else:
             allowed = items_within(worst.values, *box[worst.name])
             sides = [(worst, side) for side in branch(res.design[worst.name], allowed)]
@@ -334,6 +329,17 @@ def branch_and_bound_warm(
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats
+
+
+def split_at_items(dvars, box: Box, items: Mapping[str, float]) -> list[tuple[Any, list[float]]]:
+    """The sides of a box whose relaxation sits on ``items`` though it holds other
+    combinations: its first wide variable's items below, at and above the item (a side
+    may be empty). The box must hold more than one combination."""
+    var = next(v for v in dvars if box[v.name][0] != box[v.name][1])
+    allowed = items_within(var.values, *box[var.name])
+    at = items[var.name]
+    below, above = [a for a in allowed if a < at], [a for a in allowed if a > at]
+    return [(var, below), (var, [at]), (var, above)]
 
 
 def _value(result: Result | None) -> float | None:
