@@ -169,23 +169,6 @@ def monte_carlo(
     )
 
 
-def make_robust_solve(
-    problem: DesignProblem,
-    objective: str | None = None,
-    samples: Samples | None = None,
-    solver: str | None = None,
-    options: Mapping[str, Any] | None = None,
-    risk: str | None = None,
-    alpha: float | None = None,
-    k: float | None = None,
-    constrain_samples: bool = False,
-):
-    """Build the robust NLP and its solver once; return x0 -> Result."""
-    nlp = build_robust_nlp(problem, objective, samples, risk, alpha, k, constrain_samples)
-    merged = {**solver_options(problem, solver), **(options or {})}
-    return make_solver(nlp, solver, merged).solve
-
-
 def solve_robust(
     problem: DesignProblem,
     x0: np.ndarray | None = None,
