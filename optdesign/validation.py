@@ -143,6 +143,7 @@ def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] |
     with string keys, checked as the back-end declares (Ipopt's by Ipopt itself, the
     check the problem file's ``[solver] ipopt`` gets)."""
     if options is None:
+        solver_hints(solver).check_options({}, argument)  # what it takes from elsewhere
         return None
     if not isinstance(options, Mapping):
         raise ArgumentError(argument, f"expected a dict of solver options, got {shown(options)}")

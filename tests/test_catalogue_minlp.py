@@ -156,3 +156,37 @@ def test_a_relaxation_on_an_item_still_branches_the_rest_of_its_box():
     assert bnb.details.catalogue.items == {"p": 6, "d": 10}
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
     assert bnb.objective == pytest.approx(0.0352439, rel=1e-5)
+
+
+@pytest.mark.parametrize("planted", ["file", "link"])
+def test_a_bonmin_opt_in_the_working_directory_is_refused_before_any_work(
+    tmp_path, monkeypatch, capsys, planted
+):
+    """Bonmin reads ./bonmin.opt at every solve whatever its options say; one planted
+    there could write Bonmin's log over any file. The solve is refused, naming it, from
+    Python and in both output modes of the command line, and nothing is written."""
+    from optdesign.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    opt = tmp_path / "bonmin.opt"
+    if planted == "file":
+        opt.write_text(f"output_file {victim}\n")
+    else:
+        opt.symlink_to(tmp_path / "missing.opt")  # even a broken link would be opened
+    with pytest.raises(InputError, match=r"solver: bonmin: refused: .*bonmin\.opt would be read"):
+        od.solve(_small(), solver="bonmin", ranges=False)
+    path = tmp_path / "small.toml"
+    path.write_text((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    for extra in ([], ["--json"]):
+        code = main(
+            ["solve", str(path), "--solver", "bonmin", "--out", str(tmp_path / "o"), *extra]
+        )
+        err = capsys.readouterr().err
+        assert code == 2 and "bonmin.opt would be read by Bonmin" in err
+    assert victim.read_text() == "keep me"
+    assert not (tmp_path / "o" / "result.json").exists()
+    # the default back-end is not concerned by the file
+    opt.unlink()
+    assert solver_hints("ipopt").preflight is None

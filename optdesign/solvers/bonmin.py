@@ -34,6 +34,25 @@ BONMIN_QUIET: dict[str, Any] = {
 #: Bonmin's return statuses that carry an integer-feasible point.
 BONMIN_FOUND = ("SUCCESS", "FEASIBLE")
 
+#: The options file Bonmin reads from the working directory at every solve, whatever its
+#: options say (CasADi's interface calls Bonmin's ``readOptionsFile()``; unlike Ipopt's
+#: ``option_file_name`` nothing turns it off): one planted there could set Bonmin's
+#: options and write its log over any file (``output_file``), so no solve starts beside one.
+OPTIONS_FILE = "bonmin.opt"
+
+
+def refuse_options_file() -> None:
+    """InputError ``solver`` when the working directory holds a ``bonmin.opt`` (a file, a
+    link, even a broken one) that Bonmin would read."""
+    path = os.path.abspath(OPTIONS_FILE)
+    if os.path.lexists(path):
+        raise InputError(
+            "solver",
+            f"bonmin: refused: {path} would be read by Bonmin at the solve (options, and "
+            "files it may write); options come from the problem file's [solver] or "
+            "options=. Remove it or run from another folder",
+        )
+
 
 @contextlib.contextmanager
 def quiet_stdout() -> Iterator[None]:
@@ -85,6 +104,7 @@ def solve_minlp(minlp: Any, x0: Any, options: Mapping[str, Any] | None = None):
     from optdesign.solvers.base import MINLPSolution
 
     opts = bonmin_options(options)
+    refuse_options_file()
     solver = ca.nlpsol(
         "optdesign_bonmin",
         "bonmin",
@@ -109,6 +129,7 @@ def bonmin_nlp_solver(nlp, options: Mapping[str, Any] | None = None):
 
     class BonminNLPSolver(CasadiNLPSolver):
         def solve(self, *args: Any, **kwargs: Any):
+            refuse_options_file()
             with quiet_stdout():
                 return super().solve(*args, **kwargs)
 

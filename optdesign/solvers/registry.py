@@ -54,6 +54,10 @@ class SolverHints:
     #: "module:function" checking the back-end's options before any work
     #: (``check(options, field=...)``; None: the back-end checks them when it is built)
     options_check: str | None = None
+    #: "module:function" called before any work whatever the options (``check()``,
+    #: raising InputError): what the back-end would take from outside its options, e.g.
+    #: an options file it reads from the working directory
+    preflight: str | None = None
     #: modules a benchmark imports before timing (the back-end's lazy imports)
     preload: tuple[str, ...] = ()
     #: the result carries the constraint and bound multipliers of the NLP it solved
@@ -72,7 +76,11 @@ class SolverHints:
         return {name: float(seconds) for name in self.time_limit_options}
 
     def check_options(self, options: Mapping[str, Any], field_name: str) -> None:
-        """Refuse options the back-end would refuse, naming ``field_name``."""
+        """Refuse options the back-end would refuse, naming ``field_name`` (and what its
+        :attr:`preflight` refuses)."""
+        if self.preflight is not None:
+            module, _, attr = self.preflight.partition(":")
+            getattr(importlib.import_module(module), attr)()
         if self.options_check is not None and options:
             module, _, attr = self.options_check.partition(":")
             getattr(importlib.import_module(module), attr)(dict(options), field=field_name)
@@ -323,6 +331,7 @@ def _builtins() -> None:
             SolverHints(
                 time_limit_options=("time_limit",),
                 options_check="optdesign.solvers.bonmin:check_bonmin_options",
+                preflight="optdesign.solvers.bonmin:refuse_options_file",
                 minlp="optdesign.solvers.bonmin:solve_minlp",
             ),
         ),
