@@ -101,7 +101,7 @@ def solve(
     """
     from optdesign.studies.solve import solve as run
 
-    args = validation.solve_arguments(
+    checked = validation.solve_arguments(
         formulation=formulation,
         objective=objective,
         starts=starts,
@@ -116,11 +116,9 @@ def solve(
         time_limit=time_limit,
     )
     problem = load(problem)
-    validation.objective_of(problem, args["objective"])
-    agree = args.pop("agree")
-    spread = args.pop("contact_models")
-    result = run(problem, **args, **({"agree": agree} if agree is not None else {}))
-    if spread and result.design:
+    request = validation.solve_request(problem, checked)
+    result = run(problem, request)
+    if request.contact_models and result.design:
         from optdesign.studies.contact_spread import contact_model_spread
 
         line = contact_model_spread(problem, result.design)

@@ -64,9 +64,9 @@ from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints, solver_names
 
 def formulation(argument: str, value: Any) -> str:
     """``auto`` or a registered formulation."""
-    from optdesign.studies.solve import FORMULATIONS
+    from optdesign.studies.formulation_registry import formulation_names
 
-    return choice(argument, value, ["auto", *FORMULATIONS], "formulation")
+    return choice(argument, value, ["auto", *formulation_names()], "formulation")
 
 
 def solver(argument: str, value: Any) -> str | None:
@@ -376,13 +376,27 @@ def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> N
         )
 
 
+def solve_request(problem: Any, checked: Mapping[str, Any]) -> Any:
+    """The :class:`~optdesign.problem.request.SolveRequest` of :func:`optdesign.solve`
+    on ``problem`` (loaded), from its arguments as :func:`solve_arguments` returned them
+    (checked before the problem was loaded): the objective checked among the problem's,
+    the request built once."""
+    from optdesign.problem.request import SolveRequest
+
+    objective_of(problem, checked["objective"])
+    return SolveRequest.for_problem(problem, **checked)
+
+
 def solve_plan(problem: Any, formulation_: str = "auto", objective: str | None = None) -> str:
     """The formulation :func:`optdesign.solve` will use for ``objective``, after the
-    checks that need no solve (the file's solver options, a combination no formulation
-    honours), so that a caller refuses before any work."""
+    checks that need no solve (a named formulation that does not apply, the file's
+    solver options, a combination no formulation honours), so that a caller refuses
+    before any work."""
+    from optdesign.problem.request import SolveRequest
     from optdesign.studies.solve import plan_solve
 
-    return plan_solve(problem, formulation_, objective)
+    request = SolveRequest.for_problem(problem, objective, formulation=formulation_)
+    return plan_solve(problem, request).name
 
 
 def readme_file(argument: str, path: Any) -> Path | None:
