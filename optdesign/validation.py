@@ -359,21 +359,15 @@ def front_store(problem: Any, method: str) -> str | None:
 
 
 def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> None:
-    """A front's time limit (``time_limit``, None: none) is applied by every method
-    named in ``methods``: only a continuous epsilon sweep stops at one (a method object
-    is checked when it runs)."""
+    """A front's time limit (``time_limit``, None: none) is applied by every method in
+    ``methods`` (names or method objects), built as the front builds them: only a
+    continuous epsilon sweep stops at one."""
     if time_limit is None:
         return
-    from optdesign.studies.pareto.catalogue_front import has_catalogue
+    from optdesign.studies.pareto.methods import check_time_limit, make_method
 
-    named = [m for m in methods if isinstance(m, str)]
-    other = [m for m in named if m not in ("epsilon", "uniform")]
-    if other or (named and has_catalogue(problem)):
-        what = f"the {other[0]} method" if other else "a catalogue front"
-        raise ArgumentError(
-            "time_limit",
-            f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
-        )
+    for method_ in methods:
+        check_time_limit(make_method(problem, method_), time_limit)
 
 
 def solve_request(problem: Any, checked: Mapping[str, Any]) -> Any:

@@ -188,16 +188,17 @@ def _no_catalogue(problem: DesignProblem, name: str) -> None:
         raise ProblemError(f"--formulation {name}: {reason}")
 
 
+def continuous_only(problem: DesignProblem, advice: str) -> bool | str:
+    """True when every free variable is continuous, else the reason, ending in
+    ``advice``: a predicate of the formulations that solve no catalogue variable."""
+    disc = [v.name for v in problem.free if v.discrete]
+    return not disc or f"variables {', '.join(disc)} take catalogue values; {advice}"
+
+
 def nlp_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
     """The ``nlp`` formulation's predicate: True unless a variable takes catalogue
     values (then the reason)."""
-    disc = [v.name for v in problem.free if v.discrete]
-    if disc:
-        return (
-            f"variables {', '.join(disc)} take catalogue values; "
-            "use --formulation catalogue (or auto)"
-        )
-    return True
+    return continuous_only(problem, "use --formulation catalogue (or auto)")
 
 
 def solve_nlp_formulation(problem: DesignProblem, request: SolveRequest) -> Result:

@@ -40,7 +40,13 @@ from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import finish, solve_nlp, solver_options, start_points
+from optdesign.studies.nlp_solve import (
+    continuous_only,
+    finish,
+    solve_nlp,
+    solver_options,
+    start_points,
+)
 from optdesign.studies.runner import map_inherited
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -292,13 +298,7 @@ def robust_applies(problem: DesignProblem, request: SolveRequest | None = None) 
             'robust design needs a [tolerances] section (e.g. R = "0.05 mm", '
             'phi0 = "0.1 deg", fit = "uniform")'
         )
-    disc = [v.name for v in problem.free if v.discrete]
-    if disc:
-        return (
-            f"variables {', '.join(disc)} take catalogue values; robust design needs "
-            "continuous variables"
-        )
-    return True
+    return continuous_only(problem, "robust design needs continuous variables")
 
 
 def solve_robust_formulation(problem: DesignProblem, request: SolveRequest) -> Result:
