@@ -55,8 +55,11 @@ def solve(
         A :class:`DesignProblem`, a problem-file path or a problem dict.
     formulation
         ``"auto"`` (catalogue when a variable takes catalogue values, robust when the
-        problem has tolerances, GP when it is a geometric program, else NLP), or one of
-        ``"nlp"``, ``"gp"``, ``"catalogue"``, ``"robust"``.
+        problem has tolerances, GP when it is a geometric program in ``objective``, a
+        formulation of your own that applies (:func:`optdesign.register_formulation`),
+        else NLP), or one of ``"nlp"``, ``"gp"``, ``"catalogue"``, ``"robust"`` or a
+        registered name (:func:`optdesign.formulation_names`); one that does not apply
+        to the problem is refused with the reason, before any work.
     objective
         Objective to minimise (default: the problem's first).
     starts, seed
@@ -98,6 +101,11 @@ def solve(
         Status, objective, design, every objective at the design, active and violated
         constraints, the independent check, the multistart record, bounds/certificates,
         and for a result with no feasible design its diagnosis.
+
+    Notes
+    -----
+    The arguments, checked, travel down as one :class:`optdesign.SolveRequest`: the
+    record a formulation's ``applies`` and ``solve`` receive.
     """
     from optdesign.studies.solve import solve as run
 
