@@ -55,8 +55,11 @@ def solve(
         A :class:`DesignProblem`, a problem-file path or a problem dict.
     formulation
         ``"auto"`` (catalogue when a variable takes catalogue values, robust when the
-        problem has tolerances, GP when it is a geometric program, else NLP), or one of
-        ``"nlp"``, ``"gp"``, ``"catalogue"``, ``"robust"``.
+        problem has tolerances, GP when it is a geometric program in ``objective``, a
+        formulation of your own that applies (:func:`optdesign.register_formulation`),
+        else NLP), or one of ``"nlp"``, ``"gp"``, ``"catalogue"``, ``"robust"`` or a
+        registered name (:func:`optdesign.formulation_names`); one that does not apply
+        to the problem is refused with the reason, before any work.
     objective
         Objective to minimise (default: the problem's first).
     starts, seed
@@ -98,10 +101,15 @@ def solve(
         Status, objective, design, every objective at the design, active and violated
         constraints, the independent check, the multistart record, bounds/certificates,
         and for a result with no feasible design its diagnosis.
+
+    Notes
+    -----
+    The arguments, checked, travel down as one :class:`optdesign.SolveRequest`: the
+    record a formulation's ``applies`` and ``solve`` receive.
     """
     from optdesign.studies.solve import solve as run
 
-    args = validation.solve_arguments(
+    checked = validation.solve_arguments(
         formulation=formulation,
         objective=objective,
         starts=starts,
@@ -116,11 +124,9 @@ def solve(
         time_limit=time_limit,
     )
     problem = load(problem)
-    validation.objective_of(problem, args["objective"])
-    agree = args.pop("agree")
-    spread = args.pop("contact_models")
-    result = run(problem, **args, **({"agree": agree} if agree is not None else {}))
-    if spread and result.design:
+    request = validation.solve_request(problem, checked)
+    result = run(problem, request)
+    if request.contact_models and result.design:
         from optdesign.studies.contact_spread import contact_model_spread
 
         line = contact_model_spread(problem, result.design)

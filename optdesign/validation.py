@@ -64,9 +64,9 @@ from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints, solver_names
 
 def formulation(argument: str, value: Any) -> str:
     """``auto`` or a registered formulation."""
-    from optdesign.studies.solve import FORMULATIONS
+    from optdesign.studies.formulation_registry import formulation_names
 
-    return choice(argument, value, ["auto", *FORMULATIONS], "formulation")
+    return choice(argument, value, ["auto", *formulation_names()], "formulation")
 
 
 def solver(argument: str, value: Any) -> str | None:
@@ -360,30 +360,38 @@ def front_store(problem: Any, method: str) -> str | None:
 
 
 def front_time_limit(problem: Any, methods: Sequence[Any], time_limit: Any) -> None:
-    """A front's time limit (``time_limit``, None: none) is applied by every method
-    named in ``methods``: only a continuous epsilon sweep stops at one (a method object
-    is checked when it runs)."""
+    """A front's time limit (``time_limit``, None: none) is applied by every method in
+    ``methods`` (names or method objects), built as the front builds them: only a
+    continuous epsilon sweep stops at one."""
     if time_limit is None:
         return
-    from optdesign.studies.pareto.catalogue_front import has_catalogue
+    from optdesign.studies.pareto.methods import check_time_limit, make_method
 
-    named = [m for m in methods if isinstance(m, str)]
-    other = [m for m in named if m not in ("epsilon", "uniform")]
-    if other or (named and has_catalogue(problem)):
-        what = f"the {other[0]} method" if other else "a catalogue front"
-        raise ArgumentError(
-            "time_limit",
-            f"not applied by {what}: only a continuous epsilon sweep stops at a time limit",
-        )
+    for method_ in methods:
+        check_time_limit(make_method(problem, method_), time_limit)
+
+
+def solve_request(problem: Any, checked: Mapping[str, Any]) -> Any:
+    """The :class:`~optdesign.problem.request.SolveRequest` of :func:`optdesign.solve`
+    on ``problem`` (loaded), from its arguments as :func:`solve_arguments` returned them
+    (checked before the problem was loaded): the objective checked among the problem's,
+    the request built once."""
+    from optdesign.problem.request import SolveRequest
+
+    objective_of(problem, checked["objective"])
+    return SolveRequest.for_problem(problem, **checked)
 
 
 def solve_plan(problem: Any, formulation_: str = "auto", objective: str | None = None) -> str:
     """The formulation :func:`optdesign.solve` will use for ``objective``, after the
-    checks that need no solve (the file's solver options, a combination no formulation
-    honours), so that a caller refuses before any work."""
+    checks that need no solve (a named formulation that does not apply, the file's
+    solver options, a combination no formulation honours), so that a caller refuses
+    before any work."""
+    from optdesign.problem.request import SolveRequest
     from optdesign.studies.solve import plan_solve
 
-    return plan_solve(problem, formulation_, objective)
+    request = SolveRequest.for_problem(problem, objective, formulation=formulation_)
+    return plan_solve(problem, request).name
 
 
 def readme_file(argument: str, path: Any) -> Path | None:

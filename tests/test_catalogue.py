@@ -73,14 +73,15 @@ def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
 
 
 def test_catalogue_problem_is_never_solved_as_continuous():
-    from optdesign.studies.solve import choose_formulation, solve
+    import optdesign as od
+    from optdesign.studies.formulation_registry import choose_formulation
 
     problem = load_problem(CATALOGUE)
     assert choose_formulation(problem, "auto") == "catalogue"
     with pytest.raises(ProblemError, match="catalogue values"):
-        solve(problem, "nlp", starts=1)
+        od.solve(problem, "nlp", starts=1)
     with pytest.raises(ProblemError, match=r"variable p: .*catalogue"):
-        solve(problem, "gp", starts=1)
+        od.solve(problem, "gp", starts=1)
 
 
 def test_node_solver_ipopt_options_file_wins_over_node_defaults():

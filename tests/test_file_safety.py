@@ -611,29 +611,36 @@ def test_read_file_caps_and_refuses_special_files(tmp_path):
         scan_store(tmp_path / "s.jsonl")
 
 
-def test_a_refused_run_leaves_no_default_output_folder(tmp_path, monkeypatch, capsys):
-    """A run refused after its default folder was made (the GP check needs the model)
-    removes the folder again: nothing in the working directory; one line names why."""
+def test_a_refused_run_leaves_no_default_output_folder(
+    tmp_path, tmp_path_factory, monkeypatch, capsys
+):
+    """A run refused after its default folder was made (a [reference] is checked when
+    the formulation starts) removes the folder again: nothing in the working directory;
+    one line names why. A formulation named that does not apply is refused before any
+    folder is made, even one the user named."""
     monkeypatch.chdir(tmp_path)
-    code = main(["solve", str(ROOT / "problems" / "cs_min_backlash.toml"), "--formulation", "gp"])
+    cs = ["solve", str(ROOT / "problems" / "cs_min_backlash.toml"), "--formulation", "gp"]
+    code = main(cs)
     err = capsys.readouterr().err
     assert code == 2
     assert list(tmp_path.iterdir()) == []
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "\\n" not in lines[0]
     assert "not a geometric program: variable n: not DGP" in lines[0]
+    assert main([*cs, "--out", "mine"]) == 2 and list(tmp_path.iterdir()) == []
+    assert "not a geometric program" in capsys.readouterr().err
+    # the GP formulation checks the file's [reference] once the folder is made
+    bad = tmp_path_factory.mktemp("files") / "bad.toml"
+    fork = (ROOT / "problems" / "fork_min_backlash.toml").read_text()
+    bad.write_text(fork + '\n[reference]\nR = "60 mm"\n')
+    code = main(["solve", str(bad)])
+    err = capsys.readouterr().err
+    assert code == 2 and list(tmp_path.iterdir()) == []
+    assert err.strip().splitlines() == [
+        "optdesign: error: reference.p: missing (every free variable needs a value)"
+    ]
     # a folder the user named is kept, empty or not
-    code = main(
-        [
-            "solve",
-            str(ROOT / "problems" / "cs_min_backlash.toml"),
-            "--formulation",
-            "gp",
-            "--out",
-            "mine",
-        ]
-    )
-    assert code == 2 and (tmp_path / "mine").is_dir()
+    assert main(["solve", str(bad), "--out", "mine"]) == 2 and (tmp_path / "mine").is_dir()
     # a run that writes keeps its default folder
     problem = ROOT / "problems" / "fork_min_backlash.toml"
     assert main(["solve", str(problem), *QUICK, "--no-plot", "--no-report"]) == 0

@@ -127,7 +127,7 @@ def test_cli_gp_on_a_non_gp_problem_names_the_variable(capsys):
 
 def test_auto_picks_gp_for_the_fork_and_nlp_for_the_crank_slider():
     from optdesign.cli import _load_plugins
-    from optdesign.studies.solve import choose_formulation
+    from optdesign.studies.formulation_registry import choose_formulation
 
     _load_plugins()
     assert choose_formulation(load_problem(FORK), "auto") == "gp"
@@ -140,7 +140,7 @@ def test_auto_decides_with_the_chosen_objective():
     pick gp and refuse "not a geometric program"."""
 
     import optdesign as od
-    from optdesign.studies.solve import choose_formulation
+    from optdesign.studies.formulation_registry import choose_formulation
 
     problem = od.load(FORK)
     assert choose_formulation(problem, "auto") == "gp"

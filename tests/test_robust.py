@@ -140,7 +140,7 @@ def test_monte_carlo_with_no_scatter_is_the_nominal_value(problem):
 
 def test_auto_picks_robust_for_a_file_with_tolerances():
     from optdesign.cli import build_parser
-    from optdesign.studies.solve import choose_formulation
+    from optdesign.studies.formulation_registry import choose_formulation
 
     build_parser()  # registers the formulations and their auto predicates
     from optdesign.problem import load_problem

@@ -37,6 +37,7 @@ from optdesign.formulations.discrete import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.details import CatalogueCombination, CatalogueDetails
 from optdesign.solvers.multistart import (
     best_of,
@@ -431,17 +432,22 @@ def relaxation_bound(result: Result) -> float:
     return float("nan") if result.bound is None else float(result.bound)
 
 
-def solve_catalogue_formulation(problem: DesignProblem, **options: Any) -> Result:
+def catalogue_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
+    """The ``catalogue`` formulation's predicate: some free variable takes catalogue
+    values (the objective does not matter)."""
+    return bool(discrete_variables(problem)) or "no variable takes catalogue values"
+
+
+def solve_catalogue_formulation(problem: DesignProblem, request: SolveRequest) -> Result:
     """``formulation="catalogue"``: the exact catalogue optimum and its relaxation bound."""
     reference_design(problem)
     result = solve_catalogue(
         problem,
-        method=options.get("method") or "auto",
-        starts=options.get("starts"),
-        seed=options.get("seed"),
-        objective=options.get("objective"),
-        solver=options.get("solver"),
-        options=options.get("options"),
+        starts=request.starts,
+        seed=request.seed,
+        objective=request.objective,
+        solver=request.solver,
+        options=request.options,
     )
     return attach_reference(problem, result)
 

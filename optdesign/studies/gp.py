@@ -8,13 +8,13 @@ the same problem (warm-started from the GP design), and the relative gap between
 from __future__ import annotations
 
 import time
-from typing import Any
 
 import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp import GPData, build_gp
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.details import ExactNLP, GPDetails, GPRows, GPTiming
 from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
 from optdesign.solvers.result import Result
@@ -26,11 +26,15 @@ def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
     """The GP of ``problem``; raise ProblemError naming what breaks DGP form otherwise."""
     gp = build_gp(problem, objective)
     if not gp.is_gp:
-        raise ProblemError(
-            f"--formulation gp: problem {problem.name!r} is not a geometric program: "
-            + "; ".join(gp.explain().splitlines())
-        )
+        raise ProblemError(f"--formulation gp: {not_gp(problem, gp)}")
     return gp
+
+
+def not_gp(problem: DesignProblem, gp: GPData) -> str:
+    """Why ``problem`` is not a geometric program: what breaks DGP form in ``gp``."""
+    return f"problem {problem.name!r} is not a geometric program: " + "; ".join(
+        gp.explain().splitlines()
+    )
 
 
 def solve_gp_problem(
@@ -118,16 +122,23 @@ def solve_gp_problem(
     return result
 
 
-def solve_gp_formulation(problem: DesignProblem, **options: Any) -> Result:
+def gp_applies(problem: DesignProblem, request: SolveRequest) -> bool | str:
+    """The ``gp`` formulation's predicate: the problem is a geometric program in the
+    request's objective (else what breaks DGP form)."""
+    gp = build_gp(problem, request.objective)
+    return gp.is_gp or not_gp(problem, gp)
+
+
+def solve_gp_formulation(problem: DesignProblem, request: SolveRequest) -> Result:
     """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
     reference_design(problem)  # validate [reference] before solving
-    named = options.get("solver")
+    named = request.solver
     solver = solver_for_kind(named, "gp")
     result = solve_gp_problem(
         problem,
-        objective=options.get("objective"),
-        nlp_starts=options.get("starts"),
-        seed=options.get("seed"),
+        objective=request.objective,
+        nlp_starts=request.starts,
+        seed=request.seed,
         solver=solver,
     )
     if named and named != solver:

@@ -2,10 +2,11 @@
 (thread-safe caches), the multistart from Sobol starts, the independent check of the
 best point on the NumPy path (:func:`finish`) and the ranges of the optimal set.
 
-Shared by every formulation and study that solves an NLP (the ``nlp`` formulation, the
+Shared by every formulation and study that solves an NLP (the ``nlp`` formulation, whose
+predicate and solve are :func:`nlp_applies` and :func:`solve_nlp_formulation`, the
 catalogue's nodes, the robust and GP formulations' exact NLP, the diagnosis, the fronts);
-the formulation registry and :func:`~optdesign.studies.solve.solve` sit above it in
-:mod:`optdesign.studies.solve`.
+the formulation registry (:mod:`optdesign.studies.formulation_registry`) and
+:func:`~optdesign.studies.solve.solve` sit above it.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import numpy as np
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.multistart import multistart, sobol_starts
 from optdesign.solvers.registry import default_solver, make_solver, solver_hints
 from optdesign.solvers.result import (
@@ -29,6 +31,7 @@ from optdesign.solvers.result import (
     SolutionStatus,
     TerminationCondition,
 )
+from optdesign.studies.reference import attach_reference
 from optdesign.studies.runner import map_inherited
 from optdesign.studies.verify import nan_notes, verify_design
 from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
@@ -180,12 +183,39 @@ def _objective_set(problem: DesignProblem, objective: str) -> tuple[str, ...]:
 
 
 def _no_catalogue(problem: DesignProblem, name: str) -> None:
+    reason = nlp_applies(problem)
+    if reason is not True:
+        raise ProblemError(f"--formulation {name}: {reason}")
+
+
+def continuous_only(problem: DesignProblem, advice: str) -> bool | str:
+    """True when every free variable is continuous, else the reason, ending in
+    ``advice``: a predicate of the formulations that solve no catalogue variable."""
     disc = [v.name for v in problem.free if v.discrete]
-    if disc:
-        raise ProblemError(
-            f"--formulation {name}: variables {', '.join(disc)} take catalogue values; "
-            "use --formulation catalogue (or auto)"
-        )
+    return not disc or f"variables {', '.join(disc)} take catalogue values; {advice}"
+
+
+def nlp_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
+    """The ``nlp`` formulation's predicate: True unless a variable takes catalogue
+    values (then the reason)."""
+    return continuous_only(problem, "use --formulation catalogue (or auto)")
+
+
+def solve_nlp_formulation(problem: DesignProblem, request: SolveRequest) -> Result:
+    """``formulation="nlp"``: the multistart NLP of the request, checked against the
+    file's reference design when it has one."""
+    result = solve_nlp(
+        problem,
+        objective=request.objective,
+        starts=request.starts,
+        seed=request.seed,
+        workers=request.workers,
+        solver=request.solver,
+        options=request.options,
+        agree=request.agree,
+        time_limit=request.time_limit,
+    )
+    return attach_reference(problem, result)
 
 
 def optimal_ranges(

@@ -34,12 +34,19 @@ from optdesign.formulations.robust import (
     tolerances_of,
 )
 from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
+from optdesign.problem.request import SolveRequest
 from optdesign.reports.tables import format_table
 from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import finish, solve_nlp, solver_options, start_points
+from optdesign.studies.nlp_solve import (
+    continuous_only,
+    finish,
+    solve_nlp,
+    solver_options,
+    start_points,
+)
 from optdesign.studies.runner import map_inherited
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -266,27 +273,37 @@ def _attach_sensitivities(
         result.notes.append(f"sensitivities not computed: {exc}")
 
 
-def solve_robust_formulation(problem: DesignProblem, **options: Any) -> Result:
+def robust_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
+    """The ``robust`` formulation's predicate: the problem has tolerances and its
+    variables are continuous (else the reason)."""
+    if problem.spec.tolerances is None:
+        return (
+            'robust design needs a [tolerances] section (e.g. R = "0.05 mm", '
+            'phi0 = "0.1 deg", fit = "uniform")'
+        )
+    return continuous_only(problem, "robust design needs continuous variables")
+
+
+def solve_robust_formulation(problem: DesignProblem, request: SolveRequest) -> Result:
     """``formulation="robust"``: the nominal optimum (multistart), then the robust optimum
     started from it."""
-    objective = options.get("objective") or problem.objective_names[0]
-    solver = options.get("solver")
+    objective = request.objective
     nominal = solve_nlp(
         problem,
         objective=objective,
-        starts=options.get("starts"),
-        seed=options.get("seed"),
-        workers=options.get("workers") or 1,
-        solver=solver,
-        options=options.get("options"),
+        starts=request.starts,
+        seed=request.seed,
+        workers=request.workers,
+        solver=request.solver,
+        options=request.options,
     )
     x0 = np.array([nominal.design[v.name] for v in problem.free]) if nominal.design else None
     result = solve_robust(
         problem,
         x0=x0,
         objective=objective,
-        solver=solver,
-        options=options.get("options"),
+        solver=request.solver,
+        options=request.options,
         sensitivities=True,
     )
     result.details.robust.nominal_optimum = NominalOptimum(

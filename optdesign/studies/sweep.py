@@ -34,6 +34,7 @@ import numpy as np
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.studies.sensitivity import at_values
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -308,15 +309,16 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
     if not task["continuation"]:
         from optdesign.studies.solve import solve
 
-        best = solve(
+        request = SolveRequest.for_problem(
             problem,
-            objective=objective,
+            objective,
             starts=task["starts"],
             seed=task["seed"],
             ranges=False,
             diagnose=True,  # an infeasible point: what to relax (no design to show)
             sensitivities=task["sensitivities"],  # a catalogue's: with its neighbouring items
         )
+        best = solve(problem, request)
         solves, checked = 1, True
     else:
         shared = _shared_solver(task)

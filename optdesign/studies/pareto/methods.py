@@ -26,6 +26,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from optdesign.argument_checks import ArgumentError
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
@@ -431,14 +432,17 @@ def make_method(
 
 
 def check_time_limit(method: Any, time_limit: float | None, field: str = "time_limit") -> None:
-    """Refuse a time limit the method does not apply (only continuous epsilon sweeps stop
-    at one)."""
-    if time_limit is not None and not getattr(method, "honours_time_limit", False):
-        raise InputError(
-            field,
-            f"not applied by the {getattr(method, 'name', type(method).__name__)} method: "
-            "only a continuous epsilon sweep ('epsilon', 'uniform') stops at a time limit",
-        )
+    """Refuse a time limit the method (an object, see :func:`make_method`) does not
+    apply: only a continuous epsilon sweep stops at one. The one refusal of
+    :func:`optdesign.pareto` and ``optdesign pareto``, before any work."""
+    if time_limit is None or getattr(method, "honours_time_limit", False):
+        return
+    what = getattr(method, "what", FrontMethod.what)
+    if what == FrontMethod.what:  # a method that does not describe itself: its name
+        what = f"the {getattr(method, 'name', type(method).__name__)} method"
+    raise ArgumentError(
+        field, f"not applied by {what}: only a continuous epsilon sweep stops at a time limit"
+    )
 
 
 def compute_front(
