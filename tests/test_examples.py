@@ -12,7 +12,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 EXAMPLE = EXAMPLES / "custom_mechanism.py"
 
 
-@pytest.mark.parametrize("name", ["custom_mechanism.py", "bell_crank.py"])
+@pytest.mark.parametrize("name", ["custom_mechanism.py", "bell_crank.py", "fin_actuator_sweep.py"])
 def test_examples_use_only_public_names(name):
     tree = ast.parse((EXAMPLES / name).read_text())
     for node in ast.walk(tree):
@@ -48,3 +48,21 @@ def test_custom_mechanism_solves_fronts_and_benches(tmp_path):
     rows = {r["config"]: r for r in report.rows}
     assert rows["ipopt-exact"]["success"] and rows["slsqp-exact"]["success"]
     assert rows["ipopt-exact"]["objective"] == pytest.approx(result.objective, rel=1e-6)
+
+
+def test_the_fin_actuator_sweep_example_states_a_valid_sweep():
+    """examples/fin_actuator_sweep.py (minutes to run: its chart is in docs/) names a
+    problem and parameters od.sweep takes: the lock of 60 N, both axes of the right
+    dimension, 7 x 3 points."""
+    import optdesign as od
+    from optdesign.studies.sweep import parameter_dimension
+
+    module = runpy.run_path(str(EXAMPLES / "fin_actuator_sweep.py"), run_name="example")
+    problem = od.load(module["strong_lock_actuator"]())
+    assert problem.spec.requirements.lock.force_max == pytest.approx(60.0)  # N
+    dims = {path: parameter_dimension(problem, path) for path in module["VARY"]}
+    assert dims == {
+        "requirements.hinge_moment": "moment",
+        "requirements.deflection_rate": "angular_speed",
+    }
+    assert [spec[2] for spec in module["VARY"].values()] == [7, 3]
