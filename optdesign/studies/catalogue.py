@@ -101,8 +101,9 @@ class NodeSolver:
         node = solver_hints(solver).node_options
         if node is not None:
             # The back-end's node options (infeasible boxes are common; a node still
-            # counts as infeasible only once all its starts and RETRY_STARTS more say
-            # so), then the problem file's own options, then the caller's.
+            # counts as infeasible only once all its starts say so, and RETRY_STARTS
+            # more unless verdicts_decide), then the problem file's own options, then
+            # the caller's.
             options = {**node, **solver_options(problem, solver), **(options or {})}
         self.backend = solver_for(problem, solver, options, names)
         self.verdicts = solver_hints(solver).infeasible_verdicts

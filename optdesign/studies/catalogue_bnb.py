@@ -25,9 +25,13 @@ infeasible is a sub-box of one whose NLP had no feasible start, under tighter li
 (the NLP's feasible set only shrinks). Heuristic, as before: the node NLPs are non-convex
 and solved locally, so a node's bound is the best local optimum its starts found. A node
 is pruned, or called infeasible, only on the same starts as the cold search (the warm
-start plus the multistart and its retries); what the warm start changes is the bound of
-a node it does not prune (one start instead of several), which steers the order of the
-search and the branching variable, not which node may be discarded. A first incumbent
+start plus the multistart, and its retries unless two starts or more all ended with the
+back-end's verdict of local infeasibility: :meth:`NodeSolver.verdicts_decide`); a
+combination met again as a leaf is solved from the new start, and with the full
+multistart again only when that start beats its stored value. What the warm start
+changes is the bound of a node it does not prune (one start instead of several), which
+steers the order of the search and the branching variable, not which node may be
+discarded. A first incumbent
 prunes only what the search itself would prune, so it changes the work, not the answer.
 
 Ties are decided by value, then by the items: of two combinations whose objectives tie
