@@ -99,3 +99,37 @@ def test_node_solver_ipopt_options_file_wins_over_node_defaults():
     assert own.backend.options["ipopt"]["expect_infeasible_problem"] == "no"
     caller = NodeSolver(problem_from_dict(data), options={"expect_infeasible_problem": "yes"})
     assert caller.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
+
+
+def _weak_pins():
+    """The shipped problem with 4 and 5 mm pins: too weak for the hinge moment whatever
+    the lead, so every node is infeasible."""
+    data = tomllib.loads(CATALOGUE.read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["4 mm", "5 mm"]}
+    return problem_from_dict(data)
+
+
+def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
+    """Ipopt's own verdict on every start decides the node: 2 starts, no retries; a
+    start stopped by its iteration limit, or a single start, still gets the
+    RETRY_STARTS retries."""
+    from optdesign.studies.catalogue import RETRY_STARTS, NodeSolver
+
+    box = {"p": (5.0, 5.0), "d": (4.0, 4.0)}
+    ns = NodeSolver(_weak_pins(), starts=2)
+    r = ns.solve(box)
+    assert r.status == "infeasible"
+    assert r.multistart.outcomes == ["locally infeasible"] * 2
+    assert ns.n_solves == r.multistart.n_starts == 2
+    assert ns.verdicts == ("Infeasible_Problem_Detected",)
+    # 5 iterations stop every start before a verdict: the retries run
+    capped = NodeSolver(_weak_pins(), starts=2, options={"max_iter": 5})
+    r = capped.solve(box)
+    assert r.status != "optimal"
+    assert r.multistart.n_starts == capped.n_solves == 2 + RETRY_STARTS
+    assert r.multistart.outcomes[:2] == ["iteration limit"] * 2
+    # a single start's verdict is retried (e.g. from a neighbouring optimum)
+    one = NodeSolver(_weak_pins(), starts=1)
+    r = one.solve(box)
+    assert r.multistart.outcomes == ["locally infeasible"] * (1 + RETRY_STARTS)

@@ -153,3 +153,30 @@ def test_first_feasible_searches_the_rest_of_a_box_whose_relaxation_sat_on_items
     assert found is not None and found.success
     assert (found.design["a"], found.design["b"]) == (2.0, 3.0)
     assert {"a": (2.0, 2.0), "b": (4.0, 4.0)} in ns.boxes  # the failed leaf was tried
+
+
+class CountedNodes(TiedNodes):
+    """The tied node solver, recording how each box was solved."""
+
+    def __init__(self):
+        super().__init__()
+        self.calls: list[tuple[dict, bool]] = []
+
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True):
+        self.calls.append((dict(box), warm and x_hint is not None and not fallback))
+        return super().solve(box, x_hint, warm, prunes, fallback)
+
+
+def test_a_combination_met_again_is_solved_from_the_new_start_only():
+    """The root sits on (2, 4), a leaf; the box a = 2 it splits off sits on (2, 4) again:
+    that combination gets its full multistart once, then only the new start (which does
+    not beat it), and the answer is the same."""
+    ns = CountedNodes()
+    best, _ = branch_and_bound_warm(ns, ns.solve({}), ())
+    assert (best.design["a"], best.design["b"]) == (2.0, 1.0)
+    leaf = {"a": (2.0, 2.0), "b": (4.0, 4.0)}
+    how = [one_start for box, one_start in ns.calls if box == leaf]
+    assert how == [False, True]
+    full = [tuple(sorted(box.items())) for box, one_start in ns.calls if not one_start]
+    fixed = [b for b in full if all(lo == hi for _, (lo, hi) in b)]
+    assert len(fixed) == len(set(fixed))  # no combination's multistart twice

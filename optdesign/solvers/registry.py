@@ -40,6 +40,11 @@ class SolverHints:
     restart_options: Mapping[str, Any] | None = None
     #: options of a solve that may meet an infeasible sub-problem (a catalogue node)
     node_options: Mapping[str, Any] | None = None
+    #: the back-end's return messages (``Result.message``) by which it declares that it
+    #: converged to a point of local infeasibility, as opposed to a stop (iterations,
+    #: errors) or a solved point that fails the check: a catalogue node whose every
+    #: start ended with one of them is not retried (empty: every failed node is)
+    infeasible_verdicts: tuple[str, ...] = ()
     #: options of the back-end as the primary solver of a front's sweep
     sweep_options: Mapping[str, Any] | None = None
     #: the option that caps the iterations (None: none a study may set)
@@ -300,6 +305,7 @@ def _builtins() -> None:
         warm_start_options=IPOPT_WARM,
         restart_options=IPOPT_TIE,
         node_options=IPOPT_NODE,
+        infeasible_verdicts=("Infeasible_Problem_Detected",),
         iteration_option="max_iter",
         deadline_options={DEADLINE_OPTION: True},
         time_limit_options=("max_wall_time", "max_cpu_time"),

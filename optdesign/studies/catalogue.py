@@ -71,7 +71,11 @@ class NodeSolver:
     One solver (:func:`optdesign.studies.nlp_solve.solver_for`) serves every node: a node
     only passes its own variable bounds. A node whose starts all fail is tried again from
     :data:`RETRY_STARTS` more Sobol starts before it counts as infeasible, so a poor
-    first start (e.g. a declared one) never makes a feasible problem look infeasible.
+    first start (e.g. a declared one) that stops at an iteration limit or an error never
+    makes a feasible problem look infeasible; when two starts or more all ended with the
+    back-end's own verdict of local infeasibility (:meth:`verdicts_decide`), the node is
+    infeasible on those starts (over the catalogue instance family no retry ever found a feasible
+    point after such starts: benchmarks/README.md, "Catalogue searches (issue 25)").
     """
 
     def __init__(
@@ -97,10 +101,12 @@ class NodeSolver:
         node = solver_hints(solver).node_options
         if node is not None:
             # The back-end's node options (infeasible boxes are common; a node still
-            # counts as infeasible only once all its starts and RETRY_STARTS more say
-            # so), then the problem file's own options, then the caller's.
+            # counts as infeasible only once all its starts say so, and RETRY_STARTS
+            # more unless verdicts_decide), then the problem file's own options, then
+            # the caller's.
             options = {**node, **solver_options(problem, solver), **(options or {})}
         self.backend = solver_for(problem, solver, options, names)
+        self.verdicts = solver_hints(solver).infeasible_verdicts
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
         self.starts = max(1, starts)
@@ -174,8 +180,9 @@ class NodeSolver:
                 self.n_cold += 1
         results += [self.backend.solve(start(x0=p), self.target, box) for p in pts]
         if not any(r.success for r in results):
-            retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
-            results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
+            if not self.verdicts_decide(results):
+                retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
+                results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
             if not any(r.success for r in results):
                 if self.memo is not None:
                     self.memo.add_infeasible(bounds, self.eps)
@@ -195,6 +202,19 @@ class NodeSolver:
             failed=outcome_counts(outcomes),
         )
         return best
+
+    def verdicts_decide(self, results: Sequence[Result]) -> bool:
+        """Whether the failed starts of a node call it infeasible without the retries:
+        at least two starts, every one ended with the back-end's own verdict of local
+        infeasibility (:attr:`~optdesign.solvers.registry.SolverHints.infeasible_verdicts`).
+        A start stopped by its iteration limit or an error, or a solved point that fails
+        the check, leaves the node to the retries; so does a single start (a node solver
+        of one start: the neighbouring items of an optimum, the diagnosis)."""
+        return (
+            len(results) >= 2
+            and bool(self.verdicts)
+            and all(r.message in self.verdicts for r in results)
+        )
 
     def x_of(self, result: Result) -> np.ndarray | None:
         if not result.design:

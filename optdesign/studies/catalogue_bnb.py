@@ -25,9 +25,13 @@ infeasible is a sub-box of one whose NLP had no feasible start, under tighter li
 (the NLP's feasible set only shrinks). Heuristic, as before: the node NLPs are non-convex
 and solved locally, so a node's bound is the best local optimum its starts found. A node
 is pruned, or called infeasible, only on the same starts as the cold search (the warm
-start plus the multistart and its retries); what the warm start changes is the bound of
-a node it does not prune (one start instead of several), which steers the order of the
-search and the branching variable, not which node may be discarded. A first incumbent
+start plus the multistart, and its retries unless two starts or more all ended with the
+back-end's verdict of local infeasibility: :meth:`NodeSolver.verdicts_decide`); a
+combination met again as a leaf is solved from the new start, and with the full
+multistart again only when that start beats its stored value. What the warm start
+changes is the bound of a node it does not prune (one start instead of several), which
+steers the order of the search and the branching variable, not which node may be
+discarded. A first incumbent
 prunes only what the search itself would prune, so it changes the work, not the answer.
 
 Ties are decided by value, then by the items: of two combinations whose objectives tie
@@ -252,6 +256,21 @@ def branch_and_bound_warm(
             seed_key = combination_key(seed_items, names)
         heapq.heappush(heap, (root.objective, next(counter), full, root, None))
 
+    solved: dict[tuple[float, ...], Result] = {}  # each combination's full multistart
+
+    def leaf_solve(box: Box, x) -> Result:
+        # A combination solved before (from another node's optimum) is solved again only
+        # from the new start: the rest of its multistart is the same Sobol points. The
+        # full multistart runs again only when that start beats the stored value.
+        key = box_key(box, names)
+        done = solved.get(key)
+        if done is not None:
+            new = ns.solve(box, x, warm=True, fallback=False)
+            if not (new.success and (not done.success or improves(new.objective, done.objective))):
+                return done
+        solved[key] = ns.solve(box, x)
+        return solved[key]
+
     def prunes(bound: float, box: Box) -> bool:
         # the same rule against the search's incumbent and the candidate: worse beyond
         # the tie tolerance, or a tie that no combination of the box can win on its items
@@ -283,7 +302,7 @@ def branch_and_bound_warm(
             if one_combination:
                 leaf = res  # already solved with every catalogue variable fixed
             else:
-                leaf = ns.solve(fixed_box(items), x)
+                leaf = leaf_solve(fixed_box(items), x)
                 stats["nodes"] += 1
             stats["leaves"] += 1
             key = combination_key(items, names)
@@ -308,7 +327,7 @@ def branch_and_bound_warm(
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
             # a box of one combination is a leaf: its value is reported, full multistart
             if fixed:
-                r = ns.solve(child, x)
+                r = leaf_solve(child, x)
             else:
                 r = ns.solve(child, x, warm=True, prunes=partial(_prunes_box, prunes, child))
             stats["nodes"] += 1
