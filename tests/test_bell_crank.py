@@ -189,6 +189,16 @@ def test_a_mechanism_whose_pins_are_undeclared_is_told_when_registered():
     with pytest.raises(UserCodeError, match="pin_joints must be a tuple of distinct names"):
         od.register_mechanism(Twice)
 
+    # each of the three conditions refuses on its own: a list of good names, a blank name
+    for bad in (["pin (nut)"], ("pin (nut)", "  ")):
+
+        class Odd(Lever):
+            name = "t23_odd"
+            pin_joints = bad
+
+        with pytest.raises(UserCodeError, match="pin_joints must be a tuple of distinct"):
+            od.register_mechanism(Odd)
+
     class TwoInLine(Lever):
         name = "t23_two_in_line"
         pin_joints = ("pin (nut)", "pin (lever)")

@@ -97,5 +97,6 @@ def test_the_command_line_builds_methods_as_od_pareto_does(tmp_path):
     assert make_method(problem, "uniform", 7, starts=2) == EpsilonConstraint(
         points=7, spacing="uniform", name="uniform", starts=2
     )
-    with pytest.raises(InputError, match="weighted_sum would leave the catalogue"):
+    with pytest.raises(InputError, match="weighted_sum would leave the catalogue") as caught:
         make_method(catalogue, "weighted_sum", 7)
+    assert caught.value.field == "method"  # the argument named, as od.pareto spells it

@@ -57,6 +57,19 @@ def test_tracer_merges_like_terms_into_a_monomial():
     # a difference that does not cancel stays a signomial; abs of it is not DGP
     assert isinstance(abs(R - 50.0), NotGP)
     assert isinstance(np.cos(R), NotGP)
+    # abs of a sum of negative terms is its negation (a posynomial), of positive ones itself
+    flipped = abs(-2.0 * R - 3.0)
+    assert isinstance(flipped, Signomial) and flipped.terms[(1.0, 0.0)] == pytest.approx(2.0)
+    assert flipped.terms[(0.0, 0.0)] == pytest.approx(3.0)
+    assert abs(2.0 * R) is not None and abs(2.0 * R).terms[(1.0, 0.0)] == pytest.approx(2.0)
+
+
+def test_an_objective_the_model_does_not_give_is_named_in_the_gp_diagnosis():
+    fork = load_problem(ROOT / "problems" / "fork_min_backlash.toml")
+    checks = [c for c in build_gp(fork, "no_such").checks if c.what == "objective"]
+    assert [(c.name, c.ok, c.reason) for c in checks] == [
+        ("no_such", False, "objective not available for this problem")
+    ]
 
 
 def test_iso286_fit_is_a_posynomial_that_matches_the_numbers():

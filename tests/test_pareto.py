@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign.problem import load_problem
 from optdesign.problem.design_problem import relative_violation
 from optdesign.studies.pareto import compute_front
@@ -355,3 +356,12 @@ def test_catalogue_problem_fronts_stay_on_the_catalogue_or_are_refused(tmp_path,
     for p in front.points:
         for name, values in items.items():
             assert p.design[name] in values
+
+
+def test_the_front_solver_reaches_every_point(fork, tmp_path):
+    """solver="ipopt" solves every epsilon point with Ipopt (the primary throughout);
+    by default the registry's primary (SLSQP) solves the points it can."""
+    ipopt = od.pareto(fork, ["size", "backlash"], 6, out=tmp_path / "i", starts=2, solver="ipopt")
+    assert ipopt.points and {p.solver for p in ipopt.points} == {"ipopt"}
+    default = od.pareto(fork, ["size", "backlash"], 6, out=tmp_path / "d", starts=2)
+    assert "scipy-slsqp-exact" in {p.solver for p in default.points}

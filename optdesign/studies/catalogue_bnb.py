@@ -183,7 +183,7 @@ def shared_memo(key: tuple, full: Box) -> InfeasibleBoxes:
     return _MEMOS[key]
 
 
-def _on_items(ns, dvars, box: Box, res: Result) -> tuple[Any, dict[str, float]]:
+def _on_items(dvars, box: Box, res: Result) -> tuple[Any, dict[str, float]]:
     """The catalogue variable farthest (relatively) from an item in its range (None when
     every one sits on an item) and the nearest items."""
     worst, worst_d, items = None, ON_ITEM_TOL, {}
@@ -295,7 +295,7 @@ def branch_and_bound_warm(
             stats["pruned"] += 1
             continue
         x = ns.x_of(res)
-        worst, items = _on_items(ns, dvars, box, res)
+        worst, items = _on_items(dvars, box, res)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
             one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
