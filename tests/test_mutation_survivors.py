@@ -329,3 +329,12 @@ def test_an_objective_without_a_problem_or_a_declaration_is_shown_bare():
     assert objective_shown(problem, "not_an_objective", 2.0) == Shown(2.0, "")
     shown = objective_shown(problem, "CVaR_0.9(backlash)", 0.03)  # a statistic of it
     assert shown.unit == "deg" and shown.value == pytest.approx(0.03)
+
+
+def test_an_angle_is_shown_in_the_unit_the_file_wrote_it_in():
+    from optdesign.reports.display_units import shown
+
+    as_rad = shown(0.5, "rad", "rad")
+    assert (as_rad.value, as_rad.unit) == (0.5, "rad")
+    as_deg = shown(0.5, "rad")
+    assert as_deg.unit == "deg" and as_deg.value == pytest.approx(math.degrees(0.5), rel=1e-15)
