@@ -182,3 +182,24 @@ def test_auto_decides_with_the_chosen_objective_on_the_command_line(tmp_path, ca
     text = capsys.readouterr().out
     assert "nlp-epigraph" in text
     assert re.search(r"objective +backlash_rss = 0\.019498", text)
+
+
+def test_a_bound_that_puts_a_sum_of_terms_above_a_constant_is_named_with_its_side():
+    """posynomial >= constant is not DGP: a lower bound on p + d, or an upper bound on
+    -(p + d), each named with its side and the terms."""
+    lower = problem_from_dict(copy.deepcopy(CS_FIXED))
+    lower.add_constraint(
+        "p_plus_d", lambda q: q.design["p"] + q.design["d"], lower="20 mm", unit="mm"
+    )
+    upper = problem_from_dict(copy.deepcopy(CS_FIXED))
+    upper.add_constraint(
+        "p_plus_d", lambda q: -q.design["p"] - q.design["d"], upper="-20 mm", unit="mm"
+    )
+    reasons = [[c.reason for c in build_gp(p).checks if not c.ok] for p in (lower, upper)]
+    assert reasons == [
+        ["p_plus_d: a lower bound 20 on a sum of terms (p + d); posynomial >= constant is not DGP"],
+        [
+            "p_plus_d: an upper bound -20 on a sum of terms (-p - d); posynomial >= constant "
+            "is not DGP"
+        ],
+    ]

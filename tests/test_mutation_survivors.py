@@ -338,3 +338,40 @@ def test_an_angle_is_shown_in_the_unit_the_file_wrote_it_in():
     assert (as_rad.value, as_rad.unit) == (0.5, "rad")
     as_deg = shown(0.5, "rad")
     assert as_deg.unit == "deg" and as_deg.value == pytest.approx(math.degrees(0.5), rel=1e-15)
+
+
+def test_the_dn_row_names_the_diameter_of_its_rule():
+    from optdesign.problem.drive_requirements import drive_blocks
+
+    def dn_text(rule):
+        data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+        data["requirements"]["dn_rule"] = rule
+        problem = problem_from_dict(data)
+        q = problem.quantities(problem.design_dict(problem.midpoint()))
+        return next(b for b in drive_blocks(q, problem.phi_labels) if b.name == "dn").description
+
+    assert dn_text("ball-centre").startswith("d_m x screw speed (DN value; rule ball-centre")
+    assert dn_text("HIWIN") == (
+        "d0 x screw speed (DN value; rule HIWIN: ground limit 90,000 on the nominal diameter)"
+    )
+
+
+def test_the_table_fit_ratio_of_a_catalogue_node_is_iso_286_over_the_formula():
+    """H7/g6 at 6 mm in ISO 286-2's tables: hole +12/0 um, shaft -4/-12 um, so 24 um
+    largest and 4 um smallest clearance; the node's parameter is that over the smooth
+    (IT formula) clearance, the smallest ratio over the node's pins."""
+    from optdesign.fits import clearance
+    from optdesign.problem.drive import _fit_ratios
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    problem = problem_from_dict(data)
+    at6 = _fit_ratios(problem, {"d": (6.0, 6.0)})
+    assert at6["fit_ratio_max"] == pytest.approx(0.024 / clearance("H7/g6", 6.0, "max", "smooth"))
+    assert at6["fit_ratio_min"] == pytest.approx(0.004 / clearance("H7/g6", 6.0, "min", "smooth"))
+    assert at6["fit_ratio_max"] < 0.95  # the table is tighter than the formula here
+    wide = _fit_ratios(problem, {"d": (5.0, 8.0)})
+    ratios = [
+        clearance("H7/g6", D, "max", "table") / clearance("H7/g6", D, "max", "smooth")
+        for D in (5.0, 6.0, 8.0)
+    ]
+    assert wide["fit_ratio_max"] == pytest.approx(min(ratios))

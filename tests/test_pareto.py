@@ -365,3 +365,18 @@ def test_the_front_solver_reaches_every_point(fork, tmp_path):
     assert ipopt.points and {p.solver for p in ipopt.points} == {"ipopt"}
     default = od.pareto(fork, ["size", "backlash"], 6, out=tmp_path / "d", starts=2)
     assert "scipy-slsqp-exact" in {p.solver for p in default.points}
+
+
+def test_each_epsilon_record_names_the_neighbour_it_started_from(fork, tmp_path):
+    """The store says which chain computed each point: an epsilon point starts from the
+    nearer anchor or the point before it in its chain, which the store holds."""
+    import json
+
+    od.pareto(fork, ["size", "backlash"], 6, out=tmp_path, starts=2)
+    lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
+    records = [json.loads(line) for line in lines]
+    ids = {r["id"] for r in records}
+    eps = [r for r in records if r["kind"] == "eps"]
+    assert len(eps) == 6
+    assert all(r["warm"] in ids and r["warm"] != r["id"] for r in eps)
+    assert {r["warm"] for r in eps} >= {"anchor-size", "anchor-backlash"}

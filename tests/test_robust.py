@@ -162,3 +162,17 @@ def test_a_robust_ripple_equals_its_numpy_statistic_at_the_optimum(problem):
     check = robust.details.robust.saa_check
     assert check is not None and robust.objective == pytest.approx(check, rel=1e-6)
     assert "ripple" in robust.details.robust.risk_label
+
+
+def test_requirements_held_at_every_sample_cost_something_and_hold():
+    """constrain_samples=True writes every requirement once per sample: the optimum is
+    verified and no better than with the requirements at the nominal design only."""
+    data = _data(
+        R="0.5 mm", l="0.5 mm", n="0.5 mm", phi0="0.5 deg", fit="uniform", samples=4, seed=1
+    )
+    small = problem_from_dict(data)
+    free = solve_robust(small, x0=X_NOMINAL, starts=1)
+    held = solve_robust(small, x0=X_NOMINAL, starts=1, constrain_samples=True)
+    assert free.status == held.status == "optimal" and held.verified
+    assert held.objective >= free.objective * (1 - 1e-9)
+    assert held.details.robust.constrain_samples and not free.details.robust.constrain_samples

@@ -283,13 +283,13 @@ def _classify_block(
                     continue  # a positive posynomial is always >= a non-positive number
                 if len(pos) > 1:
                     text = _fmt_row(names, row, c0)
-                    side = "lower" if kind == "lower" else "upper"
+                    side = "a lower" if kind == "lower" else "an upper"
                     return (
                         DGPCheck(
                             "constraint",
                             name,
                             False,
-                            f"{where}: a {side} bound {bound:g} on a sum of terms "
+                            f"{where}: {side} bound {bound:g} on a sum of terms "
                             f"({text}); posynomial >= constant is not DGP",
                             text,
                             False,
