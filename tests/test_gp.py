@@ -62,6 +62,13 @@ def test_tracer_merges_like_terms_into_a_monomial():
     assert isinstance(flipped, Signomial) and flipped.terms[(1.0, 0.0)] == pytest.approx(2.0)
     assert flipped.terms[(0.0, 0.0)] == pytest.approx(3.0)
     assert abs(2.0 * R) is not None and abs(2.0 * R).terms[(1.0, 0.0)] == pytest.approx(2.0)
+    # a product merges the like terms it makes: (R + 1)(R + 1) = R^2 + 2 R + 1
+    square = (R + 1.0) * (R + 1.0)
+    assert {k: float(v) for k, v in square.terms.items()} == {
+        (2.0, 0.0): 1.0,
+        (1.0, 0.0): 2.0,
+        (0.0, 0.0): 1.0,
+    }
 
 
 def test_an_objective_the_model_does_not_give_is_named_in_the_gp_diagnosis():
@@ -70,6 +77,10 @@ def test_an_objective_the_model_does_not_give_is_named_in_the_gp_diagnosis():
     assert [(c.name, c.ok, c.reason) for c in checks] == [
         ("no_such", False, "objective not available for this problem")
     ]
+    # a variable whose lower bound is not positive is named as the offending term
+    cs = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
+    n = next(c for c in build_gp(cs).checks if c.what == "variable" and c.name == "n")
+    assert (n.ok, n.term) == (False, "n") and "lower bound 0 mm is not positive" in n.reason
 
 
 def test_iso286_fit_is_a_posynomial_that_matches_the_numbers():
