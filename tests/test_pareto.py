@@ -380,3 +380,23 @@ def test_each_epsilon_record_names_the_neighbour_it_started_from(fork, tmp_path)
     assert len(eps) == 6
     assert all(r["warm"] in ids and r["warm"] != r["id"] for r in eps)
     assert {r["warm"] for r in eps} >= {"anchor-size", "anchor-backlash"}
+
+
+def test_extra_cold_starts_at_every_point_keep_the_front(fork, tmp_path):
+    """extra_starts=2: every epsilon point also runs its neighbour's design and two
+    seeded Sobol starts (a front's check against local optima); on the fork's front they
+    find nothing better, so the front is the warm-started one, point for point, and each
+    record counts its solves."""
+    import json
+
+    plain = od.pareto(fork, ["size", "backlash"], 6, out=tmp_path / "p", starts=2)
+    extra = od.pareto(fork, ["size", "backlash"], 6, out=tmp_path / "e", starts=2, extra_starts=2)
+    for a, b in zip(plain.points, extra.points, strict=True):
+        assert b.objectives["size"] == pytest.approx(a.objectives["size"], rel=1e-6)
+        assert b.objectives["backlash"] == pytest.approx(a.objectives["backlash"], rel=1e-6)
+    lines = (tmp_path / "e" / "epsilon.jsonl").read_text().splitlines()[1:]
+    eps = [r for r in map(json.loads, lines) if r["kind"] == "eps"]
+    # the warm start, the neighbour's design and two Sobol starts; a point retried (a
+    # jump in design space, say) runs the larger of its retry starts and the extra ones
+    assert all(r["n_solves"] == 4 for r in eps if not r["retried"])
+    assert all(r["n_solves"] >= 4 for r in eps) and sum(not r["retried"] for r in eps) >= 4
