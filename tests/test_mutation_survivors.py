@@ -375,3 +375,13 @@ def test_the_table_fit_ratio_of_a_catalogue_node_is_iso_286_over_the_formula():
         for D in (5.0, 6.0, 8.0)
     ]
     assert wide["fit_ratio_max"] == pytest.approx(min(ratios))
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.5, -0.1, 0.7])
+def test_a_pin_poisson_ratio_outside_its_range_is_refused_with_the_value(nu):
+    from optdesign.mechanisms.joints import PinJoint
+
+    with pytest.raises(InputError) as caught:
+        PinJoint(8.0, 12.0, nu=nu)
+    assert caught.value.field == "pin.nu"
+    assert caught.value.reason == f"Poisson ratio must lie in (0, 0.5), got {nu!r}"
