@@ -385,3 +385,14 @@ def test_a_pin_poisson_ratio_outside_its_range_is_refused_with_the_value(nu):
         PinJoint(8.0, 12.0, nu=nu)
     assert caught.value.field == "pin.nu"
     assert caught.value.reason == f"Poisson ratio must lie in (0, 0.5), got {nu!r}"
+
+
+def test_only_palmgrens_contact_is_restricted_to_steel():
+    from optdesign.mechanisms.joints import PinJoint
+
+    titanium = 1.1e5  # MPa
+    for contact in ("duan2017", "conforming"):
+        assert PinJoint(8.0, 12.0, E=titanium, contact=contact).E == titanium
+    with pytest.raises(InputError, match="Palmgren's approach is an empirical law of steel"):
+        PinJoint(8.0, 12.0, E=titanium, contact="palmgren")
+    assert PinJoint(8.0, 12.0, E=2.1e5, contact="palmgren").contact == "palmgren"
