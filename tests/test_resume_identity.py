@@ -244,7 +244,7 @@ def _tamper(rec: dict, how: str) -> None:
         ("no status", "no text field 'status'"),
         ("x and design disagree", "'x' that is not its design"),
         ("fixed variable changed", "fixed variable i_a = 3"),
-        ("warm start of the wrong size", "warm start of the wrong size"),
+        ("warm start of the wrong size", " holds a warm start of the wrong size"),
     ],
 )
 def test_a_record_that_cannot_be_trusted_refuses_the_resume(run, capsys, how, reason):
