@@ -137,7 +137,7 @@ def solve(
 def pareto(
     problem: DesignProblem | str | Path | Mapping[str, Any],
     objectives: Sequence[str] | str,
-    points: int = 50,
+    points: int = validation.DEFAULT_FRONT_POINTS,
     method: str | Any = "epsilon",
     **options: Any,
 ):

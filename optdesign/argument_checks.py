@@ -25,6 +25,8 @@ from optdesign.errors import InputError
 MAX_WORKERS = 256
 MAX_STARTS = 10_000
 MAX_POINTS = 10_000
+#: Points of a front when the caller gives none (od.pareto, the command line, the bench).
+DEFAULT_FRONT_POINTS = 50
 MAX_SEED = 2**32 - 1
 MAX_POP = 100_000
 MAX_GENERATIONS = 100_000

@@ -26,6 +26,7 @@ from typing import Any
 
 # The checks of one argument, re-exported: the CLI and the API call them as validation.X.
 from optdesign.argument_checks import (  # noqa: F401
+    DEFAULT_FRONT_POINTS,
     MAX_GENERATIONS,
     MAX_NAME,
     MAX_POINTS,

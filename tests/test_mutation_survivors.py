@@ -299,7 +299,7 @@ def test_a_gp_objective_with_a_negative_term_is_not_a_gp():
     problem.add_objective("lead_margin", lambda q: 12.0 - q.design["p"], unit="mm")
     gp = build_gp(problem, "lead_margin")
     check = {c.name: c for c in gp.checks}["lead_margin"]
-    assert not gp.is_gp and check in gp.failures()
+    assert not gp.is_gp and check in gp.failures() and check.what == "objective"
     assert check.reason == "lead_margin[] has a negative term: -p + 12 (a signomial)"
     assert check.cvxpy_is_dgp is False
     assert build_gp(problem, "backlash").is_gp
@@ -396,3 +396,100 @@ def test_only_palmgrens_contact_is_restricted_to_steel():
     with pytest.raises(InputError, match="Palmgren's approach is an empirical law of steel"):
         PinJoint(8.0, 12.0, E=titanium, contact="palmgren")
     assert PinJoint(8.0, 12.0, E=2.1e5, contact="palmgren").contact == "palmgren"
+
+
+# --- survivors of the second sample (docs/testing.md, "The second sample") ------------------
+def test_a_point_worse_than_its_looser_neighbour_is_retried_on_its_own_target(monkeypatch):
+    """An epsilon point whose warm solve is worse than a neighbour with a tighter bound is
+    re-solved from cold starts, every solve on the point's own objective, and the record
+    says why."""
+    from optdesign.studies.pareto import tasks
+    from optdesign.studies.pareto.eps_solver import EpsSolver
+    from optdesign.studies.pareto.records import PointRecord
+
+    problem = load(ROOT / "problems" / "fork_min_backlash.toml")
+    common = {"problem": problem, "objectives": ["backlash", "size"], "solver": "ipopt"}
+    first = {**common, "id": "p-0", "kind": "eps", "target": "backlash", "index": 0}
+    solo = tasks.front_task({**first, "eps": {"size": 1e9}}, {})
+    assert PointRecord.from_dict(solo).success and solo["retried"] == ""
+    # a neighbour claiming a better backlash under a tighter size bound: the point, whose
+    # bound is looser, cannot be worse, so it doubts its warm solve
+    neighbour = {**solo, "id": "p-1", "objectives": {**solo["objectives"]}}
+    neighbour["objectives"]["backlash"] *= 0.9
+    neighbour["eps"] = {"size": 5e8}
+    targets = []
+    original = EpsSolver.solve
+
+    def spy(self, target, eps, start):
+        targets.append(target)
+        return original(self, target, eps, start)
+
+    monkeypatch.setattr(EpsSolver, "solve", spy)
+    task = {**first, "eps": {"size": 1e9}, "warm": "p-1", "retry_starts": 2, "seed": 3}
+    rec = tasks.front_task(task, {"p-1": neighbour})
+    assert rec["retried"] == "worse than its neighbour with a looser bound"
+    assert rec["n_solves"] == 4 and targets == ["backlash"] * 4  # warm, neighbour, 2 Sobol
+    assert rec["objectives"]["backlash"] == pytest.approx(solo["objectives"]["backlash"], rel=1e-6)
+
+
+def test_a_ratio_ripple_limit_is_not_a_gp_and_the_diagnosis_says_why():
+    """ripple_max bounds (max - min)/(max + min) over the grid, a difference of
+    posynomials over a sum: the GP diagnosis names it as a constraint that is not DGP."""
+    import copy
+
+    from test_gp import CS_FIXED
+
+    from optdesign.formulations.gp import build_gp
+
+    data = copy.deepcopy(CS_FIXED)
+    data["requirements"]["ripple_max"] = 0.2
+    data["variables"]["R"] = {"lower": 60, "upper": 120}  # the ratio's shape depends on R
+    gp = build_gp(problem_from_dict(data))
+    check = {c.name: c for c in gp.checks}["ripple_max"]
+    assert (check.what, check.ok, check.cvxpy_is_dgp) == ("constraint", False, False)
+    assert check.reason == (
+        "ripple = (max - min)/(max + min) over the grid is a ratio of a difference of posynomials"
+    )
+    assert not gp.is_gp and check in gp.failures()
+
+
+def test_an_objective_the_gp_cannot_trace_is_a_failed_check_not_an_unknown_one():
+    import copy
+
+    from test_gp import CS_FIXED
+
+    from optdesign import math as m
+    from optdesign.formulations.gp import build_gp
+
+    problem = problem_from_dict(copy.deepcopy(CS_FIXED))
+    problem.add_objective("wavy", lambda q: m.sin(q.design["p"]), unit="")
+    check = next(c for c in build_gp(problem, "wavy").checks if c.what == "objective")
+    assert check.name == "wavy" and check.ok is False and check.reason
+
+
+def test_the_default_clearance_chain_reads_each_fixed_clearance_under_its_key():
+    """A mechanism with the default chain (screw bearings A, screw/nut B, output shaft O):
+    the file's clearances reach the backlash, c / (dx/dphi) rad each on the screw's line;
+    for the yoke x = R sin(phi), dx/dphi = R cos(phi)."""
+    from test_framework import yoke_data
+
+    from optdesign import math as m
+
+    class ChainYoke(od.Mechanism):
+        name = "t21_chain_yoke"
+        variables = {"R": od.VariableInfo("length", "crank radius")}  # noqa: RUF012
+        pin_joints = ("crank pin",)
+
+        def nut_position(self, phi):
+            return self.R * m.sin(phi)
+
+    od.register_mechanism(ChainYoke, replace=True)
+    data = yoke_data("t21_chain_yoke")
+    data["clearances"] = {"A": "0.02 mm", "B": "0.01 mm", "O": "0.005 deg"}
+    problem = od.load(data)
+    R = 80.0
+    backlash = problem.quantities({"R": R, "p": 5.0, "i_a": 2.0}).backlash
+    phi = np.asarray(problem.phi)
+    expected = np.degrees(0.03 / (R * np.cos(phi))) + 0.005
+    assert np.asarray(backlash.worst_case, dtype=float).ravel() == pytest.approx(expected, rel=1e-9)
+    assert sorted(backlash.per_joint) == ["A screw bearings", "B screw/nut", "O output shaft"]

@@ -29,8 +29,8 @@ def _pareto(sub):
     p.add_argument(
         "--points",
         type=checked(check.points, literal),
-        default=50,
-        help="points of the front (default 50)",
+        default=check.DEFAULT_FRONT_POINTS,
+        help=f"points of the front (default {check.DEFAULT_FRONT_POINTS})",
     )
     p.add_argument(
         "--method",

@@ -26,7 +26,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from optdesign.argument_checks import ArgumentError
+from optdesign.argument_checks import DEFAULT_FRONT_POINTS, ArgumentError
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
@@ -448,7 +448,7 @@ def check_time_limit(method: Any, time_limit: float | None, field: str = "time_l
 def compute_front(
     problem: DesignProblem,
     objectives: Sequence[str],
-    points: int = 50,
+    points: int = DEFAULT_FRONT_POINTS,
     method: str | Any = "epsilon",
     **options: Any,
 ) -> Front:
