@@ -129,7 +129,39 @@ def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
     assert r.status != "optimal"
     assert r.multistart.n_starts == capped.n_solves == 2 + RETRY_STARTS
     assert r.multistart.outcomes[:2] == ["iteration limit"] * 2
-    # a single start's verdict is retried (e.g. from a neighbouring optimum)
+    # a single start's verdict is retried (e.g. from a neighbouring optimum): the first
+    # retry's verdict decides
     one = NodeSolver(_weak_pins(), starts=1)
     r = one.solve(box)
-    assert r.multistart.outcomes == ["locally infeasible"] * (1 + RETRY_STARTS)
+    assert r.multistart.outcomes == ["locally infeasible"] * 2
+    # two verdicts end a larger multistart too: its other starts are not run
+    four = NodeSolver(_weak_pins(), starts=4)
+    r = four.solve(box)
+    assert r.status == "infeasible" and four.n_solves == r.multistart.n_starts == 2
+    assert r.multistart.n_planned == 4
+
+
+def test_a_start_that_reaches_the_nodes_floor_settles_it():
+    """A floor (the parent's trusted value) no start can go below: the start that reaches
+    it ends the multistart; one it cannot reach leaves the full multistart."""
+    from optdesign.studies.catalogue import NodeSolver
+    from optdesign.studies.catalogue_bnb import trusted
+
+    problem = problem_from_dict(tomllib.loads(CATALOGUE.read_text()))
+    box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
+    full = NodeSolver(problem, starts=4)
+    ref = full.solve(box)
+    assert ref.success and ref.multistart.n_starts == 4 and trusted(ref, 4)
+    settled = NodeSolver(problem, starts=4)
+    r = settled.solve(box, full.x_of(ref), floor=ref.objective * (1 - 1e-7))
+    assert r.objective == pytest.approx(ref.objective, rel=1e-6)
+    assert (r.multistart.n_starts, r.multistart.stopped_early) == (1, True)
+    assert trusted(r, 4)
+    # a floor 1 % below the value: no start reaches it, every start runs
+    low = NodeSolver(problem, starts=4)
+    r = low.solve(box, full.x_of(ref), floor=ref.objective * 0.99)
+    assert (r.multistart.n_starts, r.multistart.stopped_early) == (4, False)
+    # a warm start whose value the search would prune is settled by the floor alone
+    warm = NodeSolver(problem, starts=4)
+    r = warm.solve(box, full.x_of(ref), warm=True, prunes=lambda v: True, floor=ref.objective)
+    assert r.multistart.n_starts == 1 and warm.n_cold == 0

@@ -60,7 +60,7 @@ class TiedNodes:
         self.starts = 1
         self.boxes: list[dict] = []
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True):
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
         self.boxes.append(dict(box))
         lo_a, hi_a = box.get("a", (A_ITEMS[0], A_ITEMS[-1]))
         _, hi_b = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
@@ -136,8 +136,8 @@ class TrapNodes(TiedNodes):
     """The relaxation of every wide box sits on (2, top of b), but the combination
     (2, 4) is infeasible with its own items (its box's data were the most favourable)."""
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True):
-        result = super().solve(box, x_hint, warm, prunes, fallback)
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+        result = super().solve(box, x_hint, warm, prunes, fallback, floor)
         fixed = all(box.get(n, (0, 1))[0] == box.get(n, (0, 1))[1] for n in self.names)
         if fixed and (box["a"][0], box["b"][0]) == (2.0, 4.0):
             return Result("infeasible", float("nan"), {}, "fake", "nlp", 0.0)
@@ -162,9 +162,9 @@ class CountedNodes(TiedNodes):
         super().__init__()
         self.calls: list[tuple[dict, bool]] = []
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True):
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
         self.calls.append((dict(box), warm and x_hint is not None and not fallback))
-        return super().solve(box, x_hint, warm, prunes, fallback)
+        return super().solve(box, x_hint, warm, prunes, fallback, floor)
 
 
 def test_a_combination_met_again_is_solved_from_the_new_start_only():

@@ -49,7 +49,7 @@ from optdesign.solvers.multistart import (
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes, split_at_items
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes, split_at_items, trusted
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
@@ -72,10 +72,11 @@ class NodeSolver:
     only passes its own variable bounds. A node whose starts all fail is tried again from
     :data:`RETRY_STARTS` more Sobol starts before it counts as infeasible, so a poor
     first start (e.g. a declared one) that stops at an iteration limit or an error never
-    makes a feasible problem look infeasible; when two starts or more all ended with the
-    back-end's own verdict of local infeasibility (:meth:`verdicts_decide`), the node is
-    infeasible on those starts (over the catalogue instance family no retry ever found a feasible
-    point after such starts: benchmarks/README.md, "Catalogue searches (issue 25)").
+    makes a feasible problem look infeasible. Two starts that both end with the back-end's
+    own verdict of local infeasibility (:meth:`verdicts_decide`) end the multistart: the
+    node is infeasible on those two starts (over the catalogue instance family, no later
+    start or retry ever found a feasible point after two such verdicts:
+    benchmarks/README.md, "Catalogue searches (issue 25)").
     """
 
     def __init__(
@@ -130,6 +131,7 @@ class NodeSolver:
         warm: bool = False,
         prunes: Callable[[float], bool] | None = None,
         fallback: bool = True,
+        floor: float | None = None,
     ) -> Result:
         """Best of the multistart on the box where ``bounds`` replace the catalogue
         variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
@@ -140,6 +142,13 @@ class NodeSolver:
         a cold node does, so infeasibility and pruning rest on the same starts as before.
         ``fallback=False``: the warm start's result whatever it is (a first incumbent's
         value, which only needs to be feasible).
+        ``floor``: a lower bound on the node's value that the search trusts (its parent's
+        relaxation value, when :func:`~optdesign.studies.catalogue_bnb.trusted`); the box
+        is a sub-box of the parent's, its item data no more favourable, so no start can
+        end below it. A
+        start that reaches it (within the tie tolerance) ends the multistart: the node's
+        value is settled (``multistart.stopped_early``), whether the search would prune
+        it or not.
         """
         if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
             self.n_implied += 1
@@ -167,22 +176,42 @@ class NodeSolver:
         if self.starts > 1:
             pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
         start = partial(self.nlp.start, parameters=box.parameters)
+        n_planned = len(pts)
+
+        def at_floor(r: Result) -> bool:
+            return floor is not None and r.success and not improves(floor, r.objective)
+
         results = []
         if warm and x_hint is not None:
             results.append(self.backend.solve(start(x0=pts.pop(0)), self.target, box))
             first_ok = results[0]
-            if first_ok.success and (prunes is None or not prunes(first_ok.objective)):
+            if first_ok.success and (
+                prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
+            ):
                 pts = []  # the warm start decides this node
             elif not fallback:
                 self.n_solves += 1
                 return first_ok
             else:
                 self.n_cold += 1
-        results += [self.backend.solve(start(x0=p), self.target, box) for p in pts]
+
+        def run(points) -> bool:
+            """Solve from ``points`` in order, stopping at a start that settles the node
+            (True) or once the starts so far decide it infeasible (verdicts_decide)."""
+            for p in points:
+                results.append(self.backend.solve(start(x0=p), self.target, box))
+                if at_floor(results[-1]):
+                    return True
+                if self.verdicts_decide(results):
+                    return False
+            return False
+
+        settled = bool(results) and at_floor(results[0])
+        if not settled:
+            settled = run(pts)
         if not any(r.success for r in results):
             if not self.verdicts_decide(results):
-                retry = sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1)
-                results += [self.backend.solve(start(x0=p), self.target, box) for p in retry]
+                run(sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1))
             if not any(r.success for r in results):
                 if self.memo is not None:
                     self.memo.add_infeasible(bounds, self.eps)
@@ -200,16 +229,20 @@ class NodeSolver:
             self.seed,
             outcomes=outcomes,
             failed=outcome_counts(outcomes),
+            n_planned=n_planned,
+            stopped_early=settled,
         )
         return best
 
     def verdicts_decide(self, results: Sequence[Result]) -> bool:
-        """Whether the failed starts of a node call it infeasible without the retries:
-        at least two starts, every one ended with the back-end's own verdict of local
-        infeasibility (:attr:`~optdesign.solvers.registry.SolverHints.infeasible_verdicts`).
-        A start stopped by its iteration limit or an error, or a solved point that fails
-        the check, leaves the node to the retries; so does a single start (a node solver
-        of one start: the neighbouring items of an optimum, the diagnosis)."""
+        """Whether the starts so far call a node infeasible, without its other starts
+        and the retries: at least two starts, every one ended with the back-end's own
+        verdict of local infeasibility
+        (:attr:`~optdesign.solvers.registry.SolverHints.infeasible_verdicts`). A start
+        stopped by its iteration limit or an error, or a solved point that fails the
+        check, leaves the node to its other starts and the retries; a node solver of one
+        start (the neighbouring items of an optimum, the diagnosis) decides on its start
+        and the first retry."""
         return (
             len(results) >= 2
             and bool(self.verdicts)
@@ -227,14 +260,15 @@ def _no_item(solver: str, message: str) -> Result:
 
 
 def enumerate_catalogue(
-    ns: NodeSolver, x_hint=None
+    ns: NodeSolver, x_hint=None, floor: float | None = None
 ) -> tuple[Result | None, list[CatalogueCombination]]:
-    """Solve every combination of catalogue items; the best and the table of all."""
+    """Solve every combination of catalogue items; the best and the table of all.
+    ``floor``: the relaxation's value (a combination that reaches it is settled)."""
     dvars = discrete_variables(ns.problem)
     table, best = [], None
     for combo in itertools.product(*(v.values for v in dvars)):
         items = {v.name: float(c) for v, c in zip(dvars, combo, strict=True)}
-        r = ns.solve(_fixed(items), x_hint)
+        r = ns.solve(_fixed(items), x_hint, floor=floor)
         table.append(CatalogueCombination(items, r.status, r.objective))
         # a tie (within PRUNE_TOL) keeps the earlier combination, as branch and bound does
         if r.success and (best is None or improves(r.objective, best.objective, PRUNE_TOL)):
@@ -337,7 +371,8 @@ def solve_catalogue(
         starts_per_node=n_starts,
     )
     if method == "enumerate":
-        best, info.enumerated = enumerate_catalogue(ns, ns.x_of(root))
+        floor = root.objective if root.success and trusted(root, ns.starts) else None
+        best, info.enumerated = enumerate_catalogue(ns, ns.x_of(root), floor)
     elif method == "minlp":
         from optdesign.studies.catalogue_minlp import solve_minlp
 

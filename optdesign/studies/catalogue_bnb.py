@@ -76,6 +76,14 @@ def cannot_improve(bound: float, incumbent: float) -> bool:
     return bound >= incumbent - PRUNE_TOL * abs(incumbent)
 
 
+def trusted(result: Result, starts: int) -> bool:
+    """Whether a node's value may serve its children as a floor (see
+    :meth:`~optdesign.studies.catalogue.NodeSolver.solve`): it comes from the node
+    solver's full multistart of ``starts``, or it was settled at its own trusted floor."""
+    ms = result.multistart
+    return ms is not None and (ms.n_starts >= starts or ms.stopped_early)
+
+
 def combination_key(values: Mapping[str, float], names: Sequence[str]) -> tuple[float, ...]:
     """The order of item combinations that decides a tie: the items of ``names`` (the
     catalogue variables, in their declared order), compared lexicographically."""
@@ -250,15 +258,17 @@ def branch_and_bound_warm(
     seed: Result | None = None  # the best candidate's leaf
     seed_items: dict | None = None
     seed_key: tuple[float, ...] | None = None
+    root_floor = root.objective if root.success and trusted(root, ns.starts) else None
     if root.success:
         seed, seed_items = first_incumbent(ns, candidates, stats)
         if seed_items is not None:
             seed_key = combination_key(seed_items, names)
-        heapq.heappush(heap, (root.objective, next(counter), full, root, None))
+        # the last field: the floor of the node's children (see NodeSolver.solve)
+        heapq.heappush(heap, (root.objective, next(counter), full, root, None, None))
 
     solved: dict[tuple[float, ...], Result] = {}  # each combination's full multistart
 
-    def leaf_solve(box: Box, x) -> Result:
+    def leaf_solve(box: Box, x, floor: float | None) -> Result:
         # A combination solved before (from another node's optimum) is solved again only
         # from the new start: the rest of its multistart is the same Sobol points. The
         # full multistart runs again only when that start beats the stored value.
@@ -268,7 +278,7 @@ def branch_and_bound_warm(
             new = ns.solve(box, x, warm=True, fallback=False)
             if not (new.success and (not done.success or improves(new.objective, done.objective))):
                 return done
-        solved[key] = ns.solve(box, x)
+        solved[key] = ns.solve(box, x, floor=floor)
         return solved[key]
 
     def prunes(bound: float, box: Box) -> bool:
@@ -280,21 +290,25 @@ def branch_and_bound_warm(
         return False
 
     while heap:
-        bound, _, box, res, warm_from = heapq.heappop(heap)
+        bound, _, box, res, warm_from, floor = heapq.heappop(heap)
         if prunes(bound, box):
             if warm_from is not None:
                 # a bound from the warm start alone: pruned only on the full multistart
-                res = ns.solve(box, warm_from)
+                res = ns.solve(box, warm_from, floor=floor)
                 stats["nodes"] += 1
                 if not res.success:
                     stats["infeasible"] += 1
                     continue
                 if not prunes(res.objective, box):
-                    heapq.heappush(heap, (res.objective, next(counter), box, res, None))
+                    entry = (res.objective, next(counter), box, res, None, floor)
+                    heapq.heappush(heap, entry)
                     continue
             stats["pruned"] += 1
             continue
         x = ns.x_of(res)
+        # the children's floor: this node's value when the search trusts it, else the
+        # floor it had itself (a sub-box's value is never below its box's)
+        below = bound if trusted(res, ns.starts) else floor
         worst, items = _on_items(dvars, box, res)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
@@ -302,7 +316,7 @@ def branch_and_bound_warm(
             if one_combination:
                 leaf = res  # already solved with every catalogue variable fixed
             else:
-                leaf = leaf_solve(fixed_box(items), x)
+                leaf = leaf_solve(fixed_box(items), x, below)
                 stats["nodes"] += 1
             stats["leaves"] += 1
             key = combination_key(items, names)
@@ -327,9 +341,10 @@ def branch_and_bound_warm(
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
             # a box of one combination is a leaf: its value is reported, full multistart
             if fixed:
-                r = leaf_solve(child, x)
+                r = leaf_solve(child, x, below)
             else:
-                r = ns.solve(child, x, warm=True, prunes=partial(_prunes_box, prunes, child))
+                test = partial(_prunes_box, prunes, child)
+                r = ns.solve(child, x, warm=True, prunes=test, floor=below)
             stats["nodes"] += 1
             if not r.success:
                 stats["infeasible"] += 1
@@ -337,14 +352,14 @@ def branch_and_bound_warm(
             if prunes(r.objective, child):
                 stats["pruned"] += 1
                 continue
-            warm_only = not fixed and r.multistart is not None and r.multistart.n_starts < ns.starts
-            entry = (r.objective, next(counter), child, r, x if warm_only else None)
+            warm_only = not fixed and r.multistart is not None and not trusted(r, ns.starts)
+            entry = (r.objective, next(counter), child, r, x if warm_only else None, below)
             heapq.heappush(heap, entry)
     if seed is not None and wins(seed.objective, seed_key, _value(incumbent), inc_key):
         # the candidate beats every leaf of the search (or ties with smaller items): it
         # is the optimum, and as a reported leaf it gets the full multistart (its own
         # start first)
-        full = ns.solve(fixed_box(seed_items), ns.x_of(seed))
+        full = ns.solve(fixed_box(seed_items), ns.x_of(seed), floor=root_floor)
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats

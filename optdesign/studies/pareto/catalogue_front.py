@@ -53,6 +53,10 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         lo = lo_rec.objectives[a] * (1 + ANCHOR_SLACK) + 1e-12
         hi = max(hi_rec.objectives[a], lo)
         eps = {a: float(lo + task["eps_frac"] * (hi - lo))}
+        if task["eps_frac"] == 0.0:  # the anchor's own tie-break, at its own limit
+            return _end_of_front(task, lo_rec, dict(lo_rec.eps), t0)
+        if task["eps_frac"] == 1.0:
+            return _end_of_front(task, hi_rec, eps, t0)
     result = solve_catalogue(
         problem,
         starts=task["starts"],
@@ -68,6 +72,25 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
     info = result.details.catalogue
     rec.n_solves = info.nlp_solves if info is not None else 0
+    rec.wall_time_s = time.perf_counter() - t0
+    return rec.to_dict()
+
+
+def _end_of_front(task: Mapping[str, Any], anchor: PointRecord, eps: dict, t0: float) -> dict:
+    """An end point of the front is its anchor's design, not solved again.
+
+    The first point (``a <= a_min (1 + slack)``, minimise ``b``) is the anchor's own
+    tie-break, and keeps its limit; at the last (``a <=`` the other anchor's ``a``,
+    minimise ``b``) the other anchor minimised ``b`` first and meets the limit exactly,
+    so no design does better on ``b`` (to the anchors' slack). The record keeps the
+    anchor's design, values and check; the point's limit on ``a`` replaces the anchor's
+    on ``b`` among the active rows."""
+    a, b = task["eps_name"], task["target"]
+    rec = PointRecord.from_dict(anchor.to_dict())
+    rec.id, rec.kind, rec.target, rec.eps = task["id"], task["kind"], b, eps
+    rec.active = sorted({*(r for r in rec.active if r != f"{b}_max"), f"{a}_max"})
+    rec.message = f"{rec.message}; the design of {anchor.id}".lstrip("; ")
+    rec.n_solves = 0
     rec.wall_time_s = time.perf_counter() - t0
     return rec.to_dict()
 
