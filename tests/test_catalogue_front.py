@@ -30,7 +30,7 @@ def small_front(tmp_path_factory):
 
 
 def test_the_ends_of_a_catalogue_front_are_its_anchors(small_front):
-    problem, front, records = small_front
+    _, front, records = small_front
     first, last = records["epsilon-catalogue-0000"], records["epsilon-catalogue-0002"]
     for end, anchor, limit in (
         (first, records["anchor-backlash"], "backlash_max"),
