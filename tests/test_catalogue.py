@@ -165,3 +165,33 @@ def test_a_start_that_reaches_the_nodes_floor_settles_it():
     warm = NodeSolver(problem, starts=4)
     r = warm.solve(box, full.x_of(ref), warm=True, prunes=lambda v: True, floor=ref.objective)
     assert r.multistart.n_starts == 1 and warm.n_cold == 0
+
+
+def test_a_box_proved_infeasible_under_a_limit_is_implied_only_under_tighter_ones():
+    """The memo a front's points share: a box the search proved infeasible under an
+    epsilon limit is skipped (no NLP) under that limit or a tighter one, and solved again
+    under a looser one, where it is feasible."""
+    from optdesign.studies.catalogue import NodeSolver
+    from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+
+    problem = problem_from_dict(tomllib.loads(CATALOGUE.read_text()))
+    box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
+    free = NodeSolver(problem, "motor_torque", starts=2).solve(box)
+    assert free.success
+    memo = InfeasibleBoxes({"p": (2.0, 10.0), "d": (4.0, 16.0)})
+    least = NodeSolver(problem, "backlash", starts=2).solve(box).objective
+    limit = least * 0.9  # below the least backlash of the box: infeasible
+
+    def node(eps):
+        ns = NodeSolver(problem, "motor_torque", starts=2, eps=eps)
+        ns.memo = memo
+        return ns, ns.solve(box)
+
+    tight, r = node({"backlash": limit})
+    assert not r.success and tight.n_solves > 0 and tight.n_implied == 0
+    tighter, r = node({"backlash": limit * 0.9})
+    assert not r.success and tighter.n_solves == 0 and tighter.n_implied == 1
+    looser, r = node({"backlash": free.objectives["backlash"] * 2})
+    assert r.success and looser.n_implied == 0
+    unlimited, r = node({})
+    assert r.success and unlimited.n_implied == 0

@@ -123,3 +123,17 @@ def test_front_csv_without_units_is_read_as_internal(solved, tmp_path):
     path.write_text("\n".join(lines) + "\n")
     internal = read_front_csv(path, ["ripple", "motor_torque"], problem)
     assert np.array_equal(internal, front.F)
+
+
+def test_front_csv_without_an_on_front_column_keeps_every_row(solved, tmp_path):
+    """A table of points with no ``on_front`` column (written by hand or by another
+    tool): every row is a point of the front; with the column, only its True rows."""
+    problem, _, front = solved
+    path = tmp_path / "plain.csv"
+    lines = ["ripple,motor_torque"] + [f"{float(a)!r},{float(b)!r}" for a, b in front.F]
+    path.write_text("\n".join(lines) + "\n")
+    assert np.array_equal(read_front_csv(path, ["ripple", "motor_torque"], problem), front.F)
+    marked = tmp_path / "marked.csv"
+    rows = [f"{float(a)!r},{float(b)!r},{k != 0}" for k, (a, b) in enumerate(front.F)]
+    marked.write_text("\n".join(["ripple,motor_torque,on_front", *rows]) + "\n")
+    assert np.array_equal(read_front_csv(marked, ["ripple", "motor_torque"]), front.F[1:])

@@ -225,6 +225,8 @@ def _tamper(rec: dict, how: str) -> None:
         rec["x"][1] += 0.5
     elif how == "fixed variable changed":
         rec["design"]["i_a"] = 3.0
+    elif how == "fixed variable nudged":  # 1e-10 relative: more than a float's rounding
+        rec["design"]["i_a"] *= 1 + 1e-10
     elif how == "warm start of the wrong size":
         rec["raw"]["z"] = rec["raw"]["z"][:1] if isinstance(rec["raw"]["z"], list) else [0.0]
     else:  # pragma: no cover
@@ -244,6 +246,7 @@ def _tamper(rec: dict, how: str) -> None:
         ("no status", "no text field 'status'"),
         ("x and design disagree", "'x' that is not its design"),
         ("fixed variable changed", "fixed variable i_a = 3"),
+        ("fixed variable nudged", "fixed variable i_a = 2.0000000002, the problem 2.0"),
         ("warm start of the wrong size", " holds a warm start of the wrong size"),
     ],
 )

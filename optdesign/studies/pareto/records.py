@@ -328,7 +328,8 @@ def _design_problem(problem: DesignProblem, rec: PointRecord) -> str | None:
     for name, value in problem.fixed_values.items():
         stored = rec.design.get(name, value)
         if not math.isclose(stored, value, rel_tol=1e-12, abs_tol=1e-15):
-            return f"has the fixed variable {name} = {stored:.10g}, the problem {value:.10g}"
+            # every digit shown: a difference the tolerance sees must be visible
+            return f"has the fixed variable {name} = {stored!r}, the problem {value!r}"
     if rec.x is not None and (
         len(rec.x) != len(x) or not np.allclose(rec.x, x, rtol=1e-12, atol=0.0, equal_nan=False)
     ):
