@@ -206,8 +206,10 @@ def bench(
     Returns
     -------
     BenchReport
-        Every run's row, per-configuration statistics, performance profiles, the summary
-        table; ``.summary()``, ``.to_frame()``, ``.plot()``.
+        Every run's row (``.rows``: :class:`~optdesign.studies.bench.BenchRow`, read by
+        attribute: ``row.config``, ``row.success``, ``row.gap``), per-configuration
+        statistics, performance profiles, the summary table; ``.summary()``,
+        ``.to_frame()``, ``.plot()``.
     """
     from optdesign.studies.bench import run_bench
 

@@ -30,6 +30,7 @@ from optdesign.studies.bench.metrics import (
     paired_time_ratio,
     performance_profile,
 )
+from optdesign.studies.bench.rows import BenchRow
 from optdesign.text import csv_cell, printable
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -48,7 +49,7 @@ def md_cell(text: object) -> str:
 def stats_table(
     stats: Mapping[str, Mapping[str, Any]],
     descriptions: Mapping[str, str],
-    rows: Sequence[Mapping[str, Any]],
+    rows: Sequence[BenchRow],
 ) -> str:
     """Markdown table of :func:`config_stats`, best configuration first, with the median
     per-instance ratio of each configuration's time to the best one's."""
@@ -127,7 +128,7 @@ def eval_counts(n_evals: Mapping[str, int]) -> tuple[int | None, int | None, int
 
 
 def write_outputs(
-    rows, out: Path, configs, suite_name, wall, time_limit, hard, skipped=None
+    rows: Sequence[BenchRow], out: Path, configs, suite_name, wall, time_limit, hard, skipped=None
 ) -> dict[str, Any]:
     """bench_runs.csv, bench_profiles.png, summary.md, bench_stats.json in ``out``;
     ``skipped``: mechanism -> why the suite has no instances of it (listed last)."""
@@ -137,10 +138,11 @@ def write_outputs(
         w = csv.DictWriter(fh, CSV_FIELDS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
-            f, g, h = eval_counts(r.get("n_evals") or {})
-            row = {**r, "n_fun": f, "n_grad": g, "n_hess": h}
-            row["reason"] = str(r.get("reason", ""))[:200]
-            w.writerow({k: csv_cell(v) for k, v in row.items() if k in CSV_FIELDS})
+            f, g, h = eval_counts(r.n_evals or {})
+            counts = {"n_fun": f, "n_grad": g, "n_hess": h, "reason": str(r.reason)[:200]}
+            w.writerow(
+                {k: csv_cell(counts[k] if k in counts else getattr(r, k)) for k in CSV_FIELDS}
+            )
         atomic_write_text(out / "bench_runs.csv", fh.getvalue())
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
     fronts = [c for c in configs if get_config(c).kind == "front"]
@@ -151,9 +153,9 @@ def write_outputs(
         with atomic_output(out / "bench_profiles.png") as tmp:
             save_figure(fig, tmp, tight=False)
     desc = {c: get_config(c).description for c in configs}
-    stats_all = config_stats([r for r in rows if r["config"] in single], single)
-    shipped = [r for r in rows if r["family"] == "shipped"]
-    n_inst = len({r["instance"] for r in rows})
+    stats_all = config_stats([r for r in rows if r.config in single], single)
+    shipped = [r for r in rows if r.family == "shipped"]
+    n_inst = len({r.instance for r in rows})
     lines = [
         f"Suite `{suite_name}`: {n_inst} instances, {len(rows)} runs, wall time {wall:.0f} s "
         f"(soft time limit {time_limit:g} s per run, hard timeout {hard:g} s). "
@@ -176,12 +178,12 @@ def write_outputs(
             "### Shipped problems (problems/*.toml)",
             "",
             stats_table(
-                config_stats([r for r in shipped if r["config"] in single], single), desc, shipped
+                config_stats([r for r in shipped if r.config in single], single), desc, shipped
             ),
         ]
         lines += ["", _shipped_table(shipped, single)]
     if fronts:
-        st = config_stats([r for r in rows if r["config"] in fronts], fronts)
+        st = config_stats([r for r in rows if r.config in fronts], fronts)
         lines += [
             "",
             "### Pareto-front instances (gap = 1 - hypervolume / best hypervolume)",
@@ -210,21 +212,21 @@ def write_outputs(
     }
 
 
-def _shipped_table(rows, configs) -> str:
-    insts = sorted({r["instance"] for r in rows})
+def _shipped_table(rows: Sequence[BenchRow], configs: Sequence[str]) -> str:
+    insts = sorted({r.instance for r in rows})
     head = "| configuration | " + " | ".join(f"{md_cell(i)}: time (s) / gap" for i in insts) + " |"
     lines = [head, "|---|" + "---|" * len(insts)]
-    by = {(r["instance"], r["config"]): r for r in rows}
+    by = {(r.instance, r.config): r for r in rows}
     for c in configs:
         cells = []
         for i in insts:
             r = by.get((i, c))
-            if r is None or not r.get("applicable", True):
+            if r is None or not r.applicable:
                 cells.append("n/a")
-            elif not r.get("success"):
-                cells.append(md_cell(r["status"]))
+            elif not r.success:
+                cells.append(md_cell(r.status))
             else:
-                cells.append(f"{r['time_s']:.3g} / {r['gap']:.1e}")
+                cells.append(f"{r.time_s:.3g} / {r.gap:.1e}")
         lines.append(f"| {md_cell(c)} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -285,10 +287,12 @@ def update_readme(readme: Path, summary: str) -> bool:
     return True
 
 
-def profiles(rows, configs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def profiles(
+    rows: Sequence[BenchRow], configs: Sequence[str]
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Time and gap performance profiles of the single-objective configurations."""
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
-    chosen = [r for r in rows if r["config"] in single]
+    chosen = [r for r in rows if r.config in single]
     taus_t = np.logspace(0, 3, 200)
     taus_g = np.logspace(0, 6, 200)
     _, Tt = measure_table(chosen, single, "time")
@@ -299,7 +303,7 @@ def profiles(rows, configs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     }
 
 
-def profiles_figure(rows, configs):
+def profiles_figure(rows: Sequence[BenchRow], configs: Sequence[str]):
     """The profiles as a matplotlib Figure."""
     from optdesign.plots.profiles import plot_profiles
 

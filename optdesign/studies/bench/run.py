@@ -21,6 +21,7 @@ from optdesign.studies.bench.configs import default_configs, get_config, preload
 from optdesign.studies.bench.instances import Instance, coverage, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
 from optdesign.studies.bench.metrics import add_gaps, config_stats
+from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.sandbox import run_task
 
 
@@ -31,7 +32,8 @@ class BenchReport:
     Attributes
     ----------
     rows
-        One dict per (instance, configuration) run, with its gap to the best known value.
+        One :class:`~optdesign.studies.bench.rows.BenchRow` per (instance, configuration)
+        run, with its gap to the best known value.
     configs
         The configurations run.
     stats
@@ -47,7 +49,7 @@ class BenchReport:
         (empty for the caller's own problems).
     """
 
-    rows: list[dict[str, Any]]
+    rows: list[BenchRow]
     configs: list[str]
     stats: dict[str, dict[str, Any]] = field(default_factory=dict)
     summary_markdown: str = ""
@@ -74,7 +76,7 @@ class BenchReport:
             "iterations",
             "reason",
         )
-        return pd.DataFrame([{k: r.get(k) for k in keep} for r in self.rows])
+        return pd.DataFrame([{k: getattr(r, k) for k in keep} for r in self.rows])
 
     def plot(self, ax=None):
         """Dolan-More profiles (time and gap) of the single-objective configurations."""
@@ -187,13 +189,15 @@ def run_bench(
     if resume:
         wall += _stored_wall(meta_path, key_text)
     atomic_write_text(meta_path, json.dumps({"key": key_text, "wall_time_s": wall}))
-    rows = add_gaps([dict(records[t["id"]]) for t in tasks if t["id"] in records])
+    # The one place a stored (or just computed) JSON row becomes a BenchRow; each was
+    # checked by from_dict on resume (row_check) or comes from the sandbox.
+    rows = add_gaps([BenchRow.from_dict(records[t["id"]]) for t in tasks if t["id"] in records])
     paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard, skipped)
     single = [c for c in names if get_config(c).kind not in ("front", "debug")]
     return BenchReport(
         rows=rows,
         configs=names,
-        stats=config_stats([r for r in rows if r["config"] in single], single),
+        stats=config_stats([r for r in rows if r.config in single], single),
         summary_markdown=paths["summary_text"],
         paths=paths,
         wall_time_s=wall,
