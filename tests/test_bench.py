@@ -335,3 +335,21 @@ def test_a_store_of_the_old_format_resumes(tmp_path):
     crash = rows["debug-crash"]
     assert crash.status == "error" and crash.reason == res.rows[1].reason
     assert "deliberate crash" in crash.reason and crash.best_known == stored["objective"]
+
+
+def test_a_stored_row_without_its_identity_refuses_the_resume(tmp_path):
+    # Once read unchecked: the summary then failed on the missing key with a traceback.
+    from optdesign.storage import StoreError
+
+    inst = make_instance("shipped", 2)
+    kwargs = dict(workers=1, progress=False, time_limit=5.0, hard_timeout=10.0)
+    bench.run_bench("quick", ["debug-crash"], tmp_path, instances=[inst], **kwargs)
+    store = tmp_path / "bench_runs.jsonl"
+    head, line = store.read_text().splitlines()
+    row = json.loads(line)
+    del row["family"]
+    store.write_text(head + "\n" + json.dumps(row) + "\n")
+    with pytest.raises(
+        StoreError, match=r"line 2: record .*debug-crash' has no text field 'family'"
+    ):
+        bench.run_bench("quick", ["debug-crash"], tmp_path, instances=[inst], resume=True, **kwargs)
