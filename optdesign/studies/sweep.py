@@ -38,7 +38,7 @@ from optdesign.problem.request import SolveRequest
 from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sensitivity import at_values
-from optdesign.tolerances import OBJECTIVE_TIE_TOL
+from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2
@@ -283,7 +283,7 @@ def active_names(problem: DesignProblem, result) -> list[str]:
         value = result.design.get(var.name)
         if value is None:
             continue
-        tol = 1e-6 * max(1.0, abs(var.upper - var.lower))
+        tol = FEASIBILITY_TOL * max(1.0, abs(var.upper - var.lower))  # active: at its bound
         for side, bound in (("lower", var.lower), ("upper", var.upper)):
             if abs(value - bound) < tol:
                 names.add(f"{var.name}.{side}")
