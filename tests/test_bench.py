@@ -181,8 +181,8 @@ def test_best_configuration_and_paired_time_ratio():
         row("a", "subset", 0.1),  # applies to one instance only
     ]
     stats = config_stats(rows, ["fast", "slow", "subset"])
-    assert stats["fast"]["success_rate"] == pytest.approx(2 / 3)
-    assert stats["slow"]["median_time_s"] == 4.0
+    assert stats["fast"].success_rate == pytest.approx(2 / 3)
+    assert stats["slow"].median_time_s == 4.0
     # "slow" solves more instances; "subset" (1 run) is not crowned on its easy subset
     assert best_config(stats) == "slow"
     ratio, n = paired_time_ratio(rows, "fast", "slow")

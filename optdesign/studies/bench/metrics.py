@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -115,7 +115,34 @@ def measure_table(
     return instances, T
 
 
-def config_stats(rows: Sequence[BenchRow], configs: Sequence[str]) -> dict[str, dict[str, Any]]:
+@dataclass
+class ConfigStats:
+    """One configuration's statistics over the runs it applied to (``bench_stats.json``
+    holds :func:`dataclasses.asdict` of it).
+
+    Attributes
+    ----------
+    runs
+        Applicable runs.
+    success_rate, solved_rate
+        Fractions of the runs that succeeded, and that succeeded with gap <=
+        :data:`SOLVED_GAP` (nan without runs).
+    median_time_s, median_gap
+        Medians over the successful runs (nan without one).
+    failures
+        Status -> number of failed runs (``"check failed"``: the solver claimed success,
+        the independent check did not).
+    """
+
+    runs: int
+    success_rate: float
+    solved_rate: float
+    median_time_s: float
+    median_gap: float
+    failures: dict[str, int] = field(default_factory=dict)
+
+
+def config_stats(rows: Sequence[BenchRow], configs: Sequence[str]) -> dict[str, ConfigStats]:
     """Per configuration: runs, success rate, solved rate (gap <= SOLVED_GAP), median time
     of successful runs, median gap, failure reasons."""
     stats = {}
@@ -130,30 +157,30 @@ def config_stats(rows: Sequence[BenchRow], configs: Sequence[str]) -> dict[str, 
                 if st in SOLVED_STATUSES:
                     st = "check failed"  # the solver claimed success, the NumPy check did not
                 reasons[st] = reasons.get(st, 0) + 1
-        stats[c] = {
-            "runs": len(rs),
-            "success_rate": len(ok) / len(rs) if rs else float("nan"),
-            "solved_rate": len(solved) / len(rs) if rs else float("nan"),
-            "median_time_s": float(np.median([r.time_s for r in ok])) if ok else float("nan"),
-            "median_gap": float(np.median([r.gap for r in ok])) if ok else float("nan"),
-            "failures": reasons,
-        }
+        stats[c] = ConfigStats(
+            runs=len(rs),
+            success_rate=len(ok) / len(rs) if rs else float("nan"),
+            solved_rate=len(solved) / len(rs) if rs else float("nan"),
+            median_time_s=float(np.median([r.time_s for r in ok])) if ok else float("nan"),
+            median_gap=float(np.median([r.gap for r in ok])) if ok else float("nan"),
+            failures=reasons,
+        )
     return stats
 
 
-def best_config(stats: Mapping[str, Mapping[str, Any]]) -> str | None:
+def best_config(stats: Mapping[str, ConfigStats]) -> str | None:
     """The best configuration among those run on the most instances: highest solved rate,
     ties broken by median time. (A configuration that applies to a subset only, such as
     the GP on the fork instances, is not crowned on that easier subset.)"""
-    most = max((s["runs"] for s in stats.values()), default=0)
+    most = max((s.runs for s in stats.values()), default=0)
     cands = [
         (c, s)
         for c, s in stats.items()
-        if s["runs"] == most and most and math.isfinite(s["median_time_s"])
+        if s.runs == most and most and math.isfinite(s.median_time_s)
     ]
     if not cands:
         return None
-    return min(cands, key=lambda cs: (-round(cs[1]["solved_rate"], 9), cs[1]["median_time_s"]))[0]
+    return min(cands, key=lambda cs: (-round(cs[1].solved_rate, 9), cs[1].median_time_s))[0]
 
 
 def paired_time_ratio(rows: Sequence[BenchRow], config: str, best: str) -> tuple[float, int]:

@@ -13,6 +13,7 @@ import json
 import math
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,7 @@ from optdesign.studies.bench.configs import get_config
 from optdesign.studies.bench.metrics import (
     GAP_FLOOR,
     SOLVED_GAP,
+    ConfigStats,
     best_config,
     config_stats,
     measure_table,
@@ -47,7 +49,7 @@ def md_cell(text: object) -> str:
 
 
 def stats_table(
-    stats: Mapping[str, Mapping[str, Any]],
+    stats: Mapping[str, ConfigStats],
     descriptions: Mapping[str, str],
     rows: Sequence[BenchRow],
 ) -> str:
@@ -58,8 +60,8 @@ def stats_table(
         stats,
         key=lambda c: (
             c != best,
-            -(stats[c]["solved_rate"] or 0),
-            stats[c]["median_time_s"] if math.isfinite(stats[c]["median_time_s"]) else 1e9,
+            -(stats[c].solved_rate or 0),
+            stats[c].median_time_s if math.isfinite(stats[c].median_time_s) else 1e9,
         ),
     )
     lines = [
@@ -69,17 +71,17 @@ def stats_table(
     ]
     for c in order:
         s = stats[c]
-        if not s["runs"]:
+        if not s.runs:
             continue
         ratio, n_pairs = paired_time_ratio(rows, c, best) if best else (float("nan"), 0)
-        fails = ", ".join(f"{md_cell(k)} {v}" for k, v in sorted(s["failures"].items())) or "-"
+        fails = ", ".join(f"{md_cell(k)} {v}" for k, v in sorted(s.failures.items())) or "-"
         name = md_cell(c)
         lines.append(
             f"| {'**' + name + '**' if c == best else name} | {md_cell(descriptions.get(c, ''))} "
-            f"| {s['runs']} | "
-            f"{100 * s['success_rate']:.0f} % | {100 * s['solved_rate']:.0f} % | "
-            f"{_fmt(s['median_time_s'], '.3g')} | {_fmt(ratio, '.2f')} ({n_pairs}) | "
-            f"{_fmt(s['median_gap'], '.1e')} | {fails} |"
+            f"| {s.runs} | "
+            f"{100 * s.success_rate:.0f} % | {100 * s.solved_rate:.0f} % | "
+            f"{_fmt(s.median_time_s, '.3g')} | {_fmt(ratio, '.2f')} ({n_pairs}) | "
+            f"{_fmt(s.median_gap, '.1e')} | {fails} |"
         )
     return "\n".join(lines)
 
@@ -198,7 +200,13 @@ def write_outputs(
     atomic_write_text(
         out / "bench_stats.json",
         json.dumps(
-            clean_json({"all": stats_all, "wall_time_s": wall, "suite": suite_name}),
+            clean_json(
+                {
+                    "all": {c: asdict(s) for c, s in stats_all.items()},
+                    "wall_time_s": wall,
+                    "suite": suite_name,
+                }
+            ),
             indent=1,
             default=str,
             allow_nan=False,

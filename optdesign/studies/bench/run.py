@@ -20,7 +20,7 @@ from optdesign.store_identity import identity_key
 from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
 from optdesign.studies.bench.instances import Instance, coverage, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
-from optdesign.studies.bench.metrics import add_gaps, config_stats
+from optdesign.studies.bench.metrics import ConfigStats, add_gaps, config_stats
 from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.sandbox import run_task
 
@@ -51,7 +51,7 @@ class BenchReport:
 
     rows: list[BenchRow]
     configs: list[str]
-    stats: dict[str, dict[str, Any]] = field(default_factory=dict)
+    stats: dict[str, ConfigStats] = field(default_factory=dict)
     summary_markdown: str = ""
     paths: dict[str, Any] = field(default_factory=dict)
     wall_time_s: float = 0.0
