@@ -4,10 +4,19 @@ shared by the Pareto fronts and the sweeps (both run through
 
 from __future__ import annotations
 
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+
+def study_folder(out: Path | str | None, kind: str) -> Path:
+    """The folder of a study's store: ``out`` (made if missing), or a new temporary
+    folder ``optdesign-KIND-...`` (never a folder of committed files by default)."""
+    folder = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix=f"optdesign-{kind}-"))
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
 
 
 @dataclass
@@ -38,3 +47,7 @@ class RunOptions:
     on_record: Callable | None = None
     overwrite: bool = False
     time_limit: float | None = None
+
+    def folder(self, kind: str) -> Path:
+        """:func:`study_folder` of :attr:`out`."""
+        return study_folder(self.out, kind)

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import difflib
 import math
-import tempfile
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -493,10 +492,7 @@ def run_sweep(
         "solver": solver_identity(problem, default_solver("nlp")),
         "optdesign": version(),
     }
-    out = run.out
-    base = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-sweep-"))
-    base.mkdir(parents=True, exist_ok=True)
-    store = base / "sweep.jsonl"
+    store = run.folder("sweep") / "sweep.jsonl"
     records = run_tasks(
         tasks,
         sweep_point,

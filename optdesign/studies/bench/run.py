@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -23,6 +22,7 @@ from optdesign.studies.bench.instances import suite as build_suite
 from optdesign.studies.bench.metrics import ConfigStats, add_gaps, config_stats
 from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.sandbox import run_task
+from optdesign.studies.run_options import study_folder
 
 
 @dataclass
@@ -164,8 +164,7 @@ def run_bench(
     # Solver libraries imported here, before the workers and the runs' children are
     # forked: a run's time is then its solve, not the import of its library.
     preload_modules(names)
-    out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-bench-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = study_folder(out, "bench")
     store = out / "bench_runs.jsonl"
     key = bench_identity(suite_name, tasks, time_limit, hard, problems)
     t0 = time.perf_counter()
