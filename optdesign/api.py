@@ -345,6 +345,12 @@ def sweep(
         The points (parameters, status, objective, design, binding set, the multistart
         checks and jumps, what fails at an infeasible point); ``.summary()``,
         ``.to_frame()`` (columns ``"name [unit]"``), ``.plot()`` (the design chart).
+
+    Notes
+    -----
+    The arguments, checked, travel down as one :class:`optdesign.SolveRequest` (how each
+    point is solved; a point a formulation solves receives it) and one
+    :class:`~optdesign.studies.run_options.RunOptions` (where and how the points run).
     """
     from optdesign.studies.run_options import RunOptions
     from optdesign.studies.sweep import run_sweep
