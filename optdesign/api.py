@@ -26,6 +26,7 @@ from typing import Any
 from optdesign import validation
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.result import Result
 
 __all__ = ["bench", "bench_configurations", "load", "pareto", "report", "solve", "sweep"]
@@ -206,8 +207,10 @@ def bench(
     Returns
     -------
     BenchReport
-        Every run's row, per-configuration statistics, performance profiles, the summary
-        table; ``.summary()``, ``.to_frame()``, ``.plot()``.
+        Every run's row (``.rows``: :class:`~optdesign.studies.bench.BenchRow`, read by
+        attribute: ``row.config``, ``row.success``, ``row.gap``), per-configuration
+        statistics, performance profiles, the summary table; ``.summary()``,
+        ``.to_frame()``, ``.plot()``.
     """
     from optdesign.studies.bench import run_bench
 
@@ -342,7 +345,14 @@ def sweep(
         The points (parameters, status, objective, design, binding set, the multistart
         checks and jumps, what fails at an infeasible point); ``.summary()``,
         ``.to_frame()`` (columns ``"name [unit]"``), ``.plot()`` (the design chart).
+
+    Notes
+    -----
+    The arguments, checked, travel down as one :class:`optdesign.SolveRequest` (how each
+    point is solved; a point a formulation solves receives it) and one
+    :class:`~optdesign.studies.run_options.RunOptions` (where and how the points run).
     """
+    from optdesign.studies.run_options import RunOptions
     from optdesign.studies.sweep import run_sweep
 
     starts = validation.starts("starts", starts)
@@ -357,18 +367,23 @@ def sweep(
     validation.run_folder(out, resume, overwrite)
     problem = load(problem)
     validation.objective_of(problem, objective)
-    return run_sweep(
+    # A sweep's points show no ranges of the optimal set; an infeasible point is
+    # diagnosed (what to relax: it has no design to show).
+    request = SolveRequest.for_problem(
         problem,
-        vary,
-        objective=objective,
-        check_every=check_every,
+        objective,
         starts=starts,
         seed=seed,
+        sensitivities=sensitivities,
+        ranges=False,
+        diagnose=True,
+    )
+    run = RunOptions(
         out=out,
+        workers=workers,
+        scheduler=scheduler,
         resume=resume,
         overwrite=overwrite,
         progress=progress,
-        sensitivities=sensitivities,
-        workers=workers,
-        scheduler=scheduler,
     )
+    return run_sweep(problem, vary, request, check_every=check_every, run=run)

@@ -11,7 +11,8 @@ from __future__ import annotations
 #: A design is feasible when no requirement row is violated by more than this, relative
 #: to max(1, |bound|) (the independent check, :func:`optdesign.studies.verify.
 #: verify_design`) or on the solver's scaled rows (:func:`optdesign.solvers.base.
-#: constraint_reports`); a row within it of its bound is active.
+#: constraint_reports`); a row within it of its bound is active, and so is a free
+#: variable's bound within it (relative to max(1, upper - lower)) of the variable's value.
 FEASIBILITY_TOL = 1e-6
 
 #: Two objective values tie when they differ by at most this, relative to the larger of

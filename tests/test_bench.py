@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from optdesign.studies.bench.metrics import (
     paired_time_ratio,
     performance_profile,
 )
+from optdesign.studies.bench.rows import BenchRow, BenchRowError
 
 
 def test_instances_are_reproducible_and_validated():
@@ -90,15 +92,15 @@ def test_failures_are_recorded_and_the_run_goes_on(tmp_path):
         hard_timeout=2.0,
         instances=[inst],
     )
-    rows = {r["config"]: r for r in res.rows}
+    rows = {r.config: r for r in res.rows}
     assert set(rows) == {"debug-crash", "debug-hang", "debug-abort", "ipopt-exact"}
-    assert rows["debug-crash"]["status"] == "error"
-    assert "deliberate crash" in rows["debug-crash"]["reason"]
-    assert rows["debug-hang"]["status"] == "timeout"
-    assert 2.0 <= rows["debug-hang"]["time_s"] < 10.0
-    assert rows["debug-abort"]["status"] == "crash"
-    assert not any(rows[c]["success"] for c in ("debug-crash", "debug-hang", "debug-abort"))
-    assert rows["ipopt-exact"]["success"] and rows["ipopt-exact"]["gap"] == 0.0
+    assert rows["debug-crash"].status == "error"
+    assert "deliberate crash" in rows["debug-crash"].reason
+    assert rows["debug-hang"].status == "timeout"
+    assert 2.0 <= rows["debug-hang"].time_s < 10.0
+    assert rows["debug-abort"].status == "crash"
+    assert not any(rows[c].success for c in ("debug-crash", "debug-hang", "debug-abort"))
+    assert rows["ipopt-exact"].success and rows["ipopt-exact"].gap == 0.0
     # every run was streamed to the store as it finished
     lines = (tmp_path / "bench_runs.jsonl").read_text().splitlines()
     assert sum(1 for line in lines if '"config"' in line) == 4
@@ -115,7 +117,7 @@ def test_failures_are_recorded_and_the_run_goes_on(tmp_path):
         resume=True,
     )
     assert (tmp_path / "bench_runs.jsonl").read_text().splitlines() == lines
-    assert [r["status"] for r in again.rows] == [r["status"] for r in res.rows]
+    assert [r.status for r in again.rows] == [r.status for r in res.rows]
 
 
 def test_quick_suite_every_configuration_and_consistent_metrics(tmp_path):
@@ -124,28 +126,28 @@ def test_quick_suite_every_configuration_and_consistent_metrics(tmp_path):
     )
     rows = res.rows
     configs = bench.default_configs()
-    ran = {r["config"] for r in rows if r.get("applicable", True)}
+    ran = {r.config for r in rows if r.applicable}
     assert ran == set(configs), f"not run: {set(configs) - ran}"
     for r in rows:
-        if r.get("success"):
-            assert r["gap"] is not None and r["gap"] >= 0.0
-            if "front" not in r:
-                assert r["violation"] <= 1e-6
+        if r.success:
+            assert r.gap is not None and r.gap >= 0.0
+            if not r.is_front:
+                assert r.violation <= 1e-6
         else:
-            assert r["gap"] is None
+            assert r.gap is None
     by_inst: dict[str, list] = {}
     for r in rows:
-        if r.get("success"):
-            by_inst.setdefault(r["instance"], []).append(r["gap"])
+        if r.success:
+            by_inst.setdefault(r.instance, []).append(r.gap)
     assert by_inst, "no configuration succeeded anywhere"
     for gaps in by_inst.values():
         assert min(gaps) == 0.0  # the best configuration defines the best known value
     # the shipped crank-slider backlash problem: best known = the documented optimum
-    best = {r["instance"]: r["best_known"] for r in rows if r["family"] == "shipped"}
+    best = {r.instance: r.best_known for r in rows if r.family == "shipped"}
     assert best["shipped-001"] == pytest.approx(0.0362197, rel=1e-5)
     # the catalogue fork instance: its design uses a catalogue lead
-    fork = next(r for r in rows if r["family"] == "fork_backlash" and r["config"] == "ipopt-exact")
-    assert fork["catalogue"] and fork["n_subproblems"] == 3
+    fork = next(r for r in rows if r.family == "fork_backlash" and r.config == "ipopt-exact")
+    assert fork.catalogue and fork.n_subproblems == 3
     with (tmp_path / "bench_runs.csv").open() as fh:
         assert len(list(csv.DictReader(fh))) == len(rows)
     summary = (tmp_path / "summary.md").read_text()
@@ -167,7 +169,7 @@ def test_cli_lists_configurations(capsys):
 
 def test_best_configuration_and_paired_time_ratio():
     def row(inst, cfg, t, ok=True):
-        return {"instance": inst, "config": cfg, "time_s": t, "success": ok, "gap": 0.0}
+        return BenchRow(inst, "f", 0, "m", "o", False, cfg, "nlp", time_s=t, success=ok, gap=0.0)
 
     rows = [
         row("a", "fast", 1.0),
@@ -179,8 +181,8 @@ def test_best_configuration_and_paired_time_ratio():
         row("a", "subset", 0.1),  # applies to one instance only
     ]
     stats = config_stats(rows, ["fast", "slow", "subset"])
-    assert stats["fast"]["success_rate"] == pytest.approx(2 / 3)
-    assert stats["slow"]["median_time_s"] == 4.0
+    assert stats["fast"].success_rate == pytest.approx(2 / 3)
+    assert stats["slow"].median_time_s == 4.0
     # "slow" solves more instances; "subset" (1 run) is not crowned on its easy subset
     assert best_config(stats) == "slow"
     ratio, n = paired_time_ratio(rows, "fast", "slow")
@@ -230,3 +232,124 @@ def test_solver_libraries_are_imported_before_the_runs_fork():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["[]", "['cvxpy',", "'pymoo.optimize',", "'scipy.optimize']"]
+
+
+# --- the typed row and its store ----------------------------------------------------------
+RESULTS = Path(__file__).resolve().parents[1] / "benchmarks" / "results"
+
+
+def _committed_rows() -> list[str]:
+    """The rows of the committed benchmark store (written before BenchRow existed)."""
+    return (RESULTS / "bench_runs.jsonl").read_text().splitlines()[1:]
+
+
+def test_every_committed_row_round_trips_byte_for_byte():
+    lines = _committed_rows()
+    assert len(lines) > 1000
+    shapes = set()
+    for line in lines:
+        data = json.loads(line)
+        row = BenchRow.from_dict(data)
+        assert json.dumps(row.to_dict(), allow_nan=True) == line
+        assert row.instance == data["instance"] and row.success is data["success"]
+        shapes.add(tuple(data))
+    assert len(shapes) == 3  # single-objective runs, failures, fronts: each kept as it is
+    # a row built in code writes every stored field, and reads back equal
+    made = BenchRow("x-1", "x", 1, "fork", "backlash", False, "c", "nlp", objective=0.5, id="i")
+    assert BenchRow.from_dict(made.to_dict()) == made
+    assert "gap" not in made.to_dict() and "stored_keys" not in made.to_dict()
+
+
+@pytest.mark.parametrize(
+    ("change", "reason"),
+    [
+        ({"status": 3}, "has no status or success flag"),
+        ({"success": "yes"}, "has no status or success flag"),
+        ({"time_s": float("nan")}, "has a time that is not a finite number (nan)"),
+        ({"time_s": -1.0}, "has a time that is not a finite number (-1.0)"),
+        ({"objective": "low"}, "has an objective that is not a number"),
+        ({"instance": None}, "has no text field 'instance'"),
+        ({"seed": 1.5}, "has no integer field 'seed'"),
+        ({"applicable": 1}, "has no flag field 'applicable'"),
+        ({"colour": "red"}, "has an unknown field 'colour'"),
+    ],
+)
+def test_a_stored_row_that_is_not_a_row_is_refused_naming_why(change, reason):
+    data = json.loads(_committed_rows()[0])
+    BenchRow.from_dict(data)
+    with pytest.raises(BenchRowError) as info:
+        BenchRow.from_dict({**data, **change})
+    assert str(info.value) == reason
+
+
+def test_the_committed_store_regenerates_the_readme_block(tmp_path):
+    # What `optdesign bench --update-readme` pastes, rebuilt from the committed store's
+    # rows through BenchRow, is the block the README holds, character for character.
+    from optdesign.studies.bench.metrics import add_gaps
+    from optdesign.studies.bench.report import README_BEGIN, README_END, write_outputs
+
+    rows = add_gaps([BenchRow.from_dict(json.loads(line)) for line in _committed_rows()])
+    names = [c for c in bench.default_configs(True) if c in {r.config for r in rows}]
+    wall = json.loads((RESULTS / "bench_meta.json").read_text())["wall_time_s"]
+    paths = write_outputs(rows, tmp_path, names, "default", wall, 1.0, 4.0, {})
+    readme = (RESULTS.parent / "README.md").read_text()
+    block = readme[readme.index(README_BEGIN) + len(README_BEGIN) + 1 : readme.index(README_END)]
+    assert paths["summary_text"] == block
+    with (tmp_path / "bench_runs.csv").open() as fh:
+        assert len(list(csv.DictReader(fh))) == len(rows)
+
+
+def test_a_store_of_the_old_format_resumes(tmp_path):
+    # The store keeps the keys and their order of the rows written before BenchRow; a
+    # row from the committed store (old code) takes the place of the run's own and is
+    # trusted on resume, read back with its values.
+    inst = make_instance("shipped", 2)
+    kwargs = dict(workers=1, progress=False, time_limit=5.0, hard_timeout=10.0)
+    res = bench.run_bench(
+        "quick", ["slsqp-exact", "debug-crash"], tmp_path, instances=[inst], **kwargs
+    )
+    store = tmp_path / "bench_runs.jsonl"
+    lines = store.read_text().splitlines()
+    old = {json.loads(line)["id"]: line for line in _committed_rows()}
+    old_failure = next(json.loads(v) for v in old.values() if json.loads(v)["status"] == "skipped")
+    by_id = {json.loads(line)["id"]: k for k, line in enumerate(lines) if k}
+    ours = json.loads(lines[by_id["shipped-002|slsqp-exact"]])
+    assert list(ours) == list(json.loads(old["shipped-002|slsqp-exact"]))
+    assert list(json.loads(lines[by_id["shipped-002|debug-crash"]])) == list(old_failure)
+    lines[by_id["shipped-002|slsqp-exact"]] = old["shipped-002|slsqp-exact"]
+    store.write_text("\n".join(lines) + "\n")
+    again = bench.run_bench(
+        "quick", ["slsqp-exact", "debug-crash"], tmp_path, instances=[inst], resume=True, **kwargs
+    )
+    assert store.read_text().splitlines() == lines  # nothing ran again
+    rows = {r.config: r for r in again.rows}
+    stored = json.loads(old["shipped-002|slsqp-exact"])
+    assert (
+        rows["slsqp-exact"].objective == stored["objective"] == pytest.approx(0.0194989, rel=1e-5)
+    )
+    assert rows["slsqp-exact"].to_dict() == {
+        **stored,
+        "gap": 0.0,
+        "best_known": stored["objective"],
+    }
+    crash = rows["debug-crash"]
+    assert crash.status == "error" and crash.reason == res.rows[1].reason
+    assert "deliberate crash" in crash.reason and crash.best_known == stored["objective"]
+
+
+def test_a_stored_row_without_its_identity_refuses_the_resume(tmp_path):
+    # Once read unchecked: the summary then failed on the missing key with a traceback.
+    from optdesign.storage import StoreError
+
+    inst = make_instance("shipped", 2)
+    kwargs = dict(workers=1, progress=False, time_limit=5.0, hard_timeout=10.0)
+    bench.run_bench("quick", ["debug-crash"], tmp_path, instances=[inst], **kwargs)
+    store = tmp_path / "bench_runs.jsonl"
+    head, line = store.read_text().splitlines()
+    row = json.loads(line)
+    del row["family"]
+    store.write_text(head + "\n" + json.dumps(row) + "\n")
+    with pytest.raises(
+        StoreError, match=r"line 2: record .*debug-crash' has no text field 'family'"
+    ):
+        bench.run_bench("quick", ["debug-crash"], tmp_path, instances=[inst], resume=True, **kwargs)

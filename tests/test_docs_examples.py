@@ -45,7 +45,7 @@ def test_the_readmes_python_examples_run_as_written(tmp_path, monkeypatch, mecha
     assert sweep.points[4].objective == pytest.approx(result.objective, rel=1e-6)  # 500 N*m
     bench = namespace["report"]
     assert bench.configs == ["ipopt-exact", "slsqp-exact", "de"]
-    assert len(bench.rows) >= 3 and {row["config"] for row in bench.rows} == set(bench.configs)
+    assert len(bench.rows) >= 3 and {row.config for row in bench.rows} == set(bench.configs)
     # the mechanism snippet registers a working mechanism
     exec(compile(blocks[1], "README.md (second python block)", "exec"), namespace)
     yoke = namespace["ScotchYoke"]

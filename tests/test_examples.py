@@ -45,9 +45,9 @@ def test_custom_mechanism_solves_fronts_and_benches(tmp_path):
     assert F[-1, 1] == pytest.approx(result.objective, rel=2e-7)
     # the user's constraint reached the front too
     assert all(p.design["R"] >= F[0, 0] * (1 - 1e-9) for p in front.points)
-    rows = {r["config"]: r for r in report.rows}
-    assert rows["ipopt-exact"]["success"] and rows["slsqp-exact"]["success"]
-    assert rows["ipopt-exact"]["objective"] == pytest.approx(result.objective, rel=1e-6)
+    rows = {r.config: r for r in report.rows}
+    assert rows["ipopt-exact"].success and rows["slsqp-exact"].success
+    assert rows["ipopt-exact"].objective == pytest.approx(result.objective, rel=1e-6)
 
 
 def test_the_fin_actuator_sweep_example_states_a_valid_sweep():

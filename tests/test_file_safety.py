@@ -498,7 +498,7 @@ def test_bench_outputs_replace_planted_links_and_resume_reads_no_device(tmp_path
         (out / n).symlink_to(victims[n].path)
     problem = od.load(_problem(tmp_path))
     report = od.bench(problems=[problem], solvers=["slsqp"], out=out)
-    assert [r["status"] for r in report.rows] == ["optimal"]
+    assert [r.status for r in report.rows] == ["optimal"]
     assert all(v.untouched() for v in victims.values())
     assert all(not (out / n).is_symlink() for n in names)
     # a resume reads bench_meta.json back: planted as /dev/zero, it is not read
@@ -506,7 +506,7 @@ def test_bench_outputs_replace_planted_links_and_resume_reads_no_device(tmp_path
     (out / "bench_meta.json").symlink_to("/dev/zero")
     with within(60):
         again = od.bench(problems=[problem], solvers=["slsqp"], out=out, resume=True)
-    assert again.rows[0]["objective"] == report.rows[0]["objective"]
+    assert again.rows[0].objective == report.rows[0].objective
 
 
 def test_reproduce_replaces_a_planted_plot_link(tmp_path, capsys):

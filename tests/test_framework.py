@@ -175,8 +175,8 @@ def test_a_solver_back_end_registered_from_outside_the_package(tmp_path):
     # and the benchmark takes it by its name
     # a generous soft limit: a loaded machine must not turn the check into a timing test
     report = od.bench(problems=[problem], solvers=["cobyqa", "ipopt-exact"], time_limit=300.0)
-    rows = {r["config"]: r for r in report.rows}
-    assert rows["cobyqa"]["success"] and rows["cobyqa"]["gap"] < 1e-4
+    rows = {r.config: r for r in report.rows}
+    assert rows["cobyqa"].success and rows["cobyqa"].gap < 1e-4
 
 
 def test_a_mechanism_from_a_separate_package_by_entry_point(tmp_path):

@@ -341,12 +341,12 @@ def test_bench_resume_checks_its_problems_options_and_its_rows(tmp_path):
     problem_file = _write_problem(tmp_path, "\n[solver]\nipopt = { tol = 1e-10 }\n")
     out = tmp_path / "bench"
     first = od.bench(problems=[od.load(problem_file)], solvers=["slsqp"], out=out)
-    assert [r["status"] for r in first.rows] == ["optimal"]
+    assert [r.status for r in first.rows] == ["optimal"]
     store = out / "bench_runs.jsonl"
     # the same run resumes, recomputing nothing
     before = store.read_bytes()
     again = od.bench(problems=[od.load(problem_file)], solvers=["slsqp"], out=out, resume=True)
-    assert again.rows[0]["objective"] == first.rows[0]["objective"]
+    assert again.rows[0].objective == first.rows[0].objective
     assert store.read_bytes() == before
     # the problem's [solver] options changed: refused, naming them
     problem_file.write_text(problem_file.read_text().replace("1e-10", "1e-8"))

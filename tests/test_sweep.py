@@ -283,3 +283,41 @@ def test_a_worse_warm_start_is_caught_as_a_jump(tmp_path, monkeypatch):
         alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}))
         assert p.objective == pytest.approx(alone.objective, rel=1e-9)
     assert "the multistart check found a better optimum" in sweep.summary()
+
+
+def test_the_points_are_solved_with_the_one_request_od_sweep_builds(tmp_path, monkeypatch):
+    # od.sweep checks its arguments and builds one SolveRequest; a point its formulation
+    # solves (a catalogue problem: no continuation) receives it as it is, the file's
+    # seed filled in, no ranges, an infeasible point diagnosed.
+    import optdesign.studies.solve as solve_module
+    from optdesign.problem.request import SolveRequest
+
+    seen = []
+    original = solve_module.solve
+
+    def spy(problem, request):
+        seen.append(request)
+        return original(problem, request)
+
+    monkeypatch.setattr(solve_module, "solve", spy)
+    problem = od.load(PROBLEMS / "cs_min_backlash_catalogue.toml")
+    sweep = od.sweep(problem, {HINGE: ("400 N*m", "600 N*m", 2)}, starts=1, out=tmp_path)
+    assert problem.spec.solver.seed is not None
+    want = SolveRequest(
+        "backlash",
+        starts=1,
+        seed=problem.spec.solver.seed,
+        ranges=False,
+        diagnose=True,
+        sensitivities=False,
+    )
+    assert seen == [want, want]
+    assert [p.success for p in sweep.points] == [True, True]
+
+
+@pytest.mark.parametrize("check_every", [0, 10_001, 2.5, True])
+def test_check_every_is_refused_by_od_sweep_naming_it(check_every, tmp_path):
+    with pytest.raises(od.InputError) as info:
+        od.sweep(FORK, {HINGE: ("200 N*m", "300 N*m", 2)}, check_every=check_every, out=tmp_path)
+    assert info.value.field == "check_every"
+    assert not (tmp_path / "sweep.jsonl").exists()

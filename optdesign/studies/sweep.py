@@ -23,10 +23,9 @@ from __future__ import annotations
 
 import difflib
 import math
-import tempfile
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -36,8 +35,9 @@ from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.registry import default_solver, solver_hints
+from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sensitivity import at_values
-from optdesign.tolerances import OBJECTIVE_TIE_TOL
+from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2
@@ -282,7 +282,7 @@ def active_names(problem: DesignProblem, result) -> list[str]:
         value = result.design.get(var.name)
         if value is None:
             continue
-        tol = 1e-6 * max(1.0, abs(var.upper - var.lower))
+        tol = FEASIBILITY_TOL * max(1.0, abs(var.upper - var.lower))  # active: at its bound
         for side, bound in (("lower", var.lower), ("upper", var.upper)):
             if abs(value - bound) < tol:
                 names.add(f"{var.name}.{side}")
@@ -302,22 +302,15 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
     t0 = time.perf_counter()
     base: DesignProblem = task["problem"]
     problem = at_values(base, dict(zip(task["paths"], task["values"], strict=True)))
-    objective = task["objective"]
+    request: SolveRequest = task["request"]
+    objective = request.objective
     prev = next(iter(deps.values()), None) if deps else None
     solves = 0
     warm = None
     if not task["continuation"]:
         from optdesign.studies.solve import solve
 
-        request = SolveRequest.for_problem(
-            problem,
-            objective,
-            starts=task["starts"],
-            seed=task["seed"],
-            ranges=False,
-            diagnose=True,  # an infeasible point: what to relax (no design to show)
-            sensitivities=task["sensitivities"],  # a catalogue's: with its neighbouring items
-        )
+        # a catalogue's sensitivities come with its neighbouring items
         best = solve(problem, request)
         solves, checked = 1, True
     else:
@@ -338,9 +331,9 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         checked = changed or task["scheduled_check"]
         if checked:
             if shared is not None:
-                full = shared.multistart(problem, task["starts"], task["seed"])
+                full = shared.multistart(problem, request.starts, request.seed)
             else:
-                full = solve_nlp(problem, objective, starts=task["starts"], seed=task["seed"])
+                full = solve_nlp(problem, objective, starts=request.starts, seed=request.seed)
             solves += full.multistart.n_starts if full.multistart else 1
             if best is None or _better(full, best):
                 best = full
@@ -367,7 +360,7 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         "sensitivities": {},
     }
     if (
-        task["sensitivities"]
+        request.sensitivities
         and best.success
         and solver_hints(best.solver).multipliers
         and "lam_g" in best.raw
@@ -396,8 +389,9 @@ def _shared_solver(task: Mapping[str, Any]):
     from optdesign.studies.sweep_solver import SweepSolver
 
     base = task["problem"]
-    key = ("sweep-solver", base.token, tuple(task["paths"]), task["objective"])
-    return cached(key, lambda: SweepSolver(base, task["paths"], task["objective"]))
+    objective = task["request"].objective
+    key = ("sweep-solver", base.token, tuple(task["paths"]), objective)
+    return cached(key, lambda: SweepSolver(base, task["paths"], objective))
 
 
 def _better(a, b) -> bool:
@@ -427,36 +421,42 @@ def _violated(problem: DesignProblem, result) -> list[str]:
 def run_sweep(
     problem: DesignProblem,
     vary: Any,
+    request: SolveRequest,
     *,
-    objective: str | None = None,
     check_every: int = 10,
-    starts: int | None = None,
-    seed: int | None = None,
-    out: str | Path | None = None,
-    resume: bool = False,
-    overwrite: bool = False,
-    progress: bool = False,
-    sensitivities: bool = False,
-    workers: int = 1,
-    scheduler: str | None = None,
+    run: RunOptions | None = None,
 ) -> Sweep:
-    """The sweep of :func:`optdesign.sweep` (arguments checked there)."""
+    """The sweep of :func:`optdesign.sweep` (arguments checked there).
+
+    Parameters
+    ----------
+    problem, vary
+        The problem and ``{path: (start, stop, count)}`` (checked here: :func:`sweep_axes`).
+    request
+        How each point is solved: its objective, the multistart (``starts``, ``seed``;
+        None: the problem file's), the sensitivities; a point a formulation solves (no
+        continuation) is solved with it as it is.
+    check_every
+        A full multistart every this many points along a row.
+    run
+        Where and how the points run (store folder, resume, workers, progress).
+    """
     from optdesign.studies.identity import problem_digest, solver_identity, version
     from optdesign.studies.runner import run_tasks
 
+    run = run if run is not None else RunOptions()
     t0 = time.perf_counter()
     axes = sweep_axes(problem, vary)
-    objective = objective or problem.objective_names[0]
-    if isinstance(check_every, bool) or not isinstance(check_every, int) or check_every < 1:
-        raise InputError("check_every", f"a positive integer, got {check_every!r}")
+    objective = request.objective
     cont = continuable(problem)
     from optdesign.studies.sweep_solver import sweep_mode
 
     paths = [a.path for a in axes]
     mode = sweep_mode(problem, paths, [(a.values[0], a.values[-1]) for a in axes])
     mode = mode if cont else "formulation"
-    starts = starts if starts is not None else problem.spec.solver.starts
-    seed = seed if seed is not None else problem.spec.solver.seed
+    starts = request.starts if request.starts is not None else problem.spec.solver.starts
+    seed = request.seed if request.seed is not None else problem.spec.solver.seed
+    request = replace(request, starts=starts, seed=seed)  # the file's, stated in the identity
     order = grid_order(axes)
     tasks = []
     n0 = len(axes[0].values)
@@ -472,13 +472,9 @@ def run_sweep(
                 "index": k,
                 # the ends of every row and every check_every-th point along it
                 "scheduled_check": idx[0] % check_every == 0 or idx[0] == n0 - 1,
-                "objective": objective,
+                "request": request,
                 "continuation": cont,
                 "mode": mode,
-                "sensitivities": bool(sensitivities),
-                "check_every": check_every,
-                "starts": starts,
-                "seed": seed,
             }
         )
     key = {
@@ -489,27 +485,25 @@ def run_sweep(
             "check_every": check_every,
             "continuation": cont,
             "mode": mode,
-            "sensitivities": bool(sensitivities),
+            "sensitivities": bool(request.sensitivities),
             "starts": starts,
             "seed": seed,
         },
         "solver": solver_identity(problem, default_solver("nlp")),
         "optdesign": version(),
     }
-    base = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-sweep-"))
-    base.mkdir(parents=True, exist_ok=True)
-    store = base / "sweep.jsonl"
+    store = run.folder("sweep") / "sweep.jsonl"
     records = run_tasks(
         tasks,
         sweep_point,
         store,
-        resume=resume,
-        overwrite=overwrite,
-        progress="sweep" if progress else False,
+        resume=run.resume,
+        overwrite=run.overwrite,
+        progress="sweep" if run.progress else False,
         key=key,
         check=sweep_store_check,
-        workers=workers,
-        scheduler=scheduler,
+        workers=run.workers,
+        scheduler=run.scheduler,
     )
     by_grid = sorted(order, key=lambda idx: tuple(reversed(idx)))
     points = []

@@ -4,7 +4,8 @@ gaps, Dolan-More profiles and the summary.
 
 - :mod:`.configs`: the configurations registry (solver back-ends, GP, DE, fronts);
 - :mod:`.instances`: instance families from the mechanisms, the shipped problems;
-- :mod:`.sandbox`: one run in a forked child; :mod:`.metrics`: gaps, profiles, stats;
+- :mod:`.sandbox`: one run in a forked child; :mod:`.rows`: :class:`BenchRow`, one run's
+  typed record (the stored JSON line); :mod:`.metrics`: gaps, profiles, stats;
 - :mod:`.report`: CSV, PNG and the Markdown summary; :mod:`.run`: :func:`run_bench`.
 """
 
@@ -16,11 +17,13 @@ from optdesign.studies.bench.configs import (
     get_config,
     register_config,
 )
+from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.run import BenchReport, make_tasks, run_bench
 
 __all__ = [
     "CONFIGS",
     "BenchReport",
+    "BenchRow",
     "Config",
     "NotApplicable",
     "default_configs",

@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from optdesign.solvers.result import SOLVED_STATUSES
+from optdesign.studies.bench.rows import BenchRow
 
 #: A run solved an instance when it succeeded and its gap is at most this (relative).
 SOLVED_GAP = 1e-4
@@ -18,7 +19,7 @@ SOLVED_GAP = 1e-4
 GAP_FLOOR = 1e-6
 
 
-def add_gaps(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def add_gaps(rows: list[BenchRow]) -> list[BenchRow]:
     """Objective gap of every successful row to the best known value of its instance.
 
     Single objective: ``(f - f_best) / max(|f_best|, 1e-12)`` with ``f_best`` the least
@@ -26,35 +27,32 @@ def add_gaps(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     point per instance (nadir of all successful fronts + 10 % of their range). Failed
     rows get ``gap = None``.
     """
-    by_inst: dict[str, list[dict]] = {}
+    by_inst: dict[str, list[BenchRow]] = {}
     for r in rows:
-        r["gap"], r["best_known"] = None, None
-        if r.get("applicable", True):
-            by_inst.setdefault(r["instance"], []).append(r)
+        r.gap, r.best_known = None, None
+        if r.applicable:
+            by_inst.setdefault(r.instance, []).append(r)
     for inst_rows in by_inst.values():
-        ok = [r for r in inst_rows if r.get("success")]
-        for r in inst_rows:
-            r["gap"] = None
-            r["best_known"] = None
+        ok = [r for r in inst_rows if r.success]
         if not ok:
             continue
-        if any("front" in r for r in ok):
+        if any(r.is_front for r in ok):
             from optdesign.studies.pareto.metrics import hypervolume, reference_point
 
-            allF = np.vstack([np.asarray(r["front"], dtype=float) for r in ok])
+            allF = np.vstack([np.asarray(r.front, dtype=float) for r in ok])
             ref = reference_point(allF)
-            hv = {id(r): float(hypervolume(np.asarray(r["front"], dtype=float), ref)) for r in ok}
+            hv = {id(r): float(hypervolume(np.asarray(r.front, dtype=float), ref)) for r in ok}
             best = max(hv.values())
             for r in ok:
-                r["hypervolume"] = hv[id(r)]
-                r["best_known"] = best
-                r["gap"] = max(0.0, 1.0 - hv[id(r)] / best) if best > 0 else 0.0
+                r.hypervolume = hv[id(r)]
+                r.best_known = best
+                r.gap = max(0.0, 1.0 - hv[id(r)] / best) if best > 0 else 0.0
             continue
-        best = min(float(r["objective"]) for r in ok)
+        best = min(float(r.objective) for r in ok)  # type: ignore[arg-type]
         for r in inst_rows:
-            r["best_known"] = best
+            r.best_known = best
         for r in ok:
-            r["gap"] = (float(r["objective"]) - best) / max(abs(best), 1e-12)
+            r.gap = (float(r.objective) - best) / max(abs(best), 1e-12)  # type: ignore[arg-type]
     return rows
 
 
@@ -98,78 +96,100 @@ def performance_profile(table: np.ndarray, taus: np.ndarray, floor: float = 0.0)
 
 
 def measure_table(
-    rows: Sequence[Mapping[str, Any]], configs: Sequence[str], measure: str
+    rows: Sequence[BenchRow], configs: Sequence[str], measure: str
 ) -> tuple[list[str], np.ndarray]:
     """(instances, table) of ``measure`` ("time" or "gap"): inf for failures, nan where a
     configuration did not apply."""
-    instances = sorted({r["instance"] for r in rows if r.get("applicable", True)})
+    instances = sorted({r.instance for r in rows if r.applicable})
     idx = {k: i for i, k in enumerate(instances)}
     cidx = {c: j for j, c in enumerate(configs)}
     T = np.full((len(instances), len(configs)), np.nan)
     for r in rows:
-        if not r.get("applicable", True) or r["config"] not in cidx or r["instance"] not in idx:
+        if not r.applicable or r.config not in cidx or r.instance not in idx:
             continue
-        ok = bool(r.get("success"))
         if measure == "time":
-            v = float(r["time_s"]) if ok else np.inf
+            v = float(r.time_s) if r.success else np.inf
         else:
-            v = float(r["gap"]) if ok and r.get("gap") is not None else np.inf
-        T[idx[r["instance"]], cidx[r["config"]]] = v
+            v = float(r.gap) if r.success and r.gap is not None else np.inf
+        T[idx[r.instance], cidx[r.config]] = v
     return instances, T
 
 
-def config_stats(
-    rows: Sequence[Mapping[str, Any]], configs: Sequence[str]
-) -> dict[str, dict[str, Any]]:
+@dataclass
+class ConfigStats:
+    """One configuration's statistics over the runs it applied to (``bench_stats.json``
+    holds :func:`dataclasses.asdict` of it).
+
+    Attributes
+    ----------
+    runs
+        Applicable runs.
+    success_rate, solved_rate
+        Fractions of the runs that succeeded, and that succeeded with gap <=
+        :data:`SOLVED_GAP` (nan without runs).
+    median_time_s, median_gap
+        Medians over the successful runs (nan without one).
+    failures
+        Status -> number of failed runs (``"check failed"``: the solver claimed success,
+        the independent check did not).
+    """
+
+    runs: int
+    success_rate: float
+    solved_rate: float
+    median_time_s: float
+    median_gap: float
+    failures: dict[str, int] = field(default_factory=dict)
+
+
+def config_stats(rows: Sequence[BenchRow], configs: Sequence[str]) -> dict[str, ConfigStats]:
     """Per configuration: runs, success rate, solved rate (gap <= SOLVED_GAP), median time
     of successful runs, median gap, failure reasons."""
     stats = {}
     for c in configs:
-        rs = [r for r in rows if r["config"] == c and r.get("applicable", True)]
-        ok = [r for r in rs if r.get("success")]
-        solved = [r for r in ok if r.get("gap") is not None and r["gap"] <= SOLVED_GAP]
+        rs = [r for r in rows if r.config == c and r.applicable]
+        ok = [r for r in rs if r.success]
+        solved = [r for r in ok if r.gap is not None and r.gap <= SOLVED_GAP]
         reasons: dict[str, int] = {}
         for r in rs:
-            if not r.get("success"):
-                st = str(r.get("status"))
+            if not r.success:
+                st = str(r.status)
                 if st in SOLVED_STATUSES:
                     st = "check failed"  # the solver claimed success, the NumPy check did not
                 reasons[st] = reasons.get(st, 0) + 1
-        stats[c] = {
-            "runs": len(rs),
-            "success_rate": len(ok) / len(rs) if rs else float("nan"),
-            "solved_rate": len(solved) / len(rs) if rs else float("nan"),
-            "median_time_s": float(np.median([r["time_s"] for r in ok])) if ok else float("nan"),
-            "median_gap": float(np.median([r["gap"] for r in ok])) if ok else float("nan"),
-            "failures": reasons,
-        }
+        stats[c] = ConfigStats(
+            runs=len(rs),
+            success_rate=len(ok) / len(rs) if rs else float("nan"),
+            solved_rate=len(solved) / len(rs) if rs else float("nan"),
+            median_time_s=float(np.median([r.time_s for r in ok])) if ok else float("nan"),
+            median_gap=float(np.median([r.gap for r in ok])) if ok else float("nan"),
+            failures=reasons,
+        )
     return stats
 
 
-def best_config(stats: Mapping[str, Mapping[str, Any]]) -> str | None:
+def best_config(stats: Mapping[str, ConfigStats]) -> str | None:
     """The best configuration among those run on the most instances: highest solved rate,
     ties broken by median time. (A configuration that applies to a subset only, such as
     the GP on the fork instances, is not crowned on that easier subset.)"""
-    most = max((s["runs"] for s in stats.values()), default=0)
+    most = max((s.runs for s in stats.values()), default=0)
     cands = [
         (c, s)
         for c, s in stats.items()
-        if s["runs"] == most and most and math.isfinite(s["median_time_s"])
+        if s.runs == most and most and math.isfinite(s.median_time_s)
     ]
     if not cands:
         return None
-    return min(cands, key=lambda cs: (-round(cs[1]["solved_rate"], 9), cs[1]["median_time_s"]))[0]
+    return min(cands, key=lambda cs: (-round(cs[1].solved_rate, 9), cs[1].median_time_s))[0]
 
 
-def paired_time_ratio(
-    rows: Sequence[Mapping[str, Any]], config: str, best: str
-) -> tuple[float, int]:
+def paired_time_ratio(rows: Sequence[BenchRow], config: str, best: str) -> tuple[float, int]:
     """Median over the instances both configurations solved successfully of
     time(config) / time(best), and the number of such instances."""
     t: dict[tuple[str, str], float] = {
-        (r["instance"], r["config"]): float(r["time_s"])
+        (r.instance, r.config): float(r.time_s)
         for r in rows
-        if r.get("success") and r["config"] in (config, best)
+        if r.success and r.config in (config, best)
     }
     ratios = [
         t[(i, config)] / t[(i, best)]

@@ -13,6 +13,7 @@ import json
 import math
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -24,12 +25,14 @@ from optdesign.studies.bench.configs import get_config
 from optdesign.studies.bench.metrics import (
     GAP_FLOOR,
     SOLVED_GAP,
+    ConfigStats,
     best_config,
     config_stats,
     measure_table,
     paired_time_ratio,
     performance_profile,
 )
+from optdesign.studies.bench.rows import BenchRow
 from optdesign.text import csv_cell, printable
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -46,9 +49,9 @@ def md_cell(text: object) -> str:
 
 
 def stats_table(
-    stats: Mapping[str, Mapping[str, Any]],
+    stats: Mapping[str, ConfigStats],
     descriptions: Mapping[str, str],
-    rows: Sequence[Mapping[str, Any]],
+    rows: Sequence[BenchRow],
 ) -> str:
     """Markdown table of :func:`config_stats`, best configuration first, with the median
     per-instance ratio of each configuration's time to the best one's."""
@@ -57,8 +60,8 @@ def stats_table(
         stats,
         key=lambda c: (
             c != best,
-            -(stats[c]["solved_rate"] or 0),
-            stats[c]["median_time_s"] if math.isfinite(stats[c]["median_time_s"]) else 1e9,
+            -(stats[c].solved_rate or 0),
+            stats[c].median_time_s if math.isfinite(stats[c].median_time_s) else 1e9,
         ),
     )
     lines = [
@@ -68,17 +71,17 @@ def stats_table(
     ]
     for c in order:
         s = stats[c]
-        if not s["runs"]:
+        if not s.runs:
             continue
         ratio, n_pairs = paired_time_ratio(rows, c, best) if best else (float("nan"), 0)
-        fails = ", ".join(f"{md_cell(k)} {v}" for k, v in sorted(s["failures"].items())) or "-"
+        fails = ", ".join(f"{md_cell(k)} {v}" for k, v in sorted(s.failures.items())) or "-"
         name = md_cell(c)
         lines.append(
             f"| {'**' + name + '**' if c == best else name} | {md_cell(descriptions.get(c, ''))} "
-            f"| {s['runs']} | "
-            f"{100 * s['success_rate']:.0f} % | {100 * s['solved_rate']:.0f} % | "
-            f"{_fmt(s['median_time_s'], '.3g')} | {_fmt(ratio, '.2f')} ({n_pairs}) | "
-            f"{_fmt(s['median_gap'], '.1e')} | {fails} |"
+            f"| {s.runs} | "
+            f"{100 * s.success_rate:.0f} % | {100 * s.solved_rate:.0f} % | "
+            f"{_fmt(s.median_time_s, '.3g')} | {_fmt(ratio, '.2f')} ({n_pairs}) | "
+            f"{_fmt(s.median_gap, '.1e')} | {fails} |"
         )
     return "\n".join(lines)
 
@@ -127,7 +130,7 @@ def eval_counts(n_evals: Mapping[str, int]) -> tuple[int | None, int | None, int
 
 
 def write_outputs(
-    rows, out: Path, configs, suite_name, wall, time_limit, hard, skipped=None
+    rows: Sequence[BenchRow], out: Path, configs, suite_name, wall, time_limit, hard, skipped=None
 ) -> dict[str, Any]:
     """bench_runs.csv, bench_profiles.png, summary.md, bench_stats.json in ``out``;
     ``skipped``: mechanism -> why the suite has no instances of it (listed last)."""
@@ -137,10 +140,11 @@ def write_outputs(
         w = csv.DictWriter(fh, CSV_FIELDS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
-            f, g, h = eval_counts(r.get("n_evals") or {})
-            row = {**r, "n_fun": f, "n_grad": g, "n_hess": h}
-            row["reason"] = str(r.get("reason", ""))[:200]
-            w.writerow({k: csv_cell(v) for k, v in row.items() if k in CSV_FIELDS})
+            f, g, h = eval_counts(r.n_evals or {})
+            counts = {"n_fun": f, "n_grad": g, "n_hess": h, "reason": str(r.reason)[:200]}
+            w.writerow(
+                {k: csv_cell(counts[k] if k in counts else getattr(r, k)) for k in CSV_FIELDS}
+            )
         atomic_write_text(out / "bench_runs.csv", fh.getvalue())
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
     fronts = [c for c in configs if get_config(c).kind == "front"]
@@ -151,9 +155,9 @@ def write_outputs(
         with atomic_output(out / "bench_profiles.png") as tmp:
             save_figure(fig, tmp, tight=False)
     desc = {c: get_config(c).description for c in configs}
-    stats_all = config_stats([r for r in rows if r["config"] in single], single)
-    shipped = [r for r in rows if r["family"] == "shipped"]
-    n_inst = len({r["instance"] for r in rows})
+    stats_all = config_stats([r for r in rows if r.config in single], single)
+    shipped = [r for r in rows if r.family == "shipped"]
+    n_inst = len({r.instance for r in rows})
     lines = [
         f"Suite `{suite_name}`: {n_inst} instances, {len(rows)} runs, wall time {wall:.0f} s "
         f"(soft time limit {time_limit:g} s per run, hard timeout {hard:g} s). "
@@ -176,12 +180,12 @@ def write_outputs(
             "### Shipped problems (problems/*.toml)",
             "",
             stats_table(
-                config_stats([r for r in shipped if r["config"] in single], single), desc, shipped
+                config_stats([r for r in shipped if r.config in single], single), desc, shipped
             ),
         ]
         lines += ["", _shipped_table(shipped, single)]
     if fronts:
-        st = config_stats([r for r in rows if r["config"] in fronts], fronts)
+        st = config_stats([r for r in rows if r.config in fronts], fronts)
         lines += [
             "",
             "### Pareto-front instances (gap = 1 - hypervolume / best hypervolume)",
@@ -196,7 +200,13 @@ def write_outputs(
     atomic_write_text(
         out / "bench_stats.json",
         json.dumps(
-            clean_json({"all": stats_all, "wall_time_s": wall, "suite": suite_name}),
+            clean_json(
+                {
+                    "all": {c: asdict(s) for c, s in stats_all.items()},
+                    "wall_time_s": wall,
+                    "suite": suite_name,
+                }
+            ),
             indent=1,
             default=str,
             allow_nan=False,
@@ -210,21 +220,21 @@ def write_outputs(
     }
 
 
-def _shipped_table(rows, configs) -> str:
-    insts = sorted({r["instance"] for r in rows})
+def _shipped_table(rows: Sequence[BenchRow], configs: Sequence[str]) -> str:
+    insts = sorted({r.instance for r in rows})
     head = "| configuration | " + " | ".join(f"{md_cell(i)}: time (s) / gap" for i in insts) + " |"
     lines = [head, "|---|" + "---|" * len(insts)]
-    by = {(r["instance"], r["config"]): r for r in rows}
+    by = {(r.instance, r.config): r for r in rows}
     for c in configs:
         cells = []
         for i in insts:
             r = by.get((i, c))
-            if r is None or not r.get("applicable", True):
+            if r is None or not r.applicable:
                 cells.append("n/a")
-            elif not r.get("success"):
-                cells.append(md_cell(r["status"]))
+            elif not r.success:
+                cells.append(md_cell(r.status))
             else:
-                cells.append(f"{r['time_s']:.3g} / {r['gap']:.1e}")
+                cells.append(f"{r.time_s:.3g} / {r.gap:.1e}")
         lines.append(f"| {md_cell(c)} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -285,10 +295,12 @@ def update_readme(readme: Path, summary: str) -> bool:
     return True
 
 
-def profiles(rows, configs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def profiles(
+    rows: Sequence[BenchRow], configs: Sequence[str]
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Time and gap performance profiles of the single-objective configurations."""
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
-    chosen = [r for r in rows if r["config"] in single]
+    chosen = [r for r in rows if r.config in single]
     taus_t = np.logspace(0, 3, 200)
     taus_g = np.logspace(0, 6, 200)
     _, Tt = measure_table(chosen, single, "time")
@@ -299,7 +311,7 @@ def profiles(rows, configs) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     }
 
 
-def profiles_figure(rows, configs):
+def profiles_figure(rows: Sequence[BenchRow], configs: Sequence[str]):
     """The profiles as a matplotlib Figure."""
     from optdesign.plots.profiles import plot_profiles
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -20,8 +19,10 @@ from optdesign.store_identity import identity_key
 from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
 from optdesign.studies.bench.instances import Instance, coverage, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
-from optdesign.studies.bench.metrics import add_gaps, config_stats
+from optdesign.studies.bench.metrics import ConfigStats, add_gaps, config_stats
+from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.sandbox import run_task
+from optdesign.studies.run_options import study_folder
 
 
 @dataclass
@@ -31,7 +32,8 @@ class BenchReport:
     Attributes
     ----------
     rows
-        One dict per (instance, configuration) run, with its gap to the best known value.
+        One :class:`~optdesign.studies.bench.rows.BenchRow` per (instance, configuration)
+        run, with its gap to the best known value.
     configs
         The configurations run.
     stats
@@ -47,9 +49,9 @@ class BenchReport:
         (empty for the caller's own problems).
     """
 
-    rows: list[dict[str, Any]]
+    rows: list[BenchRow]
     configs: list[str]
-    stats: dict[str, dict[str, Any]] = field(default_factory=dict)
+    stats: dict[str, ConfigStats] = field(default_factory=dict)
     summary_markdown: str = ""
     paths: dict[str, Any] = field(default_factory=dict)
     wall_time_s: float = 0.0
@@ -74,7 +76,7 @@ class BenchReport:
             "iterations",
             "reason",
         )
-        return pd.DataFrame([{k: r.get(k) for k in keep} for r in self.rows])
+        return pd.DataFrame([{k: getattr(r, k) for k in keep} for r in self.rows])
 
     def plot(self, ax=None):
         """Dolan-More profiles (time and gap) of the single-objective configurations."""
@@ -162,8 +164,7 @@ def run_bench(
     # Solver libraries imported here, before the workers and the runs' children are
     # forked: a run's time is then its solve, not the import of its library.
     preload_modules(names)
-    out = Path(out) if out is not None else Path(tempfile.mkdtemp(prefix="optdesign-bench-"))
-    out.mkdir(parents=True, exist_ok=True)
+    out = study_folder(out, "bench")
     store = out / "bench_runs.jsonl"
     key = bench_identity(suite_name, tasks, time_limit, hard, problems)
     t0 = time.perf_counter()
@@ -187,13 +188,15 @@ def run_bench(
     if resume:
         wall += _stored_wall(meta_path, key_text)
     atomic_write_text(meta_path, json.dumps({"key": key_text, "wall_time_s": wall}))
-    rows = add_gaps([dict(records[t["id"]]) for t in tasks if t["id"] in records])
+    # The one place a stored (or just computed) JSON row becomes a BenchRow; each was
+    # checked by from_dict on resume (row_check) or comes from the sandbox.
+    rows = add_gaps([BenchRow.from_dict(records[t["id"]]) for t in tasks if t["id"] in records])
     paths = write_outputs(rows, out, names, suite_name, wall, time_limit, hard, skipped)
     single = [c for c in names if get_config(c).kind not in ("front", "debug")]
     return BenchReport(
         rows=rows,
         configs=names,
-        stats=config_stats([r for r in rows if r["config"] in single], single),
+        stats=config_stats([r for r in rows if r.config in single], single),
         summary_markdown=paths["summary_text"],
         paths=paths,
         wall_time_s=wall,

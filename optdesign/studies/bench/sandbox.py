@@ -23,6 +23,7 @@ from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import SOLVED_STATUSES, Result, is_success
 from optdesign.studies.bench.configs import Config, NotApplicable, get_config
 from optdesign.studies.bench.instances import Instance, make_instance
+from optdesign.studies.bench.rows import BenchRow, BenchRowError, is_number
 from optdesign.studies.verify import verify_design
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -292,10 +293,6 @@ def _fix(inst: Instance, problem: DesignProblem, combo: Mapping[str, float]) -> 
 
 
 # --- trusting a stored row ---------------------------------------------------------------
-def _num(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool)
-
-
 def row_check(tasks: list[Mapping[str, Any]]):
     """``check(row)`` for the runner's resume: why a stored benchmark row cannot be
     trusted (see :func:`row_problem`); each instance's problem is built once."""
@@ -316,38 +313,36 @@ def row_problem(
 ) -> str | None:
     """Why a stored row of ``task`` cannot be trusted, or None.
 
-    Every row must name its configuration and carry a status, a success flag and a
-    finite time. A successful single-objective row must hold a finite objective and a
-    design inside the instance's bounds that the independent check confirms, with the
-    same objective value (a resumed benchmark recomputes nothing it trusts); a
-    successful front row finite objective vectors and a violation within the check's
-    tolerance.
+    Every row must name its configuration and be a :class:`BenchRow` (its identity, a
+    status, a success flag and a finite time; :meth:`BenchRow.from_dict`). A successful
+    single-objective row must hold a finite objective and a design inside the instance's
+    bounds that the independent check confirms, with the same objective value (a resumed
+    benchmark recomputes nothing it trusts); a successful front row finite objective
+    vectors and a violation within the check's tolerance.
     """
-    if row.get("config") != task["config"]:
+    if not isinstance(row, Mapping) or row.get("config") != task["config"]:
         return f"is not a run of configuration {task['config']!r}"
-    if not isinstance(row.get("status"), str) or not isinstance(row.get("success"), bool):
-        return "has no status or success flag"
-    if not (_num(row.get("time_s")) and math.isfinite(row["time_s"]) and row["time_s"] >= 0):
-        return f"has a time that is not a finite number ({row.get('time_s')!r:.40})"
-    if row.get("objective") is not None and not _num(row["objective"]):
-        return "has an objective that is not a number"
-    if not row["success"]:
+    try:
+        r = BenchRow.from_dict(row)
+    except BenchRowError as exc:
+        return str(exc)
+    if not r.success:
         return None
-    if row["status"] not in SOLVED_STATUSES:
-        return f"counts as a success with status {row['status']!r}"
+    if r.status not in SOLVED_STATUSES:
+        return f"counts as a success with status {r.status!r}"
     if get_config(task["config"]).kind == "front":
-        return _front_row_problem(row)
+        return _front_row_problem(r)
     inst = task_instance(task)
     if inst.id not in problems:
         problems[inst.id] = inst.problem()
     problem = problems[inst.id]
     objective = inst.objectives[0]
-    design = row.get("design")
-    if row.get("verified") is not True or not isinstance(design, dict):
+    design = r.design
+    if r.verified is not True or not isinstance(design, dict):
         return "counts as a success without a design confirmed by the independent check"
-    if not (_num(row["objective"]) and math.isfinite(row["objective"])):
-        return f"counts as a success with objective {row['objective']!r}"
-    missing = [v.name for v in problem.free if not _num(design.get(v.name))]
+    if not (is_number(r.objective) and math.isfinite(r.objective)):
+        return f"counts as a success with objective {r.objective!r}"
+    missing = [v.name for v in problem.free if not is_number(design.get(v.name))]
     if missing:
         return f"has no value of {missing[0]} in its design"
     x = np.array([design[v.name] for v in problem.free], dtype=float)
@@ -360,23 +355,23 @@ def row_problem(
     if not ok:
         return f"has a design that violates {violated[0].describe()}"
     value = float(objs[objective])
-    if abs(row["objective"] - value) > 1e-7 * max(abs(value), 1e-12):
-        return f"has objective {row['objective']:.10g}, but its design gives {value:.10g}"
+    if abs(r.objective - value) > 1e-7 * max(abs(value), 1e-12):
+        return f"has objective {r.objective:.10g}, but its design gives {value:.10g}"
     return None
 
 
-def _front_row_problem(row: Mapping[str, Any]) -> str | None:
-    front = row.get("front")
+def _front_row_problem(row: BenchRow) -> str | None:
+    front = row.front
     if not (
         isinstance(front, list)
         and len(front) >= 2
         and all(
-            isinstance(p, list) and p and all(_num(v) and math.isfinite(v) for v in p)
+            isinstance(p, list) and p and all(is_number(v) and math.isfinite(v) for v in p)
             for p in front
         )
     ):
         return "counts as a success without at least two finite front points"
-    v = row.get("violation")
-    if not (_num(v) and 0 <= v <= FEASIBILITY_TOL):
+    v = row.violation
+    if not (is_number(v) and 0 <= v <= FEASIBILITY_TOL):
         return f"counts as a success with violation {v!r}"
     return None

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import functools
 import tempfile
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -19,21 +18,7 @@ from optdesign.safe_io import slug
 from optdesign.studies.identity import run_identity
 from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.records import record_problem
-
-
-@dataclass
-class RunOptions:
-    """Where and how a front's tasks run (not what they compute)."""
-
-    out: Path | str | None = None
-    workers: int = 1
-    scheduler: str | Any | None = None
-    resume: bool = False
-    progress: bool = False
-    on_record: Callable | None = None
-    overwrite: bool = False  # start afresh over a store of an earlier run in ``out``
-    # wall-clock seconds of the study: no point begins after it (epsilon sweeps)
-    time_limit: float | None = None
+from optdesign.studies.run_options import RunOptions as RunOptions  # the fronts import it here
 
 
 def check_front_problem(problem: DesignProblem) -> None:
