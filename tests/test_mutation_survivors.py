@@ -425,10 +425,22 @@ def test_a_point_worse_than_its_looser_neighbour_is_retried_on_its_own_target(mo
         return original(self, target, eps, start)
 
     monkeypatch.setattr(EpsSolver, "solve", spy)
+    boxes = []
+    sobol = tasks.sobol_starts
+
+    def drawn(lo, hi, n, seed):
+        boxes.append((np.array(lo), np.array(hi), n, seed))
+        return sobol(lo, hi, n, seed)
+
+    monkeypatch.setattr(tasks, "sobol_starts", drawn)
     task = {**first, "eps": {"size": 1e9}, "warm": "p-1", "retry_starts": 2, "seed": 3}
     rec = tasks.front_task(task, {"p-1": neighbour})
     assert rec["retried"] == "worse than its neighbour with a looser bound"
     assert rec["n_solves"] == 4 and targets == ["backlash"] * 4  # warm, neighbour, 2 Sobol
+    # the cold starts are drawn over the whole box, seeded by the point's index
+    ((lo, hi, n, seed),) = boxes
+    assert np.array_equal(lo, problem.lower()) and np.array_equal(hi, problem.upper())
+    assert (n, seed) == (2, 3)
     assert rec["objectives"]["backlash"] == pytest.approx(solo["objectives"]["backlash"], rel=1e-6)
 
 
