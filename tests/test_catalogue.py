@@ -195,3 +195,54 @@ def test_a_box_proved_infeasible_under_a_limit_is_implied_only_under_tighter_one
     assert r.success and looser.n_implied == 0
     unlimited, r = node({})
     assert r.success and unlimited.n_implied == 0
+
+
+def test_the_memo_proves_a_box_whose_item_combinations_other_proofs_cover():
+    """With the items known, a box is infeasible when each of its item combinations lies
+    in some proved box whose limits the query holds at least as tight; one combination
+    left uncovered, or a proof at looser limits only, and it is not."""
+    from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+
+    full = {"a": (1.0, 3.0), "b": (1.0, 2.0)}
+    memo = InfeasibleBoxes(full, {"a": (1.0, 2.0, 3.0), "b": (1.0, 2.0)})
+    memo.add_infeasible({"a": (1.0, 1.0)}, {})  # a = 1, any b
+    memo.add_infeasible({"a": (2.0, 3.0), "b": (1.0, 1.0)}, {})
+    memo.add_infeasible({"a": (2.0, 3.0), "b": (2.0, 2.0)}, {"f": 5.0})  # only if f <= 5
+    assert not memo.known_infeasible({}, {})
+    assert memo.known_infeasible({}, {"f": 4.0}) and memo.known_infeasible({}, {"f": 5.0})
+    assert not memo.known_infeasible({}, {"f": 6.0})
+    assert memo.known_infeasible({"b": (1.0, 1.0)}, {})  # a = 1 and the second proof
+    # without the items only a single proof's box counts
+    bare = InfeasibleBoxes(full)
+    for box, eps in memo.proofs:
+        bare.add_infeasible(box, eps)
+    assert not bare.known_infeasible({}, {"f": 4.0})
+    assert bare.known_infeasible({"a": (1.0, 1.0), "b": (2.0, 2.0)}, {})
+
+
+def test_a_pruned_box_with_a_trusted_value_is_a_proof_under_a_lower_limit():
+    """A box pruned on a value the search trusts (a full multistart) is infeasible under
+    any limit on the objective below that value: recorded in a front's memo with the
+    search's own limits; a one-start value or a search with no memo records nothing."""
+    from types import SimpleNamespace
+
+    from optdesign.solvers.result import MultistartInfo, Result
+    from optdesign.studies.catalogue_bnb import PRUNE_TOL, InfeasibleBoxes, _bound_proof
+
+    def result(n_starts):
+        r = Result("optimal", 2.0, {"a": 1.0}, "fake", "nlp", 0.0)
+        r.multistart = MultistartInfo(n_starts, n_starts, 1, 1e-6)
+        return r
+
+    memo = InfeasibleBoxes({"a": (1.0, 3.0)})
+    ns = SimpleNamespace(memo=memo, starts=4, eps={"g": 7.0}, objective="f")
+    _bound_proof(ns, {"a": (2.0, 3.0)}, result(4))
+    ((box, eps),) = memo.proofs
+    assert box == {"a": (2.0, 3.0)}
+    assert eps == {"g": 7.0, "f": pytest.approx(2.0 * (1 - PRUNE_TOL), rel=1e-15)}
+    assert memo.known_infeasible({"a": (3.0, 3.0)}, {"g": 7.0, "f": 1.9})
+    assert not memo.known_infeasible({"a": (3.0, 3.0)}, {"g": 7.0, "f": 2.0})
+    assert not memo.known_infeasible({"a": (3.0, 3.0)}, {"f": 1.9})  # g not held
+    _bound_proof(ns, {"a": (1.0, 1.0)}, result(1))  # a warm start's value alone
+    _bound_proof(SimpleNamespace(memo=None, starts=4, eps={}, objective="f"), {}, result(4))
+    assert len(memo.proofs) == 1

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import heapq
 import itertools
+import math
 from collections.abc import Mapping, Sequence
 from functools import partial
 from typing import Any
@@ -134,8 +135,11 @@ class InfeasibleBoxes:
     lies in the first one's.
     """
 
-    def __init__(self, full: Box):
+    def __init__(self, full: Box, items: Mapping[str, Sequence[float]] | None = None):
         self.full = dict(full)
+        #: each catalogue variable's items: with them, a box is also proved infeasible
+        #: when every item combination in it lies in some proved box (a union of proofs)
+        self.items = {k: tuple(sorted(v)) for k, v in items.items()} if items else None
         self._proofs: list[tuple[dict[str, tuple[float, float]], dict[str, float]]] = []
 
     def __len__(self) -> int:
@@ -158,18 +162,41 @@ class InfeasibleBoxes:
         self._proofs.append(({**self.full, **box}, dict(eps)))
 
     def known_infeasible(self, box: Box, eps: Mapping[str, float]) -> bool:
-        """Whether a stored proof covers ``box`` under limits ``eps``."""
+        """Whether stored proofs cover ``box`` under limits ``eps``: one proof's box holds
+        it, or (with :attr:`items`) every item combination of it lies in a proof's box."""
         box = {**self.full, **box}
-        for wide, limits in self._proofs:
-            inside = all(
-                wide[k][0] - _tol(wide[k][0]) <= lo and hi <= wide[k][1] + _tol(wide[k][1])
-                for k, (lo, hi) in box.items()
-                if k in wide
+        applicable = [
+            wide
+            for wide, limits in self._proofs
+            if all(k in eps and eps[k] <= v for k, v in limits.items())
+        ]
+        if any(_inside(box, wide) for wide in applicable):
+            return True
+        if self.items is None or len(applicable) < 2:
+            return False
+        names = list(self.items)
+        lists = [items_within(self.items[k], *box[k]) for k in names]
+        if math.prod(len(v) for v in lists) > MAX_COVER_COMBINATIONS:
+            return False
+        return all(
+            any(
+                _inside({k: (c, c) for k, c in zip(names, combo, strict=True)}, w)
+                for w in applicable
             )
-            tighter = all(k in eps and eps[k] <= v for k, v in limits.items())
-            if inside and tighter:
-                return True
-        return False
+            for combo in itertools.product(*lists)
+        )
+
+
+#: Item combinations a box may hold for the memo to check them one by one.
+MAX_COVER_COMBINATIONS = 4096
+
+
+def _inside(box: Box, wide: Box) -> bool:
+    return all(
+        wide[k][0] - _tol(wide[k][0]) <= lo and hi <= wide[k][1] + _tol(wide[k][1])
+        for k, (lo, hi) in box.items()
+        if k in wide
+    )
 
 
 def _tol(v: float) -> float:
@@ -182,12 +209,14 @@ _MEMOS: dict[tuple, InfeasibleBoxes] = {}
 _MEMO_MAX = 8
 
 
-def shared_memo(key: tuple, full: Box) -> InfeasibleBoxes:
+def shared_memo(
+    key: tuple, full: Box, items: Mapping[str, Sequence[float]] | None = None
+) -> InfeasibleBoxes:
     """The memo of ``key`` in this process (made on first use)."""
     if key not in _MEMOS:
         while len(_MEMOS) >= _MEMO_MAX:
             _MEMOS.pop(next(iter(_MEMOS)))
-        _MEMOS[key] = InfeasibleBoxes(full)
+        _MEMOS[key] = InfeasibleBoxes(full, items)
     return _MEMOS[key]
 
 
@@ -304,6 +333,7 @@ def branch_and_bound_warm(
                     heapq.heappush(heap, entry)
                     continue
             stats["pruned"] += 1
+            _bound_proof(ns, box, res)
             continue
         x = ns.x_of(res)
         # the children's floor: this node's value when the search trusts it, else the
@@ -351,6 +381,7 @@ def branch_and_bound_warm(
                 continue
             if prunes(r.objective, child):
                 stats["pruned"] += 1
+                _bound_proof(ns, child, r)
                 continue
             warm_only = not fixed and r.multistart is not None and not trusted(r, ns.starts)
             entry = (r.objective, next(counter), child, r, x if warm_only else None, below)
@@ -363,6 +394,23 @@ def branch_and_bound_warm(
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats
+
+
+def _bound_proof(ns, box: Box, res: Result) -> None:
+    """A pruned box's value, when the search trusts it, is the least the objective takes
+    over the box under the search's limits: under a limit on the objective below it the
+    box is infeasible. Recorded in a front's shared memo (not in a single search's
+    proofs), where a later point's or anchor's limit on this objective implies it: the
+    tree's bounds carried from one search to the next."""
+    memo = getattr(ns, "memo", None)
+    if memo is None or not res.success or not trusted(res, ns.starts):
+        return
+    value = res.objective
+    # below the value by the pruning tolerance: past the solve's own tolerance
+    limit = value - PRUNE_TOL * max(abs(value), 1e-12)
+    eps = dict(ns.eps)
+    eps[ns.objective] = min(limit, eps.get(ns.objective, math.inf))
+    memo.add_infeasible(box, eps)
 
 
 def split_at_items(dvars, box: Box, items: Mapping[str, float]) -> list[tuple[Any, list[float]]]:

@@ -65,6 +65,8 @@ def front_knowledge(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
     memo = None
     if task.get("memo"):
         problem = task["problem"]
-        full = {v.name: (v.lower, v.upper) for v in discrete_variables(problem)}
-        memo = shared_memo((problem_digest(problem), task["starts"], task["seed"]), full)
+        dvars = discrete_variables(problem)
+        full = {v.name: (v.lower, v.upper) for v in dvars}
+        items = {v.name: v.values for v in dvars}
+        memo = shared_memo((problem_digest(problem), task["starts"], task["seed"]), full, items)
     return {"incumbents": incumbents, "memo": memo}
