@@ -180,3 +180,28 @@ def test_a_combination_met_again_is_solved_from_the_new_start_only():
     full = [tuple(sorted(box.items())) for box, one_start in ns.calls if not one_start]
     fixed = [b for b in full if all(lo == hi for _, (lo, hi) in b)]
     assert len(fixed) == len(set(fixed))  # no combination's multistart twice
+
+
+class NearItemNodes(TiedNodes):
+    """One catalogue variable that matters, b in (1, 2, 3, 4), with the relaxation at
+    b = 3.9 (off its items, nearest 4); a has a single item. The optimum is b = 4."""
+
+    def __init__(self):
+        super().__init__()
+        self.problem = _Problem([_Var("a", (1.0,)), _Var("b", B_ITEMS)])
+
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+        self.boxes.append(dict(box))
+        lo, hi = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
+        b = min(max(3.9, lo), hi)
+        return Result("optimal", (b - 3.9) ** 2 + 1.0, {"a": 1.0, "b": b}, "fake", "nlp", 0.0)
+
+
+def test_a_branch_child_that_is_one_combination_is_solved_not_taken_for_a_leaf():
+    """Branching b around 3.9 gives the child b = 4 alone, the combination nearest the
+    relaxation: it is a leaf still to solve (an earlier search skipped it as "the leaf
+    just solved", reporting b = 3)."""
+    ns = NearItemNodes()
+    best, _ = branch_and_bound_warm(ns, ns.solve({}), ())
+    assert best.design["b"] == 4.0 and best.objective == pytest.approx(1.01)
+    assert {"a": (1.0, 1.0), "b": (4.0, 4.0)} in ns.boxes

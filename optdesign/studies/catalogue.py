@@ -28,7 +28,6 @@ import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.discrete import (
-    ON_ITEM_TOL,
     branch,
     discrete_variables,
     items_within,
@@ -49,7 +48,7 @@ from optdesign.solvers.multistart import (
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes, split_at_items, trusted
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_items, trusted
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
@@ -113,6 +112,10 @@ class NodeSolver:
         self.starts = max(1, starts)
         self.seed = seed
         self.names = [v.name for v in problem.free]
+        #: the catalogue variables the objective depends on: branched on first (a
+        #: variable that only bounds the feasible set, e.g. the pin diameter of a torque
+        #: objective, is left for last, where the tie rule needs it)
+        self.branch_first = objective_variables(self.nlp, problem, self.objective)
         self.n_solves = 0
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
@@ -253,6 +256,26 @@ class NodeSolver:
         if not result.design:
             return None
         return np.array([result.design[n] for n in self.names])
+
+
+def objective_variables(nlp, problem: DesignProblem, objective: str) -> tuple[str, ...]:
+    """The catalogue variables ``objective`` depends on in ``nlp``: through the design
+    vector or through the item data the variable selects (the node parameters whose
+    values move with its item). Structural (:meth:`NLP.objective_depends_on`), so exact
+    for any mechanism."""
+    base = problem.parameter_values({})
+    found = []
+    for v in discrete_variables(problem):
+        moved = {
+            name
+            for item in v.values
+            for name, value in problem.parameter_values({v.name: (item, item)}).items()
+            if value != base[name]
+        }
+        k = problem.free.index(v)
+        if nlp.objective_depends_on(objective, k, sorted(moved)):
+            found.append(v.name)
+    return tuple(found)
 
 
 def _no_item(solver: str, message: str) -> Result:
@@ -439,20 +462,8 @@ def first_feasible(ns: NodeSolver) -> Result | None:
     stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []
     while stack:
         box, res = stack.pop()
-        worst, worst_d = None, ON_ITEM_TOL
-        for v in dvars:
-            _item, dist = nearest_item(
-                res.design[v.name], tuple(items_within(v.values, *box[v.name]))
-            )
-            if dist > worst_d:
-                worst, worst_d = v, dist
+        worst, items = on_items(dvars, box, res, getattr(ns, "branch_first", ()))
         if worst is None:  # on items: the leaf with them fixed
-            items = {
-                v.name: nearest_item(
-                    res.design[v.name], tuple(items_within(v.values, *box[v.name]))
-                )[0]
-                for v in dvars
-            }
             leaf = ns.solve(_fixed(items), ns.x_of(res))
             if leaf.success:
                 return leaf
