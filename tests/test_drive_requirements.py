@@ -67,3 +67,31 @@ def test_screw_buckling_is_imposed_and_named_when_it_cannot_be_met():
 def test_lock_requirement_errors(lock, message):
     with pytest.raises(ProblemError, match=message):
         _problem(lock=lock)
+
+
+@pytest.mark.parametrize(
+    "kept",
+    ["static_safety_min", "life_min"],
+)
+def test_a_rating_requirement_without_a_catalogue_screw_is_refused_naming_it(kept):
+    """fin_actuator with its screw given by hand (d0, p fixed, no catalogue): the static
+    safety and the life need the catalogue's ratings; each is refused on its own, naming
+    itself and how to give a catalogue."""
+    import tomllib
+    from pathlib import Path
+
+    import optdesign as od
+
+    root = Path(__file__).resolve().parents[1]
+    data = tomllib.loads((root / "problems" / "fin_actuator.toml").read_text())
+    for key in ("catalogue", "nut_stiffness_rule", "mounting_factors"):
+        data["screw"].pop(key, None)
+    for name in ("static_safety_min", "life_min"):
+        if name != kept:
+            data["requirements"].pop(name, None)
+    data["variables"]["d0"], data["variables"]["p"] = "20 mm", "5 mm"
+    with pytest.raises(ProblemError) as caught:
+        od.solve(od.load(data), starts=1)
+    assert str(caught.value) == (
+        f'requirements.{kept}: needs a catalogue screw ([screw] catalogue = "HIWIN")'
+    )
