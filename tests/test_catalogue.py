@@ -246,17 +246,3 @@ def test_a_pruned_box_with_a_trusted_value_is_a_proof_under_a_lower_limit():
     _bound_proof(ns, {"a": (1.0, 1.0)}, result(1))  # a warm start's value alone
     _bound_proof(SimpleNamespace(memo=None, starts=4, eps={}, objective="f"), {}, result(4))
     assert len(memo.proofs) == 1
-
-
-def test_the_search_branches_first_on_the_variables_its_objective_depends_on():
-    """fin_actuator: the peak motor torque depends on the screw (its diameter d0 and
-    lead p) and not on the pin diameter; the backlash on the pin (its size and its table
-    fit) and not on the screw."""
-    from optdesign.studies.catalogue import NodeSolver, objective_variables
-
-    fin = load_problem(ROOT / "problems" / "fin_actuator.toml")
-    torque = NodeSolver(fin, "motor_torque")
-    assert torque.branch_first == ("d0", "p")
-    assert objective_variables(torque.nlp, fin, "backlash") == ("d",)
-    cs = problem_from_dict(tomllib.loads(CATALOGUE.read_text()))
-    assert NodeSolver(cs, "motor_torque").branch_first == ("p",)

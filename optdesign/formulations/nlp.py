@@ -181,19 +181,6 @@ class NLP:
         exprs = [*self.objective_values.values(), *[x[k] for k in range(self.n_design)]]
         return ca.Function("target_values", [self.z, self.theta], [ca.vertcat(*exprs)])
 
-    def objective_depends_on(
-        self, objective: str, variable: int, parameters: Sequence[str] = ()
-    ) -> bool:
-        """Whether ``objective``'s value, or its envelope rows (a max or spread over the
-        grid is an auxiliary variable those rows bound), depends structurally on design
-        variable ``variable`` (index among the free ones) or on one of ``parameters``."""
-        heads = {f"{objective}{s}" for s in ("_envelope", "_lower_envelope", "_upper_envelope")}
-        rows = [k for k, g in enumerate(self.g_names) if g.split("[", 1)[0] in heads]
-        expr = ca.vertcat(self.objective_values[objective], *(self.g[k] for k in rows))
-        symbols = [self.z[variable]]
-        symbols += [self.theta[self.param_names.index(n)] for n in parameters]
-        return any(ca.depends_on(expr, s) for s in symbols)
-
     @cached_property
     def g_fun(self) -> ca.Function:
         """(z, theta) -> the constraint rows."""

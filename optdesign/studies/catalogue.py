@@ -112,10 +112,6 @@ class NodeSolver:
         self.starts = max(1, starts)
         self.seed = seed
         self.names = [v.name for v in problem.free]
-        #: the catalogue variables the objective depends on: branched on first (a
-        #: variable that only bounds the feasible set, e.g. the pin diameter of a torque
-        #: objective, is left for last, where the tie rule needs it)
-        self.branch_first = objective_variables(self.nlp, problem, self.objective)
         self.n_solves = 0
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
@@ -256,26 +252,6 @@ class NodeSolver:
         if not result.design:
             return None
         return np.array([result.design[n] for n in self.names])
-
-
-def objective_variables(nlp, problem: DesignProblem, objective: str) -> tuple[str, ...]:
-    """The catalogue variables ``objective`` depends on in ``nlp``: through the design
-    vector or through the item data the variable selects (the node parameters whose
-    values move with its item). Structural (:meth:`NLP.objective_depends_on`), so exact
-    for any mechanism."""
-    base = problem.parameter_values({})
-    found = []
-    for v in discrete_variables(problem):
-        moved = {
-            name
-            for item in v.values
-            for name, value in problem.parameter_values({v.name: (item, item)}).items()
-            if value != base[name]
-        }
-        k = problem.free.index(v)
-        if nlp.objective_depends_on(objective, k, sorted(moved)):
-            found.append(v.name)
-    return tuple(found)
 
 
 def _no_item(solver: str, message: str) -> Result:
@@ -462,7 +438,7 @@ def first_feasible(ns: NodeSolver) -> Result | None:
     stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []
     while stack:
         box, res = stack.pop()
-        worst, items = on_items(dvars, box, res, getattr(ns, "branch_first", ()))
+        worst, items = on_items(dvars, box, res)
         if worst is None:  # on items: the leaf with them fixed
             leaf = ns.solve(_fixed(items), ns.x_of(res))
             if leaf.success:

@@ -220,24 +220,17 @@ def shared_memo(
     return _MEMOS[key]
 
 
-def on_items(
-    dvars, box: Box, res: Result, first: Sequence[str] = ()
-) -> tuple[Any, dict[str, float]]:
+def on_items(dvars, box: Box, res: Result) -> tuple[Any, dict[str, float]]:
     """The catalogue variable to branch on - the one farthest (relatively) from an item
-    in its range, among ``first`` (the variables the objective depends on) when one of
-    them is off its items, else among all (None when every one sits on an item) - and
-    the nearest items."""
+    in its range, None when every one sits on an item - and the nearest items."""
     worst, worst_d, items = None, ON_ITEM_TOL, {}
-    preferred, preferred_d = None, ON_ITEM_TOL
     for v in dvars:
         allowed = tuple(items_within(v.values, *box[v.name]))
         item, dist = nearest_item(res.design[v.name], allowed)
         items[v.name] = item
         if dist > worst_d:
             worst, worst_d = v, dist
-        if v.name in first and dist > preferred_d:
-            preferred, preferred_d = v, dist
-    return (preferred if preferred is not None else worst), items
+    return worst, items
 
 
 def first_incumbent(
@@ -346,17 +339,9 @@ def branch_and_bound_warm(
         # the children's floor: this node's value when the search trusts it, else the
         # floor it had itself (a sub-box's value is never below its box's)
         below = bound if trusted(res, ns.starts) else floor
-        first = getattr(ns, "branch_first", ())
-        worst, items = on_items(dvars, box, res, first)
+        worst, items = on_items(dvars, box, res)
         sides: list[tuple[Any, list[float]]] = []
-        # the objective's variables sit on items but their box holds others: split them
-        # at their items before branching on a variable the objective ignores, so the
-        # boxes that cannot win are pruned (or proved infeasible) once, not once per item
-        # of the other variable
-        wide = [v for v in dvars if v.name in first and box[v.name][0] != box[v.name][1]]
-        if worst is not None and worst.name not in first and wide:
-            sides = split_at_items(wide, box, items)
-        elif worst is None:  # every catalogue variable sits on an item: a leaf
+        if worst is None:  # every catalogue variable sits on an item: a leaf
             one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
             if one_combination:
                 leaf = res  # already solved with every catalogue variable fixed
