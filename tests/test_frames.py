@@ -137,3 +137,18 @@ def test_front_csv_without_an_on_front_column_keeps_every_row(solved, tmp_path):
     rows = [f"{float(a)!r},{float(b)!r},{k != 0}" for k, (a, b) in enumerate(front.F)]
     marked.write_text("\n".join(["ripple,motor_torque,on_front", *rows]) + "\n")
     assert np.array_equal(read_front_csv(marked, ["ripple", "motor_torque"]), front.F[1:])
+
+
+def test_the_frame_lists_the_rejected_points_only_when_asked(solved):
+    """``to_frame(rejected=True)`` adds the points a front rejected (dominated, failed),
+    marked off the front; the default lists the front alone."""
+    import copy
+    from dataclasses import replace
+
+    _, _, front = solved
+    front = copy.deepcopy(front)
+    front.rejected = [replace(front.points[0], id="r-0", rejected="dominated")]
+    plain, full = front.to_frame(), front.to_frame(rejected=True)
+    assert list(plain["id"]) == [p.id for p in front.points]
+    assert list(full["id"]) == [*plain["id"], "r-0"]
+    assert list(full["on_front"]) == [True] * len(plain) + [False]

@@ -79,6 +79,9 @@ def test_paper_pin_under_the_four_contact_models():
     # linear: the tangent stiffness is 1/C at any load
     pin = PinJoint(10.0, 20.0, contact="huth", lug=lug)
     assert float(pin.contact_stiffness(5000.0)) == pytest.approx(1 / C, rel=1e-12)
+    # over a grid (an unloaded point too): the same stiffness at every point, finite
+    grid = pin.contact_stiffness(np.array([0.0, 2500.0, -5000.0]))
+    assert np.asarray(grid).shape == (3,) and np.allclose(grid, 1 / C, rtol=1e-12)
 
 
 def test_casadi_matches_numpy():

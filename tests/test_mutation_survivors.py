@@ -560,3 +560,31 @@ def test_a_failed_tie_break_of_the_far_anchor_names_what_its_point_violates(tmp_
         chains({"id": "anchor-backlash"}, {}, {**first, "anchor-backlash": failed})
     assert "anchor backlash: no feasible design found (status failed)" in str(caught.value)
     assert f"at the best point found: {shown}" in str(caught.value)
+
+
+def test_a_design_independent_ripple_limit_is_checked_by_the_gp_against_its_value():
+    """With the linkage fixed the ripple does not depend on the design: the GP checks
+    ripple_max against the value itself (the NumPy model's at any design) - met at 0.3,
+    named as the infeasible requirement at 0.2."""
+    import copy
+
+    from test_gp import CS_FIXED
+
+    from optdesign.formulations.gp import build_gp
+
+    ripple = None
+    for limit, lead in ((0.3, None), (0.2, None), (0.2, 5.0)):
+        data = copy.deepcopy(CS_FIXED)
+        data["requirements"]["ripple_max"] = limit
+        if lead is not None:  # the ratio then depends on no free variable at all
+            data["variables"]["p"] = lead
+        problem = problem_from_dict(data)
+        if ripple is None:
+            q = problem.quantities(problem.design_dict(problem.midpoint()))
+            ratio = np.asarray(q.ratio, dtype=float).ravel()
+            ripple = (ratio.max() - ratio.min()) / (ratio.max() + ratio.min())
+            assert ripple == pytest.approx(0.238162, abs=1e-6)
+        gp = build_gp(problem)
+        assert gp.is_gp and "ripple_max" not in {c.name for c in gp.checks}
+        expected = [] if limit > ripple else [f"ripple = {ripple:.6g} > ripple_max = 0.2"]
+        assert gp.infeasible == expected

@@ -34,7 +34,7 @@ from optdesign import math as m
 from optdesign.formulations.signomial import NotGP, Signomial
 from optdesign.problem.design_problem import DesignProblem
 
-__all__ = ["DGPCheck", "GPData", "GPRow", "NotGP", "Signomial", "build_gp", "diagnose", "is_gp"]
+__all__ = ["DGPCheck", "GPData", "GPRow", "NotGP", "Signomial", "build_gp", "is_gp"]
 
 
 # --------------------------------------------------------------------------------------
@@ -457,11 +457,6 @@ def _objective_rows(gp: GPData, name, kind, expr, problem, names, n_grid) -> DGP
     gp.objective_rows = _prune(out)
     shape = "max over the grid of posynomials" if kind == "max" else "posynomial"
     return DGPCheck("objective", name, True, f"{shape}, {len(gp.objective_rows)} rows kept")
-
-
-def diagnose(problem: DesignProblem, objective: str | None = None) -> list[DGPCheck]:
-    """Per objective, constraint block and variable: DGP or not, and why not."""
-    return build_gp(problem, objective).checks
 
 
 def is_gp(problem: DesignProblem, objective: str | None = None) -> bool:
