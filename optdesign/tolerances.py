@@ -12,7 +12,9 @@ from __future__ import annotations
 #: to max(1, |bound|) (the independent check, :func:`optdesign.studies.verify.
 #: verify_design`) or on the solver's scaled rows (:func:`optdesign.solvers.base.
 #: constraint_reports`); a row within it of its bound is active, and so is a free
-#: variable's bound within it (relative to max(1, upper - lower)) of the variable's value.
+#: variable's bound within it (relative to max(1, upper - lower)) of the variable's value
+#: (:func:`optdesign.reports.limits.at_bound`, shared by the summary, the limits table
+#: and a sweep's binding set).
 FEASIBILITY_TOL = 1e-6
 
 #: Two objective values tie when they differ by at most this, relative to the larger of

@@ -19,6 +19,7 @@ import numpy as np
 
 from optdesign.reports.display_units import Shown, angle_unit, shown
 from optdesign.text import printable
+from optdesign.tolerances import FEASIBILITY_TOL
 
 #: Row names never shown as limits: the objective's epigraph rows, and membership checks
 #: (a design is a catalogue item: met with equality by every catalogue design).
@@ -183,8 +184,21 @@ def symmetric(f: Callable[[Any], Any], lower: float | None, upper: float | None)
     return abs(float(f(lower)) + float(f(upper))) <= 1e-9 * max(1.0, abs(float(f(upper))))
 
 
-def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> list[Limit]:
-    """Free variables of ``design`` at a bound (within ``rel`` of the bound range)."""
+def at_bound(var: Any, value: float, rel: float = FEASIBILITY_TOL) -> str | None:
+    """``"lower"`` or ``"upper"`` when free variable ``var`` is within ``rel`` (relative
+    to max(1, its bound range)) of that bound at ``value``, else None: the test of a
+    variable at its bound (:data:`optdesign.tolerances.FEASIBILITY_TOL`)."""
+    tol = rel * max(1.0, abs(var.upper - var.lower))
+    for side, bound in (("lower", var.lower), ("upper", var.upper)):
+        if abs(value - bound) < tol:
+            return side
+    return None
+
+
+def bound_limits(
+    problem: Any, design: dict[str, float], rel: float = FEASIBILITY_TOL
+) -> list[Limit]:
+    """Free variables of ``design`` at a bound (:func:`at_bound`)."""
     from optdesign.reports.display_units import variable_shown
 
     out = []
@@ -192,9 +206,8 @@ def bound_limits(problem: Any, design: dict[str, float], rel: float = 1e-6) -> l
         value = design.get(var.name)
         if value is None:
             continue
-        tol = rel * max(1.0, abs(var.upper - var.lower))
         for side, bound in (("lower", var.lower), ("upper", var.upper)):
-            if abs(value - bound) < tol:
+            if at_bound(var, value, rel) == side:
                 v = variable_shown(problem, var, value)
                 out.append(
                     Limit(

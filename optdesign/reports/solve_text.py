@@ -16,6 +16,7 @@ import math
 from optdesign.reports.display_units import objective_shown, requirement_echo, variable_shown
 from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.limits import (
+    at_bound,
     bound_limits,
     limits_of,
     objective_where,
@@ -146,12 +147,8 @@ def _design_table(problem, result: Result) -> str:
         v = variable_shown(problem, var, val)
         unit = v.unit
         if var.free:
-            at = ""
-            tol = 1e-6 * max(1.0, abs(var.upper - var.lower))
-            if abs(val - var.lower) < tol:
-                at = "at lower bound"
-            elif abs(val - var.upper) < tol:
-                at = "at upper bound"
+            side = at_bound(var, val)
+            at = f"at {side} bound" if side else ""
             lo = variable_shown(problem, var, var.lower).value
             hi = variable_shown(problem, var, var.upper).value
             bounds = f"[{lo:.6g}, {hi:.6g}]"

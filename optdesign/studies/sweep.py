@@ -37,7 +37,7 @@ from optdesign.problem.request import SolveRequest
 from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sensitivity import at_values
-from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2
@@ -275,17 +275,14 @@ def neighbour(idx: tuple[int, ...]) -> tuple[int, ...] | None:
 # --- one point -------------------------------------------------------------------------
 def active_names(problem: DesignProblem, result) -> list[str]:
     """The binding set of a result: requirement (block) names and ``VAR.lower/upper``."""
-    from optdesign.reports.limits import is_internal
+    from optdesign.reports.limits import at_bound, is_internal
 
     names = {r.name.split("[", 1)[0] for r in result.active if not is_internal(r.name)}
     for var in problem.free:
         value = result.design.get(var.name)
-        if value is None:
-            continue
-        tol = FEASIBILITY_TOL * max(1.0, abs(var.upper - var.lower))  # active: at its bound
-        for side, bound in (("lower", var.lower), ("upper", var.upper)):
-            if abs(value - bound) < tol:
-                names.add(f"{var.name}.{side}")
+        side = None if value is None else at_bound(var, value)
+        if side is not None:
+            names.add(f"{var.name}.{side}")
     return sorted(names)
 
 
