@@ -100,3 +100,17 @@ def test_the_command_line_builds_methods_as_od_pareto_does(tmp_path):
     with pytest.raises(InputError, match="weighted_sum would leave the catalogue") as caught:
         make_method(catalogue, "weighted_sum", 7)
     assert caught.value.field == "method"  # the argument named, as od.pareto spells it
+
+
+def test_a_front_takes_the_callers_seed_and_makes_its_nested_folder(tmp_path):
+    """``seed`` reaches the method (its settings, the store's identity) in place of the
+    file's; ``out`` may name a folder whose parents do not exist yet."""
+    import json
+
+    fork = od.load(FORK)
+    assert fork.spec.solver.seed != 7
+    out = tmp_path / "new" / "front"
+    front = od.pareto(fork, ["size", "backlash"], 3, out=out, starts=1, seed=7)
+    assert front.settings["seed"] == 7 and front.settings["starts"] == 1
+    header = json.loads((out / "epsilon.jsonl").read_text().splitlines()[0])
+    assert '"seed": 7' in json.dumps(header)

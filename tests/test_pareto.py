@@ -60,6 +60,12 @@ def test_non_dominated_and_spacing():
     uneven = np.array([[0, 1], [0.1, 0.9], [0.2, 0.8], [1, 0]], dtype=float)
     assert spacing(uneven) > 0.2
     assert spread(uneven) > 0.5
+    # Deb's Delta with the true extremes (given in any order): even gaps of 0.4 sqrt(2)
+    # between the points, 0.1 sqrt(2) from each end to its extreme: 0.2 / (0.2 + 0.8)
+    inner = np.array([[0.1, 0.9], [0.5, 0.5], [0.9, 0.1]])
+    unit = (np.zeros(2), np.ones(2))
+    for extremes in ([[0.0, 1.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 1.0]]):
+        assert spread(inner, np.array(extremes), unit) == pytest.approx(0.2, rel=1e-12)
 
 
 # --- epsilon-constraint --------------------------------------------------------------------
