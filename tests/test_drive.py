@@ -128,6 +128,11 @@ def test_back_drive_requirement_on_a_sliding_screw(rule):
         assert res.design["p"] > p_lock + 1.0
     q = _quantities(problem, **{v.name: res.design[v.name] for v in problem.free})
     assert (float(q.efficiency_back) <= 1e-9) == (rule == "forbidden")
+    from optdesign.problem.drive_requirements import drive_blocks
+
+    block = next(b for b in drive_blocks(q, problem.phi_labels) if b.name == "back_drive")
+    wanted = "back-drivable" if rule == "required" else "self-locking"
+    assert block.description == f"back-driving efficiency ({wanted})"
 
 
 def test_lock_load_uses_the_model_back_efficiency():

@@ -286,7 +286,7 @@ REFUSED = {
         FIN,
         [('length = "300 mm" ', 'length = "1e-300 mm" ')],
         "",
-        ["screw.length", "out of range"],
+        ["screw.length", "out of range (a nonzero magnitude below 1e-12 mm)"],
     ),
     "bearing stiffness 1e-300 N/um": (
         FIN,
@@ -304,7 +304,7 @@ REFUSED = {
         FIN,
         [("static_safety_min = 1.5", "static_safety_min = 1e300")],
         "",
-        ["requirements.static_safety_min", "out of range"],
+        ["requirements.static_safety_min", "out of range (magnitude above 1e+15)"],
     ),
     "a string for a switch": (
         FIN,
