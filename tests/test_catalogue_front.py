@@ -45,6 +45,16 @@ def test_the_ends_of_a_catalogue_front_are_its_anchors(small_front):
     assert len(front.points) >= 2
 
 
+def test_the_inner_point_is_solved_at_the_limit_midway_between_the_anchors(small_front):
+    _, _, records = small_front
+    middle = records["epsilon-catalogue-0001"]
+    # the limits evenly spaced in backlash between the two anchors' values
+    lo = records["anchor-backlash"]["objectives"]["backlash"] * (1 + 1e-7) + 1e-12
+    hi = records["anchor-motor_torque"]["objectives"]["backlash"]
+    assert middle["eps"]["backlash"] == pytest.approx(0.5 * (lo + hi), rel=1e-12)
+    assert middle["objectives"]["backlash"] <= middle["eps"]["backlash"] * (1 + 1e-6)
+
+
 def test_each_end_is_the_optimum_of_its_own_limit(small_front):
     """Solved again as a catalogue search of its own (min motor torque s.t. its backlash
     limit), each end point's torque is the search's, to the anchors' slack."""

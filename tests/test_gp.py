@@ -62,6 +62,11 @@ def test_tracer_merges_like_terms_into_a_monomial():
     assert isinstance(flipped, Signomial) and flipped.terms[(1.0, 0.0)] == pytest.approx(2.0)
     assert flipped.terms[(0.0, 0.0)] == pytest.approx(3.0)
     assert abs(2.0 * R) is not None and abs(2.0 * R).terms[(1.0, 0.0)] == pytest.approx(2.0)
+    # numpy's roots and powers of a monomial: the exponents and coefficients they give
+    d = Signomial.variable(names, 1, np.array([90.0, 10.0]))
+    root = np.sqrt(4.0 * R * d**3)
+    assert {k: float(v) for k, v in root.terms.items()} == {(0.5, 1.5): 2.0}
+    assert float(np.sqrt(4.0 * R).evaluate(np.array([9.0, 1.0]))) == pytest.approx(6.0)
     # a product merges the like terms it makes: (R + 1)(R + 1) = R^2 + 2 R + 1
     square = (R + 1.0) * (R + 1.0)
     assert {k: float(v) for k, v in square.terms.items()} == {

@@ -588,3 +588,33 @@ def test_a_design_independent_ripple_limit_is_checked_by_the_gp_against_its_valu
         assert gp.is_gp and "ripple_max" not in {c.name for c in gp.checks}
         expected = [] if limit > ripple else [f"ripple = {ripple:.6g} > ripple_max = 0.2"]
         assert gp.infeasible == expected
+
+
+def test_the_library_front_refuses_a_wrong_number_of_objectives_naming_the_field():
+    """``compute_front`` (the studies layer, under od.pareto's own checks) refuses one or
+    four objectives itself, naming ``objectives``."""
+    from optdesign.studies.pareto import compute_front
+
+    fork = load(ROOT / "problems" / "fork_min_backlash.toml")
+    for objectives in (["size"], ["size", "backlash", "ripple", "motor_torque"]):
+        with pytest.raises(InputError) as caught:
+            compute_front(fork, objectives, 3)
+        assert caught.value.field == "objectives"
+        assert caught.value.reason == f"give two or three objectives, got {objectives}"
+
+
+def test_an_anchor_message_without_the_problem_lists_the_records_violations():
+    """Without the problem the message of a failed anchor falls back on the record's own
+    list of violated rows, whatever design it holds."""
+    from optdesign.studies.pareto.chains import anchor_message
+    from optdesign.studies.pareto.records import PointRecord
+
+    rec = PointRecord(
+        "anchor-size", "anchor", "failed", False, "size", design={"R": 50.0},
+        violated=["nut_travel", "mean_ratio"],
+    )  # fmt: skip
+    assert anchor_message("size", rec) == (
+        "anchor size: no feasible design found (status failed); violated: nut_travel, mean_ratio"
+    )
+    rec.violated = []
+    assert anchor_message("size", rec).endswith("violated: none reported")
