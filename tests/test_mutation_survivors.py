@@ -618,3 +618,11 @@ def test_an_anchor_message_without_the_problem_lists_the_records_violations():
     )
     rec.violated = []
     assert anchor_message("size", rec).endswith("violated: none reported")
+
+
+def test_an_nlp_of_one_objective_named_by_a_string_holds_that_objective():
+    from optdesign.formulations.nlp import build_nlp
+
+    fork = load(ROOT / "problems" / "fork_min_backlash.toml")
+    assert list(build_nlp(fork, "size").objective_values) == ["size"]
+    assert list(build_nlp(fork, ["size", "backlash"]).objective_values) == ["size", "backlash"]
