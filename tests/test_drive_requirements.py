@@ -95,3 +95,30 @@ def test_a_rating_requirement_without_a_catalogue_screw_is_refused_naming_it(kep
     assert str(caught.value) == (
         f'requirements.{kept}: needs a catalogue screw ([screw] catalogue = "HIWIN")'
     )
+
+
+def test_the_screw_yield_row_is_the_nut_force_over_the_permissible_load_with_no_unit():
+    """fin_actuator (check_yield on by default): the row is F / F_yield(d1), a plain ratio
+    bounded by 1 - shown without a unit."""
+    import tomllib
+    from pathlib import Path
+
+    import optdesign as od
+    from optdesign.models import screw_sizing
+    from optdesign.problem.drive_requirements import drive_blocks
+
+    root = Path(__file__).resolve().parents[1]
+    problem = od.load(tomllib.loads((root / "problems" / "fin_actuator.toml").read_text()))
+    q = problem.quantities(problem.design_dict(problem.midpoint()))
+    blocks = {b.name: b for b in drive_blocks(q, problem.phi_labels)}
+    row = blocks["screw_yield"]
+    # the catalogue row (1 on a catalogue screw) is a plain number too
+    on_catalogue = next(
+        b for b in blocks.values() if "is a screw of the catalogue" in b.description
+    )
+    assert (on_catalogue.unit, on_catalogue.lower, on_catalogue.upper) == ("", 1.0, None)
+    assert (row.unit, row.lower, row.upper) == ("", None, 1.0)
+    assert row.description == "nut force / permissible shaft load"
+    force = np.abs(np.asarray(q.nut_force, dtype=float)).ravel()
+    expected = force / float(screw_sizing.yield_load(float(q.screw.d1)))
+    assert np.asarray(row.expr, dtype=float).ravel() == pytest.approx(expected, rel=1e-12)
