@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from optdesign.solvers.result import Result
+from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.catalogue import enumerate_catalogue
 from optdesign.studies.catalogue_bnb import (
     box_cannot_win,
@@ -205,3 +205,42 @@ def test_a_branch_child_that_is_one_combination_is_solved_not_taken_for_a_leaf()
     best, _ = branch_and_bound_warm(ns, ns.solve({}), ())
     assert best.design["b"] == 4.0 and best.objective == pytest.approx(1.01)
     assert {"a": (1.0, 1.0), "b": (4.0, 4.0)} in ns.boxes
+
+
+class WarmTrapNodes(TiedNodes):
+    """b in (1, 2, 3, 4), the relaxation at b = 2.5, f = (b - 2.5)^2 (b = 2 and 3 tie):
+    a warm start in the box b <= 2 lands on a local optimum 10 worse, unless its value
+    would prune the node, in which case the full multistart runs (as NodeSolver does) and
+    finds the true one."""
+
+    def __init__(self):
+        super().__init__()
+        self.problem = _Problem([_Var("a", (1.0,)), _Var("b", B_ITEMS)])
+        self.starts = 4
+
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+        self.boxes.append(dict(box))
+        lo, hi = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
+        b = min(max(2.5, lo), hi)
+        value, starts = (b - 2.5) ** 2, 4
+        if warm and x_hint is not None:
+            starts = 1
+            if hi <= 2.0 and (prunes is None or not prunes(value + 10.0)):
+                value += 10.0  # the poor local optimum of one start
+        result = Result("optimal", value, {"a": 1.0, "b": b}, "fake", "nlp", 0.0)
+        result.multistart = MultistartInfo(starts, starts, 1, 1e-6)
+        return result
+
+
+def test_a_node_kept_on_a_one_start_bound_is_solved_again_before_it_is_pruned():
+    """The box b <= 2 enters the heap on a poor one-start value; when the incumbent
+    (b = 3) would prune it, its full multistart finds b = 2 ties, the box can still win on
+    its smaller items, and it goes back on the heap: b = 2 is reported."""
+    ns = WarmTrapNodes()
+    best, _ = branch_and_bound_warm(ns, ns.solve({}), ())
+    assert best.design["b"] == 2.0 and best.objective == pytest.approx(0.25)
+    low = {"b": (1.0, 2.0)}
+    assert [box for box in ns.boxes if box.get("b") == low["b"]] == [
+        {"a": (1.0, 1.0), **low},
+        {"a": (1.0, 1.0), **low},
+    ]  # its one warm start, then its full multistart

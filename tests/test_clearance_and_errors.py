@@ -77,6 +77,8 @@ def test_assembly_error_names_angle_and_margin():
     with pytest.raises(AssemblyError, match=r"deflection -30\.000 deg.*margin") as exc:
         mech.check_assembly(np.radians(np.linspace(-30, 30, 61)))
     assert exc.value.margin < 0
+    # the message ends with the design it was checked at (the mechanism's description)
+    assert str(exc.value).endswith(f"; {mech.describe()}") and "R=90" in mech.describe()
     CrankSlider(R=90, l=80, n=50, p=5, i_a=2).check_assembly(np.radians(np.linspace(-30, 30, 61)))
 
 

@@ -310,3 +310,33 @@ def test_gp_diagnosis_of_a_user_mechanism_is_never_a_wrong_model():
     expected = 500e3 * 5.0 / (2 * np.pi * 2 * 100.0 * np.cos(np.radians(30)))
     assert r_gp.objective == pytest.approx(expected, rel=1e-6)
     assert r_auto.objective == pytest.approx(expected, rel=1e-6)
+
+
+def test_a_second_class_under_a_registered_name_needs_replace():
+    """Two different classes under one name: the second is refused naming the first
+    (a plug-in cannot shadow a built-in by accident); ``replace=True`` replaces it. A
+    mechanism's variables may be declared in the short form ``"length"``."""
+    from optdesign import math as m
+    from optdesign.errors import InputError
+    from optdesign.mechanisms.registry import get_mechanism
+
+    class Shadow(od.Mechanism):
+        name = "crank_slider"
+        variables = {"R": "length"}  # noqa: RUF012
+        pin_joints = ("crank pin",)
+
+        def nut_position(self, phi):
+            return self.R * m.sin(phi)
+
+    with pytest.raises(InputError) as caught:
+        od.register_mechanism(Shadow)
+    assert caught.value.field == "mechanism"
+    assert caught.value.reason.startswith("'crank_slider' is registered already (optdesign.")
+    assert get_mechanism("crank_slider") is not Shadow
+
+    class Fresh(Shadow):
+        name = "t21_fresh_yoke"
+
+    od.register_mechanism(Fresh)
+    info = get_mechanism("t21_fresh_yoke").variable_table()["R"]
+    assert (info.dimension, info.description) == ("length", "")

@@ -67,6 +67,12 @@ def test_tracer_merges_like_terms_into_a_monomial():
     root = np.sqrt(4.0 * R * d**3)
     assert {k: float(v) for k, v in root.terms.items()} == {(0.5, 1.5): 2.0}
     assert float(np.sqrt(4.0 * R).evaluate(np.array([9.0, 1.0]))) == pytest.approx(6.0)
+    # over the grid: a mean stays a signomial; a max or min is not DGP, and says which
+    grid = R * np.array([1.0, 3.0])
+    assert {k: float(v) for k, v in grid.mean().terms.items()} == {(1.0, 0.0): 2.0}
+    for how in ("max", "min"):
+        reduced = getattr(grid, how)()
+        assert isinstance(reduced, NotGP) and reduced.reason.startswith(f"{how} over the grid of")
     # a product merges the like terms it makes: (R + 1)(R + 1) = R^2 + 2 R + 1
     square = (R + 1.0) * (R + 1.0)
     assert {k: float(v) for k, v in square.terms.items()} == {
