@@ -588,6 +588,9 @@ def test_a_design_independent_ripple_limit_is_checked_by_the_gp_against_its_valu
         assert gp.is_gp and "ripple_max" not in {c.name for c in gp.checks}
         expected = [] if limit > ripple else [f"ripple = {ripple:.6g} > ripple_max = 0.2"]
         assert gp.infeasible == expected
+        # the ripple as the objective: a constant, the GP a feasibility check
+        check = next(c for c in build_gp(problem, "ripple").checks if c.what == "objective")
+        assert (check.ok, check.reason) == (True, f"constant {ripple:.6g} (design-independent)")
 
 
 def test_the_library_front_refuses_a_wrong_number_of_objectives_naming_the_field():
