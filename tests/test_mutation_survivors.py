@@ -629,3 +629,50 @@ def test_an_nlp_of_one_objective_named_by_a_string_holds_that_objective():
     fork = load(ROOT / "problems" / "fork_min_backlash.toml")
     assert list(build_nlp(fork, "size").objective_values) == ["size"]
     assert list(build_nlp(fork, ["size", "backlash"]).objective_values) == ["size", "backlash"]
+
+
+@pytest.mark.parametrize(
+    ("where", "value", "message"),
+    [
+        (("requirements", "hinge_moment"), "1e308 kN*m", "'1e308 kN*m' is out of range"),
+        (
+            ("variables", "d"),
+            {"catalogue": "HIWIN"},
+            "the HIWIN screw catalogue gives d0 and p only",
+        ),
+    ],
+)
+def test_fin_actuator_inputs_refused_naming_their_field(where, value, message):
+    """A hinge moment that overflows in internal units, a catalogue screw asked for a
+    variable it does not give: each refused naming the field."""
+    from optdesign.errors import OptDesignError
+
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+    data[where[0]][where[1]] = value
+    with pytest.raises(OptDesignError) as caught:
+        od.load(data)
+    assert f"{where[0]}.{where[1]}: {message}" in str(caught.value)
+
+
+def test_common_hypervolumes_use_one_reference_point_for_every_front():
+    """Two fronts measured against the reference point of both together: each front's
+    common hypervolume is its hypervolume against that point (the larger front's is
+    larger), not against its own."""
+    from optdesign.studies.pareto.front import Front, FrontPoint, common_hypervolumes
+    from optdesign.studies.pareto.metrics import hypervolume, reference_point
+
+    def front(F):
+        points = [
+            FrontPoint(f"p{k}", "eps", "optimal", True, "a", objectives={"a": a, "b": b})
+            for k, (a, b) in enumerate(F)
+        ]
+        return Front(["a", "b"], "m", points)
+
+    small, large = front([[1.0, 2.0], [2.0, 1.0]]), front([[0.5, 3.0], [3.0, 0.5], [1.0, 1.0]])
+    common_hypervolumes([small, large])
+    ref = reference_point(np.vstack([small.F, large.F]))
+    for f in (small, large):
+        assert f.metrics["common_reference_point"] == pytest.approx(ref.tolist())
+        assert f.metrics["hypervolume_common"] == pytest.approx(hypervolume(f.F, ref))
+    assert small.metrics["hypervolume_common"] != pytest.approx(hypervolume(small.F))
+    assert large.metrics["hypervolume_common"] > small.metrics["hypervolume_common"]

@@ -108,3 +108,26 @@ def test_casadi_and_numpy_paths_agree(R, a_T, b_T, phi0):
     ratio, force = f([R, a_T, b_T, phi0])
     np.testing.assert_allclose(np.asarray(ratio).ravel(), num.ratio(PHI), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(np.asarray(force).ravel(), num.nut_force(PHI, 5e5), rtol=1e-10)
+
+
+def test_requirement_rows_by_hand():
+    """The pivoting screw's own requirements: the transmission angle at the horn pin
+    (cos, band flipped, shown in degrees) and the dead length (length minus stroke, mm),
+    from the plain vector geometry."""
+    from types import SimpleNamespace
+
+    mech = PivotingScrew(**DESIGN)
+    band = SimpleNamespace(min=np.radians(40.0), max=np.radians(140.0))
+    (ta,) = mech.requirement_rows("transmission_angle", band, PHI)
+    assert (ta.name, ta.unit, ta.display_unit) == ("transmission_angle", "", "deg")
+    assert ta.description == "transmission angle (horn to actuator)"
+    assert ta.lower == pytest.approx(np.cos(np.radians(140.0)))
+    assert ta.upper == pytest.approx(np.cos(np.radians(40.0)))
+    (dead,) = mech.requirement_rows("dead_length", 60.0, PHI)
+    assert (dead.name, dead.unit, dead.lower, dead.upper) == ("dead_length", "mm", 60.0, None)
+    assert dead.description == "actuator length minus stroke"
+    lengths = np.array(
+        [_length(DESIGN["R"], DESIGN["a_T"], DESIGN["b_T"], DESIGN["phi0"], f) for f in PHI]
+    )
+    stroke = abs(lengths[-1] - lengths[0])
+    assert np.asarray(dead.expr, dtype=float).ravel() == pytest.approx(lengths - stroke, rel=1e-12)

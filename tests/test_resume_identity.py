@@ -227,6 +227,8 @@ def _tamper(rec: dict, how: str) -> None:
         rec["design"]["i_a"] = 3.0
     elif how == "fixed variable nudged":  # 1e-10 relative: more than a float's rounding
         rec["design"]["i_a"] *= 1 + 1e-10
+    elif how == "warm start of no formulation":
+        rec["raw"]["nlp"] = 3
     elif how == "warm start of the wrong size":
         rec["raw"]["z"] = rec["raw"]["z"][:1] if isinstance(rec["raw"]["z"], list) else [0.0]
     else:  # pragma: no cover
@@ -248,6 +250,7 @@ def _tamper(rec: dict, how: str) -> None:
         ("fixed variable changed", "fixed variable i_a = 3"),
         ("fixed variable nudged", "fixed variable i_a = 2.0000000002, the problem 2.0"),
         ("warm start of the wrong size", " holds a warm start of the wrong size"),
+        ("warm start of no formulation", "field 'raw' is not a solution with its multipliers"),
     ],
 )
 def test_a_record_that_cannot_be_trusted_refuses_the_resume(run, capsys, how, reason):
