@@ -114,3 +114,14 @@ def test_a_front_takes_the_callers_seed_and_makes_its_nested_folder(tmp_path):
     assert front.settings["seed"] == 7 and front.settings["starts"] == 1
     header = json.loads((out / "epsilon.jsonl").read_text().splitlines()[0])
     assert '"seed": 7' in json.dumps(header)
+
+
+def test_a_method_whose_name_is_not_a_file_name_is_refused_naming_it(tmp_path):
+    """A method's name becomes its store's file name: one with a path in it is refused
+    before any work, naming the field, and nothing is written."""
+    bad = AnchorsOnly(name="../escape")
+    with pytest.raises(InputError) as caught:
+        od.pareto(od.load(FORK), ["backlash", "size"], method=bad, out=tmp_path / "out")
+    assert caught.value.field == "name"
+    assert caught.value.reason.startswith("'../escape': a method's name names its store file")
+    assert not (tmp_path / "escape.jsonl").exists()

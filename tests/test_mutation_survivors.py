@@ -343,9 +343,11 @@ def test_an_angle_is_shown_in_the_unit_the_file_wrote_it_in():
 def test_the_dn_row_names_the_diameter_of_its_rule():
     from optdesign.problem.drive_requirements import drive_blocks
 
-    def dn_text(rule):
+    def dn_text(rule, limit=None):
         data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
         data["requirements"]["dn_rule"] = rule
+        if limit is not None:
+            data["requirements"]["dn_max"] = limit
         problem = problem_from_dict(data)
         q = problem.quantities(problem.design_dict(problem.midpoint()))
         return next(b for b in drive_blocks(q, problem.phi_labels) if b.name == "dn").description
@@ -353,6 +355,10 @@ def test_the_dn_row_names_the_diameter_of_its_rule():
     assert dn_text("ball-centre").startswith("d_m x screw speed (DN value; rule ball-centre")
     assert dn_text("HIWIN") == (
         "d0 x screw speed (DN value; rule HIWIN: ground limit 90,000 on the nominal diameter)"
+    )
+    # a limit given as a number names no grade
+    assert dn_text("HIWIN", 70000) == (
+        "d0 x screw speed (DN value; rule HIWIN: limit 70,000 on the nominal diameter)"
     )
 
 
@@ -676,3 +682,40 @@ def test_common_hypervolumes_use_one_reference_point_for_every_front():
         assert f.metrics["hypervolume_common"] == pytest.approx(hypervolume(f.F, ref))
     assert small.metrics["hypervolume_common"] != pytest.approx(hypervolume(small.F))
     assert large.metrics["hypervolume_common"] > small.metrics["hypervolume_common"]
+
+
+def test_a_sparse_vector_round_trips_exactly_through_the_store():
+    """Warm starts are stored as sparse vectors when most entries are zero (inactive
+    multipliers): the nonzero entries with their indices - a 1.0 (a scaled variable at
+    its upper bound) among them - and every value comes back bit for bit."""
+    from optdesign.studies.pareto.records import json_vector, vector
+
+    v = np.zeros(10)
+    v[3], v[6] = 1.0, -2.5
+    stored = json_vector(v)
+    assert stored == {"size": 10, "index": [3, 6], "value": [1.0, -2.5]}
+    assert vector(stored).tolist() == v.tolist()
+    dense = np.array([1.0, 0.0, 1e-300, np.inf])
+    assert json_vector(dense) == [1.0, 0.0, 1e-300, None]
+    assert vector(json_vector(dense))[:3].tolist() == [1.0, 0.0, 1e-300]
+
+
+def test_a_store_left_open_never_keeps_the_process_alive(tmp_path):
+    """A store writer's fsync thread is a daemon: a program that exits (or dies) with a
+    store still open ends all the same, its records on disk."""
+    import subprocess
+    import sys
+    import textwrap
+
+    store = tmp_path / "s.jsonl"
+    store.write_text("")
+    code = textwrap.dedent(
+        f"""
+        from optdesign.storage.store import StoreWriter
+        w = StoreWriter({str(store)!r})
+        w.write({{"id": "a", "value": 1}})
+        """
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert store.read_text() == '{"id": "a", "value": 1}\n'
