@@ -67,6 +67,11 @@ def test_tracer_merges_like_terms_into_a_monomial():
     root = np.sqrt(4.0 * R * d**3)
     assert {k: float(v) for k, v in root.terms.items()} == {(0.5, 1.5): 2.0}
     assert float(np.sqrt(4.0 * R).evaluate(np.array([9.0, 1.0]))) == pytest.approx(6.0)
+    assert {k: float(v) for k, v in np.negative(2.0 * R).terms.items()} == {(1.0, 0.0): -2.0}
+    assert {k: float(v) for k, v in np.square(3.0 * d).terms.items()} == {(0.0, 2.0): 9.0}
+    cube_root = np.cbrt(8.0 * d**3)
+    assert list(cube_root.terms) == [(0.0, 1.0)]
+    assert float(cube_root.terms[(0.0, 1.0)]) == pytest.approx(2.0, rel=1e-15)
     # over the grid: a mean stays a signomial; a max or min is not DGP, and says which
     grid = R * np.array([1.0, 3.0])
     assert {k: float(v) for k, v in grid.mean().terms.items()} == {(1.0, 0.0): 2.0}
