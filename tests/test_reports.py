@@ -234,3 +234,10 @@ def test_cli_flags_skip_the_diagnosis_and_the_report(tmp_path, capsys):
     assert code == 1 and "smallest change" not in text
     assert not (out / "report.html").exists()
     assert "relaxations" not in json.loads((out / "result.json").read_text())
+
+
+def test_a_band_is_echoed_with_the_sides_the_file_gave():
+    problem = _user_problem(mean_ratio={"min": 200, "max": 260})
+    assert dict(requirement_echo(problem))["mean_ratio"] == "{min = 200, max = 260}"
+    problem = _user_problem(mean_ratio={"min": 200})
+    assert dict(requirement_echo(problem))["mean_ratio"] == "{min = 200}"
