@@ -94,6 +94,27 @@ def test_one_hot_groups_follow_the_item_data():
     assert not groups[0].data
 
 
+def test_a_catalogue_screw_makes_its_diameter_and_lead_one_group():
+    """fin_actuator: d0 and p select one screw row (its ratings, and whether the pair
+    exists), so they form one group of the catalogue's valid pairs; the pin its own."""
+    import optdesign as od
+    from optdesign.problem.drive import catalogue_items
+
+    fin = od.load(ROOT / "problems" / "fin_actuator.toml")
+    groups = item_groups(fin)
+    assert [g.names for g in groups] == [("d0", "p"), ("d",)]
+    (screw, pin) = groups
+    d0 = {v.name: v for v in fin.free}["d0"]
+    p = {v.name: v for v in fin.free}["p"]
+    pairs = {
+        (a, b)
+        for a, b in catalogue_items(fin.spec.screw.catalogue, fin.spec.screw.nut)
+        if d0.lower <= a <= d0.upper and p.lower <= b <= p.upper
+    }
+    assert set(screw.items) == pairs and len(pin.items) == len(fin.by_name["d"].values)
+    assert {"screw_Ca", "screw_d1"} <= set(screw.data)
+
+
 def test_infeasible_boxes_imply_sub_boxes_under_tighter_limits():
     memo = InfeasibleBoxes({"p": (2.0, 10.0), "d": (4.0, 25.0)})
     memo.add_infeasible({"d": (4.0, 5.0)}, {"motor_torque": 3.0})

@@ -13,6 +13,7 @@ from optdesign.problem.design_problem import relative_violation
 from optdesign.studies.pareto import compute_front
 from optdesign.studies.pareto.methods import pymoo_problem
 from optdesign.studies.pareto.metrics import (
+    front_metrics,
     hypervolume,
     non_dominated,
     reference_point,
@@ -62,6 +63,11 @@ def test_non_dominated_and_spacing():
     assert spread(uneven) > 0.5
     # Deb's Delta with the true extremes (given in any order): even gaps of 0.4 sqrt(2)
     # between the points, 0.1 sqrt(2) from each end to its extreme: 0.2 / (0.2 + 0.8)
+    # the metrics against a given reference point: the hypervolume of the front there
+    metrics = front_metrics(uneven, ref=[2.0, 2.0])
+    assert metrics["hypervolume"] == pytest.approx(hypervolume(uneven, np.array([2.0, 2.0])))
+    # by hand, strips between consecutive points: 0.1 x 1 + 0.1 x 1.1 + 0.8 x 1.2 + 1 x 2
+    assert metrics["hypervolume"] == pytest.approx(3.17)
     inner = np.array([[0.1, 0.9], [0.5, 0.5], [0.9, 0.1]])
     unit = (np.zeros(2), np.ones(2))
     for extremes in ([[0.0, 1.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 1.0]]):
