@@ -131,3 +131,14 @@ def test_requirement_rows_by_hand():
     )
     stroke = abs(lengths[-1] - lengths[0])
     assert np.asarray(dead.expr, dtype=float).ravel() == pytest.approx(lengths - stroke, rel=1e-12)
+
+
+def test_the_sketch_draws_the_horn_and_the_actuator_from_the_geometry():
+    phi = 0.2
+    sk = PivotingScrew(**DESIGN).sketch(phi)
+    a = DESIGN["phi0"] + phi
+    B = (DESIGN["R"] * np.sin(a), DESIGN["R"] * np.cos(a))
+    T = (DESIGN["a_T"], DESIGN["b_T"])
+    assert np.allclose(sk.links[0], [(0.0, 0.0), B]) and np.allclose(sk.links[1], [T, B])
+    assert np.allclose(sk.pivots, [(0.0, 0.0), T]) and np.allclose(sk.slider, B)
+    assert np.allclose(sk.axis, [T, B])

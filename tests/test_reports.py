@@ -241,3 +241,19 @@ def test_a_band_is_echoed_with_the_sides_the_file_gave():
     assert dict(requirement_echo(problem))["mean_ratio"] == "{min = 200, max = 260}"
     problem = _user_problem(mean_ratio={"min": 200})
     assert dict(requirement_echo(problem))["mean_ratio"] == "{min = 200}"
+
+
+def test_a_bare_deflection_rate_is_echoed_in_degrees_per_second():
+    import math
+    import tomllib
+    from pathlib import Path
+
+    import optdesign as od
+
+    root = Path(__file__).resolve().parents[1]
+    data = tomllib.loads((root / "problems" / "fin_actuator.toml").read_text())
+    data["requirements"]["deflection_rate"] = 2.0  # bare: internal rad/s
+    echo = dict(requirement_echo(od.load(data)))
+    assert echo["deflection_rate"] == f"{math.degrees(2.0):.6g} deg/s"
+    data["requirements"]["deflection_rate"] = "120 deg/s"  # as the file wrote it
+    assert dict(requirement_echo(od.load(data)))["deflection_rate"] == "120 deg/s"
