@@ -719,3 +719,37 @@ def test_a_store_left_open_never_keeps_the_process_alive(tmp_path):
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert store.read_text() == '{"id": "a", "value": 1}\n'
+
+
+def test_an_off_catalogue_screw_takes_the_nearest_items_data():
+    """A (d0, p) pair the catalogue lacks (an off-catalogue point of a relaxation) reads
+    the nearest row by relative distance in both: d0 = 21 mm, p = 5 mm is the
+    R20-05 row, marked as not an item."""
+    from optdesign.problem.drive import _nearest, catalogue_items
+
+    fin = load(ROOT / "problems" / "fin_actuator.toml")
+    items = catalogue_items(fin.spec.screw.catalogue, fin.spec.screw.nut)
+    row, on = _nearest(items, 21.0, 5.0)
+    assert (row.d0, row.p, on) == (20.0, 5.0, False)
+    row, on = _nearest(items, 25.0, 10.0)
+    assert (row.d0, row.p, on) == (25.0, 10.0, True)
+
+
+def test_every_search_of_a_catalogue_front_takes_the_fronts_seed(monkeypatch, tmp_path):
+    from optdesign.studies.pareto import catalogue_front
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["6 mm", "8 mm"]}
+    problem = problem_from_dict(data)
+    assert problem.spec.solver.seed != 5
+    seeds = []
+    search = catalogue_front.solve_catalogue
+
+    def spy(*args, **kwargs):
+        seeds.append(kwargs.get("seed"))
+        return search(*args, **kwargs)
+
+    monkeypatch.setattr(catalogue_front, "solve_catalogue", spy)
+    od.pareto(problem, ["backlash", "motor_torque"], 3, out=tmp_path, starts=1, seed=5)
+    assert seeds and set(seeds) == {5}
