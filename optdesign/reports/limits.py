@@ -206,19 +206,19 @@ def bound_limits(
         value = design.get(var.name)
         if value is None:
             continue
-        for side, bound in (("lower", var.lower), ("upper", var.upper)):
-            if at_bound(var, value, rel) == side:
-                v = variable_shown(problem, var, value)
-                out.append(
-                    Limit(
-                        var.name,
-                        var.description,
-                        "bound",
-                        side,
-                        v,
-                        variable_shown(problem, var, bound),
-                    )
+        side = at_bound(var, value, rel)
+        if side is not None:
+            bound = var.lower if side == "lower" else var.upper
+            out.append(
+                Limit(
+                    var.name,
+                    var.description,
+                    "bound",
+                    side,
+                    variable_shown(problem, var, value),
+                    variable_shown(problem, var, bound),
                 )
+            )
     return out
 
 

@@ -48,7 +48,7 @@ from optdesign.solvers.multistart import (
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_items, trusted
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_items, trusted_value
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
@@ -144,10 +144,9 @@ class NodeSolver:
         ``floor``: a lower bound on the node's value that the search trusts (its parent's
         relaxation value, when :func:`~optdesign.studies.catalogue_bnb.trusted`); the box
         is a sub-box of the parent's, its item data no more favourable, so no start can
-        end below it. A
-        start that reaches it (within the tie tolerance) ends the multistart: the node's
-        value is settled (``multistart.stopped_early``), whether the search would prune
-        it or not.
+        end below it. A start that reaches it (within the tie tolerance) ends the
+        multistart: the node's value is settled (``multistart.stopped_early``), whether
+        the search would prune it or not.
         """
         if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
             self.n_implied += 1
@@ -370,8 +369,9 @@ def solve_catalogue(
         starts_per_node=n_starts,
     )
     if method == "enumerate":
-        floor = root.objective if root.success and trusted(root, ns.starts) else None
-        best, info.enumerated = enumerate_catalogue(ns, ns.x_of(root), floor)
+        best, info.enumerated = enumerate_catalogue(
+            ns, ns.x_of(root), trusted_value(root, ns.starts)
+        )
     elif method == "minlp":
         from optdesign.studies.catalogue_minlp import solve_minlp
 

@@ -85,6 +85,11 @@ def trusted(result: Result, starts: int) -> bool:
     return ms is not None and (ms.n_starts >= starts or ms.stopped_early)
 
 
+def trusted_value(result: Result, starts: int) -> float | None:
+    """The node's value when it may serve as a floor (:func:`trusted`), else None."""
+    return result.objective if result.success and trusted(result, starts) else None
+
+
 def combination_key(values: Mapping[str, float], names: Sequence[str]) -> tuple[float, ...]:
     """The order of item combinations that decides a tie: the items of ``names`` (the
     catalogue variables, in their declared order), compared lexicographically."""
@@ -287,7 +292,7 @@ def branch_and_bound_warm(
     seed: Result | None = None  # the best candidate's leaf
     seed_items: dict | None = None
     seed_key: tuple[float, ...] | None = None
-    root_floor = root.objective if root.success and trusted(root, ns.starts) else None
+    root_floor = trusted_value(root, ns.starts)
     if root.success:
         seed, seed_items = first_incumbent(ns, candidates, stats)
         if seed_items is not None:
@@ -338,7 +343,8 @@ def branch_and_bound_warm(
         x = ns.x_of(res)
         # the children's floor: this node's value when the search trusts it, else the
         # floor it had itself (a sub-box's value is never below its box's)
-        below = bound if trusted(res, ns.starts) else floor
+        own = trusted_value(res, ns.starts)
+        below = own if own is not None else floor
         worst, items = on_items(dvars, box, res)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
