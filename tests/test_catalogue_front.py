@@ -64,3 +64,19 @@ def test_each_end_is_the_optimum_of_its_own_limit(small_front):
         again = solve_catalogue(problem, starts=2, objective="motor_torque", eps=end["eps"])
         assert again.success
         assert end["objectives"]["motor_torque"] == pytest.approx(again.objective, rel=1e-6)
+
+
+def test_an_anchors_first_stage_leaves_the_ties_to_its_tie_break():
+    """fin_actuator's motor torque does not depend on the pin: its catalogue optimum ties
+    over the pins the requirements allow. The anchor's first stage only needs the value
+    (its tie-break decides the design): searched with ``ties=False`` it gets the same
+    value with fewer NLP solves, at one of the tied designs."""
+    problem = od.load(ROOT / "problems" / "fin_actuator.toml")
+    decided = solve_catalogue(problem, objective="motor_torque")
+    value_only = solve_catalogue(problem, objective="motor_torque", ties=False)
+    assert decided.success and value_only.success
+    assert value_only.objective == pytest.approx(decided.objective, rel=1e-6)
+    assert value_only.details.catalogue.nlp_solves < decided.details.catalogue.nlp_solves
+    # the items decide the tie only in the first search: the smallest pin that works
+    assert decided.design["d"] <= value_only.design["d"]
+    assert decided.design["d0"] == value_only.design["d0"]

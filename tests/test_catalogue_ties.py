@@ -244,3 +244,30 @@ def test_a_node_kept_on_a_one_start_bound_is_solved_again_before_it_is_pruned():
         {"a": (1.0, 1.0), **low},
         {"a": (1.0, 1.0), **low},
     ]  # its one warm start, then its full multistart
+
+
+def test_a_value_only_search_prunes_the_ties_and_gives_the_same_value():
+    """``ties=False`` (the first stage of a lexicographic anchor): the value is the same,
+    the ties the item rule would have visited are pruned, and the design is the tied
+    combination the search met first (the top of b, where each relaxation sits)."""
+    decided = CountedNodes()
+    best, _ = branch_and_bound_warm(decided, decided.solve({}), ())
+    value_only = CountedNodes()
+    first, _ = branch_and_bound_warm(value_only, value_only.solve({}), (), ties=False)
+    assert first.objective == best.objective == pytest.approx(1.0)
+    assert (first.design["a"], first.design["b"]) == (2.0, 4.0)
+    assert (best.design["a"], best.design["b"]) == (2.0, 1.0)
+    assert len(value_only.calls) < len(decided.calls)
+    # no box holding only combinations tied with the incumbent was solved after it
+    assert {"a": (2.0, 2.0), "b": (1.0, 1.0)} not in [box for box, _ in value_only.calls]
+
+
+def test_a_value_only_search_keeps_a_strictly_better_candidate_not_a_tie():
+    ns = CountedNodes()
+    found, stats = branch_and_bound_warm(
+        ns, ns.solve({}), [{"a": 2.0, "b": 2.0}, {"a": 3.0, "b": 1.0}], ties=False
+    )
+    # the candidate (2, 2) ties with every b: the first met of the tie is kept, and the
+    # worse candidate (3, 1) never replaces it
+    assert (found.design["a"], found.design["b"]) == (2.0, 2.0)
+    assert stats["seeded"] == 2

@@ -20,3 +20,16 @@ def test_points_are_balanced():
     for k in range(5):
         cells = np.floor(pts[:, k] * 16).astype(int)
         assert sorted(cells) == list(range(16))
+
+
+def test_the_kept_points_cannot_be_changed_by_a_caller():
+    from optdesign.solvers.multistart import sobol_starts
+
+    pts = sobol_points(3, 2, seed=7)
+    assert sobol_points(3, 2, seed=7) is pts  # drawn once per (d, m, seed)
+    with pytest.raises(ValueError):
+        pts[0, 0] = 0.5
+    starts = sobol_starts(np.zeros(3), np.full(3, 2.0), 4, 7)
+    starts[0, 0] = -1.0  # the caller's own scaled copy
+    np.testing.assert_array_equal(sobol_points(3, 2, seed=7)[1:], pts[1:])
+    assert sobol_points(3, 2, seed=7)[0, 0] == pts[0, 0] != -1.0

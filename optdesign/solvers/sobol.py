@@ -52,8 +52,12 @@ def _direction_matrix(d: int, poly: np.ndarray, vinit: np.ndarray) -> list[list[
     return [[x << (BITS - 1 - j) for j, x in enumerate(row)] for row in v]
 
 
+@lru_cache(maxsize=64)
 def sobol_points(d: int, m: int, seed: int) -> np.ndarray:
     """``2**m`` scrambled Sobol' points in [0, 1)^d, equal to SciPy's for the same seed.
+
+    The points depend on ``(d, m, seed)`` alone, and a catalogue search draws the same
+    ones for each of its nodes: they are kept (read-only; ``sobol_starts`` scales a copy).
 
     Parameters
     ----------
@@ -68,7 +72,9 @@ def sobol_points(d: int, m: int, seed: int) -> np.ndarray:
     if tables is None or d > len(tables[0]):
         from scipy.stats import qmc
 
-        return qmc.Sobol(d, scramble=True, seed=seed).random_base2(m)
+        pts = qmc.Sobol(d, scramble=True, seed=seed).random_base2(m)
+        pts.flags.writeable = False
+        return pts
     v = _direction_matrix(d, *tables)
     rng = np.random.default_rng(seed)
     # Same draws, same order as SciPy: the shift bits, then the lower-triangular matrices.
@@ -99,4 +105,5 @@ def sobol_points(d: int, m: int, seed: int) -> np.ndarray:
             low += 1
         quasi = [q ^ sv[k][low] for k, q in enumerate(quasi)]
         out[i] = np.array(quasi) * scale
+    out.flags.writeable = False
     return out

@@ -300,6 +300,7 @@ def solve_catalogue(
     eps: Mapping[str, float] | None = None,
     incumbents: Sequence[Mapping[str, float]] = (),
     memo: InfeasibleBoxes | None = None,
+    ties: bool = True,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -326,6 +327,11 @@ def solve_catalogue(
     memo
         Boxes proved infeasible by earlier searches of the same problem and node
         settings (shared by a front's points; see :mod:`optdesign.studies.catalogue_bnb`).
+    ties
+        Decide a tie between combinations by their items, so that the design reported
+        does not depend on the search's path (default). False when only the optimal
+        value is wanted (the first stage of a lexicographic solve): the branch and bound
+        then prunes the ties (:func:`~optdesign.studies.catalogue_bnb.branch_and_bound_warm`).
 
     Returns
     -------
@@ -377,7 +383,7 @@ def solve_catalogue(
 
         best, info.minlp = solve_minlp(ns, minlp_solver, minlp_options)
     else:
-        best, stats = branch_and_bound(ns, root, incumbents)
+        best, stats = branch_and_bound(ns, root, incumbents, ties=ties)
         info.nodes, info.pruned = stats["nodes"], stats["pruned"]
         info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
         info.seeded = stats["seeded"]

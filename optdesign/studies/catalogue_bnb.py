@@ -41,6 +41,8 @@ order the search meets them in. A node whose bound ties with the incumbent is pr
 when its box holds no combination smaller than the incumbent's, so the answer does not
 depend on the warm bounds, the first incumbent or the number of workers. (Enumeration
 visits the combinations in that order and keeps the first of a tie: the same rule.)
+A search that only needs the optimal value (``ties=False``: the first stage of a front's
+lexicographic anchor, whose tie-break picks the design) prunes a tie whatever its items.
 """
 
 from __future__ import annotations
@@ -239,13 +241,14 @@ def on_items(dvars, box: Box, res: Result) -> tuple[Any, dict[str, float]]:
 
 
 def first_incumbent(
-    ns, candidates: Sequence[Mapping[str, float]], stats: dict
+    ns, candidates: Sequence[Mapping[str, float]], stats: dict, ties: bool = True
 ) -> tuple[Result | None, dict | None]:
     """The best feasible of ``candidates`` (item combinations), each solved as a leaf
     from the candidate's design alone (one start: its value only bounds the optimum from
-    above); a tie is decided by the items (:func:`wins`), not by the candidates' order."""
+    above); a tie is decided by the items (:func:`wins`), not by the candidates' order
+    (``ties`` False: the first of a tie is kept, see :func:`branch_and_bound_warm`)."""
     dvars = discrete_variables(ns.problem)
-    names = [v.name for v in dvars]
+    names = [v.name for v in dvars] if ties else []
     best, best_items, seen = None, None, set()
     for cand in candidates:
         try:
@@ -277,16 +280,26 @@ def _x_of_design(ns, design: Mapping[str, float]):
 
 
 def branch_and_bound_warm(
-    ns, root: Result, candidates: Sequence[Mapping[str, float]] = ()
+    ns, root: Result, candidates: Sequence[Mapping[str, float]] = (), ties: bool = True
 ) -> tuple[Result | None, dict]:
     """Best-first branch and bound from the relaxation ``root`` with warm child nodes and
-    the best of ``candidates`` (item combinations) as its first incumbent."""
+    the best of ``candidates`` (item combinations) as its first incumbent.
+
+    ``ties`` False: only the optimal value is wanted (the first stage of a lexicographic
+    solve, whose second stage picks the design among the ties): a node whose bound ties
+    with the incumbent is pruned whatever its items, and a tie never replaces the
+    incumbent. The value is the same within the tie tolerance; the design is one of the
+    tied combinations, still decided by the search's fixed order, not by timing.
+    """
     dvars = discrete_variables(ns.problem)
     full = {v.name: (v.lower, v.upper) for v in dvars}
     counter = itertools.count()
     heap: list = []
     stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
-    names = [v.name for v in dvars]
+    # the variables whose items decide a tie: none when ties are not decided (every
+    # combination then has the same empty key, so a tie neither wins nor keeps a box)
+    names = [v.name for v in dvars] if ties else []
+    all_names = [v.name for v in dvars]
     incumbent: Result | None = None  # the best leaf the search itself found
     inc_key: tuple[float, ...] | None = None
     seed: Result | None = None  # the best candidate's leaf
@@ -294,7 +307,7 @@ def branch_and_bound_warm(
     seed_key: tuple[float, ...] | None = None
     root_floor = trusted_value(root, ns.starts)
     if root.success:
-        seed, seed_items = first_incumbent(ns, candidates, stats)
+        seed, seed_items = first_incumbent(ns, candidates, stats, ties)
         if seed_items is not None:
             seed_key = combination_key(seed_items, names)
         # the last field: the floor of the node's children (see NodeSolver.solve)
@@ -306,7 +319,7 @@ def branch_and_bound_warm(
         # A combination solved before (from another node's optimum) is solved again only
         # from the new start: the rest of its multistart is the same Sobol points. The
         # full multistart runs again only when that start beats the stored value.
-        key = box_key(box, names)
+        key = box_key(box, all_names)
         done = solved.get(key)
         if done is not None:
             new = ns.solve(box, x, warm=True, fallback=False)

@@ -63,6 +63,9 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         seed=task["seed"],
         objective=task["target"],
         eps=eps,
+        # an anchor's first stage gives its tie-break the optimal value (and a first
+        # incumbent); the tie-break decides the design, so the first stage leaves ties
+        ties=task["kind"] != "anchor-multistart",
         **front_knowledge(task, deps),
     )
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
