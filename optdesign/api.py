@@ -67,7 +67,8 @@ def solve(
         Multistart size (1..10000) and Sobol seed (0..2**32-1) (default: the problem's
         ``[solver]``).
     workers
-        Local processes for the starts (1..256).
+        Local processes for the starts (1..256); on a catalogue problem, for each
+        node's starts (the same search, node for node, as one worker).
     solver, options
         Registered solver back-end (:func:`optdesign.solver_names`; None: the
         formulation's default, :func:`optdesign.solvers.registry.default_solver` - Ipopt

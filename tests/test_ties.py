@@ -17,8 +17,8 @@ from optdesign.solvers.blas import (
 )
 from optdesign.solvers.multistart import best_of, improves, multistart
 from optdesign.solvers.result import Result
+from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.pareto.metrics import non_dominated
-from optdesign.studies.runner import map_inherited
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 

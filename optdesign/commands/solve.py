@@ -47,7 +47,7 @@ def _solve(sub):
         "--workers",
         type=checked(check.workers, literal),
         default=1,
-        help="local processes for the starts",
+        help="local processes for the starts (of each node, on a catalogue problem)",
     )
     time_limit_option(
         p,

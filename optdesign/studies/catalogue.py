@@ -20,8 +20,8 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
-from functools import partial
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ from optdesign.formulations.discrete import (
     n_combinations,
     nearest_item,
 )
+from optdesign.formulations.nlp import Bounds
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
 from optdesign.problem.request import SolveRequest
@@ -52,6 +53,7 @@ from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
+from optdesign.studies.inherited_map import InheritedWorkers
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -88,8 +90,12 @@ class NodeSolver:
         options: Mapping[str, Any] | None = None,
         eps: Mapping[str, float] | None = None,
         free_rows: tuple[int, ...] = (),
+        workers: int = 1,
     ):
         self.problem = problem
+        #: Local processes for a node's starts, inside :meth:`on_workers` (see there).
+        self.workers = max(1, int(workers))
+        self._workers: InheritedWorkers | None = None
         #: Constraint rows left unbounded at every node (a requirement dropped, to find
         #: which catalogue items the others allow: the diagnosis of an infeasible problem).
         self.free_rows = np.asarray(free_rows, dtype=int)
@@ -122,6 +128,40 @@ class NodeSolver:
         #: where this search's own proofs are recorded besides (never read by it: a
         #: single search keeps its nodes; the optimum's neighbouring items read them)
         self.proofs = None
+
+    @contextmanager
+    def on_workers(self) -> Iterator[None]:
+        """Inside it, a node's starts run on :attr:`workers` local processes forked once
+        (they inherit the built solver). Each node keeps its serial answer: its starts
+        in their order up to the one that settles it or the verdicts that end it
+        (:class:`~optdesign.studies.inherited_map.InheritedWorkers`), so any number of
+        workers solves the same nodes to the same values and records."""
+        if self.workers <= 1:
+            yield
+            return
+        with InheritedWorkers(self._solve_start, self.workers) as workers:
+            self._workers = workers
+            try:
+                yield
+            finally:
+                self._workers = None
+
+    def _solve_start(self, item: tuple[Bounds, np.ndarray]) -> Result:
+        box, x0 = item
+        return self.backend.solve(
+            self.nlp.start(x0=x0, parameters=box.parameters), self.target, box
+        )
+
+    def _starts(self, box: Bounds, points, stop: Callable[[list[Result]], bool]) -> list[Result]:
+        items = [(box, np.asarray(p, dtype=float)) for p in points]
+        if self._workers is None:
+            out: list[Result] = []
+            for item in items:
+                out.append(self._solve_start(item))
+                if stop(out):
+                    break
+            return out
+        return self._workers.map(items, stop)
 
     def solve(
         self,
@@ -173,15 +213,14 @@ class NodeSolver:
         pts = [np.clip(first, lo, hi)]
         if self.starts > 1:
             pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
-        start = partial(self.nlp.start, parameters=box.parameters)
         n_planned = len(pts)
 
         def at_floor(r: Result) -> bool:
             return floor is not None and r.success and not improves(floor, r.objective)
 
-        results = []
+        results: list[Result] = []
         if warm and x_hint is not None:
-            results.append(self.backend.solve(start(x0=pts.pop(0)), self.target, box))
+            results.append(self._solve_start((box, pts.pop(0))))
             first_ok = results[0]
             if first_ok.success and (
                 prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
@@ -196,13 +235,14 @@ class NodeSolver:
         def run(points) -> bool:
             """Solve from ``points`` in order, stopping at a start that settles the node
             (True) or once the starts so far decide it infeasible (verdicts_decide)."""
-            for p in points:
-                results.append(self.backend.solve(start(x0=p), self.target, box))
-                if at_floor(results[-1]):
-                    return True
-                if self.verdicts_decide(results):
-                    return False
-            return False
+            before = list(results)
+
+            def stop(new: list[Result]) -> bool:
+                return at_floor(new[-1]) or self.verdicts_decide(before + new)
+
+            new = self._starts(box, points, stop)
+            results.extend(new)
+            return bool(new) and at_floor(new[-1])
 
         settled = bool(results) and at_floor(results[0])
         if not settled:
@@ -301,6 +341,7 @@ def solve_catalogue(
     incumbents: Sequence[Mapping[str, float]] = (),
     memo: InfeasibleBoxes | None = None,
     ties: bool = True,
+    workers: int = 1,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -332,6 +373,9 @@ def solve_catalogue(
         does not depend on the search's path (default). False when only the optimal
         value is wanted (the first stage of a lexicographic solve): the branch and bound
         then prunes the ties (:func:`~optdesign.studies.catalogue_bnb.branch_and_bound_warm`).
+    workers
+        Local processes for each node's starts (:meth:`NodeSolver.on_workers`): the same
+        nodes, values and answer as one worker.
 
     Returns
     -------
@@ -356,83 +400,86 @@ def solve_catalogue(
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or minlp")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
-    ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps)
-    ns.memo = memo
-    # the proofs of this search (a front's memo, or this search's own, which it does not
-    # read: a single search solves the nodes it always did), for the optimum's
-    # neighbouring items (studies.catalogue_sensitivity)
-    ns.proofs = (
-        memo if memo is not None else InfeasibleBoxes({v.name: (v.lower, v.upper) for v in dvars})
-    )
-    root = ns.solve({})
-    info = CatalogueDetails(
-        method=method,
-        combinations=n_comb,
-        variables={v.name: list(v.values) for v in dvars},
-        relaxation_bound=root.objective if root.success else None,
-        relaxation_status=root.status,
-        relaxation_design={k: root.design.get(k) for k in ns.names} if root.design else {},
-        starts_per_node=n_starts,
-    )
-    if method == "enumerate":
-        best, info.enumerated = enumerate_catalogue(
-            ns, ns.x_of(root), trusted_value(root, ns.starts)
+    ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps, workers=workers)
+    with ns.on_workers():
+        ns.memo = memo
+        # the proofs of this search (a front's memo, or this search's own, which it does not
+        # read: a single search solves the nodes it always did), for the optimum's
+        # neighbouring items (studies.catalogue_sensitivity)
+        ns.proofs = (
+            memo
+            if memo is not None
+            else InfeasibleBoxes({v.name: (v.lower, v.upper) for v in dvars})
         )
-    elif method == "minlp":
-        from optdesign.studies.catalogue_minlp import solve_minlp
+        root = ns.solve({})
+        info = CatalogueDetails(
+            method=method,
+            combinations=n_comb,
+            variables={v.name: list(v.values) for v in dvars},
+            relaxation_bound=root.objective if root.success else None,
+            relaxation_status=root.status,
+            relaxation_design={k: root.design.get(k) for k in ns.names} if root.design else {},
+            starts_per_node=n_starts,
+        )
+        if method == "enumerate":
+            best, info.enumerated = enumerate_catalogue(
+                ns, ns.x_of(root), trusted_value(root, ns.starts)
+            )
+        elif method == "minlp":
+            from optdesign.studies.catalogue_minlp import solve_minlp
 
-        best, info.minlp = solve_minlp(ns, minlp_solver, minlp_options)
-    else:
-        best, stats = branch_and_bound(ns, root, incumbents, ties=ties)
-        info.nodes, info.pruned = stats["nodes"], stats["pruned"]
-        info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
-        info.seeded = stats["seeded"]
-        info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
-    info.nlp_solves = ns.n_solves
-    info.infeasible_boxes = ns.proofs.proofs
-    wall = time.perf_counter() - t0
-    if best is None:
-        # Infeasible only when the continuous relaxation (every catalogue range at once)
-        # has no feasible point either; otherwise the search failed to find one.
-        relaxed_ok = root.success
-        result = Result(
-            "failed" if relaxed_ok else "infeasible",
-            float("nan"),
-            {},
-            ns.solver,
-            f"catalogue-{method}",
-            wall,
-            message=(
-                "no catalogue combination gave a feasible design although the continuous "
-                "relaxation is feasible (more starts may find one)"
-                if relaxed_ok
-                else "the continuous relaxation has no feasible design"
-            ),
+            best, info.minlp = solve_minlp(ns, minlp_solver, minlp_options)
+        else:
+            best, stats = branch_and_bound(ns, root, incumbents, ties=ties)
+            info.nodes, info.pruned = stats["nodes"], stats["pruned"]
+            info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
+            info.seeded = stats["seeded"]
+            info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
+        info.nlp_solves = ns.n_solves
+        info.infeasible_boxes = ns.proofs.proofs
+        wall = time.perf_counter() - t0
+        if best is None:
+            # Infeasible only when the continuous relaxation (every catalogue range at once)
+            # has no feasible point either; otherwise the search failed to find one.
+            relaxed_ok = root.success
+            result = Result(
+                "failed" if relaxed_ok else "infeasible",
+                float("nan"),
+                {},
+                ns.solver,
+                f"catalogue-{method}",
+                wall,
+                message=(
+                    "no catalogue combination gave a feasible design although the continuous "
+                    "relaxation is feasible (more starts may find one)"
+                    if relaxed_ok
+                    else "the continuous relaxation has no feasible design"
+                ),
+            )
+            result.details.catalogue = info
+            return finish(problem, result, objective)
+        best.formulation = f"catalogue-{method}"
+        best.wall_time_s = wall
+        # Snap to the exact items (the NLP holds them within its bound tolerance).
+        for v in dvars:
+            best.design[v.name] = nearest_item(best.design[v.name], v.values)[0]
+        info.items = {v.name: best.design[v.name] for v in dvars}
+        if root.success:
+            info.gap_to_relaxation_rel = (best.objective - root.objective) / abs(root.objective)
+        best.details.catalogue = info
+        best.bound = root.objective if root.success else None
+        items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
+        bound = (
+            f"continuous relaxation bound {root.objective:.8g} (discrete optimum "
+            f"{100 * (info.gap_to_relaxation_rel or 0.0):+.3f} % above it)"
+            if root.success
+            else f"continuous relaxation: {root.status}"
         )
-        result.details.catalogue = info
-        return finish(problem, result, objective)
-    best.formulation = f"catalogue-{method}"
-    best.wall_time_s = wall
-    # Snap to the exact items (the NLP holds them within its bound tolerance).
-    for v in dvars:
-        best.design[v.name] = nearest_item(best.design[v.name], v.values)[0]
-    info.items = {v.name: best.design[v.name] for v in dvars}
-    if root.success:
-        info.gap_to_relaxation_rel = (best.objective - root.objective) / abs(root.objective)
-    best.details.catalogue = info
-    best.bound = root.objective if root.success else None
-    items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
-    bound = (
-        f"continuous relaxation bound {root.objective:.8g} (discrete optimum "
-        f"{100 * (info.gap_to_relaxation_rel or 0.0):+.3f} % above it)"
-        if root.success
-        else f"continuous relaxation: {root.status}"
-    )
-    how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
-    best.notes.append(
-        f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
-    )
-    return finish(problem, best, objective)
+        how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
+        best.notes.append(
+            f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
+        )
+        return finish(problem, best, objective)
 
 
 def first_feasible(ns: NodeSolver) -> Result | None:
@@ -496,6 +543,7 @@ def solve_catalogue_formulation(problem: DesignProblem, request: SolveRequest) -
         objective=request.objective,
         solver=request.solver,
         options=request.options,
+        workers=request.workers,
     )
     return attach_reference(problem, result)
 

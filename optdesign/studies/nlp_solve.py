@@ -31,8 +31,8 @@ from optdesign.solvers.result import (
     SolutionStatus,
     TerminationCondition,
 )
+from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.reference import attach_reference
-from optdesign.studies.runner import map_inherited
 from optdesign.studies.verify import nan_notes, verify_design
 from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 

@@ -40,6 +40,7 @@ from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Result
+from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.nlp_solve import (
     continuous_only,
     finish,
@@ -47,7 +48,6 @@ from optdesign.studies.nlp_solve import (
     solver_options,
     start_points,
 )
-from optdesign.studies.runner import map_inherited
 from optdesign.tolerances import FEASIBILITY_TOL
 
 #: Default independent Monte Carlo: sample count and seed (different from the SAA seed).

@@ -1,0 +1,71 @@
+"""A catalogue search on local workers (issue 25): each node's starts run on processes
+forked once for the search, and every node keeps its serial answer, so any number of
+workers gives the same nodes, values, records and optimum as one."""
+
+from __future__ import annotations
+
+import os
+import time
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from optdesign.problem import problem_from_dict
+from optdesign.studies.catalogue import solve_catalogue
+from optdesign.studies.inherited_map import InheritedWorkers
+from optdesign.studies.processes import forks_workers
+
+ROOT = Path(__file__).resolve().parents[1]
+
+needs_fork = pytest.mark.skipif(not forks_workers(), reason="local workers are forked (Linux)")
+
+
+def _slow_first(k: int) -> tuple[int, int]:
+    time.sleep(0.3 if k == 0 else 0.0)
+    return k * k, os.getpid()
+
+
+@needs_fork
+def test_kept_workers_give_the_serial_prefix_call_after_call():
+    with InheritedWorkers(_slow_first, 2) as workers:
+        pids = set()
+        for _ in range(3):
+            # item 0 is slow, so items 1.. finish first; the answer is still 0..3
+            out = workers.map(list(range(8)), lambda done: sum(v >= 4 for v, _ in done) >= 2)
+            assert [v for v, _ in out] == [0, 1, 4, 9]
+            pids |= {pid for _, pid in out}
+            assert not workers.pool.busy  # the items past the answer were waited for
+        assert os.getpid() not in pids and len(pids) == 2  # the same two processes
+        assert [v for v, _ in workers.map([5, 6])] == [25, 36]
+    assert workers.pool is None
+
+
+def test_one_worker_maps_here():
+    with InheritedWorkers(_slow_first, 1) as workers:
+        assert workers.pool is None
+        assert workers.map([2, 3], lambda done: True) == [(4, os.getpid())]
+
+
+@pytest.fixture(scope="module")
+def bnb_problem():
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    return problem_from_dict(data)
+
+
+@needs_fork
+def test_a_search_on_two_workers_is_the_search_on_one(bnb_problem):
+    one = solve_catalogue(bnb_problem, method="bnb", starts=3)
+    two = solve_catalogue(bnb_problem, method="bnb", starts=3, workers=2)
+    assert one.success and two.success
+    assert two.objective == one.objective  # bit for bit: the same starts, the same order
+    assert two.design == one.design
+    a, b = one.details.catalogue, two.details.catalogue
+    assert (b.nlp_solves, b.nodes, b.pruned, b.infeasible) == (
+        a.nlp_solves,
+        a.nodes,
+        a.pruned,
+        a.infeasible,
+    )
+    assert two.multistart.objectives == one.multistart.objectives
+    assert a.infeasible_boxes == b.infeasible_boxes
