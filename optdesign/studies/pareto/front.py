@@ -13,7 +13,7 @@ from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
 
-@dataclass
+@dataclass(kw_only=True)
 class FrontPoint(PointRecord):
     """One point of a front: the solved point's record (:class:`PointRecord`, the one
     record of a solved point, whose success rule it keeps) with the method that made it
