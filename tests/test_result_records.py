@@ -21,6 +21,7 @@ from optdesign.solvers.result import ConstraintReport, Result
 from optdesign.solvers.solved_point import SHARED_FIELDS, SolvedPoint, is_success, shared_fields
 from optdesign.studies.pareto.front import FrontPoint, make_front
 from optdesign.studies.pareto.records import PointRecord
+from optdesign.studies.sweep import SweepPoint
 
 
 @pytest.mark.parametrize(
@@ -51,64 +52,19 @@ def test_result_record_and_front_point_share_one_success_rule(status, verified, 
 
 #: ``Result.to_dict()`` keys, in order, as the code wrote them before the records shared
 #: a base (main at 4e796a2): the complete internal record of a solve.
-RESULT_KEYS = [
-    "status",
-    "objective",
-    "design",
-    "solver",
-    "formulation",
-    "wall_time_s",
-    "termination",
-    "solution_status",
-    "message",
-    "objective_name",
-    "objectives",
-    "iterations",
-    "n_evals",
-    "violated",
-    "active",
-    "max_violation",
-    "verified",
-    "bound",
-    "certificate",
-    "multistart",
-    "ranges",
-    "diagnosis",
-    "sensitivities",
-    "item_steps",
-    "problem",
-    "mechanism",
-    "notes",
-    "extra",
-]
+RESULT_KEYS = (
+    "status objective design solver formulation wall_time_s termination "
+    "solution_status message objective_name objectives iterations n_evals violated "
+    "active max_violation verified bound certificate multistart ranges diagnosis "
+    "sensitivities item_steps problem mechanism notes extra"
+).split()
 
 #: A front store's JSON line (``PointRecord.to_dict()``), keys in order, as main wrote it.
-RECORD_KEYS = [
-    "id",
-    "kind",
-    "status",
-    "verified",
-    "target",
-    "message",
-    "x",
-    "design",
-    "objectives",
-    "eps",
-    "weights",
-    "active",
-    "violated",
-    "wall_time_s",
-    "iterations",
-    "solver",
-    "fallback",
-    "order",
-    "n_solves",
-    "slope",
-    "warm",
-    "retried",
-    "raw",
-    "multistart",
-]
+RECORD_KEYS = (
+    "id kind status verified target message x design objectives eps weights active "
+    "violated wall_time_s iterations solver fallback order n_solves slope warm "
+    "retried raw multistart"
+).split()
 
 STATUSES = ["optimal", "feasible", "infeasible", "failed", "max_iterations", "time_limit", ""]
 
@@ -136,6 +92,10 @@ def test_a_result_a_record_and_a_front_point_are_one_solved_point_with_one_succe
         ]
         expected = status in ("optimal", "feasible") and verified is not False
         assert [p.success for p in points] == [expected] * 4, (status, verified)
+        assert is_success(status, verified) is expected
+    for status in STATUSES:  # a sweep's point stores the checked status, no flag
+        point = SweepPoint(index=0, values=(1.0,), status=status, objective=1.0, design={})
+        assert point.success is (status in ("optimal", "feasible")), status
 
 
 def test_solved_points_are_built_by_keyword_so_an_old_positional_call_fails_loudly():
@@ -269,12 +229,7 @@ def test_typed_details_are_written_under_extra_with_the_old_keys():
         fallback="failed: iteration limit",
     )
     result = Result(
-        status="infeasible",
-        objective=math.nan,
-        design={},
-        solver="ipopt",
-        formulation="catalogue-enumerate",
-        wall_time_s=0.0,
+        status="infeasible", objective=math.nan, solver="ipopt", formulation="catalogue-enumerate"
     )
     result.details = details
     extra = result.to_dict()["extra"]

@@ -257,10 +257,8 @@ def _no_item(solver: str, message: str) -> Result:
     return Result(
         status="infeasible",
         objective=float("nan"),
-        design={},
         solver=solver,
         formulation="catalogue",
-        wall_time_s=0.0,
         message=message,
     )
 

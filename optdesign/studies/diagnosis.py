@@ -301,13 +301,7 @@ def _point(
     """A result holding only what :func:`~optdesign.studies.relaxation.relaxations`
     reads: the rows of a best point (and its NLP vector)."""
     point = Result(
-        status="infeasible",
-        objective=math.nan,
-        design={},
-        solver="",
-        formulation="",
-        wall_time_s=0.0,
-        objective_name=objective,
+        status="infeasible", objective=math.nan, formulation="", objective_name=objective
     )
     point.active, point.violated = active, violated
     if z is not None:

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.solvers.result import clean_json
+from optdesign.solvers.solved_point import SolvedPoint
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
@@ -202,5 +203,6 @@ def common_hypervolumes(fronts: Sequence[Front]) -> None:
         f.metrics["common_reference_point"] = ref.tolist()
 
 
-def anchors_of(records: Mapping[str, PointRecord]) -> dict[str, dict[str, float]]:
+def anchors_of(records: Mapping[str, SolvedPoint]) -> dict[str, dict[str, float]]:
+    """The objective values of each anchor's solved point."""
     return {k: dict(r.objectives) for k, r in records.items()}
