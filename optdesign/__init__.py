@@ -43,6 +43,8 @@ _EXPORTS: dict[str, str] = {
     "DesignProblem": "optdesign.problem.design_problem:DesignProblem",
     "Quantities": "optdesign.problem.quantities:Quantities",
     "Result": "optdesign.solvers.result:Result",
+    "SolvedPoint": "optdesign.solvers.solved_point:SolvedPoint",
+    "is_success": "optdesign.solvers.solved_point:is_success",
     "Front": "optdesign.studies.pareto:Front",
     "Mechanism": "optdesign.mechanisms.base:Mechanism",
     "VariableInfo": "optdesign.mechanisms.base:VariableInfo",

@@ -230,7 +230,14 @@ def test_a_pruned_box_with_a_trusted_value_is_a_proof_under_a_lower_limit():
     from optdesign.studies.catalogue_bnb import PRUNE_TOL, InfeasibleBoxes, _bound_proof
 
     def result(n_starts):
-        r = Result("optimal", 2.0, {"a": 1.0}, "fake", "nlp", 0.0)
+        r = Result(
+            status="optimal",
+            objective=2.0,
+            design={"a": 1.0},
+            solver="fake",
+            formulation="nlp",
+            wall_time_s=0.0,
+        )
         r.multistart = MultistartInfo(n_starts, n_starts, 1, 1e-6)
         return r
 

@@ -65,7 +65,14 @@ class TiedNodes:
         lo_a, hi_a = box.get("a", (A_ITEMS[0], A_ITEMS[-1]))
         _, hi_b = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
         a = min(max(2.0, lo_a), hi_a)
-        return Result("optimal", (a - 2.0) ** 2 + 1.0, {"a": a, "b": hi_b}, "fake", "nlp", 0.0)
+        return Result(
+            status="optimal",
+            objective=(a - 2.0) ** 2 + 1.0,
+            design={"a": a, "b": hi_b},
+            solver="fake",
+            formulation="nlp",
+            wall_time_s=0.0,
+        )
 
     def x_of(self, result):
         return np.array([result.design[n] for n in self.names])
@@ -140,7 +147,14 @@ class TrapNodes(TiedNodes):
         result = super().solve(box, x_hint, warm, prunes, fallback, floor)
         fixed = all(box.get(n, (0, 1))[0] == box.get(n, (0, 1))[1] for n in self.names)
         if fixed and (box["a"][0], box["b"][0]) == (2.0, 4.0):
-            return Result("infeasible", float("nan"), {}, "fake", "nlp", 0.0)
+            return Result(
+                status="infeasible",
+                objective=float("nan"),
+                design={},
+                solver="fake",
+                formulation="nlp",
+                wall_time_s=0.0,
+            )
         return result
 
 
@@ -194,7 +208,14 @@ class NearItemNodes(TiedNodes):
         self.boxes.append(dict(box))
         lo, hi = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
         b = min(max(3.9, lo), hi)
-        return Result("optimal", (b - 3.9) ** 2 + 1.0, {"a": 1.0, "b": b}, "fake", "nlp", 0.0)
+        return Result(
+            status="optimal",
+            objective=(b - 3.9) ** 2 + 1.0,
+            design={"a": 1.0, "b": b},
+            solver="fake",
+            formulation="nlp",
+            wall_time_s=0.0,
+        )
 
 
 def test_a_branch_child_that_is_one_combination_is_solved_not_taken_for_a_leaf():
@@ -227,7 +248,14 @@ class WarmTrapNodes(TiedNodes):
             starts = 1
             if hi <= 2.0 and (prunes is None or not prunes(value + 10.0)):
                 value += 10.0  # the poor local optimum of one start
-        result = Result("optimal", value, {"a": 1.0, "b": b}, "fake", "nlp", 0.0)
+        result = Result(
+            status="optimal",
+            objective=value,
+            design={"a": 1.0, "b": b},
+            solver="fake",
+            formulation="nlp",
+            wall_time_s=0.0,
+        )
         result.multistart = MultistartInfo(starts, starts, 1, 1e-6)
         return result
 

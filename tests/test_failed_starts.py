@@ -25,7 +25,17 @@ INSTANT = 1e-6
 
 def _result(term: TerminationCondition, message: str = "", status: str = "failed") -> Result:
     sol = SolutionStatus.OPTIMAL if status == "optimal" else SolutionStatus.NO_SOLUTION
-    return Result(status, float("nan"), {}, "ipopt", "nlp-epigraph", 0.0, term, sol, message)
+    return Result(
+        status=status,
+        objective=float("nan"),
+        design={},
+        solver="ipopt",
+        formulation="nlp-epigraph",
+        wall_time_s=0.0,
+        termination=term,
+        solution_status=sol,
+        message=message,
+    )
 
 
 @pytest.mark.parametrize(

@@ -522,7 +522,14 @@ def test_three_objective_tasks_are_indexed_row_by_row():
 
     names = ["size", "backlash", "ripple"]
     anchors = {
-        k: PointRecord(f"anchor-{k}", "anchor", "optimal", True, k, objectives=values)
+        k: PointRecord(
+            id=f"anchor-{k}",
+            kind="anchor",
+            status="optimal",
+            verified=True,
+            target=k,
+            objectives=values,
+        )
         for k, values in (
             ("size", {"size": 1.0, "backlash": 3.0, "ripple": 3.0}),
             ("backlash", {"size": 3.0, "backlash": 1.0, "ripple": 2.0}),
@@ -619,7 +626,7 @@ def test_an_anchor_message_without_the_problem_lists_the_records_violations():
     from optdesign.studies.pareto.records import PointRecord
 
     rec = PointRecord(
-        "anchor-size", "anchor", "failed", False, "size", design={"R": 50.0},
+        id="anchor-size", kind="anchor", status="failed", verified=False, target="size", design={"R": 50.0},
         violated=["nut_travel", "mean_ratio"],
     )  # fmt: skip
     assert anchor_message("size", rec) == (
@@ -669,7 +676,14 @@ def test_common_hypervolumes_use_one_reference_point_for_every_front():
 
     def front(F):
         points = [
-            FrontPoint(f"p{k}", "eps", "optimal", True, "a", objectives={"a": a, "b": b})
+            FrontPoint(
+                id=f"p{k}",
+                kind="eps",
+                status="optimal",
+                verified=True,
+                target="a",
+                objectives={"a": a, "b": b},
+            )
             for k, (a, b) in enumerate(F)
         ]
         return Front(["a", "b"], "m", points)

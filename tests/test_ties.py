@@ -24,7 +24,15 @@ PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 
 
 def result(objective, x=0.0, status="optimal", violation=0.0):
-    return Result(status, objective, {"x": x}, "fake", "nlp", 0.0, max_violation=violation)
+    return Result(
+        status=status,
+        objective=objective,
+        design={"x": x},
+        solver="fake",
+        formulation="nlp",
+        wall_time_s=0.0,
+        max_violation=violation,
+    )
 
 
 def test_best_of_ties_go_to_the_lowest_index_not_to_rounding():

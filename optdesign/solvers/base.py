@@ -18,12 +18,12 @@ import numpy as np
 
 from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.result import (
-    SOLVED_STATUSES,
     ConstraintReport,
     Result,
     SolutionStatus,
     TerminationCondition,
 )
+from optdesign.solvers.solved_point import SOLVED_STATUSES
 from optdesign.tolerances import FEASIBILITY_TOL
 
 
@@ -170,14 +170,14 @@ def failed_result(
 ) -> Result:
     """A solve that produced no point (an evaluation error the back-end cannot recover)."""
     return Result(
-        "failed",
-        float("nan"),
-        {},
-        solver,
-        f"nlp-{nlp.form}",
-        wall,
-        TerminationCondition.ERROR,
-        SolutionStatus.NO_SOLUTION,
+        status="failed",
+        objective=float("nan"),
+        design={},
+        solver=solver,
+        formulation=f"nlp-{nlp.form}",
+        wall_time_s=wall,
+        termination=TerminationCondition.ERROR,
+        solution_status=SolutionStatus.NO_SOLUTION,
         message=message,
         objective_name=target.name,
         n_evals=dict(n_evals or {}),

@@ -31,13 +31,13 @@ from optdesign.interrupts import solver_call
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.details import Details, GPDetails, GPDual, GPTiming
 from optdesign.solvers.result import (
-    SOLVED_STATUSES,
     Certificate,
     ConstraintReport,
     Result,
     SolutionStatus,
     TerminationCondition,
 )
+from optdesign.solvers.solved_point import SOLVED_STATUSES
 
 #: cvxpy status -> (termination, status word).
 _STATUS = {

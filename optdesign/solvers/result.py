@@ -12,9 +12,10 @@ import json
 import math
 from dataclasses import asdict, dataclass, field
 from enum import Enum, StrEnum
-from typing import Any
+from typing import Any, ClassVar
 
 from optdesign.solvers.details import Details
+from optdesign.solvers.solved_point import SolvedPoint, in_key_order
 
 
 class TerminationCondition(StrEnum):
@@ -239,40 +240,25 @@ class ItemStep:
         return f"{step}: {self.objective_name} {value}{change}"
 
 
-#: The statuses of a solve that found a design meeting the requirements: the one success
-#: rule of a result, a front's record and a front's point (those two also drop a point
-#: the independent check refused, ``verified is False``).
-SOLVED_STATUSES = ("optimal", "feasible")
-
-
-def is_success(status: str, verified: bool | None = None) -> bool:
-    """The one success rule of a solved point (a result, a front's record or point, a
-    bench run): a status of :data:`SOLVED_STATUSES` that the independent check on the
-    NumPy path did not refuse (``verified`` False). ``verified`` None means not checked
-    (yet): a result before :func:`optdesign.studies.nlp_solve.finish`; a stored front
-    record that claims success unchecked is refused before it is read
-    (:func:`optdesign.studies.pareto.records.record_problem`)."""
-    return status in SOLVED_STATUSES and verified is not False
-
-
-@dataclass
-class Result:
-    """Outcome of one optimisation, whatever the solver.
+@dataclass(kw_only=True)
+class Result(SolvedPoint):
+    """Outcome of one optimisation, whatever the solver: a solved point
+    (:class:`~optdesign.solvers.solved_point.SolvedPoint`: status, verified, message,
+    design, objectives, wall_time_s, iterations, solver, and the one success rule) with
+    what a solve adds. Built by keyword.
 
     Attributes
     ----------
-    status, objective, design, solver, formulation, wall_time_s
-        The answer: one status word, the objective's value, the full design.
-    termination, solution_status, message
-        Why the solver stopped and what the point is; the back-end's own message.
+    objective, formulation
+        The objective's value and the formulation that computed it.
+    termination, solution_status
+        Why the solver stopped and what the point is.
     objective_name
         What ``objective`` measures (an objective, a robust statistic, a weighted sum).
-    objectives
-        Every objective of the problem at the design (checked on the NumPy path).
+    n_evals
+        Evaluation counters of the back-end.
     violated, active, max_violation
         Constraint rows at the point, by name and amount, in their units.
-    verified
-        The independent check on the NumPy path (None: not checked).
     bound
         A lower bound on the optimum when one is known (a relaxation's optimum, a dual
         bound), for the gap.
@@ -298,23 +284,15 @@ class Result:
         it as ``"extra"``.
     """
 
-    status: str
     objective: float
-    design: dict[str, float]
-    solver: str
     formulation: str
-    wall_time_s: float
     termination: TerminationCondition = TerminationCondition.UNKNOWN
     solution_status: SolutionStatus = SolutionStatus.NO_SOLUTION
-    message: str = ""
     objective_name: str = ""
-    objectives: dict[str, float] = field(default_factory=dict)
-    iterations: int | None = None
     n_evals: dict[str, int] = field(default_factory=dict)
     violated: list[ConstraintReport] = field(default_factory=list)
     active: list[ConstraintReport] = field(default_factory=list)
     max_violation: float = math.nan
-    verified: bool | None = None
     bound: float | None = None
     certificate: Certificate | None = None
     multistart: MultistartInfo | None = None
@@ -331,10 +309,26 @@ class Result:
     # the DesignProblem solved (for plots and tables; not written to JSON)
     problem_object: Any = field(default=None, repr=False, compare=False)
 
-    @property
-    def success(self) -> bool:
-        """A feasible design was found (:func:`is_success`)."""
-        return is_success(self.status, self.verified)
+    #: The key order of :meth:`to_dict`: the one result files have always had.
+    KEYS: ClassVar[tuple[str, ...]] = (
+        "status",
+        "objective",
+        "design",
+        "solver",
+        "formulation",
+        "wall_time_s",
+        "termination",
+        "solution_status",
+        "message",
+        "objective_name",
+        "objectives",
+        "iterations",
+        "n_evals",
+        "violated",
+        "active",
+        "max_violation",
+        "verified",
+    )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (enums as strings, NaN as None, no solver internals)."""
@@ -352,7 +346,7 @@ class Result:
         }
         d["termination"] = self.termination.value
         d["solution_status"] = self.solution_status.value
-        return clean_json(d)
+        return clean_json(in_key_order(d, self.KEYS))
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), indent=kw.pop("indent", 2), **kw)

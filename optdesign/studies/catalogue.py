@@ -294,7 +294,13 @@ class NodeSolver:
 
 
 def _no_item(solver: str, message: str) -> Result:
-    return Result("infeasible", float("nan"), {}, solver, "catalogue", 0.0, message=message)
+    return Result(
+        status="infeasible",
+        objective=float("nan"),
+        solver=solver,
+        formulation="catalogue",
+        message=message,
+    )
 
 
 def enumerate_catalogue(
@@ -443,12 +449,12 @@ def solve_catalogue(
             # has no feasible point either; otherwise the search failed to find one.
             relaxed_ok = root.success
             result = Result(
-                "failed" if relaxed_ok else "infeasible",
-                float("nan"),
-                {},
-                ns.solver,
-                f"catalogue-{method}",
-                wall,
+                status="failed" if relaxed_ok else "infeasible",
+                objective=float("nan"),
+                design={},
+                solver=ns.solver,
+                formulation=f"catalogue-{method}",
+                wall_time_s=wall,
                 message=(
                     "no catalogue combination gave a feasible design although the continuous "
                     "relaxation is feasible (more starts may find one)"

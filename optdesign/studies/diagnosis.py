@@ -300,7 +300,9 @@ def _point(
 ) -> Result:
     """A result holding only what :func:`~optdesign.studies.relaxation.relaxations`
     reads: the rows of a best point (and its NLP vector)."""
-    point = Result("infeasible", math.nan, {}, "", "", 0.0, objective_name=objective)
+    point = Result(
+        status="infeasible", objective=math.nan, formulation="", objective_name=objective
+    )
     point.active, point.violated = active, violated
     if z is not None:
         point.raw["z"] = z

@@ -67,12 +67,12 @@ def solve_gp_problem(
     backend = make_solver(gp, solver.lower() if solver else default_solver("gp"))
     if gp.infeasible:
         result = Result(
-            "infeasible",
-            float("nan"),
-            {},
-            backend.name,
-            "gp",
-            t_trace,
+            status="infeasible",
+            objective=float("nan"),
+            design={},
+            solver=backend.name,
+            formulation="gp",
+            wall_time_s=t_trace,
             message="rows that no positive design can meet: " + "; ".join(gp.infeasible[:5]),
         )
         return finish(problem, result, objective)

@@ -26,11 +26,11 @@ from optdesign.problem.request import SolveRequest
 from optdesign.solvers.multistart import multistart, sobol_starts
 from optdesign.solvers.registry import default_solver, make_solver, solver_hints
 from optdesign.solvers.result import (
-    SOLVED_STATUSES,
     Result,
     SolutionStatus,
     TerminationCondition,
 )
+from optdesign.solvers.solved_point import SOLVED_STATUSES
 from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.reference import attach_reference
 from optdesign.studies.verify import nan_notes, verify_design

@@ -49,12 +49,12 @@ def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> 
     active, _ = constraint_rows(problem, x)
     values = {k: float(v) for k, v in objectives.items()}
     result = Result(
-        "optimal" if ok else "infeasible",
-        values.get(objective, float("nan")),
-        dict(problem.fixed_values),
-        "none",
-        "fixed",
-        time.perf_counter() - t0,
+        status="optimal" if ok else "infeasible",
+        objective=values.get(objective, float("nan")),
+        design=dict(problem.fixed_values),
+        solver="none",
+        formulation="fixed",
+        wall_time_s=time.perf_counter() - t0,
         termination=TerminationCondition.CONVERGED if ok else TerminationCondition.INFEASIBLE,
         solution_status=SolutionStatus.OPTIMAL if ok else SolutionStatus.INFEASIBLE,
         message="no free variable: the fixed design checked, nothing optimised",

@@ -35,6 +35,7 @@ from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.registry import default_solver, solver_hints
+from optdesign.solvers.solved_point import is_success
 from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sensitivity import at_values
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -94,7 +95,10 @@ class SweepPoint:
 
     @property
     def success(self) -> bool:
-        return self.status in ("optimal", "feasible")
+        """The one success rule (:func:`~optdesign.solvers.solved_point.is_success`); a
+        stored point's status is already the checked one (a design the independent check
+        refused is ``"infeasible"``, :func:`optdesign.studies.nlp_solve.finish`)."""
+        return is_success(self.status)
 
 
 @dataclass

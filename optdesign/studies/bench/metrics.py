@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from optdesign.solvers.result import SOLVED_STATUSES
+from optdesign.solvers.solved_point import SOLVED_STATUSES
 from optdesign.studies.bench.rows import BenchRow
 
 #: A run solved an instance when it succeeded and its gap is at most this (relative).

@@ -20,7 +20,8 @@ import numpy as np
 
 from optdesign.problem import DesignProblem, problem_from_dict
 from optdesign.solvers.blas import one_blas_thread
-from optdesign.solvers.result import SOLVED_STATUSES, Result, is_success
+from optdesign.solvers.result import Result
+from optdesign.solvers.solved_point import SOLVED_STATUSES, is_success
 from optdesign.studies.bench.configs import Config, NotApplicable, get_config
 from optdesign.studies.bench.instances import Instance, make_instance
 from optdesign.studies.bench.rows import BenchRow, BenchRowError, is_number

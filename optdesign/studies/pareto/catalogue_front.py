@@ -48,7 +48,11 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         if not (lo_rec.success and hi_rec.success):  # no frame: the run stops at check_anchor
             failed = a if not lo_rec.success else b
             return PointRecord(
-                task["id"], task["kind"], "failed", None, b, f"anchor {failed} has no design"
+                id=task["id"],
+                kind=task["kind"],
+                status="failed",
+                target=b,
+                message=f"anchor {failed} has no design",
             ).to_dict()
         lo = lo_rec.objectives[a] * (1 + ANCHOR_SLACK) + 1e-12
         hi = max(hi_rec.objectives[a], lo)

@@ -9,11 +9,12 @@ from typing import Any
 import numpy as np
 
 from optdesign.solvers.result import clean_json
+from optdesign.solvers.solved_point import SolvedPoint
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord
 
 
-@dataclass
+@dataclass(kw_only=True)
 class FrontPoint(PointRecord):
     """One point of a front: the solved point's record (:class:`PointRecord`, the one
     record of a solved point, whose success rule it keeps) with the method that made it
@@ -202,5 +203,6 @@ def common_hypervolumes(fronts: Sequence[Front]) -> None:
         f.metrics["common_reference_point"] = ref.tolist()
 
 
-def anchors_of(records: Mapping[str, PointRecord]) -> dict[str, dict[str, float]]:
+def anchors_of(records: Mapping[str, SolvedPoint]) -> dict[str, dict[str, float]]:
+    """The objective values of each anchor's solved point."""
     return {k: dict(r.objectives) for k, r in records.items()}

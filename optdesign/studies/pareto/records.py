@@ -13,12 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
-from optdesign.solvers.result import Result, clean_json, is_success
+from optdesign.solvers.result import Result, clean_json
+from optdesign.solvers.solved_point import SolvedPoint, in_key_order, shared_fields
 from optdesign.studies.nlp_solve import finish
 from optdesign.studies.verify import verify_design
 from optdesign.tolerances import FEASIBILITY_TOL
@@ -61,26 +62,40 @@ class AnchorStarts:
     stopped_early: bool
 
 
-@dataclass
-class PointRecord:
-    """One stored record (see the module docstring); ``kind`` says which task made it."""
+@dataclass(kw_only=True)
+class PointRecord(SolvedPoint):
+    """One stored record (see the module docstring): a solved point
+    (:class:`~optdesign.solvers.solved_point.SolvedPoint`, whose success rule it keeps)
+    with what the front's next tasks need. Built by keyword.
+
+    Attributes
+    ----------
+    id, kind, target
+        The task's id, which task made it (``"anchor"``, ``"eps"``, ...), the objective
+        it minimised.
+    x
+        The free variables' values, in the problem's order (None: no design).
+    eps, weights
+        The epsilon bounds, or the weights, that defined the point.
+    active, violated
+        The names of the active and violated rows (a :class:`Result` keeps the rows).
+    fallback
+        What replaced a failed solve ("" when none did).
+    raw, multistart
+        The warm start of later solves; an anchor's multistart.
+    order, n_solves, slope, warm, retried
+        An anchor's order of objectives; the solves behind the point; the front's local
+        slope; the record it started warm from; why it was re-solved.
+    """
 
     id: str
     kind: str
-    status: str
-    verified: bool | None
     target: str
-    message: str = ""
     x: list[float] | None = None
-    design: dict[str, float] = field(default_factory=dict)
-    objectives: dict[str, float] = field(default_factory=dict)
     eps: dict[str, float] = field(default_factory=dict)
     weights: dict[str, float] = field(default_factory=dict)
     active: list[str] = field(default_factory=list)
     violated: list[str] = field(default_factory=list)
-    wall_time_s: float = 0.0
-    iterations: int | None = None
-    solver: str = ""
     fallback: str = ""
     raw: RawSolution | None = None
     multistart: AnchorStarts | None = None
@@ -90,11 +105,25 @@ class PointRecord:
     warm: str | None = None
     retried: str = ""
 
-    @property
-    def success(self) -> bool:
-        """A feasible point the independent check did not refuse (the one rule,
-        :func:`~optdesign.solvers.result.is_success`)."""
-        return is_success(self.status, self.verified)
+    #: The key order of :meth:`to_dict`: the one the front stores have always had.
+    KEYS: ClassVar[tuple[str, ...]] = (
+        "id",
+        "kind",
+        "status",
+        "verified",
+        "target",
+        "message",
+        "x",
+        "design",
+        "objectives",
+        "eps",
+        "weights",
+        "active",
+        "violated",
+        "wall_time_s",
+        "iterations",
+        "solver",
+    )
 
     def to_dict(self) -> dict[str, Any]:
         d = {
@@ -102,7 +131,7 @@ class PointRecord:
             for f in fields(self)
             if f.name not in ("raw", "multistart")
         }
-        out = clean_json(d)
+        out = clean_json(in_key_order(d, self.KEYS))
         out["raw"] = self.raw.to_dict() if self.raw is not None else None
         out["multistart"] = asdict(self.multistart) if self.multistart is not None else None
         return out
@@ -153,21 +182,14 @@ def record_from_result(
             nlp_fingerprint,
         )
     return PointRecord(
+        **{**shared_fields(result), "status": status},
         id=task_id,
         kind=kind,
-        status=status,
-        verified=result.verified,
         target=target,
-        message=result.message,
         x=x,
-        design=dict(result.design),
-        objectives=dict(result.objectives),
         eps={k: float(v) for k, v in eps.items() if np.isfinite(v)},
         active=active,
         violated=[r.name for r in result.violated][:20],
-        wall_time_s=result.wall_time_s,
-        iterations=result.iterations,
-        solver=result.solver,
         fallback=result.details.fallback,
         raw=raw,
     )
