@@ -3,7 +3,8 @@
 - (a) the shipped ``problems/fin_actuator.toml`` solved as users solve it
   (``od.solve(problem)``: the catalogue branch and bound with its relaxation bound),
   ``--repeats`` times: the first from an empty solver cache (formulation and Ipopt
-  builds included), the others with the built solver;
+  builds included), the others with the built solver (``--workers N``: each node's
+  starts on N local processes);
 - (b) the catalogue front backlash vs motor torque of docs/drive.md
   (``optdesign pareto problems/fin_actuator.toml --objectives backlash,motor_torque
   --points 6 --workers 1``), in-process with 1 worker from an empty solver cache: its
@@ -13,7 +14,7 @@ Every figure is written as one JSON line to ``--out`` as soon as it is measured,
 killed run keeps what it measured. Seconds are wall-clock on a shared machine: read them
 beside the NLP solve counts, which do not depend on the load.
 
-    .venv/bin/python benchmarks/bench_catalogue.py [--repeats 2] [--points 6]
+    .venv/bin/python benchmarks/bench_catalogue.py [--repeats 2] [--points 6] [--workers 1]
         [--out benchmarks/results/bench_catalogue.jsonl] [--tag before]
 """
 
@@ -63,18 +64,20 @@ def _catalogue_info(result) -> dict:
     }
 
 
-def single(path: Path, tag: str, repeats: int) -> None:
+def single(path: Path, tag: str, repeats: int, workers: int = 1) -> None:
     problem = od.load(FIN)
     _clear_caches()
     for i in range(repeats):
         t0 = time.perf_counter()
-        res = od.solve(problem)
+        # the default (one worker) calls od.solve as the issue's code did
+        res = od.solve(problem, workers=workers) if workers > 1 else od.solve(problem)
         wall = time.perf_counter() - t0
         _write(
             path,
             {
                 "tag": tag,
                 "case": "single",
+                "workers": workers,
                 "repeat": i,
                 "cold": i == 0,
                 "wall_s": round(wall, 3),
@@ -144,11 +147,14 @@ def main() -> None:
         "--out", type=Path, default=ROOT / "benchmarks" / "results" / "bench_catalogue.jsonl"
     )
     ap.add_argument("--only", choices=("single", "front"), default=None)
+    ap.add_argument(
+        "--workers", type=int, default=1, help="local processes of the single solve's nodes"
+    )
     args = ap.parse_args()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     _write(args.out, {"tag": args.tag, "case": "start", "load": os.getloadavg()})
     if args.only in (None, "single"):
-        single(args.out, args.tag, args.repeats)
+        single(args.out, args.tag, args.repeats, args.workers)
     if args.only in (None, "front"):
         front(args.out, args.tag, args.points)
 
