@@ -291,3 +291,29 @@ def test_the_bell_crank_by_entry_point_from_the_command_line_in_another_folder(t
     bench = run("bench", "--problem", str(problem), "--solvers", "slsqp-exact", "--workers", "1")
     assert bench.returncode == 0, bench.stderr
     assert "Suite `user`: 1 instances, 1 runs" in bench.stdout
+
+
+def test_the_default_assembly_margin_gives_float_angles_and_names_the_first_nan_one():
+    """A mechanism that does not write assembly_margin gets the default: positive where
+    its nut position is finite. Its nut_position always sees float angles, even from a
+    list of ints."""
+    from optdesign.errors import AssemblyError
+
+    seen = []
+
+    class Arc(od.Mechanism):
+        name = "t32_arc"
+        variables = {"R": od.VariableInfo("length", "lever")}  # noqa: RUF012
+        pin_joints = ("pin (nut)",)
+
+        def nut_position(self, phi):
+            seen.append(np.asarray(phi).dtype)
+            return self.R * np.sqrt(1.0 - np.asarray(phi) ** 2)  # no nut past 1 rad
+
+    mech = Arc(R=50.0, p=5.0)
+    with np.errstate(invalid="ignore"):
+        assert np.asarray(mech.assembly_margin([0, 2])).tolist() == [1.0, -1.0]
+    assert seen[-1] == np.float64
+    with pytest.raises(AssemblyError) as caught:
+        mech.check_assembly(np.array([0.0, 0.5, 1.2, 1.5]))
+    assert caught.value.angle_deg == pytest.approx(math.degrees(1.2))

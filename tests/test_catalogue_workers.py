@@ -69,3 +69,21 @@ def test_a_search_on_two_workers_is_the_search_on_one(bnb_problem):
     )
     assert two.multistart.objectives == one.multistart.objectives
     assert a.infeasible_boxes == b.infeasible_boxes
+
+
+def test_a_search_reads_the_proofs_it_is_given(bnb_problem):
+    """A front's searches share one memo of infeasible boxes: a search given the proofs
+    of an earlier one skips the boxes they cover (no NLP), with the same answer."""
+    from optdesign.formulations.discrete import discrete_variables
+    from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+
+    dvars = discrete_variables(bnb_problem)
+    memo = InfeasibleBoxes(
+        {v.name: (v.lower, v.upper) for v in dvars}, {v.name: v.values for v in dvars}
+    )
+    first = solve_catalogue(bnb_problem, method="bnb", starts=3, memo=memo)
+    assert len(memo) > 0 and first.details.catalogue.implied_infeasible == 0
+    again = solve_catalogue(bnb_problem, method="bnb", starts=3, memo=memo)
+    assert again.details.catalogue.implied_infeasible > 0
+    assert again.details.catalogue.nlp_solves < first.details.catalogue.nlp_solves
+    assert again.objective == first.objective and again.design == first.design

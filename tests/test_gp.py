@@ -78,6 +78,10 @@ def test_tracer_merges_like_terms_into_a_monomial():
     for how in ("max", "min"):
         reduced = getattr(grid, how)()
         assert isinstance(reduced, NotGP) and reduced.reason.startswith(f"{how} over the grid of")
+    # terms whose exponents round alike (to 12 digits) are one term, their coefficients
+    # summed: x^0.1 x^0.2 (exponent 0.30000000000000004) and x^0.3
+    alike = Signomial(names, {(0.1 + 0.2, 0.0): 2.0, (0.3, 0.0): 3.0}, np.array([90.0, 10.0]))
+    assert {k: float(v) for k, v in alike.terms.items()} == {(0.3, 0.0): 5.0}
     # a product merges the like terms it makes: (R + 1)(R + 1) = R^2 + 2 R + 1
     square = (R + 1.0) * (R + 1.0)
     assert {k: float(v) for k, v in square.terms.items()} == {
@@ -138,6 +142,19 @@ def test_fixed_linkage_crank_slider_is_a_gp():
     assert r.status == "optimal"
     assert abs(r.details.gp.gap_gp_nlp_rel) < 1e-3
     assert r.certificate.gap_rel < 1e-6
+
+
+def test_a_constraint_the_tracer_cannot_represent_carries_its_reason_and_term():
+    """The crank-slider's rows go through cos(phi0 - a): each such constraint's check
+    says why it is not a GP and names that sub-term."""
+    checks = {
+        c.name: c
+        for c in build_gp(load_problem(ROOT / "problems" / "cs_min_backlash.toml")).checks
+        if c.what == "constraint" and not c.ok
+    }
+    for name in ("transmission_angle", "pin_shear_stress", "nut_travel"):
+        assert re.fullmatch(r"(cos|sin)\(phi0 [-+] 0\.5236\)", checks[name].term)
+        assert checks[name].reason == f"{checks[name].term} of a design variable is not a monomial"
 
 
 def test_diagnosis_names_the_offending_term():

@@ -2,6 +2,7 @@
 three objectives, the CLI."""
 
 import csv
+import time
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,9 @@ def test_non_dominated_and_spacing():
     uneven = np.array([[0, 1], [0.1, 0.9], [0.2, 0.8], [1, 0]], dtype=float)
     assert spacing(uneven) > 0.2
     assert spread(uneven) > 0.5
+    # normalised by wider bounds the gaps shrink (their sum below 1), not their evenness
+    wide = (np.zeros(2), np.full(2, 10.0))
+    assert spread(uneven, bounds=wide) == pytest.approx(spread(uneven), rel=1e-12)
     # Deb's Delta with the true extremes (given in any order): even gaps of 0.4 sqrt(2)
     # between the points, 0.1 sqrt(2) from each end to its extreme: 0.2 / (0.2 + 0.8)
     # the metrics against a given reference point: the hypervolume of the front there
@@ -78,7 +82,16 @@ def test_non_dominated_and_spacing():
 @pytest.fixture(scope="module")
 def cs_front(cs, tmp_path_factory):
     out = tmp_path_factory.mktemp("cs_front")
-    return epsilon_constraint_front(cs, ["ripple", "backlash"], 10, out=out, starts=2)
+    t0 = time.perf_counter()
+    front = epsilon_constraint_front(cs, ["ripple", "backlash"], 10, out=out, starts=2)
+    front.test_elapsed_s = time.perf_counter() - t0
+    return front
+
+
+def test_each_point_records_the_time_it_took(cs_front):
+    times = [p.wall_time_s for p in [*cs_front.points, *cs_front.rejected]]
+    assert times and all(0.0 < t < cs_front.test_elapsed_s for t in times)
+    assert sum(times) < cs_front.test_elapsed_s  # one worker: the points one after another
 
 
 def test_epsilon_front_anchors_are_the_known_optima(cs_front):
