@@ -299,3 +299,28 @@ def test_a_value_only_search_keeps_a_strictly_better_candidate_not_a_tie():
     # worse candidate (3, 1) never replaces it
     assert (found.design["a"], found.design["b"]) == (2.0, 2.0)
     assert stats["seeded"] == 2
+
+
+def test_pseudo_costs_branch_on_what_moved_the_bounds_once_each_variable_has_a_history():
+    from optdesign.studies.catalogue_bnb import PseudoCosts
+
+    def _result(value, design=None, status="optimal"):
+        return Result(status=status, objective=value, design=design or {}, formulation="nlp")
+
+    problem = _Problem([_Var("a", A_ITEMS), _Var("b", B_ITEMS)])
+    box = {"a": (1.0, 3.0), "b": (1.0, 4.0)}
+    res = _result(1.0, {"a": 1.5, "b": 2.5})
+    a, b = problem.free
+    costs = PseudoCosts()
+    # a child 10 % up and an infeasible one; a child 1 % up and one at the parent's value
+    assert costs.gain(1.0, _result(1.1)) == pytest.approx(0.1)
+    assert costs.gain(1.0, _result(float("nan"), status="infeasible")) == 1.0
+    costs.record("a", [0.1, 1.0])
+    # b has no history yet: the search's own choice stands
+    assert costs.choose(problem.free, box, res, b) is b
+    costs.record("b", [0.01, 0.0])
+    assert costs.choose(problem.free, box, res, b) is a  # 0.1 x 1 against 0.01 x 1e-6
+    assert costs.choose(problem.free, box, res, None) is None  # a leaf stays a leaf
+    # a variable on an item is not a candidate, whatever its history
+    on_b = _result(1.0, {"a": 1.5, "b": 2.0})
+    assert costs.choose(problem.free, box, on_b, a) is a

@@ -41,6 +41,8 @@ order the search meets them in. A node whose bound ties with the incumbent is pr
 when its box holds no combination smaller than the incumbent's, so the answer does not
 depend on the warm bounds, the first incumbent or the number of workers. (Enumeration
 visits the combinations in that order and keeps the first of a tie: the same rule.)
+The variable split at a node is the one farthest from an item until every candidate has
+been split before; then the one whose splits raised the bound most (:class:`PseudoCosts`).
 A search that only needs the optimal value (``ties=False``: the first stage of a front's
 lexicographic anchor, whose tie-break picks the design) prunes a tie whatever its items.
 """
@@ -314,6 +316,7 @@ def branch_and_bound_warm(
         heapq.heappush(heap, (root.objective, next(counter), full, root, None, None))
 
     solved: dict[tuple[float, ...], Result] = {}  # each combination's full multistart
+    pseudo = PseudoCosts()
 
     def leaf_solve(box: Box, x, floor: float | None) -> Result:
         # A combination solved before (from another node's optimum) is solved again only
@@ -359,6 +362,7 @@ def branch_and_bound_warm(
         own = trusted_value(res, ns.starts)
         below = own if own is not None else floor
         worst, items = on_items(dvars, box, res)
+        worst = pseudo.choose(dvars, box, res, worst)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
             one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
@@ -380,6 +384,7 @@ def branch_and_bound_warm(
         else:
             allowed = items_within(worst.values, *box[worst.name])
             sides = [(worst, side) for side in branch(res.design[worst.name], allowed)]
+        gains: list[float] = []
         for var, side in sides:
             if not side:
                 continue
@@ -395,6 +400,7 @@ def branch_and_bound_warm(
                 test = partial(_prunes_box, prunes, child)
                 r = ns.solve(child, x, warm=True, prunes=test, floor=below)
             stats["nodes"] += 1
+            gains.append(pseudo.gain(bound, r))
             if not r.success:
                 stats["infeasible"] += 1
                 continue
@@ -405,6 +411,8 @@ def branch_and_bound_warm(
             warm_only = not fixed and r.multistart is not None and not trusted(r, ns.starts)
             entry = (r.objective, next(counter), child, r, x if warm_only else None, below)
             heapq.heappush(heap, entry)
+        if worst is not None and gains:
+            pseudo.record(worst.name, gains)
     if seed is not None and wins(seed.objective, seed_key, _value(incumbent), inc_key):
         # the candidate beats every leaf of the search (or ties with smaller items): it
         # is the optimum, and as a reported leaf it gets the full multistart (its own
@@ -413,6 +421,53 @@ def branch_and_bound_warm(
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats
+
+
+class PseudoCosts:
+    """Pseudo-costs of the search's branching: what splitting each catalogue variable has
+    cost so far.
+
+    A branching's cost is the product of its two children's relative rises over the
+    parent's value (SCIP's product rule; an infeasible child counts as
+    :attr:`INFEASIBLE_GAIN`, a side with no items as the other side); a variable's
+    pseudo-cost is the mean over its branchings. Once every variable off its items has a
+    history, the one with the highest pseudo-cost is split; before that, the farthest
+    from an item (:func:`on_items`). The history is the search's own, in its order, so
+    the choice never depends on timing or the number of workers.
+    """
+
+    #: The relative rise counted for an infeasible child (as if its value doubled).
+    INFEASIBLE_GAIN = 1.0
+
+    def __init__(self) -> None:
+        self.scores: dict[str, list[float]] = {}
+
+    def gain(self, parent: float, child: Result) -> float:
+        """The relative rise of a child's value over its parent's ``parent``."""
+        if not child.success:
+            return self.INFEASIBLE_GAIN
+        return max(child.objective - parent, 0.0) / max(abs(parent), 1e-300)
+
+    def record(self, name: str, gains: Sequence[float]) -> None:
+        """One branching on ``name`` whose children rose by ``gains`` (one or two)."""
+        g = [max(x, 1e-6) for x in gains]
+        self.scores.setdefault(name, []).append(g[0] * (g[1] if len(g) > 1 else g[0]))
+
+    def choose(self, dvars, box: Box, res: Result, worst):
+        """The variable to split at the node ``res`` over ``box``: ``worst`` (the search's
+        own choice, None at a leaf) unless every variable off its items has a history."""
+        if worst is None:
+            return None
+        off = [
+            v
+            for v in dvars
+            if nearest_item(res.design[v.name], tuple(items_within(v.values, *box[v.name])))[1]
+            > ON_ITEM_TOL
+        ]
+        if len(off) < 2 or not all(v.name in self.scores for v in off):
+            return worst
+        # the first of equal pseudo-costs, in the declared order (max keeps the first)
+        return max(off, key=lambda v: sum(self.scores[v.name]) / len(self.scores[v.name]))
 
 
 def _bound_proof(ns, box: Box, res: Result) -> None:
