@@ -87,3 +87,14 @@ def test_a_search_reads_the_proofs_it_is_given(bnb_problem):
     assert again.details.catalogue.implied_infeasible > 0
     assert again.details.catalogue.nlp_solves < first.details.catalogue.nlp_solves
     assert again.objective == first.objective and again.design == first.design
+
+
+def test_a_box_without_an_item_is_infeasible_without_a_solve_and_names_its_solver():
+    import optdesign as od
+    from optdesign.studies.catalogue import NodeSolver
+
+    ns = NodeSolver(od.load(ROOT / "problems" / "fin_actuator.toml"))
+    # the catalogue's screws are d0 x lead pairs: it has no 14 mm screw of 2 mm lead
+    none = ns.solve({"d0": (14.0, 14.0), "p": (2.0, 2.0)})
+    assert (none.status, none.message) == ("infeasible", "no catalogue item in this box")
+    assert none.solver == "ipopt" and ns.n_solves == 0

@@ -137,6 +137,10 @@ def test_front_csv_without_an_on_front_column_keeps_every_row(solved, tmp_path):
     rows = [f"{float(a)!r},{float(b)!r},{k != 0}" for k, (a, b) in enumerate(front.F)]
     marked.write_text("\n".join(["ripple,motor_torque,on_front", *rows]) + "\n")
     assert np.array_equal(read_front_csv(marked, ["ripple", "motor_torque"]), front.F[1:])
+    # an objective the table lacks is named (a column "backlash [deg]" would do)
+    with pytest.raises(KeyError) as caught:
+        read_front_csv(marked, ["ripple", "backlash"])
+    assert caught.value.args == ("backlash",)
 
 
 def test_the_frame_lists_the_rejected_points_only_when_asked(solved):

@@ -82,6 +82,10 @@ def test_tracer_merges_like_terms_into_a_monomial():
     # summed: x^0.1 x^0.2 (exponent 0.30000000000000004) and x^0.3
     alike = Signomial(names, {(0.1 + 0.2, 0.0): 2.0, (0.3, 0.0): 3.0}, np.array([90.0, 10.0]))
     assert {k: float(v) for k, v in alike.terms.items()} == {(0.3, 0.0): 5.0}
+    # dividing by a term whose coefficient is zero at some grid angle is refused, saying so
+    over_zero = 1.0 / (R * np.array([0.0, 1.0]))
+    assert isinstance(over_zero, NotGP) and "zero on the grid" in over_zero.reason
+    assert isinstance(1.0 / (R * np.array([0.5, 1.0])), Signomial)
     # a product merges the like terms it makes: (R + 1)(R + 1) = R^2 + 2 R + 1
     square = (R + 1.0) * (R + 1.0)
     assert {k: float(v) for k, v in square.terms.items()} == {

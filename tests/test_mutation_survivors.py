@@ -393,6 +393,20 @@ def test_a_pin_poisson_ratio_outside_its_range_is_refused_with_the_value(nu):
     assert caught.value.reason == f"Poisson ratio must lie in (0, 0.5), got {nu!r}"
 
 
+def test_a_symbolic_poisson_ratio_is_not_range_checked_and_reaches_the_clearance():
+    """The joint model takes symbolic material data (a CasADi symbol): only a number is
+    checked against (0, 0.5); the symbol is kept for the contact clearance."""
+    import casadi as ca
+
+    from optdesign.mechanisms.joints import PinJoint
+
+    nu = ca.SX.sym("nu")
+    pin = PinJoint(8.0, 12.0, nu=nu)
+    assert pin.nu is nu
+    with pytest.raises(InputError):
+        PinJoint(8.0, 12.0, nu=0.5)
+
+
 def test_only_palmgrens_contact_is_restricted_to_steel():
     from optdesign.mechanisms.joints import PinJoint
 
