@@ -781,3 +781,19 @@ def test_every_search_of_a_catalogue_front_takes_the_fronts_seed(monkeypatch, tm
     monkeypatch.setattr(catalogue_front, "solve_catalogue", spy)
     od.pareto(problem, ["backlash", "motor_torque"], 3, out=tmp_path, starts=1, seed=5)
     assert seeds and set(seeds) == {5}
+
+
+def test_a_keyed_pin_joint_adds_its_fixed_clearance_to_the_pins():
+    """docs/mechanisms.md: a joint's ``key`` names its fixed clearance in the problem's
+    ``[clearances]`` table; on a sized pin joint the value adds to the pin's own."""
+    from optdesign.mechanisms.joints import Joint, PinJoint, with_fixed_clearances
+
+    pin = Joint("P lever pin", "P", sensitivity=0.01, force=100.0, pin=PinJoint(8.0, 12.0))
+    slide = Joint("A slide", "A", sensitivity=0.01)
+    unkeyed = Joint("Q other pin", "", sensitivity=0.01, force=100.0, pin=PinJoint(8.0, 12.0))
+    out = with_fixed_clearances([pin, slide, unkeyed], {"P": 0.004, "A": 0.002})
+    assert [j.name for j in out] == ["P lever pin", "A slide", "Q other pin"]
+    assert [j.clearance for j in out] == [0.004, 0.002, 0.0]
+    assert out[0].pin is pin.pin  # the pin itself is kept: its fit adds on top
+    # a joint with neither a pin nor a fixed clearance is dropped from the chain
+    assert with_fixed_clearances([slide], {}) == []
