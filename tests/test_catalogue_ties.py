@@ -84,6 +84,16 @@ def _search(candidates=()):
     return best, stats
 
 
+def test_the_search_counts_each_node_it_solves():
+    """``details.catalogue.nodes``: every node solve (root, children, leaves, the first
+    incumbent's candidates)."""
+    for candidates in ((), [{"a": 2.0, "b": 4.0}, {"a": 3.0, "b": 1.0}]):
+        ns = TiedNodes()
+        _, stats = branch_and_bound_warm(ns, ns.solve({}), candidates)
+        assert stats["nodes"] == len(ns.boxes)
+        assert stats["seeded"] == len(candidates)
+
+
 def test_the_smallest_tied_items_win_whatever_the_search_meets_first():
     best, stats = _search()
     assert best.objective == pytest.approx(1.0)
@@ -324,3 +334,30 @@ def test_pseudo_costs_branch_on_what_moved_the_bounds_once_each_variable_has_a_h
     # a variable on an item is not a candidate, whatever its history
     on_b = _result(1.0, {"a": 1.5, "b": 2.0})
     assert costs.choose(problem.free, box, on_b, a) is a
+
+
+class WarmThenInfeasibleNodes(WarmTrapNodes):
+    """As WarmTrapNodes, but the box b <= 2 has no feasible design: its one warm start
+    stopped on a poor point, its full multistart finds none."""
+
+    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+        result = super().solve(box, x_hint, warm, prunes, fallback, floor)
+        if box.get("b", (1.0, 4.0))[1] <= 2.0 and not warm:
+            return Result(
+                status="infeasible",
+                objective=float("nan"),
+                design={},
+                solver="fake",
+                formulation="nlp",
+                wall_time_s=0.0,
+            )
+        return result
+
+
+def test_a_node_kept_on_a_one_start_bound_and_found_infeasible_is_counted():
+    ns = WarmThenInfeasibleNodes()
+    best, stats = branch_and_bound_warm(ns, ns.solve({}), ())
+    assert best.design["b"] == 3.0
+    low = [box for box in ns.boxes if box.get("b") == (1.0, 2.0)]
+    assert len(low) == 2  # its warm start, then the full multistart that finds no design
+    assert stats["infeasible"] == 1

@@ -9,6 +9,7 @@ import time
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from optdesign.problem import problem_from_dict
@@ -98,3 +99,42 @@ def test_a_box_without_an_item_is_infeasible_without_a_solve_and_names_its_solve
     none = ns.solve({"d0": (14.0, 14.0), "p": (2.0, 2.0)})
     assert (none.status, none.message) == ("infeasible", "no catalogue item in this box")
     assert none.solver == "ipopt" and ns.n_solves == 0
+
+
+def test_a_node_solver_of_another_back_end_does_not_take_the_files_ipopt_options():
+    """``[solver] ipopt = {...}`` are Ipopt's: a catalogue search on another NLP back-end
+    (here CasADi's sqpmethod, which has no ``mu_strategy``) is built without them."""
+    import copy
+
+    from optdesign.studies.catalogue import NodeSolver
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data = copy.deepcopy(data)
+    data.setdefault("solver", {})["ipopt"] = {"mu_strategy": "monotone"}
+    problem = problem_from_dict(data)
+    assert NodeSolver(problem, solver="sqpmethod").solver == "sqpmethod"
+    assert NodeSolver(problem).backend.name == "ipopt"
+
+
+def test_a_node_solver_leaves_its_free_rows_unbounded():
+    """The diagnosis of an infeasible catalogue problem solves nodes with one
+    requirement's rows dropped (``free_rows``): both their bounds go."""
+    import copy
+
+    from optdesign.studies.catalogue import NodeSolver
+
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+    data = copy.deepcopy(data)
+    data["requirements"]["nut_travel_max"] = "50 mm"  # an upper limit no design meets
+    problem = problem_from_dict(data)
+    items = {"d0": (25.0, 25.0), "p": (5.0, 5.0), "d": (6, 6)}
+    assert not NodeSolver(problem, starts=1).solve(items).success
+    rows = [i for i, n in enumerate(NodeSolver(problem).nlp.g_names) if n.startswith("nut_travel")]
+    freed = NodeSolver(problem, starts=1, free_rows=tuple(rows)).solve(items)
+    assert freed.success
+    # its design meets every requirement but the dropped one, which it violates
+    from optdesign.studies.verify import verify_design
+
+    x = np.array([freed.design[v.name] for v in problem.free])
+    ok, violated, _ = verify_design(problem, x)
+    assert not ok and {v.name.split("[")[0] for v in violated} == {"nut_travel"}

@@ -136,6 +136,18 @@ def test_fork_gp_agrees_with_exact_nlp_and_is_certified():
     assert r.design["R"] == pytest.approx(110 / (2 * np.tan(np.radians(30))), rel=1e-6)
 
 
+def test_a_requirement_a_fixed_linkage_cannot_meet_is_named_at_its_angles():
+    """With the linkage fixed the transmission angle's rows are constants: outside their
+    band they are infeasible whatever the lead and pins, each named at its angle."""
+    data = copy.deepcopy(CS_FIXED)
+    data["requirements"]["transmission_angle"] = {"min": "89 deg", "max": "140 deg"}
+    gp = build_gp(problem_from_dict(data))
+    assert gp.is_gp  # constants are no obstacle to the form, only to feasibility
+    rows = [r for r in gp.infeasible if r.startswith("transmission_angle[")]
+    assert rows and rows[0].startswith("transmission_angle[phi=-23.0deg] = 0.0216494")
+    assert all("outside [" in r for r in rows)
+
+
 def test_fixed_linkage_crank_slider_is_a_gp():
     problem = problem_from_dict(copy.deepcopy(CS_FIXED))
     gp = build_gp(problem)
