@@ -147,7 +147,7 @@ def run(contender: str, problem, de_limit: float):
             "wall_s": round(time.perf_counter() - t0, 3),
         }
     if contender == "enumerate":
-        res = solve_catalogue(problem, method="enumerate")
+        res = solve_catalogue(problem, method="enumerate", agree=0)  # the reference: every start
     elif contender == "bnb":
         res = solve_catalogue(problem, method="bnb")
     elif contender.startswith("bonmin-"):

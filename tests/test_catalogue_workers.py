@@ -56,8 +56,10 @@ def bnb_problem():
 
 @needs_fork
 def test_a_search_on_two_workers_is_the_search_on_one(bnb_problem):
-    one = solve_catalogue(bnb_problem, method="bnb", starts=3)
-    two = solve_catalogue(bnb_problem, method="bnb", starts=3, workers=2)
+    # 4 starts, the file's agree of 3: a node stopped on agreement has run a 4th start on
+    # the other worker, whose result is dropped
+    one = solve_catalogue(bnb_problem, method="bnb", starts=4)
+    two = solve_catalogue(bnb_problem, method="bnb", starts=4, workers=2)
     assert one.success and two.success
     assert two.objective == one.objective  # bit for bit: the same starts, the same order
     assert two.design == one.design
@@ -138,3 +140,34 @@ def test_a_node_solver_leaves_its_free_rows_unbounded():
     x = np.array([freed.design[v.name] for v in problem.free])
     ok, violated, _ = verify_design(problem, x)
     assert not ok and {v.name.split("[")[0] for v in violated} == {"nut_travel"}
+
+
+def test_a_node_multistart_stops_once_agree_starts_agree(bnb_problem):
+    """As the problem's own multistart (``[solver] agree``, 3 by default): a node's
+    starts stop once that many agree on the best value; the answer is the same as with
+    every start (``agree=0``), with fewer NLP solves."""
+    from optdesign.studies import catalogue
+
+    nodes: list = []
+    solve = catalogue.NodeSolver.solve
+
+    def recorded(self, *a, **k):
+        r = solve(self, *a, **k)
+        nodes.append(r.multistart)
+        return r
+
+    catalogue.NodeSolver.solve = recorded
+    try:
+        every = solve_catalogue(bnb_problem, method="bnb", starts=4, agree=0)
+        assert not any(m.stopped_early for m in nodes if m is not None and m.n_starts > 1)
+        nodes.clear()
+        agreed = solve_catalogue(bnb_problem, method="bnb", starts=4)
+    finally:
+        catalogue.NodeSolver.solve = solve
+    assert bnb_problem.spec.solver.agree == 3
+    assert agreed.objective == pytest.approx(every.objective, rel=1e-9)
+    assert agreed.design == every.design
+    assert agreed.details.catalogue.nlp_solves < every.details.catalogue.nlp_solves
+    # the nodes stopped on agreement (not at a floor): three starts of the four planned
+    stopped = [m for m in nodes if m is not None and m.stopped_early and m.n_at_best >= 3]
+    assert stopped and all((m.n_starts, m.n_planned) == (3, 4) for m in stopped)

@@ -77,7 +77,11 @@ class NodeSolver:
     own verdict of local infeasibility (:meth:`verdicts_decide`) end the multistart: the
     node is infeasible on those two starts (over the catalogue instance family, no later
     start or retry ever found a feasible point after two such verdicts:
-    benchmarks/README.md, "Catalogue searches (issue 25)").
+    benchmarks/README.md, "Catalogue searches (issue 25)"). As the problem's own
+    multistart, a node's multistart stops once :attr:`agree` starts agree on the best
+    value (the file's ``[solver] agree``, 3 by default, through :func:`solve_catalogue`;
+    over the same cases no later start beat a value that 3 starts agreed on:
+    ``benchmarks/catalogue_agreement.py``).
     """
 
     def __init__(
@@ -91,8 +95,12 @@ class NodeSolver:
         eps: Mapping[str, float] | None = None,
         free_rows: tuple[int, ...] = (),
         workers: int = 1,
+        agree: int = 0,
     ):
         self.problem = problem
+        #: A node's multistart stops once this many of its starts agree on the best value
+        #: (0: every start), as the problem's own multistart does (``[solver] agree``).
+        self.agree = max(0, int(agree))
         #: Local processes for a node's starts, inside :meth:`on_workers` (see there).
         self.workers = max(1, int(workers))
         self._workers: InheritedWorkers | None = None
@@ -181,6 +189,8 @@ class NodeSolver:
         a cold node does, so infeasibility and pruning rest on the same starts as before.
         ``fallback=False``: the warm start's result whatever it is (a first incumbent's
         value, which only needs to be feasible).
+        A multistart also ends once :attr:`agree` of its starts agree on the best value
+        (``multistart.stopped_early``, its value then trusted as a full multistart's).
         ``floor``: a lower bound on the node's value that the search trusts (its parent's
         relaxation value, when :func:`~optdesign.studies.catalogue_bnb.trusted`); the box
         is a sub-box of the parent's, its item data no more favourable, so no start can
@@ -218,6 +228,9 @@ class NodeSolver:
         def at_floor(r: Result) -> bool:
             return floor is not None and r.success and not improves(floor, r.objective)
 
+        def agreed(rs: list[Result]) -> bool:
+            return bool(self.agree) and len(rs) > 1 and best_of(rs)[1] >= self.agree
+
         results: list[Result] = []
         if warm and x_hint is not None:
             results.append(self._solve_start((box, pts.pop(0))))
@@ -234,15 +247,17 @@ class NodeSolver:
 
         def run(points) -> bool:
             """Solve from ``points`` in order, stopping at a start that settles the node
-            (True) or once the starts so far decide it infeasible (verdicts_decide)."""
+            (True: it reached the floor, or ``agree`` starts agree on the best value) or
+            once the starts so far decide it infeasible (verdicts_decide)."""
             before = list(results)
 
             def stop(new: list[Result]) -> bool:
-                return at_floor(new[-1]) or self.verdicts_decide(before + new)
+                done = before + new
+                return at_floor(new[-1]) or agreed(done) or self.verdicts_decide(done)
 
             new = self._starts(box, points, stop)
             results.extend(new)
-            return bool(new) and at_floor(new[-1])
+            return bool(new) and (at_floor(new[-1]) or agreed(results))
 
         settled = bool(results) and at_floor(results[0])
         if not settled:
@@ -348,6 +363,7 @@ def solve_catalogue(
     memo: InfeasibleBoxes | None = None,
     ties: bool = True,
     workers: int = 1,
+    agree: int | None = None,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -382,6 +398,9 @@ def solve_catalogue(
     workers
         Local processes for each node's starts (:meth:`NodeSolver.on_workers`): the same
         nodes, values and answer as one worker.
+    agree
+        A node's multistart stops once this many starts agree on the best value (default:
+        the problem file's ``[solver] agree``; 0: every start).
 
     Returns
     -------
@@ -406,7 +425,10 @@ def solve_catalogue(
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or minlp")
     n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
     seed = seed if seed is not None else problem.spec.solver.seed
-    ns = NodeSolver(problem, objective, n_starts, seed, solver, options, eps, workers=workers)
+    agree = agree if agree is not None else problem.spec.solver.agree
+    ns = NodeSolver(
+        problem, objective, n_starts, seed, solver, options, eps, workers=workers, agree=agree
+    )
     with ns.on_workers():
         ns.memo = memo
         # the proofs of this search (a front's memo, or this search's own, which it does not
@@ -550,6 +572,7 @@ def solve_catalogue_formulation(problem: DesignProblem, request: SolveRequest) -
         solver=request.solver,
         options=request.options,
         workers=request.workers,
+        agree=request.agree,
     )
     return attach_reference(problem, result)
 
