@@ -21,17 +21,15 @@ import argparse
 import json
 import os
 import sys
-import tempfile
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import optdesign as od
 from optdesign.studies import catalogue as cat
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from bench_catalogue_solvers import instance  # noqa: E402
+from catalogue_cases import run_cases  # noqa: E402
 
 VERDICT = "locally infeasible"
 
@@ -69,19 +67,7 @@ def main() -> None:
         print(json.dumps(row), flush=True)
 
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    for family in ("fin", "cs"):
-        for seed in range(8):
-            problem, _ = instance(family, seed)
-            for method in ("bnb", "enumerate"):
-                cat.solve_catalogue(problem, method=method)
-            tally(f"{family}-{seed}")
-    for name in ("fin_actuator", "cs_min_backlash_catalogue"):
-        od.solve(od.load(ROOT / "problems" / f"{name}.toml"))
-        tally(name)
-    with tempfile.TemporaryDirectory() as out:
-        fin = od.load(ROOT / "problems" / "fin_actuator.toml")
-        od.pareto(fin, ["backlash", "motor_torque"], points=6, workers=1, out=out)
-    tally("fin_actuator front, 6 points")
+    run_cases(tally)
 
 
 if __name__ == "__main__":

@@ -50,6 +50,18 @@ class _Problem:
     free: list[_Var]
 
 
+def _infeasible() -> Result:
+    """A fake node solve with no design."""
+    return Result(
+        status="infeasible",
+        objective=float("nan"),
+        design={},
+        solver="fake",
+        formulation="nlp",
+        wall_time_s=0.0,
+    )
+
+
 class TiedNodes:
     """A node solver whose objective, (a - 2)^2 + 1, ignores b; each relaxation sits at
     the top of b's range, so the search meets the largest b first."""
@@ -157,14 +169,7 @@ class TrapNodes(TiedNodes):
         result = super().solve(box, x_hint, warm, prunes, fallback, floor)
         fixed = all(box.get(n, (0, 1))[0] == box.get(n, (0, 1))[1] for n in self.names)
         if fixed and (box["a"][0], box["b"][0]) == (2.0, 4.0):
-            return Result(
-                status="infeasible",
-                objective=float("nan"),
-                design={},
-                solver="fake",
-                formulation="nlp",
-                wall_time_s=0.0,
-            )
+            return _infeasible()
         return result
 
 
@@ -343,14 +348,7 @@ class WarmThenInfeasibleNodes(WarmTrapNodes):
     def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
         result = super().solve(box, x_hint, warm, prunes, fallback, floor)
         if box.get("b", (1.0, 4.0))[1] <= 2.0 and not warm:
-            return Result(
-                status="infeasible",
-                objective=float("nan"),
-                design={},
-                solver="fake",
-                formulation="nlp",
-                wall_time_s=0.0,
-            )
+            return _infeasible()
         return result
 
 
