@@ -18,7 +18,6 @@ counts) goes to ``--out`` as it is measured.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import sys
@@ -32,7 +31,7 @@ from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from catalogue_cases import run_cases  # noqa: E402
+from catalogue_cases import run_cases, write_row  # noqa: E402
 
 
 def stop_prefix(values: list[float], agree: int) -> int | None:
@@ -97,9 +96,7 @@ def main() -> None:
             "later_start_better": changed,
             "examples": examples[:5],
         }
-        with args.out.open("a") as fh:
-            fh.write(json.dumps(row) + "\n")
-        print(json.dumps(row), flush=True)
+        write_row(args.out, row)
 
     args.out.parent.mkdir(parents=True, exist_ok=True)
     run_cases(tally)

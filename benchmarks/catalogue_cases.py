@@ -7,6 +7,7 @@ neighbouring items) and the 6-point catalogue front of ``fin_actuator``. After e
 
 from __future__ import annotations
 
+import json
 import sys
 import tempfile
 from collections.abc import Callable
@@ -34,3 +35,10 @@ def run_cases(tally: Callable[[str], None]) -> None:
         fin = od.load(ROOT / "problems" / "fin_actuator.toml")
         od.pareto(fin, ["backlash", "motor_torque"], points=6, workers=1, out=out)
     tally("fin_actuator front, 6 points")
+
+
+def write_row(path: Path, row: dict) -> None:
+    """Append ``row`` to the JSON lines of ``path`` (the counts so far) and print it."""
+    with path.open("a") as fh:
+        fh.write(json.dumps(row) + "\n")
+    print(json.dumps(row), flush=True)

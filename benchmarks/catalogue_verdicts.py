@@ -18,7 +18,6 @@ per case (cumulative counts) goes to ``--out`` as it is measured.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
@@ -29,7 +28,7 @@ from optdesign.studies import catalogue as cat
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from catalogue_cases import run_cases  # noqa: E402
+from catalogue_cases import run_cases, write_row  # noqa: E402
 
 VERDICT = "locally infeasible"
 
@@ -62,9 +61,7 @@ def main() -> None:
             "later_converged": len(later),
             "examples": later[:5],
         }
-        with args.out.open("a") as fh:
-            fh.write(json.dumps(row) + "\n")
-        print(json.dumps(row), flush=True)
+        write_row(args.out, row)
 
     args.out.parent.mkdir(parents=True, exist_ok=True)
     run_cases(tally)
