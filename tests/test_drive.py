@@ -196,6 +196,26 @@ def test_screw_speed_dn_critical_speed_and_static_safety_by_hand(fin):
     assert np.max(c["static_safety"].values) == pytest.approx(1.5 * F.max() / row["C0a"], rel=1e-7)
 
 
+def test_buckling_limits_the_nut_force_to_the_buckling_load(fin):
+    """The screw_buckling rows are nut force / buckling load, at most 1: with the screw
+    ten times longer the same design buckles, and the check names it."""
+    import tomllib
+
+    problem, _ = fin
+    x = np.array([FIN_DESIGN[v.name] for v in problem.free])
+    row = problem.evaluate(x).constraints["screw_buckling"]
+    assert (row.lower, row.upper) == (None, 1.0) and np.max(row.values) < 1.0
+    data = tomllib.loads(FIN.read_text())
+    data["screw"]["length"] = "3000 mm"
+    long_screw = problem_from_dict(data)
+    row = long_screw.evaluate(x).constraints["screw_buckling"]
+    assert np.max(row.values) > 1.0 and row.upper == 1.0
+    from optdesign.studies.verify import verify_design
+
+    ok, violated, _ = verify_design(long_screw, x)
+    assert not ok and "screw_buckling" in {v.name.split("[")[0] for v in violated}
+
+
 def test_life_over_the_duty_cycle_by_miners_rule(fin):
     _, q = fin
     row = _catalogue_row(25.0, 5.0)

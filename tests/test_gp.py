@@ -82,6 +82,10 @@ def test_tracer_merges_like_terms_into_a_monomial():
     # summed: x^0.1 x^0.2 (exponent 0.30000000000000004) and x^0.3
     alike = Signomial(names, {(0.1 + 0.2, 0.0): 2.0, (0.3, 0.0): 3.0}, np.array([90.0, 10.0]))
     assert {k: float(v) for k, v in alike.terms.items()} == {(0.3, 0.0): 5.0}
+    # dividing by a sum of terms is not a GP, and says so
+    over_sum = 1.0 / (R + 1.0)
+    assert isinstance(over_sum, NotGP)
+    assert over_sum.reason == f"division by a sum of terms ({over_sum.term}) is not a posynomial"
     # dividing by a term whose coefficient is zero at some grid angle is refused, saying so
     over_zero = 1.0 / (R * np.array([0.0, 1.0]))
     assert isinstance(over_zero, NotGP) and "zero on the grid" in over_zero.reason
@@ -134,6 +138,16 @@ def test_fork_gp_agrees_with_exact_nlp_and_is_certified():
     assert cert.gap_rel < 1e-6
     # nut travel 2 R tan 30 <= 110 is what fixes R
     assert r.design["R"] == pytest.approx(110 / (2 * np.tan(np.radians(30))), rel=1e-6)
+
+
+def test_a_catalogue_variable_is_no_gp_variable_and_the_check_says_what_to_use():
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    check = next(c for c in build_gp(problem).checks if c.what == "variable" and c.name == "p")
+    assert not check.ok
+    assert check.reason == (
+        "takes catalogue values [2, 2.5, 3, 4, 5, 6, 8, 10]; a GP is "
+        "continuous (use --formulation catalogue)"
+    )
 
 
 def test_a_requirement_a_fixed_linkage_cannot_meet_is_named_at_its_angles():

@@ -123,6 +123,9 @@ def test_requirement_rows_by_hand():
     assert ta.description == "transmission angle (horn to actuator)"
     assert ta.lower == pytest.approx(np.cos(np.radians(140.0)))
     assert ta.upper == pytest.approx(np.cos(np.radians(40.0)))
+    # shown in degrees, a cosine rounded past +-1 as 0 and 180 deg (never NaN)
+    assert ta.display(np.cos(np.radians(40.0))) == pytest.approx(40.0)
+    assert ta.display(1.0 + 1e-12) == 0.0 and ta.display(-1.0 - 1e-12) == 180.0
     (dead,) = mech.requirement_rows("dead_length", 60.0, PHI)
     assert (dead.name, dead.unit, dead.lower, dead.upper) == ("dead_length", "mm", 60.0, None)
     assert dead.description == "actuator length minus stroke"
