@@ -171,3 +171,21 @@ def test_a_node_multistart_stops_once_agree_starts_agree(bnb_problem):
     # the nodes stopped on agreement (not at a floor): three starts of the four planned
     stopped = [m for m in nodes if m is not None and m.stopped_early and m.n_at_best >= 3]
     assert stopped and all((m.n_starts, m.n_planned) == (3, 4) for m in stopped)
+
+
+def test_a_search_that_finds_no_combination_says_whether_the_relaxation_was_feasible(
+    bnb_problem, monkeypatch
+):
+    """No catalogue design from the search: "failed" (more starts may find one) when the
+    continuous relaxation has a feasible design, "infeasible" only when it has none."""
+    from optdesign.studies import catalogue
+
+    stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
+    monkeypatch.setattr(catalogue, "branch_and_bound", lambda *a, **k: (None, stats))
+    result = solve_catalogue(bnb_problem, method="bnb", starts=2)
+    assert result.status == "failed" and not result.design
+    assert result.message == (
+        "no catalogue combination gave a feasible design although the continuous "
+        "relaxation is feasible (more starts may find one)"
+    )
+    assert result.details.catalogue.relaxation_status == "optimal"
