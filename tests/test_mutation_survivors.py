@@ -797,3 +797,24 @@ def test_a_keyed_pin_joint_adds_its_fixed_clearance_to_the_pins():
     assert out[0].pin is pin.pin  # the pin itself is kept: its fit adds on top
     # a joint with neither a pin nor a fixed clearance is dropped from the chain
     assert with_fixed_clearances([slide], {}) == []
+
+
+def test_a_joint_a_plug_in_declares_wrongly_is_refused_naming_it():
+    """A mechanism's clearance chain (docs/mechanisms.md): each joint needs a sensitivity
+    unless it is angular, a pin joint the force it carries, and no clearance is negative."""
+    from optdesign.mechanisms.joints import Joint, PinJoint
+
+    cases = [
+        (dict(name="C slide", key="C"), "joint C slide", "needs a sensitivity (rad/mm)"),
+        (
+            dict(name="D pin", sensitivity=0.01, pin=PinJoint(8.0, 12.0)),
+            "joint D pin",
+            "a pin joint needs the force it carries",
+        ),
+        (dict(name="A", sensitivity=0.01, clearance=-0.001), "joint A.clearance", "must be >= 0"),
+    ]
+    for kwargs, field, reason in cases:
+        with pytest.raises(InputError) as caught:
+            Joint(**kwargs)
+        assert (caught.value.field, caught.value.reason) == (field, reason)
+    assert Joint(name="O shaft", angular=True).sensitivity is None  # an angle needs none
