@@ -818,3 +818,15 @@ def test_a_joint_a_plug_in_declares_wrongly_is_refused_naming_it():
             Joint(**kwargs)
         assert (caught.value.field, caught.value.reason) == (field, reason)
     assert Joint(name="O shaft", angular=True).sensitivity is None  # an angle needs none
+
+
+def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
+    """``build_robust_nlp(..., risk=...)`` (od.solve's robust formulation with a risk of
+    the caller's): the caller's measure is minimised, the file's only by default."""
+    from optdesign.formulations.robust import build_robust_nlp
+
+    from optdesign.problem import load_problem
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")  # risk = "cvar"
+    assert build_robust_nlp(problem).default_target == "CVaR_0.9(backlash)"
+    assert build_robust_nlp(problem, risk="mean_std").default_target == "mean+2std(backlash)"
