@@ -824,7 +824,6 @@ def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
     """``build_robust_nlp(..., risk=...)`` (od.solve's robust formulation with a risk of
     the caller's): the caller's measure is minimised, the file's only by default."""
     from optdesign.formulations.robust import build_robust_nlp
-
     from optdesign.problem import load_problem
 
     problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")  # risk = "cvar"
