@@ -232,6 +232,9 @@ def test_auto_decides_with_the_chosen_objective():
     problem = od.load(FORK)
     assert choose_formulation(problem, "auto") == "gp"
     assert choose_formulation(problem, "auto", "backlash_rss") == "nlp"
+    # the library predicate says the same, objective by objective
+    assert is_gp(problem) and is_gp(problem, "backlash")
+    assert not is_gp(problem, "backlash_rss")
     result = od.solve(problem, "auto", objective="backlash_rss", ranges=False)
     assert result.formulation == "nlp-epigraph" and result.status == "optimal"
     assert result.objective_name == "backlash_rss"

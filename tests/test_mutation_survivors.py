@@ -829,3 +829,8 @@ def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
     problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")  # risk = "cvar"
     assert build_robust_nlp(problem).default_target == "CVaR_0.9(backlash)"
     assert build_robust_nlp(problem, risk="mean_std").default_target == "mean+2std(backlash)"
+    # and the caller's k of mean + k std, and alpha of CVaR, over the file's (2 and 0.9)
+    assert build_robust_nlp(problem, risk="mean_std", k=3.0).default_target == (
+        "mean+3std(backlash)"
+    )
+    assert build_robust_nlp(problem, alpha=0.8).default_target == "CVaR_0.8(backlash)"
