@@ -216,6 +216,18 @@ def test_buckling_limits_the_nut_force_to_the_buckling_load(fin):
     assert not ok and "screw_buckling" in {v.name.split("[")[0] for v in violated}
 
 
+def test_a_screw_diameter_of_zero_is_no_catalogue_item():
+    """Off the catalogue the nearest screw's data stand in (and the membership block
+    fails); a diameter or lead that is not positive has no nearest screw: NaN."""
+    from optdesign.problem.drive import _lookup, catalogue_items
+
+    items = catalogue_items("HIWIN", None)
+    vals, on = _lookup(items, np.array([25.0, 26.0, 0.0]), np.array([5.0, 5.0, 5.0]), ["d1"])
+    assert on.tolist() == [1.0, 0.0, 0.0]
+    assert vals["d1"][0] == vals["d1"][1] == pytest.approx(22.32)  # 26 x 5 -> the 25 x 5
+    assert np.isnan(vals["d1"][2])
+
+
 def test_life_over_the_duty_cycle_by_miners_rule(fin):
     _, q = fin
     row = _catalogue_row(25.0, 5.0)

@@ -140,6 +140,14 @@ def test_fork_gp_agrees_with_exact_nlp_and_is_certified():
     assert r.design["R"] == pytest.approx(110 / (2 * np.tan(np.radians(30))), rel=1e-6)
 
 
+def test_the_objectives_gp_rows_keep_the_angle_of_each_grid_row():
+    """The fork's worst-case backlash is a max over the grid: one posynomial row per
+    angle, pruned to the row that dominates the others, labelled with its angle."""
+    gp = build_gp(load_problem(FORK))
+    assert [(r.name, r.label) for r in gp.objective_rows] == [("backlash", "phi=+0.0deg")]
+    assert gp.n_rows_before_pruning > len(gp.objective_rows)
+
+
 def test_a_catalogue_variable_is_no_gp_variable_and_the_check_says_what_to_use():
     problem = load_problem(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
     check = next(c for c in build_gp(problem).checks if c.what == "variable" and c.name == "p")
