@@ -834,3 +834,17 @@ def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
         "mean+3std(backlash)"
     )
     assert build_robust_nlp(problem, alpha=0.8).default_target == "CVaR_0.8(backlash)"
+
+
+def test_an_epsilon_bound_on_a_quantity_the_formulation_lacks_is_refused_naming_them():
+    from optdesign.errors import ProblemError
+    from optdesign.problem import load_problem
+    from optdesign.studies.nlp_solve import formulation_for
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
+    nlp = formulation_for(problem, ("backlash", "ripple"))
+    with pytest.raises(ProblemError) as caught:
+        nlp.bounds(eps={"size": 1.0})
+    assert str(caught.value) == (
+        "epsilon bound on 'size': not an objective of this formulation (backlash, ripple)"
+    )
