@@ -216,6 +216,17 @@ def test_buckling_limits_the_nut_force_to_the_buckling_load(fin):
     assert not ok and "screw_buckling" in {v.name.split("[")[0] for v in violated}
 
 
+def test_the_drive_requirements_carry_their_units_for_the_reports(fin):
+    """What a report shows beside each drive requirement's value and limit."""
+    from optdesign.reports.limits import block_infos
+
+    problem, _ = fin
+    units = {name: info.unit for name, info in block_infos(problem).items()}
+    assert units["life"] == "h"
+    assert units["screw_buckling"] == units["static_safety"] == ""
+    assert block_infos(problem)["life"].description.startswith("rated life L10 over")
+
+
 def test_a_screw_diameter_of_zero_is_no_catalogue_item():
     """Off the catalogue the nearest screw's data stand in (and the membership block
     fails); a diameter or lead that is not positive has no nearest screw: NaN."""
