@@ -189,3 +189,48 @@ def test_a_search_that_finds_no_combination_says_whether_the_relaxation_was_feas
         "relaxation is feasible (more starts may find one)"
     )
     assert result.details.catalogue.relaxation_status == "optimal"
+
+
+def test_a_single_search_reports_the_boxes_it_proved_infeasible(bnb_problem):
+    """A search without a front's memo still records its own proofs (the optimum's
+    neighbouring items read them, and ``details.catalogue.infeasible_boxes`` lists them)."""
+    result = solve_catalogue(bnb_problem, method="bnb", starts=3)
+    boxes = result.details.catalogue.infeasible_boxes
+    assert boxes and all(isinstance(box, dict) and isinstance(eps, dict) for box, eps in boxes)
+    assert all(set(box) <= {"p", "d"} for box, _ in boxes)
+
+
+def test_a_failed_relaxation_is_said_so_beside_the_items_found(monkeypatch):
+    """Enumeration solves every combination from its own starts, so a design can come
+    out although the relaxation's starts failed: the note says the relaxation failed, and
+    no bound is claimed."""
+    import copy
+    import math
+
+    from optdesign.solvers.result import Result
+    from optdesign.studies import catalogue
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data = copy.deepcopy(data)
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["5 mm", "6 mm", "8 mm"]}
+    problem = problem_from_dict(data)
+    solve = catalogue.NodeSolver.solve
+
+    def root_fails(self, bounds, *a, **k):
+        if not bounds:
+            return Result(
+                status="failed",
+                objective=math.nan,
+                design={},
+                solver="ipopt",
+                formulation="nlp",
+                wall_time_s=0.0,
+            )
+        return solve(self, bounds, *a, **k)
+
+    monkeypatch.setattr(catalogue.NodeSolver, "solve", root_fails)
+    result = solve_catalogue(problem, method="enumerate", starts=2)
+    assert result.success and result.bound is None
+    note = next(n for n in result.notes if n.startswith("catalogue items chosen"))
+    assert "; continuous relaxation: failed; enumerate," in note and "nan" not in note

@@ -848,3 +848,62 @@ def test_an_epsilon_bound_on_a_quantity_the_formulation_lacks_is_refused_naming_
     assert str(caught.value) == (
         "epsilon bound on 'size': not an objective of this formulation (backlash, ripple)"
     )
+
+
+def test_a_robust_nlp_of_no_sample_is_refused_naming_the_field():
+    from types import SimpleNamespace
+
+    from optdesign.errors import ProblemError
+    from optdesign.formulations.robust import build_robust_nlp
+    from optdesign.problem import load_problem
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")
+    with pytest.raises(ProblemError) as caught:
+        build_robust_nlp(problem, samples=SimpleNamespace(n=0))
+    assert str(caught.value) == "tolerances.samples: need at least one sample"
+
+
+def test_a_robust_ripple_names_every_samples_envelope_variables():
+    """A spread objective (the ratio ripple) under scatter: two envelope variables per
+    sample, each named, as many names as auxiliary variables."""
+    from optdesign.formulations.robust import build_robust_nlp, draw_samples
+    from optdesign.problem import load_problem
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")
+    samples = draw_samples(problem, 3, 0)
+    nlp = build_robust_nlp(problem, "ripple", samples=samples)
+    assert nlp.z.shape[0] == nlp.n_design + len(nlp.aux_names)
+    for s in range(3):
+        assert {f"ripple_lo[s{s}]", f"ripple_hi[s{s}]"} <= set(nlp.aux_names)
+
+
+def test_a_mechanism_without_its_kinematics_or_pins_says_what_to_write():
+    import optdesign as od
+    from optdesign.errors import InputError
+
+    class Bare(od.Mechanism):
+        name = "t32_bare"
+        variables = {"R": od.VariableInfo("length", "lever")}  # noqa: RUF012
+
+    bare = Bare(R=50.0, p=5.0)
+    with pytest.raises(NotImplementedError, match=r"^Bare must define nut_position\(phi\)$"):
+        bare.nut_position(0.1)
+    with pytest.raises(InputError) as caught:
+        bare.joints(np.zeros(3), 1.0e5, None)
+    assert caught.value.field == "pin_joints"
+    assert caught.value.reason.endswith("declares no pins: set pin_joints or write joints()")
+
+
+def test_a_tie_in_distance_from_the_items_branches_on_the_first_declared_variable():
+    from types import SimpleNamespace
+
+    from optdesign.studies.catalogue_bnb import on_items
+
+    a = SimpleNamespace(name="a", values=(1.0, 2.0))
+    b = SimpleNamespace(name="b", values=(10.0, 20.0))
+    box = {"a": (1.0, 2.0), "b": (10.0, 20.0)}
+    res = SimpleNamespace(design={"a": 1.5, "b": 15.0})  # both halfway: the same distance
+    worst, items = on_items([a, b], box, res)
+    assert worst is a and items == {"a": 1.0, "b": 10.0}
+    on = SimpleNamespace(design={"a": 2.0, "b": 10.0})
+    assert on_items([a, b], box, on)[0] is None
