@@ -82,6 +82,8 @@ def test_tracer_merges_like_terms_into_a_monomial():
     # summed: x^0.1 x^0.2 (exponent 0.30000000000000004) and x^0.3
     alike = Signomial(names, {(0.1 + 0.2, 0.0): 2.0, (0.3, 0.0): 3.0}, np.array([90.0, 10.0]))
     assert {k: float(v) for k, v in alike.terms.items()} == {(0.3, 0.0): 5.0}
+    # a monomial written as the reports show it
+    assert (2.0 * R * d**2).describe() == "2*R*d^2"
     # dividing by a sum of terms is not a GP, and says so
     over_sum = 1.0 / (R + 1.0)
     assert isinstance(over_sum, NotGP)
@@ -146,6 +148,12 @@ def test_the_objectives_gp_rows_keep_the_angle_of_each_grid_row():
     gp = build_gp(load_problem(FORK))
     assert [(r.name, r.label) for r in gp.objective_rows] == [("backlash", "phi=+0.0deg")]
     assert gp.n_rows_before_pruning > len(gp.objective_rows)
+
+
+def test_a_posynomial_constraints_check_counts_its_rows():
+    checks = {c.name: c for c in build_gp(load_problem(FORK)).checks if c.what == "constraint"}
+    shear = checks["pin_shear_stress"]
+    assert shear.ok and re.fullmatch(r"[1-9][0-9]* posynomial rows", shear.reason)
 
 
 def test_a_catalogue_variable_is_no_gp_variable_and_the_check_says_what_to_use():

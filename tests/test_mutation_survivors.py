@@ -907,3 +907,20 @@ def test_a_tie_in_distance_from_the_items_branches_on_the_first_declared_variabl
     assert worst is a and items == {"a": 1.0, "b": 10.0}
     on = SimpleNamespace(design={"a": 2.0, "b": 10.0})
     assert on_items([a, b], box, on)[0] is None
+
+
+def test_the_conforming_contact_pressure_uses_the_pin_radius():
+    """The conforming solution's peak pressure scales as E* dR / R (R the pin's radius,
+    dR the radial clearance): checked against the model's dimensionless pressure."""
+    from optdesign.mechanisms.joints import PinJoint
+    from optdesign.models import pin_contact as pc
+
+    pin = PinJoint(8.0, 12.0, contact="conforming")
+    F = 2000.0
+    dR = 0.5 * float(pin.fit_clearance())
+    E_s = pc.effective_modulus_similar(pin.E, pin.nu)
+    P_star = pc.load_parameter(F, pin.L, dR, pin.E, pin.nu)
+    expected = E_s * dR / 4.0 * pc.max_pressure_star(P_star)  # R = d / 2 = 4 mm
+    assert float(pin.contact_pressure(F)) == pytest.approx(expected, rel=1e-12)
+    wider = PinJoint(16.0, 12.0, contact="conforming", extra=0.0)
+    assert float(wider.contact_pressure(F)) < float(pin.contact_pressure(F))
