@@ -19,7 +19,7 @@ import pytest
 import optdesign as od
 from optdesign.problem import problem_from_dict
 from optdesign.studies.catalogue import solve_catalogue
-from optdesign.studies.pareto import FrontMethod, PointRecord
+from optdesign.studies.pareto import NSGA2, FrontMethod, PointRecord, make_method
 from optdesign.studies.pareto.catalogue_front import catalogue_task
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,6 +52,20 @@ def test_a_front_method_without_starts_or_seed_takes_the_problem_files():
     problem = od.load(ROOT / "problems" / "fork_min_backlash.toml")
     solver = problem.spec.solver
     assert _NoSettings().starts_and_seed(problem) == (solver.starts, solver.seed)
+
+
+def test_nsga2_is_a_front_method_of_a_catalogue_problem():
+    """NSGA-II searches catalogue variables as item indices: it is not refused on a
+    catalogue problem, and every point it gives is a catalogue design."""
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    assert make_method(problem, "nsga2", 7, pop_size=8) == NSGA2(pop_size=8)
+    front = od.pareto(
+        problem, ["backlash", "motor_torque"], method="nsga2", pop_size=8, generations=3, seed=1
+    )
+    assert front.method == "nsga2" and front.points
+    leads = {2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0}
+    for point in front.points:
+        assert point.design["p"] in leads and point.verified
 
 
 # --- catalogue fronts: the shared memo ----------------------------------------------------
