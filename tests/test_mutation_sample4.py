@@ -10,6 +10,7 @@ pass on the code.
 from __future__ import annotations
 
 import json
+import shutil
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +19,7 @@ import pytest
 
 import optdesign as od
 from optdesign.problem import problem_from_dict
+from optdesign.storage import StoreError
 from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.pareto import NSGA2, FrontMethod, PointRecord, make_method
 from optdesign.studies.pareto.catalogue_front import catalogue_task
@@ -113,3 +115,59 @@ def test_a_sequential_catalogue_fronts_inner_point_reuses_the_proofs_before_it(
     assert inner.success and alone.success
     assert inner.objectives["motor_torque"] == pytest.approx(alone.objective, rel=1e-6)
     assert inner.n_solves < alone.details.catalogue.nlp_solves
+
+
+# --- resuming a stored front ------------------------------------------------------------
+@pytest.fixture(scope="module")
+def weighted_run(tmp_path_factory):
+    """A finished 3-point weighted-sum front of cs_min_backlash (its output folder)."""
+    out = tmp_path_factory.mktemp("weighted")
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
+    assert len(front.points) >= 2
+    return problem, out
+
+
+def _resume_weighted(problem, out, points=3, starts=1):
+    return od.pareto(
+        problem,
+        ["backlash", "size"],
+        points,
+        method="weighted_sum",
+        starts=starts,
+        out=out,
+        resume=True,
+    )
+
+
+def test_resuming_a_weighted_sum_front_with_other_settings_names_the_setting(
+    weighted_run, tmp_path
+):
+    problem, finished = weighted_run
+    out = shutil.copytree(finished, tmp_path / "out")
+    with pytest.raises(
+        StoreError, match=r"method's settings changed \(method.n: stored 3, now 4\)"
+    ):
+        _resume_weighted(problem, out, points=4)
+    with pytest.raises(StoreError, match=r"\(method.starts: stored 1, now 2\)"):
+        _resume_weighted(problem, out, starts=2)
+
+
+@pytest.mark.parametrize("status", [None, "failed"])
+def test_a_stored_record_whose_verified_flag_is_not_a_boolean_refuses_the_resume(
+    weighted_run, tmp_path, status
+):
+    """A record's ``verified`` is true, false or null; anything else refuses the resume,
+    a failed record's too (a failed record is otherwise not checked further)."""
+    problem, finished = weighted_run
+    out = shutil.copytree(finished, tmp_path / "out")
+    store = out / "weighted_sum.jsonl"
+    lines = [json.loads(x) for x in store.read_text().splitlines()]
+    k = next(k for k, r in enumerate(lines) if k and r.get("verified") is True)
+    lines[k]["verified"] = "yes"
+    if status is not None:
+        lines[k]["status"] = status
+    store.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    with pytest.raises(StoreError, match=f"line {k + 1}: record") as caught:
+        _resume_weighted(problem, out)
+    assert "field 'verified' is not true, false or null" in str(caught.value)
