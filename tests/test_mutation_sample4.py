@@ -18,10 +18,19 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
+from optdesign.errors import ProblemError
 from optdesign.problem import problem_from_dict
+from optdesign.reports.display_units import requirement_echo
 from optdesign.storage import StoreError
 from optdesign.studies.catalogue import solve_catalogue
-from optdesign.studies.pareto import NSGA2, FrontMethod, PointRecord, make_method
+from optdesign.studies.pareto import (
+    NSGA2,
+    EpsilonConstraint,
+    FrontMethod,
+    PointRecord,
+    compute_front,
+    make_method,
+)
 from optdesign.studies.pareto.catalogue_front import catalogue_task
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,6 +77,18 @@ def test_nsga2_is_a_front_method_of_a_catalogue_problem():
     leads = {2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0}
     for point in front.points:
         assert point.design["p"] in leads and point.verified
+
+
+def test_a_method_object_with_settings_beside_it_is_refused_naming_them():
+    """Settings go into a method object, not beside it: the library front refuses them,
+    naming each, before any work."""
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    method = EpsilonConstraint(points=3)
+    with pytest.raises(ProblemError, match=r"options \['seed', 'starts'\] go into the method"):
+        make_method(problem, method, 7, starts=2, seed=1)
+    with pytest.raises(ProblemError, match=r"options \['starts'\] go into the method object"):
+        compute_front(problem, ["backlash", "size"], 3, method, starts=2)
+    assert make_method(problem, method, 7) is method
 
 
 # --- catalogue fronts: the shared memo ----------------------------------------------------
@@ -171,3 +192,22 @@ def test_a_stored_record_whose_verified_flag_is_not_a_boolean_refuses_the_resume
     with pytest.raises(StoreError, match=f"line {k + 1}: record") as caught:
         _resume_weighted(problem, out)
     assert "field 'verified' is not true, false or null" in str(caught.value)
+
+
+# --- the input echo of a report -------------------------------------------------------
+def test_a_bare_zero_angle_is_echoed_in_the_one_angle_unit_the_file_wrote():
+    """A bare 0 has no unit of its own: a file that wrote every angle in rad sees it in
+    rad too, one that wrote them in degrees in deg."""
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash.toml").read_text())
+    req = data["requirements"]
+    req["deflection"] = {"min": 0, "max": "0.5 rad", "points": 11}
+    req["transmission_angle"] = {"min": "0.7 rad", "max": "2.4 rad"}
+    req["rod_inclination_max"] = "0.5 rad"
+    echo = dict(requirement_echo(problem_from_dict(data)))
+    assert echo["deflection"] == "{min = 0 rad, max = 0.5 rad, points = 11}"
+    req["deflection"] = {"min": 0, "max": "30 deg", "points": 11}
+    req["transmission_angle"] = {"min": "40 deg", "max": "140 deg"}
+    req["rod_inclination_max"] = "30 deg"
+    data["variables"]["phi0"] = {"lower": "-30 deg", "upper": "30 deg"}
+    echo = dict(requirement_echo(problem_from_dict(data)))
+    assert echo["deflection"] == "{min = 0 deg, max = 30 deg, points = 11}"
