@@ -1,10 +1,10 @@
 """Tests written from the fourth mutation sample's survivors (issue 21, mutmut, SEED=23)
 in studies/pareto, storage, units, reports and studies/relaxation.
 
-Each test names the behaviour it pins, not the mutant it was written from; the mutants
-and their verdicts are listed in docs/testing.md. Every test is checked to fail on its
-mutant (``MUTANT_UNDER_TEST=<name> pytest`` in a copy of the run's ``mutants/``) and to
-pass on the code.
+Each test names the behaviour it pins, not the mutant it was written from (the mutants
+and their verdicts go to the fourth sample's table in docs/testing.md). Every test was
+checked to fail on its mutant (``MUTANT_UNDER_TEST=<name> pytest`` in a copy of the
+run's ``mutants/``) and to pass on the code.
 """
 
 from __future__ import annotations
