@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
-from optdesign.errors import ProblemError
+from optdesign import units
+from optdesign.errors import InputError, ProblemError
 from optdesign.problem import problem_from_dict
 from optdesign.reports.display_units import requirement_echo
 from optdesign.storage import StoreError
@@ -211,3 +212,23 @@ def test_a_bare_zero_angle_is_echoed_in_the_one_angle_unit_the_file_wrote():
     data["variables"]["phi0"] = {"lower": "-30 deg", "upper": "30 deg"}
     echo = dict(requirement_echo(problem_from_dict(data)))
     assert echo["deflection"] == "{min = 0 deg, max = 30 deg, points = 11}"
+
+
+# --- units ------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("written", "suggested"),
+    [
+        ("999999999999999 s", '"999999999999999 mm"'),
+        ("1e15 s", '"1000000000000000.0 mm"'),
+        ("-1e15 s", '"-1000000000000000.0 mm"'),
+        ("2.5 s", '"2.5 mm"'),
+    ],
+)
+def test_a_wrong_dimension_suggests_the_number_whole_below_1e15_and_as_a_float_from_it(
+    written, suggested
+):
+    with pytest.raises(InputError) as caught:
+        units.to_internal(written, "length", "f")
+    assert str(caught.value) == (
+        f"f: {written!r} is a time, expected a length (write e.g. {suggested})"
+    )
