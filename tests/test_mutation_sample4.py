@@ -9,10 +9,12 @@ run's ``mutants/``) and to pass on the code.
 
 from __future__ import annotations
 
+import copy
+import csv
 import json
 import shutil
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pytest
@@ -33,6 +35,8 @@ from optdesign.studies.pareto import (
     make_method,
 )
 from optdesign.studies.pareto.catalogue_front import catalogue_task
+from optdesign.studies.pareto.io import write_front_csv
+from optdesign.studies.pareto.tasks import ANCHOR_SLACK, row_eps
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -147,7 +151,7 @@ def weighted_run(tmp_path_factory):
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
     assert len(front.points) >= 2
-    return problem, out
+    return problem, out, front
 
 
 def _resume_weighted(problem, out, points=3, starts=1):
@@ -165,7 +169,7 @@ def _resume_weighted(problem, out, points=3, starts=1):
 def test_resuming_a_weighted_sum_front_with_other_settings_names_the_setting(
     weighted_run, tmp_path
 ):
-    problem, finished = weighted_run
+    problem, finished, _ = weighted_run
     out = shutil.copytree(finished, tmp_path / "out")
     with pytest.raises(
         StoreError, match=r"method's settings changed \(method.n: stored 3, now 4\)"
@@ -181,7 +185,7 @@ def test_a_stored_record_whose_verified_flag_is_not_a_boolean_refuses_the_resume
 ):
     """A record's ``verified`` is true, false or null; anything else refuses the resume,
     a failed record's too (a failed record is otherwise not checked further)."""
-    problem, finished = weighted_run
+    problem, finished, _ = weighted_run
     out = shutil.copytree(finished, tmp_path / "out")
     store = out / "weighted_sum.jsonl"
     lines = [json.loads(x) for x in store.read_text().splitlines()]
@@ -232,3 +236,80 @@ def test_a_wrong_dimension_suggests_the_number_whole_below_1e15_and_as_a_float_f
     assert str(caught.value) == (
         f"f: {written!r} is a time, expected a length (write e.g. {suggested})"
     )
+
+
+# --- what a stored front holds ----------------------------------------------------------
+def _stored(out: Path, name: str) -> dict[str, dict]:
+    lines = (out / f"{name}.jsonl").read_text().splitlines()[1:]
+    return {r["id"]: r for r in map(json.loads, lines)}
+
+
+def test_a_weighted_sum_fronts_points_are_stored_as_weighted_sum_records(weighted_run):
+    _, out, _ = weighted_run
+    records = _stored(out, "weighted_sum")
+    points = [r for r in records.values() if r["id"].startswith("ws-")]
+    assert len(points) == 3
+    assert {r["kind"] for r in points} == {"weighted_sum"}
+    assert {r["kind"] for k, r in records.items() if k.startswith("anchor-")} == {
+        "anchor-multistart",
+        "anchor",
+    }
+
+
+def test_an_anchors_tie_break_minimises_its_second_objective_within_its_first(weighted_run):
+    """The anchor of backlash holds backlash at its optimum (plus the anchors' slack) and
+    then minimises size: no design the front found within that backlash is smaller."""
+    _, out, _ = weighted_run
+    records = _stored(out, "weighted_sum")
+    anchor, first = records["anchor-backlash"], records["anchor-backlash-ms"]
+    assert anchor["order"] == ["backlash", "size"]
+    # the bound, to the solver's feasibility tolerance
+    bound = (first["objectives"]["backlash"] * (1 + ANCHOR_SLACK) + 1e-12) * (1 + 1e-6)
+    assert anchor["objectives"]["backlash"] <= bound
+    within = [r for r in records.values() if r["objectives"]["backlash"] <= bound]
+    assert len(within) >= 3  # the first stage and a weighted point too
+    assert all(anchor["objectives"]["size"] <= r["objectives"]["size"] for r in within)
+
+
+def test_front_csv_lists_the_rejected_points_off_the_front(weighted_run, tmp_path):
+    """front.csv holds every point, the rejected ones (dominated, failed) marked off it."""
+    problem, _, front = weighted_run
+    front = copy.deepcopy(front)
+    front.rejected = [replace(front.points[0], id="r-0", rejected="dominated")]
+    path = write_front_csv(front, problem, tmp_path / "front.csv")
+    with path.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["id"] for r in rows] == [*(p.id for p in front.points), "r-0"]
+    assert [r["on_front"] for r in rows] == ["True"] * len(front.points) + ["False"]
+
+
+def test_an_epsilon_front_solves_the_limits_it_is_given(tmp_path):
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    method = EpsilonConstraint(eps_values=[0.05, 0.1, 0.15], starts=1)
+    front = od.pareto(problem, ["backlash", "size"], method=method, out=tmp_path)
+    records = _stored(tmp_path, "epsilon")
+    assert [records[f"epsilon-{i:04d}"]["eps"] for i in range(3)] == [
+        {"backlash": 0.05},
+        {"backlash": 0.1},
+        {"backlash": 0.15},
+    ]
+    # each limit is active at its point: backlash on it, to the solver's tolerance
+    got = sorted(p.objectives["backlash"] for p in front.points)
+    assert got == pytest.approx([0.05, 0.1, 0.15], rel=1e-6)
+
+
+def test_a_three_objective_grid_point_lies_at_its_fraction_between_the_row_head_and_b_max():
+    head = PointRecord(
+        id="row-head",
+        kind="eps",
+        status="optimal",
+        verified=True,
+        target="size",
+        objectives={"backlash": 1.0, "size": 2.0, "ripple": 0.1},
+    )
+    task = {"b_name": "size", "b_hi": 10.0, "frac": 0.25, "eps_row": {"backlash": 1.5}}
+    lo = 2.0 * (1 + ANCHOR_SLACK) + 1e-12
+    assert row_eps(task, head) == {"backlash": 1.5, "size": pytest.approx(lo + 0.25 * (10 - lo))}
+    # a failed head gives no lower end: the point sits at B_max
+    failed = replace(head, status="failed", verified=None)
+    assert row_eps(task, failed) == {"backlash": 1.5, "size": 10.0}
