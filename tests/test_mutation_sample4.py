@@ -36,7 +36,7 @@ from optdesign.studies.pareto import (
 )
 from optdesign.studies.pareto.catalogue_front import catalogue_task
 from optdesign.studies.pareto.io import write_front_csv
-from optdesign.studies.pareto.tasks import ANCHOR_SLACK, row_eps
+from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps, row_eps
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -94,6 +94,14 @@ def test_a_method_object_with_settings_beside_it_is_refused_naming_them():
     with pytest.raises(ProblemError, match=r"options \['starts'\] go into the method object"):
         compute_front(problem, ["backlash", "size"], 3, method, starts=2)
     assert make_method(problem, method, 7) is method
+
+
+def test_a_catalogue_front_of_three_objectives_is_refused_saying_it_takes_two():
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    with pytest.raises(InputError) as caught:
+        od.pareto(problem, ["backlash", "motor_torque", "size"], 3)
+    assert caught.value.field == "objectives"
+    assert str(caught.value) == "objectives: a catalogue front takes two objectives"
 
 
 # --- catalogue fronts: the shared memo ----------------------------------------------------
@@ -313,3 +321,25 @@ def test_a_three_objective_grid_point_lies_at_its_fraction_between_the_row_head_
     # a failed head gives no lower end: the point sits at B_max
     failed = replace(head, status="failed", verified=None)
     assert row_eps(task, failed) == {"backlash": 1.5, "size": 10.0}
+
+
+def test_an_arc_step_from_a_neighbour_without_a_slope_takes_the_frames_slope():
+    """The next limit of an arc-spaced sweep is a Newton step along the front's arc; a
+    neighbour whose multiplier gave no slope steps with the frame's mean slope rb / ra."""
+    frame = {"a0": 0.0, "b0": 1.0, "ra": 1.0, "rb": 2.0, "a_lo": 0.0, "a_hi": 1.0}
+    task = {"frame": frame, "eps_name": "a", "target": "b", "arc": 1.0, "fallback_eps": 0.9}
+    nb = PointRecord(
+        id="p",
+        kind="eps",
+        status="optimal",
+        verified=True,
+        target="b",
+        objectives={"a": 0.2, "b": 1.6},
+        eps={"a": 0.2},
+    )
+    # s1 = 0.2 / 1 + (1 - 1.6) / 2 = -0.1; slope 2 / 1 = 2; ds/da = 1 + 2 / 2 = 2
+    assert arc_eps(task, nb) == {"a": pytest.approx(0.2 + 1.1 / 2)}
+    # the neighbour's own slope -6: ds/da = 1 + 6 / 2 = 4
+    assert arc_eps(task, replace(nb, slope=-6.0)) == {"a": pytest.approx(0.2 + 1.1 / 4)}
+    # no neighbour's design: the task's fallback limit
+    assert arc_eps(task, None) == {"a": 0.9}
