@@ -343,3 +343,22 @@ def test_an_arc_step_from_a_neighbour_without_a_slope_takes_the_frames_slope():
     assert arc_eps(task, replace(nb, slope=-6.0)) == {"a": pytest.approx(0.2 + 1.1 / 4)}
     # no neighbour's design: the task's fallback limit
     assert arc_eps(task, None) == {"a": 0.9}
+
+
+def test_a_point_far_from_its_neighbours_design_is_retried_saying_so():
+    """An epsilon point whose design lies more than a fifth of the box from its warm
+    neighbour's is re-solved from cold starts, and its record says why."""
+    from optdesign.studies.pareto.tasks import front_task
+
+    problem = od.load(ROOT / "problems" / "fork_min_backlash.toml")
+    common = {"problem": problem, "objectives": ["backlash", "size"], "solver": "ipopt"}
+    first = {**common, "id": "p-0", "kind": "eps", "target": "backlash", "index": 0}
+    solo = front_task({**first, "eps": {"size": 1e9}}, {})
+    assert solo["retried"] == ""
+    # a neighbour no better (so not the "worse" retry) at the far corner of the box
+    neighbour = {**solo, "id": "p-1", "objectives": {**solo["objectives"]}}
+    neighbour["objectives"]["backlash"] *= 1.1
+    neighbour["eps"], neighbour["x"] = {"size": 5e8}, [float(v) for v in problem.lower()]
+    task = {**first, "eps": {"size": 1e9}, "warm": "p-1", "retry_starts": 1, "seed": 3}
+    rec = front_task(task, {"p-1": neighbour})
+    assert rec["retried"] == "jump in design space"
