@@ -53,7 +53,7 @@ from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
-from optdesign.studies.inherited_map import InheritedWorkers
+from optdesign.studies.inherited_map import InheritedWorkers, map_serial
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -163,12 +163,7 @@ class NodeSolver:
     def _starts(self, box: Bounds, points, stop: Callable[[list[Result]], bool]) -> list[Result]:
         items = [(box, np.asarray(p, dtype=float)) for p in points]
         if self._workers is None:
-            out: list[Result] = []
-            for item in items:
-                out.append(self._solve_start(item))
-                if stop(out):
-                    break
-            return out
+            return map_serial(self._solve_start, items, stop)
         return self._workers.map(items, stop)
 
     def solve(

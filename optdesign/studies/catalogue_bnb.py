@@ -229,13 +229,21 @@ def shared_memo(
     return _MEMOS[key]
 
 
+def item_distances(dvars, box: Box, res: Result) -> list[tuple[Any, float, float]]:
+    """(variable, nearest item within the box, relative distance to it) of each catalogue
+    variable at the node ``res`` over ``box``, in the declared order."""
+    out = []
+    for v in dvars:
+        item, dist = nearest_item(res.design[v.name], tuple(items_within(v.values, *box[v.name])))
+        out.append((v, item, dist))
+    return out
+
+
 def on_items(dvars, box: Box, res: Result) -> tuple[Any, dict[str, float]]:
     """The catalogue variable to branch on - the one farthest (relatively) from an item
     in its range, None when every one sits on an item - and the nearest items."""
     worst, worst_d, items = None, ON_ITEM_TOL, {}
-    for v in dvars:
-        allowed = tuple(items_within(v.values, *box[v.name]))
-        item, dist = nearest_item(res.design[v.name], allowed)
+    for v, item, dist in item_distances(dvars, box, res):
         items[v.name] = item
         if dist > worst_d:
             worst, worst_d = v, dist
@@ -458,12 +466,7 @@ class PseudoCosts:
         own choice, None at a leaf) unless every variable off its items has a history."""
         if worst is None:
             return None
-        off = [
-            v
-            for v in dvars
-            if nearest_item(res.design[v.name], tuple(items_within(v.values, *box[v.name])))[1]
-            > ON_ITEM_TOL
-        ]
+        off = [v for v, _, dist in item_distances(dvars, box, res) if dist > ON_ITEM_TOL]
         if len(off) < 2 or not all(v.name in self.scores for v in off):
             return worst
         # the first of equal pseudo-costs, in the declared order (max keeps the first)

@@ -27,7 +27,10 @@ def _call_inherited(key: int, item: Any) -> Any:
     return _INHERITED[key](item)
 
 
-def _serial(fn, items, stop) -> list[Any]:
+def map_serial(
+    fn: Callable[[Any], Any], items: list[Any], stop: Callable[[list[Any]], bool] | None = None
+) -> list[Any]:
+    """The serial answer itself: ``fn`` over ``items`` here, in order, up to ``stop``."""
     out: list[Any] = []
     for item in items:
         out.append(fn(item))
@@ -71,7 +74,7 @@ def map_inherited(
     still running are stopped. Off Linux (no fork) it runs here.
     """
     if workers <= 1 or not forks_workers() or len(items) <= 1:
-        return _serial(fn, items, stop)
+        return map_serial(fn, items, stop)
     key = id(fn)
     _INHERITED[key] = fn
     try:
@@ -107,7 +110,7 @@ class InheritedWorkers:
     def map(self, items: list[Any], stop: Callable[[list[Any]], bool] | None = None) -> list[Any]:
         """The serial answer of ``fn`` over ``items`` (see :func:`map_inherited`)."""
         if self.pool is None or len(items) <= 1:
-            return _serial(self.fn, items, stop)
+            return map_serial(self.fn, items, stop)
         out = _prefix_map(self.pool, self.key, items, stop)
         while self.pool.busy:  # the items past the answer: finished, and dropped
             self.pool.wait()
