@@ -95,6 +95,20 @@ def test_efficiency_from_the_lead_reaches_motor_torque():
     assert T1 == pytest.approx(T * eta * 0.95, rel=1e-7)
 
 
+@pytest.mark.parametrize(("kind", "mu"), [("ball", 0.003), ("trapezoidal", 0.1)])
+def test_a_screw_without_friction_takes_its_kinds_documented_default(kind, mu):
+    """docs/drive.md: no ``friction`` means 0.003 for a ball screw, 0.1 for a sliding one."""
+    plain = problem_from_dict(_data({"kind": kind}, {"d0": "20 mm"}))
+    given = problem_from_dict(_data({"kind": kind, "friction": mu}, {"d0": "20 mm"}))
+    eta = float(_quantities(plain, **DESIGN).efficiency)
+    assert eta == pytest.approx(float(_quantities(given, **DESIGN).efficiency), rel=1e-12)
+    if kind == "ball":  # the lead-angle formula by hand, p = 5, d_m = 20
+        lam = math.atan(5.0 / (math.pi * 20.0))
+        assert eta == pytest.approx(math.tan(lam) / math.tan(lam + math.atan(mu)), rel=1e-12)
+    else:  # a sliding screw at mu 0.1 is far below a ball screw
+        assert eta < 0.5
+
+
 def _self_locking_lead(d_m: float, mu: float) -> float:
     """Largest lead of a self-locking Tr thread (alpha = 15 deg): lam = phi', where
     tan(phi') = mu / cos(alpha_n) and tan(alpha_n) = tan(alpha) cos(lam)."""

@@ -101,6 +101,25 @@ def test_tracer_merges_like_terms_into_a_monomial():
     }
 
 
+def test_integer_powers_of_a_sum_of_terms_are_expanded_from_the_first():
+    """(R + 1)^1 is R + 1 and (R + 1)^3 its expansion; a fractional power of a sum is no
+    posynomial and says so."""
+    names = ("R", "d")
+    R = Signomial.variable(names, 0, np.array([90.0, 10.0]))
+    first = (R + 1.0) ** 1
+    assert isinstance(first, Signomial)
+    assert {k: float(v) for k, v in first.terms.items()} == {(1.0, 0.0): 1.0, (0.0, 0.0): 1.0}
+    cube = (R + 1.0) ** 3
+    assert {k: float(v) for k, v in cube.terms.items()} == {
+        (3.0, 0.0): 1.0,
+        (2.0, 0.0): 3.0,
+        (1.0, 0.0): 3.0,
+        (0.0, 0.0): 1.0,
+    }
+    half = (R + 1.0) ** 0.5
+    assert isinstance(half, NotGP) and "not a posynomial" in half.reason
+
+
 def test_an_objective_the_model_does_not_give_is_named_in_the_gp_diagnosis():
     fork = load_problem(ROOT / "problems" / "fork_min_backlash.toml")
     checks = [c for c in build_gp(fork, "no_such").checks if c.what == "objective"]

@@ -5,11 +5,17 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.robust import Samples, draw_samples, sampled_objective
+from optdesign.formulations.robust import (
+    Samples,
+    build_robust_nlp,
+    draw_samples,
+    sampled_objective,
+)
 from optdesign.problem.load import problem_from_dict
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.robust import (
@@ -176,3 +182,16 @@ def test_requirements_held_at_every_sample_cost_something_and_hold():
     assert free.status == held.status == "optimal" and held.verified
     assert held.objective >= free.objective * (1 - 1e-9)
     assert held.details.robust.constrain_samples and not free.details.robust.constrain_samples
+
+
+def test_a_robust_nlp_offers_the_nominal_objective_as_its_second_target(problem):
+    """The robust formulation's targets: the risk measure and the nominal objective, which
+    at a design equals the NumPy path's value there (and names the NLP's fingerprint)."""
+    nlp = build_robust_nlp(problem, samples=draw_samples(problem, 4, seed=0))
+    assert nlp.targets == ["CVaR_0.9(backlash)", "backlash (nominal)"]
+    assert len(nlp.fingerprint) == 16
+    value = ca.Function("nominal", [nlp.z, nlp.p], [nlp.objective_values["backlash (nominal)"]])
+    z = nlp.z_from_x(X_NOMINAL)
+    nominal = float(value(z, nlp.params(nlp.target("backlash (nominal)"))))
+    assert nominal == pytest.approx(problem.evaluate(X_NOMINAL).objectives["backlash"], rel=1e-9)
+    assert nominal == pytest.approx(0.0362197, rel=1e-5)

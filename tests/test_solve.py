@@ -321,3 +321,17 @@ def test_sqpmethod_solves_quietly_and_takes_the_users_options(capfd):
         options={"print_iteration": True},
     )
     assert "iter" in capfd.readouterr().out
+
+
+def test_a_starts_auxiliary_variables_are_set_with_the_solves_parameters():
+    """A catalogue node solves with its items' values (parameters): the start's epigraph
+    variable (the largest backlash) is the tightest for those values, not the defaults."""
+    problem = load_problem(PROBLEMS / "fin_actuator.toml")
+    nlp = build_nlp(problem)
+    assert nlp.aux_names == ["backlash_max"]
+    x = 0.5 * (problem.lower() + problem.upper())
+    half = 0.5 * np.asarray(nlp.param_defaults, dtype=float)
+    z0 = nlp.start(x, parameters=half).z0
+    assert z0 == pytest.approx(nlp.z_from_x(x, half), rel=1e-12)
+    # the fit ratios and screw values change the backlash: the defaults give another start
+    assert abs(z0[-1] - nlp.z_from_x(x)[-1]) > 1e-3
