@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 import re
 from pathlib import Path
 
@@ -207,6 +208,29 @@ def test_fixed_linkage_crank_slider_is_a_gp():
     assert r.status == "optimal"
     assert abs(r.details.gp.gap_gp_nlp_rel) < 1e-3
     assert r.certificate.gap_rel < 1e-6
+
+
+def test_a_block_without_bounds_is_skipped_and_the_blocks_after_it_still_count(monkeypatch):
+    """A plug-in may state rows with no bound (shown, not required): the GP leaves that
+    block out and still builds every bounded block after it."""
+    problem = problem_from_dict(copy.deepcopy(CS_FIXED))
+    plain = build_gp(problem)
+    traced = problem.expressions
+
+    def with_a_free_block_first(design, **kwargs):
+        ex = traced(design, **kwargs)
+        first = ex.constraints[0]
+        free = dataclasses.replace(first, name="shown_only", lower=None, upper=None)
+        ex.constraints = [free, *ex.constraints]
+        return ex
+
+    monkeypatch.setattr(problem, "expressions", with_a_free_block_first)
+    gp = build_gp(problem)
+    assert gp.is_gp, gp.explain()
+    names = [c.name for c in gp.checks if c.what == "constraint"]
+    assert "shown_only" not in names
+    assert names == [c.name for c in plain.checks if c.what == "constraint"] and len(names) > 2
+    assert len(gp.rows) == len(plain.rows)
 
 
 def test_a_constraint_the_tracer_cannot_represent_carries_its_reason_and_term():

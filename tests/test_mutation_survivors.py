@@ -261,6 +261,20 @@ def test_the_catalogue_formulation_takes_the_callers_settings():
     assert "relaxation has no feasible design" in starved.message
 
 
+def test_a_catalogue_result_keeps_the_callers_seed_and_objective_even_when_infeasible():
+    """The seed of a node's multistart is the caller's (the report prints it), and a
+    search that finds nothing still names the objective it was asked for."""
+    problem = _catalogue((5, 6), (5, 6, 8))
+    assert problem.objective_names[0] == "backlash"
+    seeded = od.solve(problem, "catalogue", objective="ripple", starts=2, seed=7, ranges=False)
+    assert seeded.multistart.seed == 7 and seeded.objective_name == "ripple"
+    starved = od.solve(
+        problem, "catalogue", objective="ripple", options={"max_iter": 1}, ranges=False,
+        diagnose=False,
+    )  # fmt: skip
+    assert starved.status == "infeasible" and starved.objective_name == "ripple"
+
+
 def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5):
     """The diagnosis's depth-first search (reached only when no item combination near the
     relaxation works, so no other fast test calls it): a leaf on the catalogue whose
