@@ -228,8 +228,14 @@ def test_the_schema_follows_the_mechanism():
         od.load(data)
     data = _fork_data()
     data["mechanism"] = "crank_slider_typo"
-    with pytest.raises(ProblemError, match=r"unknown mechanism .*registered: .*pivoting_screw"):
+    with pytest.raises(
+        ProblemError, match=r"unknown mechanism .*registered: .*pivoting_screw"
+    ) as e:
         od.load(data)
+    from optdesign.mechanisms.registry import registered
+
+    assert f"(registered: {', '.join(registered())})" in str(e.value)  # one name after another
+    assert {"crank_slider", "fork", "pivoting_screw"} <= set(registered())
     data = _fork_data()
     data["variables"]["l"] = "80 mm"
     with pytest.raises(ProblemError, match=r"variables\.l: unknown variable for a shifting fork"):
