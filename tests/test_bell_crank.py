@@ -12,6 +12,7 @@ import math
 import runpy
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -111,6 +112,12 @@ def test_positions_and_ratio_against_root_finding_and_finite_differences():
         assert float(mech.ratio(np.array([phi]))[0]) == pytest.approx(ratio, rel=1e-8)
     # the neutral layout: dx/dphi = R r1 / r2 (rod, crank arms and pushrod at right angles)
     assert hand(0.0)[0] == pytest.approx(60.0 * 40.0 / 50.0, rel=1e-9)
+    # the angle as a CasADi symbol: one expression in phi, equal at every angle
+    phi_s = ca.SX.sym("phi")
+    ratio_of = ca.Function("ratio", [phi_s], [mech.ratio(phi_s)])
+    for phi in PHIS:
+        expected = 2 * math.pi * DESIGN["i_a"] * hand(phi)[0] / DESIGN["p"]
+        assert float(ratio_of(phi)) == pytest.approx(expected, rel=1e-8)
 
 
 def test_loads_and_sensitivities_against_statics_and_perturbed_rods():

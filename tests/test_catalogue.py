@@ -253,3 +253,17 @@ def test_a_pruned_box_with_a_trusted_value_is_a_proof_under_a_lower_limit():
     _bound_proof(ns, {"a": (1.0, 1.0)}, result(1))  # a warm start's value alone
     _bound_proof(SimpleNamespace(memo=None, starts=4, eps={}, objective="f"), {}, result(4))
     assert len(memo.proofs) == 1
+
+
+def test_the_shared_memos_keep_the_newest_searches_and_evict_the_oldest(monkeypatch):
+    """A process keeps the infeasible-box memos of its last eight catalogue searches: a
+    ninth search evicts the oldest one (never fails), a known search gets its own back."""
+    from optdesign.studies import catalogue_bnb
+
+    monkeypatch.setattr(catalogue_bnb, "_MEMOS", {})
+    full = {"p": (5.0, 8.0)}
+    memos = [catalogue_bnb.shared_memo(("search", k), full) for k in range(10)]
+    assert list(catalogue_bnb._MEMOS) == [("search", k) for k in range(2, 10)]
+    assert catalogue_bnb.shared_memo(("search", 9), full) is memos[9]
+    assert catalogue_bnb.shared_memo(("search", 0), full) is not memos[0]  # evicted: a new one
+    assert ("search", 2) not in catalogue_bnb._MEMOS

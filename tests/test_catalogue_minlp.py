@@ -10,7 +10,8 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError, ProblemError
-from optdesign.formulations.catalogue_minlp import item_groups
+from optdesign.formulations.catalogue_minlp import build_catalogue_minlp, item_groups
+from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import problem_from_dict
 from optdesign.solvers.registry import solver_hints
 from optdesign.studies.catalogue import NodeSolver, solve_catalogue
@@ -211,3 +212,20 @@ def test_a_bonmin_opt_in_the_working_directory_is_refused_before_any_work(
     # the default back-end is not concerned by the file
     opt.unlink()
     assert solver_hints("ipopt").preflight is None
+
+
+def test_a_minlp_start_puts_each_groups_one_binary_on_the_nearest_item():
+    """Bonmin's start: the NLP's scaled design, then per catalogue group binaries of 0
+    and 1 with the 1 on the item nearest the design (relative distance)."""
+    problem = _small()
+    nlp = build_nlp(problem)
+    minlp = build_catalogue_minlp(problem, nlp, nlp.target("backlash"))
+    x = problem.start()
+    names = list(nlp.design_names)
+    cases = [(5.2, 7.5, [1, 0, 0, 0, 1], (5.0, 8.0)), (5.5, 6.5, [0, 1, 0, 1, 0], (6.0, 6.0))]
+    for p, d, binaries, (lead, pin) in cases:
+        x[names.index("p")], x[names.index("d")] = p, d
+        start = minlp.start(x)
+        assert start[: minlp.n_z] == pytest.approx(nlp.z_from_x(x), rel=1e-12)
+        assert start[minlp.n_z :].tolist() == binaries
+        assert minlp.items(start) == {"p": lead, "d": pin}

@@ -443,9 +443,10 @@ def test_screw_requirements_without_a_screw_are_refused(field, value):
     from optdesign.errors import ProblemError
 
     data = _data(None, None, **{field: value, "deflection_rate": "60 deg/s"})
-    with pytest.raises(ProblemError, match=rf"requirements\.{field}: needs a \[screw\]"):
+    with pytest.raises(ProblemError, match=rf"requirements\.{field}: needs a \[screw\]") as e:
         problem = problem_from_dict(data)
         problem.evaluate(np.array([80.0, 120.0, 60.0, 5.0, 0.1]))
+    assert str(e.value).endswith("needs a [screw] section (its size, catalogue and mounting)")
 
 
 def test_screw_side_compliance_by_hand(fin):

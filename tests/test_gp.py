@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.gp import NotGP, Signomial, build_gp, is_gp
+from optdesign.formulations.gp import NotGP, Signomial, build_gp, is_gp, to_cvxpy
 from optdesign.models.fit_formulas import fit_clearance
 from optdesign.problem import load_problem, problem_from_dict
 from optdesign.studies.gp import require_gp, solve_gp_problem
@@ -231,6 +231,29 @@ def test_a_block_without_bounds_is_skipped_and_the_blocks_after_it_still_count(m
     assert "shown_only" not in names
     assert names == [c.name for c in plain.checks if c.what == "constraint"] and len(names) > 2
     assert len(gp.rows) == len(plain.rows)
+
+
+def test_the_cvxpy_gps_bound_rows_read_as_x_over_upper_and_lower_over_x():
+    """to_cvxpy lists each variable's bounds beside the constraints as GP rows
+    c exp(A log x) <= 1: x / upper and lower / x, equal to 1 on the bound."""
+    gp = build_gp(problem_from_dict(copy.deepcopy(CS_FIXED)))
+    _, xs, _, cons = to_cvxpy(gp)
+    rows = {(r.name, r.kind): r for r, _ in cons if r.name.startswith("bound:")}
+    assert len(rows) == 2 * len(gp.names) == 2 * len(xs)
+    lo, hi = np.asarray(gp.lower, dtype=float), np.asarray(gp.upper, dtype=float)
+    mid = np.sqrt(lo * hi)
+
+    def value(row, x):
+        return float(row.c @ np.exp(row.A @ np.log(x)))
+
+    for k, name in enumerate(gp.names):
+        up, down = rows[(f"bound:{name}", "upper")], rows[(f"bound:{name}", "lower")]
+        at_upper, at_lower = mid.copy(), mid.copy()
+        at_upper[k], at_lower[k] = hi[k], lo[k]
+        assert value(up, at_upper) == pytest.approx(1.0, rel=1e-12)
+        assert value(down, at_lower) == pytest.approx(1.0, rel=1e-12)
+        assert value(up, mid) == pytest.approx(mid[k] / hi[k], rel=1e-12)
+        assert value(down, mid) == pytest.approx(lo[k] / mid[k], rel=1e-12)
 
 
 def test_a_constraint_the_tracer_cannot_represent_carries_its_reason_and_term():

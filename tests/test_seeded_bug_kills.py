@@ -142,6 +142,24 @@ def test_relaxation_need_is_the_worst_point_of_the_row():
     assert _need(np.array([3.0, 4.0]), lower, hi_side=False) == 0.0
 
 
+def test_a_relaxation_site_starts_from_the_design_clipped_into_its_box_only():
+    """At a site (catalogue items held in a sub-box) the solves start from the given
+    design with the held variables clipped into the box and the others unchanged."""
+    from optdesign.formulations.nlp import build_nlp
+    from optdesign.studies.relaxation import Site, _Prepared
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    nlp = build_nlp(problem)
+    names = [v.name for v in problem.free]
+    x = 0.5 * (problem.lower() + problem.upper())
+    held = (problem.upper()[names.index("R")] - 1.0, problem.upper()[names.index("R")])
+    site = _Prepared(problem, nlp, Site(box={"R": held}, x_start=x))
+    start = nlp.x_from_z(site.starts[-1].z0)
+    expected = x.copy()
+    expected[names.index("R")] = held[0]
+    np.testing.assert_allclose(start, expected, rtol=1e-12)
+
+
 # --- branch and bound: what may be pruned --------------------------------------------------
 def test_prune_tolerance_is_relative_one_in_a_million():
     from optdesign.studies.catalogue import PRUNE_TOL, cannot_improve
