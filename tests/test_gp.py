@@ -237,9 +237,10 @@ def test_the_cvxpy_gps_bound_rows_read_as_x_over_upper_and_lower_over_x():
     """to_cvxpy lists each variable's bounds beside the constraints as GP rows
     c exp(A log x) <= 1: x / upper and lower / x, equal to 1 on the bound."""
     gp = build_gp(problem_from_dict(copy.deepcopy(CS_FIXED)))
-    _, xs, _, cons = to_cvxpy(gp)
+    _, xs, t, cons = to_cvxpy(gp)
     rows = {(r.name, r.kind): r for r, _ in cons if r.name.startswith("bound:")}
     assert len(rows) == 2 * len(gp.names) == 2 * len(xs)
+    assert [x.name() for x in xs] == list(gp.names) and t.name() == "t"  # as cvxpy prints
     lo, hi = np.asarray(gp.lower, dtype=float), np.asarray(gp.upper, dtype=float)
     mid = np.sqrt(lo * hi)
 

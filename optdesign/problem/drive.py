@@ -145,7 +145,10 @@ def fit_values(problem) -> str:
 
 
 def parameter_defaults(problem) -> dict[str, float]:
-    """The problem's parameters and their defaults (at the middle of the catalogues)."""
+    """The problem's parameters and their defaults: a fit ratio of 1 (the smooth
+    formula's clearance) or the fit's favourable table clearance; the screw's values are
+    placeholders (1), which every catalogue solve replaces by its items' values
+    (:func:`parameter_values`)."""
     out: dict[str, float] = {}
     if "d" in problem.by_name and fit_values(problem) == "table":
         d = problem.by_name["d"]
