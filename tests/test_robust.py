@@ -9,7 +9,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from optdesign.errors import ProblemError
+from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.robust import (
     Samples,
     build_robust_nlp,
@@ -195,3 +195,20 @@ def test_a_robust_nlp_offers_the_nominal_objective_as_its_second_target(problem)
     nominal = float(value(z, nlp.params(nlp.target("backlash (nominal)"))))
     assert nominal == pytest.approx(problem.evaluate(X_NOMINAL).objectives["backlash"], rel=1e-9)
     assert nominal == pytest.approx(0.0362197, rel=1e-5)
+
+
+def test_sampled_fit_draws_one_per_pin_and_a_wrong_count_is_refused(problem):
+    """Robust design draws one fit fraction per sized pin (0: the fit's least clearance,
+    1: its largest); a count that differs from the chain's pins is refused, saying both."""
+    design = problem.design_dict(X_NOMINAL)
+    n_pins = sum(j.pin is not None for j in problem.quantities(design).joints)
+    assert n_pins == 2
+
+    def worst(u):
+        q = problem.quantities(design, fit_fractions=[u] * n_pins)
+        return float(np.max(q.backlash.worst_case))
+
+    assert worst(0.0) < worst(0.5) < worst(1.0)
+    assert worst(0.5) == pytest.approx(0.5 * (worst(0.0) + worst(1.0)), rel=0.05)
+    with pytest.raises(InputError, match=r"^tolerances\.fit: 3 fit draws for 2 pin joints$"):
+        problem.quantities(design, fit_fractions=[0.5] * 3).joints  # noqa: B018
