@@ -229,3 +229,21 @@ def test_a_minlp_start_puts_each_groups_one_binary_on_the_nearest_item():
         assert start[: minlp.n_z] == pytest.approx(nlp.z_from_x(x), rel=1e-12)
         assert start[minlp.n_z :].tolist() == binaries
         assert minlp.items(start) == {"p": lead, "d": pin}
+
+
+def test_a_nodes_first_start_is_the_hint_clipped_into_the_nodes_box(monkeypatch):
+    """The hint (the parent's optimum) may lie outside a child's box on either side: the
+    node's first start is it clipped into the box, whatever the back-end does with bounds."""
+    problem = _small()
+    solver = NodeSolver(problem, starts=1)
+    names = [v.name for v in problem.free]
+    seen = []
+    real = solver._solve_start
+    monkeypatch.setattr(solver, "_solve_start", lambda item: seen.append(item[1]) or real(item))
+    hint = problem.start()
+    hint[names.index("p")], hint[names.index("d")] = 8.0, 4.0  # above p's box, below d's
+    solver.solve({"p": (5.0, 6.0), "d": (6.0, 8.0)}, x_hint=hint)
+    first = seen[0]
+    assert (first[names.index("p")], first[names.index("d")]) == (6.0, 6.0)
+    others = [k for k, n in enumerate(names) if n not in ("p", "d")]
+    assert first[others].tolist() == hint[others].tolist()
