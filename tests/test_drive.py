@@ -513,5 +513,11 @@ def test_efficiency_min_requirement():
     eta = math.tan(lam) / math.tan(lam + math.atan(0.1 / math.cos(alpha_n)))
     assert float(np.ravel(block.values)[0]) == pytest.approx(eta * 0.9, rel=1e-9)
     assert block.lower == 0.5 and block.upper is None
+    # a plain number, described as the reports show it
+    x = np.array([DESIGN[v.name] for v in problem.free])
+    (stated,) = [
+        b for b in problem.expressions(problem.design_dict(x)).constraints if b.name == "efficiency"
+    ]
+    assert (stated.unit, stated.description) == ("", "forward efficiency of screw and gear")
     # 0.9 x 0.431 = 0.388 < 0.5: the design violates the requirement by that much
     assert ev.violation >= 0.5 - eta * 0.9 - 1e-12
