@@ -257,6 +257,21 @@ def test_the_cvxpy_gps_bound_rows_read_as_x_over_upper_and_lower_over_x():
         assert value(down, mid) == pytest.approx(lo[k] / mid[k], rel=1e-12)
 
 
+def test_a_ripple_limit_that_depends_on_the_design_is_named_as_no_gp():
+    """With a free arm the ratio's spread varies with the design: a ripple limit is then
+    a ratio of a difference of posynomials, and the check names the ripple as the term."""
+    data = copy.deepcopy(CS_FIXED)
+    data["variables"]["R"] = {"lower": 75, "upper": 105}
+    data["requirements"]["ripple_max"] = 0.2
+    gp = build_gp(problem_from_dict(data))
+    (check,) = [c for c in gp.checks if c.name == "ripple_max"]
+    assert (check.what, check.ok, check.term) == ("constraint", False, "ripple")
+    assert check.reason == (
+        "ripple = (max - min)/(max + min) over the grid is a ratio of a difference of posynomials"
+    )
+    assert not gp.is_gp
+
+
 def test_a_constraint_the_tracer_cannot_represent_carries_its_reason_and_term():
     """The crank-slider's rows go through cos(phi0 - a): each such constraint's check
     says why it is not a GP and names that sub-term."""

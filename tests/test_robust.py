@@ -212,3 +212,21 @@ def test_sampled_fit_draws_one_per_pin_and_a_wrong_count_is_refused(problem):
     assert worst(0.5) == pytest.approx(0.5 * (worst(0.0) + worst(1.0)), rel=0.05)
     with pytest.raises(InputError, match=r"^tolerances\.fit: 3 fit draws for 2 pin joints$"):
         problem.quantities(design, fit_fractions=[0.5] * 3).joints  # noqa: B018
+
+
+def test_the_robust_nlp_is_finite_everywhere_inside_the_bounds(problem):
+    """Ipopt may step to any design in the box: the sampled linkages are guarded like
+    the nominal one, so the objective, the rows and their derivatives stay finite
+    (at designs where a sampled linkage cannot assemble, too)."""
+    nlp = build_robust_nlp(problem, samples=draw_samples(problem, 4, seed=0))
+    fg = ca.Function(
+        "fg",
+        [nlp.z, nlp.p],
+        [nlp.f, nlp.g, ca.gradient(nlp.f, nlp.z), ca.jacobian(nlp.g, nlp.z)],
+    )
+    weights = nlp.params(nlp.target())
+    rng = np.random.default_rng(0)
+    for zd in rng.random((200, nlp.n_design)):
+        z = nlp.z_from_x(nlp.x_from_z(np.concatenate([zd, np.zeros(len(nlp.aux_names))])))
+        for out in fg(z, weights):
+            assert np.all(np.isfinite(np.asarray(out.full()))), nlp.x_from_z(z)
