@@ -1,0 +1,855 @@
+"""The GP builder's and the signomial tracer's observable behaviour, pinned case by case.
+
+Issue 21 (mutation deliverable): every value, name and message that
+:mod:`optdesign.formulations.gp` and :mod:`optdesign.formulations.signomial` produce -
+the tracer's terms and texts, each branch of a row's classification, the pruning, the
+diagnosis, the cvxpy problem - against hand computations or the NumPy model.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from optdesign.formulations import gp as gpmod
+from optdesign.formulations.gp import (
+    DGPCheck,
+    GPData,
+    GPRow,
+    _as_row,
+    _classify_block,
+    _constant_spread,
+    _cvxpy_flag,
+    _fmt_row,
+    _prune,
+    _rows_of,
+    build_gp,
+    is_gp,
+    to_cvxpy,
+)
+from optdesign.formulations.signomial import NotGP, Signomial
+from optdesign.problem import load_problem, problem_from_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+FORK = ROOT / "problems" / "fork_min_backlash.toml"
+NAMES = ("R", "d")
+REF = np.array([2.0, 3.0])
+
+
+def _vars():
+    return Signomial.variable(NAMES, 0, REF), Signomial.variable(NAMES, 1, REF)
+
+
+def _terms(s) -> dict:
+    """The terms of a signomial as plain floats (lists for grid coefficients)."""
+    return {k: np.asarray(v, dtype=float).tolist() for k, v in s.terms.items()}
+
+
+def _sig(terms: dict) -> Signomial:
+    return Signomial(NAMES, terms, REF)
+
+
+# --------------------------------------------------------------------------------------
+# Signomial: construction, values, text
+# --------------------------------------------------------------------------------------
+def test_a_variable_is_one_unit_term_at_its_position():
+    """variable(names, k) is x_k (exponent 1 at k, coefficient 1), valued at the reference."""
+    R, d = _vars()
+    assert _terms(d) == {(0.0, 1.0): 1.0} and _terms(R) == {(1.0, 0.0): 1.0}
+    assert d.names == NAMES and d.ref is REF
+    assert (float(R), float(d)) == (2.0, 3.0)
+    assert not R.is_constant and R.shape == ()
+
+
+def test_zero_coefficients_and_cancelled_terms_are_dropped():
+    """A term zero everywhere on the grid is no term; like terms that cancel vanish."""
+    s = _sig({(1.0, 0.0): 0.0, (0.0, 1.0): np.zeros(3), (0.0, 0.0): np.array([0.0, 1.0])})
+    assert _terms(s) == {(0.0, 0.0): [0.0, 1.0]}
+    # exponents equal to 12 digits are one term: 2 R - 2 R^(1 + 1e-13) is nothing
+    gone = _sig({(1.0, 0.0): 2.0, (1.0 + 1e-13, 0.0): -2.0})
+    assert gone.terms == {} and gone.is_constant and gone.constant_value() == 0.0
+    R, _ = _vars()
+    assert (R - R).terms == {} and (R - R).describe() == "0"
+    # three terms merging into one key keep the sum of all three
+    three = _sig({(0.5, 0.0): 1.0, (0.5 + 1e-14, 0.0): 2.0, (0.5 - 1e-14, 0.0): 4.0})
+    assert _terms(three) == {(0.5, 0.0): 7.0}
+
+
+def test_evaluate_sums_the_monomials_and_float_is_the_grid_maximum_at_the_reference():
+    """2 R^2 / d + 3 at (2, 3) is 8/3 + 3; float() of a grid value is its largest entry."""
+    R, d = _vars()
+    s = 2.0 * R**2 / d + 3.0
+    assert s.evaluate(np.array([2.0, 3.0])) == pytest.approx(8.0 / 3.0 + 3.0, rel=1e-15)
+    assert s.evaluate(np.array([1.0, 4.0])) == pytest.approx(0.5 + 3.0, rel=1e-15)
+    grid = R * np.array([1.0, 3.0, 2.0]) + d
+    assert np.asarray(grid.evaluate(np.array([2.0, 3.0]))).tolist() == [5.0, 9.0, 7.0]
+    assert float(grid) == 9.0  # at REF (2, 3): the largest of 5, 9, 7
+    assert (R - R).evaluate(np.array([2.0, 3.0])) == 0.0
+
+
+def test_shape_constancy_and_constant_value():
+    """The shape broadcasts the coefficients; a constant's value is its zero-exponent term."""
+    R, _ = _vars()
+    assert (R * np.ones(3) + np.ones((2, 1))).shape == (2, 3)
+    c = R - R + np.array([1.0, 2.0])
+    assert c.is_constant and np.asarray(c.constant_value()).tolist() == [1.0, 2.0]
+    assert (R + 1.0).is_constant is False
+
+
+def test_describe_writes_terms_as_the_reports_show_them():
+    """Coefficients to 4 significant digits, unit ones left out, signs between terms."""
+    assert _sig({(1.0, 0.0): 0.8660254, (0.0, 0.0): -50.0}).describe() == "0.866*R - 50"
+    assert _sig({(1.0, 0.0): 0.8660254, (0.0, 0.0): -50.0}).describe(digits=2) == "0.87*R - 50"
+    assert _sig({(1.0, 0.0): -2.0, (0.0, 1.0): 1.0}).describe() == "-2*R + d"
+    assert _sig({(1.0, 0.0): -1.0}).describe() == "-R"
+    assert _sig({(2.0, -1.0): 1.0}).describe() == "R^2*d^-1"
+    assert _sig({(0.5, 0.0): 3.0}).describe() == "3*R^0.5"
+    assert _sig({(1.0 / 3.0, 0.0): 1.0}).describe() == "R^0.3333"
+    assert _sig({(0.0, 0.0): 1.0}).describe() == "1"
+    assert _sig({(0.0, 0.0): -1.0}).describe() == "-1"
+    assert _sig({(1.0, 0.0): 12345.678}).describe() == "1.235e+04*R"
+    assert _sig({(1.0, 1.0): 2.0, (0.0, 0.0): 0.25}).describe() == "2*R*d + 0.25"
+
+
+def test_describe_reads_the_coefficients_of_the_grid_row_asked():
+    """describe(row) takes each grid coefficient at that row (the last past the end) and
+    leaves out the terms that are zero there."""
+    s = _sig({(1.0, 0.0): np.array([1.0, 2.0, 3.0])})
+    assert [s.describe(r) for r in (None, 0, 1, 2, 7)] == ["R", "R", "2*R", "3*R", "3*R"]
+    part = _sig({(1.0, 0.0): np.array([0.0, 2.0]), (0.0, 0.0): 1.0})
+    assert (part.describe(0), part.describe(1)) == ("1", "2*R + 1")
+
+
+def test_a_grid_row_where_every_term_is_zero_reads_0():
+    """Every coefficient zero at the row asked: "0" (it read "-")."""
+    assert _sig({(1.0, 0.0): np.array([0.0, 2.0])}).describe(0) == "0"
+    assert (
+        _sig({(1.0, 0.0): np.array([0.0, 2.0]), (0.0, 0.0): np.array([0.0, 1.0])}).describe() == "0"
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Signomial: arithmetic
+# --------------------------------------------------------------------------------------
+def test_sums_differences_and_negation_give_the_exact_terms():
+    """+, - and unary - on signomials and numbers, on either side."""
+    R, d = _vars()
+    assert _terms(5.0 - R) == {(0.0, 0.0): 5.0, (1.0, 0.0): -1.0}
+    assert _terms(R - 5) == {(1.0, 0.0): 1.0, (0.0, 0.0): -5.0}
+    assert _terms(2 + R) == {(1.0, 0.0): 1.0, (0.0, 0.0): 2.0}
+    assert _terms(R - d) == {(1.0, 0.0): 1.0, (0.0, 1.0): -1.0}
+    assert _terms(-(2.0 * R + 1.0)) == {(1.0, 0.0): -2.0, (0.0, 0.0): -1.0}
+    assert +R is R
+    assert _terms(R + np.float64(2.0)) == {(1.0, 0.0): 1.0, (0.0, 0.0): 2.0}
+    assert isinstance((R + np.int64(2)).terms[(0.0, 0.0)], float)
+    assert isinstance((R + np.array(2.0)).terms[(0.0, 0.0)], float)
+    grid = R + np.array([1, 2])  # an integer array becomes a float coefficient
+    assert grid.terms[(0.0, 0.0)].dtype == np.float64
+    assert _terms(grid) == {(1.0, 0.0): 1.0, (0.0, 0.0): [1.0, 2.0]}
+
+
+def test_products_and_quotients_give_the_exact_terms():
+    """Products merge like terms; a quotient by a monomial inverts it."""
+    R, d = _vars()
+    assert _terms(R / 2) == {(1.0, 0.0): 0.5}
+    assert _terms(6.0 / R) == {(-1.0, 0.0): 6.0}
+    assert _terms(R / d) == {(1.0, -1.0): 1.0}
+    assert _terms((R * d) / (2.0 * R)) == {(0.0, 1.0): 0.5}
+    assert _terms((R + d) * (R - d)) == {(2.0, 0.0): 1.0, (0.0, 2.0): -1.0}
+    assert _terms(3 * R * d) == {(1.0, 1.0): 3.0}
+    assert _terms(R / (R * np.array([0.5, 4.0]))) == {(0.0, 0.0): [2.0, 0.25]}
+
+
+def test_anything_but_numbers_and_tracers_is_refused_by_the_operators():
+    """A string or None in an expression is Python's TypeError, not a silent term."""
+    R, _ = _vars()
+    for op in (
+        lambda: R + "x",
+        lambda: "x" + R,
+        lambda: R - "x",
+        lambda: "x" - R,
+        lambda: R * None,
+        lambda: None * R,
+        lambda: R / "x",
+        lambda: "x" / R,
+    ):
+        with pytest.raises(TypeError):
+            op()
+
+
+def test_division_by_a_sum_of_terms_is_not_a_gp_and_says_why():
+    """R/(R + d) and 2/(R + 1) are not monomials: each NotGP names the divisor."""
+    R, d = _vars()
+    over_sum = R / (R + d)
+    assert isinstance(over_sum, NotGP)
+    assert (over_sum.reason, over_sum.term) == (
+        "division by a sum of terms (R + d) is not a posynomial",
+        "R + d",
+    )
+    rover = 2.0 / (R + 1.0)
+    assert (rover.reason, rover.term) == (
+        "division by a sum of terms (R + 1) is not a posynomial",
+        "R + 1",
+    )
+
+
+def test_division_by_a_term_zero_at_some_angle_names_the_term():
+    """1/(R [0, 2]): NotGP naming the divisor where it is not zero (it read "division by -")."""
+    R, _ = _vars()
+    zero = 1.0 / (R * np.array([0.0, 2.0]))
+    assert isinstance(zero, NotGP)
+    assert (zero.reason, zero.term) == ("division by 2*R, which is zero on the grid", "2*R")
+    assert isinstance(R / (R * np.array([1.0, 0.0])), NotGP)
+
+
+def test_not_gp_values_pass_through_every_operation_unchanged():
+    """Once a value is not a signomial, that first reason reaches the block."""
+    R, _ = _vars()
+    n = NotGP("first reason", "t")
+    assert (n.reason, n.term, NotGP("r").term) == ("first reason", "t", "")
+    assert repr(n) == "NotGP('first reason')"
+    assert float(n) == 1.0
+    results = [
+        n + 1, 1 + n, n - 1, 1 - n, n * 2, 2 * n, n / 2, 2 / n, n**2, 2**n, -n, +n, abs(n),
+        np.cos(n), n.mean(), n.max(), n.min(), n.sum(),
+        R + n, n + R, R - n, R * n, n * R, R / n, np.add(R, n), np.multiply(n, R),
+    ]  # fmt: skip
+    assert all(r is n for r in results)
+
+
+# --------------------------------------------------------------------------------------
+# Signomial: powers and abs
+# --------------------------------------------------------------------------------------
+def test_powers_of_a_monomial_scale_its_exponents():
+    """(c x^a)^e = c^e x^(a e); an integer power of a negative term stays a monomial."""
+    R, d = _vars()
+    assert _terms((2.0 * R) ** 3) == {(3.0, 0.0): 8.0}
+    root = (2.0 * R * d**2) ** 0.5
+    assert list(root.terms) == [(0.5, 1.0)]
+    assert root.terms[(0.5, 1.0)] == pytest.approx(math.sqrt(2.0), rel=1e-15)
+    assert _terms((-2.0 * R) ** 2) == {(2.0, 0.0): 4.0}
+    assert _terms((-2.0 * R) ** 3) == {(3.0, 0.0): -8.0}
+    assert _terms(R**-1) == {(-1.0, 0.0): 1.0}
+    assert (R - R) ** 2 is not None and ((R - R) ** 2).terms == {}
+    assert _terms((R - R) ** 0) == {(0.0, 0.0): 1.0}
+
+
+def test_a_fractional_power_of_a_negative_term_is_not_a_gp():
+    """(-2 R)^0.5, or a grid coefficient negative at one angle: NotGP naming the term."""
+    R, _ = _vars()
+    neg = (-2.0 * R) ** 0.5
+    assert isinstance(neg, NotGP)
+    assert (neg.reason, neg.term) == ("(-2*R)^0.5 of a negative term", "-2*R")
+    assert isinstance((R * np.array([1.0, -1.0])) ** 1.5, NotGP)
+    assert isinstance((R * np.array([1.0, 0.0])) ** 1.5, Signomial)
+
+
+def test_integer_powers_of_a_sum_up_to_six_are_expanded():
+    """(R + 1)^6 has the binomial coefficients; ^7 or ^0 of a sum is not expanded."""
+    R, _ = _vars()
+    six = (R + 1.0) ** 6
+    assert _terms(six) == {(float(k), 0.0): float(math.comb(6, k)) for k in range(7)}
+    assert _terms((R + 1.0) ** 2) == {(2.0, 0.0): 1.0, (1.0, 0.0): 2.0, (0.0, 0.0): 1.0}
+    tail = "a power of a sum of terms is not a posynomial (generalised posynomials are not "
+    tail += "supported by optdesign's GP builder)"
+    for e in (7, 0, 0.5, -1):
+        p = (R + 1.0) ** e
+        assert isinstance(p, NotGP) and (p.reason, p.term) == (f"(R + 1)^{e:g}: {tail}", "R + 1")
+    neg = (-R - 1.0) ** 0.5  # one sign: the same refusal, not "both signs"
+    assert neg.reason == f"(-R - 1)^0.5: {tail}"
+
+
+def test_a_power_of_a_sum_of_both_signs_is_named_a_signomial():
+    """(R - 1)^0.5 names both signs; zero grid entries carry no sign."""
+    R, _ = _vars()
+    p = (R - 1.0) ** 0.5
+    assert (p.reason, p.term) == (
+        "(R - 1)^0.5: power of a signomial (terms of both signs)",
+        "R - 1",
+    )
+    zero_at_one = (R * np.array([0.0, 1.0]) + 1.0) ** 0.5
+    assert "not a posynomial" in zero_at_one.reason and "both signs" not in zero_at_one.reason
+
+
+def test_an_exponent_that_depends_on_the_design_is_not_a_gp():
+    """R^d, R^(not GP) and 2^R: the exponent's own message."""
+    R, d = _vars()
+    for p in (R**d, R ** NotGP("other"), np.power(2.0, R)):
+        assert isinstance(p, NotGP)
+        assert p.reason == "a design variable in an exponent is not a monomial"
+
+
+def test_abs_keeps_a_posynomial_negates_a_negative_sum_and_refuses_mixed_signs():
+    """|R + 1| is itself, |-R - 2| is R + 2, |R - 1| and |R [-1, 1]| are not GP."""
+    R, _ = _vars()
+    pos = R + 1.0
+    assert abs(pos) is pos
+    assert _terms(abs(-R - 2.0)) == {(1.0, 0.0): 1.0, (0.0, 0.0): 2.0}
+    mixed = abs(R - 1.0)
+    assert (mixed.reason, mixed.term) == ("|R - 1|: absolute value of a signomial", "R - 1")
+    assert isinstance(abs(R * np.array([-1.0, 1.0])), NotGP)
+    assert _terms(abs(R * np.array([-1.0, 0.0]))) == {(1.0, 0.0): [1.0, 0.0]}
+    empty = R - R
+    assert abs(empty) is empty
+
+
+# --------------------------------------------------------------------------------------
+# Signomial: NumPy protocol and grid reductions
+# --------------------------------------------------------------------------------------
+def test_numpy_arithmetic_ufuncs_give_the_operators_terms():
+    """np.add/subtract/multiply/divide/power and the unary ones trace like the operators."""
+    R, d = _vars()
+    assert _terms(np.add(2.0, R)) == {(0.0, 0.0): 2.0, (1.0, 0.0): 1.0}
+    assert _terms(np.subtract(5.0, R)) == {(0.0, 0.0): 5.0, (1.0, 0.0): -1.0}
+    assert _terms(np.subtract(R, d)) == {(1.0, 0.0): 1.0, (0.0, 1.0): -1.0}
+    assert _terms(np.multiply(3.0, R)) == {(1.0, 0.0): 3.0}
+    assert _terms(np.true_divide(6.0, R)) == {(-1.0, 0.0): 6.0}
+    assert _terms(np.power(R, 2.0)) == {(2.0, 0.0): 1.0}
+    assert _terms(np.array([1.0, 2.0]) * R) == {(1.0, 0.0): [1.0, 2.0]}
+    assert _terms(np.array([1.0, 2.0]) - R) == {(0.0, 0.0): [1.0, 2.0], (1.0, 0.0): -1.0}
+    assert _terms(np.negative(R)) == {(1.0, 0.0): -1.0}
+    assert np.positive(R) is R
+    assert _terms(np.absolute(-2.0 * R)) == {(1.0, 0.0): 2.0}
+    assert _terms(np.fabs(-2.0 * R)) == {(1.0, 0.0): 2.0}
+    assert _terms(np.sqrt(4.0 * R**2)) == {(1.0, 0.0): 2.0}
+    assert _terms(np.square(R + 1.0)) == {(2.0, 0.0): 1.0, (1.0, 0.0): 2.0, (0.0, 0.0): 1.0}
+    cube = np.cbrt(8.0 * d**3)
+    assert list(cube.terms) == [(0.0, 1.0)] and cube.terms[(0.0, 1.0)] == pytest.approx(2.0)
+
+
+def test_numpy_ufuncs_of_constants_are_numbers():
+    """A ufunc of design-independent tracers is NumPy's value of their constants."""
+    R, _ = _vars()
+    assert np.cos(R - R + 0.5) == pytest.approx(math.cos(0.5), rel=1e-15)
+    assert np.exp(R - R) == 1.0
+    assert np.maximum(R - R + 3.0, 2.0) == 3.0
+    assert np.arctan2(R - R + 1.0, 2.0) == pytest.approx(math.atan2(1.0, 2.0), rel=1e-15)
+
+
+def test_other_numpy_functions_of_a_design_variable_name_themselves():
+    """cos(R), maximum(R, 2), arctan2(R, d): not monomials, each named with its argument."""
+    R, d = _vars()
+    cases = [
+        (np.cos(R), "cos(R)"),
+        (np.maximum(R, 2.0), "maximum(R, ...)"),
+        (np.arctan2(R, d), "arctan2(R, d)"),
+        (np.sin(2.0 * R + 1.0), "sin(2*R + 1)"),
+    ]
+    for value, term in cases:
+        assert isinstance(value, NotGP)
+        assert (value.reason, value.term) == (
+            f"{term} of a design variable is not a monomial",
+            term,
+        )
+    red = np.add.reduce(R)
+    assert isinstance(red, NotGP) and red.reason == "numpy add.reduce on a design variable"
+    out = np.add(R, 1.0, out=np.empty(()))
+    assert isinstance(out, NotGP) and out.reason == "numpy add.__call__ on a design variable"
+
+
+def test_a_mean_over_the_grid_stays_a_signomial_and_max_or_min_do_not():
+    """mean over the last axis of each coefficient; max/min over the grid are no GP."""
+    R, _ = _vars()
+    assert _terms((R * np.array([1.0, 3.0]) + 2.0).mean()) == {(1.0, 0.0): 2.0, (0.0, 0.0): 2.0}
+    two_d = (R * np.array([[1.0, 3.0], [5.0, 7.0]])).mean()
+    assert _terms(two_d) == {(1.0, 0.0): [2.0, 6.0]}
+    assert _terms(np.mean(R * np.array([1.0, 3.0]))) == {(1.0, 0.0): 2.0}
+    assert R.mean() is R and R.max() is R and R.min() is R  # no grid: nothing to reduce
+    grid = R * np.array([2.0, 3.0])
+    for how in ("max", "min"):
+        reduced = getattr(grid, how)()
+        assert isinstance(reduced, NotGP) and reduced.reason == f"{how} over the grid of 2*R"
+
+
+# --------------------------------------------------------------------------------------
+# gp.py: the diagnosis records
+# --------------------------------------------------------------------------------------
+def test_a_checks_describe_line_for_each_verdict():
+    """The one line per item that explain() and the refusals show."""
+    assert DGPCheck("constraint", "x", True).describe() == "constraint x: DGP"
+    ok = DGPCheck("constraint", "x", True, "2 posynomial rows")
+    assert ok.describe() == "constraint x: DGP (2 posynomial rows)"
+    bad = DGPCheck("objective", "b", False, "why", "t", False)
+    assert bad.describe() == "objective b: not DGP: why [offending term: t] [cvxpy is_dgp(): False]"
+    assert DGPCheck("objective", "b", False, "why").describe() == "objective b: not DGP: why"
+    flag = DGPCheck("variable", "p", False, "why", "", True)
+    assert flag.describe() == "variable p: not DGP: why [cvxpy is_dgp(): True]"
+
+
+def test_explain_lists_only_the_failures_one_per_line():
+    """is_gp is all checks DGP; explain() joins the failures' lines, empty for a GP."""
+    good = DGPCheck("constraint", "a", True, "1 posynomial rows")
+    bad1 = DGPCheck("constraint", "b", False, "r1")
+    bad2 = DGPCheck("objective", "c", False, "r2", "t")
+    gp = GPData(["x"], np.ones(1), np.ones(1), "c", "", [], [], [good, bad1, bad2])
+    assert not gp.is_gp and gp.failures() == [bad1, bad2]
+    assert gp.explain() == "constraint b: not DGP: r1\nobjective c: not DGP: r2 [offending term: t]"
+    fine = GPData(["x"], np.ones(1), np.ones(1), "c", "", [], [], [good])
+    assert fine.is_gp and fine.explain() == "" and fine.failures() == []
+    assert fine.infeasible == [] and fine.n_rows_before_pruning == 0
+
+
+# --------------------------------------------------------------------------------------
+# gp.py: rows
+# --------------------------------------------------------------------------------------
+def test_rows_of_splits_each_grid_row_into_its_variable_terms_and_constant():
+    """Per grid row: the non-zero variable terms and the sum of the constant terms."""
+    R, d = _vars()
+    expr = 2.0 * R + np.array([1.0, 2.0]) + d * np.array([0.0, 5.0])
+    rows, consts = _rows_of(expr, 2)
+    assert rows == [{(1.0, 0.0): 2.0}, {(1.0, 0.0): 2.0, (0.0, 1.0): 5.0}]
+    assert consts == [1.0, 2.0]
+    assert _rows_of(3.0, 2) == ([{}, {}], [3.0, 3.0])
+    assert _rows_of(np.array([1, 4]), 2) == ([{}, {}], [1.0, 4.0])
+    assert _rows_of(R, 3) == ([{(1.0, 0.0): 1.0}] * 3, [0, 0, 0])
+
+
+def test_a_row_is_written_with_its_constant_last():
+    """_fmt_row shows a row's terms then its constant (left out when zero)."""
+    assert _fmt_row(["R", "d"], {(1.0, 0.0): 2.0}, -3.0) == "2*R - 3"
+    assert _fmt_row(["R", "d"], {(1.0, 0.0): 2.0, (0.0, -1.0): 1.0}, 0.0) == "2*R + d^-1"
+
+
+def test_a_gp_row_holds_the_exponents_and_the_coefficients_over_the_scale():
+    """_as_row: one exponent row per term, coefficients divided by the scale, the labels."""
+    row = _as_row(
+        "blk", "lab", ["R", "d"], {(1.0, 0.0): 2.0, (0.0, -1.0): 4.0}, 2.0, "lower", 5.0, "mm"
+    )
+    assert (row.name, row.label, row.kind, row.bound, row.unit) == (
+        "blk",
+        "lab",
+        "lower",
+        5.0,
+        "mm",
+    )
+    assert row.A.tolist() == [[1.0, 0.0], [0.0, -1.0]] and row.c.tolist() == [1.0, 2.0]
+    assert row.A.dtype == np.float64 and row.c.dtype == np.float64
+    default = GPRow("n", "", np.zeros((1, 2)), np.ones(1))
+    assert (default.kind, default.bound, default.unit) == ("upper", 1.0, "")
+
+
+def _row(terms: dict, name: str = "blk") -> GPRow:
+    return GPRow(name, "", np.array(list(terms), dtype=float), np.array(list(terms.values())))
+
+
+def test_pruning_drops_rows_implied_by_another_and_keeps_the_first_of_equal_rows():
+    """A row whose monomials and coefficients another row covers is implied by it."""
+    r0 = _row({(1.0, 0.0): 1.0})  # <= r1 (R <= 2 R)
+    r1 = _row({(1.0, 0.0): 2.0})
+    r2 = _row({(1.0, 0.0): 2.0})  # equal to r1: the first one stays
+    r3 = _row({(1.0, 0.0): 1.0, (0.0, 1.0): 1.0})  # covers r0 (more monomials)
+    r4 = _row({(0.0, 1.0): 3.0})  # larger than r3's d term: not implied
+    kept = _prune([r0, r1, r2, r3, r4])
+    assert [id(r) for r in kept] == [id(r1), id(r3), id(r4)]
+    assert _prune([r2, r1]) == [r2]
+    assert _prune([]) == []
+    # one coefficient larger than the other row's: both stay
+    a, b = _row({(1.0, 0.0): 3.0, (0.0, 1.0): 1.0}), _row({(1.0, 0.0): 1.0, (0.0, 1.0): 2.0})
+    assert len(_prune([a, b])) == 2
+
+
+def test_cvxpy_judges_a_row_of_positive_variables():
+    """A posynomial row is DGP for cvxpy; a negative term or constant is not."""
+    names = ["R", "d"]
+    assert _cvxpy_flag(names, {(1.0, 0.0): 1.0, (0.0, 2.0): 3.0}, 0.0) is True
+    assert _cvxpy_flag(names, {(1.0, 0.0): 1.0}, 2.0) is True
+    assert _cvxpy_flag(names, {(1.0, 0.0): 1.0}, -2.0) is False
+    assert _cvxpy_flag(names, {(1.0, 0.0): 1.0, (0.0, 1.0): -1.0}, 0.0) is False
+    assert _cvxpy_flag(names, {(-1.0, 0.5): -1.0}, 0.0) is False
+    assert _cvxpy_flag(["R"], {(1.0, 0.0): 1.0}, 0.0) is None  # a malformed row: no verdict
+
+
+# --------------------------------------------------------------------------------------
+# gp.py: one block's classification
+# --------------------------------------------------------------------------------------
+def _classify(expr, lower, upper, labels=("a", "b"), unit="mm"):
+    return _classify_block("blk", expr, lower, upper, list(labels), unit, ["R", "d"], 2)
+
+
+def test_a_block_that_is_not_a_signomial_keeps_its_reason_and_term():
+    """A NotGP block: a failed check with the tracer's reason and term, no rows."""
+    check, rows, infeasible = _classify(NotGP("why", "cos(R)"), None, 1.0)
+    assert check == DGPCheck("constraint", "blk", False, "why", "cos(R)")
+    assert (rows, infeasible) == ([], [])
+
+
+def test_constant_rows_outside_their_band_are_infeasible_named_at_their_angle():
+    """A row without design terms holds or not: outside [lower, upper] it is listed."""
+    check, rows, infeasible = _classify(np.array([1.0, 5.0]), 2.0, 4.0)
+    assert check == DGPCheck("constraint", "blk", True, "no row depends on the design")
+    assert rows == []
+    assert infeasible == ["blk[a] = 1 mm outside [2.0, 4.0]", "blk[b] = 5 mm outside [2.0, 4.0]"]
+    _, _, inside = _classify(np.array([2.0, 4.0]), 2.0, 4.0)
+    assert inside == []
+    # labels that do not fit the rows are left out; a missing bound shows as None
+    _, _, one = _classify(np.array([1.0, 5.0]), None, 4.0, labels=("a",))
+    assert one == ["blk = 5 mm outside [None, 4.0]"]
+    R, _ = _vars()
+    _, _, traced = _classify(R - R + np.array([3.0, 6.0]), 2.0, 4.0)
+    assert traced == ["blk[b] = 6 mm outside [2.0, 4.0]"]
+
+
+def test_constant_rows_are_compared_with_a_relative_tolerance_of_1e_9():
+    """1e-9 of the bound (at least 1e-9) is no violation; twice that is."""
+    for bound in (100.0, 0.5):
+        tol = 1e-9 * max(1.0, bound)
+        values = np.array([bound + 0.5 * tol, bound + 2 * tol])
+        _, _, above = _classify(values, None, bound)
+        assert [s.split(" = ")[0] for s in above] == ["blk[b]"]
+        values = np.array([bound - 0.5 * tol, bound - 2 * tol])
+        _, _, below = _classify(values, bound, None)
+        assert [s.split(" = ")[0] for s in below] == ["blk[b]"]
+
+
+def test_a_posynomial_upper_bound_becomes_a_row_over_the_bound_minus_the_constant():
+    """[2, 4] R + 3 <= 11: rows R/4 and R/2 (posy <= 11 - 3); the lower bound 1 always holds."""
+    R, _ = _vars()
+    check, rows, infeasible = _classify(R * np.array([2.0, 4.0]) + 3.0, 1.0, 11.0)
+    assert check == DGPCheck("constraint", "blk", True, "2 posynomial rows")
+    assert infeasible == []
+    assert [(r.name, r.label, r.kind, r.bound, r.unit) for r in rows] == [
+        ("blk", "a", "upper", 11.0, "mm"),
+        ("blk", "b", "upper", 11.0, "mm"),
+    ]
+    assert [r.A.tolist() for r in rows] == [[[1.0, 0.0]], [[1.0, 0.0]]]
+    assert [r.c.tolist() for r in rows] == [[0.25], [0.5]]
+
+
+def test_a_monomial_lower_bound_becomes_its_inverse_row():
+    """2 R d >= 4 is 2 R^-1 d^-1 <= 1 (kind lower, bound 4)."""
+    R, d = _vars()
+    check, rows, _ = _classify(2.0 * R * d, 4.0, None, labels=())
+    assert check.ok and check.reason == "1 posynomial rows"
+    ((row,),) = [rows]
+    assert (row.label, row.kind, row.bound) == ("", "lower", 4.0)
+    assert row.A.tolist() == [[-1.0, -1.0]] and row.c.tolist() == [2.0]
+
+
+def test_a_negative_monomial_plus_a_constant_flips_its_bounds():
+    """-2 R + 10 <= 4 is R >= 3 (row 3/R <= 1); -2 R + 10 >= 12 no positive R meets."""
+    R, _ = _vars()
+    check, rows, infeasible = _classify(-2.0 * R + 10.0, 12.0, 4.0, labels=())
+    assert check.ok and check.reason == "1 posynomial rows"
+    ((row,),) = [rows]
+    assert (row.kind, row.bound, row.A.tolist(), row.c.tolist()) == (
+        "upper",
+        4.0,
+        [[-1.0, 0.0]],
+        [3.0],
+    )
+    assert infeasible == ["blk: -2*R + 10 cannot meet 12.0"]
+    # only the unmeetable side: no row at all
+    check, rows, infeasible = _classify(-2.0 * R + 10.0, 12.0, None, labels=())
+    assert (check.reason, rows, infeasible) == (
+        "no row depends on the design",
+        [],
+        ["blk: -2*R + 10 cannot meet 12.0"],
+    )
+    # -2 R + 10 >= -4 always holds for... R <= 7: a posynomial <= 7 row (kind lower)
+    _, rows, _ = _classify(-2.0 * R + 10.0, -4.0, None, labels=())
+    assert [(r.kind, r.bound, r.A.tolist(), r.c.tolist()) for r in rows] == [
+        ("lower", -4.0, [[1.0, 0.0]], [2.0 / 14.0])
+    ]
+
+
+def test_a_posynomial_bounded_below_a_positive_constant_cannot_meet_it():
+    """2 R + 3 <= 2 at each angle: named with the row, its terms and the bound."""
+    R, _ = _vars()
+    check, rows, infeasible = _classify(2.0 * R + 3.0 * np.ones(2), None, 2.0)
+    assert check.ok and rows == []
+    assert infeasible == ["blk[a]: 2*R + 3 cannot meet 2.0", "blk[b]: 2*R + 3 cannot meet 2.0"]
+
+
+def test_a_row_of_both_signs_is_a_signomial_named_at_its_angle():
+    """R - d + 2 at angle b: the whole block fails there, with the row and cvxpy's verdict."""
+    R, d = _vars()
+    check, rows, infeasible = _classify(R - d * np.array([0.0, 1.0]) + 2.0, None, 5.0)
+    assert (rows, infeasible) == ([], [])
+    assert check == DGPCheck(
+        "constraint",
+        "blk",
+        False,
+        "blk[b] is a signomial (terms of both signs): R - d + 2",
+        "R - d + 2",
+        False,
+    )
+
+
+def test_a_posynomial_bounded_from_below_names_the_angle_and_side():
+    """R + d >= 20 at angle a: posynomial >= constant, not DGP; cvxpy's verdict False."""
+    R, d = _vars()
+    check, rows, _ = _classify(R + d, 20.0, None, labels=("a",))
+    assert rows == []
+    assert check == DGPCheck(
+        "constraint",
+        "blk",
+        False,
+        "blk[a]: a lower bound 20 on a sum of terms (R + d); posynomial >= constant is not DGP",
+        "R + d",
+        False,
+    )
+    # at or below zero the lower bound always holds: no failure, no row
+    check, rows, _ = _classify(R + d + 1.0, 1.0, None, labels=("a",))
+    assert (check.ok, check.reason, rows) == (True, "no row depends on the design", [])
+
+
+# --------------------------------------------------------------------------------------
+# gp.py: the fork's GP against the NumPy model
+# --------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def fork():
+    return load_problem(FORK)
+
+
+def _posy(row: GPRow, x: np.ndarray) -> float:
+    return float(row.c @ np.exp(row.A @ np.log(x)))
+
+
+def _designs(problem, n=4, seed=3):
+    rng = np.random.default_rng(seed)
+    lo, hi = problem.lower(), problem.upper()
+    return [lo + (hi - lo) * rng.random(lo.size) for _ in range(n)]
+
+
+def test_the_forks_gp_is_diagnosed_block_by_block(fork):
+    """Variables, objective, units, per-block row counts before and after pruning."""
+    gp = build_gp(fork)
+    assert gp.names == ["R", "p", "d"] and gp.objective == "backlash"
+    assert gp.lower.tolist() == [30.0, 2.0, 4.0] and gp.upper.tolist() == [120.0, 10.0, 30.0]
+    assert gp.objective_unit == "deg" and gp.infeasible == [] and gp.is_gp
+    assert [(c.what, c.name, c.ok, c.reason) for c in gp.checks] == [
+        ("objective", "backlash", True, "max over the grid of posynomials, 1 rows kept"),
+        ("constraint", "ratio_positive", True, "61 posynomial rows"),
+        ("constraint", "mean_ratio", True, "2 posynomial rows"),
+        ("constraint", "nut_travel", True, "1 posynomial rows"),
+        ("constraint", "pin_bearing_pressure", True, "61 posynomial rows"),
+        ("constraint", "pin_shear_stress", True, "61 posynomial rows"),
+    ]
+    # 61 objective rows + 61 + 2 + 1 + 61 + 61 constraint rows, before pruning
+    assert gp.n_rows_before_pruning == 61 + 61 + 2 + 1 + 61 + 61
+    assert [(r.name, r.label, r.kind, r.bound, r.unit) for r in gp.rows] == [
+        ("ratio_positive", "phi=+0.0deg", "lower", 1.0, ""),
+        ("mean_ratio", "", "upper", 260.0, ""),
+        ("mean_ratio", "", "lower", 200.0, ""),
+        ("nut_travel", "", "upper", 110.0, "mm"),
+        ("pin_bearing_pressure", "phi=+0.0deg", "upper", 100.0, "MPa"),
+        ("pin_shear_stress", "phi=+0.0deg", "upper", 200.0, "MPa"),
+    ]
+
+
+def test_every_gp_row_is_the_numpy_models_row_over_its_bound(fork):
+    """At random designs each GP row times its bound (upper) or the bound over it (lower)
+    is the first-order model's value at the row's angle; the objective row is the
+    objective there, and the kept rows give each block's worst value over the grid."""
+    gp = build_gp(fork)
+    labels = fork.phi_labels
+    for x in _designs(fork):
+        ex = fork.expressions(fork.design_dict(x), first_order=True)
+        blocks = {b.name: b for b in ex.constraints}
+        for row in gp.rows:
+            values = np.broadcast_to(np.asarray(blocks[row.name].expr, dtype=float), (61,))
+            v = values[labels.index(row.label)] if row.label else values[0]
+            p = _posy(row, x)
+            assert (p * row.bound if row.kind == "upper" else row.bound / p) == pytest.approx(
+                v, rel=1e-9
+            )
+        for name in ("pin_bearing_pressure", "pin_shear_stress"):
+            kept = [r for r in gp.rows if r.name == name]
+            worst = np.max(np.asarray(blocks[name].expr, dtype=float))
+            assert max(_posy(r, x) for r in kept) * kept[0].bound == pytest.approx(worst, rel=1e-9)
+        backlash = np.asarray(ex.objectives["backlash"].expr, dtype=float)
+        assert max(_posy(r, x) for r in gp.objective_rows) == pytest.approx(
+            backlash.max(), rel=1e-9
+        )
+
+
+def test_a_scalar_or_max_objective_of_the_fork_has_its_rows_and_unit(fork):
+    """size and nut_travel are one posynomial row; motor_torque a max over the grid;
+    each row's value is the model's objective at random designs."""
+    expected = {
+        "size": ("mm", "posynomial, 1 rows kept", ""),
+        "nut_travel": ("mm", "posynomial, 1 rows kept", ""),
+        "motor_torque": ("N*mm", "max over the grid of posynomials, 1 rows kept", "phi=+0.0deg"),
+    }
+    for name, (unit, reason, label) in expected.items():
+        gp = build_gp(fork, name)
+        check = next(c for c in gp.checks if c.what == "objective")
+        assert (gp.objective, gp.objective_unit, check.ok, check.reason) == (
+            name,
+            unit,
+            True,
+            reason,
+        )
+        assert [(r.name, r.label, r.kind) for r in gp.objective_rows] == [
+            (name, label, "objective")
+        ]
+        for x in _designs(fork, 2):
+            value = np.max(np.asarray(fork.expressions(fork.design_dict(x)).objectives[name].expr))
+            assert _posy(gp.objective_rows[0], x) == pytest.approx(float(value), rel=1e-9)
+
+
+def test_the_forks_ripple_objective_is_the_constant_one_seventh(fork):
+    """The fork's ratio goes as 1/cos^2: max/min = 4/3 over +-30 deg, spread 1/7, whatever
+    the design; the GP keeps it as one constant row."""
+    gp = build_gp(fork, "ripple")
+    check = next(c for c in gp.checks if c.what == "objective")
+    assert (check.ok, check.reason) == (True, "constant 0.142857 (design-independent)")
+    ((row,),) = [gp.objective_rows]
+    assert (row.name, row.label) == ("ripple", "")
+    assert row.A.tolist() == [[0.0, 0.0, 0.0]] and row.c[0] == pytest.approx(1.0 / 7.0, rel=1e-12)
+
+
+def test_the_spread_of_a_constant_or_single_term_grid_value():
+    """(max - min)/(max + min) of numbers or of one positive term; None otherwise."""
+    R, _ = _vars()
+    assert _constant_spread(np.array([1.0, 3.0])) == pytest.approx(0.5)
+    assert _constant_spread(R * np.array([1.0, 3.0])) == pytest.approx(0.5)
+    assert _constant_spread(R * np.array([2.0, 2.0])) == 0.0
+    assert _constant_spread(R * np.array([0.0, 3.0])) is None
+    assert _constant_spread(R * np.array([1.0, 3.0]) + 1.0) is None
+    assert _constant_spread(NotGP("x")) is None
+
+
+def test_an_objective_of_the_model_that_is_not_dgp_names_its_power_of_a_sum(fork):
+    """backlash_rss is the root of a sum of squares: not DGP, the sum as its term."""
+    gp = build_gp(fork, "backlash_rss")
+    check = next(c for c in gp.checks if c.what == "objective")
+    assert (
+        check.ok is False
+        and check.term
+        and check.reason
+        == (
+            f"({check.term})^0.5: a power of a sum of terms is not a posynomial "
+            "(generalised posynomials are not supported by optdesign's GP builder)"
+        )
+    )
+    assert gp.objective_unit == "deg" and gp.objective_rows == []
+
+
+def test_a_model_that_raises_while_traced_is_named_and_nothing_else_is_checked(fork, monkeypatch):
+    """The model's exception becomes the problem's check; no objective or block after it."""
+    seen = {}
+
+    def boom(design, **kwargs):
+        seen.update(kwargs)
+        seen["design"] = design
+        raise ValueError("boom")
+
+    problem = copy.deepcopy(fork)
+    monkeypatch.setattr(problem, "expressions", boom)
+    gp = build_gp(problem)
+    assert [(c.what, c.name, c.ok, c.reason) for c in gp.checks] == [
+        ("problem", "fork_min_backlash", False, "model not traceable (ValueError: boom)")
+    ]
+    assert gp.rows == [] and gp.objective_rows == [] and gp.objective_unit == ""
+    assert gp.explain() == (
+        "problem fork_min_backlash: not DGP: model not traceable (ValueError: boom)"
+    )
+    # the tracers: first-order Hertz, one variable per free name, at the bounds' middle
+    assert seen["first_order"] is True
+    R = seen["design"]["R"]
+    assert isinstance(R, Signomial) and R.names == ("R", "p", "d")
+    assert _terms(seen["design"]["d"]) == {(0.0, 0.0, 1.0): 1.0}
+    assert R.ref.tolist() == [75.0, 6.0, 17.0]
+    assert seen["design"]["i_a"] == 2.0
+
+
+def test_a_non_positive_lower_bound_is_named_with_its_unit_and_the_log_reason():
+    """A GP variable must live in (0, inf): its check says so with its bound."""
+    cs = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
+    n = next(c for c in build_gp(cs).checks if c.what == "variable" and c.name == "n")
+    assert n.reason == (
+        "lower bound 0 mm is not positive; GP variables live in (0, inf) (log change of variables)"
+    )
+
+
+def test_is_gp_refuses_catalogue_or_non_positive_variables_without_tracing(fork, monkeypatch):
+    """The cheap tests first: build_gp is not called for those; it is for the rest, with
+    the objective asked."""
+    asked = []
+
+    def fake_build(problem, objective=None):
+        asked.append(objective)
+        return GPData([], np.ones(0), np.ones(0), "", "", [], [], [DGPCheck("o", "o", True)])
+
+    monkeypatch.setattr(gpmod, "build_gp", fake_build)
+    assert is_gp(load_problem(ROOT / "problems" / "cs_min_backlash_catalogue.toml")) is False
+    assert is_gp(load_problem(ROOT / "problems" / "cs_min_backlash.toml")) is False
+    assert asked == []
+    assert is_gp(fork, "size") is True and asked == ["size"]
+
+
+# --------------------------------------------------------------------------------------
+# gp.py: the cvxpy problem
+# --------------------------------------------------------------------------------------
+def test_the_cvxpy_problem_holds_the_rows_then_the_bounds_and_solves_by_hand():
+    """min 1/(x y) s.t. x/8 + y/8 <= 1 in [1, 10]^2: x = y = 4, t = 1/16 (AM-GM)."""
+    obj = GPRow("f", "", np.array([[-1.0, -1.0]]), np.array([1.0]), "objective", 0.0)
+    con = GPRow("sum", "", np.array([[1.0, 0.0], [0.0, 1.0]]), np.array([0.125, 0.125]))
+    gp = GPData(["x", "y"], np.array([1.0, 1.0]), np.array([10.0, 5.0]), "f", "", [obj], [con], [])
+    prob, xs, t, cons = to_cvxpy(gp)
+    assert [r.name for r, _ in cons] == ["f", "sum", "bound:x", "bound:x", "bound:y", "bound:y"]
+    assert cons[0][0] is obj and cons[1][0] is con
+    bounds = [(r.label, r.kind, r.bound, r.A.tolist(), r.c.tolist()) for r, _ in cons[2:]]
+    assert bounds == [
+        ("upper", "upper", 10.0, [[1.0, 0.0]], [0.1]),
+        ("lower", "lower", 1.0, [[-1.0, -0.0]], [1.0]),
+        ("upper", "upper", 5.0, [[0.0, 1.0]], [0.2]),
+        ("lower", "lower", 1.0, [[-0.0, -1.0]], [1.0]),
+    ]
+    assert [x.name() for x in xs] == ["x", "y"] and t.name() == "t"
+    assert prob.is_dgp()
+    prob.solve(gp=True)
+    assert prob.value == pytest.approx(1.0 / 16.0, rel=1e-5)
+    assert [float(x.value) for x in xs] == pytest.approx([4.0, 4.0], rel=1e-4)
+    # the bound on y binds when it is below 4: y = 3, x = 5, t = 1/15
+    gp.upper = np.array([10.0, 3.0])
+    prob, xs, _, _ = to_cvxpy(gp)
+    prob.solve(gp=True)
+    assert prob.value == pytest.approx(1.0 / 15.0, rel=1e-5)
+    assert [float(x.value) for x in xs] == pytest.approx([5.0, 3.0], rel=1e-4)
+
+
+def test_the_cvxpy_problem_of_a_constant_objective_is_its_value():
+    """A design-independent objective row (zero exponents): the optimum is that constant."""
+    obj = GPRow("ripple", "", np.zeros((1, 1)), np.array([0.25]))
+    gp = GPData(["x"], np.array([1.0]), np.array([2.0]), "ripple", "", [obj], [], [])
+    prob, _, _, cons = to_cvxpy(gp)
+    assert len(cons) == 3
+    prob.solve(gp=True)
+    assert prob.value == pytest.approx(0.25, rel=1e-6)
+
+
+def test_a_crank_slider_with_its_linkage_fixed_keeps_its_constant_angle_rows_out_of_the_gp():
+    """Constant rows are checked, not sent to cvxpy: the transmission angle's 61 rows
+    leave no row; the lead and pin rows remain."""
+    from test_gp import CS_FIXED
+
+    data = copy.deepcopy(CS_FIXED)
+    data["requirements"]["transmission_angle"] = {"min": "30 deg", "max": "150 deg"}
+    gp = build_gp(problem_from_dict(data))
+    check = next(c for c in gp.checks if c.name == "transmission_angle")
+    assert (check.ok, check.reason) == (True, "no row depends on the design")
+    assert "transmission_angle" not in {r.name for r in gp.rows} and gp.infeasible == []
+    assert gp.names == ["p", "d"]
+
+
+def test_an_objective_that_is_zero_at_every_design_is_no_gp_and_auto_takes_the_nlp(fork):
+    """The fork has no drive: its drive_loss is 0 whatever the design. The GP refuses it
+    (cvxpy's min t over no row was reported "failed: unbounded"); auto solves the NLP."""
+    import optdesign as od
+
+    gp = build_gp(fork, "drive_loss")
+    check = next(c for c in gp.checks if c.what == "objective")
+    assert (check.ok, check.term, check.reason) == (
+        False,
+        "drive_loss",
+        "drive_loss is 0 whatever the design: a GP minimises a positive posynomial",
+    )
+    assert not is_gp(fork, "drive_loss") and gp.objective_rows == []
+    result = od.solve(fork, "auto", objective="drive_loss", ranges=False)
+    assert (result.formulation, result.status, result.objective) == ("nlp-epigraph", "optimal", 0.0)
