@@ -460,6 +460,7 @@ def test_cvxpy_judges_a_row_of_positive_variables():
     assert _cvxpy_flag(names, {(1.0, 0.0): 1.0}, -2.0) is False
     assert _cvxpy_flag(names, {(1.0, 0.0): 1.0, (0.0, 1.0): -1.0}, 0.0) is False
     assert _cvxpy_flag(names, {(-1.0, 0.5): -1.0}, 0.0) is False
+    assert _cvxpy_flag(names, {(-1.0, 0.0): 2.0, (0.0, -2.0): 1.0}, 0.0) is True
     assert _cvxpy_flag(["R"], {(1.0, 0.0): 1.0}, 0.0) is None  # a malformed row: no verdict
 
 
@@ -592,6 +593,11 @@ def test_a_posynomial_bounded_from_below_names_the_angle_and_side():
         "R + d",
         False,
     )
+    check, _, _ = _classify(R + d + 1.0, 20.0, None, labels=("a",))
+    assert (check.reason, check.term) == (
+        "blk[a]: a lower bound 20 on a sum of terms (R + d + 1); posynomial >= constant is not DGP",
+        "R + d + 1",
+    )
     # at or below zero the lower bound always holds: no failure, no row
     check, rows, _ = _classify(R + d + 1.0, 1.0, None, labels=("a",))
     assert (check.ok, check.reason, rows) == (True, "no row depends on the design", [])
@@ -687,6 +693,8 @@ def test_a_scalar_or_max_objective_of_the_fork_has_its_rows_and_unit(fork):
         assert [(r.name, r.label, r.kind) for r in gp.objective_rows] == [
             (name, label, "objective")
         ]
+        # one scalar row instead of the 61 grid rows of backlash
+        assert gp.n_rows_before_pruning == 186 + (61 if label else 1)
         for x in _designs(fork, 2):
             value = np.max(np.asarray(fork.expressions(fork.design_dict(x)).objectives[name].expr))
             assert _posy(gp.objective_rows[0], x) == pytest.approx(float(value), rel=1e-9)
@@ -853,3 +861,147 @@ def test_an_objective_that_is_zero_at_every_design_is_no_gp_and_auto_takes_the_n
     assert not is_gp(fork, "drive_loss") and gp.objective_rows == []
     result = od.solve(fork, "auto", objective="drive_loss", ranges=False)
     assert (result.formulation, result.status, result.objective) == ("nlp-epigraph", "optimal", 0.0)
+
+
+def _cs_fixed():
+    from test_gp import CS_FIXED
+
+    return problem_from_dict(copy.deepcopy(CS_FIXED))
+
+
+def test_an_objectives_constant_term_is_a_row_of_zero_exponents():
+    """p + 2 mm (scalar): one row, the monomial p and the constant 2 (exponents 0)."""
+    problem = _cs_fixed()
+    problem.add_objective("lead_plus", lambda q: q.design["p"] + 2.0, unit="mm")
+    gp = build_gp(problem, "lead_plus")
+    check = next(c for c in gp.checks if c.what == "objective")
+    assert (check.ok, check.reason, gp.objective_unit) == (True, "posynomial, 1 rows kept", "mm")
+    ((row,),) = [gp.objective_rows]
+    assert (row.name, row.label, row.kind, row.bound) == ("lead_plus", "", "objective", 0.0)
+    assert row.A.tolist() == [[1.0, 0.0], [0.0, 0.0]] and row.c.tolist() == [1.0, 2.0]
+
+
+def test_a_grid_objective_keeps_the_row_of_its_largest_coefficient_at_its_angle():
+    """d (1 + phi_k / 30 deg) / 2 over the grid: of 61 rows the one at +30 deg (d) stays."""
+    problem = _cs_fixed()
+    weights = np.linspace(0.0, 1.0, 61)
+    problem.add_objective("wave", lambda q: q.design["d"] * weights, unit="mm")
+    gp = build_gp(problem, "wave")
+    ((row,),) = [gp.objective_rows]
+    assert (row.label, row.A.tolist(), row.c.tolist()) == ("phi=+30.0deg", [[0.0, 1.0]], [1.0])
+    # the weight 0 at -30 deg leaves no term there: 60 rows before pruning
+    constraint_rows = build_gp(problem).n_rows_before_pruning - 61  # backlash: 61 rows
+    assert gp.n_rows_before_pruning == constraint_rows + 60
+
+
+def test_a_grid_objective_with_a_negative_term_is_named_at_its_angle():
+    """d (phi_k / 30 deg) is -d at -30 deg: not DGP, named at that angle; cvxpy agrees."""
+    problem = _cs_fixed()
+    weights = np.linspace(-1.0, 1.0, 61)
+    problem.add_objective("wave", lambda q: q.design["d"] * weights + 1.0, unit="mm")
+    check = next(c for c in build_gp(problem, "wave").checks if c.what == "objective")
+    assert (check.ok, check.term, check.cvxpy_is_dgp) == (False, "-d + 1", False)
+    assert check.reason == "wave[phi=-30.0deg] has a negative term: -d + 1 (a signomial)"
+
+
+def test_a_limit_on_a_non_spread_objective_is_an_upper_bounded_block(fork, monkeypatch):
+    """The generic objective-limit path (only ripple_max uses it today, a spread): a
+    limit of 100 mm on size (= R) is the block size_max with the row R/100 <= 1."""
+    problem = copy.deepcopy(fork)
+    monkeypatch.setattr(problem, "objective_limits", lambda: {"size": 100.0})
+    gp = build_gp(problem)
+    check = next(c for c in gp.checks if c.name == "size_max")
+    assert (check.what, check.ok, check.reason) == ("constraint", True, "1 posynomial rows")
+    row = gp.rows[-1]
+    assert (row.name, row.label, row.kind, row.bound, row.unit) == (
+        "size_max",
+        "",
+        "upper",
+        100.0,
+        "mm",
+    )
+    assert row.A.tolist() == [[1.0, 0.0, 0.0]] and row.c.tolist() == [0.01]
+    assert len(gp.rows) == 7 and gp.infeasible == []
+
+
+def test_a_positive_lower_bound_at_or_below_one_is_a_gp_variable():
+    """Only a lower bound <= 0 breaks the log change of variables: 1 mm and 0.5 mm do not."""
+    from test_gp import CS_FIXED
+
+    for lower in (1.0, 0.5):
+        data = copy.deepcopy(CS_FIXED)
+        data["variables"]["p"] = {"lower": lower, "upper": 10}
+        problem = problem_from_dict(data)
+        gp = build_gp(problem)
+        assert [c for c in gp.checks if c.what == "variable"] == [] and gp.is_gp
+        assert is_gp(problem)
+
+
+def test_a_bound_that_leaves_a_small_or_no_margin_over_the_constant():
+    """2 R + 3 <= 3.5 is 4 R <= 1; <= 3 no positive R meets; -2 R + 10 <= 9.5 is
+    0.25/R <= 1."""
+    R, _ = _vars()
+    _, rows, infeasible = _classify(2.0 * R + 3.0, None, 3.5, labels=())
+    assert [(r.A.tolist(), r.c.tolist()) for r in rows] == [([[1.0, 0.0]], [4.0])]
+    assert infeasible == []
+    _, rows, infeasible = _classify(2.0 * R + 3.0, None, 3.0, labels=())
+    assert rows == [] and infeasible == ["blk: 2*R + 3 cannot meet 3.0"]
+    _, rows, infeasible = _classify(-2.0 * R + 10.0, None, 9.5, labels=())
+    assert [(r.A.tolist(), r.c.tolist()) for r in rows] == [([[-1.0, 0.0]], [0.25])]
+    assert infeasible == []
+
+
+def test_a_spread_objective_that_depends_on_the_design_is_not_dgp():
+    """(max - min)/(max + min) of d w_k + 1 over the grid: a difference of posynomials
+    over a sum; the term is the expression at the first angle."""
+    problem = _cs_fixed()
+    weights = np.linspace(1.0, 2.0, 61)
+    problem.add_objective("wobble", lambda q: q.design["d"] * weights + 1.0, kind="spread")
+    gp = build_gp(problem, "wobble")
+    check = next(c for c in gp.checks if c.what == "objective")
+    assert (check.ok, check.term, check.cvxpy_is_dgp) == (False, "d + 1", False)
+    assert check.reason == (
+        "wobble = (max - min)/(max + min) over the grid: a difference of posynomials "
+        "divided by a sum is not log-log convex"
+    )
+    assert gp.objective_rows == []
+
+
+def test_every_operation_keeps_the_reference_design_for_float():
+    """float() of any traced value is its value at the reference design R = 2, d = 3
+    (the mechanisms' input checks read it)."""
+    R, d = _vars()
+    cases = [
+        (R + 1.0, 3.0),
+        (1.0 + R, 3.0),
+        (5.0 - R, 3.0),
+        (R - 5.0, -3.0),
+        (-(2.0 * R + 1.0), -5.0),
+        (R * d, 6.0),
+        (R / d, 2.0 / 3.0),
+        (6.0 / R, 3.0),
+        (R**2, 4.0),
+        ((R + 1.0) ** 2, 9.0),
+        (abs(-R - 2.0), 4.0),
+        (np.add(2.0, R), 4.0),
+        (np.subtract(5.0, R), 3.0),
+        (np.true_divide(6.0, d), 2.0),
+        (np.sqrt(R * d * 6.0), 6.0),
+        ((R * np.array([1.0, 3.0])).mean(), 4.0),
+    ]
+    for value, expected in cases:
+        assert value.ref is REF
+        assert float(value) == pytest.approx(expected, rel=1e-15)
+    assert ((R - R) ** 0).ref is REF and float((R - R) ** 0) == 1.0
+
+
+def test_small_positive_coefficients_are_no_negative_terms():
+    """Coefficients in (0, 1) and zeros on the grid are positive enough for a root or abs."""
+    R, _ = _vars()
+    half = (0.25 * R) ** 0.5
+    assert list(half.terms) == [(0.5, 0.0)] and half.terms[(0.5, 0.0)] == pytest.approx(0.5)
+    small = 0.5 * R
+    assert abs(small) is small
+    grid = R * np.array([1.0, 0.0])
+    assert abs(grid) is grid
+    assert _terms((R + 1.0) ** 1) == {(1.0, 0.0): 1.0, (0.0, 0.0): 1.0}

@@ -3,17 +3,19 @@
 Usage::
 
     python benchmarks/mutation/kill_subset.py MUTANTS_DIR MUTMUT_ALL PATTERN N SEED \
-        [--extra tests/test_x.py ...] [--deselect TEST_ID ...] [--only NAMES_FILE] [--python PY]
+        [--extra TEST ...] [--no-covering] [--then TEST ...] [--deselect TEST_ID ...] \
+        [--only NAMES_FILE] [--python PY]
 
 ``MUTANTS_DIR`` is a copy of a mutation run's ``mutants/`` (never the running one: the
 tests write caches there), ``MUTMUT_ALL`` the run's ``mutmut results --all true`` listing.
 The subset is ``N`` of the mutant names matching the regular expression ``PATTERN``,
-drawn by ``random.Random(SEED)`` from the sorted names. Each mutant faces the tests
-mutmut's own stats (``mutmut-stats.json``) list for its function - the tests the
-mutation run gives it - preceded by the ``--extra`` test files; pytest stops at the
-first failure (killed). One line per mutant on stdout (``killed``/``survived``/
-``error rc=N``/``timeout``), a summary at the end. Run it at ``nice`` 10 on a shared
-machine: it runs one pytest at a time.
+drawn by ``random.Random(SEED)`` from the sorted names. Each mutant faces the
+``--extra`` tests, then the tests mutmut's own stats (``mutmut-stats.json``) list for
+its function - the tests the mutation run gives it - unless ``--no-covering``; pytest
+stops at the first failure (killed). ``--then`` tests run on each survivor
+(``killed-then`` when they kill it: a before/after count in one pass). One line per
+mutant on stdout (``killed``, ``killed-then``, ``survived``, ``error rc=N``,
+``timeout``), a summary at the end. It runs one pytest at a time, at ``nice`` 10.
 """
 
 from __future__ import annotations
@@ -36,6 +38,15 @@ def main() -> int:
     ap.add_argument("n", type=int)
     ap.add_argument("seed", type=int)
     ap.add_argument("--extra", nargs="*", default=[])
+    ap.add_argument(
+        "--no-covering", action="store_true", help="only the --extra tests, not mutmut's"
+    )
+    ap.add_argument(
+        "--then",
+        nargs="*",
+        default=[],
+        help="tests run on each survivor (verdict 'killed-then' when they fail)",
+    )
     ap.add_argument("--deselect", nargs="*", default=[], help="test ids left out")
     ap.add_argument("--only", type=Path, help="run only these names (one a line)")
     ap.add_argument("--python", default=sys.executable)
@@ -58,7 +69,7 @@ def main() -> int:
     for name in subset:
         function = re.sub(r"__mutmut_\d+$", "", name)
         tests = sorted(
-            covering.get(function, []),
+            [] if args.no_covering else covering.get(function, []),
             key=lambda t: (not t.startswith("tests/test_gp.py"), duration.get(t, 0.0), t),
         )
         cmd = ["nice", "-n", "10", args.python, "-m", "pytest", "-q", "-x"]
@@ -66,25 +77,32 @@ def main() -> int:
         for test in args.deselect:
             cmd += ["--deselect", test]
         env = dict(os.environ, MUTANT_UNDER_TEST=name, PYTHONPATH=str(args.mutants))
-        if not args.extra and not tests:
-            verdict = "no tests"
-        else:
-            try:
-                rc = subprocess.run(
-                    cmd,
-                    cwd=args.mutants,
-                    env=env,
-                    stdout=subprocess.DEVNULL,
-                    stderr=subprocess.DEVNULL,
-                    timeout=args.timeout,
-                ).returncode
-                verdict = {0: "survived", 1: "killed"}.get(rc, f"error rc={rc}")
-            except subprocess.TimeoutExpired:
-                verdict = "timeout"
+        verdict = run(cmd, env, args) if args.extra or tests else "no tests"
+        if verdict in ("survived", "no tests") and args.then:
+            then = cmd[: cmd.index("no:cacheprovider") + 1] + args.then
+            for test in args.deselect:
+                then += ["--deselect", test]
+            verdict = {"killed": "killed-then"}.get(run(then, env, args), verdict)
         counts[verdict] = counts.get(verdict, 0) + 1
         print(f"{verdict:10s} {name}", flush=True)
     print("summary:", ", ".join(f"{k} {v}" for k, v in sorted(counts.items())), flush=True)
     return 0
+
+
+def run(cmd: list[str], env: dict[str, str], args: argparse.Namespace) -> str:
+    """pytest's verdict on one mutant: killed (a test failed), survived, or why neither."""
+    try:
+        rc = subprocess.run(
+            cmd,
+            cwd=args.mutants,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            timeout=args.timeout,
+        ).returncode
+    except subprocess.TimeoutExpired:
+        return "timeout"
+    return {0: "survived", 1: "killed"}.get(rc, f"error rc={rc}")
 
 
 if __name__ == "__main__":
