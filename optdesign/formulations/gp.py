@@ -453,6 +453,14 @@ def _objective_rows(gp: GPData, name, kind, expr, problem, names, n_grid) -> DGP
         if not terms:
             continue
         out.append(_as_row(name, labels[r], names, terms, 1.0, "objective", 0.0, ""))
+    if not out:  # 0 at every design: cvxpy's min t would be "unbounded", not an optimum
+        return DGPCheck(
+            "objective",
+            name,
+            False,
+            f"{name} is 0 whatever the design: a GP minimises a positive posynomial",
+            name,
+        )
     gp.n_rows_before_pruning += len(out)
     gp.objective_rows = _prune(out)
     shape = "max over the grid of posynomials" if kind == "max" else "posynomial"

@@ -146,6 +146,8 @@ class Signomial:
             mag = f"{abs(val):.{digits}g}"
             text = mag if not mono else (mono if mag == "1" else f"{mag}*{mono}")
             parts.append(("- " if val < 0 else "+ ") + text)
+        if not parts:  # every coefficient is zero at this grid row
+            return "0"
         out = " ".join(parts)
         return out[2:] if out.startswith("+ ") else "-" + out[2:]
 
@@ -204,7 +206,9 @@ class Signomial:
             )
         ((a, c),) = self.terms.items()
         if np.any(np.asarray(c) == 0.0):
-            return NotGP(f"division by {self.describe()}, which is zero on the grid")
+            # shown at a grid row where it is not zero: at the others it reads "0"
+            shown = self.describe(int(np.flatnonzero(np.ravel(c))[0]))
+            return NotGP(f"division by {shown}, which is zero on the grid", shown)
         return Signomial(self.names, {tuple(-e for e in a): 1.0 / c}, self.ref)
 
     def __truediv__(self, other):
