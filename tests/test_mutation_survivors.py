@@ -430,6 +430,12 @@ def test_only_palmgrens_contact_is_restricted_to_steel():
     with pytest.raises(InputError, match="Palmgren's approach is an empirical law of steel"):
         PinJoint(8.0, 12.0, E=titanium, contact="palmgren")
     assert PinJoint(8.0, 12.0, E=2.1e5, contact="palmgren").contact == "palmgren"
+    # the steel band 1.9e5-2.2e5 MPa, both ends included
+    for steel in (1.9e5, 2.2e5):
+        assert PinJoint(8.0, 12.0, E=steel, contact="palmgren").E == steel
+    for not_steel in (1.89e5, 2.21e5):
+        with pytest.raises(InputError, match=r"^materials\.pin\.E: Palmgren's approach"):
+            PinJoint(8.0, 12.0, E=not_steel, contact="palmgren")
 
 
 # --- survivors of the second sample (docs/testing.md, "The second sample") ------------------
