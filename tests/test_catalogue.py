@@ -267,3 +267,16 @@ def test_the_shared_memos_keep_the_newest_searches_and_evict_the_oldest(monkeypa
     assert catalogue_bnb.shared_memo(("search", 9), full) is memos[9]
     assert catalogue_bnb.shared_memo(("search", 0), full) is not memos[0]  # evicted: a new one
     assert ("search", 2) not in catalogue_bnb._MEMOS
+
+
+def test_the_catalogue_search_refuses_a_problem_without_catalogue_variables():
+    """Through the API and called directly: one message, naming the formulation."""
+    import optdesign as od
+    from optdesign.studies.catalogue import solve_catalogue
+
+    problem = od.load(Path(__file__).resolve().parents[1] / "problems" / "cs_min_backlash.toml")
+    message = "--formulation catalogue: no variable takes catalogue values"
+    for call in (lambda: od.solve(problem, "catalogue"), lambda: solve_catalogue(problem)):
+        with pytest.raises(ProblemError) as refused:
+            call()
+        assert str(refused.value) == message
