@@ -6,6 +6,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import optdesign as od
@@ -247,3 +248,34 @@ def test_a_nodes_first_start_is_the_hint_clipped_into_the_nodes_box(monkeypatch)
     assert (first[names.index("p")], first[names.index("d")]) == (6.0, 6.0)
     others = [k for k, n in enumerate(names) if n not in ("p", "d")]
     assert first[others].tolist() == hint[others].tolist()
+
+
+def test_a_nodes_starts_are_its_seeds_sobol_points_and_a_retry_draws_new_ones(monkeypatch):
+    """A cold node starts from the problem's start, then the Sobol points of the solver's
+    seed (the same on every run); when every start fails, the retry tries RETRY_STARTS
+    Sobol points of the next seed, not the ones it tried."""
+    from optdesign.solvers.multistart import sobol_starts
+    from optdesign.solvers.result import Result
+    from optdesign.studies import catalogue
+
+    problem = _small()
+    solver = NodeSolver(problem, starts=3, seed=5)
+    seen = []
+
+    def fails(item):
+        seen.append(item[1])
+        return Result(status="failed", objective=float("nan"), formulation="nlp", message="x")
+
+    monkeypatch.setattr(solver, "_solve_start", fails)
+    bounds = {"p": (5.0, 6.0), "d": (6.0, 8.0)}
+    solver.solve(bounds)
+    names = [v.name for v in problem.free]
+    lo, hi = problem.lower().copy(), problem.upper().copy()
+    for name, (a, b) in bounds.items():
+        lo[names.index(name)], hi[names.index(name)] = a, b
+    assert len(seen) == 3 + catalogue.RETRY_STARTS
+    np.testing.assert_array_equal(seen[0], np.clip(problem.start(), lo, hi))
+    np.testing.assert_array_equal(np.array(seen[1:3]), sobol_starts(lo, hi, 2, 5))
+    retry = sobol_starts(lo, hi, catalogue.RETRY_STARTS, 6)
+    np.testing.assert_array_equal(np.array(seen[3:]), retry)
+    assert not np.isin(retry, np.array(seen[1:3])).all(axis=1).any()

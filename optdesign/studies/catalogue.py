@@ -70,8 +70,10 @@ class NodeSolver:
     """Solve the problem's NLP on a sub-box of the catalogue variables.
 
     One solver (:func:`optdesign.studies.nlp_solve.solver_for`) serves every node: a node
-    only passes its own variable bounds. A node whose starts all fail is tried again from
-    :data:`RETRY_STARTS` more Sobol starts before it counts as infeasible, so a poor
+    only passes its own variable bounds. A node's starts are the hint (or the problem's
+    start) and the Sobol points of the solver's ``seed``. A node whose starts all fail is
+    tried again from :data:`RETRY_STARTS` Sobol points of ``seed + 1`` (points it has not
+    tried) before it counts as infeasible, so a poor
     first start (e.g. a declared one) that stops at an iteration limit or an error never
     makes a feasible problem look infeasible. Two starts that both end with the back-end's
     own verdict of local infeasibility (:meth:`verdicts_decide`) end the multistart: the
