@@ -9,12 +9,17 @@ run's ``mutants/``) and to pass on the code.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
 
 import optdesign as od
+from optdesign.errors import InputError
+from optdesign.studies.pareto import compute_front
 from optdesign.studies.pareto.front import FrontPoint, make_front
+from optdesign.studies.pareto.io import write_front_csv
+from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_problem
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -83,10 +88,60 @@ def test_an_ipopt_front_warm_starts_its_sweep_solves(cs_min_backlash):
 def test_a_library_front_of_a_repeated_objective_is_refused_naming_the_field(cs_min_backlash):
     """``compute_front`` (below the API's own check) refuses an objective given twice,
     naming the field and the list, before any solve."""
-    from optdesign.errors import InputError
-    from optdesign.studies.pareto import compute_front
-
     with pytest.raises(InputError) as caught:
         compute_front(cs_min_backlash, ["backlash", "backlash"], 3)
     assert caught.value.field == "objectives"
     assert str(caught.value) == "objectives: repeated objective in ['backlash', 'backlash']"
+
+
+def test_a_library_front_of_an_unknown_method_is_refused_naming_the_known_ones(cs_min_backlash):
+    """``compute_front`` refuses a method name it does not know, listing the known ones."""
+    with pytest.raises(InputError) as caught:
+        compute_front(cs_min_backlash, ["backlash", "size"], 3, method="simplex")
+    assert caught.value.field == "method"
+    assert str(caught.value).startswith("method: unknown method 'simplex' (known: epsilon, ")
+
+
+# --- the sweep's solves -------------------------------------------------------------------
+def test_an_epsilon_point_that_needs_no_retry_is_solved_once(cs_min_backlash, tmp_path):
+    """Without extra starts, a point whose warm start succeeds (not worse than its
+    neighbour, no jump) costs one solve, and its record says so."""
+    od.pareto(cs_min_backlash, ["backlash", "size"], 5, out=tmp_path, starts=1)
+    lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
+    eps = [r for r in map(json.loads, lines) if r["kind"] == "eps"]
+    plain = [r for r in eps if not r["retried"]]
+    assert len(eps) == 5 and len(plain) >= 3
+    assert [r["n_solves"] for r in plain] == [1] * len(plain)
+
+
+# --- files of a front ---------------------------------------------------------------------
+def test_an_empty_fronts_csv_has_the_heading_every_front_csv_starts_with(cs_min_backlash, tmp_path):
+    """A front with no point still writes front.csv: the one heading ``method``, the
+    first heading of a front with points."""
+    empty = make_front([], ["backlash", "size"], "epsilon", problem=cs_min_backlash)
+    path = write_front_csv(empty, cs_min_backlash, tmp_path / "empty.csv")
+    assert path.read_text() == "method\n"
+    full = _front_of_midpoints(cs_min_backlash)
+    text = write_front_csv(full, cs_min_backlash, tmp_path / "full.csv").read_text()
+    assert text.split(",")[0] == "method"
+
+
+# --- stored records -----------------------------------------------------------------------
+def test_a_stored_anchor_whose_multistart_is_not_a_multistart_record_is_not_trusted(
+    cs_min_backlash,
+):
+    """A stored record's ``multistart`` is null or the anchor's multistart record (every
+    field); anything else is named as the reason the record cannot be trusted."""
+    record = PointRecord(
+        id="anchor-backlash-ms",
+        kind="anchor-multistart",
+        target="backlash",
+        status="failed",
+        multistart=AnchorStarts(
+            n_starts=2, n_planned=2, n_at_best=0, agree=None, stopped_early=False
+        ),
+    ).to_dict()
+    assert record_problem(cs_min_backlash, record) is None
+    for broken in ({"n_starts": 2}, [2, 2, 0, None, False], "2 starts"):
+        why = record_problem(cs_min_backlash, {**record, "multistart": broken})
+        assert why == "field 'multistart' is not a multistart record"
