@@ -10,13 +10,15 @@ run's ``mutants/``) and to pass on the code.
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
-from optdesign.studies.pareto import compute_front
+from optdesign.studies.pareto import FrontMethod, compute_front
 from optdesign.studies.pareto.front import FrontPoint, make_front
 from optdesign.studies.pareto.io import write_front_csv
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_problem
@@ -145,3 +147,38 @@ def test_a_stored_anchor_whose_multistart_is_not_a_multistart_record_is_not_trus
     for broken in ({"n_starts": 2}, [2, 2, 0, None, False], "2 starts"):
         why = record_problem(cs_min_backlash, {**record, "multistart": broken})
         assert why == "field 'multistart' is not a multistart record"
+
+
+# --- the catalogue refusal of the front-method template -----------------------------------
+@dataclass
+class _CatalogueOnly(FrontMethod):
+    """A plug-in front method that needs catalogue variables."""
+
+    name: str = "catalogue-only"
+    designs: ClassVar[str] = "catalogue"
+
+
+def test_a_front_method_that_needs_catalogue_variables_refuses_a_continuous_problem(
+    cs_min_backlash, tmp_path
+):
+    """A method declaring ``designs = "catalogue"`` is refused on a problem without
+    catalogue variables, naming the field and the method, before any store is written."""
+    with pytest.raises(InputError) as caught:
+        compute_front(cs_min_backlash, ["backlash", "size"], 3, _CatalogueOnly(), out=tmp_path)
+    assert caught.value.field == "method"
+    assert str(caught.value) == "method: catalogue-only: no variable takes catalogue values"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_catalogue_front_of_a_problem_without_catalogue_variables_is_refused_first(
+    cs_min_backlash, tmp_path
+):
+    """``CatalogueEpsilon`` given to ``od.pareto`` on a continuous problem is refused
+    naming the field, before its store is opened (it used to write the store and fail in
+    its first task on a message naming ``--formulation catalogue``)."""
+    from optdesign.studies.pareto import CatalogueEpsilon
+
+    with pytest.raises(InputError) as caught:
+        od.pareto(cs_min_backlash, ["backlash", "size"], method=CatalogueEpsilon(), out=tmp_path)
+    assert str(caught.value) == "method: epsilon-catalogue: no variable takes catalogue values"
+    assert list(tmp_path.iterdir()) == []
