@@ -182,3 +182,84 @@ def test_a_catalogue_front_of_a_problem_without_catalogue_variables_is_refused_f
         od.pareto(cs_min_backlash, ["backlash", "size"], method=CatalogueEpsilon(), out=tmp_path)
     assert str(caught.value) == "method: epsilon-catalogue: no variable takes catalogue values"
     assert list(tmp_path.iterdir()) == []
+
+
+# --- the work a front reports ---------------------------------------------------------------
+def test_a_weighted_sum_front_counts_the_solves_of_its_points_and_anchors(
+    cs_min_backlash, tmp_path
+):
+    """A weighted-sum front's ``n_solves`` is one solve a point plus every solve behind its
+    anchors (their multistarts and tie-breaks), as its store records them."""
+    front = od.pareto(
+        cs_min_backlash, ["backlash", "size"], 4, method="weighted_sum", out=tmp_path, starts=1
+    )
+    lines = (tmp_path / "weighted_sum.jsonl").read_text().splitlines()[1:]
+    records = list(map(json.loads, lines))
+    points = [r for r in records if r["kind"] == "weighted_sum"]
+    anchors = [r for r in records if r["kind"] == "anchor"]
+    assert len(points) == 4 and len(anchors) == 2
+    assert all(r["n_solves"] >= 2 for r in anchors)  # the multistart's solve and the tie's
+    assert front.n_solves == 4 + sum(r["n_solves"] for r in anchors)
+
+
+def test_nsga2_runs_the_generations_it_is_given(cs_min_backlash, monkeypatch):
+    """NSGA-II evaluates one population a generation, for exactly ``generations``."""
+    from optdesign.studies.pareto import methods
+
+    calls = []
+    real = methods.pymoo_problem
+
+    def counted(problem, objectives):
+        inner = real(problem, objectives)
+        evaluate = inner._evaluate
+
+        def _evaluate(X, out, *args, **kwargs):
+            calls.append(len(X))
+            if len(calls) > 10:
+                raise RuntimeError("NSGA-II ran past the generations it was given")
+            return evaluate(X, out, *args, **kwargs)
+
+        inner._evaluate = _evaluate
+        return inner
+
+    monkeypatch.setattr(methods, "pymoo_problem", counted)
+    front = od.pareto(
+        cs_min_backlash, ["backlash", "size"], method="nsga2", pop_size=8, generations=3, seed=1
+    )
+    assert calls == [8, 8, 8]
+    assert front.settings == {"pop_size": 8, "generations": 3, "seed": 1}
+
+
+# --- the chains of an epsilon front -------------------------------------------------------
+def _record(id_, kind, objectives):
+    return PointRecord(
+        id=id_,
+        kind=kind,
+        target="size",
+        status="optimal",
+        verified=True,
+        objectives=objectives,
+    ).to_dict()
+
+
+def test_an_arc_point_whose_neighbour_failed_takes_the_evenly_spaced_limit():
+    """An arc-spaced point whose neighbour has no design cannot predict its limit from
+    the neighbour: it takes its place on an even spacing between the frame's ends."""
+    from optdesign.studies.pareto.chains import TwoChains
+    from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps
+
+    chains = TwoChains(["backlash", "size"], 5, "epsilon", {}, "arc", None)
+    done = {
+        "anchor-backlash": _record("anchor-backlash", "anchor", {"backlash": 1.0, "size": 10.0}),
+        "anchor-size-ms": _record(
+            "anchor-size-ms", "anchor-multistart", {"backlash": 5.0, "size": 2.0}
+        ),
+    }
+    (first,) = chains({"id": "anchor-size-ms"}, done["anchor-size-ms"], done)
+    (second,) = chains(first, {}, done)
+    assert second["index"] == 1 and second["eps_name"] == "backlash"
+    lo = 1.0 * (1 + ANCHOR_SLACK) + 1e-12
+    assert first["eps"] == {"backlash": lo}
+    failed = PointRecord(id=first["id"], kind="eps", target="size", status="failed")
+    assert arc_eps(second, failed) == {"backlash": pytest.approx(lo + (5.0 - lo) / 4, rel=1e-12)}
+    assert arc_eps(second, None) == arc_eps(second, failed)
