@@ -263,3 +263,19 @@ def test_an_arc_point_whose_neighbour_failed_takes_the_evenly_spaced_limit():
     failed = PointRecord(id=first["id"], kind="eps", target="size", status="failed")
     assert arc_eps(second, failed) == {"backlash": pytest.approx(lo + (5.0 - lo) / 4, rel=1e-12)}
     assert arc_eps(second, None) == arc_eps(second, failed)
+
+
+def test_resuming_a_store_whose_identity_line_was_torn_says_it_has_none(cs_min_backlash, tmp_path):
+    """A store holding only a torn first line (a run stopped while writing its identity)
+    is no store of any run: the resume is refused, saying so and how to start over."""
+    from optdesign.storage import StoreError
+
+    store = tmp_path / "epsilon.jsonl"
+    store.write_text('{"__store__": 2, "identity": {"objec')
+    with pytest.raises(StoreError) as caught:
+        od.pareto(cs_min_backlash, ["backlash", "size"], 3, out=tmp_path, resume=True, starts=1)
+    assert str(caught.value) == (
+        f"--resume: {store} cannot be resumed: it has no identity line; start over with "
+        "--overwrite or use another output folder"
+    )
+    assert store.read_text() == '{"__store__": 2, "identity": {"objec'
