@@ -149,6 +149,17 @@ def test_a_stored_anchor_whose_multistart_is_not_a_multistart_record_is_not_trus
         assert why == "field 'multistart' is not a multistart record"
 
 
+# --- catalogue fronts ---------------------------------------------------------------------
+def test_a_catalogue_front_of_fewer_than_two_points_is_refused_naming_the_count():
+    """A catalogue front needs two points at least: ``points=1`` is refused, naming the
+    field and the count, before any search."""
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    with pytest.raises(InputError) as caught:
+        compute_front(problem, ["backlash", "motor_torque"], 1)
+    assert caught.value.field == "points"
+    assert str(caught.value) == "points: a front needs at least 2 points, got 1"
+
+
 # --- the catalogue refusal of the front-method template -----------------------------------
 @dataclass
 class _CatalogueOnly(FrontMethod):
