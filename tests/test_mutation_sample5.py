@@ -149,6 +149,18 @@ def test_a_stored_anchor_whose_multistart_is_not_a_multistart_record_is_not_trus
         assert why == "field 'multistart' is not a multistart record"
 
 
+def test_a_stored_record_whose_lists_are_not_lists_of_names_is_not_trusted(cs_min_backlash):
+    """A stored record's ``active``, ``violated`` and ``order`` are lists of names; a
+    number among them is named as the reason the record cannot be trusted."""
+    record = PointRecord(
+        id="epsilon-0001", kind="eps", target="size", status="failed", active=["backlash"]
+    ).to_dict()
+    assert record_problem(cs_min_backlash, record) is None
+    for name in ("active", "violated", "order"):
+        why = record_problem(cs_min_backlash, {**record, name: ["backlash", 5]})
+        assert why == f"field {name!r} is not a list of names"
+
+
 # --- catalogue fronts ---------------------------------------------------------------------
 def test_a_catalogue_front_of_fewer_than_two_points_is_refused_naming_the_count():
     """A catalogue front needs two points at least: ``points=1`` is refused, naming the
@@ -211,6 +223,35 @@ def test_a_weighted_sum_front_counts_the_solves_of_its_points_and_anchors(
     assert len(points) == 4 and len(anchors) == 2
     assert all(r["n_solves"] >= 2 for r in anchors)  # the multistart's solve and the tie's
     assert front.n_solves == 4 + sum(r["n_solves"] for r in anchors)
+
+
+def test_a_weighted_sum_point_whose_neighbour_failed_restarts_from_its_chains_anchor(
+    cs_min_backlash, tmp_path, monkeypatch
+):
+    """The weighted-sum chain starts at the last objective's anchor (weight 0 on the
+    first); a point whose neighbour failed starts again from that anchor's design."""
+    from optdesign.studies.pareto import tasks
+
+    real = tasks.TASK_KINDS["weighted_sum"]
+    given = {}
+
+    def weighted(task, deps):
+        given[task["id"]] = task["x0"]
+        if task["id"] == "ws-0001":  # a failed point: the next one starts without it
+            return PointRecord(
+                id=task["id"], kind="weighted_sum", target="backlash", status="failed"
+            ).to_dict()
+        return real(task, deps)
+
+    monkeypatch.setitem(tasks.TASK_KINDS, "weighted_sum", weighted)
+    front = od.pareto(
+        cs_min_backlash, ["backlash", "size"], 3, method="weighted_sum", out=tmp_path, starts=1
+    )
+    lines = (tmp_path / "weighted_sum.jsonl").read_text().splitlines()[1:]
+    anchors = {r["id"]: r["x"] for r in map(json.loads, lines) if r["kind"] == "anchor"}
+    assert anchors["anchor-size"] != anchors["anchor-backlash"]
+    assert given == {f"ws-000{i}": anchors["anchor-size"] for i in range(3)}
+    assert "ws-0002" in {p.id for p in front.points}
 
 
 def test_nsga2_runs_the_generations_it_is_given(cs_min_backlash, monkeypatch):
