@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
+import numpy as np
 import pytest
 
 import optdesign as od
@@ -294,11 +295,10 @@ def _record(id_, kind, objectives):
     ).to_dict()
 
 
-def test_an_arc_point_whose_neighbour_failed_takes_the_evenly_spaced_limit():
-    """An arc-spaced point whose neighbour has no design cannot predict its limit from
-    the neighbour: it takes its place on an even spacing between the frame's ends."""
+def _arc_chain():
+    """The first two tasks of a 5-point arc sweep between anchor A (backlash 1, size 10)
+    and B's multistart optimum (backlash 5, size 2)."""
     from optdesign.studies.pareto.chains import TwoChains
-    from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps
 
     chains = TwoChains(["backlash", "size"], 5, "epsilon", {}, "arc", None)
     done = {
@@ -309,6 +309,15 @@ def test_an_arc_point_whose_neighbour_failed_takes_the_evenly_spaced_limit():
     }
     (first,) = chains({"id": "anchor-size-ms"}, done["anchor-size-ms"], done)
     (second,) = chains(first, {}, done)
+    return first, second
+
+
+def test_an_arc_point_whose_neighbour_failed_takes_the_evenly_spaced_limit():
+    """An arc-spaced point whose neighbour has no design cannot predict its limit from
+    the neighbour: it takes its place on an even spacing between the frame's ends."""
+    from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps
+
+    first, second = _arc_chain()
     assert second["index"] == 1 and second["eps_name"] == "backlash"
     lo = 1.0 * (1 + ANCHOR_SLACK) + 1e-12
     assert first["eps"] == {"backlash": lo}
@@ -331,3 +340,45 @@ def test_resuming_a_store_whose_identity_line_was_torn_says_it_has_none(cs_min_b
         "--overwrite or use another output folder"
     )
     assert store.read_text() == '{"__store__": 2, "identity": {"objec'
+
+
+def test_an_arc_step_never_asks_below_the_first_anchors_limit():
+    """A neighbour already past the point's arc position steps back, but never below
+    the frame's lower end (anchor A's optimum plus the anchors' slack): no limit
+    tighter than the best A can reach."""
+    from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps
+
+    _, second = _arc_chain()
+    lo = 1.0 * (1 + ANCHOR_SLACK) + 1e-12
+    past = PointRecord(
+        id="epsilon-0000",
+        kind="eps",
+        target="size",
+        status="optimal",
+        verified=True,
+        objectives={"backlash": 1.0, "size": 2.0},
+    )
+    assert arc_eps(second, past) == {"backlash": lo}
+
+
+# --- metrics ------------------------------------------------------------------------------
+def test_the_spread_of_coincident_points_is_zero():
+    """Points that all coincide have no uneven gap: their spread is 0, not NaN."""
+    from optdesign.studies.pareto.metrics import spread
+
+    F = np.array([[1.0, 2.0], [1.0, 2.0], [1.0, 2.0]])
+    assert spread(F) == 0.0
+    assert spread(np.array([[0.0, 2.0], [1.0, 1.0], [2.0, 0.0]])) == 0.0  # even gaps
+
+
+# --- anchors ------------------------------------------------------------------------------
+def test_an_anchor_whose_starts_succeed_solves_each_start_once(cs_min_backlash, tmp_path):
+    """An anchor's multistart re-runs its starts with the fallback back-end only when no
+    start reached a solution: starts that succeed cost one solve each."""
+    od.pareto(cs_min_backlash, ["backlash", "size"], 3, out=tmp_path, starts=2)
+    lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
+    ms = [r for r in map(json.loads, lines) if r["kind"] == "anchor-multistart"]
+    assert len(ms) == 2
+    for r in ms:
+        assert r["status"] == "optimal" and r["multistart"]["n_at_best"] >= 1
+        assert r["n_solves"] == r["multistart"]["n_starts"] == 2
