@@ -87,6 +87,18 @@ def test_an_ipopt_front_warm_starts_its_sweep_solves(cs_min_backlash):
     assert "warm_start_init_point" not in eps.backend("fallback").options["ipopt"]
 
 
+def test_a_front_solvers_back_end_is_its_primary_by_default(cs_min_backlash):
+    """``EpsSolver.backend()`` with no use named is the primary back-end (the registry's
+    front primary, SLSQP), the one every sweep solve tries first."""
+    from optdesign.studies.pareto.eps_solver import EpsSolver
+
+    eps = EpsSolver(cs_min_backlash, ["backlash", "size"])
+    assert eps.has_fallback
+    assert eps.backend() is eps.backend("primary")
+    assert eps.backend().name == "scipy-slsqp-exact"
+    assert eps.backend("fallback").name == "ipopt"
+
+
 # --- the front's objectives ---------------------------------------------------------------
 def test_a_library_front_of_a_repeated_objective_is_refused_naming_the_field(cs_min_backlash):
     """``compute_front`` (below the API's own check) refuses an objective given twice,
