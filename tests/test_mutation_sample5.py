@@ -174,6 +174,28 @@ def test_a_stored_record_whose_lists_are_not_lists_of_names_is_not_trusted(cs_mi
         assert why == f"field {name!r} is not a list of names"
 
 
+def test_a_failed_points_record_keeps_the_names_of_its_first_twenty_violated_rows(
+    cs_min_backlash,
+):
+    """A front's record names at most 20 violated rows (the first ones, in the
+    solver's order): a point violating a whole grid does not fill the store."""
+    import math
+
+    from optdesign.solvers.result import ConstraintReport, Result
+    from optdesign.studies.pareto.records import record_from_result
+
+    rows = [
+        ConstraintReport(name=f"deflection[{i}]", value=1.0, lower=None, upper=0.5, amount=0.5)
+        for i in range(25)
+    ]
+    result = Result(
+        status="infeasible", solver="ipopt", objective=math.nan, formulation="nlp", violated=rows
+    )
+    rec = record_from_result(cs_min_backlash, result, "eps", "size", {"backlash": 0.01}, "e-1")
+    assert rec.violated == [f"deflection[{i}]" for i in range(20)]
+    assert not rec.success
+
+
 # --- catalogue fronts ---------------------------------------------------------------------
 def test_a_catalogue_front_of_fewer_than_two_points_is_refused_naming_the_count():
     """A catalogue front needs two points at least: ``points=1`` is refused, naming the
