@@ -120,7 +120,7 @@ class CatalogueEpsilon(FrontMethod):
     seed: int | None = None
     name: str = "epsilon-catalogue"
 
-    designs: ClassVar[str] = "any"
+    designs: ClassVar[str] = "catalogue"
     n_objectives: ClassVar[tuple[int, ...]] = (2,)
     what: ClassVar[str] = "a catalogue front"
     max_default_starts: ClassVar[int | None] = 4
