@@ -238,7 +238,8 @@ def test_the_cvxpy_gps_bound_rows_read_as_x_over_upper_and_lower_over_x():
     c exp(A log x) <= 1: x / upper and lower / x, equal to 1 on the bound."""
     gp = build_gp(problem_from_dict(copy.deepcopy(CS_FIXED)))
     _, xs, t, cons = to_cvxpy(gp)
-    rows = {(r.name, r.kind): r for r, _ in cons if r.name.startswith("bound:")}
+    rows = {(r.name, r.label): r for r, _ in cons if r.name.startswith("bound:")}
+    assert all(key[1] == row.kind for key, row in rows.items())  # "upper" / "lower"
     assert len(rows) == 2 * len(gp.names) == 2 * len(xs)
     assert [x.name() for x in xs] == list(gp.names) and t.name() == "t"  # as cvxpy prints
     lo, hi = np.asarray(gp.lower, dtype=float), np.asarray(gp.upper, dtype=float)
@@ -270,6 +271,19 @@ def test_a_ripple_limit_that_depends_on_the_design_is_named_as_no_gp():
         "ripple = (max - min)/(max + min) over the grid is a ratio of a difference of posynomials"
     )
     assert not gp.is_gp
+
+
+def test_a_gp_optimum_on_a_variable_bound_names_that_bounds_multiplier():
+    """Pins of at least 20 mm (the optimum's 7.6 mm excluded): the GP ends on the bound,
+    and its multipliers name it as the reports do, bound:d[lower]."""
+    data = copy.deepcopy(CS_FIXED)
+    data["variables"]["d"] = {"lower": 20, "upper": 30}
+    result = solve_gp_problem(problem_from_dict(data), nlp_starts=1)
+    assert result.status == "optimal"
+    assert result.design["d"] == pytest.approx(20.0, rel=1e-6)
+    multipliers = result.details.gp.dual.multipliers
+    assert multipliers["bound:d[lower]"] > 0.1
+    assert not [k for k in multipliers if k.startswith("bound:") and k != "bound:d[lower]"]
 
 
 def test_a_constraint_the_tracer_cannot_represent_carries_its_reason_and_term():
