@@ -416,3 +416,19 @@ def test_an_anchor_whose_starts_succeed_solves_each_start_once(cs_min_backlash, 
     for r in ms:
         assert r["status"] == "optimal" and r["multistart"]["n_at_best"] >= 1
         assert r["n_solves"] == r["multistart"]["n_starts"] == 2
+
+
+def test_an_anchor_multistart_whose_starts_succeed_is_not_solved_again_with_the_fallback():
+    """The fallback re-run is for a multistart none of whose starts succeeded: one start
+    that reaches the optimum is one solve, and agreeing starts stop the multistart."""
+    from optdesign.studies.pareto.tasks import multistart_task
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    order = ["backlash", "size"]
+    for starts, agree, solves in [(1, None, 1), (4, 3, 3)]:
+        task = {"problem": problem, "order": order, "objectives": order, "starts": starts,
+                "seed": 0, "agree": agree, "id": "anchor-backlash-ms"}  # fmt: skip
+        record = multistart_task(task, {})
+        assert record["status"] == "optimal" and record["n_solves"] == solves
+        assert record["multistart"]["n_starts"] == solves
+        assert record["objectives"]["backlash"] == pytest.approx(0.0362197, rel=1e-5)
