@@ -1,0 +1,625 @@
+"""The catalogue search's observable behaviour, pinned function by function.
+
+Branch and bound, enumeration, first incumbents, the diagnosis's depth-first search and
+the pseudo-costs run here on a fake node solver whose relaxation is known in closed form
+(a separable quadratic over a box, with one linear limit), so every count, value and item
+is checked against a hand trace or a brute-force enumeration; the pure helpers (pruning,
+tie rules, item distances, the infeasible-box memo) against values worked out by hand.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from optdesign.errors import ProblemError
+from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.studies import catalogue_bnb
+from optdesign.studies.catalogue import (
+    NodeSolver,
+    _no_item,
+    catalogue_applies,
+    enumerate_catalogue,
+    first_feasible,
+    is_on_catalogue,
+    minlp_back_end,
+    relaxation_bound,
+    solve_catalogue,
+)
+from optdesign.studies.catalogue_bnb import (
+    PRUNE_TOL,
+    InfeasibleBoxes,
+    PseudoCosts,
+    _prunes_box,
+    _value,
+    _x_of_design,
+    box_cannot_win,
+    box_key,
+    branch_and_bound_warm,
+    cannot_improve,
+    combination_key,
+    first_incumbent,
+    fixed_box,
+    item_distances,
+    on_items,
+    split_at_items,
+    trusted,
+    trusted_value,
+    wins,
+)
+
+
+@dataclass
+class _Var:
+    name: str
+    values: tuple[float, ...]
+    discrete: bool = True
+
+    @property
+    def lower(self) -> float:
+        return self.values[0]
+
+    @property
+    def upper(self) -> float:
+        return self.values[-1]
+
+
+@dataclass
+class _Problem:
+    free: list[_Var]
+
+
+def _result(value: float, design: dict, n_starts: int = 1, early: bool = False) -> Result:
+    r = Result(
+        status="optimal",
+        objective=value,
+        design=dict(design),
+        solver="fake",
+        formulation="nlp",
+        wall_time_s=0.0,
+    )
+    r.multistart = MultistartInfo(
+        n_starts=n_starts, n_converged=n_starts, n_at_best=1, tolerance=1e-6, stopped_early=early
+    )
+    return r
+
+
+def _failed() -> Result:
+    return Result(
+        status="infeasible",
+        objective=float("nan"),
+        design={},
+        solver="fake",
+        formulation="nlp",
+        wall_time_s=0.0,
+    )
+
+
+class QuadNodes:
+    """A node solver of sum (x - centre)^2 over the box, with x[cap_name] <= cap: the
+    relaxation's optimum is the centre clipped into the box (and under the cap), a box
+    whose cap variable starts above the cap is infeasible. A warm solve (or
+    ``fallback=False``) is one start; otherwise the full multistart of ``starts``."""
+
+    def __init__(self, items: dict, centre: dict, cap: float = math.inf, starts: int = 2):
+        self.problem = _Problem([_Var(k, v) for k, v in items.items()])
+        self.names = list(items)
+        self.centre = centre
+        self.cap_name = self.names[0]
+        self.cap = cap
+        self.starts = starts
+        self.memo = None
+        self.eps: dict = {}
+        self.objective = "f"
+        self.calls: list[tuple[dict, bool, float | None]] = []
+
+    def value(self, point: dict) -> float:
+        return sum((point[n] - self.centre[n]) ** 2 for n in self.names)
+
+    def solve(self, bounds, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+        self.calls.append((dict(bounds), warm, floor))
+        box = {v.name: bounds.get(v.name, (v.lower, v.upper)) for v in self.problem.free}
+        lo, hi = box[self.cap_name]
+        if lo > self.cap:
+            return _failed()
+        box[self.cap_name] = (lo, min(hi, self.cap))
+        point = {n: min(max(self.centre[n], box[n][0]), box[n][1]) for n in self.names}
+        value = self.value(point)
+        one = warm and x_hint is not None and (not fallback or prunes is None or not prunes(value))
+        return _result(value, point, 1 if one else self.starts)
+
+    def x_of(self, result):
+        if not result.design:
+            return None
+        return np.array([result.design[n] for n in self.names])
+
+
+def _brute(ns: QuadNodes) -> tuple[float, tuple[float, ...]]:
+    """The best feasible item combination by enumeration (smallest items on a tie)."""
+    best = None
+    for combo in itertools.product(*(v.values for v in ns.problem.free)):
+        if combo[0] > ns.cap:
+            continue
+        f = ns.value(dict(zip(ns.names, combo, strict=True)))
+        if best is None or f < best[0] - PRUNE_TOL * abs(best[0]):
+            best = (f, combo)
+    return best
+
+
+def _root(ns: QuadNodes) -> Result:
+    return ns.solve({})
+
+
+def test_branch_and_bound_on_one_variable_follows_the_hand_trace():
+    """Items 1..4 around 2.4: two children, one leaf, a split below it, a warm node re-solved
+    and pruned: 6 nodes, 2 pruned, 1 leaf, item 2 at 0.16."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.4}, cap=3.5)
+    best, stats = branch_and_bound_warm(ns, _root(ns))
+    assert best.objective == pytest.approx(0.16) and best.design == {"a": 2.0}
+    assert stats == {"nodes": 6, "pruned": 2, "infeasible": 0, "leaves": 1, "seeded": 0}
+    # children solved warm from the root's optimum with its value as their floor
+    assert ns.calls[1] == ({"a": (1.0, 2.0)}, True, 0.0)
+    assert ns.calls[2] == ({"a": (3.0, 4.0)}, True, 0.0)
+    # the leaf and the warm node's full multistart, cold, with the root's floor
+    assert ({"a": (2.0, 2.0)}, False, 0.0) in ns.calls
+    assert ns.calls[-1] == ({"a": (3.0, 4.0)}, False, 0.0)
+
+
+def test_a_candidate_worse_than_the_search_is_seeded_but_not_reported():
+    """A first incumbent at item 3 prunes the right child at once; the search's item 2
+    wins: 6 nodes, 1 seeded, 2 pruned."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.4}, cap=3.5)
+    best, stats = branch_and_bound_warm(ns, _root(ns), [{"a": 3.0}])
+    assert best.design == {"a": 2.0} and best.objective == pytest.approx(0.16)
+    assert stats == {"nodes": 6, "pruned": 2, "infeasible": 0, "leaves": 1, "seeded": 1}
+    # the candidate's leaf: one warm start from its design
+    assert ns.calls[1] == ({"a": (3.0, 3.0)}, True, None)
+
+
+def test_a_candidate_that_is_the_optimum_is_reported_after_its_full_multistart():
+    """When the search's own leaves cannot beat the candidate (here: none is solved,
+    every box pruned by it), the candidate is solved again with the full multistart from
+    its own design and the root's floor, and reported."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 1.0}, cap=3.5)
+    best, stats = branch_and_bound_warm(ns, _root(ns), [{"a": 1.0}])
+    assert best.design == {"a": 1.0} and best.objective == 0.0
+    assert best.multistart.n_starts == 2  # the full multistart, not the seed's one start
+    assert ns.calls[-1] == ({"a": (1.0, 1.0)}, False, 0.0)
+    assert stats["seeded"] == 1 and stats["leaves"] == 0
+
+
+def test_an_infeasible_side_is_counted_and_the_only_item_under_the_cap_wins():
+    """Under a cap of 1.5 only item 1 is feasible: the relaxation sits at 1.5, the right
+    side [2, 4] is infeasible, the left one is a leaf: 3 nodes, 1 infeasible, 1 leaf."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.4}, cap=1.5)
+    best, stats = branch_and_bound_warm(ns, _root(ns))
+    assert best.design == {"a": 1.0} and best.objective == pytest.approx(1.96)
+    assert stats == {"nodes": 3, "pruned": 0, "infeasible": 1, "leaves": 1, "seeded": 0}
+
+
+def test_an_infeasible_root_ends_the_search_before_any_candidate():
+    """No feasible relaxation: no incumbent, no candidate solved, one node."""
+    ns = QuadNodes({"a": (1.0, 2.0)}, {"a": 1.0}, cap=0.5)
+    best, stats = branch_and_bound_warm(ns, _root(ns), [{"a": 1.0}])
+    assert best is None
+    assert stats == {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
+    assert len(ns.calls) == 1
+
+
+@pytest.mark.parametrize("ca", [0.7, 1.5, 2.4, 2.5, 3.2, 3.5, 4.6])
+@pytest.mark.parametrize("cb", [0.2, 1.5, 2.5, 2.9])
+@pytest.mark.parametrize("cap", [1.0, 2.5, 4.0])
+def test_branch_and_bound_and_enumeration_equal_the_brute_force_optimum(ca, cb, cap):
+    """Over a grid of centres (ties at .5 included) and caps, both searches report the
+    brute-force optimum and its smallest tied items."""
+    items = {"a": (1.0, 2.0, 3.0, 4.0), "b": (1.0, 2.0, 3.0)}
+    ns = QuadNodes(items, {"a": ca, "b": cb}, cap=cap)
+    value, combo = _brute(ns)
+    best, _ = branch_and_bound_warm(ns, _root(ns))
+    assert best.objective == pytest.approx(value, abs=1e-12)
+    assert (best.design["a"], best.design["b"]) == combo
+    best, table = enumerate_catalogue(QuadNodes(items, {"a": ca, "b": cb}, cap=cap))
+    assert best.objective == pytest.approx(value, abs=1e-12)
+    assert (best.design["a"], best.design["b"]) == combo
+    assert len(table) == 12
+
+
+def test_ties_false_keeps_the_value_and_may_report_either_tied_item():
+    """``ties=False``: the optimal value is the same; the tied items are not decided by
+    size, the first met (the larger item 3, met first by the search here) is kept."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.5})
+    best, _ = branch_and_bound_warm(ns, _root(ns), [{"a": 3.0}], ties=False)
+    assert best.objective == pytest.approx(0.25) and best.design == {"a": 3.0}
+    best, _ = branch_and_bound_warm(ns, _root(ns), [{"a": 3.0}], ties=True)
+    assert best.objective == pytest.approx(0.25) and best.design == {"a": 2.0}
+
+
+def test_enumeration_lists_every_combination_in_order_and_keeps_the_first_tie():
+    """The table follows the product of the item lists; infeasible items are listed with
+    their status; the floor reaches every solve; a tie keeps the earlier combination."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0), "b": (5.0, 6.0)}, {"a": 1.5, "b": 5.0}, cap=2.5)
+    best, table = enumerate_catalogue(ns, np.array([1.0, 5.0]), floor=0.125)
+    assert [c.items for c in table] == [
+        {"a": a, "b": b} for a, b in itertools.product((1.0, 2.0, 3.0), (5.0, 6.0))
+    ]
+    assert [c.status for c in table] == ["optimal"] * 4 + ["infeasible"] * 2
+    assert [c.objective for c in table[:4]] == [0.25, 1.25, 0.25, 1.25]
+    assert math.isnan(table[4].objective)
+    assert best.design == {"a": 1.0, "b": 5.0}
+    assert all(floor == 0.125 and not warm for _, warm, floor in ns.calls)
+
+
+def test_enumeration_with_no_feasible_combination_has_no_best():
+    """Every combination infeasible: None, and the full table."""
+    ns = QuadNodes({"a": (2.0, 3.0)}, {"a": 2.0}, cap=1.0)
+    best, table = enumerate_catalogue(ns)
+    assert best is None and [c.status for c in table] == ["infeasible", "infeasible"]
+
+
+def test_first_incumbent_skips_unusable_candidates_and_decides_ties_by_items():
+    """Candidates lacking a variable, with a non-number, or repeating an item (after
+    snapping) are not solved; of two tied ones the smaller items win, unless ties are
+    off (the first stays)."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.5})
+    cands = [{}, {"a": None}, {"a": "x"}, {"a": 3.1}, {"a": 2.9}, {"a": 2.0}, {"b": 1.0}]
+    stats = {"nodes": 0, "seeded": 0}
+    best, items = first_incumbent(ns, cands, stats)
+    assert items == {"a": 2.0} and best.objective == pytest.approx(0.25)
+    assert stats == {"nodes": 2, "seeded": 2}  # 3.1 and 2.0; 2.9 snaps to 3 (seen)
+    assert [c[0] for c in ns.calls] == [{"a": (3.0, 3.0)}, {"a": (2.0, 2.0)}]
+    assert all(warm for _, warm, _ in ns.calls)
+    stats = {"nodes": 0, "seeded": 0}
+    best, items = first_incumbent(ns, cands, stats, ties=False)
+    assert items == {"a": 3.0}
+    # a better candidate after a worse one replaces it
+    best, items = first_incumbent(ns, [{"a": 1.0}, {"a": 3.0}], {"nodes": 0, "seeded": 0})
+    assert items == {"a": 3.0} and best.objective == pytest.approx(0.25)
+    assert first_incumbent(ns, [], {"nodes": 0, "seeded": 0}) == (None, None)
+
+
+def test_a_candidate_missing_a_continuous_variable_is_no_start():
+    """A design vector needs every free variable: one missing gives None, the values in
+    the solver's order otherwise."""
+    ns = QuadNodes({"a": (1.0, 2.0), "b": (1.0, 2.0)}, {"a": 1.0, "b": 1.0})
+    assert _x_of_design(ns, {"a": 1.0}) is None
+    assert _x_of_design(ns, {"b": 2.0, "a": 1.0}).tolist() == [1.0, 2.0]
+
+
+def test_first_feasible_returns_the_leaf_under_the_better_child():
+    """Depth first with the better child explored first: item 2 (0.16), not item 3; an
+    infeasible relaxation gives None."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.4}, cap=3.5)
+    leaf = first_feasible(ns)
+    assert leaf.design == {"a": 2.0} and leaf.objective == pytest.approx(0.16)
+    assert ns.calls[-1][0] == {"a": (2.0, 2.0)}
+    assert first_feasible(QuadNodes({"a": (2.0, 3.0)}, {"a": 2.0}, cap=1.0)) is None
+
+
+def test_first_feasible_on_two_variables_finds_a_feasible_combination():
+    """Two variables under a cap: the leaf found is feasible (under the cap) and on items."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0), "b": (1.0, 2.0, 3.0)}, {"a": 3.6, "b": 2.4}, 2.5)
+    leaf = first_feasible(ns)
+    assert leaf.design == {"a": 2.0, "b": 2.0}
+
+
+def test_cannot_improve_prunes_within_the_relative_tolerance_only():
+    """A bound 1e-6 (relative) below the incumbent is pruned, one further below is not;
+    the tolerance scales with the incumbent's magnitude, negative ones included."""
+    assert cannot_improve(2.0, 2.0) and cannot_improve(2.0 - 1.9e-6, 2.0)
+    assert not cannot_improve(2.0 - 2.1e-6, 2.0)
+    assert cannot_improve(-2.0 - 1.9e-6, -2.0) and not cannot_improve(-2.0 - 2.1e-6, -2.0)
+    assert cannot_improve(3.0, 2.0)
+
+
+def test_a_nodes_value_is_trusted_from_a_full_multistart_or_an_early_stop():
+    """Trusted: as many starts as the node solver's, or stopped early; not: fewer, no
+    multistart, or a failed node (no value)."""
+    assert trusted(_result(1.0, {}, 4), 4) and trusted(_result(1.0, {}, 5), 4)
+    assert not trusted(_result(1.0, {}, 3), 4)
+    assert trusted(_result(1.0, {}, 1, early=True), 4)
+    bare = _result(1.0, {})
+    bare.multistart = None
+    assert not trusted(bare, 1)
+    assert trusted_value(_result(1.5, {}, 4), 4) == 1.5
+    assert trusted_value(_result(1.5, {}, 1), 4) is None
+    failed = _failed()
+    failed.multistart = MultistartInfo(4, 0, 0, 1e-6)
+    assert trusted_value(failed, 4) is None
+
+
+def test_tie_rules_compare_values_then_items():
+    """wins: better beyond the tolerance wins, a tie goes to smaller items, no best yet
+    always loses to the newcomer; box_cannot_win: a tie is kept while the box holds
+    smaller items."""
+    names = ["a", "b"]
+    assert combination_key({"b": 2, "a": 1}, names) == (1.0, 2.0)
+    assert box_key({"a": (1, 3), "b": (2, 4)}, names) == (1.0, 2.0)
+    assert wins(5.0, (9.0,), None, None) and wins(5.0, (9.0,), 4.0, None)
+    assert wins(1.0, (9.0,), 2.0, (1.0,))
+    assert not wins(3.0, (0.0,), 2.0, (1.0,))
+    assert wins(2.0 + 1e-7, (0.0,), 2.0, (1.0,))  # tie, smaller items
+    assert not wins(2.0 - 1e-7, (1.0,), 2.0, (1.0,))  # tie, same items
+    assert not wins(2.0, (2.0,), 2.0, (1.0,))
+    box = {"a": (1.0, 3.0), "b": (1.0, 1.0)}
+    assert not box_cannot_win(1.0, box, names, 2.0, (2.0, 1.0))  # better
+    assert box_cannot_win(3.0, box, names, 2.0, (0.0, 0.0))  # worse, whatever the items
+    assert not box_cannot_win(2.0, box, names, 2.0, (2.0, 1.0))  # tie, (1, 1) smaller
+    assert box_cannot_win(2.0, box, names, 2.0, (1.0, 1.0))  # tie, nothing smaller
+    assert box_cannot_win(2.0 + 1.9e-6, box, names, 2.0, (2.0, 1.0)) is False
+    assert box_cannot_win(2.0 + 2.1e-6, box, names, 2.0, (2.0, 1.0))
+
+
+def test_small_helpers_of_the_search():
+    """A combination's box, a result's value, a pruning test bound to its box."""
+    assert fixed_box({"a": 2.0, "b": 3.0}) == {"a": (2.0, 2.0), "b": (3.0, 3.0)}
+    assert _value(None) is None and _value(_result(1.25, {})) == 1.25
+    seen = []
+    assert _prunes_box(lambda v, b: seen.append((v, b)) or True, {"a": (1, 2)}, 3.0)
+    assert seen == [(3.0, {"a": (1, 2)})]
+
+
+def test_item_distances_and_the_variable_farthest_from_an_item():
+    """The nearest item within the box and its distance relative to max(1, item); the
+    farthest variable is split, the first of equal distances, none when all sit on items."""
+    dvars = [_Var("a", (1.0, 2.0, 3.0, 4.0)), _Var("b", (10.0, 20.0))]
+    box = {"a": (3.0, 4.0), "b": (10.0, 20.0)}
+    res = _result(0.0, {"a": 2.4, "b": 13.0})
+    (va, ia, da), (vb, ib, db) = item_distances(dvars, box, res)
+    assert (va.name, ia, vb.name, ib) == ("a", 3.0, "b", 10.0)
+    assert da == pytest.approx(0.6 / 3.0) and db == pytest.approx(3.0 / 10.0)
+    worst, items = on_items(dvars, box, res)
+    assert worst.name == "b" and items == {"a": 3.0, "b": 10.0}
+    # below 1, the distance is absolute: 0.5 from item 0.5 counts as 0.5
+    ((_, item, dist),) = item_distances(
+        [_Var("c", (0.5, 2.0))], {"c": (0.5, 2.0)}, _result(0, {"c": 1.0})
+    )
+    assert (item, dist) == (0.5, 0.5)
+    tied = _result(0.0, {"a": 1.5, "b": 10.0})
+    assert on_items(dvars, {"a": (1.0, 4.0), "b": (10.0, 20.0)}, tied)[0].name == "a"
+    on = _result(0.0, {"a": 2.0 + 1e-7, "b": 20.0})
+    assert on_items(dvars, {"a": (1.0, 4.0), "b": (10.0, 20.0)}, on) == (
+        None,
+        {"a": 2.0, "b": 20.0},
+    )
+
+
+def test_split_at_items_cuts_the_first_wide_variable_below_at_and_above():
+    """The first variable whose range holds more than one item is cut around the item the
+    relaxation sits on (a side may be empty)."""
+    dvars = [_Var("a", (1.0, 2.0, 3.0)), _Var("b", (1.0, 2.0, 3.0, 4.0))]
+    sides = split_at_items(dvars, {"a": (2.0, 2.0), "b": (1.0, 4.0)}, {"a": 2.0, "b": 3.0})
+    assert [(v.name, s) for v, s in sides] == [("b", [1.0, 2.0]), ("b", [3.0]), ("b", [4.0])]
+    sides = split_at_items(dvars, {"a": (1.0, 2.0), "b": (1.0, 4.0)}, {"a": 1.0, "b": 3.0})
+    assert [(v.name, s) for v, s in sides] == [("a", []), ("a", [1.0]), ("a", [2.0])]
+
+
+def test_pseudo_costs_gain_record_and_choice():
+    """Gains are relative rises (infeasible: 1); a branching's cost the product of its two
+    gains floored at 1e-6 (one side: its square); the highest mean is split once every
+    variable off its items has a history, the first of equal ones."""
+    pc = PseudoCosts()
+    assert pc.gain(2.0, _result(3.0, {})) == 0.5
+    assert pc.gain(2.0, _result(1.0, {})) == 0.0
+    assert pc.gain(-2.0, _result(-1.0, {})) == 0.5
+    assert pc.gain(2.0, _failed()) == PseudoCosts.INFEASIBLE_GAIN == 1.0
+    assert pc.gain(0.0, _result(1e-300, {})) == pytest.approx(1.0)
+    pc.record("a", [0.5, 0.2])
+    pc.record("a", [0.3])
+    pc.record("b", [0.0, 0.5])
+    assert pc.scores["a"] == pytest.approx([0.1, 0.09])
+    assert pc.scores["b"] == pytest.approx([5e-7])
+    dvars = [_Var("a", (1.0, 2.0, 3.0)), _Var("b", (1.0, 2.0, 3.0)), _Var("c", (1.0, 2.0))]
+    box = {"a": (1.0, 3.0), "b": (1.0, 3.0), "c": (1.0, 2.0)}
+    both_off = _result(0.0, {"a": 1.5, "b": 2.2, "c": 1.0})
+    assert pc.choose(dvars, box, both_off, dvars[1]).name == "a"
+    assert pc.choose(dvars, box, both_off, None) is None
+    one_off = _result(0.0, {"a": 1.5, "b": 2.0, "c": 1.0})
+    assert pc.choose(dvars, box, one_off, dvars[1]).name == "b"  # one off: the search's
+    c_off = _result(0.0, {"a": 1.5, "b": 2.0, "c": 1.5})
+    assert pc.choose(dvars, box, c_off, dvars[2]).name == "c"  # c has no history
+    pc.record("b", [0.1, 0.95])  # mean of b: (5e-7 + 0.095) / 2 < a's 0.095
+    assert pc.choose(dvars, box, both_off, dvars[1]).name == "a"
+    even = PseudoCosts()
+    even.record("a", [0.5])
+    even.record("b", [0.5])
+    assert even.choose(dvars, box, both_off, dvars[1]).name == "a"  # the first of a tie
+
+
+def test_the_memo_counts_copies_and_rebuilds_its_proofs():
+    """len counts proofs; proofs are copies in order; from_proofs rebuilds the same
+    verdicts; a proof's box is completed with the full ranges."""
+    full = {"a": (1.0, 4.0), "b": (1.0, 3.0)}
+    memo = InfeasibleBoxes(full)
+    assert len(memo) == 0
+    memo.add_infeasible({"a": (2.0, 3.0)}, {"f": 1.0})
+    memo.add_infeasible({"b": (3.0, 3.0)}, {})
+    assert len(memo) == 2
+    proofs = memo.proofs
+    assert proofs == [
+        ({"a": (2.0, 3.0), "b": (1.0, 3.0)}, {"f": 1.0}),
+        ({"a": (1.0, 4.0), "b": (3.0, 3.0)}, {}),
+    ]
+    proofs[0][0]["a"] = (0.0, 9.0)
+    proofs[0][1]["f"] = 99.0
+    assert memo.proofs[0] == ({"a": (2.0, 3.0), "b": (1.0, 3.0)}, {"f": 1.0})
+    again = InfeasibleBoxes.from_proofs(full, memo.proofs)
+    assert again.proofs == memo.proofs and len(again) == 2
+    assert again.known_infeasible({"a": (2.5, 3.0), "b": (1.0, 1.0)}, {"f": 0.5})
+    assert not again.known_infeasible({"a": (2.5, 3.5), "b": (1.0, 1.0)}, {"f": 0.5})
+    assert again.known_infeasible({"a": (1.0, 4.0), "b": (3.0, 3.0)}, {})
+    assert not again.known_infeasible({"b": (2.0, 3.0)}, {})
+
+
+def test_a_box_inside_a_proof_within_a_relative_1e_12_only():
+    """A box edge past a proof's by 1e-13 of it is inside (the NLP's bound slack), by 1e-11
+    it is not; at magnitudes below 1 the slack is 1e-12 absolute."""
+    memo = InfeasibleBoxes({"a": (0.0, 300.0)})
+    memo.add_infeasible({"a": (100.0, 200.0)}, {})
+    assert memo.known_infeasible({"a": (100.0 - 1e-11, 200.0 + 1e-11)}, {})
+    assert not memo.known_infeasible({"a": (100.0 - 1e-9, 200.0)}, {})
+    assert not memo.known_infeasible({"a": (100.0, 200.0 + 1e-9)}, {})
+    small = InfeasibleBoxes({"a": (0.0, 1.0)})
+    small.add_infeasible({"a": (0.1, 0.2)}, {})
+    assert small.known_infeasible({"a": (0.1 - 5e-13, 0.2 + 5e-13)}, {})
+    assert not small.known_infeasible({"a": (0.1 - 5e-12, 0.2)}, {})
+
+
+def test_the_memo_checks_item_combinations_one_by_one_only_up_to_its_limit():
+    """Two proofs covering the items between them prove the box; a single one, or a box
+    of more than MAX_COVER_COMBINATIONS combinations, is not checked item by item."""
+    assert catalogue_bnb.MAX_COVER_COMBINATIONS == 4096
+    values = tuple(float(k) for k in range(1, 4098))  # 4097 items
+    memo = InfeasibleBoxes({"a": (1.0, 4097.0)}, {"a": values[::-1]})
+    assert memo.items == {"a": values}  # sorted
+    memo.add_infeasible({"a": (1.0, 2048.0)}, {})
+    assert not memo.known_infeasible({"a": (1.0, 4096.0)}, {})  # one proof: no cover
+    memo.add_infeasible({"a": (2049.0, 4097.0)}, {})
+    assert memo.known_infeasible({"a": (1.0, 4096.0)}, {})  # 4096 combinations
+    assert not memo.known_infeasible({}, {})  # 4097: too many to check
+
+
+def test_shared_memos_carry_the_items_and_are_found_by_key(monkeypatch):
+    """A shared memo made with items checks combinations; the same key returns it."""
+    monkeypatch.setattr(catalogue_bnb, "_MEMOS", {})
+    assert catalogue_bnb._MEMO_MAX == 8
+    memo = catalogue_bnb.shared_memo(("k",), {"a": (1.0, 3.0)}, {"a": (3.0, 1.0, 2.0)})
+    assert memo.items == {"a": (1.0, 2.0, 3.0)}
+    assert catalogue_bnb.shared_memo(("k",), {}) is memo
+    assert catalogue_bnb.shared_memo(("j",), {"a": (1.0, 3.0)}).items is None
+
+
+def test_a_pruned_warm_node_leaves_a_proof_only_from_a_trusted_value():
+    """A search with a memo records, for every box pruned on a full multistart, the box
+    under a limit just below its value; the proofs' limits sit PRUNE_TOL under the
+    pruned values."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.4}, cap=3.5)
+    ns.memo = InfeasibleBoxes({"a": (1.0, 4.0)})
+    ns.eps = {"g": 5.0}
+    branch_and_bound_warm(ns, _root(ns))
+    proofs = ns.memo.proofs
+    assert [box for box, _ in proofs] == [{"a": (1.0, 1.0)}, {"a": (3.0, 4.0)}]
+    assert proofs[0][1] == {"g": 5.0, "f": pytest.approx(1.96 * (1 - PRUNE_TOL), rel=1e-15)}
+    assert proofs[1][1]["f"] == pytest.approx(0.36 * (1 - PRUNE_TOL), rel=1e-15)
+
+
+def test_verdicts_decide_needs_two_starts_all_with_the_backends_verdict():
+    """Two or more starts, a back-end that has verdicts, and every message one of them."""
+    ns = object.__new__(NodeSolver)
+    ns.verdicts = ("Infeasible_Problem_Detected",)
+
+    def res(msg):
+        r = _failed()
+        r.message = msg
+        return r
+
+    v, other = res("Infeasible_Problem_Detected"), res("Maximum_Iterations_Exceeded")
+    assert ns.verdicts_decide([v, v]) and ns.verdicts_decide([v, v, v])
+    assert not ns.verdicts_decide([v]) and not ns.verdicts_decide([])
+    assert not ns.verdicts_decide([v, other])
+    ns.verdicts = ()
+    assert not ns.verdicts_decide([v, v])
+
+
+def test_a_result_without_design_has_no_vector_and_a_missing_item_is_infeasible():
+    """x_of: None for no design, the values in the free variables' order otherwise;
+    _no_item: an infeasible catalogue result with its reason and no value."""
+    ns = object.__new__(NodeSolver)
+    ns.names = ["b", "a"]
+    assert ns.x_of(_failed()) is None
+    assert ns.x_of(_result(0.0, {"a": 1.0, "b": 2.0})).tolist() == [2.0, 1.0]
+    r = _no_item("ipopt", "no catalogue item in this box")
+    assert (r.status, r.formulation, r.solver) == ("infeasible", "catalogue", "ipopt")
+    assert r.message == "no catalogue item in this box" and math.isnan(r.objective)
+    assert not r.success
+
+
+def test_the_minlp_back_end_is_a_registered_minlp_solver_or_refused_naming_them():
+    """None: the first MINLP back-end (bonmin); bonmin itself; ipopt refused, naming it
+    and the ones that do solve a MINLP."""
+    assert minlp_back_end(None) == "bonmin" and minlp_back_end("bonmin") == "bonmin"
+    with pytest.raises(ProblemError) as err:
+        minlp_back_end("ipopt")
+    assert str(err.value) == (
+        "catalogue method minlp: back-end 'ipopt' solves no MINLP (those that do: bonmin)"
+    )
+
+
+def test_catalogue_predicates_and_the_relaxation_bound():
+    """catalogue_applies names why not; is_on_catalogue within 1e-12; the bound NaN when
+    none was recorded."""
+    problem = _Problem([_Var("a", (1.0, 2.5))])
+    assert catalogue_applies(problem) is True
+    plain = _Problem([_Var("x", (0.0, 1.0), discrete=False)])
+    assert catalogue_applies(plain) == "no variable takes catalogue values"
+    assert is_on_catalogue(problem, {"a": 2.5 + 1e-13})
+    assert not is_on_catalogue(problem, {"a": 2.5 + 1e-9})
+    assert not is_on_catalogue(problem, {"a": 1.75})
+    assert is_on_catalogue(plain, {"x": 0.3})  # no catalogue variable
+    r = _result(1.0, {})
+    assert math.isnan(relaxation_bound(r))
+    r.bound = 0.75
+    assert relaxation_bound(r) == 0.75
+
+
+def test_solve_catalogue_refuses_what_it_cannot_search():
+    """No catalogue variable, or an unknown method: a ProblemError saying so."""
+    plain = _Problem([_Var("x", (0.0, 1.0), discrete=False)])
+    with pytest.raises(ProblemError, match="no variable takes catalogue values"):
+        solve_catalogue(plain)
+    with pytest.raises(ProblemError) as err:
+        solve_catalogue(_small(), method="exhaustive")
+    assert str(err.value) == "catalogue method 'exhaustive': use auto, enumerate, bnb or minlp"
+
+
+def _small(pins=("5 mm", "6 mm", "8 mm")):
+    import tomllib
+    from pathlib import Path
+
+    from optdesign.problem import problem_from_dict
+
+    path = Path(__file__).resolve().parents[1] / "problems" / "cs_min_backlash_catalogue.toml"
+    data = tomllib.loads(path.read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": list(pins)}
+    return problem_from_dict(data)
+
+
+def test_an_enumerated_catalogue_result_records_its_search():
+    """auto enumerates 6 combinations: the details, the gap to the relaxation computed
+    from the two values, the snapped items and the summary note."""
+    r = solve_catalogue(_small(), starts=2)
+    info = r.details.catalogue
+    assert r.formulation == "catalogue-enumerate" and info.method == "enumerate"
+    assert info.combinations == 6 and info.starts_per_node == 2
+    assert info.variables == {"p": [5.0, 6.0], "d": [5.0, 6.0, 8.0]}
+    assert info.items == {"p": 6.0, "d": 6.0} and r.design["d"] == 6.0
+    assert info.relaxation_status == "optimal"
+    assert r.bound == info.relaxation_bound < r.objective
+    assert info.gap_to_relaxation_rel == pytest.approx((r.objective - r.bound) / abs(r.bound))
+    assert sorted(info.relaxation_design) == sorted(v.name for v in _small().free)
+    assert len(info.enumerated) == 6 and info.nlp_solves >= 7
+    note = next(n for n in r.notes if n.startswith("catalogue items chosen"))
+    gap = 100 * info.gap_to_relaxation_rel
+    assert note == (
+        f"catalogue items chosen: p = 6 mm, d = 6 mm; continuous relaxation bound "
+        f"{r.bound:.8g} (discrete optimum {gap:+.3f} % above it); enumerate, "
+        f"{info.nlp_solves} NLP solves"
+    )
+
+
+def test_an_infeasible_catalogue_names_the_relaxation_as_infeasible():
+    """Pins too weak for any lead: status infeasible, the relaxation's verdict, no items."""
+    r = solve_catalogue(_small(pins=("4 mm", "5 mm")), method="bnb", starts=2)
+    assert r.status == "infeasible" and r.formulation == "catalogue-bnb"
+    assert r.message == "the continuous relaxation has no feasible design"
+    info = r.details.catalogue
+    assert info.relaxation_bound is None and info.relaxation_status != "optimal"
+    assert info.items is None and info.nodes == 1 and r.design == {}
+    # the root's two starts both end with Ipopt's verdict: no retries, and the whole box
+    # is this search's one proof
+    assert info.nlp_solves == 2
+    assert info.infeasible_boxes == [({"p": (5.0, 6.0), "d": (4.0, 5.0)}, {})]
