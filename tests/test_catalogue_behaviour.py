@@ -591,7 +591,10 @@ def _small(pins=("5 mm", "6 mm", "8 mm")):
 def test_an_enumerated_catalogue_result_records_its_search():
     """auto enumerates 6 combinations: the details, the gap to the relaxation computed
     from the two values, the snapped items and the summary note."""
-    r = solve_catalogue(_small(), starts=2)
+    problem = _small()
+    # a catalogue variable without a unit (display only): its item has no trailing space
+    object.__setattr__(problem.by_name["d"], "unit", "")
+    r = solve_catalogue(problem, starts=2)
     info = r.details.catalogue
     assert r.formulation == "catalogue-enumerate" and info.method == "enumerate"
     assert info.combinations == 6 and info.starts_per_node == 2
@@ -605,7 +608,7 @@ def test_an_enumerated_catalogue_result_records_its_search():
     note = next(n for n in r.notes if n.startswith("catalogue items chosen"))
     gap = 100 * info.gap_to_relaxation_rel
     assert note == (
-        f"catalogue items chosen: p = 6 mm, d = 6 mm; continuous relaxation bound "
+        f"catalogue items chosen: p = 6 mm, d = 6; continuous relaxation bound "
         f"{r.bound:.8g} (discrete optimum {gap:+.3f} % above it); enumerate, "
         f"{info.nlp_solves} NLP solves"
     )
@@ -623,3 +626,50 @@ def test_an_infeasible_catalogue_names_the_relaxation_as_infeasible():
     # is this search's one proof
     assert info.nlp_solves == 2
     assert info.infeasible_boxes == [({"p": (5.0, 6.0), "d": (4.0, 5.0)}, {})]
+
+
+def test_a_node_solver_clamps_its_settings_and_records_its_multistart():
+    """starts, workers and agree below their least are raised to 1, 1 and 0; a node's
+    multistart records its starts, seed, values and plan; ``agree`` 2 stops it after two
+    agreeing starts (settled), 0 runs every start."""
+    problem = _small()
+    box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
+    low = NodeSolver(problem, starts=0, workers=0, agree=-2)
+    assert (low.starts, low.workers, low.agree) == (1, 1, 0)
+    assert low.objective == "backlash" and low.names == [v.name for v in problem.free]
+    assert (low.n_solves, low.n_cold, low.n_implied, low.memo, low.proofs) == (0, 0, 0, None, None)
+    r = low.solve(box)
+    assert r.objective == pytest.approx(0.0340646, rel=1e-5)  # H7/g6 at 6 mm, lead 6
+    assert (r.multistart.n_starts, r.multistart.n_planned, low.n_solves) == (1, 1, 1)
+    every = NodeSolver(problem, starts=3, seed=5, agree=0)
+    r = every.solve(box)
+    ms = r.multistart
+    assert (ms.n_starts, ms.n_converged, ms.n_planned, ms.seed) == (3, 3, 3, 5)
+    assert ms.stopped_early is False and ms.outcomes == ["converged"] * 3
+    # the three tie (within 1e-6): the first start's value is the node's
+    assert len(ms.objectives) == 3 and r.objective == ms.objectives[0]
+    assert ms.n_at_best == 3 and every.n_solves == 3
+    two = NodeSolver(problem, starts=3, seed=5, agree=2)
+    r = two.solve(box)
+    assert (r.multistart.n_starts, r.multistart.stopped_early, two.n_solves) == (2, True, 2)
+
+
+def test_a_warm_node_decides_alone_unless_its_value_would_prune_it():
+    """A warm start whose value the search would prune runs the rest of the multistart
+    (a cold fallback counted); with ``fallback=False`` its own result comes back at once;
+    a warm start not pruned decides the node with one solve."""
+    problem = _small()
+    box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
+    ref = NodeSolver(problem, starts=3)
+    x = ref.x_of(ref.solve(box))
+    pruned = NodeSolver(problem, starts=3)
+    r = pruned.solve(box, x, warm=True, prunes=lambda v: True)
+    assert (pruned.n_cold, pruned.n_solves, r.multistart.n_starts) == (1, 3, 3)
+    alone = NodeSolver(problem, starts=3)
+    r = alone.solve(box, x, warm=True, prunes=lambda v: True, fallback=False)
+    assert (alone.n_cold, alone.n_solves, r.multistart) == (0, 1, None)
+    assert r.objective == pytest.approx(0.0340646, rel=1e-5)
+    kept = NodeSolver(problem, starts=3)
+    r = kept.solve(box, x, warm=True, prunes=lambda v: False)
+    assert (kept.n_cold, kept.n_solves, r.multistart.n_starts) == (0, 1, 1)
+    assert r.multistart.n_planned == 3
