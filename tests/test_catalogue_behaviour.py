@@ -102,10 +102,12 @@ def _failed() -> Result:
 class QuadNodes:
     """A node solver of sum (x - centre)^2 over the box, with x[cap_name] <= cap: the
     relaxation's optimum is the centre clipped into the box (and under the cap), a box
-    whose cap variable starts above the cap is infeasible. A warm solve (or
-    ``fallback=False``) is one start; otherwise the full multistart of ``starts``."""
+    whose cap variable starts above the cap is infeasible, and so is a combination of
+    ``bad`` solved alone (item data worse than the relaxation's: the relaxation of a box
+    holding it stays a lower bound). A warm solve (or ``fallback=False``) is one start;
+    otherwise the full multistart of ``starts``."""
 
-    def __init__(self, items: dict, centre: dict, cap: float = math.inf, starts: int = 2):
+    def __init__(self, items: dict, centre: dict, cap: float = math.inf, starts: int = 2, bad=()):
         self.problem = _Problem([_Var(k, v) for k, v in items.items()])
         self.names = list(items)
         self.centre = centre
@@ -115,16 +117,21 @@ class QuadNodes:
         self.memo = None
         self.eps: dict = {}
         self.objective = "f"
+        self.bad = {tuple(float(c) for c in b) for b in bad}
         self.calls: list[tuple[dict, bool, float | None]] = []
+        self.hints: list = []
 
     def value(self, point: dict) -> float:
         return sum((point[n] - self.centre[n]) ** 2 for n in self.names)
 
     def solve(self, bounds, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
         self.calls.append((dict(bounds), warm, floor))
+        self.hints.append(None if x_hint is None else np.asarray(x_hint).tolist())
         box = {v.name: bounds.get(v.name, (v.lower, v.upper)) for v in self.problem.free}
         lo, hi = box[self.cap_name]
         if lo > self.cap:
+            return _failed()
+        if all(a == b for a, b in box.values()) and tuple(a for a, _ in box.values()) in self.bad:
             return _failed()
         box[self.cap_name] = (lo, min(hi, self.cap))
         point = {n: min(max(self.centre[n], box[n][0]), box[n][1]) for n in self.names}
@@ -142,7 +149,7 @@ def _brute(ns: QuadNodes) -> tuple[float, tuple[float, ...]]:
     """The best feasible item combination by enumeration (smallest items on a tie)."""
     best = None
     for combo in itertools.product(*(v.values for v in ns.problem.free)):
-        if combo[0] > ns.cap:
+        if combo[0] > ns.cap or tuple(float(c) for c in combo) in ns.bad:
             continue
         f = ns.value(dict(zip(ns.names, combo, strict=True)))
         if best is None or f < best[0] - PRUNE_TOL * abs(best[0]):
@@ -673,3 +680,90 @@ def test_a_warm_node_decides_alone_unless_its_value_would_prune_it():
     r = kept.solve(box, x, warm=True, prunes=lambda v: False)
     assert (kept.n_cold, kept.n_solves, r.multistart.n_starts) == (0, 1, 1)
     assert r.multistart.n_planned == 3
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        [(2.0, 1.0)],
+        [(2.0, 1.0), (3.0, 1.0), (2.0, 2.0)],
+        [(a, 1.0) for a in (1.0, 2.0, 3.0, 4.0)],
+        [(a, b) for a in (1.0, 2.0, 3.0) for b in (1.0, 2.0, 3.0)],
+    ],
+)
+@pytest.mark.parametrize("ca,cb", [(2.0, 1.0), (2.4, 1.3), (2.5, 1.5)])
+def test_a_relaxation_on_an_infeasible_combination_still_searches_its_box(bad, ca, cb):
+    """A relaxation sitting on items whose combination is infeasible alone: branch and
+    bound and enumeration still find the brute-force optimum among the box's others,
+    and the diagnosis's search some feasible combination."""
+    items = {"a": (1.0, 2.0, 3.0, 4.0), "b": (1.0, 2.0, 3.0)}
+    ns = QuadNodes(items, {"a": ca, "b": cb}, bad=bad)
+    value, combo = _brute(ns)
+    best, _ = branch_and_bound_warm(ns, _root(ns))
+    assert (best.design["a"], best.design["b"]) == combo
+    assert best.objective == pytest.approx(value, abs=1e-12)
+    best, _ = enumerate_catalogue(QuadNodes(items, {"a": ca, "b": cb}, bad=bad))
+    assert (best.design["a"], best.design["b"]) == combo
+    leaf = first_feasible(QuadNodes(items, {"a": ca, "b": cb}, bad=bad))
+    assert (leaf.design["a"], leaf.design["b"]) not in ns.bad
+
+
+def test_first_feasible_splits_a_box_whose_relaxations_items_fail():
+    """The relaxation sits on item 2, whose combination fails alone: the box is split
+    below, at and above it; the side above (item 3, explored first on the tie) works.
+    Every child is solved from its parent's optimum."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.0}, bad=[(2.0,)])
+    leaf = first_feasible(ns)
+    assert leaf.design == {"a": 3.0} and leaf.objective == 1.0
+    assert [c[0] for c in ns.calls] == [
+        {},
+        {"a": (2.0, 2.0)},
+        {"a": (1.0, 1.0)},
+        {"a": (3.0, 4.0)},
+        {"a": (3.0, 3.0)},
+    ]
+    assert ns.hints == [None, [2.0], [2.0], [2.0], [3.0]]
+
+
+def test_candidates_are_solved_from_their_own_designs_with_one_start():
+    """A candidate's leaf starts from its design as given (not snapped) and is one start."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0, 4.0)}, {"a": 2.5})
+    best, items = first_incumbent(ns, [{"a": 3.1}], {"nodes": 0, "seeded": 0})
+    assert ns.hints == [[3.1]] and items == {"a": 3.0}
+    assert best.multistart.n_starts == 1
+
+
+def test_a_tied_candidate_with_smaller_items_prunes_the_search_and_is_reported():
+    """Items 2 and 3 tie around 2.5; the candidates 3 then 2 make 2 the first incumbent,
+    which prunes both leaves (neither can win the tie) and is reported after its full
+    multistart: 6 nodes, 2 pruned, no leaf."""
+    ns = QuadNodes({"a": (2.0, 3.0)}, {"a": 2.5})
+    best, stats = branch_and_bound_warm(ns, _root(ns), [{"a": 3.0}, {"a": 2.0}])
+    assert best.design == {"a": 2.0} and best.multistart.n_starts == 2
+    assert stats == {"nodes": 6, "pruned": 2, "infeasible": 0, "leaves": 0, "seeded": 2}
+
+
+def test_enumeration_starts_from_the_relaxation_and_trusts_its_value(monkeypatch):
+    """solve_catalogue enumerates from the relaxation's optimum, with its value as the
+    floor (a full multistart's value is trusted)."""
+    from optdesign.studies import catalogue
+
+    seen = []
+
+    def spy(ns, x_hint=None, floor=None):
+        seen.append((x_hint, floor))
+        return None, []
+
+    monkeypatch.setattr(catalogue, "enumerate_catalogue", spy)
+    r = solve_catalogue(_small(), method="enumerate", starts=2)
+    ((x_hint, floor),) = seen
+    info = r.details.catalogue
+    assert floor == info.relaxation_bound
+    assert x_hint.tolist() == [info.relaxation_design[n] for n in info.relaxation_design]
+    # no combination found although the relaxation is feasible: a failed search, said so
+    assert (r.status, r.formulation, r.design) == ("failed", "catalogue-enumerate", {})
+    assert r.message == (
+        "no catalogue combination gave a feasible design although the continuous "
+        "relaxation is feasible (more starts may find one)"
+    )
+    assert math.isnan(r.objective) and info.enumerated == []
