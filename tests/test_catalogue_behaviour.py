@@ -582,7 +582,8 @@ def test_solve_catalogue_refuses_what_it_cannot_search():
     assert str(err.value) == "catalogue method 'exhaustive': use auto, enumerate, bnb or minlp"
 
 
-def _small(pins=("5 mm", "6 mm", "8 mm")):
+def _small(pins=("5 mm", "6 mm", "8 mm"), leads=("5 mm", "6 mm"), solver=None):
+    """The shipped catalogue problem with a few leads and pins (6 combinations)."""
     import tomllib
     from pathlib import Path
 
@@ -590,8 +591,10 @@ def _small(pins=("5 mm", "6 mm", "8 mm")):
 
     path = Path(__file__).resolve().parents[1] / "problems" / "cs_min_backlash_catalogue.toml"
     data = tomllib.loads(path.read_text())
-    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["p"] = {"values": list(leads)}
     data["variables"]["d"] = {"values": list(pins)}
+    if solver:
+        data["solver"] = solver
     return problem_from_dict(data)
 
 
@@ -767,3 +770,114 @@ def test_enumeration_starts_from_the_relaxation_and_trusts_its_value(monkeypatch
         "relaxation is feasible (more starts may find one)"
     )
     assert math.isnan(r.objective) and info.enumerated == []
+
+
+def _spied_search(monkeypatch, stats=None):
+    """solve_catalogue with its searches replaced by spies finding nothing (only the root
+    relaxation is solved): the calls they got."""
+    from optdesign.studies import catalogue
+
+    calls: dict = {}
+
+    def enum(ns, x_hint=None, floor=None):
+        calls["enumerate"] = ns
+        return None, []
+
+    def bnb(ns, root, incumbents=(), ties=True):
+        calls["bnb"] = (ns, root, incumbents, ties)
+        keys = ("nodes", "pruned", "infeasible", "leaves", "seeded")
+        return None, dict(stats or dict.fromkeys(keys, 0))
+
+    monkeypatch.setattr(catalogue, "enumerate_catalogue", enum)
+    monkeypatch.setattr(catalogue, "branch_and_bound", bnb)
+    return calls
+
+
+def test_auto_enumerates_up_to_sixteen_combinations_and_branches_above(monkeypatch):
+    """2 x 8 = 16 combinations are enumerated, 2 x 9 = 18 searched by branch and bound."""
+    calls = _spied_search(monkeypatch)
+    eight = [f"{k} mm" for k in (4, 5, 6, 8, 10, 12, 16, 20)]
+    r = solve_catalogue(_small(pins=eight), starts=1)
+    assert r.formulation == "catalogue-enumerate" and r.details.catalogue.combinations == 16
+    assert "bnb" not in calls
+    r = solve_catalogue(_small(pins=[*eight, "25 mm"]), starts=1)
+    assert r.formulation == "catalogue-bnb" and r.details.catalogue.combinations == 18
+    assert "bnb" in calls
+
+
+def test_branch_and_bound_gets_the_root_candidates_and_tie_rule_and_reports_its_counts(
+    monkeypatch,
+):
+    """The search's counts land in the details field by field; the candidates, the tie
+    rule and the memo reach it; the memo's proofs are the details' boxes."""
+    stats = {"nodes": 11, "pruned": 12, "infeasible": 13, "leaves": 14, "seeded": 15}
+    calls = _spied_search(monkeypatch, stats)
+    memo = InfeasibleBoxes({"p": (5.0, 6.0)})
+    memo.add_infeasible({"p": (9.0, 9.0)}, {"backlash": 1.0})
+    cands = [{"p": 6.0}]
+    r = solve_catalogue(_small(), method="bnb", starts=1, incumbents=cands, ties=False, memo=memo)
+    ns, root, incumbents, ties = calls["bnb"]
+    assert incumbents is cands and ties is False and ns.memo is memo and ns.proofs is memo
+    info = r.details.catalogue
+    assert root.objective == info.relaxation_bound
+    assert (info.nodes, info.pruned, info.infeasible, info.leaves, info.seeded) == (
+        11,
+        12,
+        13,
+        14,
+        15,
+    )
+    assert (info.warm_fallbacks, info.implied_infeasible) == (0, 0)
+    assert info.infeasible_boxes == [({"p": (9.0, 9.0)}, {"backlash": 1.0})]
+    assert info.nlp_solves == ns.n_solves == 1 and r.status == "failed"
+
+
+def test_the_files_solver_settings_are_the_nodes_defaults(monkeypatch):
+    """Without arguments a node takes the file's starts (at most 4), seed and agree."""
+    calls = _spied_search(monkeypatch)
+    solve_catalogue(_small(solver={"starts": 7, "seed": 3, "agree": 2}), method="enumerate")
+    ns = calls["enumerate"]
+    assert (ns.starts, ns.seed, ns.agree) == (4, 3, 2)
+    solve_catalogue(_small(solver={"starts": 2, "seed": 1, "agree": 0}), method="enumerate")
+    ns = calls["enumerate"]
+    assert (ns.starts, ns.seed, ns.agree) == (2, 1, 0)
+    r = solve_catalogue(
+        _small(), method="enumerate", starts=3, seed=9, agree=1, objective="backlash"
+    )
+    ns = calls["enumerate"]
+    assert (ns.starts, ns.seed, ns.agree, ns.objective) == (3, 9, 1, "backlash")
+    assert r.details.catalogue.starts_per_node == 3
+
+
+def test_a_node_implied_infeasible_by_the_memo_is_not_solved():
+    """A box a stored proof covers: infeasible with the memo's reason and no NLP solve."""
+    ns = NodeSolver(_small(), starts=2)
+    ns.memo = InfeasibleBoxes({"p": (5.0, 6.0), "d": (5.0, 8.0)})
+    ns.memo.add_infeasible({"p": (6.0, 6.0)}, {})
+    r = ns.solve({"p": (6.0, 6.0), "d": (5.0, 6.0)})
+    assert (r.status, r.formulation) == ("infeasible", "catalogue")
+    assert r.message == "infeasible: a wider box was at looser limits"
+    assert (ns.n_implied, ns.n_solves) == (1, 0)
+    assert ns.solve({"p": (5.0, 5.0), "d": (6.0, 6.0)}).success and ns.n_implied == 1
+
+
+def test_an_infeasible_node_is_one_proof_in_the_memo_or_the_searchs_own_record():
+    """A node with no feasible start is recorded once: in the memo, and in the proofs
+    when they are another record; freeing the failing requirement's rows makes it feasible."""
+    weak = _small(pins=("4 mm", "5 mm"))
+    box = {"p": (5.0, 5.0), "d": (4.0, 4.0)}
+    full = {"p": (5.0, 6.0), "d": (4.0, 5.0)}
+    ns = NodeSolver(weak, starts=2)
+    ns.memo = ns.proofs = InfeasibleBoxes(full)
+    assert not ns.solve(box).success
+    assert ns.memo.proofs == [({"p": (5.0, 5.0), "d": (4.0, 4.0)}, {})]
+    own = NodeSolver(weak, starts=2, eps={"backlash": 1.0})
+    own.proofs = InfeasibleBoxes(full)
+    assert not own.solve(box).success
+    assert own.proofs.proofs == [({"p": (5.0, 5.0), "d": (4.0, 4.0)}, {"backlash": 1.0})]
+    # the 4 mm pin fails on its bearing pressure alone: that requirement's rows left
+    # unbounded (the diagnosis's search), the node is feasible
+    rows = tuple(
+        k for k, g in enumerate(own.nlp.g_names) if g.split("[", 1)[0] == "pin_bearing_pressure"
+    )
+    assert rows and NodeSolver(weak, starts=2, free_rows=rows).solve(box).success
