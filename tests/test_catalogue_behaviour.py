@@ -107,7 +107,15 @@ class QuadNodes:
     holding it stays a lower bound). A warm solve (or ``fallback=False``) is one start;
     otherwise the full multistart of ``starts``."""
 
-    def __init__(self, items: dict, centre: dict, cap: float = math.inf, starts: int = 2, bad=()):
+    def __init__(
+        self,
+        items: dict,
+        centre: dict,
+        cap: float = math.inf,
+        starts: int = 2,
+        bad=(),
+        worse_once: float = 0.0,
+    ):
         self.problem = _Problem([_Var(k, v) for k, v in items.items()])
         self.names = list(items)
         self.centre = centre
@@ -120,6 +128,10 @@ class QuadNodes:
         self.bad = {tuple(float(c) for c in b) for b in bad}
         self.calls: list[tuple[dict, bool, float | None]] = []
         self.hints: list = []
+        #: added to a combination's value at its first full multistart (a local optimum
+        #: its starts stopped at, which a later start beats)
+        self.worse_once = worse_once
+        self.worse_seen: set = set()
 
     def value(self, point: dict) -> float:
         return sum((point[n] - self.centre[n]) ** 2 for n in self.names)
@@ -136,6 +148,11 @@ class QuadNodes:
         box[self.cap_name] = (lo, min(hi, self.cap))
         point = {n: min(max(self.centre[n], box[n][0]), box[n][1]) for n in self.names}
         value = self.value(point)
+        fixed = all(a == b for a, b in box.values()) and len(bounds) == len(self.names)
+        key = tuple(sorted(bounds.items()))
+        if fixed and not warm and self.worse_once and key not in self.worse_seen:
+            self.worse_seen.add(key)
+            value += self.worse_once
         one = warm and x_hint is not None and (not fallback or prunes is None or not prunes(value))
         return _result(value, point, 1 if one else self.starts)
 
@@ -159,6 +176,34 @@ def _brute(ns: QuadNodes) -> tuple[float, tuple[float, ...]]:
 
 def _root(ns: QuadNodes) -> Result:
     return ns.solve({})
+
+
+def _cold_leaf_solves(ns: QuadNodes) -> dict:
+    """How many full multistarts each combination (a box of one item per variable) got."""
+    out: dict = {}
+    for box, warm, _ in ns.calls:
+        if len(box) == len(ns.names) and all(a == b for a, b in box.values()) and not warm:
+            key = tuple(box[n][0] for n in ns.names)
+            out[key] = out.get(key, 0) + 1
+    return out
+
+
+def test_a_combination_met_again_is_solved_from_the_new_start_only():
+    """Centre (2.4, 2.5): the combination (2, 2) is reached from two nodes; the second
+    time one warm start (no better) returns the stored full multistart."""
+    items = {"a": (1.0, 2.0, 3.0, 4.0), "b": (1.0, 2.0, 3.0)}
+    ns = QuadNodes(items, {"a": 2.4, "b": 2.5})
+    best, _ = branch_and_bound_warm(ns, _root(ns))
+    assert best.design == {"a": 2.0, "b": 2.0} and best.multistart.n_starts == 2
+    box = {"a": (2.0, 2.0), "b": (2.0, 2.0)}
+    assert [warm for b, warm, _ in ns.calls if b == box] == [False, True]
+    assert _cold_leaf_solves(ns)[(2.0, 2.0)] == 1
+    # a first multistart stuck 0.01 above: the new start beats it, the full multistart
+    # runs again and its value is the one reported
+    ns = QuadNodes(items, {"a": 2.4, "b": 2.5}, worse_once=0.01)
+    best, _ = branch_and_bound_warm(ns, _root(ns))
+    assert [warm for b, warm, _ in ns.calls if b == box] == [False, True, False]
+    assert best.design == {"a": 2.0, "b": 2.0} and best.objective == pytest.approx(0.41)
 
 
 def test_branch_and_bound_on_one_variable_follows_the_hand_trace():
@@ -229,6 +274,7 @@ def test_branch_and_bound_and_enumeration_equal_the_brute_force_optimum(ca, cb, 
     best, _ = branch_and_bound_warm(ns, _root(ns))
     assert best.objective == pytest.approx(value, abs=1e-12)
     assert (best.design["a"], best.design["b"]) == combo
+    assert max(_cold_leaf_solves(ns).values(), default=0) <= 1
     best, table = enumerate_catalogue(QuadNodes(items, {"a": ca, "b": cb}, cap=cap))
     assert best.objective == pytest.approx(value, abs=1e-12)
     assert (best.design["a"], best.design["b"]) == combo
