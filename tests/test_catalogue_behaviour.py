@@ -115,6 +115,7 @@ class QuadNodes:
         starts: int = 2,
         bad=(),
         worse_once: float = 0.0,
+        warm_worse: float = 0.0,
     ):
         self.problem = _Problem([_Var(k, v) for k, v in items.items()])
         self.names = list(items)
@@ -132,6 +133,9 @@ class QuadNodes:
         #: its starts stopped at, which a later start beats)
         self.worse_once = worse_once
         self.worse_seen: set = set()
+        #: added to a one-start value of a box of several combinations (a warm start
+        #: stopped above the box's optimum, which the full multistart finds)
+        self.warm_worse = warm_worse
 
     def value(self, point: dict) -> float:
         return sum((point[n] - self.centre[n]) ** 2 for n in self.names)
@@ -153,7 +157,11 @@ class QuadNodes:
         if fixed and not warm and self.worse_once and key not in self.worse_seen:
             self.worse_seen.add(key)
             value += self.worse_once
+        if warm and x_hint is not None and not fixed:
+            value += self.warm_worse
         one = warm and x_hint is not None and (not fallback or prunes is None or not prunes(value))
+        if not one and warm and not fixed:
+            value -= self.warm_worse  # the full multistart finds the box's optimum
         return _result(value, point, 1 if one else self.starts)
 
     def x_of(self, result):
@@ -265,11 +273,13 @@ def test_an_infeasible_root_ends_the_search_before_any_candidate():
 @pytest.mark.parametrize("ca", [0.7, 1.5, 2.4, 2.5, 3.2, 3.5, 4.6])
 @pytest.mark.parametrize("cb", [0.2, 1.5, 2.5, 2.9])
 @pytest.mark.parametrize("cap", [1.0, 2.5, 4.0])
-def test_branch_and_bound_and_enumeration_equal_the_brute_force_optimum(ca, cb, cap):
-    """Over a grid of centres (ties at .5 included) and caps, both searches report the
-    brute-force optimum and its smallest tied items."""
+@pytest.mark.parametrize("warm_worse", [0.0, 0.3])
+def test_branch_and_bound_and_enumeration_equal_the_brute_force_optimum(ca, cb, cap, warm_worse):
+    """Over a grid of centres (ties at .5 included) and caps, with warm starts exact or
+    0.3 above the box's optimum, both searches report the brute-force optimum and its
+    smallest tied items."""
     items = {"a": (1.0, 2.0, 3.0, 4.0), "b": (1.0, 2.0, 3.0)}
-    ns = QuadNodes(items, {"a": ca, "b": cb}, cap=cap)
+    ns = QuadNodes(items, {"a": ca, "b": cb}, cap=cap, warm_worse=warm_worse)
     value, combo = _brute(ns)
     best, _ = branch_and_bound_warm(ns, _root(ns))
     assert best.objective == pytest.approx(value, abs=1e-12)
@@ -927,3 +937,14 @@ def test_an_infeasible_node_is_one_proof_in_the_memo_or_the_searchs_own_record()
         k for k, g in enumerate(own.nlp.g_names) if g.split("[", 1)[0] == "pin_bearing_pressure"
     )
     assert rows and NodeSolver(weak, starts=2, free_rows=rows).solve(box).success
+
+
+def test_a_candidate_without_every_free_variable_is_not_solved():
+    """A candidate holding the items but not a continuous variable gives no start: it is
+    skipped, nothing solved or counted."""
+    ns = QuadNodes({"a": (1.0, 2.0, 3.0)}, {"a": 2.0})
+    ns.names = ["a", "z"]  # a continuous variable z besides the catalogue one
+    stats = {"nodes": 0, "seeded": 0}
+    assert first_incumbent(ns, [{"a": 2.0}], stats) == (None, None)
+    assert stats == {"nodes": 0, "seeded": 0} and ns.calls == []
+    assert _x_of_design(ns, {"a": 2.0, "z": 0.5}).tolist() == [2.0, 0.5]
