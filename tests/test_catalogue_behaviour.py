@@ -718,6 +718,9 @@ def test_a_node_solver_clamps_its_settings_and_records_its_multistart():
     two = NodeSolver(problem, starts=3, seed=5, agree=2)
     r = two.solve(box)
     assert (r.multistart.n_starts, r.multistart.stopped_early, two.n_solves) == (2, True, 2)
+    # agreement needs two starts at least, even when one start would be "agreed"
+    one = NodeSolver(problem, starts=3, seed=5, agree=1)
+    assert one.solve(box).multistart.n_starts == 2
 
 
 def test_a_warm_node_decides_alone_unless_its_value_would_prune_it():
