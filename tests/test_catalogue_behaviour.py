@@ -205,6 +205,8 @@ def test_a_combination_met_again_is_solved_from_the_new_start_only():
     assert best.design == {"a": 2.0, "b": 2.0} and best.multistart.n_starts == 2
     box = {"a": (2.0, 2.0), "b": (2.0, 2.0)}
     assert [warm for b, warm, _ in ns.calls if b == box] == [False, True]
+    revisit = [h for (b, warm, _), h in zip(ns.calls, ns.hints, strict=True) if b == box and warm]
+    assert revisit == [[2.0, 2.0]]  # the optimum of the node it was met from
     assert _cold_leaf_solves(ns)[(2.0, 2.0)] == 1
     # a first multistart stuck 0.01 above: the new start beats it, the full multistart
     # runs again and its value is the one reported
@@ -227,6 +229,9 @@ def test_branch_and_bound_on_one_variable_follows_the_hand_trace():
     # the leaf and the warm node's full multistart, cold, with the root's floor
     assert ({"a": (2.0, 2.0)}, False, 0.0) in ns.calls
     assert ns.calls[-1] == ({"a": (3.0, 4.0)}, False, 0.0)
+    # each from its parent's optimum: the root's 2.4, then the node's 2; the warm node
+    # re-solved from the start it was first solved from
+    assert ns.hints == [None, [2.4], [2.4], [2.0], [2.0], [2.4]]
 
 
 def test_a_candidate_worse_than_the_search_is_seeded_but_not_reported():
