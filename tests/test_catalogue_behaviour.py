@@ -911,6 +911,9 @@ def test_the_files_solver_settings_are_the_nodes_defaults(monkeypatch):
     ns = calls["enumerate"]
     assert (ns.starts, ns.seed, ns.agree, ns.objective) == (3, 9, 1, "backlash")
     assert r.details.catalogue.starts_per_node == 3
+    # the caller's back-end and its options serve every node
+    solve_catalogue(_small(), method="enumerate", starts=1, solver="sqpmethod", options={})
+    assert calls["enumerate"].solver == "sqpmethod"
 
 
 def test_a_node_implied_infeasible_by_the_memo_is_not_solved():
