@@ -959,3 +959,23 @@ def test_a_candidate_without_every_free_variable_is_not_solved():
     assert first_incumbent(ns, [{"a": 2.0}], stats) == (None, None)
     assert stats == {"nodes": 0, "seeded": 0} and ns.calls == []
     assert _x_of_design(ns, {"a": 2.0, "z": 0.5}).tolist() == [2.0, 0.5]
+
+
+def test_a_minlp_back_end_picks_the_items_and_the_default_nlp_solves_the_nodes(monkeypatch):
+    """``solver="bonmin"`` under auto (or method minlp) hands bonmin and its options to
+    the MINLP search; the nodes (relaxation, chosen items) take the default NLP back-end."""
+    from optdesign.studies import catalogue_minlp
+
+    seen = []
+
+    def spy(ns, solver, options):
+        seen.append((ns.solver, solver, options))
+        return None, None
+
+    monkeypatch.setattr(catalogue_minlp, "solve_minlp", spy)
+    opts = {"bonmin.algorithm": "B-BB"}
+    r = solve_catalogue(_small(), starts=1, solver="bonmin", options=opts)
+    assert seen == [("ipopt", "bonmin", opts)]
+    assert r.formulation == "catalogue-minlp" and r.details.catalogue.method == "minlp"
+    r = solve_catalogue(_small(), method="minlp", starts=1)
+    assert seen[-1] == ("ipopt", "bonmin", None) and r.status == "failed"
