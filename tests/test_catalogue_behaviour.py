@@ -446,7 +446,7 @@ def test_item_distances_and_the_variable_farthest_from_an_item():
         [_Var("c", (0.5, 2.0))], {"c": (0.5, 2.0)}, _result(0, {"c": 1.0})
     )
     assert (item, dist) == (0.5, 0.5)
-    tied = _result(0.0, {"a": 1.5, "b": 10.0})
+    tied = _result(0.0, {"a": 1.5, "b": 15.0})  # both 0.5 from an item
     assert on_items(dvars, {"a": (1.0, 4.0), "b": (10.0, 20.0)}, tied)[0].name == "a"
     on = _result(0.0, {"a": 2.0 + 1e-7, "b": 20.0})
     assert on_items(dvars, {"a": (1.0, 4.0), "b": (10.0, 20.0)}, on) == (
