@@ -319,6 +319,7 @@ def test_enumeration_lists_every_combination_in_order_and_keeps_the_first_tie():
     assert math.isnan(table[4].objective)
     assert best.design == {"a": 1.0, "b": 5.0}
     assert all(floor == 0.125 and not warm for _, warm, floor in ns.calls)
+    assert ns.hints == [[1.0, 5.0]] * 6
 
 
 def test_enumeration_with_no_feasible_combination_has_no_best():
@@ -716,7 +717,7 @@ def test_a_node_solver_clamps_its_settings_and_records_its_multistart():
     r = every.solve(box)
     ms = r.multistart
     assert (ms.n_starts, ms.n_converged, ms.n_planned, ms.seed) == (3, 3, 3, 5)
-    assert ms.stopped_early is False and ms.outcomes == ["converged"] * 3
+    assert ms.stopped_early is False and ms.outcomes == ["converged"] * 3 and ms.failed == {}
     # the three tie (within 1e-6): the first start's value is the node's
     assert len(ms.objectives) == 3 and r.objective == ms.objectives[0]
     assert ms.n_at_best == 3 and every.n_solves == 3
@@ -735,6 +736,7 @@ def test_a_warm_node_decides_alone_unless_its_value_would_prune_it():
     problem = _small()
     box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
     ref = NodeSolver(problem, starts=3)
+    assert (ref.seed, ref.workers, ref.agree, ref.eps) == (0, 1, 0, {})  # the defaults
     x = ref.x_of(ref.solve(box))
     pruned = NodeSolver(problem, starts=3)
     r = pruned.solve(box, x, warm=True, prunes=lambda v: True)
@@ -936,7 +938,9 @@ def test_an_infeasible_node_is_one_proof_in_the_memo_or_the_searchs_own_record()
     full = {"p": (5.0, 6.0), "d": (4.0, 5.0)}
     ns = NodeSolver(weak, starts=2)
     ns.memo = ns.proofs = InfeasibleBoxes(full)
-    assert not ns.solve(box).success
+    r = ns.solve(box)
+    assert not r.success and r.multistart.failed == {"locally infeasible": 2}
+    assert (r.multistart.n_starts, r.multistart.n_converged) == (2, 0)
     assert ns.memo.proofs == [({"p": (5.0, 5.0), "d": (4.0, 4.0)}, {})]
     own = NodeSolver(weak, starts=2, eps={"backlash": 1.0})
     own.proofs = InfeasibleBoxes(full)
