@@ -279,3 +279,17 @@ def test_a_nodes_starts_are_its_seeds_sobol_points_and_a_retry_draws_new_ones(mo
     retry = sobol_starts(lo, hi, catalogue.RETRY_STARTS, 6)
     np.testing.assert_array_equal(np.array(seen[3:]), retry)
     assert not np.isin(retry, np.array(seen[1:3])).all(axis=1).any()
+
+
+def test_search_coordinates_map_to_the_nearest_catalogue_items_leaving_the_population():
+    """A population method's coordinates: a catalogue variable's index rounds to its item
+    (clipped to the list), continuous ones pass; the population itself is not changed."""
+    from optdesign.formulations.discrete import CatalogueCoordinates
+
+    coordinates = CatalogueCoordinates(_small())  # p in (5, 6), d in (5, 6, 8)
+    population = np.array([[75, 120, 75, 0.6, 0, 1.4], [80, 100, 70, 1.7, 0.1, 2.2]], float)
+    before = population.copy()
+    designs = coordinates.to_design(population)
+    np.testing.assert_array_equal(designs[:, [3, 5]], [[6.0, 6.0], [6.0, 8.0]])
+    np.testing.assert_array_equal(designs[:, [0, 1, 2, 4]], before[:, [0, 1, 2, 4]])
+    np.testing.assert_array_equal(population, before)
