@@ -432,3 +432,30 @@ def test_an_anchor_multistart_whose_starts_succeed_is_not_solved_again_with_the_
         assert record["status"] == "optimal" and record["n_solves"] == solves
         assert record["multistart"]["n_starts"] == solves
         assert record["objectives"]["backlash"] == pytest.approx(0.0362197, rel=1e-5)
+
+
+def test_an_arc_step_back_starts_from_the_tighter_of_the_neighbours_value_and_limit():
+    """Stepping back along the arc (the target lies before the neighbour), the new limit
+    is a step below the lower of the neighbour's value and its own limit."""
+    from dataclasses import replace
+
+    from optdesign.studies.pareto.records import PointRecord
+    from optdesign.studies.pareto.tasks import arc_eps
+
+    frame = {"a0": 0.0, "b0": 1.0, "ra": 1.0, "rb": 2.0, "a_lo": 0.0, "a_hi": 1.0}
+    task = {"frame": frame, "eps_name": "a", "target": "b", "arc": 0.0, "fallback_eps": 0.9}
+    nb = PointRecord(id="p", kind="eps", status="optimal", verified=True, target="b",
+                     objectives={"a": 0.5, "b": 1.2}, eps={"a": 0.45})  # fmt: skip
+    # s1 = 0.5 + (1 - 1.2) / 2 = 0.4; ds/da = 1 + 2 / 2 = 2; step = (0 - 0.4) / 2 = -0.2
+    assert arc_eps(task, nb) == {"a": pytest.approx(0.45 - 0.2)}
+    assert arc_eps(task, replace(nb, eps={"a": 0.7})) == {"a": pytest.approx(0.5 - 0.2)}
+
+
+def test_a_front_without_an_output_folder_keeps_its_store_in_a_named_temporary_folder():
+    """No ``out``: the store goes to a new temporary folder whose name says what it is."""
+    from optdesign.studies.pareto.run_setup import store_path
+
+    path = store_path(None, "epsilon")
+    assert path.name == "epsilon.jsonl" and path.parent.is_dir()
+    assert path.parent.name.startswith("optdesign-pareto-")
+    path.parent.rmdir()
