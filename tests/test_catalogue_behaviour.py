@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
+from test_catalogue_ties import _Problem, _Var  # the stand-in problem of catalogue items
 
 from optdesign.errors import ProblemError
 from optdesign.solvers.result import MultistartInfo, Result
@@ -51,26 +51,6 @@ from optdesign.studies.catalogue_bnb import (
     trusted_value,
     wins,
 )
-
-
-@dataclass
-class _Var:
-    name: str
-    values: tuple[float, ...]
-    discrete: bool = True
-
-    @property
-    def lower(self) -> float:
-        return self.values[0]
-
-    @property
-    def upper(self) -> float:
-        return self.values[-1]
-
-
-@dataclass
-class _Problem:
-    free: list[_Var]
 
 
 def _result(value: float, design: dict, n_starts: int = 1, early: bool = False) -> Result:
