@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 import pytest
+from test_catalogue_ties import _infeasible as _failed
 from test_catalogue_ties import _Problem, _Var  # the stand-in problem of catalogue items
 
 from optdesign.errors import ProblemError
@@ -66,17 +67,6 @@ def _result(value: float, design: dict, n_starts: int = 1, early: bool = False) 
         n_starts=n_starts, n_converged=n_starts, n_at_best=1, tolerance=1e-6, stopped_early=early
     )
     return r
-
-
-def _failed() -> Result:
-    return Result(
-        status="infeasible",
-        objective=float("nan"),
-        design={},
-        solver="fake",
-        formulation="nlp",
-        wall_time_s=0.0,
-    )
 
 
 class QuadNodes:
