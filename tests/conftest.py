@@ -1,5 +1,6 @@
 import os
 import signal
+import tempfile
 
 import numpy as np
 import pytest
@@ -36,6 +37,23 @@ settings.register_profile(
     suppress_health_check=[HealthCheck.too_slow],
 )
 settings.load_profile(os.environ.get("OPTDESIGN_HYPOTHESIS") or "deterministic")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _temporary_folders_kept_by_pytest(tmp_path_factory):
+    """A study without ``out`` keeps its store in a new temporary folder (nothing computed
+    is lost); the suite's thousands of such folders (and those of the commands it starts)
+    go under pytest's own temporary folder, which pytest prunes, never straight to /tmp."""
+    folder = tmp_path_factory.mktemp("tempfile")
+    saved_dir, saved_env = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir = str(folder)
+    os.environ["TMPDIR"] = str(folder)
+    yield folder
+    tempfile.tempdir = saved_dir
+    if saved_env is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = saved_env
 
 
 @pytest.fixture
