@@ -272,6 +272,9 @@ def with_fixed_clearances(joints: Sequence[Joint], fixed: dict[str, Any]) -> lis
 def with_sampled_fits(joints: Sequence[Joint], fractions: Sequence[Any]) -> list[Joint]:
     """Each sized pin at ``c_min + u (c_max - c_min)`` of its fit, ``u`` from ``fractions``
     in the order of the pins (robust design draws one fraction per pin)."""
+    pins = sum(joint.pin is not None for joint in joints)
+    if pins != len(fractions):
+        raise InputError("tolerances.fit", f"{len(fractions)} fit draws for {pins} pin joints")
     out, k = [], 0
     for joint in joints:
         if joint.pin is not None:
@@ -280,6 +283,4 @@ def with_sampled_fits(joints: Sequence[Joint], fractions: Sequence[Any]) -> list
             joint = replace(joint, pin=pin)
             k += 1
         out.append(joint)
-    if k != len(fractions):
-        raise InputError("tolerances.fit", f"{len(fractions)} fit draws for {k} pin joints")
     return out

@@ -1,0 +1,313 @@
+"""optdesign/mechanisms/joints.py as a whole: each joint's clearance, stiffness and
+pressure against the models it composes (and against finite differences of its own
+clearance), the refusals at both sides of every bound, and the chain's bookkeeping
+(fixed clearances by key, sampled fits, backlash in degrees)."""
+
+import math
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from optdesign.errors import InputError
+from optdesign.fits import clearance as iso_clearance
+from optdesign.mechanisms.joints import (
+    Joint,
+    PinJoint,
+    backlash_of,
+    with_fixed_clearances,
+    with_sampled_fits,
+)
+from optdesign.models import pin_contact
+from optdesign.models.fit_formulas import Fit
+from optdesign.models.hertz_line import pin_flattening, pin_flattening_first_order
+from optdesign.models.lug_flexibility import Lug
+
+D, L, F = 10.0, 12.0, 3000.0
+LUG = Lug(cheek_thickness=5.0)
+
+
+def _pin(**kw):
+    return PinJoint(kw.pop("d", D), kw.pop("L", L), **kw)
+
+
+# --- PinJoint: refusals at both sides of each bound -------------------------------------
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.5, -0.1, 0.7])
+def test_a_poisson_ratio_outside_the_open_interval_is_refused_by_field(nu):
+    with pytest.raises(InputError) as err:
+        _pin(nu=nu)
+    assert err.value.field == "pin.nu"
+    assert "(0, 0.5)" in str(err.value)
+
+
+@pytest.mark.parametrize("nu", [1e-6, 0.25, 0.499999])
+def test_a_poisson_ratio_inside_the_open_interval_is_accepted(nu):
+    assert _pin(nu=nu).nu == nu
+
+
+@pytest.mark.parametrize(
+    "field,kw", [("pin.d", {"d": 0.0}), ("pin.L", {"L": -1.0}), ("pin.E", {"E": 0.0})]
+)
+def test_non_positive_sizes_are_refused_by_field(field, kw):
+    with pytest.raises(InputError) as err:
+        _pin(**kw)
+    assert err.value.field == field
+
+
+def test_an_unknown_contact_model_is_refused_listing_the_models():
+    with pytest.raises(InputError) as err:
+        _pin(contact="hertz")
+    assert err.value.field == "pin.contact"
+    assert "'hertz'" in str(err.value) and "palmgren" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "E,ok", [(1.9e5, True), (2.2e5, True), (1.8999e5, False), (2.2001e5, False)]
+)
+def test_palmgrens_steel_band_is_closed_at_both_ends(E, ok):
+    if ok:
+        assert _pin(contact="palmgren", E=E).E == E
+    else:
+        with pytest.raises(InputError) as err:
+            _pin(contact="palmgren", E=E)
+        assert err.value.field == "materials.pin.E"
+        assert f"{E:g} MPa" in str(err.value)
+
+
+def test_only_palmgren_checks_the_modulus_band():
+    for contact in ("duan2017", "conforming"):
+        assert _pin(contact=contact, E=7.0e4).E == 7.0e4
+
+
+def test_huth_needs_a_lug_and_names_the_lug_section():
+    with pytest.raises(InputError) as err:
+        _pin(contact="huth")
+    assert err.value.field == "materials.lug"
+    assert "cheek_thickness" in str(err.value)
+    with pytest.raises(InputError) as err:
+        _pin().lug_compliance()
+    assert err.value.field == "materials.lug"
+
+
+def test_a_symbolic_modulus_and_poisson_ratio_are_not_range_checked():
+    E, nu = ca.SX.sym("E"), ca.SX.sym("nu")
+    pin = PinJoint(D, L, E=E, nu=nu, contact="palmgren")
+    assert pin.E is E and pin.nu is nu
+
+
+def test_the_placeholder_is_one_unit_pin_made_once():
+    a, b = PinJoint.placeholder(), PinJoint.placeholder()
+    assert a is b
+    assert (a.d, a.L, a.fit, a.contact) == (1.0, 1.0, "H7/g6", "duan2017")
+
+
+# --- PinJoint: the fit's clearance --------------------------------------------------------
+
+
+@pytest.mark.parametrize("fit", ["H7/g6", "H8/f7", "H11/c11"])
+def test_the_fit_clearance_is_iso_286s_smooth_or_table_value(fit):
+    smooth = Fit.parse(fit, values="smooth")
+    for which in ("max", "min"):
+        assert _pin(fit=fit, which=which).fit_clearance() == pytest.approx(
+            float(smooth.clearance(D, which)), rel=1e-12
+        )
+        assert _pin(fit=fit, values="table").fit_clearance(which) == pytest.approx(
+            float(iso_clearance(fit, D, which, values="table")), rel=1e-12
+        )
+    lo, hi = _pin(fit=fit).fit_band()
+    assert 0.0 <= lo < hi
+    assert hi == pytest.approx(float(smooth.clearance(D, "max")))
+
+
+def test_the_table_ratio_scales_the_smooth_clearance_of_its_own_side():
+    pin = _pin(ratio_max=1.5, ratio_min=0.5)
+    smooth = Fit.parse("H7/g6", values="smooth")
+    assert pin.fit_clearance("max") == pytest.approx(1.5 * float(smooth.clearance(D, "max")))
+    assert pin.fit_clearance("min") == pytest.approx(0.5 * float(smooth.clearance(D, "min")))
+    # A symbolic diameter with table values takes the smooth formula times the ratio.
+    d = ca.SX.sym("d")
+    sym = PinJoint(d, L, values="table", ratio_max=1.25)
+    value = float(ca.Function("c", [d], [sym.fit_clearance()])(D))
+    assert value == pytest.approx(1.25 * float(smooth.clearance(D, "max")), rel=1e-12)
+
+
+def test_a_table_only_fit_takes_its_clearance_from_the_ratio_parameter():
+    d = ca.SX.sym("d")
+    pin = PinJoint(d, L, fit="H7/s6", values="table", ratio_max=0.021, ratio_min=-0.004)
+    assert float(ca.Function("c", [d], [pin.fit_clearance("max")])(D)) == pytest.approx(0.021)
+    assert float(ca.Function("c", [d], [pin.fit_clearance("min")])(D)) == pytest.approx(-0.004)
+
+
+# --- PinJoint: clearance, stiffness, pressure per contact model ---------------------------
+
+
+def test_the_duan2017_clearance_adds_each_flattened_surface_and_the_extra():
+    base = _pin().fit_clearance()
+    flat = pin_flattening(D, F, L, 2.1e5, 0.3)
+    assert _pin().clearance(F) == pytest.approx(base + 2 * flat, rel=1e-12)
+    assert _pin(surfaces=1, extra=0.004).clearance(F) == pytest.approx(
+        0.004 + base + flat, rel=1e-12
+    )
+    first = pin_flattening_first_order(D, F, L, 2.1e5, 0.3)
+    assert first != pytest.approx(flat, rel=1e-6)
+    assert _pin(first_order=True).clearance(F) == pytest.approx(base + 2 * first, rel=1e-12)
+
+
+def test_the_other_contact_models_add_their_own_approach():
+    base = _pin().fit_clearance()
+    conforming = pin_contact.approach(F, L, 0.5 * D, 0.5 * base, 2.1e5, 0.3)
+    assert _pin(contact="conforming", extra=0.001).clearance(F) == pytest.approx(
+        0.001 + base + conforming, rel=1e-12
+    )
+    assert _pin(contact="palmgren").clearance(F) == pytest.approx(
+        base + pin_contact.palmgren_approach(F, L), rel=1e-12
+    )
+    huth = _pin(contact="huth", lug=LUG)
+    assert huth.clearance(F) == pytest.approx(base + LUG.compliance(D, L, 2.1e5) * F, rel=1e-12)
+    # The four differ: a model swapped for another is seen.
+    values = [
+        _pin(contact=c, lug=LUG).clearance(F)
+        for c in ("duan2017", "conforming", "palmgren", "huth")
+    ]
+    assert len({round(v, 9) for v in values}) == 4
+
+
+@pytest.mark.parametrize("contact", ["duan2017", "conforming", "palmgren", "huth"])
+@pytest.mark.parametrize("surfaces", [1, 2])
+def test_the_contact_stiffness_is_the_inverse_slope_of_the_clearance(contact, surfaces):
+    """Independent check: central differences of the joint's own clearance in F."""
+    pin = _pin(contact=contact, lug=LUG, surfaces=surfaces)
+    for force in (500.0, 3000.0, 12000.0):
+        h = 1e-3 * force
+        slope = (pin.clearance(force + h) - pin.clearance(force - h)) / (2 * h)
+        assert float(pin.contact_stiffness(force)) == pytest.approx(1.0 / slope, rel=1e-5)
+
+
+def test_huths_stiffness_is_constant_over_a_grid_of_forces():
+    forces = np.array([0.0, 100.0, 5000.0])
+    k = _pin(contact="huth", lug=LUG).contact_stiffness(forces)
+    assert np.shape(k) == (3,)
+    assert np.allclose(k, 1.0 / LUG.compliance(D, L, 2.1e5))
+
+
+def test_the_contact_pressure_is_hertzs_peak_or_the_conforming_solutions():
+    b = math.sqrt(4.0 * D * (F / L) * (1 - 0.3**2) / (math.pi * 2.1e5))
+    hertz = 2.0 * F / (math.pi * b * L)
+    for contact in ("duan2017", "palmgren", "huth"):
+        assert _pin(contact=contact, lug=LUG).contact_pressure(F) == pytest.approx(hertz, rel=1e-12)
+    c = _pin().fit_clearance()
+    assert _pin(contact="conforming").contact_pressure(F) == pytest.approx(
+        pin_contact.max_pressure(F, L, 0.5 * D, 0.5 * c, 2.1e5, 0.3), rel=1e-12
+    )
+
+
+# --- Joint ------------------------------------------------------------------------------
+
+
+def test_a_joint_refuses_a_negative_clearance_naming_itself():
+    with pytest.raises(InputError) as err:
+        Joint("A", sensitivity=1.0, clearance=-1e-9)
+    assert err.value.field == "joint A.clearance"
+    assert Joint("A", sensitivity=1.0, clearance=0.0).clearance == 0.0
+
+
+def test_a_joint_needs_a_sensitivity_unless_angular_and_a_force_with_a_pin():
+    with pytest.raises(InputError, match="sensitivity") as err:
+        Joint("B")
+    assert err.value.field == "joint B"
+    assert Joint("shaft", angular=True, clearance=1e-3).sensitivity is None
+    with pytest.raises(InputError, match="force") as err:
+        Joint("C", sensitivity=1.0, pin=_pin())
+    assert err.value.field == "joint C"
+
+
+def test_a_joints_rotation_is_its_sensitivity_times_its_clearance_under_the_load_magnitude():
+    phi = np.linspace(-0.5, 0.5, 5)
+    S = np.array([-0.2, -0.1, 0.05, 0.1, 0.2])
+    force = np.array([-3000.0, -1000.0, 0.0, 1000.0, 3000.0])
+    pin = _pin()
+    joint = Joint("D", sensitivity=S, force=force, pin=pin, clearance=0.002)
+    expected_c = 0.002 + np.array([pin.clearance(abs(f)) for f in force])
+    assert np.allclose(joint.total_clearance(), expected_c, rtol=1e-12)
+    assert np.allclose(joint.rotation(phi), np.abs(S) * expected_c, rtol=1e-12)
+    # Without a pin, only the fixed clearance.
+    plain = Joint("A", sensitivity=S, clearance=0.01)
+    assert np.allclose(plain.rotation(phi), np.abs(S) * 0.01)
+
+
+def test_an_angular_joint_rotates_by_its_clearance_at_every_angle():
+    phi = np.linspace(-0.5, 0.5, 7)
+    rot = Joint("shaft", angular=True, clearance=2e-3, sensitivity=5.0).rotation(phi)
+    assert np.shape(rot) == (7,)
+    assert np.allclose(rot, 2e-3)
+
+
+def test_the_backlash_is_each_joints_rotation_in_degrees_summed_and_root_summed():
+    phi = np.array([0.0, 0.1])
+    joints = [
+        Joint("A", sensitivity=np.array([0.1, 0.2]), clearance=0.01),
+        Joint("B", sensitivity=np.array([0.3, -0.4]), clearance=0.02),
+        Joint("shaft", angular=True, clearance=1e-3),
+    ]
+    b = backlash_of(joints, phi)
+    deg = 180.0 / math.pi
+    a = np.array([0.001, 0.002]) * deg
+    bb = np.array([0.006, 0.008]) * deg
+    s = np.array([1e-3, 1e-3]) * deg
+    assert list(b.per_joint) == ["A", "B", "shaft"]
+    assert np.allclose(b.per_joint["B"], bb)
+    assert np.allclose(b.worst_case, a + bb + s)
+    assert np.allclose(b.rss, np.sqrt(a**2 + bb**2 + s**2))
+
+
+# --- the chain a problem sees -------------------------------------------------------------
+
+
+def test_fixed_clearances_are_set_by_key_added_to_keyed_pins_and_empty_joints_dropped():
+    pin = _pin()
+    chain = [
+        Joint("A joint", key="A", sensitivity=1.0),
+        Joint("B joint", key="B", sensitivity=1.0),
+        Joint("keyed pin", key="C", sensitivity=1.0, force=1.0, pin=pin, clearance=0.001),
+        Joint("sized pin", sensitivity=1.0, force=1.0, pin=pin),
+        Joint("unkeyed", sensitivity=1.0, clearance=0.5),
+    ]
+    out = with_fixed_clearances(chain, {"A": 0.01, "B": 0.0, "C": 0.002, "": 9.0})
+    assert [j.name for j in out] == ["A joint", "keyed pin", "sized pin"]
+    assert out[0].clearance == 0.01
+    assert out[1].clearance == pytest.approx(0.003)
+    assert out[2] is chain[3]
+    # The inputs are left as they were.
+    assert chain[0].clearance == 0.0 and chain[2].clearance == 0.001
+
+
+def test_sampled_fits_put_each_pin_at_its_own_fraction_of_its_band():
+    pins = [_pin(fit="H7/g6", extra=0.001), _pin(fit="H8/f7", d=20.0)]
+    chain = [
+        Joint("p1", sensitivity=1.0, force=0.0, pin=pins[0]),
+        Joint("A", sensitivity=1.0, clearance=0.01),
+        Joint("p2", sensitivity=1.0, force=0.0, pin=pins[1]),
+    ]
+    out = with_sampled_fits(chain, [0.25, 0.75])
+    assert out[1] is chain[1]
+    for joint, pin, u in ((out[0], pins[0], 0.25), (out[2], pins[1], 0.75)):
+        lo, hi = pin.fit_band()
+        assert joint.pin.which == "min"
+        assert joint.pin.fit_clearance() + joint.pin.extra == pytest.approx(
+            pin.extra + lo + u * (hi - lo), rel=1e-12
+        )
+
+
+def test_a_wrong_count_of_fit_draws_is_refused_naming_both_counts():
+    """Fewer draws than pins was an IndexError before the count was checked first."""
+    pin = _pin()
+    chain = [Joint(f"p{i}", sensitivity=1.0, force=0.0, pin=pin) for i in (1, 2)]
+    chain.insert(1, Joint("A", sensitivity=1.0, clearance=0.01))
+    with pytest.raises(InputError) as err:
+        with_sampled_fits(chain, [0.5])
+    assert err.value.field == "tolerances.fit"
+    assert "1 fit draws for 2 pin joints" in str(err.value)
+    with pytest.raises(InputError, match="3 fit draws for 2 pin joints"):
+        with_sampled_fits(chain, [0.5, 0.5, 0.5])
