@@ -145,3 +145,66 @@ def test_the_sketch_draws_the_horn_and_the_actuator_from_the_geometry():
     assert np.allclose(sk.links[0], [(0.0, 0.0), B]) and np.allclose(sk.links[1], [T, B])
     assert np.allclose(sk.pivots, [(0.0, 0.0), T]) and np.allclose(sk.slider, B)
     assert np.allclose(sk.axis, [T, B])
+
+
+def test_both_pins_sit_on_the_actuator_and_carry_its_force():
+    """The chain: A, B axial and O angular, then the horn pin and the trunnion, each with
+    the actuator's sensitivity 1/(dL/dphi) and force M_h/(dL/dphi) (the statics above)."""
+    mech = PivotingScrew(**DESIGN)
+    pin = PinJoint(8.0, 10.0)
+    chain = mech.joints(PHI, 2.0e5, pin)
+    assert [(j.name, j.key, j.angular, j.pin is pin) for j in chain] == [
+        ("A screw bearings", "A", False, False),
+        ("B screw/nut", "B", False, False),
+        ("O output shaft", "O", True, False),
+        ("horn pin", "", False, True),
+        ("trunnion", "", False, True),
+    ]
+    rate = np.asarray(mech.nut_velocity(PHI), dtype=float)
+    for j in (chain[0], chain[1], chain[3], chain[4]):
+        assert np.allclose(j.sensitivity, 1.0 / rate, rtol=1e-12)
+    for j in chain[3:]:
+        assert np.allclose(j.force, 2.0e5 / rate, rtol=1e-12)
+    assert np.allclose(mech.pin_force(PHI, 2.0e5), 2.0e5 / rate, rtol=1e-12)
+
+
+def test_the_size_is_the_horn_plus_the_pivot_distance():
+    mech = PivotingScrew(**DESIGN)
+    assert float(mech.size()) == pytest.approx(90.0 + np.hypot(220.0, 40.0), rel=1e-12)
+
+
+def test_a_one_sided_transmission_band_leaves_the_other_bound_open():
+    from types import SimpleNamespace
+
+    mech = PivotingScrew(**DESIGN)
+    (lower_only,) = mech.requirement_rows(
+        "transmission_angle", SimpleNamespace(min=np.radians(50.0), max=None), PHI
+    )
+    assert lower_only.lower is None
+    assert lower_only.upper == pytest.approx(np.cos(np.radians(50.0)))
+    (upper_only,) = mech.requirement_rows(
+        "transmission_angle", SimpleNamespace(min=None, max=np.radians(120.0)), PHI
+    )
+    assert upper_only.upper is None
+    assert upper_only.lower == pytest.approx(np.cos(np.radians(120.0)))
+    with pytest.raises(NotImplementedError, match="'stiffness'"):
+        mech.requirement_rows("stiffness", 1.0, PHI)
+
+
+def test_the_requirements_declared_ranges_and_the_benchmarks_template():
+    req = PivotingScrew.requirements
+    assert (req["transmission_angle"].kind, req["transmission_angle"].valid) == (
+        "band",
+        (0.0, np.pi),
+    )
+    assert (req["dead_length"].kind, req["dead_length"].dimension) == ("value", "length")
+    assert req["dead_length"].valid == (0.0, np.inf)
+    variables, requirements = PivotingScrew.bench_template()
+    assert list(variables) == ["R", "a_T", "b_T", "p", "phi0"] and variables["p"] is None
+    assert variables["a_T"] == {"lower": "-300 mm", "upper": "-40 mm"}
+    assert requirements == {
+        "transmission_angle": {"min": "40 deg", "max": "140 deg"},
+        "dead_length": "60 mm",
+    }
+    assert PivotingScrew.pin_shear_planes == 2
+    assert PivotingScrew.bench_families == {"pivot_backlash": ("backlash",)}
