@@ -150,8 +150,10 @@ def pareto(
     between exact anchors, evenly spread along the front; default), ``"uniform"``
     (epsilon evenly spaced), ``"weighted_sum"`` or ``"nsga2"``, or a method object.
     Options (all keywords; an option the method does not use is refused): ``out``
-    (folder of the resumable store), ``workers``, ``scheduler`` (Dask), ``resume``,
-    ``overwrite`` (start afresh over a stored run), ``progress``, ``starts``, ``seed``,
+    (folder of the resumable store; default: a new temporary folder
+    ``optdesign-pareto-*``, kept, named by ``Front.store``), ``workers``, ``scheduler``
+    (Dask), ``resume``, ``overwrite`` (start afresh over a stored run), ``progress``,
+    ``starts``, ``seed``,
     ``solver``, ``agree``, ``spacing``, ``eps_values``, ``retry_starts``,
     ``extra_starts``, ``deterministic``, ``time_limit`` (wall-clock seconds of a
     continuous epsilon front, refused by any other method: no point begins after it, the
