@@ -85,20 +85,24 @@ def spread(
 ) -> float:
     """Deb's spread Delta of a 2-objective front (normalised objectives).
 
-    ``extremes`` (2 x 2: the true extreme points) adds their distance to the front's ends;
-    without it only the evenness of the consecutive gaps counts. For more objectives the
+    ``extremes`` (2 x 2: the true extreme points) adds their distance to the front's ends,
+    normalised in the front's frame (``bounds``, else the front's range); without it
+    only the evenness of the consecutive gaps counts. For more objectives the
     same formula is applied to nearest-neighbour distances (a common generalisation).
     """
     F = np.asarray(F, dtype=float)
     if len(F) < 3:
         return 0.0
-    Z = _normalised(F, bounds)
+    # one frame for the front and the extremes (normalised in their own frame, two
+    # extremes always land on the corners, and their distances would always be 0)
+    frame = (F.min(axis=0), F.max(axis=0)) if bounds is None else bounds
+    Z = _normalised(F, frame)
     if F.shape[1] == 2:
         order = np.argsort(Z[:, 0])
         Z = Z[order]
         d = np.linalg.norm(np.diff(Z, axis=0), axis=1)
         if extremes is not None:
-            E = _normalised(np.asarray(extremes, dtype=float), bounds)
+            E = _normalised(np.asarray(extremes, dtype=float), frame)
             E = E[np.argsort(E[:, 0])]
             d_f = float(np.linalg.norm(Z[0] - E[0]))
             d_l = float(np.linalg.norm(Z[-1] - E[-1]))
