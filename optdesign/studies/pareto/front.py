@@ -177,6 +177,7 @@ def make_front(
     kept = []
     for p, keep in zip(good, mask, strict=True):
         if keep:
+            p.rejected = ""  # a point another front rejected is on this one
             kept.append(p)
         else:
             p.rejected = "dominated or duplicate"
