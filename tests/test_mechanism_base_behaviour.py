@@ -293,6 +293,16 @@ def test_the_default_assembly_margin_marks_the_angles_without_a_position():
     assert "circle lever R=10, e=0, tilt=0, k=1, p=1, i_a=1" in str(err.value)
 
 
+def test_a_population_is_checked_design_by_design_naming_the_first_angle():
+    """A population's margins (designs x angles) against a grid of angles."""
+    circle = CircleLever(R=np.array([[10.0], [20.0]]), p=1.0)
+    circle.check_assembly([-0.4, 0.0, 0.4])
+    with pytest.raises(AssemblyError) as err:
+        circle.check_assembly([0.0, 0.3, 0.55])
+    assert err.value.angle_deg == pytest.approx(np.degrees(0.55))
+    assert "R=<array (2, 1)>" in str(err.value)
+
+
 def test_a_margin_of_exactly_zero_does_not_assemble():
     class Touching(Lever):
         def assembly_margin(self, phi):
@@ -345,5 +355,9 @@ def test_the_automatic_derivative_on_symbolic_numeric_and_population_paths():
 def test_the_automatic_derivative_refuses_values_it_cannot_see_through():
     lev = lever()
     lev.values["R"] = np.array([object()], dtype=object)  # as the GP diagnosis's tracers
-    with pytest.raises(TypeError, match="write nut_velocity in closed form"):
+    with pytest.raises(
+        TypeError,
+        match=r"Lever\.nut_velocity is the automatic derivative of nut_position, which needs "
+        r"CasADi or NumPy values; write nut_velocity in closed form to trace it \(GP diagnosis\)",
+    ):
         lev.nut_velocity(PHI)
