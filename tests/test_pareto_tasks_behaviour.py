@@ -509,6 +509,9 @@ def test_cold_starts_keep_the_first_of_equal_points_and_take_a_better_one(fake):
     record = front_task(_eps_task(retry_starts=5, seed=1), {})
     assert record["retried"] == "failed" and record["n_solves"] == 6
     assert record["x"] == [5.0, 0.0]
+    assert record["kind"] == "eps" and record["target"] == "b" and record["eps"] == {"a": 2.0}
+    every = (PROBLEM, "eps", "b", {"a": 2.0}, "epsilon-0003", "nlp-fp")
+    assert solver.records == [every] * 6
     sobol = sobol_starts(PROBLEM.lower(), PROBLEM.upper(), 5, 1 + 7919 * 3)
     assert [s[2] for s in solver.solves[1:]] == [("x0", tuple(p)) for p in sobol]
     # the slope is asked for the point kept
@@ -590,6 +593,7 @@ def test_an_arc_step_is_a_newton_step_along_the_normalised_front():
 def test_an_arc_step_back_starts_from_the_lower_of_value_and_limit():
     assert _arc(0.5) == {"a": pytest.approx(1.8, rel=1e-14)}  # 2 - 0.125 / 0.625
     assert _arc(0.5, eps={"a": 1.9}) == {"a": pytest.approx(1.7, rel=1e-14)}
+    assert _arc(0.5, eps={}) == {"a": pytest.approx(1.8, rel=1e-14)}  # from its value
     # no step: the lower of the two, not the larger
     assert _arc(0.625) == {"a": 2.0}
 
