@@ -787,3 +787,25 @@ def test_axial_compliance_keeps_only_the_members_the_file_gives():
     # the output: through the screw's rate (dx/dphi)^2, no pin in this problem
     total = np.asarray(drive.output_compliance(q), dtype=float).ravel()
     assert total == pytest.approx(expected / _dx(80.0, 120.0, 60.0, 0.1, PHI[::2]) ** 2, rel=1e-6)
+
+
+def test_a_continuous_screw_and_the_solver_path_have_no_membership_block():
+    from test_drive import DESIGN, _data
+
+    screw = {"length": "400 mm", "nut_stiffness": "200 N/um"}
+    problem = problem_from_dict(
+        _data(screw, {"d0": "20 mm"}, deflection_rate="60 deg/s", dn_max=50_000)
+    )
+    x = np.array([DESIGN[v.name] for v in problem.free])
+    blocks = {b.name: b for b in problem.expressions(problem.design_dict(x)).constraints}
+    drive_names = [n for n in blocks if n.startswith("screw_") or n in ("dn", "stiffness")]
+    assert drive_names == ["screw_buckling", "screw_yield", "dn"]
+    fin = _fin()
+    design = fin.design_dict(_x_of(fin))
+    params = fin.parameter_values({"d0": (25.0, 25.0), "p": (5.0, 5.0), "d": (6.0, 6.0)})
+    ex = fin.expressions({**design, **fin.parameter_design(params)})
+    names = [b.name for b in ex.constraints]
+    assert "screw_catalogue_membership" not in names
+    assert [n for n in DRIVE_NAMES if n in names] == [
+        n for n in DRIVE_NAMES if n != "screw_catalogue_membership"
+    ]
