@@ -431,6 +431,14 @@ def test_lookup_scalar_and_array_and_no_screw_where_sizes_are_not_positive():
     assert on.shape == (6, 1) and on.ravel().tolist() == [1.0, 0, 0, 0, 0, 0]
     assert vals["C0a"][0, 0] == _best(25.0, 5.0)["C0a"]
     assert np.isnan(vals["C0a"][1:]).all()
+    # small positive sizes have a nearest screw; a valid design after invalid ones counts
+    d0 = np.array([0.0, 0.5, 8.0, np.nan, 32.0])
+    p = np.array([5.0, 2.5, 0.5, 5.0, 10.0])
+    vals, on = drive._lookup(items, d0, p, ["d1"])
+    assert on.tolist() == [0.0, 0.0, 0.0, 0.0, 1.0]
+    assert np.isnan(vals["d1"][[0, 3]]).all()
+    assert vals["d1"][[1, 2]].tolist() == [_best(8.0, 2.5)["d1"]] * 2
+    assert vals["d1"][4] == _best(32.0, 10.0)["d1"]
     # broadcast: one lead against two diameters
     vals, on = drive._lookup(items, np.array([20.0, 25.0]), 5.0, ["d1"])
     assert vals["d1"].tolist() == [_best(20.0, 5.0)["d1"], _best(25.0, 5.0)["d1"]]
@@ -572,12 +580,15 @@ def test_box_has_item():
     assert drive.box_has_item(problem, {"d0": (25.0, 25.0), "p": (5.0, 5.0)})
     assert not drive.box_has_item(problem, {"d0": (14.0, 14.0), "p": (5.0, 5.0)})
     assert not drive.box_has_item(problem, {"d0": (13.0, 13.9), "p": (2.0, 10.0)})
+    # 25 x 2 and 25 x 5 exist, no lead between: the box's lead ends are its own
+    assert not drive.box_has_item(problem, {"d0": (25.0, 25.0), "p": (3.0, 4.0)})
     from test_drive import _data
 
     continuous = problem_from_dict(_data({"kind": "ball"}, {"d0": "20 mm"}))
     assert drive.box_has_item(continuous, {"d0": (13.0, 13.9)})
     assert drive.box_has_item(problem_from_dict(_data(None, None)), {})
     assert continuous.parameters() == {}
+    assert problem_from_dict(_data(None, None)).parameters() == {}
 
 
 # --- drive: screw data, efficiency, speed, life --------------------------------------------
@@ -809,3 +820,27 @@ def test_a_continuous_screw_and_the_solver_path_have_no_membership_block():
     assert [n for n in DRIVE_NAMES if n in names] == [
         n for n in DRIVE_NAMES if n != "screw_catalogue_membership"
     ]
+
+
+def test_a_fit_whose_smooth_clearance_is_zero_keeps_the_ratio_one():
+    """H7/h6's least clearance is 0 by the formula and by the table: no ratio, 1."""
+    values = _fin(fit="H7/h6").parameter_values(
+        {"d": (6.0, 6.0), "d0": (25.0, 25.0), "p": (5.0, 5.0)}
+    )
+    assert values["fit_ratio_min"] == 1.0
+    assert values["fit_ratio_max"] == pytest.approx(_fit_ratio("H7/h6", [6.0], "max"))
+
+
+@pytest.mark.parametrize(
+    ("nut", "text"), [({"nut_stiffness": "200 N/um"}, "as given"), ({}, "rigid")]
+)
+def test_stiffness_description_of_a_continuous_screws_nut(nut, text):
+    from test_drive import DESIGN, _data
+
+    screw = {"length": "400 mm", "check_buckling": False, **nut}
+    problem = problem_from_dict(_data(screw, {"d0": "20 mm"}, stiffness_min="10 kN*m/rad"))
+    x = np.array([DESIGN[v.name] for v in problem.free])
+    blocks = {b.name: b for b in problem.expressions(problem.design_dict(x)).constraints}
+    assert blocks["stiffness"].description == (
+        f"required stiffness / stiffness at the output (nut: {text})"
+    )
