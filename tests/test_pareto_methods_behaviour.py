@@ -193,6 +193,23 @@ def test_a_front_refuses_no_worker_and_an_unapplied_time_limit_before_any_work(c
     assert list(tmp_path.iterdir()) == []  # nothing written
 
 
+def test_overwrite_discards_the_methods_own_store_only_when_not_resuming(cs, tmp_path):
+    def run(**options):
+        compute_front(
+            cs, ["size", "backlash"], 3, "nsga2", pop_size=4, generations=1, seed=0, **options
+        )
+
+    store, other = tmp_path / "nsga2.jsonl", tmp_path / "epsilon.jsonl"
+    store.write_text("old\n")
+    other.write_text("old\n")
+    run(out=tmp_path, overwrite=True, resume=True)
+    assert store.read_text() == "old\n"
+    run(out=tmp_path)
+    assert store.read_text() == "old\n"
+    run(out=tmp_path, overwrite=True)
+    assert not store.exists() and other.read_text() == "old\n"
+
+
 # --- NSGA-II ------------------------------------------------------------------------------
 def _g(v, lower, upper):
     """The signed relative violation of lower <= v <= upper, worst over the grid."""

@@ -180,7 +180,7 @@ def _result(cs, **more) -> Result:
 def test_a_result_becomes_a_checked_record_with_its_sorted_active_rows_and_warm_start(cs):
     rows = [
         ConstraintReport(name=n, value=0.0, lower=0.0, upper=None, amount=0.0)
-        for n in ("b[2]", "a_envelope[1]", "b[10]", "a", "ab[0]")
+        for n in ("b[2]", "a_envelope[1]", "b[10]", "a2", "a[1]", "ab[0]")
     ]
     raw = {"z": [1, 2], "lam_x": [0, 0], "lam_g": [0.5]}
     rec = record_from_result(
@@ -201,8 +201,9 @@ def test_a_result_becomes_a_checked_record_with_its_sorted_active_rows_and_warm_
     }
     assert rec.objectives["size"] == pytest.approx(160.0)
     assert rec.eps == {"backlash": 0.05}  # the infinite bound is no bound
-    # sorted by the row's base name, then the whole name; envelopes left out
-    assert rec.active == ["a", "ab[0]", "b[10]", "b[2]"]
+    # sorted by the row's base name (a before a2, unlike the plain text order), then
+    # the whole name; envelopes left out
+    assert rec.active == ["a[1]", "a2", "ab[0]", "b[10]", "b[2]"]
     assert rec.raw.nlp == "fp"
     assert rec.raw.z.tolist() == [1.0, 2.0] and rec.raw.z.dtype == float
     assert rec.raw.lam_x.tolist() == [0.0, 0.0] and rec.raw.lam_g.tolist() == [0.5]
