@@ -258,17 +258,30 @@ def test_nsga2s_problem_is_the_objectives_and_the_relative_violations(cs):
 
 
 def test_nsga2_records_its_feasible_designs_checked_on_the_numpy_path(cs):
-    front = compute_front(cs, ["size", "backlash"], 3, "nsga2", pop_size=10, generations=5, seed=1)
-    assert front.settings == {"pop_size": 10, "generations": 5, "seed": 1}
+    from pymoo.algorithms.moo.nsga2 import NSGA2 as PymooNSGA2
+    from pymoo.optimize import minimize
+
+    # pymoo's own run of the same problem: its final non-dominated feasible designs
+    res = minimize(
+        pymoo_problem(cs, ["size", "backlash"]),
+        PymooNSGA2(pop_size=12),
+        ("n_gen", 8),
+        seed=1,
+        verbose=False,
+    )
+    assert len(res.X) > 1
+    front = compute_front(cs, ["size", "backlash"], 3, "nsga2", pop_size=12, generations=8, seed=1)
+    assert front.settings == {"pop_size": 12, "generations": 8, "seed": 1}
     assert front.n_solves == 0 and front.method == "nsga2" and front.store == ""
-    assert front.points
-    for j, point in enumerate(front.points + front.rejected):
-        assert point.id == f"nsga2-{j:04d}" and point.kind == "nsga2" and point.target == ""
+    points = sorted(front.points + front.rejected, key=lambda p: p.id)
+    assert [p.id for p in points] == [f"nsga2-{j:04d}" for j in range(len(res.X))]
+    for point, x in zip(points, res.X, strict=True):
+        assert [point.design[v.name] for v in cs.free] == x.tolist()
+        assert point.kind == "nsga2" and point.target == ""
         assert point.status == "feasible" and point.verified is True
         assert (point.n_solves, point.wall_time_s) == (0, 0.0)
         assert point.design["i_a"] == 2.0 and point.design["pin_length_ratio"] == 1.5
-        x = np.array([[point.design[v.name] for v in cs.free]])
-        ev = cs.evaluate(x)
+        ev = cs.evaluate(x[None, :])
         assert ev.violation[0] <= 1e-6
         assert point.objectives == {k: float(v[0]) for k, v in ev.objectives.items()}
 
@@ -336,3 +349,49 @@ def test_a_three_objective_epsilon_front_runs_its_rows_after_its_anchors(cs, tmp
     solves = sum(stored[i]["n_solves"] for i in ids)
     solves += sum(stored[f"anchor-{k}"]["n_solves"] for k in ("size", "backlash", "ripple"))
     assert front.n_solves == solves
+
+
+# --- time limits of a run -----------------------------------------------------------------
+def _deadline_after(monkeypatch, n_records: int) -> list:
+    """The deadline passes once ``n_records`` records are stored (no timing)."""
+    # the modules that bind `passed` by name, imported before the patch
+    import optdesign.solvers.casadi_nlp
+    import optdesign.solvers.multistart  # noqa: F401
+    from optdesign.solvers import deadline
+
+    seen: list = []
+    monkeypatch.setattr(deadline, "passed", lambda: len(seen) >= n_records)
+    return seen
+
+
+def test_a_time_limit_before_the_anchors_says_the_folders_resume_continues(
+    cs, tmp_path, monkeypatch
+):
+    _deadline_after(monkeypatch, 0)
+    with pytest.raises(InputError) as err:
+        compute_front(cs, ["size", "backlash"], 4, "epsilon", out=tmp_path, time_limit=2.5)
+    assert (err.value.field, err.value.reason) == (
+        "time_limit",
+        "2.5 s passed before the anchors (size, backlash) were computed: give more time, "
+        "or resuming the run in its folder continues",
+    )
+
+
+def test_a_front_stopped_by_its_time_limit_names_the_points_left_out(cs, tmp_path, monkeypatch):
+    seen = _deadline_after(monkeypatch, 6)  # the anchors (4 records) and a few points
+    front = compute_front(
+        cs,
+        ["size", "backlash"],
+        6,
+        "epsilon",
+        out=tmp_path,
+        time_limit=2.5,
+        on_record=seen.append,
+        starts=1,
+    )
+    n = len(front.points) + len(front.rejected)
+    assert 0 < n < 6
+    assert front.notes == [
+        f"time limit of 2.5 s reached: {6 - n} of 6 points not computed (no point begins "
+        "after the limit; resuming the run in its folder computes them)"
+    ]
