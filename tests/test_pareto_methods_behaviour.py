@@ -336,19 +336,52 @@ def test_a_weighted_sum_front_chains_its_weights_from_the_last_anchor(cs, tmp_pa
     assert size[0] >= size[1] >= size[2]
 
 
-def test_a_three_objective_epsilon_front_runs_its_rows_after_its_anchors(cs, tmp_path):
+def _bars(monkeypatch) -> list:
+    """The names of the progress bars a run opens (none shows outside a terminal)."""
+    import tqdm.auto
+
+    bars: list = []
+    real = tqdm.auto.tqdm
+
+    def bar(*args, **kw):
+        bars.append(kw.get("desc"))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(tqdm.auto, "tqdm", bar)
+    return bars
+
+
+def test_a_three_objective_epsilon_front_runs_its_rows_after_its_anchors(cs, monkeypatch):
+    """Without a store, the rows find their anchors only among the records passed on."""
+    bars = _bars(monkeypatch)
+    stored: dict = {}
     front = compute_front(
-        cs, ["size", "backlash", "ripple"], 3, "epsilon", starts=1, out=tmp_path, name="three"
+        cs,
+        ["size", "backlash", "ripple"],
+        3,
+        "epsilon",
+        starts=1,
+        name="three",
+        progress=True,
+        on_record=lambda r: stored.setdefault(r["id"], r),
     )
+    assert bars == ["three: points", "three: points"]  # the anchors, then the rows
     ids = [p.id for p in front.points + front.rejected]
     assert ids and all(i.startswith("three-") for i in ids)
-    _, stored = read_store(tmp_path / "three.jsonl")
     assert {"anchor-size", "anchor-backlash", "anchor-ripple"} <= set(stored)
     assert set(ids) <= set(stored)
     assert all(p.success for p in front.points)
     solves = sum(stored[i]["n_solves"] for i in ids)
     solves += sum(stored[f"anchor-{k}"]["n_solves"] for k in ("size", "backlash", "ripple"))
     assert front.n_solves == solves
+
+
+def test_a_front_without_progress_opens_no_progress_bar(cs, monkeypatch):
+    bars = _bars(monkeypatch)
+    compute_front(cs, ["size", "backlash"], 2, "epsilon", starts=1, progress=False)
+    assert bars == []
+    compute_front(cs, ["size", "backlash"], 2, "epsilon", starts=1, progress=True)
+    assert bars == ["epsilon: points"]
 
 
 # --- time limits of a run -----------------------------------------------------------------
