@@ -225,6 +225,18 @@ def test_a_result_above_its_epsilon_bound_is_recorded_infeasible(cs):
     assert above.eps == {"backlash": backlash - 2e-6}
 
 
+def test_a_result_keeps_why_it_fell_back_and_loses_a_success_the_check_refuses(cs):
+    from optdesign.solvers.details import Details
+
+    result = _result(cs, details=Details(fallback="slsqp failed: ipopt"))
+    assert record_from_result(cs, result, "eps", "size", {}).fallback == "slsqp failed: ipopt"
+    bad = _result(cs)
+    bad.design["d"] = 4.5  # the pins too thin: a requirement violated
+    rec = record_from_result(cs, bad, "eps", "size", {})
+    assert rec.status == "infeasible" and rec.verified is False and not rec.success
+    assert rec.violated and rec.x == [*X_OK[:5], 4.5]
+
+
 def test_a_result_without_a_design_keeps_its_status_and_no_x(cs):
     failed = Result(status="failed", objective=math.nan, formulation="nlp", solver="ipopt")
     rec = record_from_result(cs, failed, "anchor", "size", {"backlash": 0.01}, "a")
