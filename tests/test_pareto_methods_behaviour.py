@@ -27,7 +27,6 @@ from optdesign.studies.pareto.methods import (
     make_method,
     pymoo_problem,
 )
-from optdesign.studies.runner import read_store
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 #: Designs of cs_min_backlash (R, l, n, p, phi0, d): feasible, and two corners (the
@@ -317,9 +316,17 @@ def test_nsga2_without_a_feasible_design_records_its_least_violating_one(cs, tmp
 
 
 # --- weighted sums and epsilon sweeps -----------------------------------------------------
-def test_a_weighted_sum_front_chains_its_weights_from_the_last_anchor(cs, tmp_path):
-    front = compute_front(cs, ["size", "backlash"], 3, "weighted_sum", out=tmp_path, starts=1)
-    _, stored = read_store(tmp_path / "weighted_sum.jsonl")
+def test_a_weighted_sum_front_chains_its_weights_from_the_last_anchor(cs):
+    """Without a store: the chain finds its anchor among the records passed on."""
+    stored: dict = {}
+    front = compute_front(
+        cs,
+        ["size", "backlash"],
+        3,
+        "weighted_sum",
+        starts=1,
+        on_record=lambda r: stored.setdefault(r["id"], r),
+    )
     assert [k for k in stored if k.startswith("ws-")] == ["ws-0000", "ws-0001", "ws-0002"]
     weights = [stored[f"ws-000{i}"]["weights"] for i in range(3)]
     assert weights == [
