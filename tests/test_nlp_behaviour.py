@@ -425,3 +425,21 @@ def test_numeric_value_of_each_kind_of_term():
     assert numeric_value(T("max", [1.0, -4.0, 2.0])) == 2.0
     assert numeric_value(T("scalar", [[7.0, 8.0]])) == 7.0
     assert numeric_value(T("scalar", 5)) == 5.0
+
+
+def test_first_order_flattening_reaches_the_values_and_the_scales(problem):
+    """first_order=True: the rows, values and scales are the first-order Hertz model's."""
+    nlp = build_nlp(problem, ["backlash"], first_order=True)
+    plain = build_nlp(problem, ["backlash"])
+
+    def grid(x):
+        ex = problem.expressions(problem.design_dict(x), first_order=True)
+        return np.ravel(np.asarray(ex.objectives["backlash"].expr, dtype=float))
+
+    b, mid = grid(X), grid(problem.midpoint())
+    value = np.ravel(np.asarray(nlp.values_fun(nlp.z_from_x(X), [])))[0]
+    assert value == pytest.approx(b.max(), rel=1e-9)
+    assert abs(value - problem.evaluate(X).objectives["backlash"]) > 1e-6 * value
+    assert nlp.target_scales[0] == pytest.approx(mid.max(), rel=1e-12)
+    assert nlp.target_scales[0] != pytest.approx(plain.target_scales[0], rel=1e-9)
+    assert nlp.g_scale[0] == pytest.approx(np.max(np.abs(mid)), rel=1e-12)

@@ -427,3 +427,71 @@ def test_an_objective_limit_keeps_its_nominal_row_and_its_auxiliaries_start(samp
     np.testing.assert_allclose(z[6:8], [r.min() / np.max(mid), r.max() / np.max(mid)], rtol=1e-9)
     (g,) = _at(nlp, X, nlp.g)
     assert (g * nlp.g_scale)[row] == pytest.approx((r.max() - r.min()) / (r.max() + r.min()))
+
+
+def test_the_parameters_of_a_solve_reach_every_sample_and_the_nominal_value():
+    """A catalogue problem's parameters (the table fit's ratios, placeholders 1 by
+    default) sit at the tail of p: with an item's values the samples' envelopes and the
+    nominal value are the NumPy path's table-fit values at that item (ISO 2338 d = 6)."""
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["tolerances"] = {"R": "0.05 mm", "fit": "uniform"}
+    p = problem_from_dict(data)
+    samples = draw_samples(p, 2, 0)
+    nlp = build_robust_nlp(p, samples=samples)
+    assert nlp.param_names == ["fit_ratio_max", "fit_ratio_min"]
+    assert nlp.param_defaults.tolist() == [1.0, 1.0]
+    x = np.array([107.2, 54.3, 102.9, 5.0, 0.205, 6.0])
+    values = p.parameter_values({"d": (6.0, 6.0), "p": (5.0, 5.0)})
+    theta = np.array([values[k] for k in nlp.param_names])
+    assert abs(theta[0] - 1.0) > 0.05 and abs(theta[1] - 1.0) > 0.05
+    fun = ca.Function("g", [nlp.z, nlp.p], [nlp.g, nlp.objective_values["backlash (nominal)"]])
+    g, nominal = fun(nlp.z_from_x(x, theta), np.concatenate([[0.0, 1.0], theta]))
+    _, placeholder = fun(nlp.z_from_x(x), np.array([0.0, 1.0, 1.0, 1.0]))
+    table = p.evaluate(x).objectives["backlash"]
+    assert float(nominal) == pytest.approx(table, rel=1e-9)
+    assert abs(float(placeholder) - table) > 1e-3 * table  # the parameters matter here
+    raw = np.ravel(np.asarray(g, dtype=float)) * nlp.g_scale
+    n_phi = len(p.phi_labels)
+    first = nlp.g_names.index(f"backlash_envelope[s0][{p.phi_labels[0]}]")
+    for s in range(2):
+        d = p.design_dict(x)
+        d["R"] = d["R"] + samples.deltas["R"][s]
+        ex = p.expressions(d, fit_fractions=list(samples.fit[s]))
+        gs = np.ravel(np.asarray(ex.objectives["backlash"].expr, dtype=float))
+        rows = raw[first + s * n_phi : first + (s + 1) * n_phi]
+        np.testing.assert_allclose(rows, gs.max() - gs, rtol=1e-9, atol=1e-12)
+
+
+def test_a_fixed_fit_keeps_the_requirements_clearance_in_every_sample(problem):
+    """fit = "fixed": no fit draw; every sample's pins keep the nominal fit clearance."""
+    p = problem_from_dict(_data(fit="fixed"))
+    samples = draw_samples(p, 2, 1)
+    nlp = build_robust_nlp(p, samples=samples)
+    z = nlp.z_from_x(X)
+    scale = np.max(np.abs(_mid_grid(p, "backlash")))
+    want = []
+    for s in range(2):
+        d = problem.design_dict(X)
+        for name, delta in samples.deltas.items():
+            d[name] = d[name] + delta[s]
+        want.append(np.max(p.expressions(d).objectives["backlash"].expr) / scale)
+    np.testing.assert_allclose(z[6:8], want, rtol=1e-9)
+
+
+def test_a_sampled_requirement_bounded_by_zero_is_scaled_by_one(samples):
+    """constrain_samples: a requirement whose bound is 0 keeps the scale 1 per sample
+    (the nominal row takes its size at the middle of the bounds)."""
+    p = problem_from_dict(_data())
+    p.add_constraint(
+        "gap", lambda q: q.design["l"] - q.design["R"], lower=0.0, unit="mm", over="design"
+    )
+    nlp = build_robust_nlp(p, samples=samples, constrain_samples=True)
+    rows = [k for k, name in enumerate(nlp.g_names) if name.startswith("gap[s")]
+    assert [nlp.g_names[k] for k in rows] == [f"gap[s{s}]" for s in range(S)]
+    assert nlp.g_scale[rows].tolist() == [1.0] * S
+    assert nlp.lbg[rows].tolist() == [0.0] * S and nlp.ubg[rows].tolist() == [np.inf] * S
+    (g,) = _at(nlp, X, nlp.g)
+    want = [X[1] + samples.deltas["l"][s] - X[0] - samples.deltas["R"][s] for s in range(S)]
+    np.testing.assert_allclose(g[rows], want, rtol=1e-9)
+    mid = p.midpoint()
+    assert nlp.g_scale[nlp.g_names.index("gap")] == pytest.approx(abs(mid[1] - mid[0]))
