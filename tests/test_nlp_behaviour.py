@@ -357,8 +357,8 @@ def test_a_start_from_a_design_or_a_vector_and_its_multipliers(nlp):
     assert s.z0.tolist() == [0.5] * 9 and s.z0.dtype == np.float64
     assert s.lam_x0.tolist() == [1.0, 2.0] and s.lam_x0.dtype == np.float64
     assert s.lam_g0.tolist() == [3.0]
-    s = nlp.start(x0=X + 100.0, z0=np.zeros(9))  # z0 wins
-    assert s.z0.tolist() == [0.0] * 9
+    s = nlp.start(x0=X + 100.0, z0=[0] * 9)  # z0 wins, as floats
+    assert s.z0.tolist() == [0.0] * 9 and s.z0.dtype == np.float64
     with pytest.raises(ValueError, match=r"^give x0 or z0$"):
         nlp.start()
     assert _vec(None) is None and _vec([[1], [2]]).tolist() == [1.0, 2.0]

@@ -495,3 +495,25 @@ def test_a_sampled_requirement_bounded_by_zero_is_scaled_by_one(samples):
     np.testing.assert_allclose(g[rows], want, rtol=1e-9)
     mid = p.midpoint()
     assert nlp.g_scale[nlp.g_names.index("gap")] == pytest.approx(abs(mid[1] - mid[0]))
+
+
+def test_the_tolerances_given_are_drawn_rather_than_the_files(problem):
+    """draw_samples(tol=...) draws the given section, not the problem's own."""
+    other = problem_from_dict(_data(R="0.2 mm", l="0 mm", n="0 mm", phi0="0 deg", fit="fixed"))
+    tol = tolerances_of(other)
+    s = draw_samples(problem, 3, 2, tol)
+    assert s.fit is None
+    rng = np.random.default_rng(2)
+    np.testing.assert_allclose(s.deltas["R"], 0.2 / 3 * rng.standard_normal(3), rtol=1e-12)
+    assert draw_samples(problem, 3, 2).fit.shape == (3, 2)
+
+
+def test_a_fit_draw_for_a_single_pin_has_one_column():
+    """The fork's one sized pin: one fit fraction per sample."""
+    data = tomllib.loads((ROOT / "problems" / "fork_min_backlash.toml").read_text())
+    data["tolerances"] = {"R": "0.05 mm", "fit": "uniform"}
+    p = problem_from_dict(data)
+    s = draw_samples(p, 3, 0)
+    rng = np.random.default_rng(0)
+    rng.standard_normal(3)
+    np.testing.assert_allclose(s.fit, rng.uniform(0.0, 1.0, (3, 1)), rtol=1e-12)
