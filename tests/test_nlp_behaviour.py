@@ -227,13 +227,16 @@ def test_the_naive_form_puts_max_and_spread_in_the_objective(problem):
 
 def test_a_requirement_bound_of_zero_takes_the_blocks_size_as_its_scale(problem):
     """A block whose bounds are both 0 (or absent on one side) is scaled by its size at
-    the middle of the bounds."""
+    the middle of the bounds; one bounded by 0.5 by 0.5."""
     data = tomllib.loads(CS.read_text())
     p = problem_from_dict(data)
     p.add_constraint(
         "gap", lambda q: q.design["l"] - q.design["R"], lower=0.0, unit="mm", over="design"
     )
+    p.add_constraint("lead_ratio", lambda q: q.design["p"] / 20.0, upper=0.5, over="design")
     nlp = build_nlp(p, ["size"])
+    k = nlp.g_names.index("lead_ratio")
+    assert (nlp.g_scale[k], nlp.ubg[k], nlp.lbg[k]) == (0.5, 1.0, -np.inf)  # its own bound
     k = nlp.g_names.index("gap")
     mid = p.midpoint()
     assert nlp.g_scale[k] == pytest.approx(abs(mid[1] - mid[0]), rel=1e-12)

@@ -517,3 +517,32 @@ def test_a_fit_draw_for_a_single_pin_has_one_column():
     rng = np.random.default_rng(0)
     rng.standard_normal(3)
     np.testing.assert_allclose(s.fit, rng.uniform(0.0, 1.0, (3, 1)), rtol=1e-12)
+
+
+def test_one_sample_is_enough_and_no_scatter_leaves_only_the_variance_guard(problem):
+    """S = 1 is accepted; with every sample at the nominal design the mean + k std
+    measure is the nominal value plus k sqrt(STD_EPS) (the guard keeps sqrt smooth)."""
+    one = build_robust_nlp(problem, samples=Samples({"R": np.array([0.01])}, None, 0))
+    assert one.aux_names == ["backlash_max[s0]", "VaR", "cvar_excess[s0]"]
+    flat = Samples({"R": np.zeros(3)}, None, 0)
+    nlp = build_robust_nlp(problem, samples=flat, risk="mean_std", k=3.0)
+    scale = np.max(np.abs(_mid_grid(problem, "backlash")))
+    v = problem.evaluate(X).objectives["backlash"] / scale
+    (f,) = _at(nlp, X, nlp.f)
+    assert float(f) == pytest.approx(v + 3.0 * np.sqrt(STD_EPS), rel=1e-12)
+    assert float(f) - v == pytest.approx(3e-6, rel=1e-6)
+
+
+def test_a_requirement_bound_below_one_is_its_own_scale_in_every_sample(samples):
+    """A requirement bounded above by 0.5 only is divided by 0.5 (not by 1) per sample."""
+    p = problem_from_dict(_data())
+    p.add_constraint("lead_ratio", lambda q: q.design["p"] / 20.0, upper=0.5, over="design")
+    nlp = build_robust_nlp(p, samples=samples, constrain_samples=True)
+    rows = [k for k, name in enumerate(nlp.g_names) if name.startswith("lead_ratio")]
+    assert [nlp.g_names[k] for k in rows] == ["lead_ratio"] + [
+        f"lead_ratio[s{s}]" for s in range(S)
+    ]
+    assert nlp.g_scale[rows].tolist() == [0.5] * (S + 1)
+    assert nlp.ubg[rows].tolist() == [1.0] * (S + 1) and nlp.lbg[rows].tolist() == [-np.inf] * (
+        S + 1
+    )
