@@ -446,3 +446,14 @@ def test_first_order_flattening_reaches_the_values_and_the_scales(problem):
     assert nlp.target_scales[0] == pytest.approx(mid.max(), rel=1e-12)
     assert nlp.target_scales[0] != pytest.approx(plain.target_scales[0], rel=1e-9)
     assert nlp.g_scale[0] == pytest.approx(np.max(np.abs(mid)), rel=1e-12)
+
+
+def test_a_variables_target_scale_is_its_middles_magnitude_even_below_one():
+    """phi0 in [-0.6, 1.0] rad: its middle 0.2 rad is its scale (1 only for a zero middle)."""
+    data = tomllib.loads(CS.read_text())
+    data["variables"]["phi0"] = {"lower": "-0.6 rad", "upper": "1.0 rad"}
+    data["variables"]["n"] = {"lower": "-1.5 mm", "upper": "1.0 mm"}
+    nlp = build_nlp(problem_from_dict(data), ["size"])
+    assert nlp.targets[3:5] == ["var:n", "var:p"]
+    assert nlp.target_scales[3] == pytest.approx(0.25, rel=1e-12)
+    assert nlp.target_scales[5] == pytest.approx(0.2, rel=1e-12)
