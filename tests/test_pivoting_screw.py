@@ -200,8 +200,14 @@ def test_the_requirements_declared_ranges_and_the_benchmarks_template():
     assert (req["dead_length"].kind, req["dead_length"].dimension) == ("value", "length")
     assert req["dead_length"].valid == (0.0, np.inf)
     variables, requirements = PivotingScrew.bench_template()
-    assert list(variables) == ["R", "a_T", "b_T", "p", "phi0"] and variables["p"] is None
-    assert variables["a_T"] == {"lower": "-300 mm", "upper": "-40 mm"}
+    assert variables == {
+        "R": {"lower": "30 mm", "upper": "120 mm"},
+        "a_T": {"lower": "-300 mm", "upper": "-40 mm"},
+        "b_T": {"lower": "-100 mm", "upper": "150 mm"},
+        "p": None,
+        "phi0": {"lower": "-0.6 rad", "upper": "0.6 rad"},
+    }
+    assert list(variables) == ["R", "a_T", "b_T", "p", "phi0"]
     assert requirements == {
         "transmission_angle": {"min": "40 deg", "max": "140 deg"},
         "dead_length": "60 mm",
