@@ -1,0 +1,128 @@
+"""optdesign/mechanisms/fork.py as a whole, against the plain geometry of a pin on a line
+at distance R in a slot of the arm (not the model's formulas): the nut position and its
+rate, the slot's assembly margin and refusal at a right angle, the pin's normal force by
+statics, the clearance chain's sensitivities by small rotations, size, drawings and the
+benchmark's declarations."""
+
+import math
+
+import numpy as np
+import pytest
+
+from optdesign.errors import AssemblyError
+from optdesign.mechanisms import PinJoint
+from optdesign.mechanisms.fork import ShiftingFork
+
+R, PHI0 = 60.0, 0.1
+PHI = np.radians(np.linspace(-30.0, 30.0, 7))
+
+
+def fork(**kw):
+    return ShiftingFork(**{"R": R, "phi0": PHI0, "p": 5.0, **kw})
+
+
+def _pin_x(phi):
+    """Where the arm's line (angle a from the pin line's normal) meets the pin's line."""
+    a = PHI0 + phi
+    return R * math.sin(a) / math.cos(a)
+
+
+def test_the_nut_position_and_rate_are_the_lines_intersection_and_its_derivative():
+    f = fork()
+    assert np.allclose(f.nut_position(PHI), [_pin_x(p) for p in PHI], rtol=1e-12)
+    h = 1e-6
+    fd = [(_pin_x(p + h) - _pin_x(p - h)) / (2 * h) for p in PHI]
+    assert np.allclose(f.nut_velocity(PHI), fd, rtol=1e-7)
+    assert np.allclose(f.ratio(PHI), 2 * np.pi * np.array(fd) / 5.0, rtol=1e-7)
+
+
+def test_the_slot_assembles_short_of_a_right_angle_only():
+    f = fork(phi0=0.0)
+    margin = f.assembly_margin(np.radians([-60.0, 0.0, 89.0]))
+    assert np.allclose(margin, np.cos(np.radians([-60.0, 0.0, 89.0])) * R**2)
+    with pytest.raises(AssemblyError) as err:
+        f.check_assembly(np.radians([0.0, 45.0, 91.0, 95.0]))
+    assert err.value.angle_deg == pytest.approx(91.0)
+    assert err.value.margin == pytest.approx(math.cos(math.radians(91.0)) * R**2)
+
+
+def test_the_pins_normal_force_holds_the_hinge_moment():
+    """Statics: the slot pushes the pin normal to the arm at distance R / cos(a) from O."""
+    f = fork()
+    M_h = 4.0e5
+    for phi in PHI:
+        a = PHI0 + phi
+        lever = R / math.cos(a)
+        assert float(f.pin_normal_force(phi, M_h)) == pytest.approx(M_h / lever, rel=1e-12)
+    assert np.allclose(f.pin_force(PHI, M_h), f.pin_normal_force(PHI, M_h))
+
+
+def test_the_chain_is_the_screw_bearings_nut_shaft_and_the_pin_in_its_slot():
+    f = fork()
+    pin = PinJoint(8.0, 10.0)
+    chain = f.joints(PHI, 4.0e5, pin)
+    assert [(j.name, j.key, j.angular) for j in chain] == [
+        ("A screw bearings", "A", False),
+        ("B screw/nut", "B", False),
+        ("O output shaft", "O", True),
+        ("C pin in slot", "", False),
+    ]
+    a = PHI0 + PHI
+    # an axial clearance dx turns the arm by dx / (dx/dphi); a slot-normal one by
+    # dn / (R / cos a), the pin's distance from O
+    assert np.allclose(chain[0].sensitivity, np.cos(a) ** 2 / R, rtol=1e-12)
+    assert np.allclose(chain[1].sensitivity, np.cos(a) ** 2 / R, rtol=1e-12)
+    assert np.allclose(chain[3].sensitivity, np.cos(a) / R, rtol=1e-12)
+    assert np.allclose(chain[3].force, 4.0e5 * np.cos(a) / R, rtol=1e-12)
+    assert chain[3].pin is pin
+    assert f.joints(PHI, 4.0e5)[3].pin is None
+
+
+def test_a_small_slot_clearance_turns_the_arm_as_the_sensitivity_says():
+    """Independent check: move the pin by dn normal to the arm, find the new arm angle."""
+    f = fork()
+    dn = 1e-6
+    for phi in PHI:
+        a = PHI0 + phi
+        x = _pin_x(phi)
+        # the pin moved normal to the arm's line: (cos a, -sin a) in the (x, y) frame
+        px, py = x + dn * math.cos(a), R - dn * math.sin(a)
+        turned = math.atan2(px, py) - a
+        assert float(f.sensitivity_slot_normal(phi)) == pytest.approx(turned / dn, rel=1e-5)
+
+
+def test_size_positions_and_sketch():
+    f = fork()
+    assert float(f.size()) == R
+    arm_end, pin = f.pin_positions(PHI)
+    assert np.allclose(arm_end[0], R * np.tan(PHI0 + PHI)) and np.allclose(arm_end[1], R)
+    assert np.allclose(pin[0], f.nut_position(PHI)) and np.allclose(pin[1], R)
+    sk = f.sketch(0.2)
+    x = _pin_x(0.2)
+    assert sk.links == [[(0.0, 0.0), (pytest.approx(x), R)]]
+    assert sk.pivots == [(0.0, 0.0)] and sk.slider == (pytest.approx(x), R)
+    assert sk.axis == ((pytest.approx(-0.3 * R), R), (pytest.approx(x + 0.3 * R), R))
+    left = f.sketch(-0.5)
+    xl = _pin_x(-0.5)
+    assert left.axis == ((pytest.approx(xl - 0.3 * R), R), (pytest.approx(0.3 * R), R))
+
+
+def test_the_declarations_and_the_benchmarks_template():
+    table = ShiftingFork.variable_table()
+    assert list(table) == ["R", "phi0", "p", "i_a"]
+    assert table["R"].positive is True and table["R"].dimension == "length"
+    assert table["phi0"].positive is False and table["phi0"].default == 0.0
+    assert table["phi0"].dimension == "angle"
+    assert ShiftingFork(R=1.0, p=1.0).phi0 == 0.0
+    assert ShiftingFork.pin_shear_planes == 1
+    assert ShiftingFork.bench_template() == (
+        {"R": {"lower": "30 mm", "upper": "120 mm"}, "p": None},
+        {},
+    )
+    assert ShiftingFork.bench_families == {
+        "fork_backlash": ("backlash",),
+        "fork_size": ("size",),
+        "fork_torque": ("motor_torque",),
+        "fork_front": ("backlash", "size"),
+    }
+    assert (ShiftingFork.name, ShiftingFork.title) == ("fork", "shifting fork")
