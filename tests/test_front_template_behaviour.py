@@ -70,7 +70,7 @@ class MadeMethod(Made, FrontMethod):
             raise InputError("bad_setting", "refused")
 
     def identity(self, starts, seed, objectives):
-        return "ipopt", {"starts": starts, "seed": seed, "made": True}
+        return "ipopt", {"starts": starts, "seed": seed, "made": True, "of": list(objectives)}
 
     def settings(self, starts, seed, objectives):
         return {"starts": starts, "seed": seed}
@@ -200,7 +200,8 @@ def test_a_stored_run_sets_up_its_store_identity_and_check(continuous, tmp_path)
     ctx = MadeMethod.seen[-1]
     assert ctx.store == tmp_path / "made.jsonl"
     assert (ctx.starts, ctx.seed) == (2, 3)
-    assert ctx.key["method"] == {"starts": 2, "seed": 3, "made": True}
+    # a method's identity gets the checked objectives (a plug-in may key its store on them)
+    assert ctx.key["method"] == {"starts": 2, "seed": 3, "made": True, "of": ["ripple", "backlash"]}
     assert ctx.key["solver"]["back_end"] == "ipopt"
     assert ctx.key["objectives"] == ["ripple", "backlash"]
     assert ctx.check is not None
