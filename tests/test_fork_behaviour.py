@@ -44,6 +44,13 @@ def test_the_slot_assembles_short_of_a_right_angle_only():
         f.check_assembly(np.radians([0.0, 45.0, 91.0, 95.0]))
     assert err.value.angle_deg == pytest.approx(91.0)
     assert err.value.margin == pytest.approx(math.cos(math.radians(91.0)) * R**2)
+    # with a neutral angle the arm's angle is phi0 + phi: right at phi = 90 deg - phi0
+    tilted = fork(phi0=math.radians(20.0))
+    angles = np.radians([-85.0, 60.0, 69.0, 71.0])
+    assert np.allclose(tilted.assembly_margin(angles), np.cos(math.radians(20.0) + angles) * R**2)
+    with pytest.raises(AssemblyError) as err:
+        tilted.check_assembly(angles)
+    assert err.value.angle_deg == pytest.approx(71.0)
 
 
 def test_the_pins_normal_force_holds_the_hinge_moment():
