@@ -140,6 +140,8 @@ def test_only_a_continuous_epsilon_sweep_takes_a_time_limit():
 # --- building a method --------------------------------------------------------------------
 def test_a_method_is_built_from_its_name_and_settings(cs):
     assert make_method(cs, "epsilon", 7) == EpsilonConstraint(points=7)
+    # by default, the epsilon method of 50 points
+    assert make_method(cs) == EpsilonConstraint(points=50)
     assert make_method(cs, "epsilon", 9, agree=None) == EpsilonConstraint(points=9, agree=None)
     assert make_method(cs, "uniform", 4, starts=2) == EpsilonConstraint(
         points=4, spacing="uniform", name="uniform", starts=2
