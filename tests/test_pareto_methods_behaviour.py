@@ -437,3 +437,28 @@ def test_a_front_stopped_by_its_time_limit_names_the_points_left_out(cs, tmp_pat
         f"time limit of 2.5 s reached: {6 - n} of 6 points not computed (no point begins "
         "after the limit; resuming the run in its folder computes them)"
     ]
+
+
+def test_a_weighted_sum_without_a_feasible_anchor_names_what_its_best_point_violates(tmp_path):
+    """The anchors of a weighted-sum front are checked with the problem: the refusal
+    evaluates the best point found, not only the record's list of violated rows."""
+    import tomllib
+
+    import optdesign as od
+    from optdesign.studies.pareto.chains import NoFeasibleAnchor
+
+    data = tomllib.loads((PROBLEMS / "cs_min_backlash.toml").read_text())
+    data["requirements"]["nut_travel_max"] = "40 mm"
+    data["requirements"]["mean_ratio"] = {"min": 250, "max": 260}
+    with pytest.raises(NoFeasibleAnchor) as err:
+        od.pareto(
+            od.load(data),
+            ["backlash", "size"],
+            points=3,
+            method="weighted_sum",
+            starts=2,
+            out=tmp_path,
+        )
+    assert err.value.objective == "backlash"
+    assert "at the best point found: mean ratio over the stroke (mean_ratio) = " in str(err.value)
+    assert ", min 250: short by " in str(err.value)

@@ -343,3 +343,16 @@ def test_atomic_write_killed_at_random_moments_never_leaves_a_partial_file(tmp_p
         assert len(data) == 1_000_000 and data == data[:1] * len(data)
         seen.add(data[0])
     assert seen - {7}  # the writer did replace the file meanwhile
+
+
+def test_an_atomic_write_gives_the_file_the_mode_of_a_plain_open(tmp_path):
+    """mkstemp makes its file 0600; the finished file has the mode ``open`` would give
+    it under the process's umask (0666 minus the umask: never executable)."""
+    old = os.umask(0o022)
+    os.umask(old)
+    path = atomic_write_text(tmp_path / "r.json", "{}")
+    assert path.read_text() == "{}"
+    assert path.stat().st_mode & 0o777 == 0o666 & ~old
+    with open(tmp_path / "plain", "w") as fh:
+        fh.write("x")
+    assert (tmp_path / "plain").stat().st_mode & 0o777 == path.stat().st_mode & 0o777
