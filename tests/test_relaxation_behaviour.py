@@ -101,3 +101,25 @@ def test_a_record_states_the_written_and_the_needed_bound():
     down = _record(row, False, 0.5, 3)
     assert (down.upper, down.written, down.needed) == (False, 2.0, 1.5)
     assert _record(row, True, None, 2).needed is None
+
+
+def test_a_relaxation_at_catalogue_items_uses_the_items_parameters():
+    """At items p = 2 mm, d = 10 mm the pin's fit takes its ISO 286 table clearance, a
+    parameter of the NLP (0.94 of the formula's here): the backlash limit that site
+    needs is smaller than with the formula's clearance (the default parameters), by
+    about that ratio on the pins' share of the backlash."""
+    data = tomllib.loads((PROBLEMS / "cs_min_backlash_catalogue.toml").read_text())
+    data["requirements"]["backlash_max"] = "0.02 deg"
+    problem = od.load(data)
+    result = od.solve(problem, starts=2, ranges=False)
+    assert result.status == "infeasible"
+    box = {"p": (2.0, 2.0), "d": (10.0, 10.0)}
+    params = problem.parameter_values(box)
+    assert params["fit_ratio_max"] == pytest.approx(0.9374, abs=1e-4)
+
+    def needed(parameters):
+        rows = relaxations(problem, result, box=box, parameters=parameters, objective="backlash")
+        return {r.name: r for r in rows}["backlash"].needed
+
+    table, formula = needed(params), needed(None)
+    assert 0.9 * formula < table < 0.99 * formula
