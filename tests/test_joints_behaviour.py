@@ -300,6 +300,15 @@ def test_sampled_fits_put_each_pin_at_its_own_fraction_of_its_band():
         )
 
 
+def test_each_of_three_pins_takes_its_own_draw_in_order():
+    pins = [_pin(d=d) for d in (8.0, 10.0, 12.0)]
+    chain = [Joint(f"p{i}", sensitivity=1.0, force=0.0, pin=pin) for i, pin in enumerate(pins)]
+    out = with_sampled_fits(chain, [0.1, 0.5, 0.9])
+    for joint, pin, u in zip(out, pins, (0.1, 0.5, 0.9), strict=True):
+        lo, hi = pin.fit_band()
+        assert joint.pin.extra == pytest.approx(u * (hi - lo), rel=1e-12)
+
+
 def test_a_wrong_count_of_fit_draws_is_refused_naming_both_counts():
     """Fewer draws than pins was an IndexError before the count was checked first."""
     pin = _pin()
