@@ -111,8 +111,8 @@ def test_items_are_the_largest_binary_of_each_group():
 
 
 def test_combinations_that_are_no_product_make_one_group(monkeypatch):
-    """A validity rule joining the variables irregularly (here: lead 6 only with pin 8)
-    makes the valid combinations no product of per-variable items: one group of them."""
+    """A validity rule joining the variables (here: lead 6 only with pin 8) makes the
+    valid combinations no product of per-variable items: one group of the valid pairs."""
     problem = _small()
     real = catalogue_minlp.box_has_item
 
