@@ -267,28 +267,16 @@ def test_a_degenerate_frame_keeps_positive_ranges():
 
 
 def test_three_objective_rows_heads_then_chains_from_the_tightest_limit():
+    values = {"A": (1.0, 8.0, 5.0), "B": (4.0, 2.0, 6.0), "C": (7.0, 5.0, 1.0)}
     anchors = {
-        "A": PointRecord(
-            id="a",
+        k: PointRecord(
+            id=k.lower(),
             kind="anchor",
-            target="A",
+            target=k,
             status="optimal",
-            objectives={"A": 1.0, "B": 8.0, "C": 5.0},
-        ),
-        "B": PointRecord(
-            id="b",
-            kind="anchor",
-            target="B",
-            status="optimal",
-            objectives={"A": 4.0, "B": 2.0, "C": 6.0},
-        ),
-        "C": PointRecord(
-            id="c",
-            kind="anchor",
-            target="C",
-            status="optimal",
-            objectives={"A": 7.0, "B": 5.0, "C": 1.0},
-        ),
+            objectives=dict(zip("ABC", v, strict=True)),
+        )
+        for k, v in values.items()
     }
     tasks = three_objective_tasks(anchors, ["A", "B", "C"], 5, "f", {"p": 1})
     n_side = 3  # ceil(sqrt(5))
