@@ -45,8 +45,11 @@ def solve(
     ranges: bool = True,
     agree: int | None = None,
     diagnose: bool = True,
+    sensitivities: bool = True,
     contact_models: bool = False,
     time_limit: float | None = None,
+    target_odds: float | None = None,
+    **unknown: Any,
 ) -> Result:
     """The optimal design of ``problem``, with its evidence.
 
@@ -85,6 +88,9 @@ def solve(
         the smallest relaxation of each conflicting requirement (``result.diagnosis``),
         for every formulation. A problem with no free variable is not optimised: its
         fixed design is checked (formulation ``"fixed"``).
+    sensitivities
+        Also what each requirement costs at the optimum (``result.sensitivities``, from
+        the solver's multipliers).
     contact_models
         Also the worst-case backlash of the optimum under each pin contact model
         (``duan2017``, ``conforming``, ``palmgren``, ``huth``; ``n/a`` with the reason
@@ -96,6 +102,14 @@ def solve(
         start begins after it, an Ipopt solve stops at it, and the result says so (a
         note; the starts cut or not begun counted in ``result.multistart.failed``); the
         diagnosis and the ranges are then skipped, with a note.
+    target_odds
+        NLP global search: go on past the stopping rule until the estimated probability
+        that a better local optimum exists is below this, in (0, 0.5] (None: Boender and
+        Rinnooy Kan's rule alone; see docs/optimisation.md,
+        "The global search").
+
+    Any other keyword is refused with an :class:`~optdesign.errors.InputError` naming the
+    nearest valid argument.
 
     Returns
     -------
@@ -122,8 +136,11 @@ def solve(
         ranges=ranges,
         agree=agree,
         diagnose=diagnose,
+        sensitivities=sensitivities,
         contact_models=contact_models,
         time_limit=time_limit,
+        target_odds=target_odds,
+        unknown=unknown,
     )
     problem = load(problem)
     request = validation.solve_request(problem, checked)
@@ -330,23 +347,24 @@ def sweep(
     ``requirements.NAME`` (``requirements.mean_ratio.min`` inside a band),
     ``variables.NAME.lower`` / ``.upper`` (a free variable's bound) or ``variables.NAME``
     (a fixed variable); start and stop are quantities of the parameter's dimension
-    (a bare number only for a plain number), count 2..1000. Points are solved by
-    continuation (warm-started from the neighbour) with a full multistart every
-    ``check_every`` points, at the ends and wherever the warm start fails or the binding
-    set changes (``starts``, ``seed``: that multistart, default the file's). The points
-    go to ``out/sweep.jsonl`` as they finish (a new temporary folder by default);
-    ``resume`` continues a stored sweep, ``overwrite`` starts afresh over one.
-    ``workers`` (local processes) or ``scheduler`` (a Dask scheduler's address): the
-    rows of a two-parameter sweep, or the points of a catalogue problem, side by side
-    (one row is one chain of warm starts; the records are the same for any number).
+    (a bare number only for a plain number), count 2..1000. Every point gets the global
+    search a cold solve of it runs (``starts``, ``seed``: that search's, default the
+    file's; the same seed at every point), then polish rounds warm-start each point from
+    its neighbours' designs until no point improves (:mod:`optdesign.studies.sweep`).
+    ``check_every`` is accepted and ignored (it set the interval of the multistart
+    checks of an older method; every point is searched now). The points go to
+    ``out/sweep.jsonl`` as they finish (a new temporary folder by default); ``resume``
+    continues a stored sweep, ``overwrite`` starts afresh over one. ``workers`` (local
+    processes) or ``scheduler`` (a Dask scheduler's address): the points of each round
+    side by side (the records are the same for any number).
     ``sensitivities``: also each point's log-sensitivities to every binding requirement
     (``point.sensitivities``, :attr:`optdesign.Result.sensitivities`).
 
     Returns
     -------
     Sweep
-        The points (parameters, status, objective, design, binding set, the multistart
-        checks and jumps, what fails at an infeasible point); ``.summary()``,
+        The points (parameters, status, objective, design, binding set, the jumps and
+        what found each optimum, what fails at an infeasible point); ``.summary()``,
         ``.to_frame()`` (columns ``"name [unit]"``), ``.plot()`` (the design chart).
 
     Notes

@@ -269,6 +269,11 @@ def generations(argument: str, value: Any) -> int:
     return integer(argument, value, 1, MAX_GENERATIONS)
 
 
+def odds(argument: str, value: Any) -> float | None:
+    """A probability the global search may stop at, in (0, 0.5] (None: the default)."""
+    return number(argument, value, 0.0, 0.5, optional=True)
+
+
 def seconds(argument: str, value: Any) -> float | None:
     """A time limit in seconds, at most a day (None: the default)."""
     return number(argument, value, 0.0, MAX_SECONDS, optional=True)

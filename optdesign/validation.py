@@ -48,6 +48,7 @@ from optdesign.argument_checks import (  # noqa: F401
     names,
     nearest,
     number,
+    odds,
     path,
     points,
     pop_size,
@@ -118,7 +119,16 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
     """The checked arguments of :func:`optdesign.solve`: ``formulation``, ``objective``
     (a string; the problem's names are checked by :func:`objective_of` once it is
     loaded), ``starts``, ``seed``, ``workers``, ``solver``, ``options``, ``ranges``,
-    ``agree``, ``diagnose``, ``contact_models``, ``time_limit``."""
+    ``agree``, ``diagnose``, ``sensitivities``, ``contact_models``, ``time_limit``,
+    ``target_odds``; ``unknown`` (the keywords the caller gave beyond these) is refused
+    with the nearest valid name."""
+    unknown = arguments.pop("unknown", None) or {}
+    for key in unknown:
+        raise ArgumentError(
+            str(key),
+            f"unknown argument of solve() ({nearest(str(key), SOLVE_ARGUMENTS)}"
+            f"known: {', '.join(SOLVE_ARGUMENTS)})",
+        )
     checked = _checked(
         {
             "formulation": formulation,
@@ -130,13 +140,34 @@ def solve_arguments(**arguments: Any) -> dict[str, Any]:
             "ranges": flag,
             "agree": agree,
             "diagnose": flag,
+            "sensitivities": flag,
             "contact_models": flag,
             "time_limit": seconds,
+            "target_odds": odds,
         },
         arguments,
     )
     checked["options"] = solver_options("options", arguments["options"], checked["solver"])
     return checked
+
+
+#: The keyword arguments of :func:`optdesign.solve` (the nearest one names a misspelling).
+SOLVE_ARGUMENTS = (
+    "formulation",
+    "objective",
+    "starts",
+    "seed",
+    "workers",
+    "solver",
+    "options",
+    "ranges",
+    "agree",
+    "diagnose",
+    "sensitivities",
+    "contact_models",
+    "time_limit",
+    "target_odds",
+)
 
 
 def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] | None:

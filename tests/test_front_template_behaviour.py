@@ -12,6 +12,8 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
+from optdesign.search.global_phase import default_max_starts
+from optdesign.studies.nlp_solve import planned_starts
 from optdesign.studies.pareto import template
 from optdesign.studies.pareto.chains import NoFeasibleAnchor
 from optdesign.studies.pareto.records import PointRecord
@@ -169,7 +171,9 @@ def test_the_leave_the_catalogue_refusal_reads_whole():
 
 def test_starts_and_seed_are_the_methods_else_the_problem_files(continuous):
     solver = continuous.spec.solver
-    assert MadeMethod().starts_and_seed(continuous) == (solver.starts, solver.seed)
+    planned = planned_starts(continuous)  # the file sets none: chosen from the dimension
+    assert solver.starts is None and planned == default_max_starts(len(continuous.free))
+    assert MadeMethod().starts_and_seed(continuous) == (planned, solver.seed)
     assert MadeMethod(starts=2, seed=5).starts_and_seed(continuous) == (2, 5)
     # seed 0 is the method's own, not "unset"
     data = tomllib.loads((PROBLEMS / "cs_min_backlash.toml").read_text())
@@ -177,7 +181,7 @@ def test_starts_and_seed_are_the_methods_else_the_problem_files(continuous):
     seeded = od.load(data)
     assert MadeMethod().starts_and_seed(seeded) == (5, 4)
     assert MadeMethod(starts=1, seed=0).starts_and_seed(seeded) == (1, 0)
-    assert Capped().starts_and_seed(continuous) == (min(solver.starts, 3), solver.seed)
+    assert Capped().starts_and_seed(continuous) == (min(planned, 3), solver.seed)
     assert Capped(starts=12).starts_and_seed(continuous)[0] == 12
 
 
@@ -186,7 +190,7 @@ def test_a_method_without_starts_or_seed_fields_takes_the_problem_files(continuo
         name = "bare"
 
     solver = continuous.spec.solver
-    assert Bare().starts_and_seed(continuous) == (solver.starts, solver.seed)
+    assert Bare().starts_and_seed(continuous) == (planned_starts(continuous), solver.seed)
 
 
 # --- the run --------------------------------------------------------------------------------------

@@ -123,7 +123,7 @@ def test_an_epsilon_point_that_needs_no_retry_is_solved_once(cs_min_backlash, tm
     neighbour, no jump) costs one solve, and its record says so."""
     od.pareto(cs_min_backlash, ["backlash", "size"], 5, out=tmp_path, starts=1)
     lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
-    eps = [r for r in map(json.loads, lines) if r["kind"] == "eps"]
+    eps = [r for r in map(json.loads, lines) if r["kind"] == "eps" and "polish" not in r["id"]]
     plain = [r for r in eps if not r["retried"]]
     assert len(eps) == 5 and len(plain) >= 3
     assert [r["n_solves"] for r in plain] == [1] * len(plain)
@@ -419,13 +419,15 @@ def test_an_anchor_whose_starts_succeed_solves_each_start_once(cs_min_backlash, 
 
 
 def test_an_anchor_multistart_whose_starts_succeed_is_not_solved_again_with_the_fallback():
-    """The fallback re-run is for a multistart none of whose starts succeeded: one start
-    that reaches the optimum is one solve, and agreeing starts stop the multistart."""
+    """The fallback re-run is for a search none of whose starts succeeded: one start
+    that reaches the optimum is one solve, and the search stops on its odds (8 starts at
+    one optimum leave fewer than half an optimum expected unseen; six free variables ask
+    for 12 counted starts)."""
     from optdesign.studies.pareto.tasks import multistart_task
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     order = ["backlash", "size"]
-    for starts, agree, solves in [(1, None, 1), (4, 3, 3)]:
+    for starts, agree, solves in [(1, None, 1), (20, 3, 12)]:
         task = {"problem": problem, "order": order, "objectives": order, "starts": starts,
                 "seed": 0, "agree": agree, "id": "anchor-backlash-ms"}  # fmt: skip
         record = multistart_task(task, {})

@@ -137,6 +137,10 @@ def test_a_records_json_keeps_the_stores_key_order_and_its_nested_records():
         "n_at_best": 2,
         "agree": 2,
         "stopped_early": True,
+        "optima": 0,
+        "counted": 0,
+        "p_better": None,
+        "stop": "",
     }
     back = PointRecord.from_dict(d)
     assert back.multistart == rec.multistart

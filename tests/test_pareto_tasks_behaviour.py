@@ -176,7 +176,7 @@ def test_a_task_builds_its_solver_from_its_problem_objectives_and_solver(fake):
     [("anchor-multistart", "anchor-multistart"), ("anchor", "anchor"), ("eps", "eps"),
      ("weighted_sum", "weighted_sum")],
 )  # fmt: skip
-def test_each_kind_of_task_makes_its_kind_of_record(fake, kind, stored):
+def test_each_kind_of_task_makes_its_kind_of_record(fake, draws, kind, stored):
     fake([_res(a=1.0, b=2.0), _res(a=1.0, b=2.0)])
     ms = _stored("ms", "anchor-multistart", a=1.0, b=2.0)
     task = {"id": "t", "kind": kind, "problem": PROBLEM, "objectives": ["a", "b"]}
@@ -186,7 +186,35 @@ def test_each_kind_of_task_makes_its_kind_of_record(fake, kind, stored):
     assert record["kind"] == stored and record["id"] == "t"
 
 
-# --- an anchor's multistart ------------------------------------------------------------------
+# --- an anchor's global search ---------------------------------------------------------------
+class Draws:
+    """Stand-in tilted starts (:class:`optdesign.search.starts.TiltedStarts`): start k is
+    (2 + k, 1 + k / 10), whatever is asked before."""
+
+    lower = np.array([2.0, 1.0])
+
+    def first(self, n):
+        return np.array([[2.0 + k, 1.0 + 0.1 * k] for k in range(n)])
+
+
+def _draw(k):
+    return ("x0", (2.0 + k, 1.0 + 0.1 * k))
+
+
+@pytest.fixture
+def draws(monkeypatch):
+    """The anchor's random starts are :class:`Draws`; logs (objective, seed) of each."""
+    asked = []
+
+    def tilted(problem, objective, seed):
+        asked.append((objective, seed))
+        return Draws()
+
+    monkeypatch.setattr(tasks, "tilted_starts", tilted)
+    monkeypatch.setattr(tasks, "own_starts", lambda problem: [])
+    return asked
+
+
 def _ms_task(**kw):
     task = {"id": "anchor-a-ms", "kind": "anchor-multistart", "problem": PROBLEM}
     task.update(objectives=["a", "b", "c"], order=["a", "b", "c"], starts=4, seed=5, agree=None)
@@ -194,80 +222,83 @@ def _ms_task(**kw):
     return task
 
 
-def test_a_multistart_solves_the_first_objective_from_the_problems_start_then_sobol(fake):
+def test_an_anchor_search_solves_the_first_objective_from_its_draws_in_order(fake, draws):
     solver = fake([_res(a=3.0), _res(a=1.0), _res(a=2.0), _res(a=5.0)])
     record = front_task(_ms_task(), {})
-    sobol = sobol_starts(PROBLEM.lower(), PROBLEM.upper(), 3, 5)
-    starts = [(5.0, 1.5), *map(tuple, sobol)]
     free = {"b": INF, "c": INF}
-    assert solver.solves == [("a", free, ("x0", s), False, None) for s in starts]
+    assert draws == [("a", 5)]
+    assert solver.solves == [("a", free, _draw(k), False, None) for k in range(4)]
     assert record["objectives"] == {"a": 1.0} and record["status"] == "optimal"
     assert record["kind"] == "anchor-multistart" and record["target"] == "a"
+    # four starts, four optima: too few to estimate anything; the cap ended it
     assert record["multistart"] == {"n_starts": 4, "n_planned": 4, "n_at_best": 1,
-                                    "agree": None, "stopped_early": False}  # fmt: skip
+                                    "agree": None, "stopped_early": False, "optima": 4,
+                                    "counted": 4, "p_better": 1.0,
+                                    "stop": "all starts run"}  # fmt: skip
     assert record["order"] == ["a", "b", "c"] and record["n_solves"] == 4
     assert record["eps"] == {} and solver.records[0][1:4] == ("anchor-multistart", "a", {})
     assert 0.0 <= record["wall_time_s"] < 60.0
 
 
-def test_a_multistart_of_one_start_solves_the_problems_start_only(fake):
+def test_an_anchor_search_of_one_start_solves_its_first_draw_only(fake, draws):
     solver = fake([_res(a=3.0)])
     record = front_task(_ms_task(starts=1, order=["b", "a"]), {})
-    assert solver.solves == [("b", {"a": INF}, ("x0", (5.0, 1.5)), False, None)]
+    assert solver.solves == [("b", {"a": INF}, _draw(0), False, None)]
     assert record["multistart"]["n_planned"] == 1 and record["n_solves"] == 1
 
 
-def test_a_multistart_stops_once_agree_starts_reach_the_best(fake):
-    """Two starts agreeing (within the tie tolerance) stop a multistart asked for two:
-    the third start is the second at the best, the fourth is never solved."""
+def test_an_anchor_search_stops_when_its_odds_settle(fake, draws):
+    """Eight starts at one optimum: fewer than half an optimum is expected unseen (2/5),
+    so the ninth start is never solved; the odds of a better one, 2/56."""
     near = 1.0 * (1 + 0.5 * OBJECTIVE_TIE_TOL)
-    solver = fake([_res(a=3.0, x=(3, 0)), _res(a=1.0, x=(1, 0)), _res(a=near, x=(2, 0))])
-    record = front_task(_ms_task(agree=2), {})
-    assert len(solver.solves) == 3 and record["n_solves"] == 3
+    answers = [_res(a=1.0, x=(1, 0))] + [_res(a=near, x=(2, 0))] * 8
+    solver = fake(answers)
+    record = front_task(_ms_task(starts=30), {})
+    assert len(solver.solves) == 8 and record["n_solves"] == 8
     assert record["x"] == [1.0, 0.0]  # the first start at the best
-    assert record["multistart"] == {"n_starts": 3, "n_planned": 4, "n_at_best": 2,
-                                    "agree": 2, "stopped_early": True}  # fmt: skip
+    ms = record["multistart"]
+    assert (ms["n_starts"], ms["optima"], ms["counted"], ms["stop"]) == (8, 1, 8, "odds")
+    assert ms["p_better"] == pytest.approx(2 / 56) and ms["stopped_early"]
 
 
-def test_a_multistart_whose_starts_agree_only_at_the_end_runs_them_all(fake):
-    solver = fake([_res(a=1.0), _res(a=3.0), _res(a=2.0), _res(a=1.0)])
-    record = front_task(_ms_task(agree=2), {})
-    assert len(solver.solves) == 4
-    assert record["multistart"] == {"n_starts": 4, "n_planned": 4, "n_at_best": 2,
-                                    "agree": 2, "stopped_early": False}  # fmt: skip
+def test_an_anchor_search_waits_for_agree_starts_at_the_best(fake, draws):
+    """agree=9: the odds settle after eight starts at one optimum, but nine must agree."""
+    solver = fake([_res(a=1.0)] * 12)
+    record = front_task(_ms_task(starts=30, agree=9), {})
+    assert len(solver.solves) == 9
+    assert record["multistart"]["n_at_best"] == 9 and record["multistart"]["agree"] == 9
 
 
-def test_a_multistart_none_of_whose_starts_succeeds_is_run_again_with_the_fallback(fake):
+def test_an_anchor_search_none_of_whose_starts_succeeds_is_run_again_with_the_fallback(fake, draws):
     answers = [_failed(3.0), _failed(2.0), _failed(4.0), _res(a=7.0, x=(7, 1)), _failed(1.0)]
     solver = fake(answers)
     record = front_task(_ms_task(starts=2, agree=1), {})
     assert [s[3] for s in solver.solves] == [False, False, True, True]
     assert [s[2] for s in solver.solves[2:]] == [s[2] for s in solver.solves[:2]]
     assert record["status"] == "optimal" and record["x"] == [7.0, 1.0]
-    # the second run stopped at its second start (agree 1): 2 + 2 solves, and the
-    # multistart record is the second run's
+    # the second search ran its two starts: 2 + 2 solves, its record the second's
     assert record["n_solves"] == 4
-    assert record["multistart"] == {"n_starts": 2, "n_planned": 2, "n_at_best": 1,
-                                    "agree": 1, "stopped_early": False}  # fmt: skip
+    ms = record["multistart"]
+    assert (ms["n_starts"], ms["n_planned"], ms["n_at_best"], ms["agree"]) == (2, 2, 1, 1)
     assert len(solver.answers) == 1  # the last scripted answer was never asked for
 
 
-def test_a_multistart_that_fails_throughout_reports_its_least_violated_start(fake):
+def test_an_anchor_search_that_fails_throughout_reports_its_least_violated_start(fake, draws):
     fake([_failed(3.0, x=(3, 0)), _failed(2.0, x=(2, 0))] * 2)
     record = front_task(_ms_task(starts=2), {})
     assert record["status"] == "failed" and record["x"] == [2.0, 0.0]
     assert record["n_solves"] == 4 and record["multistart"]["n_at_best"] == 0
-    assert record["multistart"]["n_starts"] == 2
+    assert record["multistart"]["n_starts"] == 2 and record["multistart"]["p_better"] is None
 
 
-def test_a_multistart_without_a_fallback_is_not_run_again(fake):
+def test_an_anchor_search_without_a_fallback_is_not_run_again(fake, draws):
     solver = fake([_failed(3.0), _failed(2.0)], has_fallback=False)
     record = front_task(_ms_task(starts=2), {})
     assert len(solver.solves) == 2 and record["n_solves"] == 2
     assert record["status"] == "failed"
 
 
-def test_a_multistart_with_one_success_is_not_run_again(fake):
+def test_an_anchor_search_with_one_success_is_not_run_again(fake, draws):
     solver = fake([_failed(3.0), _res(a=2.0)])
     record = front_task(_ms_task(starts=2), {})
     assert len(solver.solves) == 2 and record["n_solves"] == 2
@@ -285,7 +316,8 @@ def _ms_record(status="optimal", **objectives):
     d = _stored("ms", "anchor-multistart", status=status, x=(4.0, 0.5), **objectives)
     d["n_solves"] = 3
     d["multistart"] = {"n_starts": 3, "n_planned": 4, "n_at_best": 2, "agree": 2,
-                       "stopped_early": True}  # fmt: skip
+                       "stopped_early": True, "optima": 1, "counted": 3, "p_better": 0.5,
+                       "stop": "odds"}  # fmt: skip
     return d
 
 
@@ -665,3 +697,47 @@ def test_a_weighted_sum_point_starts_from_its_solved_neighbour(fake):
     failed = _stored("ws-0000", status="failed", a=1.0, b=4.0)
     front_task(_ws_task(warm="ws-0000"), {"ws-0000": failed})
     assert solver.starts_from == [(None, (6.0, 0.5))]
+
+
+# --- a point's polish -------------------------------------------------------------------------
+def _polish_task(sources):
+    task = {"id": "eps-0002-polish1", "kind": "polish", "problem": PROBLEM, "index": 2}
+    task.update(objectives=["a", "b"], point="p2", sources=list(sources))
+    return task
+
+
+def _point(**kw):
+    d = _stored("p2", eps={"a": 3.0}, x=(3.0, 1.0), a=3.0, b=6.0, **kw)
+    d["n_solves"] = 2
+    return d
+
+
+def test_a_polish_keeps_the_best_of_its_starts_and_says_where_it_came_from(fake):
+    solver = fake([_res(x=(4, 1), a=2.9, b=6.5), _res(x=(5, 1), a=3.0, b=4.0)])
+    deps = {"p2": _point(), "p1": _stored("p1", a=2.0, b=7.0), "p3": _stored("p3", a=4.0, b=4.0)}
+    record = front_task(_polish_task(["p1", "p3"]), deps)
+    # each start from its source's record, the point's own target and bound
+    assert solver.starts_from == [("p1", None), ("p3", None)]
+    assert [s[:2] for s in solver.solves] == [("b", {"a": 3.0}), ("b", {"a": 3.0})]
+    assert record["id"] == "eps-0002-polish1" and record["kind"] == "eps"
+    assert record["objectives"] == {"a": 3.0, "b": 4.0} and record["x"] == [5.0, 1.0]
+    assert record["warm"] == "p3" and record["retried"] == "polished from p3"
+    assert record["n_solves"] == 2 + 2 and record["slope"] == -2.5
+
+
+def test_a_polish_that_finds_nothing_better_keeps_the_point(fake):
+    near = 6.0 * (1 - 0.5 * OBJECTIVE_TIE_TOL)  # a tie is no improvement
+    fake([_res(x=(4, 1), a=3.0, b=near)])
+    record = front_task(_polish_task(["p1"]), {"p2": _point(), "p1": _stored("p1", a=2, b=7)})
+    assert record["objectives"] == {"a": 3.0, "b": 6.0} and record["x"] == [3.0, 1.0]
+    assert record["id"] == "eps-0002-polish1" and record["retried"] == ""
+    assert record["n_solves"] == 3 and record["slope"] is None
+
+
+def test_a_polish_whose_solve_fails_from_a_better_design_takes_that_design(fake):
+    fake([_failed()])
+    better = _stored("seen", x=(7.0, 2.0), a=2.5, b=5.0)
+    record = front_task(_polish_task(["seen"]), {"p2": _point(), "seen": better})
+    assert record["x"] == [7.0, 2.0] and record["objectives"] == {"a": 2.5, "b": 5.0}
+    assert record["eps"] == {"a": 3.0} and record["retried"] == "polished from seen"
+    assert record["fallback"].startswith("kept seen's design: the solve from it failed")

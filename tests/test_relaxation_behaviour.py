@@ -31,18 +31,20 @@ def infeasible():
 
 def test_the_candidates_are_the_violated_by_amount_then_the_binding(infeasible):
     problem, result = infeasible
-    assert result.status == "infeasible"
-    assert [v.name for v in result.violated] == ["mean_ratio"]
+    # the least violated point the search found stopped at Ipopt's iteration limit, with
+    # both requirements short of their limits (the other start: locally infeasible)
+    assert result.status == "max_iterations" and not result.success
+    amounts = {v.name: v.amount for v in result.violated}
+    assert set(amounts) == {"mean_ratio", "nut_travel"}
     rel = relaxations(problem, result)
-    assert [r.name for r in rel] == ["mean_ratio", "transmission_angle", "nut_travel"]
-    mr, ta, nt = rel
+    # the violated ones, by their relative amounts; no other requirement binds there
+    assert [r.name for r in rel] == ["mean_ratio", "nut_travel"]
+    mr, nt = rel
     assert (mr.upper, mr.written, mr.lower_row, mr.upper_row) == (False, 250.0, 250.0, 260.0)
     assert mr.needed == pytest.approx(240.48, abs=0.05)
     assert mr.solves > 8  # the removal, then 8 bisection steps
-    # removing the transmission angle alone leaves the problem infeasible: no number
-    assert ta.needed is None and ta.upper is True and ta.solves == 2
     assert (nt.upper, nt.written, nt.lower_row, nt.upper_row) == (True, 40.0, None, 40.0)
-    assert nt.needed > 40.0
+    assert nt.needed == pytest.approx(41.66, abs=0.05)
     assert all(r.at == "" for r in rel)
 
 
@@ -58,10 +60,7 @@ def test_the_relaxation_is_feasible_and_a_little_less_is_not(infeasible):
 
 def test_the_caps_on_requirements_and_bisection_steps(infeasible):
     problem, result = infeasible
-    assert [r.name for r in relaxations(problem, result, max_requirements=2)] == [
-        "mean_ratio",
-        "transmission_angle",
-    ]
+    assert [r.name for r in relaxations(problem, result, max_requirements=1)] == ["mean_ratio"]
     coarse = relaxations(problem, result, iterations=0, max_requirements=1)[0]
     fine = relaxations(problem, result, iterations=8, max_requirements=1)[0]
     # no bisection: the bracket, the need of the design found without the requirement

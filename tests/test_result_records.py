@@ -55,7 +55,7 @@ def test_result_record_and_front_point_share_one_success_rule(status, verified, 
 RESULT_KEYS = (
     "status objective design solver formulation wall_time_s termination "
     "solution_status message objective_name objectives iterations n_evals violated "
-    "active max_violation verified bound certificate multistart ranges diagnosis "
+    "active max_violation verified bound certificate globality multistart ranges diagnosis "
     "sensitivities item_steps problem mechanism notes extra"
 ).split()
 

@@ -268,7 +268,7 @@ def test_solve_cli_summary(tmp_path, capsys):
     )
     text = capsys.readouterr().out
     assert code == 0
-    assert "status    optimal" in text and "arm length" in text and "multistart" in text
+    assert "status    optimal" in text and "arm length" in text and "starts    2 run" in text
     assert "what limits the optimum" in text
 
 

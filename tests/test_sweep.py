@@ -1,5 +1,6 @@
-"""Issue 24: parametric sweeps by continuation (od.sweep, optdesign sweep), the store and
-its resume, infeasible points, the design chart, and the refusals of bad input."""
+"""Issue 24: parametric sweeps (od.sweep, optdesign sweep) - every point's global search,
+then polish rounds from the neighbours - the store and its resume, infeasible points,
+the design chart, and the refusals of bad input."""
 
 import json
 from pathlib import Path
@@ -10,40 +11,94 @@ import pytest
 import optdesign as od
 from optdesign.cli import main
 from optdesign.commands.sweep import parse_vary
+from optdesign.problem.request import SolveRequest
 from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.sweep import at_values, grid_order, neighbour, sweep_axes
+from optdesign.studies.run_options import RunOptions
+from optdesign.studies.sweep import (
+    at_values,
+    grid_neighbours,
+    grid_order,
+    neighbour,
+    polish_choice,
+    run_sweep,
+    sweep_axes,
+)
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 FORK = PROBLEMS / "fork_min_backlash.toml"
+CRANK = PROBLEMS / "cs_min_backlash.toml"
 HINGE = "requirements.hinge_moment"
+
+
+def _records(store: Path) -> dict[str, dict]:
+    """The records of a sweep's store by id, without their timings."""
+    out = {}
+    for line in store.read_text().splitlines()[1:]:
+        rec = json.loads(line)
+        rec.pop("time_s")
+        out[rec["id"]] = rec
+    return out
 
 
 @pytest.fixture(scope="module")
 def fork_sweep(tmp_path_factory):
     out = tmp_path_factory.mktemp("sweep")
     vary = {HINGE: ("200 N*m", "1000 N*m", 5)}
-    return od.sweep(FORK, vary, out=out, check_every=3, sensitivities=True), out
+    return od.sweep(FORK, vary, out=out, sensitivities=True), out
 
 
-def test_every_point_equals_an_independent_multistart(fork_sweep):
+def test_every_point_equals_a_cold_global_search(fork_sweep):
     sweep, _ = fork_sweep
     problem = od.load(FORK)
     assert [p.values[0] for p in sweep.points] == pytest.approx([200e3, 400e3, 600e3, 800e3, 1e6])
     for p in sweep.points:
-        alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}), starts=8, seed=5)
+        alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}))
         assert p.success and alone.success
         assert p.objective == pytest.approx(alone.objective, rel=1e-6)
-    # the checks: the ends, every third point, and where the binding set changed
-    assert [p.checked for p in sweep.points] == [True, True, False, True, True]
+    # every point had its own global search, and no polish round improved on one
+    assert all(p.checked for p in sweep.points)
+    assert [p.found_by for p in sweep.points] == ["global search"] * 5
     assert sweep.points[0].active == ["d.lower", "nut_travel"]  # a light load: the smallest pin
     assert sweep.points[1].active == ["nut_travel", "pin_bearing_pressure"]
     assert [p.active_change for p in sweep.points] == [False, True, False, False, False]
     assert not any(p.jump for p in sweep.points)
+    # a point's solves: its search's starts, then one warm start per neighbour (round 1)
+    records = _records(sweep.store)
+    for k, p in enumerate(sweep.points):
+        search = records[f"p{k:04d}"]["solves"]
+        assert search >= 3 and p.solves == search + (1 if k in (0, 4) else 2)
     # the backlash grows with the load (the pin grows with it)
     objectives = [p.objective for p in sweep.points]
     assert objectives == sorted(objectives)
     # each point carries its sensitivities: +1 % hinge moment costs about 0.24 % at 500 N*m
     assert 0.1 < sweep.points[2].sensitivities[HINGE] < 0.4
+
+
+@pytest.fixture(scope="module")
+def crank_sweeps(tmp_path_factory):
+    """A shipped problem swept by one worker and by two."""
+    out = tmp_path_factory.mktemp("crank")
+    vary = {HINGE: ("400 N*m", "600 N*m", 3)}
+    return [od.sweep(CRANK, vary, out=out / f"w{n}", workers=n) for n in (1, 2)]
+
+
+def test_a_sweep_of_a_shipped_problem_equals_a_cold_solve_at_every_point(crank_sweeps):
+    sweep, _ = crank_sweeps
+    problem = od.load(CRANK)
+    assert [p.values[0] for p in sweep.points] == pytest.approx([400e3, 500e3, 600e3])
+    for p in sweep.points:
+        cold = od.solve(at_values(problem, {HINGE: p.values[0]}), ranges=False)
+        assert p.success and cold.success
+        assert p.objective == pytest.approx(cold.objective, rel=1e-6)
+        assert p.checked
+
+
+def test_one_and_two_workers_give_the_same_records(crank_sweeps):
+    one, two = crank_sweeps
+    assert _records(two.store) == _records(one.store)
+    assert [(p.objective, p.design, p.jump, p.found_by, p.solves) for p in two.points] == [
+        (p.objective, p.design, p.jump, p.found_by, p.solves) for p in one.points
+    ]
 
 
 def test_frame_csv_and_chart_in_the_users_units(fork_sweep):
@@ -74,25 +129,28 @@ def test_resume_reuses_the_stored_points(fork_sweep):
     store = out / "sweep.jsonl"
     lines = store.read_text().splitlines()
     vary = {HINGE: ("200 N*m", "1000 N*m", 5)}
+    # check_every is accepted and ignored (every point has its search): not in the identity
     again = od.sweep(FORK, vary, out=out, check_every=3, resume=True, sensitivities=True)
     assert store.read_text().splitlines() == lines  # nothing solved again
     assert [p.objective for p in again.points] == [p.objective for p in sweep.points]
+    assert [p.solves for p in again.points] == [p.solves for p in sweep.points]
     # another range is another run: refused, naming what changed
     with pytest.raises(od.OptDesignError, match="method"):
-        od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out, check_every=3, resume=True)
+        od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out, resume=True)
     # and a new run does not silently replace the stored one
     with pytest.raises(od.OptDesignError, match="--resume"):
         od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out)
 
 
 def test_an_infeasible_point_says_what_fails(tmp_path):
-    sweep = od.sweep(
-        PROBLEMS / "cs_min_backlash.toml", {HINGE: ("10 kN*m", "15 kN*m", 2)}, out=tmp_path
-    )
+    sweep = od.sweep(CRANK, {HINGE: ("10 kN*m", "15 kN*m", 2)}, out=tmp_path)
     ok, bad = sweep.points
     assert ok.success and ok.active == ["d.upper", "nut_travel"]
     assert not bad.success  # the best design found violates the requirements
-    assert any("pin_bearing_pressure" in v for v in bad.violated)
+    # it says what fails there: what a cold solve of the point finds violated
+    cold = od.solve(at_values(od.load(CRANK), {HINGE: 15e6}), ranges=False, diagnose=False)
+    assert not cold.success and cold.violated
+    assert all(any(r.name in v for v in bad.violated) for r in cold.violated)
     text = sweep.summary()
     assert "infeasible points (what fails at the best design found):" in text
     row = next(line for line in text.splitlines() if line.startswith("1 "))
@@ -112,15 +170,25 @@ def test_two_parameters_snake_through_the_grid(tmp_path):
     assert "R.upper" in sweep.points[0].active and "R.upper" not in sweep.points[2].active
     assert sweep.points[0].objective > sweep.points[2].objective
     assert grid_order(sweep.axes) == [(0, 0), (1, 0), (0, 1), (1, 1)]
-    # each row a chain; a row's first point continues from the row before's first point
+    # a jump is judged against the chain's predecessor: along the row, a row's first
+    # point against the row before's first point
     assert [neighbour(i) for i in grid_order(sweep.axes)] == [None, (0, 0), (0, 0), (0, 1)]
+    # a polish round starts from the neighbours along the first parameter, then the rows
+    assert grid_neighbours((1, 1), (3, 3)) == [
+        ("from the previous point", (0, 1)),
+        ("from the next point", (2, 1)),
+        ("from the previous row", (1, 0)),
+        ("from the next row", (1, 2)),
+    ]
+    assert grid_neighbours((0, 0), (2, 2)) == [
+        ("from the next point", (1, 0)),
+        ("from the next row", (0, 1)),
+    ]
     assert sweep.plot().axes[0].get_xlabel() == "hinge_moment [N*m]"
-    # two workers run the rows side by side: the same records, whatever the timing
+    # two workers run the points side by side: the same records, whatever the timing
     vary = {HINGE: ("400 N*m", "600 N*m", 2), "variables.R.upper": ("90 mm", "110 mm", 2)}
     again = od.sweep(FORK, vary, out=tmp_path / "w2", workers=2)
-    assert [(p.objective, p.design, p.active) for p in again.points] == [
-        (p.objective, p.design, p.active) for p in sweep.points
-    ]
+    assert _records(again.store) == _records(sweep.store)
 
 
 @pytest.mark.parametrize(
@@ -261,9 +329,9 @@ def test_a_catalogue_problem_is_swept_point_by_point_and_item_changes_marked(tmp
 
 
 def test_a_worse_warm_start_is_caught_as_a_jump(tmp_path, monkeypatch):
-    # The warm start made to end 1 % above the optimum (as if the chain had followed a
-    # local optimum): the multistart check of every point finds the better one, marks
-    # the jump and the chain goes on from it.
+    # The warm starts made to end 1 % above the optimum (as if continuation followed a
+    # local optimum): every point's own search has the better one, the polish keeps it,
+    # and the points a warm start from the point before would have got wrong are jumps.
     import dataclasses
 
     from optdesign.studies.sweep_solver import SweepSolver
@@ -275,14 +343,128 @@ def test_a_worse_warm_start_is_caught_as_a_jump(tmp_path, monkeypatch):
         return dataclasses.replace(r, objective=r.objective * 1.01)
 
     monkeypatch.setattr(SweepSolver, "warm", worse)
-    sweep = od.sweep(FORK, {HINGE: ("400 N*m", "600 N*m", 3)}, check_every=1, out=tmp_path)
+    sweep = od.sweep(FORK, {HINGE: ("400 N*m", "600 N*m", 3)}, out=tmp_path)
     assert [p.jump for p in sweep.points] == [False, True, True]  # the first has no neighbour
+    assert [p.found_by for p in sweep.points] == ["global search"] * 3
     assert all(p.checked for p in sweep.points)
     problem = od.load(FORK)
     for p in sweep.points:
         alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}))
         assert p.objective == pytest.approx(alone.objective, rel=1e-9)
-    assert "the multistart check found a better optimum" in sweep.summary()
+    assert "jumps (a warm start from the point before would have stayed on a worse branch)" in (
+        sweep.summary()
+    )
+
+
+def test_the_polish_rule_decides_by_value_then_by_order():
+    ok = {"success": True, "max_violation": 0.0}
+    current = {**ok, "objective": 1.0}
+    # a tie (within the tolerance) keeps the point's own value
+    assert polish_choice(current, [{**ok, "objective": 1.0 - 1e-9}]) is None
+    # the better wins; of two equal ones the first in the neighbours' order
+    cands = [{**ok, "objective": 1.2}, {**ok, "objective": 0.9}, {**ok, "objective": 0.9}]
+    assert polish_choice(current, cands) == 1
+    assert polish_choice(current, [{**ok, "objective": 0.9}, {**ok, "objective": 0.8}]) == 1
+    # a feasible design beats any infeasible one; two infeasible: the smaller violation
+    bad = {"success": False, "objective": 0.1, "max_violation": 0.5}
+    assert polish_choice(current, [bad]) is None
+    assert polish_choice(bad, [{**bad, "max_violation": 0.4}, current]) == 1
+    assert polish_choice(bad, [{**bad, "max_violation": 0.4}]) == 0
+
+
+def _two_branches(monkeypatch, good_at: float) -> None:
+    """A made-up second branch: every point's own search lands on it (R shifted by
+    1000 mm, the backlash 2 % higher) except the point at ``good_at`` N*mm; a warm start
+    from a design on it stays on it, from any other design finds the true optimum."""
+    import dataclasses
+
+    from optdesign.studies.sweep_solver import SweepSolver
+
+    search, warm = SweepSolver.search, SweepSolver.warm
+
+    def worse(r):
+        design = {**r.design, "R": r.design["R"] + 1000.0}
+        return dataclasses.replace(r, objective=r.objective * 1.02, design=design)
+
+    def fake_search(self, point, starts, seed, agree=None):
+        r = search(self, point, starts, seed, agree)
+        return r if point.spec.requirements.hinge_moment == good_at else worse(r)
+
+    def fake_warm(self, point, x0):
+        k = [v.name for v in point.free].index("R")
+        if x0[k] < 500.0:
+            return warm(self, point, x0)
+        x0 = x0.copy()
+        x0[k] -= 1000.0
+        return worse(warm(self, point, x0))
+
+    monkeypatch.setattr(SweepSolver, "search", fake_search)
+    monkeypatch.setattr(SweepSolver, "warm", fake_warm)
+
+
+@pytest.mark.parametrize(
+    ("good", "found"), [(0, "from the previous point"), (4, "from the next point")]
+)
+def test_a_better_branch_spreads_through_the_polish_rounds(tmp_path, monkeypatch, good, found):
+    values = [400e3, 450e3, 500e3, 550e3, 600e3]
+    _two_branches(monkeypatch, values[good])
+    sweep = od.sweep(FORK, {HINGE: ("400 N*m", "600 N*m", 5)}, out=tmp_path)
+    problem = od.load(FORK)
+    for p in sweep.points:  # every point lifted onto the true optimum
+        alone = solve_nlp(at_values(problem, {HINGE: p.values[0]}))
+        assert p.objective == pytest.approx(alone.objective, rel=1e-6)
+        assert p.design["R"] < 500.0
+    assert [p.found_by for p in sweep.points] == [
+        "global search" if k == good else found for k in range(5)
+    ]
+    assert [p.jump for p in sweep.points] == [k != good for k in range(5)]
+    # one point a round: the better branch moves one step along the sweep each time
+    records = _records(sweep.store)
+    lifted = {rec["index"]: rec["round"] for rec in records.values() if rec.get("improved")}
+    assert lifted == {k: abs(k - good) for k in range(5) if k != good}
+    # each round's points: those next to a point lifted in the round before; the last
+    # round lifts nothing and ends the polish (5 rounds: the cap, not reached)
+    rounds = sorted({rec["round"] for rec in records.values()})
+    assert rounds == [0, 1, 2, 3, 4, 5] and not sweep.notes
+    # a point's solves: its search, one per neighbour in round 1, then one more from
+    # each neighbour in the round after that neighbour was lifted
+    for k, p in enumerate(sweep.points):
+        search = records[f"p{k:04d}"]["solves"]
+        beside = [j for j in (k - 1, k + 1) if 0 <= j < 5]
+        assert p.solves == search + len(beside) + sum(j in lifted for j in beside)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_killed_sweep_resumes_to_the_same_records(tmp_path, monkeypatch, workers):
+    # Killed in the middle of its polish rounds, the sweep resumes from its store: the
+    # records stored are not computed again and the answer is the uninterrupted one's.
+    _two_branches(monkeypatch, 400e3)
+    problem = od.load(FORK)
+    vary = {HINGE: ("400 N*m", "600 N*m", 5)}
+    request = SolveRequest.for_problem(problem, ranges=False, sensitivities=False)
+    whole = run_sweep(problem, vary, request, run=RunOptions(out=tmp_path / "whole"))
+
+    seen = []
+
+    def kill(record):
+        seen.append(record["id"])
+        if len(seen) == 8:  # round 0 done, round 1 under way
+            raise KeyboardInterrupt
+
+    out = tmp_path / "killed"
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(problem, vary, request, run=RunOptions(out=out, on_record=kill, workers=workers))
+    stored = (out / "sweep.jsonl").read_text().splitlines()
+    assert len(stored) == 1 + 8
+    again = []
+    resume = RunOptions(out=out, resume=True, on_record=again.append, workers=workers)
+    resumed = run_sweep(problem, vary, request, run=resume)
+    assert not set(seen) & {r["id"] for r in again}  # nothing stored was solved again
+    assert (out / "sweep.jsonl").read_text().splitlines()[: len(stored)] == stored
+    assert _records(resumed.store) == _records(whole.store)
+    assert [(p.objective, p.found_by, p.jump) for p in resumed.points] == [
+        (p.objective, p.found_by, p.jump) for p in whole.points
+    ]
 
 
 def test_the_points_are_solved_with_the_one_request_od_sweep_builds(tmp_path, monkeypatch):
@@ -316,7 +498,7 @@ def test_the_points_are_solved_with_the_one_request_od_sweep_builds(tmp_path, mo
 
 
 @pytest.mark.parametrize("check_every", [0, 10_001, 2.5, True])
-def test_check_every_is_refused_by_od_sweep_naming_it(check_every, tmp_path):
+def test_check_every_still_checked_by_od_sweep_naming_it(check_every, tmp_path):
     with pytest.raises(od.InputError) as info:
         od.sweep(FORK, {HINGE: ("200 N*m", "300 N*m", 2)}, check_every=check_every, out=tmp_path)
     assert info.value.field == "check_every"

@@ -6,6 +6,7 @@ points as they finish; ``--resume`` continues from them) to the output folder.
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 import time
@@ -80,10 +81,12 @@ def _pareto(sub):
     )
     p.add_argument(
         "--deterministic",
-        action="store_true",
+        action=argparse.BooleanOptionalAction,
+        default=True,
         help="epsilon fronts: the two chains meet in the middle, so the front is the same "
-        "for any --workers and a resumed run equals an uninterrupted one (slower with "
-        "several workers); by default they meet where timing makes them meet",
+        "for any --workers and a resumed run equals an uninterrupted one (the default); "
+        "--no-deterministic lets them meet where timing makes them meet (faster with "
+        "several workers, the front may depend on them)",
     )
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plot")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -49,7 +49,7 @@ def parse_vary(text: str) -> tuple[str, tuple[str, str, int]]:
 
 @command("sweep")
 def _sweep(sub):
-    p = sub.add_parser("sweep", help="the optimum against one or two parameters (continuation)")
+    p = sub.add_parser("sweep", help="the optimum against one or two parameters")
     p.add_argument("file", type=Path, help="problem file (TOML)")
     p.add_argument(
         "--vary",
@@ -63,14 +63,13 @@ def _sweep(sub):
         "--check-every",
         type=checked(lambda a, v: check.integer(a, v, 1, 10_000), literal),
         default=10,
-        help="a full multistart every this many points (default 10), and at the ends, "
-        "where the warm start fails and where the binding set changes",
+        help="ignored (every point gets its global search); accepted for older scripts",
     )
     p.add_argument(
         "--starts",
         type=checked(check.starts, literal),
         default=None,
-        help="starts of the multistart checks (default: the file's)",
+        help="the most starts of each point's global search (default: the file's)",
     )
     p.add_argument(
         "--seed", type=checked(check.seed, literal), default=None, help="seed (default: file's)"
@@ -79,8 +78,7 @@ def _sweep(sub):
         "--workers",
         type=checked(check.workers, literal),
         default=1,
-        help="local processes: the rows of a two-parameter sweep (or a catalogue problem's "
-        "points) side by side (default 1)",
+        help="local processes: the points side by side (default 1)",
     )
     p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
     p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")

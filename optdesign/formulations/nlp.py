@@ -304,6 +304,35 @@ def typical(value) -> float:
     return float(v) if np.isfinite(v) and v > 0 else 1.0
 
 
+#: Designs tried for the scales when the middle of the bounds does not assemble.
+SCALE_SAMPLE = 64
+
+
+def scales_design(problem: DesignProblem) -> np.ndarray:
+    """Where the formulation takes its scales: the middle of the bounds, unless a model
+    is undefined there (a linkage that does not assemble: NaN), then the least violated
+    of :data:`SCALE_SAMPLE` fixed random designs (the same for every solve), so that a
+    user's linkage that assembles only in part of its box still gets the scales of a
+    design that exists. A declared start never changes the scales."""
+    mid = problem.midpoint()
+    if not problem.free:
+        return mid
+    with np.errstate(all="ignore"):
+        ev = problem.evaluate(mid)
+    if np.isfinite(ev.violation) and all(np.isfinite(v) for v in ev.objectives.values()):
+        return mid
+    lo, hi = problem.lower(), problem.upper()
+    sample = lo + np.random.default_rng(0).random((SCALE_SAMPLE, len(lo))) * (hi - lo)
+    with np.errstate(all="ignore"):
+        ev = problem.evaluate(sample)
+    finite = np.all(
+        [np.isfinite(np.asarray(v, dtype=float)) for v in ev.objectives.values()], axis=0
+    )
+    violation = np.where(finite, np.nan_to_num(ev.violation, nan=np.inf), np.inf)
+    best = int(np.argmin(violation))
+    return sample[best] if np.isfinite(violation[best]) else mid
+
+
 def numeric_value(term) -> float:
     """The value of an objective term of one design on the NumPy path."""
     e = np.asarray(term.expr, dtype=float)
@@ -354,7 +383,7 @@ def build_nlp(
     design = problem.design_dict([x[k] for k in range(n)])
     design.update(problem.parameter_design(dict(zip(defaults, ca.vertsplit(theta), strict=True))))
     ex = problem.expressions(design, guarded=True, first_order=first_order)
-    mid = problem.midpoint()
+    mid = scales_design(problem)
     with np.errstate(all="ignore"):  # the scales' design may lie where a model is undefined
         ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
     for name in names:

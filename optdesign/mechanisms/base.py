@@ -33,6 +33,7 @@ from optdesign.mechanisms.joints import Backlash, Joint, PinJoint, backlash_of
 from optdesign.models._checks import require_finite, require_positive
 from optdesign.models.loads import force_from_rate, motor_torque
 from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity
+from optdesign.models.validity import Validity
 from optdesign.user_code import call_method
 
 #: Physical dimensions a variable may have (keys of optdesign.units.INTERNAL_UNITS).
@@ -53,12 +54,18 @@ class VariableInfo:
         Fixed values and lower bounds must be > 0 (lengths such as an arm).
     default
         Value used when a problem does not declare the variable (None: required).
+    valid
+        The range of validity of the models the variable feeds
+        (:class:`~optdesign.models.validity.Validity`, internal units): a problem file's
+        value, bound, start or catalogue value outside it is refused when read (None:
+        any positive or finite value).
     """
 
     dimension: str
     description: str
     positive: bool = True
     default: float | None = None
+    valid: Validity | None = None
 
     def __post_init__(self):
         if self.dimension not in DIMENSIONS:

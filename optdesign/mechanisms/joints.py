@@ -103,7 +103,7 @@ class PinJoint:
         if self.contact not in CONTACT_MODELS:
             raise InputError("pin.contact", f"{self.contact!r}: use one of {CONTACT_MODELS}")
         if self.contact == "palmgren" and not m.is_symbolic(self.E):
-            if not 1.9e5 <= float(self.E) <= 2.2e5:
+            if not pin_contact.PALMGREN_MODULUS.contains(float(self.E)):
                 raise InputError(
                     "materials.pin.E",
                     f"Palmgren's approach is an empirical law of steel (E about 2.1e5 MPa), "

@@ -14,12 +14,35 @@ All functions accept floats, NumPy arrays or CasADi symbols (see optdesign.math)
 ``floor`` guards the square root of the assembly margin for solvers: with ``floor=None``
 the NumPy path returns NaN where the linkage cannot assemble (the mechanism layer checks
 and names the angle); a solver passes a small positive floor so no NaN ever reaches it.
+
+Validity
+--------
+assembly margin (l^2 - u^2)/l^2 : > 0 (a problem keeps it above 0.01)
+    The closed forms are exact (no small-angle term) wherever the linkage assembles;
+    at the toggle position the nut velocity and the forces are singular. A design
+    problem bounds the margin (``assembly_margin_min``).
 """
 
 from __future__ import annotations
 
 from optdesign import math as m
 from optdesign.models.ratio import ratio_from_nut_velocity
+from optdesign.models.validity import Validity
+
+ASSEMBLY_MARGIN = Validity(
+    "crank_slider.assembly_margin",
+    "crank-slider kinematics",
+    "assembly margin (l^2 - u^2)/l^2",
+    0.0,
+    1.0,
+    "",
+    "the closed forms hold wherever the linkage assembles, away from its toggle position",
+    open_lower=True,
+    checked=("file", "design"),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (ASSEMBLY_MARGIN,)
 
 
 def arm_angle(phi, phi0=0.0):

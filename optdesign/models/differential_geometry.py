@@ -17,6 +17,12 @@ Sign: curvatures are normal curvatures with respect to n, so a sphere parametris
 an outward n has kappa = -1/R. Contact mechanics wants "convex positive": with n the
 outward normal of the body, the convex-positive curvature is ``-kappa``
 (see :mod:`optdesign.models.prsm`).
+
+Validity
+--------
+a regular surface : E G - F^2 > 0
+    The fundamental forms and curvatures exist where the parametrisation is regular
+    (its tangent vectors independent). Documented.
 """
 
 from __future__ import annotations
@@ -27,6 +33,23 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 import scipy.linalg
+
+from optdesign.models.validity import Validity
+
+REGULARITY = Validity(
+    "differential_geometry.regularity",
+    "surface curvature",
+    "E G - F^2 of the first fundamental form",
+    0.0,
+    None,
+    "mm^2",
+    "curvatures exist where the parametrisation is regular",
+    open_lower=True,
+    checked=("documented",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (REGULARITY,)
 
 
 def fundamental_forms(r: ca.SX, u: ca.SX, v: ca.SX) -> dict[str, ca.SX]:

@@ -23,6 +23,14 @@ exact.
 Output: an angle in rad at the output shaft when a mechanism is given (nut-side error
 times 1/(dx/dphi), the sensitivity of models.crank_slider / models.fork); a nut-side
 displacement in mm without one (the paper's screw on its own).
+
+Validity
+--------
+each source small against the lead and the link lengths
+    Every term is linear in its source ("gain x value"), mapped to the output by the
+    first-order sensitivities of the linkage: the same small-angle range as the
+    clearance chain (:data:`optdesign.models.clearance.BACKLASH`, 5 deg at the output).
+    Documented (the studies' budgets).
 """
 
 from __future__ import annotations
@@ -35,6 +43,22 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import InputError
+from optdesign.models.validity import Validity
+
+OUTPUT_ERROR = Validity(
+    "error_budget.output_error",
+    "transmission-error budget",
+    "output angle error",
+    0.0,
+    5.0,
+    "deg",
+    "the terms are mapped through first-order sensitivities, like the clearance chain",
+    checked=("documented",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (OUTPUT_ERROR,)
+
 
 #: Distributions of Table 1. ``periodic``: amplitude x sin(uniform phase).
 DISTRIBUTIONS = ("fixed", "uniform", "normal", "periodic")

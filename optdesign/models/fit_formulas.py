@@ -37,6 +37,12 @@ mean of p and s): they exist only as table values (:mod:`optdesign.models.iso286
 
 ``values="table"`` (``Fit.clearance``, :func:`fit_clearance`) returns the standard's
 printed, stepped values instead; see :mod:`optdesign.models.iso286`.
+
+Validity
+--------
+D : 0 < D <= 500 mm
+    The tolerance unit i = 0.45 D^(1/3) + 0.001 D is ISO 286-1's for sizes up to 500 mm
+    (:data:`optdesign.models.iso286.NOMINAL_SIZE`, the same record).
 """
 
 from __future__ import annotations
@@ -50,6 +56,10 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models import iso286
+from optdesign.models.iso286 import NOMINAL_SIZE
+
+#: The ranges of validity of this model: the tables' (module docstring).
+VALIDITY = (NOMINAL_SIZE,)
 
 #: IT grade -> multiple of the tolerance unit i.
 IT_FACTORS: dict[int, float] = {

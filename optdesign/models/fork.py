@@ -3,12 +3,40 @@
 The nut pin C moves on a line at perpendicular distance R from the output axis O and
 slides in a slot of the output arm; at deflection phi (arm at a = phi0 + phi, phi0 = 0 in
 the paper) the nut sits at s = R tan a and the pin at R / cos a from O.
+
+Validity
+--------
+arm angle phi0 + phi : |a| < 90 deg
+    s = R tan(a) is exact and has its pole at 90 deg (the pin leaves along the slot).
+    The stroke of a problem stays far from it (checked by the ratio's rows: a finite,
+    positive ratio).
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from optdesign import math as m
 from optdesign.models.ratio import ratio_from_nut_velocity
+from optdesign.models.validity import Validity
+
+ARM_ANGLE = Validity(
+    "fork.arm_angle",
+    "shifting-fork kinematics",
+    "arm angle phi0 + phi",
+    float(-np.pi / 2),
+    float(np.pi / 2),
+    "rad",
+    "s = R tan(a) is exact and has its pole at 90 deg",
+    shown_unit="deg",
+    scale=float(180.0 / np.pi),
+    open_lower=True,
+    open_upper=True,
+    checked=("documented",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (ARM_ANGLE,)
 
 
 @m.shareable

@@ -18,11 +18,38 @@ which does not lose digits to cancellation when b << D. First-order form: b^2 / 
 Limits: eq. 10 is a cylinder on a flat; a pin in a bore with small clearance is a
 conforming contact where the half-width grows and Hertz stops holding once the arc is
 wide (docs/clearance_and_backlash.md). Where b approaches D/2 the formula has no real value.
+
+Validity
+--------
+b / (D/2) : <= 0.25
+    Hertz's solution treats each body as an elastic half-space, which needs a contact
+    strip narrow against the radius of curvature. At b = D/8 the strip subtends
+    +-14.5 deg of the pin, where the conforming-contact module finds Hertz's formulas
+    within 3 % of the exact solution (15 deg, :mod:`optdesign.models.pin_contact`), and
+    the sagitta (11) departs by 1.6 % from its first-order form b^2/D; at b = D/2 (11)
+    has no real value at all. A steel pin at its usual bearing limit (100 MPa) has
+    b/(D/2) = 0.047.
+E, nu : :data:`~optdesign.models.validity.ELASTIC_MODULUS`, :data:`~optdesign.models.validity.POISSON_RATIO`
+    Linear elasticity of a real solid.
 """
 
 from __future__ import annotations
 
 from optdesign import math as m
+from optdesign.models.validity import ELASTIC_MODULUS, POISSON_RATIO, Validity
+
+HALF_WIDTH_RATIO = Validity(
+    "hertz_line.half_width_ratio",
+    "Hertz line contact",
+    "contact half-width over the pin radius b/(d/2)",
+    0.0,
+    0.25,
+    "",
+    "Hertz's half-space needs a contact strip narrow against the radius (within 3 % up to b = d/8)",
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (HALF_WIDTH_RATIO, ELASTIC_MODULUS, POISSON_RATIO)
 
 
 def contact_half_width(D, F, L, E, nu):

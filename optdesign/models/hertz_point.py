@@ -32,6 +32,15 @@ Hamrock & Brewe's curve fits (kappa, E, K as power/log laws in Ry/Rx) are in
 :func:`hamrock_brewe` for comparison; they are approximations, not used by the solver.
 
 The elliptic solve is numeric (SciPy); this module is NumPy/SciPy only.
+
+Validity
+--------
+curvature difference F(rho) : 0 <= F(rho) < 1
+    An ellipse of contact exists for a gap A x^2 + B y^2 with 0 < A <= B (refused
+    otherwise, and where the ellipse is beyond double precision).
+semi-axes small against the radii, linear elasticity
+    Hertz's half-space, as for the line contact; E, nu in the ranges of
+    :mod:`optdesign.models.validity`. Documented (the thread-contact study).
 """
 
 from __future__ import annotations
@@ -44,6 +53,23 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk, ellipkm1
 
 from optdesign.errors import InputError
+from optdesign.models.validity import ELASTIC_MODULUS, POISSON_RATIO, Validity
+
+CURVATURE_DIFFERENCE = Validity(
+    "hertz_point.curvature_difference",
+    "Hertz point contact",
+    "curvature difference F(rho)",
+    0.0,
+    1.0,
+    "",
+    "an elliptical contact needs a gap A x^2 + B y^2 with 0 < A <= B",
+    open_upper=True,
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (CURVATURE_DIFFERENCE, ELASTIC_MODULUS, POISSON_RATIO)
+
 
 # Series coefficients c_n = ((2n)! / (2^(2n) (n!)^2))^2 of K(m) = pi/2 sum c_n m^n; used
 # to evaluate F(rho) near e = 0 where the closed form loses all digits to cancellation.

@@ -56,6 +56,13 @@ Most extremes sit in the first step (1..3 mm, where the standard departs most fr
 own formulas) or at a step's ends (the formula at D against the value of the step's
 geometric mean); at the low end of a step the smooth model understates the clearance (the
 unsafe side for backlash), so the table is the one to use for a design at a fixed size.
+
+Validity
+--------
+D : 0 < D <= 500 mm
+    The sizes ISO 286-2 tabulates here; larger sizes (to 3150 mm) follow another
+    tolerance unit in the standard and are not stored. Refused by :func:`clearance_um`
+    (field ``D``) and, in a problem, when the file is read (the pin diameter's range).
 """
 
 # Sources of the tables below (values in um, as printed):
@@ -82,9 +89,25 @@ from __future__ import annotations
 import numpy as np
 
 from optdesign.errors import InputError
+from optdesign.models.validity import Validity
 
 #: Largest nominal size (mm) the tables cover.
 MAX_SIZE = 500.0
+
+NOMINAL_SIZE = Validity(
+    "iso286.nominal_size",
+    "ISO 286 fits",
+    "nominal size D",
+    0.0,
+    MAX_SIZE,
+    "mm",
+    "the tables (and the formulas of ISO 286-1 as this project uses them) cover 0 < D <= 500 mm",
+    open_lower=True,
+    checked=("call",),
+)
+
+#: The ranges of validity of this model (module docstring).
+VALIDITY: tuple[Validity, ...] = (NOMINAL_SIZE,)
 
 #: Upper limits (mm) of the 25 size steps of the fundamental-deviation tables.
 STEPS = (

@@ -18,6 +18,16 @@ force is a CasADi expression in a design problem and a NumPy array in a sweep.
 The coupling to a mechanism is :func:`motor_shaft_lock_load`: hinge moment -> nut force
 (virtual work) -> motor-shaft moment through the back-driving efficiencies -> the lock
 force for the largest moment over the stroke.
+
+Validity
+--------
+friction coefficient mu : 0 < mu <= 1
+    Coulomb friction of lining, plate and pin contacts (0.1-0.6); above 1 the hold is
+    adhesion or a form lock, which the [Y16] laws do not describe (checked when the file
+    is read, ``requirements.lock.mu``).
+bearing misalignment : <= 0.5 deg
+    The reconstructed balance of the rolling pin lock is the paper's for a bearing plane
+    within 0.5 deg of the plane of F1. Documented.
 """
 
 from __future__ import annotations
@@ -31,6 +41,35 @@ from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models._checks import require_nonnegative, require_positive
 from optdesign.models.loads import backdriven_motor_torque
+from optdesign.models.validity import Validity
+
+LOCK_FRICTION = Validity(
+    "lock.friction",
+    "motor-shaft lock",
+    "friction coefficient",
+    0.0,
+    1.0,
+    "",
+    "Coulomb friction of the lock's contacts lies below 1 (linings 0.1-0.6)",
+    open_lower=True,
+    checked=("file",),
+)
+MISALIGNMENT = Validity(
+    "lock.misalignment",
+    "rolling pin lock",
+    "bearing misalignment",
+    0.0,
+    float(np.radians(0.5)),
+    "rad",
+    "the paper's balance holds for a bearing plane within 0.5 deg of the load's",
+    shown_unit="deg",
+    scale=float(180.0 / np.pi),
+    checked=("documented",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (LOCK_FRICTION, MISALIGNMENT)
+
 
 #: Pressure laws of a friction annulus: a new lining (uniform pressure) and a worn-in one
 #: (uniform wear, p r = const).

@@ -22,6 +22,20 @@ The same form is what FE pre-processors use (Altair HyperMesh's ``*fastenercreat
 writes it as b1 = b/n on the t1 terms and b2 = b/n^2 on the t2 terms). Checked against
 pyNastran's independent implementation (see docs/validation.md).
 
+Validity
+--------
+t1 / d, t2 / d : 0.2 ... 2
+    Huth's constants a, b were fitted to tests of sheet joints whose member thickness
+    was about 0.2 to 2 pin diameters; the power law ((t1 + t2)/(2 d))^a is an
+    extrapolation outside them (a lug far thinner than its pin tears out before it
+    bends the pin; a lug far thicker turns the pin into a beam built in at both ends).
+t1, t2 : 0.001 ... 1000 mm
+    A member at least a micrometre thick (the roughness of a reamed bore is 0.4-1.6 um:
+    a thinner one is a surface film, not a lug) and at most a metre (a bulkhead, no
+    sheet joint).
+E1, E2, E3 : :data:`~optdesign.models.validity.ELASTIC_MODULUS`
+    Linear elasticity of a real solid.
+
 Units: mm, N, MPa (C in mm/N).
 """
 
@@ -32,6 +46,30 @@ from typing import Any
 
 from optdesign.errors import InputError
 from optdesign.models._checks import require_positive
+from optdesign.models.validity import ELASTIC_MODULUS, Validity
+
+LUG_THICKNESS = Validity(
+    "lug_flexibility.thickness",
+    "Huth's lug flexibility",
+    "lug thickness",
+    1.0e-3,
+    1.0e3,
+    "mm",
+    "a lug is at least a micrometre (the roughness of its bore) and at most a metre thick",
+    checked=("file",),
+)
+THICKNESS_RATIO = Validity(
+    "lug_flexibility.thickness_ratio",
+    "Huth's lug flexibility",
+    "thickness over pin diameter t/d",
+    0.2,
+    2.0,
+    "",
+    "Huth fitted his constants to joints with t/d of about 0.2 to 2",
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (LUG_THICKNESS, THICKNESS_RATIO, ELASTIC_MODULUS)
 
 #: Huth's constants (a, b) per joint type, metallic members [H86].
 HUTH_CONSTANTS: dict[str, tuple[float, float]] = {

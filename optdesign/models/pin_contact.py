@@ -52,6 +52,22 @@ No published table of Persson's solution was found to test against (see the test
 the checks are the Hertz limit, Lame's solution for the uniform mode, the 90 deg limit
 and equilibrium of the computed pressure.
 
+Validity
+--------
+P* : (0, 100]
+    The explicit approximation (what a design problem evaluates) was fitted to the exact
+    solution on P* = 0.01 ... 100 and is exact in the Hertz limit P* -> 0; beyond 100 the
+    arc exceeds 84 deg, the pin wraps its bore, and the fit was never checked there.
+    P* > 0 needs a radial gap (a clearance fit, checked when the problem is read).
+Hertz's half-angle of the conforming pair : <= 15 deg
+    :func:`hertz_half_angle` and :func:`hertz_max_pressure` are within 3 % of the exact
+    solution up to eps = 15 deg (:func:`in_hertz_range`); a comparison, not used by the
+    design problems.
+E (Palmgren) : 1.9e5 ... 2.2e5 MPa
+    Palmgren's law is an empirical fit to steel line contacts (bearing rollers): it has
+    no modulus in it, so it holds for steel only (refused otherwise when the pin joint
+    is built).
+
 Units: mm, N, MPa, rad.
 """
 
@@ -65,6 +81,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models._checks import require_positive
+from optdesign.models.validity import Validity
 
 #: Half-angle up to which Hertz's formulas are within 3 % of the exact solution (rad).
 HERTZ_MAX_HALF_ANGLE = float(np.radians(15.0))
@@ -78,6 +95,42 @@ _D_ALPHA, _D_GAMMA = 0.33103, 1.1019
 
 #: Palmgren's constant for steel line contact (mm N^-0.9 mm^0.8).
 PALMGREN_CONSTANT = 3.84e-5
+
+LOAD_PARAMETER = Validity(
+    "pin_contact.load_parameter",
+    "conforming pin-in-bore contact",
+    "load parameter P*",
+    0.0,
+    FIT_MAX_LOAD,
+    "",
+    "the explicit approximation was fitted to the exact solution for P* up to 100",
+    open_lower=True,
+)
+HERTZ_CONFORMING_HALF_ANGLE = Validity(
+    "pin_contact.hertz_half_angle",
+    "Hertz's formulas for a conforming pin",
+    "contact half-angle",
+    0.0,
+    HERTZ_MAX_HALF_ANGLE,
+    "rad",
+    "Hertz's small-arc formulas are within 3 % of the exact solution up to 15 deg",
+    shown_unit="deg",
+    scale=180.0 / np.pi,
+    checked=("documented",),
+)
+PALMGREN_MODULUS = Validity(
+    "pin_contact.palmgren_modulus",
+    "Palmgren's approach",
+    "pin modulus",
+    1.9e5,
+    2.2e5,
+    "MPa",
+    "an empirical law of steel line contacts (E about 2.1e5 MPa)",
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (LOAD_PARAMETER, HERTZ_CONFORMING_HALF_ANGLE, PALMGREN_MODULUS)
 
 
 def effective_modulus_similar(E, nu):

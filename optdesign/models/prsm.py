@@ -32,6 +32,12 @@ labelling; the "omega = 0" simplification does, so :meth:`ThreadContact.hertz_al
 offers both the index pairing and the nearest-plane pairing. When the roller thread is
 nearly spherical (arc centred on its axis) its two curvatures are close and its
 principal directions are set by the helix twist, about 45 deg off the axial plane.
+
+Validity
+--------
+flank half-angle beta : 5 ... 80 deg; starts n >= 3
+    The roller's arc profile and the tooth that fits in the roller need them (refused
+    by :class:`PRSMGeometry` otherwise).
 """
 
 from __future__ import annotations
@@ -52,6 +58,26 @@ from optdesign.models.hertz_point import (
     hertz_point_contact_aligned,
 )
 from optdesign.models.thread_surface import flank_builder, thread_flank
+from optdesign.models.validity import Validity
+
+FLANK_HALF_ANGLE = Validity(
+    "prsm.flank_half_angle",
+    "planetary roller screw geometry",
+    "flank half-angle beta",
+    float(np.radians(5.0)),
+    float(np.radians(80.0)),
+    "rad",
+    "the roller's arc profile and a tooth that fits in the roller need 5 < beta < 80 deg",
+    shown_unit="deg",
+    scale=float(180.0 / np.pi),
+    open_lower=True,
+    open_upper=True,
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (FLANK_HALF_ANGLE,)
+
 
 #: Steel (docs/thread_contact.md): E (MPa), Poisson's ratio.
 STEEL_E = 2.06e5

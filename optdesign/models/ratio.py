@@ -3,6 +3,13 @@
 The ratio is motor angle per output angle, i = d(theta_motor)/d(phi). The nut moves
 p/(2 pi) per screw radian and the gear pair divides by i_a, so for a nut velocity
 v = dx/dphi (mm/rad), i = 2 pi i_a v / p.
+
+Validity
+--------
+The exact ratio holds wherever the nut velocity is defined; the papers' finite-step
+ratio lags it by about half a step (documented; a design problem uses the exact one).
+The ratio must stay positive over the stroke (a dead point inside it is refused by the
+row ``ratio_positive``).
 """
 
 from __future__ import annotations
@@ -10,6 +17,21 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from optdesign import math as m
+from optdesign.models.validity import Validity
+
+RATIO = Validity(
+    "ratio.ratio",
+    "reduction ratio",
+    "reduction ratio i",
+    1.0,
+    None,
+    "",
+    "a dead point inside the stroke (i <= 0) is no transmission; a problem keeps i >= 1",
+    checked=("design",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (RATIO,)
 
 
 def ratio_from_nut_velocity(v, p, i_a):

@@ -15,6 +15,13 @@ The extracted text drops "alpha_s" after "tan"; with it, eta = 1 when f_k = f_r 
 
 Units: r_s, r_RP and the rolling-friction coefficient f_r are lengths in mm (the paper
 gives metres: r_s = 0.04 m -> 40 mm, f_r = 1e-5 m -> 0.01 mm); f_k is dimensionless.
+
+Validity
+--------
+contact angle beta : 0 < beta < 90 deg
+    Eq. 10-14 resolve the contact force on a flank inclined by beta; sin(beta) > 0 is
+    needed for the rolling-friction angle (refused by the functions outside (0, pi)).
+    The paper's figures span 30-60 deg.
 """
 
 from __future__ import annotations
@@ -27,6 +34,25 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models import screw
+from optdesign.models.validity import Validity
+
+CONTACT_ANGLE = Validity(
+    "roller_screw.contact_angle",
+    "planetary roller screw efficiency",
+    "contact angle beta",
+    0.0,
+    float(np.pi),
+    "rad",
+    "the rolling-friction angle needs a flank that carries load, sin(beta) > 0",
+    shown_unit="deg",
+    scale=float(180.0 / np.pi),
+    open_lower=True,
+    open_upper=True,
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (CONTACT_ANGLE,)
 
 
 def rolling_friction_angle(f_r, r_RP, beta):

@@ -1,11 +1,55 @@
 """Lead screw relations ([Z00]; docs/screw.md and 8).
 
 lambda: lead angle, tan(lambda) = p / (pi d_m); phi_f: friction angle, tan(phi_f) = mu.
+
+Validity
+--------
+lead angle lambda : 0 < lambda <= 45 deg
+    The square-thread analogy (the nut as a block on an inclined plane of slope lambda
+    with a friction angle phi_f) is written for screws, whose leads are short against
+    the circumference: ball-screw catalogues stop at a lead of about twice the diameter
+    (lambda about 30 deg), and tan(lambda + phi_f) has its pole at 90 deg. Above 45 deg
+    the back-driving efficiency exceeds the forward one: a "screw" that the nut drives
+    better than the motor is a helical cam, which no screw catalogue or friction figure
+    describes.
+friction coefficient mu : 0 <= mu < 1
+    Coulomb friction of lubricated threads and ball tracks (0.002-0.2); 1 would put the
+    friction angle at 45 deg (checked when the problem file is read,
+    ``screw.friction``).
 """
 
 from __future__ import annotations
 
 from optdesign import math as m
+from optdesign.models.validity import Validity
+
+LEAD_ANGLE = Validity(
+    "screw.lead_angle",
+    "screw efficiency",
+    "lead angle",
+    0.0,
+    0.7853981633974483,
+    "rad",
+    "the inclined-plane model of a screw holds for leads short against the circumference "
+    "(lambda <= 45 deg)",
+    shown_unit="deg",
+    scale=57.29577951308232,
+    open_lower=True,
+)
+FRICTION_COEFFICIENT = Validity(
+    "screw.friction",
+    "screw efficiency",
+    "friction coefficient",
+    0.0,
+    1.0,
+    "",
+    "Coulomb friction of lubricated threads and ball tracks lies well below 1",
+    open_upper=True,
+    checked=("file",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (LEAD_ANGLE, FRICTION_COEFFICIENT)
 
 
 def lead_angle(p, d_m):

@@ -9,6 +9,12 @@ with d0 at equal lead, ball and circuits with one exception the CSV marks (R20-2
 printed with a higher Ca than R25-2T4-FSI and a higher rigidity than R20-2T6-FSI).
 
 Units in the records: mm, N, N/mm (the catalogue's N/um x 1000), kg.
+
+Validity
+--------
+items : the rows of the CSV (d0 8-40 mm, leads 2-20 mm)
+    Catalogue data hold for the items printed; a (d0, p) pair the catalogue does not
+    list is no screw (refused by the lookups, and by the problem when read).
 """
 
 from __future__ import annotations
@@ -21,6 +27,22 @@ from dataclasses import dataclass
 from importlib import resources
 
 from optdesign.errors import InputError
+from optdesign.models.validity import Validity
+
+CATALOGUE_ITEMS = Validity(
+    "screw_catalogue.diameter",
+    "ball-screw catalogue",
+    "nominal diameter d0",
+    8.0,
+    40.0,
+    "mm",
+    "the catalogue's data hold for the items it prints (d0 8-40 mm, leads 2-20 mm)",
+    checked=("call", "file"),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (CATALOGUE_ITEMS,)
+
 
 #: The catalogue every record comes from.
 CATALOGUE_SOURCE = (

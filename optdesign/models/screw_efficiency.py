@@ -34,6 +34,12 @@ screws that is lam <= phi_f (or phi'); :func:`self_locking_margin` gives phi_f -
 (> 0 self-locks), a smooth constraint.
 
 Units: p, d_m, r_RP, f_r in mm; angles in rad; mu, f_k dimensionless.
+
+Validity
+--------
+The lead angle and the friction coefficient of :mod:`optdesign.models.screw` (the
+inclined-plane model every kind uses; the same records), and for the roller screw the
+contact angle of :mod:`optdesign.models.roller_screw`.
 """
 
 from __future__ import annotations
@@ -46,6 +52,10 @@ from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models import roller_screw, screw
 from optdesign.models._checks import require_nonnegative, require_positive
+
+#: The ranges of validity of this model: the inclined plane's and the roller screw's.
+VALIDITY = (*screw.VALIDITY, *roller_screw.VALIDITY)
+
 
 #: Kinds of screw :func:`screw_efficiency` knows ("trapezoidal" and "acme" are sliding).
 SCREW_KINDS = ("ball", "sliding", "trapezoidal", "acme", "roller")

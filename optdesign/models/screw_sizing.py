@@ -10,6 +10,16 @@ revolutions or hours; mass in kg; inertia in kg*mm^2 (x 1e-3 gives N*mm*s^2, the
 that pairs with N*mm torques). Efficiency of the screw:
 :mod:`optdesign.models.screw_efficiency`; catalogue data:
 :mod:`optdesign.models.screw_catalogue`.
+
+Validity
+--------
+buckling (Euler) : slenderness 4 la / d1 >= 90, or the yield load governs
+    Euler's load holds for an elastic, slender column; a shorter shaft yields first,
+    and the problem checks the catalogues' yield load P2 beside it (``check_yield``),
+    so the smaller of the two stands. Documented, not checked.
+life : load factor f_w 1 ... 3
+    ISO 3408-5's L10 life with the makers' load factors (1-1.2 smooth, 1.2-1.5 normal,
+    1.5-3 with impact); checked when the file is read (``requirements.f_w``).
 """
 
 from __future__ import annotations
@@ -20,6 +30,32 @@ from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models._checks import require_positive
 from optdesign.models.screw import series_stiffness
+from optdesign.models.validity import Validity
+
+BUCKLING_SLENDERNESS = Validity(
+    "screw_sizing.buckling_slenderness",
+    "Euler buckling of the screw shaft",
+    "slenderness 4 la / d1",
+    90.0,
+    None,
+    "",
+    "Euler's load is elastic; shorter shafts yield first, which the yield load P2 covers",
+    checked=("documented",),
+)
+LOAD_FACTOR = Validity(
+    "screw_sizing.load_factor",
+    "rated life (ISO 3408-5)",
+    "load factor f_w",
+    1.0,
+    3.0,
+    "",
+    "the makers' load factors run from 1 (smooth running) to 3 (heavy impact)",
+    checked=("file",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (BUCKLING_SLENDERNESS, LOAD_FACTOR)
+
 
 #: Young's modulus of screw steel used by the catalogues (MPa).
 E_STEEL = 2.06e5

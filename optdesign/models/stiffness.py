@@ -26,6 +26,15 @@ the rod with its pins with r = d|BC|/dphi (:mod:`optdesign.models.crank_slider`)
 fork the nut rate is R / cos^2(phi). tests/test_stiffness.py checks the formula against
 the equilibrium of the crank-slider with springs, solved without it.
 
+Validity
+--------
+stiffness of a member (nut, bearings) : 1 ... 1e9 N/mm
+    A member of the chain is a steel part or a preloaded rolling contact: preloaded
+    nuts and angular-contact bearing pairs are 1e5-2e6 N/mm (100-2000 N/um); below
+    1 N/mm a part is a soft spring, and 1e9 N/mm is stiffer than a steel cylinder 100 mm
+    across and 10 mm long (E A / L = 1.6e8 N/mm). The reflection to the output itself is
+    exact (linear elasticity, small deflections).
+
 Units: mm, N, MPa, N*mm/rad.
 """
 
@@ -37,6 +46,22 @@ from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models._checks import require_positive
 from optdesign.models.screw_sizing import E_STEEL
+from optdesign.models.validity import Validity
+
+MEMBER_STIFFNESS = Validity(
+    "stiffness.member",
+    "stiffness chain",
+    "axial stiffness of a member",
+    1.0,
+    1.0e9,
+    "N/mm",
+    "the parts of a screw drive are 1e5-2e6 N/mm; 1e9 N/mm is stiffer than any steel part "
+    "of its size",
+    checked=("file",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (MEMBER_STIFFNESS,)
 
 #: Poisson's ratio of steel assumed for the shear modulus.
 NU_STEEL = 0.3

@@ -15,8 +15,9 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
   catalogue screw whose ``d0`` or ``p`` is missing, continuous, or whose declared values
   (fixed, or the bounds of ``catalogue = ...``) hold no pair of the catalogue;
 - ``screw.nut_offset`` not shorter than ``screw.length`` (the nut outside the shaft);
-- a ``[reference]`` value of a positive variable (a length, a lead) that is not positive,
-  or a ``[tolerances]`` band that can take one below zero;
+- a ``[reference]`` value of a positive variable (a length, a lead) that is not positive
+  or outside the range of validity of the models it feeds (the pin's), or a
+  ``[tolerances]`` band that can take one below zero;
 - a pin fit the chosen ISO 286 values cannot evaluate (``fit_values``), at a pin diameter
   outside the tables, or whose clearance is negative (an interference: a pin joint needs a
   clearance, and the backlash model would subtract it);
@@ -103,6 +104,9 @@ def _reference(problem: Any) -> None:
         if info is not None and info.positive and not value > 0:
             unit = UNITS[info.dimension]
             raise ProblemError(f"reference.{name}: must be positive, got {value:g} {unit}".rstrip())
+        valid = getattr(info, "valid", None)  # the models' range (a pin of 5 km is none)
+        if valid is not None and not valid.contains(value):
+            raise ProblemError(f"reference.{name}: {valid.refusal(value)}")
 
 
 def _tolerances(problem: Any) -> None:

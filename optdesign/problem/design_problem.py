@@ -479,8 +479,7 @@ class DesignProblem:
             constraints: dict[str, BlockValues] = {}
             worst = np.zeros(pop)
             for block in ex.constraints:
-                e = np.asarray(block.expr, dtype=float)
-                e = e.reshape(pop, -1) if e.size % pop == 0 and e.ndim > 0 else np.full((pop, 1), e)
+                e = population_rows(np.asarray(block.expr, dtype=float), pop)
                 viol = relative_violation(e, block.lower, block.upper)
                 worst = np.maximum(worst, np.nan_to_num(viol.max(axis=-1), nan=np.inf))
                 constraints[block.name] = BlockValues(e, block.lower, block.upper)
@@ -534,6 +533,19 @@ def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
     if term.kind == "max":
         return e.max(axis=-1)
     return e[:, 0]
+
+
+def population_rows(e: np.ndarray, pop: int) -> np.ndarray:
+    """A constraint block's values as one row per design of a population of ``pop``: a
+    block that does not depend on the design (a grid row, one row, or one number) is
+    the same row for every design."""
+    if e.ndim == 0:
+        return np.full((pop, 1), float(e))
+    if e.ndim == 2 and e.shape[0] == 1 and pop > 1:
+        return np.broadcast_to(e, (pop, e.shape[1]))
+    if e.size % pop == 0:
+        return e.reshape(pop, -1)
+    return np.broadcast_to(e.reshape(1, -1), (pop, e.size))
 
 
 def relative_violation(values, lower, upper):

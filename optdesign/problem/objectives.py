@@ -7,6 +7,7 @@ formulation, check, report and plot reads names and units from these records.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -17,6 +18,25 @@ from optdesign.errors import InputError
 #: ``spread``: (max - min)/(max + min) over the grid (the ratio ripple);
 #: ``max``: the largest value over the grid; ``scalar``: one value per design.
 KINDS = ("spread", "max", "scalar")
+
+
+def _is_range(valid: Any) -> bool:
+    """``valid`` is ``(lower, upper)``: finite numbers or None, lower <= upper."""
+    if not (isinstance(valid, tuple) and len(valid) == 2):
+        return False
+    bounds = [b for b in valid if b is not None]
+    if not all(
+        isinstance(b, int | float) and not isinstance(b, bool) and math.isfinite(b) for b in bounds
+    ):
+        return False
+    return len(bounds) < 2 or bounds[0] <= bounds[1]
+
+
+#: The range of a value that cannot be negative (a length, a clearance, a force ...).
+NON_NEGATIVE: tuple[float | None, float | None] = (0.0, None)
+
+#: The range of a fraction (a ripple: a spread of positive values; a loss of power).
+FRACTION: tuple[float | None, float | None] = (0.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -38,6 +58,13 @@ class ObjectiveInfo:
         What it is and how it is computed, for reports and docs.
     display_unit, display_scale
         How users read it: value * display_scale in display_unit (e.g. ripple in %).
+    valid
+        The physical range of the value, ``(lower, upper)`` in ``unit`` (None: no bound on
+        that side): a ripple lies in [0, 1] (a spread of positive ratios), a backlash, a
+        size, a torque cannot be negative. A value outside it is no result, whatever a
+        solver reports (an epigraph variable or an iterate where the mechanism does not
+        assemble gives one): :meth:`range_problem` says why. None (the default, and a
+        user's objective) declares no range: the value must only be finite.
     """
 
     name: str
@@ -48,16 +75,55 @@ class ObjectiveInfo:
     formula: str = ""
     display_unit: str | None = None
     display_scale: float = 1.0
+    valid: tuple[float | None, float | None] | None = None
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise InputError(f"objective {self.name}.kind", f"{self.kind!r} not in {KINDS}")
         if not callable(self.fn):
             raise InputError(f"objective {self.name}.fn", "must be a function of the quantities")
+        if self.valid is not None and not _is_range(self.valid):
+            raise InputError(
+                f"objective {self.name}.valid",
+                f"expected (lower, upper) of finite numbers or None; got {self.valid!r}",
+            )
 
     @property
     def shown_unit(self) -> str:
         return self.unit if self.display_unit is None else self.display_unit
+
+    def range_problem(self, value: Any) -> str:
+        """Why ``value`` cannot be this objective's value, or ``""``: a value that is not
+        a finite number (NaN, inf), or one outside :attr:`valid` (shown in the display
+        unit, e.g. ``ripple -21 % is below its physical range [0, 100] %``)."""
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            return f"{self.name} is not a number ({value!r:.40})"
+        if not math.isfinite(v):
+            return f"{self.name} is {v!r}, not a finite number"
+        if self.valid is None:
+            return ""
+        lo, hi = self.valid
+        below, above = lo is not None and v < lo, hi is not None and v > hi
+        if not (below or above):
+            return ""
+        s, unit = self.display_scale, self.shown_unit
+        shown = "".join(
+            [
+                "[",
+                "-inf" if lo is None else f"{lo * s:g}",
+                ", ",
+                "inf" if hi is None else f"{hi * s:g}",
+                "]",
+                f" {unit}" if unit else "",
+            ]
+        )
+        where = "below" if below else "above"
+        return (
+            f"{self.name} {v * s:.6g}{' ' + unit if unit else ''} is {where} its physical "
+            f"range {shown}"
+        )
 
 
 @dataclass(frozen=True)
@@ -160,7 +226,10 @@ def _backlash_rss(q):
     return None if q.pin is None else q.backlash.rss
 
 
-#: The built-in objectives, declared once.
+#: The built-in objectives, declared once, each with its physical range (``valid``): every
+#: design that meets the requirements has a ratio >= 1 (``ratio_positive``), so its ripple
+#: is a fraction, its nut travel and motor torque are positive; clearances, sizes, masses,
+#: compliances and forces are never negative; the drive's loss is a fraction of its power.
 BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
     o.name: o
     for o in (
@@ -173,6 +242,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "(i_max - i_min)/(i_max + i_min) of the ratio over the stroke",
             display_unit="%",
             display_scale=100.0,
+            valid=FRACTION,
         ),
         ObjectiveInfo(
             "backlash",
@@ -181,6 +251,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "deg",
             "worst-case output backlash",
             "max over the stroke of the sum of each joint's clearance times its sensitivity",
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "backlash_rss",
@@ -189,6 +260,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "deg",
             "RSS output backlash",
             "max over the stroke of the root-sum-square of the joints' contributions",
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "size",
@@ -197,6 +269,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "mm",
             "size of the mechanism",
             "the mechanism's size measure (crank-slider R + l, fork R, ...)",
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "nut_travel",
@@ -205,6 +278,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "mm",
             "nut travel",
             "x(phi_max) - x(phi_min)",
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "motor_torque",
@@ -215,6 +289,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "max of F_nut p / (2 pi i_a eta_screw eta_gear)",
             display_unit="N*m",
             display_scale=1e-3,
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "drive_loss",
@@ -225,6 +300,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "1 - forward efficiency of screw x gear",
             display_unit="%",
             display_scale=100.0,
+            valid=FRACTION,
         ),
         ObjectiveInfo(
             "screw_mass",
@@ -233,6 +309,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "kg",
             "mass of the screw shaft",
             "solid steel shaft of d0 over the support length",
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "motor_inertia",
@@ -243,6 +320,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "J_screw / i_a^2, J_screw of a solid steel shaft of d0 over the support length",
             display_unit="kg*cm^2",
             display_scale=1e-2,
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "hinge_compliance",
@@ -253,6 +331,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "sum over the chain of (sensitivity^2 / member stiffness)",
             display_unit="urad/(N*m)",
             display_scale=1e9,
+            valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(
             "lock_force",
@@ -261,6 +340,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "N",
             "magnet force of the motor-shaft lock",
             "lock force holding the hinge moment reflected to the motor shaft",
+            valid=NON_NEGATIVE,
         ),
     )
 }

@@ -42,6 +42,9 @@ class SolveRequest:
         start).
     time_limit
         Wall-clock seconds of the NLP multistart (None: no limit).
+    target_odds
+        NLP global search: also go on until the estimated probability that a better
+        local optimum exists is below this (None: the stopping rule's own threshold).
     ranges, diagnose, sensitivities
         Also the ranges of the optimal set, the diagnosis of a result with no feasible
         design, what each requirement costs at the optimum.
@@ -58,6 +61,7 @@ class SolveRequest:
     options: Mapping[str, Any] | None = None
     agree: int | None = None
     time_limit: float | None = None
+    target_odds: float | None = None
     ranges: bool = True
     diagnose: bool = True
     sensitivities: bool = True

@@ -63,6 +63,7 @@ from optdesign.problem.spec_types import (  # noqa: F401 - the names of optdesig
     Stiffness,
     Time,
     _Model,
+    in_range,
 )
 
 
@@ -84,9 +85,12 @@ class SolverOptions(_Model):
     """Defaults of ``optdesign solve`` for this problem (the CLI may override them)."""
 
     # the caps of the API's and the command line's arguments (optdesign.validation)
-    starts: int = Field(8, ge=1, le=MAX_STARTS)
+    #: The most starts of the global search (None: chosen from the number of free
+    #: variables, :func:`optdesign.search.global_phase.default_max_starts`).
+    starts: int | None = Field(None, ge=1, le=MAX_STARTS)
     seed: int = Field(0, ge=0, le=MAX_SEED)
-    #: The multistart stops once this many starts agree on the best value (0: run all).
+    #: The global search stops when the odds of a better optimum say so and at least this
+    #: many starts reached the best value (0: the odds never stop it, every start runs).
     agree: int = Field(3, ge=0, le=MAX_STARTS)
     ipopt: dict[str, Any] = Field(default_factory=dict)
 
@@ -224,6 +228,17 @@ def _in_range(valid: tuple[float, float], dimension: str):
     return check
 
 
+def _clearance_type(dimension: str) -> Any:
+    """The type of a fixed clearance of ``dimension``: a quantity held to the clearance
+    chain's range of validity (a play of micrometres, not a metre; an angle within the
+    small-angle limit), :mod:`optdesign.models.clearance`."""
+    from optdesign.models.clearance import FIXED_CLEARANCE_ANGLE, FIXED_CLEARANCE_LENGTH
+
+    record = {"length": FIXED_CLEARANCE_LENGTH, "angle": FIXED_CLEARANCE_ANGLE}.get(dimension)
+    typ = QUANTITY_TYPES[dimension]
+    return typ if record is None else Annotated[typ, AfterValidator(in_range(record))]
+
+
 @cache
 def spec_model(mechanism_cls: type) -> type[ProblemSpec]:
     """The problem-file model of one mechanism class (cached per class).
@@ -238,7 +253,7 @@ def spec_model(mechanism_cls: type) -> type[ProblemSpec]:
     req_fields = {k: _requirement_field(v) for k, v in mechanism_cls.requirements.items()}
     Req = create_model(f"{name}Requirements", __base__=Requirements, **req_fields)
     cl_fields: dict[str, Any] = {
-        key: (QUANTITY_TYPES[dim], Field(0.0, ge=0.0, description=desc))
+        key: (_clearance_type(dim), Field(0.0, ge=0.0, description=desc))
         for key, (dim, desc) in mechanism_cls.fixed_clearances.items()
     }
     Cl = create_model(f"{name}Clearances", __base__=_Model, **cl_fields)

@@ -10,6 +10,10 @@ from pydantic import (
     model_validator,
 )
 
+from optdesign.models.lock import LOCK_FRICTION
+from optdesign.models.lug_flexibility import LUG_THICKNESS
+from optdesign.models.stiffness import MEMBER_STIFFNESS
+from optdesign.models.validity import ELASTIC_MODULUS
 from optdesign.problem.spec_types import (
     Angle,
     Dimensionless,
@@ -20,11 +24,13 @@ from optdesign.problem.spec_types import (
     Stiffness,
     _Model,
     _shown,
+    within,
 )
 
 
 class Material(_Model):
-    """Elastic constants of a pin material."""
+    """Elastic constants of a pin material (E within linear elasticity's range,
+    :data:`~optdesign.models.validity.ELASTIC_MODULUS`)."""
 
     E: Pressure = 2.1e5
     nu: Dimensionless = 0.3
@@ -33,6 +39,7 @@ class Material(_Model):
     def _physical(self):
         if self.E <= 0:
             raise ValueError(f"E must be positive, got {self.E}")
+        within(ELASTIC_MODULUS, self.E, "E")
         if not 0.0 < self.nu < 0.5:
             raise ValueError(f"nu must lie in (0, 0.5), got {self.nu}")
         return self
@@ -41,7 +48,10 @@ class Material(_Model):
 class Lug(_Model):
     """The lug (or clevis) around the sized pin, for ``pin_contact = "huth"`` (Huth's
     flexibility, :mod:`optdesign.models.lug_flexibility`). Single or double shear is the
-    problem's ``pin_shear_planes`` (the mechanism's default unless the file sets it)."""
+    problem's ``pin_shear_planes`` (the mechanism's default unless the file sets it).
+    Thicknesses and moduli within the model's ranges of validity
+    (:data:`~optdesign.models.lug_flexibility.LUG_THICKNESS`,
+    :data:`~optdesign.models.validity.ELASTIC_MODULUS`)."""
 
     cheek_thickness: Length
     thickness: Length | None = None
@@ -56,6 +66,8 @@ class Lug(_Model):
             if value is not None and not value > 0:
                 unit = "mm" if name.endswith("thickness") else "MPa"
                 raise ValueError(f"{name}: must be positive, got {value:g} {unit}")
+            record = LUG_THICKNESS if name.endswith("thickness") else ELASTIC_MODULUS
+            within(record, value, name)
         return self
 
 
@@ -142,6 +154,8 @@ class Screw(_Model):
             value = getattr(self, name)
             if value is not None and not value > 0:
                 raise ValueError(f"{name} must be positive, got {value:g}")
+            if name.endswith("stiffness"):
+                within(MEMBER_STIFFNESS, value, name)
         if self.nut is not None and self.catalogue is None:
             raise ValueError("nut selects a catalogue nut type: give catalogue too")
         return self
@@ -170,7 +184,7 @@ class MotorLock(_Model):
     radius: Length | None = None
     r1: Length | None = None
     r2: Length | None = None
-    mu: Dimensionless = Field(0.3, gt=0.0)
+    mu: Dimensionless = Field(0.3, gt=0.0)  # and at most 1 (LOCK_FRICTION, below)
     eta_screw_back: Dimensionless = Field(1.0, gt=0.0, le=1.0)
     eta_gear_back: Dimensionless = Field(1.0, gt=0.0, le=1.0)
     force_max: Force | None = None
@@ -186,4 +200,5 @@ class MotorLock(_Model):
             raise ValueError(f"a {self.kind} lock needs a positive radius")
         if self.force_max is not None and not self.force_max > 0:
             raise ValueError(f"force_max: must be positive, got {self.force_max:g} N")
+        within(LOCK_FRICTION, self.mu, "mu")
         return self

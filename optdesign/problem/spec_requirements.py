@@ -14,6 +14,7 @@ from pydantic import (
 )
 
 from optdesign.errors import InputError
+from optdesign.models.clearance import BACKLASH
 from optdesign.models.fit_formulas import Fit
 from optdesign.problem.spec_drive import (
     DutyStep,
@@ -34,6 +35,7 @@ from optdesign.problem.spec_types import (
     Time,
     _Model,
     _shown,
+    within,
 )
 
 
@@ -83,6 +85,8 @@ class Requirements(_Model):
             value = getattr(self, name)
             if isinstance(value, int | float) and not value > 0:
                 raise ValueError(f"{name}: must be positive, got {_shown(name, value)}")
+        if self.backlash_max is not None:  # the backlash model's range (small angles)
+            within(BACKLASH, math.degrees(self.backlash_max), "backlash_max")
         span = self.deflection.max - self.deflection.min
         if span > 2 * math.pi + 1e-12:
             raise ValueError(

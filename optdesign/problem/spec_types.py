@@ -20,6 +20,7 @@ from pydantic import (
 )
 
 from optdesign.errors import InputError
+from optdesign.models.validity import Validity
 from optdesign.units import to_internal
 
 
@@ -154,6 +155,25 @@ POSITIVE_REQUIREMENTS: dict[str, tuple[str, float]] = {
     "stiffness_min": ("N*m/rad", 1e-3),
     "dn_max": ("mm/min", 1.0),
 }
+
+
+def within(record: Validity, value: Any, name: str = "") -> None:
+    """Raise ValueError unless ``value`` (internal units) lies in the model's range of
+    validity ``record``: ``"name: 1e-09 mm is outside [0.001 mm, 1000 mm] (Huth's lug
+    flexibility: ...)"`` (``name`` empty: a field's own validator, which pydantic names)."""
+    if value is not None and not record.contains(value):
+        raise ValueError(f"{name}: {record.refusal(value)}" if name else record.refusal(value))
+
+
+def in_range(record: Validity):
+    """A field's validator (``Annotated[Length, AfterValidator(in_range(record))]``) that
+    holds its value to the model's range of validity ``record`` (:func:`within`)."""
+
+    def check(value: Any) -> Any:
+        within(record, value)
+        return value
+
+    return check
 
 
 def _shown(name: str, value: float) -> str:

@@ -16,13 +16,17 @@ from typing import Any
 
 from optdesign.errors import InputError, ProblemError
 from optdesign.mechanisms.base import VariableInfo
+from optdesign.models.loads import PIN_DIAMETER, PIN_LENGTH, PIN_SLENDERNESS
 from optdesign.units import Bare, to_internal
 
-#: Variables of the sized pin joints and of the screw's size, the same for every mechanism.
+#: Variables of the sized pin joints and of the screw's size, the same for every mechanism;
+#: the pin's carry the pin model's ranges of validity (:mod:`optdesign.models.loads`).
 PIN_VARIABLES: dict[str, VariableInfo] = {
-    "d": VariableInfo("length", "pin diameter"),
-    "pin_length": VariableInfo("length", "pin length L"),
-    "pin_length_ratio": VariableInfo("dimensionless", "pin length ratio L/d"),
+    "d": VariableInfo("length", "pin diameter", valid=PIN_DIAMETER),
+    "pin_length": VariableInfo("length", "pin length L", valid=PIN_LENGTH),
+    "pin_length_ratio": VariableInfo(
+        "dimensionless", "pin length ratio L/d", valid=PIN_SLENDERNESS
+    ),
     "d0": VariableInfo("length", "screw nominal (mean) diameter"),
 }
 
@@ -133,6 +137,9 @@ def parse_variable(
     def positive(value: float, where: str) -> None:
         if info.positive and not value > 0:
             raise ProblemError(f"{where}: must be positive, got {value:g} {unit}".rstrip())
+        valid = getattr(info, "valid", None)
+        if valid is not None and not valid.contains(value):
+            raise ProblemError(f"{where}: {valid.refusal(value)}")
 
     if not isinstance(raw, dict):
         value = q(raw, "")
@@ -184,6 +191,7 @@ def parse_variable(
             f"{field}: lower bound {lower:g} {unit} is above upper bound {upper:g} {unit}"
         )
     positive(lower, f"{field}.lower")
+    positive(upper, f"{field}.upper")  # its range (positive: it is above the lower bound)
     start = q(raw["start"], "start") if "start" in raw else None
     if start is not None and not lower <= start <= upper:
         raise ProblemError(f"{field}.start: {start:g} lies outside [{lower:g}, {upper:g}]")

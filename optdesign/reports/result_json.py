@@ -48,6 +48,7 @@ def result_document(result: Result) -> dict[str, Any]:
         "termination": result.termination.value,
         "message": result.message,
         "verified": result.verified,
+        "validity": validity_document(result),
         "wall_time": {"value": result.wall_time_s, "unit": "s"},
     }
     name = result.objective_name
@@ -126,6 +127,40 @@ def result_document(result: Result) -> dict[str, Any]:
         doc["multistart"] = asdict(result.multistart)
     doc["notes"] = list(result.notes)
     return clean_json(doc)
+
+
+def validity_document(result: Result) -> dict[str, Any]:
+    """Whether the design lies where its models hold: ``{"within": true | false | null,
+    "outside": [...]}``, one entry per quantity outside its model's range of validity
+    (model, quantity, worst value, range, angle) - such a design is never verified
+    (``within`` null: nothing was checked, no design)."""
+    from optdesign.models.validity_registry import declared_ranges
+    from optdesign.studies.verify import is_validity
+
+    records = declared_ranges().values()
+    outside = []
+    for r in result.violated:
+        if not is_validity(r):
+            continue
+        base, _, where = r.name.removeprefix("validity: ").partition("[")
+        model, _, quantity = base.partition(": ")
+        record = next(
+            (v for v in records if v.model == model and quantity.startswith(v.quantity)), None
+        )
+        outside.append(
+            {
+                "name": r.name.split("[", 1)[0],
+                "model": model,
+                "quantity": quantity,
+                "value": {"value": r.value, "unit": r.unit},
+                "lower": None if r.lower is None else {"value": r.lower, "unit": r.unit},
+                "upper": None if r.upper is None else {"value": r.upper, "unit": r.unit},
+                "at": where.rstrip("]"),
+                "why": "" if record is None else record.why,
+            }
+        )
+    within = None if result.verified is None else not outside
+    return {"within": within, "outside": outside}
 
 
 def _design(problem: Any, result: Result) -> dict[str, Any]:

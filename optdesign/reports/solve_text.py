@@ -26,6 +26,7 @@ from optdesign.reports.limits import (
 from optdesign.reports.tables import format_table
 from optdesign.solvers.result import Result
 from optdesign.text import printable
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 def objective_unit(problem, name: str) -> tuple[str, float]:
@@ -42,26 +43,74 @@ def objective_value(result: Result) -> float:
     return float(phys) if phys is not None and math.isfinite(phys) else result.objective
 
 
+def feasibility_text(result: Result) -> str:
+    """What the independent check of the design found, in words: ``"verified by the
+    NumPy model (every requirement within 1e-06 relative; every model within its range
+    of validity)"``, ``"NOT verified: ..."`` - naming each model used outside its range
+    (``"small-angle clearance: worst-case backlash 1.29e+07 deg > 5 deg at
+    phi=+30.0deg"``), whose design is no answer whatever its requirements."""
+    from optdesign.studies.verify import is_validity
+
+    if result.verified is None:
+        return "not checked (no design)"
+    if result.verified:
+        return (
+            f"verified by the NumPy model (every requirement within {FEASIBILITY_TOL:g} "
+            "relative; every model within its range of validity)"
+        )
+    outside = [r for r in result.violated if is_validity(r)]
+    rows = "the NumPy model finds the requirements below violated"
+    if not outside:
+        return f"NOT verified: {rows}"
+
+    def said(r) -> str:
+        base, _, where = r.name.removeprefix("validity: ").partition("[")
+        unit = f" {r.unit}" if r.unit else ""
+        if math.isnan(r.value):
+            value = "is not a number"
+        elif r.upper is not None and r.value > r.upper:
+            value = f"{r.value:.3g}{unit} > {r.upper:.3g}{unit}"
+        elif r.lower is not None and r.value < r.lower:
+            value = f"{r.value:.3g}{unit} < {r.lower:.3g}{unit}"
+        else:
+            value = f"{r.value:.3g}{unit}"
+        return f"{base} {value}" + (f" at {where.rstrip(']')}" if where else "")
+
+    shown = "; ".join(said(r) for r in outside[:3])
+    if len(outside) > 3:
+        shown += f"; and {len(outside) - 3} more"
+    text = f"NOT verified: the design lies outside the range where its models hold ({shown})"
+    if len(outside) < len(result.violated):
+        text += f"; and {rows}"
+    return printable(text)
+
+
 def result_summary(result: Result) -> str:
     """Readable summary: status, objective, requirements, design, limits, diagnosis."""
     problem = result.problem_object
     label = problem.mechanism.label() if problem is not None else result.mechanism
     lines = [f"problem   {printable(result.problem)} ({printable(label)})"]
-    check = {True: "passed", False: "FAILED", None: "n/a"}[result.verified]
     lines.append(
         f"status    {result.status} (solver {result.solver}, {result.formulation}, "
-        f"{result.message or result.termination.value}); independent check: {check}"
+        f"{result.message or result.termination.value})"
     )
+    lines.append(f"feasible  {feasibility_text(result)}")
+    if result.globality is not None and result.success:
+        lines.append(f"global    {printable(result.globality.text())}")
     name = result.objective_name
     value = objective_shown(problem, name, objective_value(result)).text(8)
-    where = "" if result.success else " at the best point found (requirements not met)"
+    where = ""
+    if not result.success:
+        met = "feasible; the solver did not converge" if result.verified else "requirements not met"
+        where = f" at the best point found ({met})"
     lines.append(f"objective {printable(name)} = {value}{where}")
     lines.append(f"time      {result.wall_time_s:.3f} s")
     if result.multistart:
         ms = result.multistart
+        stop = f"; stopped: {ms.stop}" if ms.stop else ""
         lines.append(
-            f"multistart {ms.n_at_best} of {ms.n_starts} starts reached the best point "
-            f"(within {ms.tolerance:g} relative; {ms.n_converged} converged; seed {ms.seed})"
+            f"starts    {ms.n_starts} run, {ms.n_converged} converged, {ms.n_at_best} at the "
+            f"best value (within {ms.tolerance:g} relative; seed {ms.seed}{stop})"
         )
         if ms.failed:  # the starts that cost time and gave nothing: how many and why
             lines.append(f"          {ms.failure_text()}")
@@ -115,6 +164,8 @@ def result_summary(result: Result) -> str:
     if not result.success:
         if result.formulation == "fixed":
             end = "the fixed design does not meet the requirements above"
+        elif result.verified:  # feasible, checked: only the optimality is missing
+            end = f"a feasible design, but no optimum: the solver stopped ({result.status})"
         else:
             end = "no feasible design found"
             if result.status != "infeasible":  # not proven: the solver stopped

@@ -26,7 +26,8 @@ def sweep_columns(sweep: Any) -> list[tuple[str, str, Any]]:
         ("status", "", lambda p: p.status),
         ("binding", "", lambda p: ";".join(p.active)),
         ("active_change", "", lambda p: p.active_change),
-        ("multistart_check", "", lambda p: p.checked),
+        ("global_search", "", lambda p: p.checked),
+        ("found_by", "", lambda p: p.found_by),
         ("jump", "", lambda p: p.jump),
         ("what_fails", "", lambda p: "; ".join(p.violated)),
     ]
@@ -72,7 +73,8 @@ def _num(v: Any) -> Any:
 
 def sweep_summary(sweep: Any) -> str:
     """The summary: what was swept, the table, the points where the binding set changes,
-    the jumps the multistart checks found, and the infeasible points with what fails."""
+    the jumps (points a warm start from the point before would have left on a worse
+    branch), and the infeasible points with what fails."""
     problem = sweep.problem
     n = len(sweep.points)
     solved = [p for p in sweep.points if p.success]
@@ -80,17 +82,21 @@ def sweep_summary(sweep: Any) -> str:
         f"{a.label} {a.shown[0]:.6g}..{a.shown[-1]:.6g} ({len(a.values)} points)"
         for a in sweep.axes
     )
-    how = "continuation (warm starts from the neighbour)" if sweep.continuation else "each solved"
-    checked = sum(p.checked for p in sweep.points)
+    how = (
+        "each point's own global search, then warm starts from its neighbours until none improves"
+        if sweep.continuation
+        else "each solved by its formulation"
+    )
     lines = [
         f"problem   {printable(problem.name)}",
         f"sweep     {printable(what)}; minimise {printable(sweep.objective)}",
-        f"points    {len(solved)} of {n} solved; {how}; {checked} checked by a full multistart",
+        f"points    {len(solved)} of {n} solved; {how}",
         f"time      {sweep.wall_time_s:.3f} s",
     ]
     lines += [f"note      {printable(n)}" for n in sweep.notes]
     headers, rows = sweep_rows(sweep)
-    keep = [i for i, h in enumerate(headers) if h not in ("what_fails", "active_change", "jump")]
+    hidden = ("what_fails", "active_change", "jump", "found_by", "global_search")
+    keep = [i for i, h in enumerate(headers) if h not in hidden]
     from optdesign.reports.tables import format_table
 
     # an infeasible point's numbers are of the best design found, not an optimum: "-"
@@ -106,8 +112,11 @@ def sweep_summary(sweep: Any) -> str:
         lines += [f"  point {p.index}: {printable(';'.join(p.active))}" for p in changes]
     jumps = [p for p in sweep.points if p.jump]
     if jumps:
-        lines += ["", "the multistart check found a better optimum than the warm start (a jump):"]
-        lines += [f"  point {p.index}" for p in jumps]
+        lines += [
+            "",
+            "jumps (a warm start from the point before would have stayed on a worse branch):",
+        ]
+        lines += [f"  point {p.index}: found {printable(p.found_by)}" for p in jumps]
     bad = [p for p in sweep.points if not p.success]
     if bad:
         lines += ["", "infeasible points (what fails at the best design found):"]
@@ -119,7 +128,7 @@ def sweep_summary(sweep: Any) -> str:
 
 
 #: Columns shown for an infeasible point too.
-_ALWAYS = ("status", "multistart_check")
+_ALWAYS = ("status",)
 
 
 def _cell(v: Any) -> str:

@@ -44,16 +44,17 @@ def best_of(results: Sequence[Result], rel_tol: float = OBJECTIVE_TIE_TOL) -> tu
         # No feasible start: report the least violated one.
         viol = [r.max_violation if math.isfinite(r.max_violation) else math.inf for r in results]
         least = min(viol)
-        first = next(k for k, v in enumerate(viol) if v <= least + _tolerance(least, rel_tol))
+        first = next(k for k, v in enumerate(viol) if v <= least + tie_width(least, rel_tol))
         return results[first], 0
     least = min(r.objective for r in ok)
-    tol = _tolerance(least, rel_tol)
+    tol = tie_width(least, rel_tol)
     at_best = [r for r in ok if r.objective <= least + tol]
     return at_best[0], len(at_best)
 
 
-def _tolerance(value: float, rel_tol: float) -> float:
-    # the absolute width of a tie at ``value`` (values near 0 tie within rel_tol * 1e-12)
+def tie_width(value: float, rel_tol: float = OBJECTIVE_TIE_TOL) -> float:
+    """The absolute width of a tie at ``value``: ``rel_tol`` relative to the larger of
+    |value| and 1e-12 (0 for a value that is not finite)."""
     return rel_tol * max(abs(value), 1e-12) if math.isfinite(value) else 0.0
 
 
@@ -76,6 +77,10 @@ def start_outcome(result: Result) -> str:
     term = result.termination
     if "Restoration_Failed" in message:
         return "restoration failed"
+    if "(bound not tight" in message:
+        return "bound not tight"
+    if "(independent check failed)" in message:
+        return "independent check failed"
     if term == TerminationCondition.MAX_ITERATIONS:
         return "iteration limit"
     if term == TerminationCondition.MAX_TIME:
@@ -103,7 +108,7 @@ def outcome_counts(outcomes: Sequence[str]) -> dict[str, int]:
 def improves(value: float, best: float, rel_tol: float = OBJECTIVE_TIE_TOL) -> bool:
     """Whether ``value`` is better than ``best`` by more than a tie (``rel_tol``
     relative): a search keeps its earlier incumbent on a tie, as :func:`best_of` does."""
-    return value < best - _tolerance(best, rel_tol)
+    return value < best - tie_width(best, rel_tol)
 
 
 def multistart(

@@ -69,9 +69,103 @@ class ConstraintReport:
         return text
 
 
+def percent(p: float) -> str:
+    """A probability as summaries write it: ``"0.4 %"``, ``"< 0.1 %"``, ``"12 %"``."""
+    if p < 1e-3:
+        return "< 0.1 %"
+    return f"{100 * p:.2g} %" if p < 0.1 else f"{100 * p:.0f} %"
+
+
+@dataclass(frozen=True)
+class Odds:
+    """What the counted starts of a search say about the optima not seen
+    (:func:`optdesign.search.odds.odds`: Boender and Rinnooy Kan's estimates).
+
+    Attributes
+    ----------
+    starts, optima
+        The counted starts (independent draws that converged) and the distinct local
+        optima they reached.
+    expected_optima
+        The posterior mean of the number of local optima (inf: fewer than ``optima + 3``
+        counted starts).
+    p_better
+        The estimated probability that an optimum better than the best seen exists: the
+        expected share of the starts' distribution held by regions not reached yet (1.0
+        while the posterior is improper).
+    p_better_any
+        The cautious figure: the best optimum any of them with equal chance, whatever the
+        size of its region.
+    """
+
+    starts: int
+    optima: int
+    expected_optima: float
+    p_better: float
+    p_better_any: float
+
+    @property
+    def expected_unseen(self) -> float:
+        """The expected number of local optima not seen yet."""
+        return self.expected_optima - self.optima
+
+    def text(self) -> str:
+        """``"3 local optima seen in 24 starts; estimated probability that a better one
+        exists: 2.2 %"``."""
+        s = "" if self.starts == 1 else "s"
+        seen = f"{self.optima} local optim{'um' if self.optima == 1 else 'a'} seen in "
+        seen += f"{self.starts} counted start{s}"
+        if self.optima == 0:
+            return seen
+        if self.p_better >= 1.0:
+            return seen + "; too few starts to estimate the odds of a better one"
+        return seen + f"; estimated probability that a better one exists: {percent(self.p_better)}"
+
+
+@dataclass
+class Globality:
+    """What is known of whether an optimum is the global one, in words that say exactly
+    what was checked.
+
+    Attributes
+    ----------
+    proved
+        True only where a certificate covers the whole problem (a convex program's dual
+        bound).
+    basis
+        What the claim rests on: ``"a geometric program: convex; dual bound within
+        1e-9"``, ``"the global search stopped at its cap of 32 starts"``, ...
+    odds
+        The global search's odds (:class:`Odds`), when a search ran.
+    """
+
+    proved: bool = False
+    basis: str = ""
+    odds: Odds | None = None
+
+    def text(self) -> str:
+        """``"proved (a geometric program: ...)"`` or ``"not proved; 1 local optimum seen
+        in 8 counted starts; estimated probability that a better one exists: 3.6 %"``."""
+        if self.proved:
+            return f"proved ({self.basis})" if self.basis else "proved"
+        parts = ["not proved"]
+        if self.odds is not None:
+            parts.append(self.odds.text())
+        if self.basis:
+            parts.append(self.basis)
+        return "; ".join(parts)
+
+
 @dataclass
 class MultistartInfo:
-    """How a multistart went."""
+    """How a multistart went.
+
+    ``optima`` (the distinct local optima's values, best first), ``counted`` (the starts
+    the odds count: independent draws that converged), ``odds`` and ``stop`` (why the
+    search stopped: ``"odds"``, ``"agree"``, ``"all starts run"``, ``"time limit"``, ``"no
+    feasible start"``) are filled by the global search (:mod:`optdesign.search`); a plain
+    multistart over a given list of starts leaves them empty.
+    """
 
     n_starts: int
     n_converged: int
@@ -88,6 +182,10 @@ class MultistartInfo:
     outcomes: list[str] = field(default_factory=list)
     #: The starts that did not converge, counted by reason (most frequent first).
     failed: dict[str, int] = field(default_factory=dict)
+    optima: list[float] = field(default_factory=list)
+    counted: int = 0
+    odds: Odds | None = None
+    stop: str = ""
 
     def failure_text(self) -> str:
         """``"5 failed: 3 restoration failed, 2 iteration limit"``; "" when none failed."""
@@ -264,6 +362,9 @@ class Result(SolvedPoint):
         bound), for the gap.
     certificate
         A duality certificate of the optimum (GP).
+    globality
+        What is known of whether the optimum is the global one (:class:`Globality`): a
+        proof, or the global search's odds.
     multistart
         How the starts went.
     ranges
@@ -295,6 +396,7 @@ class Result(SolvedPoint):
     max_violation: float = math.nan
     bound: float | None = None
     certificate: Certificate | None = None
+    globality: Globality | None = None
     multistart: MultistartInfo | None = None
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
     diagnosis: Diagnosis | None = None

@@ -34,6 +34,7 @@ from optdesign.interrupts import solver_call
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+from optdesign.tolerances import FEASIBILITY_TOL
 
 
 class _TimeUp(Exception):
@@ -71,12 +72,38 @@ class ScipyNLPSolver:
     ``n_evals`` counts SciPy's requests (``f``, ``grad_f``, ``g``, ``jac_g``, ``hess_f``,
     ``hess_g``, the names the benchmark summary reads) and, with exact derivatives, the
     combined CasADi evaluations (``fgj``).
+
+    The best point of a solve is kept as it goes (the start and every iterate: the
+    feasible one of least objective, else the least violation, rows within
+    :data:`~optdesign.tolerances.FEASIBILITY_TOL`). A solve that does not converge - the
+    time limit, the iteration limit, a SciPy failure - returns that point, never a line
+    search's last trial or an iterate worse than one it passed (SLSQP's last point after
+    "Positive directional derivative for linesearch" may be far outside the feasible
+    set, with an epigraph variable thousands below the objective it bounds).
+
+    SLSQP has no restoration phase: from a start where a user's mechanism does not
+    assemble (its guarded model then gives huge values: a backlash of 1.5e11 deg at the
+    middle of a six-bar's bounds) its linearised rows are incompatible (exit 4), and a
+    quasi-Newton matrix spoilt on the way ends a run at "Positive directional derivative
+    for linesearch" (exit 8), often near a solution. After these exits (and the singular
+    LSQ subproblems, 5 and 6) it starts again with a fresh matrix from the best feasible
+    point (from the run's last point while it has found none: the start was where it
+    failed), its epigraph variables tightened, at most :attr:`RESTARTS` times, never twice
+    from one point; the iteration and time limits count every run.
     """
 
     DEFAULTS: ClassVar[dict[str, dict[str, Any]]] = {
         "SLSQP": {"maxiter": 500, "ftol": 1e-10},
         "trust-constr": {"maxiter": 2000, "gtol": 1e-8, "xtol": 1e-10},
     }
+
+    #: SLSQP's exit statuses after which it starts again from the best point (4 inequality
+    #: constraints incompatible, 5 and 6 singular matrix E or C in the LSQ subproblem, 8
+    #: positive directional derivative for linesearch).
+    RESTART_EXITS: ClassVar[tuple[int, ...]] = (4, 5, 6, 8)
+
+    #: At most this many restarts in one solve.
+    RESTARTS: ClassVar[int] = 3
 
     def __init__(
         self,
@@ -120,7 +147,6 @@ class ScipyNLPSolver:
     # --- counted, time-limited evaluations -------------------------------------------------
     def _tick(self, key: str, z) -> None:
         self.n_evals[key] = self.n_evals.get(key, 0) + 1
-        self._last = np.array(z, dtype=float)
         if time.perf_counter() - self._t0 > self.time_limit:
             raise _TimeUp
 
@@ -173,6 +199,81 @@ class ScipyNLPSolver:
     def _hess_g(self, z, v):
         self._tick("hess_g", z)
         return np.asarray(ca.densify(self.hess_g_fun(z, self._p, v)), dtype=float)
+
+    # --- the best point of a solve -----------------------------------------------------
+    def _rank(self, z: np.ndarray) -> tuple[int, float]:
+        """``(0, f)`` at a point that meets every row (the rows are scaled: within
+        FEASIBILITY_TOL, as :func:`~optdesign.solvers.base.make_result` reads them),
+        else ``(1, largest violation)``; lower is better."""
+        if self.derivatives == "exact":
+            f, _, g, _ = self._cached("fgj", z)
+        else:
+            f, g = float(self.f_fun(z, self._p)), self._cached("g", z)
+        lb, ub = self._lbg, self._ubg
+        with np.errstate(invalid="ignore"):
+            amounts = np.maximum(
+                np.where(np.isfinite(lb), lb - g, 0.0), np.where(np.isfinite(ub), g - ub, 0.0)
+            )
+        viol = float(np.max(amounts, initial=0.0)) if np.isfinite(g).all() else math.inf
+        if viol <= FEASIBILITY_TOL and math.isfinite(f):
+            return 0, float(f)
+        return 1, viol if math.isfinite(viol) else math.inf
+
+    def _track(self, z) -> None:
+        """Keep ``z`` if it is the best point of the solve so far."""
+        z = np.array(z, dtype=float)
+        rank = self._rank(z)
+        if self._best is None or rank < self._best[0]:
+            self._best = (rank, z)
+
+    def _iterate(self, x, *_state) -> None:
+        """SciPy's callback after each iteration: ``(x)`` from SLSQP, ``(x, state)`` from
+        trust-constr (SciPy 1.16's SLSQP knows no ``intermediate_result`` form)."""
+        self._track(x)
+
+    def _tightened(self, z: np.ndarray) -> np.ndarray:
+        """``z`` with its epigraph variables at their tightest values at its design (the
+        maxima and minima they bound), within their bounds: a restart's start."""
+        nlp = self.nlp
+        n = nlp.n_design
+        if nlp.aux_init is None or len(z) == n:
+            return z
+        aux = np.asarray(nlp.aux_init(z[:n], self._theta), dtype=float).ravel()
+        aux = np.where(np.isfinite(aux), aux, z[n:])
+        return np.clip(np.concatenate([z[:n], aux]), self._lbz, self._ubz)
+
+    def _minimize(self, z0: np.ndarray, kwargs: dict[str, Any]) -> tuple[Any, int, str]:
+        """SciPy's run from ``z0``, restarted after the exits of :attr:`RESTART_EXITS`
+        (SLSQP) from the best feasible point, or from the run's last point while none is
+        feasible (a start is never repeated: a run is deterministic); (its result,
+        iterations of all runs, a note on the restarts for the message)."""
+        self._track(z0)
+        res = so.minimize(self._f, z0, **kwargs)
+        iters = int(res.get("nit", 0))
+        if self.method != "SLSQP":
+            return res, iters, ""
+        maxiter = int(kwargs["options"].get("maxiter", 100))
+        first, starts = str(res.message), [z0]
+        while (
+            res.status in self.RESTART_EXITS
+            and len(starts) <= self.RESTARTS
+            and iters < maxiter
+            and self._best is not None
+        ):
+            feasible = self._best[0][0] == 0
+            z = self._best[1] if feasible else np.asarray(res.x, dtype=float)
+            z = self._tightened(z)
+            if any(np.array_equal(z, s) for s in starts):
+                break  # nowhere new to start from
+            starts.append(z)
+            options = {**kwargs["options"], "maxiter": maxiter - iters}
+            res = so.minimize(self._f, z, **{**kwargs, "options": options})
+            iters += int(res.get("nit", 0))
+        note = ""
+        if len(starts) > 1:
+            times = "once" if len(starts) == 2 else f"{len(starts) - 1} times"
+            note = f" (restarted {times} after: {first})"
+        return res, iters, note
 
     @staticmethod
     def _split_rows(lb: np.ndarray, ub: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -235,7 +336,9 @@ class ScipyNLPSolver:
         # Aux variables may have infinite bounds: SciPy takes +-inf in Bounds.
         z0 = np.clip(start.z0, lbz, ubz)
         self.n_evals = {}
-        self._last = z0.copy()
+        self._lbz, self._ubz, self._lbg, self._ubg = lbz, ubz, lb, ub
+        self._theta = nlp.parameter_values(bounds.parameters)
+        self._best: tuple[tuple[int, float], np.ndarray] | None = None
         self._t0 = time.perf_counter()
         exact = self.derivatives == "exact"
         kwargs: dict[str, Any] = {
@@ -243,6 +346,7 @@ class ScipyNLPSolver:
             "bounds": so.Bounds(lbz, ubz),
             "constraints": self._constraints(lb, ub, rows),
             "options": dict(self.options),
+            "callback": self._iterate,
         }
         if self.method == "trust-constr":
             kwargs["jac"] = self._grad if exact else "2-point"
@@ -252,17 +356,17 @@ class ScipyNLPSolver:
         lam_g = np.zeros(len(lb))
         try:
             with solver_call():
-                res = so.minimize(self._f, z0, **kwargs)
-            z, iters, message = (
-                np.asarray(res.x, dtype=float),
-                int(res.get("nit", 0)),
-                str(res.message),
-            )
+                res, iters, note = self._minimize(z0, kwargs)
+            z, message = np.asarray(res.x, dtype=float), str(res.message) + note
             status, term = self._status(res)
-            if self.method == "SLSQP":
+            if status != "optimal" and self._best is not None and self._best[0] < self._rank(z):
+                z = self._best[1]  # not converged: the best point it passed
+            elif self.method == "SLSQP":
                 lam_g = self._lam_g(res, len(lb), rows)
         except _TimeUp:
-            z, iters, message = self._last, None, f"wall-time limit {self.time_limit:g} s reached"
+            # the best point so far, not the last one evaluated (a line search's trial)
+            z = self._best[1] if self._best is not None else z0
+            iters, message = None, f"wall-time limit {self.time_limit:g} s reached"
             status, term = "time_limit", TerminationCondition.MAX_TIME
         except (ValueError, np.linalg.LinAlgError, RuntimeError) as exc:
             wall = time.perf_counter() - self._t0

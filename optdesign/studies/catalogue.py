@@ -47,7 +47,7 @@ from optdesign.solvers.multistart import (
     start_outcome,
 )
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
-from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.solvers.result import Globality, MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
 from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_items, trusted_value
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
@@ -61,6 +61,9 @@ from optdesign.tolerances import OBJECTIVE_TIE_TOL
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
 ENUMERATE_MAX = 16
 
+
+#: Starts per node when neither the caller nor the problem file sets them.
+NODE_STARTS = 4
 
 #: Sobol starts a node tries before it is called infeasible, when its own starts fail.
 RETRY_STARTS = 4
@@ -420,7 +423,11 @@ def solve_catalogue(
         method = "enumerate" if n_comb <= ENUMERATE_MAX else "bnb"
     if method not in ("enumerate", "bnb", "minlp"):
         raise ProblemError(f"catalogue method {method!r}: use auto, enumerate, bnb or minlp")
-    n_starts = starts if starts is not None else min(problem.spec.solver.starts, 4)
+    n_starts = (
+        starts
+        if starts is not None
+        else min(problem.spec.solver.starts or NODE_STARTS, NODE_STARTS)
+    )
     seed = seed if seed is not None else problem.spec.solver.seed
     agree = agree if agree is not None else problem.spec.solver.agree
     ns = NodeSolver(
@@ -571,7 +578,23 @@ def solve_catalogue_formulation(problem: DesignProblem, request: SolveRequest) -
         workers=request.workers,
         agree=request.agree,
     )
+    result.globality = catalogue_globality(result)
     return attach_reference(problem, result)
+
+
+def catalogue_globality(result: Result) -> Globality:
+    """What a catalogue optimum's search covers: every item combination, each by a
+    local multistart of its continuous variables (no proof of those)."""
+    details = result.details.catalogue
+    if details is None:
+        return Globality(basis="no catalogue search")
+    how = {"enumerate": "enumerated", "bnb": "bounded by branch and bound"}.get(
+        details.method, "chosen by a MINLP back-end"
+    )
+    return Globality(
+        basis=f"the {details.combinations} item combinations {how}; the continuous "
+        f"variables of each by a {details.starts_per_node}-start local multistart"
+    )
 
 
 def is_on_catalogue(problem: DesignProblem, design: Mapping[str, float]) -> bool:

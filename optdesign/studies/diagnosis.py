@@ -22,7 +22,9 @@ formulation, and the diagnosis says it in its ``basis``:
 
 A result whose best point violates no requirement (a solver that stopped early, a
 catalogue search that missed every feasible item) gets no relaxation but a note saying
-so: the problem may well be feasible.
+so: the problem may well be feasible. A best point whose models are used outside their
+ranges of validity gets none either: relaxing a requirement cannot bring a model back
+into its range; the note names the models and quantities, and the inputs to check.
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Re
 from optdesign.studies.catalogue import NodeSolver, first_feasible
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.relaxation import Site, relaxations
-from optdesign.studies.verify import constraint_rows
+from optdesign.studies.verify import constraint_rows, is_validity
 
 #: Items of each catalogue variable tried around the continuous best point, and the most
 #: combinations of them solved (nearest first).
@@ -70,6 +72,10 @@ def diagnose(
     point only, no relaxation (e.g. for an error message)."""
     if result.success:
         return result
+    outside = [r for r in result.violated if is_validity(r)]
+    if outside:
+        result.diagnosis = Diagnosis(basis="the best point found", note=validity_note(outside))
+        return result
     nlp_solver = solver_for_kind(solver, "nlp")
     kind = result.formulation
     if kind == "fixed":
@@ -94,6 +100,18 @@ def diagnose(
         old = result.diagnosis.note
         result.diagnosis.note = f"{found}; {old}" if old else found
     return result
+
+
+def validity_note(outside: list[ConstraintReport]) -> str:
+    """Why a best point outside its models' ranges gets no relaxation, naming them."""
+    what = sorted({r.name.removeprefix("validity: ").split("[", 1)[0] for r in outside})
+    shown = "; ".join(what[:4]) + (f"; and {len(what) - 4} more" if len(what) > 4 else "")
+    return (
+        f"the best point found lies outside the range where its models hold ({shown}): "
+        "no relaxation of a requirement brings a model back into its range; check the "
+        "inputs those models read (the pin's material and lug, the fit, [clearances], "
+        "pin_length_ratio) and the bounds of the variables (docs/validity.md)"
+    )
 
 
 def _nothing_violated(result: Result) -> str:

@@ -17,7 +17,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.details import ExactNLP, GPDetails, GPRows, GPTiming
 from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
-from optdesign.solvers.result import Result
+from optdesign.solvers.result import Globality, Result
 from optdesign.studies.nlp_solve import finish, solve_nlp
 from optdesign.studies.reference import attach_reference, reference_design
 
@@ -89,6 +89,12 @@ def solve_gp_problem(
     result = finish(problem, result, objective)
     cert = result.certificate
     if cert is not None:
+        result.globality = Globality(
+            proved=True,
+            basis=f"for the GP model, which is convex: dual bound {cert.lower_bound:.8g}, "
+            f"relative gap {cert.gap_rel:.1e}; the exact model (exact Hertz) is checked at "
+            "this design, not optimised",
+        )
         result.notes.append(
             f"GP certificate: dual bound {cert.lower_bound:.8g} <= optimum <= "
             f"{cert.objective:.8g} (relative gap {cert.gap_rel:.2e})"

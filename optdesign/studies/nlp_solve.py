@@ -23,7 +23,9 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
-from optdesign.solvers.multistart import multistart, sobol_starts
+from optdesign.search.global_phase import default_max_starts, global_search, search_globality
+from optdesign.search.starts import TiltedStarts, problem_evaluator
+from optdesign.solvers.multistart import sobol_starts
 from optdesign.solvers.registry import default_solver, make_solver, solver_hints
 from optdesign.solvers.result import (
     Result,
@@ -109,13 +111,41 @@ def solver_options(problem: DesignProblem, name: str | None = None) -> dict[str,
 
 # --- the NLP path -----------------------------------------------------------------------
 def start_points(problem: DesignProblem, n_starts: int, seed: int, x0=None) -> np.ndarray:
-    """The multistart's starts: ``x0`` (or the declared start, else the middle of the
-    bounds) first, then scrambled-Sobol points of the whole box."""
+    """A plain multistart's starts: ``x0`` (or the declared start, else the middle of the
+    bounds) first, then scrambled-Sobol points of the whole box (the robust formulation's
+    and a catalogue node's starts; the NLP's are the global search's)."""
     first = problem.start() if x0 is None else np.asarray(x0, dtype=float)
     pts = [first]
     if n_starts > 1:
         pts += list(sobol_starts(problem.lower(), problem.upper(), n_starts - 1, seed))
     return np.array(pts)
+
+
+def own_starts(problem: DesignProblem, x0=None) -> list[np.ndarray]:
+    """The starts a search solves before its random draws: ``x0`` when given, else the
+    problem's declared start when it declares one (none: every start is a draw)."""
+    if x0 is not None:
+        return [np.asarray(x0, dtype=float)]
+    if any(v.start is not None for v in problem.free):
+        return [problem.start()]
+    return []
+
+
+def tilted_starts(problem: DesignProblem, objective: str, seed: int) -> TiltedStarts:
+    """The global search's random starts for ``objective`` (judged on the NumPy path)."""
+    known = objective in problem.objectives
+    evaluate = problem_evaluator(problem, objective if known else None)
+    return TiltedStarts(evaluate, problem.lower(), problem.upper(), seed)
+
+
+def planned_starts(problem: DesignProblem, starts: int | None = None) -> int:
+    """The most starts of a search: ``starts``, else the problem file's ``[solver]
+    starts``, else chosen from the number of free variables."""
+    if starts is not None:
+        return int(starts)
+    if problem.spec.solver.starts is not None:
+        return int(problem.spec.solver.starts)
+    return default_max_starts(len(problem.free))
 
 
 def solve_nlp(
@@ -129,34 +159,38 @@ def solve_nlp(
     x0: np.ndarray | None = None,
     agree: int | None = None,
     time_limit: float | None = None,
+    target_odds: float | None = None,
 ) -> Result:
-    """Multistart NLP solve of ``problem``.
+    """The global search for the NLP optimum of ``problem`` (:mod:`optdesign.search`).
 
     Parameters
     ----------
     objective
         Objective to minimise (default: the problem's first).
     starts, seed
-        Number of starts and Sobol seed (default: the problem file's ``[solver]``).
+        The most starts and the seed of their draws (default: the problem file's
+        ``[solver]``; no ``starts`` there: chosen from the number of free variables).
     workers
         Local processes for the starts.
     solver, options
         Registered back-end (None: the registry's default for an NLP) and its options.
     x0
-        First start (default: the declared start, else the middle of the bounds).
+        A start of the caller's, solved first (default: the declared start, if any).
     agree
-        Stop once this many starts agree on the best value (default: the problem file's
-        ``[solver] agree``, 3; 0: every start). On every shipped problem all 8 default
-        starts reach the same optimum (benchmarks/README.md, "Overhead").
+        The search stops when the odds of a better optimum say so and at least this many
+        starts reached the best value (default: the problem file's ``[solver] agree``, 3;
+        0: the odds never stop it, every start runs).
     time_limit
-        Wall-clock seconds for the multistart: no start begins after it, and a solve of
-        a back-end that declares deadline options (Ipopt) stops at it (status
+        Wall-clock seconds for the search: no start begins after it, and a solve of a
+        back-end that declares deadline options (Ipopt) stops at it (status
         ``time_limit``); other back-ends finish the start they are in.
+    target_odds
+        Also stop only once the estimated probability of a better optimum is at most
+        this (None: Boender and Rinnooy Kan's rule alone).
     """
     _no_catalogue(problem, "nlp")
     objective = objective or problem.objective_names[0]
     objectives = _objective_set(problem, objective)
-    n_starts = starts if starts is not None else problem.spec.solver.starts
     seed = seed if seed is not None else problem.spec.solver.seed
     agree = agree if agree is not None else problem.spec.solver.agree
     watch = solver_hints(solver).deadline_options
@@ -164,17 +198,106 @@ def solve_nlp(
         options = {**(options or {}), **watch}
     backend = solver_for(problem, solver, options, objectives)
     target = backend.nlp.target(objective)
-    pts = start_points(problem, n_starts, seed, x0)
-    result = multistart(
-        lambda x: backend.solve(x, target),
-        pts,
+    target_index = backend.nlp.targets.index(objective)
+    result = global_search(
+        lambda x: checked_start(problem, backend.solve(x, target), objective),
+        tilted_starts(problem, objective, seed),
+        own=own_starts(problem, x0),
+        max_starts=planned_starts(problem, starts),
+        agree=agree,
+        target=target_odds,
         workers=workers,
         seed=seed,
-        agree=agree or None,
         time_limit=time_limit,
         parallel_map=map_inherited,
+        abs_tol=SOLVER_RESOLUTION * float(backend.nlp.target_scales[target_index]),
     )
+    result = refine(problem, backend, result, objective)
+    result.globality = search_globality(result.multistart)
     return finish(problem, result, objective)
+
+
+#: What a local solve resolves of an objective, relative to the objective's scale (the
+#: formulation divides it by its value at the scales' design): two starts whose values
+#: differ by less are counted as one optimum by the search's odds.
+SOLVER_RESOLUTION = 1e-6
+
+#: An optimum whose value is below this fraction of its objective's scale is solved once
+#: more from itself with the objective scaled to 1 there (:func:`refine`).
+REFINE_BELOW = 0.01
+
+
+def refine(problem: DesignProblem, backend, result: Result, objective: str) -> Result:
+    """The best start solved once more, warm, with its objective divided by its own value,
+    when that value is far below the objective's scale (a ripple of 1e-4 where the scale,
+    taken at the middle of the bounds, is 0.1): the solver's tolerance then holds the
+    value to its own relative precision, not to the scale's. The refined point replaces
+    the start's only when it is checked and no worse; the search's record stays."""
+    nlp = backend.nlp
+    if not result.success or objective not in nlp.targets or "z" not in result.raw:
+        return result
+    scale = float(nlp.target_scales[nlp.targets.index(objective)])
+    value = float(result.objective)
+    if not (np.isfinite(value) and 0.0 < abs(value) < REFINE_BELOW * scale):
+        return result
+    weight = scale / abs(value)
+    again = backend.solve(nlp.start(z0=result.raw["z"]), nlp.target({objective: weight}))
+    again.objective = again.objective / weight
+    again = checked_start(problem, again, objective)
+    if not again.success or again.objective > value:
+        return result
+    again.multistart, again.notes = result.multistart, result.notes
+    again.wall_time_s += result.wall_time_s
+    return again
+
+
+#: A start whose solver value and NumPy model value of the objective differ by more than
+#: this (relative) did not end at an optimum: the solver's bound variable is not tight.
+BOUND_TIGHT_TOL = 1e-4
+
+
+def checked_start(problem: DesignProblem, result: Result, objective: str) -> Result:
+    """One start's result judged on the NumPy path, as the best one is
+    (:func:`finish`): a design the check refuses is no success ("independent check
+    failed"); a success whose solver value is not the model's objective (an epigraph
+    variable left above the function it bounds: a stationary point of the formulation,
+    not of the problem) is no success either; otherwise its objective is the model's
+    value, so that starts are ranked and counted by the value every report shows."""
+    if not result.design:
+        return result
+    x = np.array([result.design[v.name] for v in problem.free])
+    ok, violated, objectives = verify_design(problem, x)
+    result.verified = ok
+    if not result.success:  # its end point still tells whether a feasible design exists
+        return result
+    value = float(objectives.get(objective, np.nan))
+    if not ok:
+        _refuse(result, " (independent check failed)")
+        result.violated = violated
+    elif np.isfinite(value):
+        if abs(result.objective - value) > BOUND_TIGHT_TOL * max(abs(value), 1e-12):
+            _refuse(
+                result,
+                f" (bound not tight: the solver's value {result.objective:.6g}, the model's "
+                f"{value:.6g})",
+                TerminationCondition.NUMERICAL_ERROR,
+                "failed",
+            )
+        else:
+            result.objective = value
+    return result
+
+
+def _refuse(
+    result: Result,
+    why: str,
+    termination: TerminationCondition = TerminationCondition.INFEASIBLE,
+    status: str = "infeasible",
+) -> None:
+    result.status = status
+    result.termination = termination
+    result.solution_status = SolutionStatus.INFEASIBLE
+    result.message += why
 
 
 def _objective_set(problem: DesignProblem, objective: str) -> tuple[str, ...]:
@@ -214,6 +337,7 @@ def solve_nlp_formulation(problem: DesignProblem, request: SolveRequest) -> Resu
         options=request.options,
         agree=request.agree,
         time_limit=request.time_limit,
+        target_odds=request.target_odds,
     )
     return attach_reference(problem, result)
 
@@ -278,6 +402,9 @@ def finish(problem: DesignProblem, result: Result, objective: str | None = None)
     result.verified = ok
     result.notes += nan_notes(problem, objectives, violated)
     result.objectives = {k: float(v) for k, v in objectives.items()}
+    value = result.objectives.get(result.objective_name, np.nan)
+    if ok and np.isfinite(value):  # one value everywhere: the model's, which was checked
+        result.objective = float(value)
     result.design = {**problem.fixed_values, **result.design}
     if claimed and not ok:
         # The solver claims success but the independent check disagrees: not a design.

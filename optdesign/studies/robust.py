@@ -39,7 +39,7 @@ from optdesign.reports.tables import format_table
 from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
-from optdesign.solvers.result import Result
+from optdesign.solvers.result import Globality, Result
 from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.nlp_solve import (
     continuous_only,
@@ -311,6 +311,10 @@ def solve_robust_formulation(problem: DesignProblem, request: SolveRequest) -> R
         objective,
         nominal.objectives.get(objective, nominal.objective),
         nominal.design,
+    )
+    result.globality = Globality(
+        basis="the robust optimum: a local solve started at the nominal optimum, which the "
+        "global search found" + (f" ({nominal.globality.text()})" if nominal.globality else "")
     )
     return result
 

@@ -23,14 +23,21 @@ import numpy as np
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
+from optdesign.problem.validity import outside_ranges
 from optdesign.safe_io import refuse_file_options
 from optdesign.solvers.deadline import deadline, passed
 from optdesign.solvers.registry import solver_hints
-from optdesign.solvers.result import Diagnosis, Result, SolutionStatus, TerminationCondition
+from optdesign.solvers.result import (
+    Diagnosis,
+    Globality,
+    Result,
+    SolutionStatus,
+    TerminationCondition,
+)
 from optdesign.studies.diagnosis import diagnose as diagnose_result
 from optdesign.studies.formulation_registry import Formulation, pick_formulation
 from optdesign.studies.nlp_solve import optimal_ranges, solver_options
-from optdesign.studies.verify import constraint_rows, verify_design
+from optdesign.studies.verify import constraint_rows, is_validity, validity_report, verify_design
 
 
 def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> Result:
@@ -67,6 +74,7 @@ def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> 
         problem=problem.name,
         mechanism=problem.mechanism_name,
         problem_object=problem,
+        globality=Globality(basis="no free variable: nothing to search"),
     )
     return result
 
@@ -108,11 +116,29 @@ def solve(problem: DesignProblem, request: SolveRequest) -> Result:
     with deadline(time_limit):
         result = _solve_within(problem, formulation, request)
         late = passed()
+    name_outside_ranges(problem, result)
     if late and ((request.diagnose and not result.success) or (request.ranges and result.success)):
         what = "the diagnosis" if not result.success else "the ranges of the optimal set"
         result.notes.append(f"{what} not computed: the time limit of {time_limit:g} s was reached")
         return result
     return _evidence(problem, result, request)
+
+
+def name_outside_ranges(problem: DesignProblem, result: Result) -> None:
+    """Add to a failed result's violated rows the quantities of its best point outside
+    their models' ranges of validity (:func:`optdesign.studies.verify.validity_report`),
+    when the rows it has are the solver's own; a success, and a failure the independent
+    check refused, name them already."""
+    if result.success or not result.design or any(is_validity(r) for r in result.violated):
+        return
+    try:
+        x = np.array([result.design[v.name] for v in problem.free], dtype=float)
+        found = outside_ranges(problem, x)
+    except Exception:  # the best point of a failed solve: its own rows say what failed
+        return
+    if found:
+        result.violated = [*result.violated, *(validity_report(o) for o in found)]
+        result.verified = False
 
 
 def _solve_within(
@@ -130,6 +156,18 @@ def _solve_within(
     return result
 
 
+def _multipliers(result: Result, requested: str | None) -> bool:
+    """Whether the result carries multipliers a sensitivity can read. ``result.solver``
+    is the label the run reports (``scipy-slsqp-exact`` for the ``slsqp`` back-end), not
+    always a registered name: the requested back-end answers then."""
+    if "lam_g" not in result.raw:
+        return False
+    try:
+        return solver_hints(result.solver).multipliers
+    except InputError:
+        return solver_hints(requested).multipliers
+
+
 def _evidence(problem: DesignProblem, result: Result, request: SolveRequest) -> Result:
     """The diagnosis of a result with no feasible design, the ranges of an optimum."""
     solver, options = request.solver, request.options
@@ -141,13 +179,7 @@ def _evidence(problem: DesignProblem, result: Result, request: SolveRequest) -> 
             text = " ".join(str(exc).split())[:300]
             result.diagnosis = Diagnosis(note=f"not computed: {type(exc).__name__}: {text}")
     continuous = result.formulation.startswith("nlp") and not any(v.discrete for v in problem.free)
-    if (
-        sensitivities
-        and result.success
-        and continuous
-        and solver_hints(result.solver).multipliers
-        and "lam_g" in result.raw
-    ):
+    if sensitivities and result.success and continuous and _multipliers(result, solver):
         try:  # what each requirement costs, from Ipopt's multipliers
             from optdesign.studies.sensitivity import nlp_sensitivities
 
@@ -158,8 +190,7 @@ def _evidence(problem: DesignProblem, result: Result, request: SolveRequest) -> 
         sensitivities
         and result.success
         and result.formulation.startswith("catalogue")
-        and solver_hints(result.solver).multipliers
-        and "lam_g" in result.raw
+        and _multipliers(result, solver)
     ):
         try:  # the continuous part at the chosen items, and the neighbouring items
             from optdesign.studies.catalogue_sensitivity import catalogue_sensitivities

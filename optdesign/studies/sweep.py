@@ -1,29 +1,55 @@
 """Parametric sweeps: how the optimum moves when a requirement, a bound or a fixed
 variable changes (``od.sweep``, ``optdesign sweep``).
 
-One or two parameters, each over an evenly spaced range. The points are solved by
-*continuation*: every point is warm-started from its neighbour's design (one Ipopt solve;
-the point before it along the first parameter, the first point of a row from the first
-point of the row before: every row a chain, :func:`neighbour`), and a full multistart
-checks the point - independently of the neighbour - every ``check_every`` points, at
-the ends of every row, wherever the warm start fails and wherever the binding set differs
-from the neighbour's. A multistart that finds a better optimum than the warm start marks a
-*jump* (the chain had followed a local optimum), and the chain goes on from the better one.
+One or two parameters, each over an evenly spaced range. Each point is a problem of its
+own, and the sweep's answer at a point is what a cold solve of that point finds, or
+better. Two kinds of work make it:
+
+1. **The global search of every point** (round 0). Each point gets the global search of
+   :mod:`optdesign.search` - the point's declared start, if any, then tilted random
+   starts until the odds of a better optimum say stop - cold, independently of every
+   other point, with the same seed at every point (the request's, else the problem
+   file's): the search ``od.solve`` runs on that point's problem, from the same starts
+   (in mode ``"shared"`` on the sweep's one NLP, :mod:`optdesign.studies.sweep_solver`).
+   These tasks depend on nothing, so they run side by side on any number of workers.
+2. **Polish rounds** (rounds 1, 2, ...). A point is warm-started from the current design
+   of each of its grid neighbours (:func:`grid_neighbours`: the previous and the next
+   point along the first parameter, then the previous and the next row), one local
+   solve each, and keeps the best (:func:`polish_choice`: by value, ties keeping the
+   point's own design, then the first neighbour in that order; never by timing). Round 1
+   polishes every point from every neighbour; a later round only the points next to one
+   that improved in the round before, and only from those (a neighbour whose design did
+   not change would give the same solve again). The rounds stop when one improves
+   nothing, at the latest after as many rounds as the longest axis has points (a note
+   says when the cap stopped them): a better branch found at one point so spreads along
+   the sweep as far as it is better.
+
+Each round is one :func:`optdesign.studies.runner.run_tasks` call on the sweep's JSONL
+store, its tasks depending only on the records of the rounds before it: the sweep is
+the same for any number of workers, every record goes to the store as it finishes, and
+a killed sweep resumes where it stopped (a resume with other settings is refused naming
+what changed). A point's latest record is its answer: ``found_by`` says what found its
+optimum (``"global search"``, or the neighbour a polish round started from: ``"from
+the previous point"``, ``"from the next point"``, ``"from the previous row"``,
+``"from the next row"``), ``solves`` counts every local solve behind it, and ``jump``
+marks a point where plain continuation would have been wrong: its optimum is better
+than what a warm start from its predecessor along the chain (:func:`neighbour`) reaches,
+or a polish round improved on its own global search.
 
 A problem with catalogue variables or tolerances is solved point by point by its own
-formulation (:func:`optdesign.studies.solve.solve`), without continuation (a note says so).
-
-The points go to a JSONL store as they finish (:func:`optdesign.studies.runner.run_tasks`,
-the store of fronts): a killed sweep resumes where it stopped, and a resume with other
-settings is refused naming what changed. An infeasible point is a point: its record says
-what fails at the best design found.
+formulation (:func:`optdesign.studies.solve.solve`), without continuation or polish (a
+note says so). An infeasible point is a point: its record says what fails at the best
+design found.
 """
 
 from __future__ import annotations
 
 import difflib
+import functools
 import math
+import threading
 import time
+from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -34,11 +60,11 @@ import numpy as np
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
+from optdesign.solvers.multistart import tie_width
 from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.solvers.solved_point import is_success
 from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sensitivity import at_values
-from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2
@@ -73,11 +99,15 @@ class Axis:
 
 @dataclass
 class SweepPoint:
-    """One point of a sweep (see the record written by :func:`sweep_point`).
+    """One point of a sweep (its latest record, see :func:`sweep_point`).
 
     ``active_change``: the binding set or a catalogue item differs from the point before
-    it in the sweep's order (both solved); ``checked``: a full multistart checked it;
-    ``jump``: that multistart found a better optimum than the warm start."""
+    it in the sweep's order (both solved); ``checked``: the point got its own global
+    search (or its formulation's solve); ``jump``: plain continuation would have stayed on
+    a worse branch here - the optimum is better than the warm start from the point before
+    reached, or a polish round improved on the point's own search; ``found_by``: what
+    found the optimum (``"global search"``, ``"from the previous point"``, ...);
+    ``solves``: every local solve spent on the point."""
 
     index: int
     values: tuple[float, ...]
@@ -92,6 +122,7 @@ class SweepPoint:
     solves: int = 0
     time_s: float = 0.0
     sensitivities: dict[str, float] = field(default_factory=dict)
+    found_by: str = "global search"
 
     @property
     def success(self) -> bool:
@@ -266,9 +297,10 @@ def grid_order(axes: Sequence[Axis]) -> list[tuple[int, ...]]:
 
 
 def neighbour(idx: tuple[int, ...]) -> tuple[int, ...] | None:
-    """The point a point continues from: the one before it along the first parameter;
-    the first point of a row continues from the first point of the row before. Every
-    row is so a chain of its own (rows run side by side with several workers)."""
+    """The point a point would continue from in a plain chain of warm starts: the one
+    before it along the first parameter; the first point of a row continues from the
+    first point of the row before. A point's ``jump`` compares its optimum with the warm
+    start from it."""
     if idx[0] > 0:
         return (idx[0] - 1, *idx[1:])
     if len(idx) == 2 and idx[1] > 0:
@@ -277,6 +309,36 @@ def neighbour(idx: tuple[int, ...]) -> tuple[int, ...] | None:
 
 
 # --- one point -------------------------------------------------------------------------
+#: What found a point's optimum when its own search did (``found_by``).
+GLOBAL_SEARCH = "global search"
+#: ... when the point was solved by its formulation (no continuation).
+FORMULATION = "its formulation"
+#: The grid neighbours a polish round starts from, in their order (axis, step) -> name.
+FROM_NEIGHBOUR = {
+    (0, -1): "from the previous point",
+    (0, 1): "from the next point",
+    (1, -1): "from the previous row",
+    (1, 1): "from the next row",
+}
+
+
+def grid_neighbours(
+    idx: tuple[int, ...], shape: Sequence[int]
+) -> list[tuple[str, tuple[int, ...]]]:
+    """The grid neighbours of ``idx`` a polish round starts from, in their fixed order
+    (the previous and the next point along the first parameter, then along the second),
+    each with its ``found_by`` name."""
+    out = []
+    for axis in range(len(idx)):
+        for step in (-1, 1):
+            k = idx[axis] + step
+            if 0 <= k < shape[axis]:
+                other = list(idx)
+                other[axis] = k
+                out.append((FROM_NEIGHBOUR[(axis, step)], tuple(other)))
+    return out
+
+
 def active_names(problem: DesignProblem, result) -> list[str]:
     """The binding set of a result: requirement (block) names and ``VAR.lower/upper``."""
     from optdesign.reports.limits import at_bound, is_internal
@@ -297,67 +359,157 @@ def continuable(problem: DesignProblem) -> bool:
 
 
 def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
-    """Solve one point of a sweep (a task of :func:`run_sweep`; JSON-able record)."""
-    from optdesign.studies.nlp_solve import solve_nlp
-
+    """One task of :func:`run_sweep` (a JSON-able record): round 0 solves a point on its
+    own (its global search, or its formulation); a later round polishes it from its
+    neighbours' designs (:func:`polish_point`)."""
+    if task.get("round", 0):
+        return polish_point(task, deps)
     t0 = time.perf_counter()
-    base: DesignProblem = task["problem"]
-    problem = at_values(base, dict(zip(task["paths"], task["values"], strict=True)))
+    problem = _point_problem(task)
     request: SolveRequest = task["request"]
-    objective = request.objective
-    prev = next(iter(deps.values()), None) if deps else None
-    solves = 0
-    warm = None
+    shared = None
     if not task["continuation"]:
         from optdesign.studies.solve import solve
 
         # a catalogue's sensitivities come with its neighbouring items
         best = solve(problem, request)
-        solves, checked = 1, True
+        solves, found_by = 1, FORMULATION
     else:
         shared = _shared_solver(task)
-        if prev is not None and prev.get("design"):
-            x0 = np.array([prev["design"][v.name] for v in problem.free])
-            if shared is not None:
-                warm = shared.warm(problem, x0)
-            else:
-                warm = solve_nlp(problem, objective, starts=1, x0=x0)
-            solves += 1
-        best = warm
-        changed = (
-            warm is None
-            or not warm.success
-            or (prev is not None and active_names(problem, warm) != prev.get("active"))
-        )
-        checked = changed or task["scheduled_check"]
-        if checked:
-            if shared is not None:
-                full = shared.multistart(problem, request.starts, request.seed)
-            else:
-                full = solve_nlp(problem, objective, starts=request.starts, seed=request.seed)
-            solves += full.multistart.n_starts if full.multistart else 1
-            if best is None or _better(full, best):
-                best = full
-    jump = bool(
-        warm is not None
-        and best is not warm
-        and warm.success
-        and best.objective < warm.objective - OBJECTIVE_TIE_TOL * max(1.0, abs(warm.objective))
-    )
-    active = active_names(problem, best) if best.success else []
+        if shared is not None:
+            best = shared.search(problem, request.starts, request.seed, request.agree)
+        else:
+            from optdesign.studies.nlp_solve import solve_nlp
+
+            best = solve_nlp(
+                problem,
+                request.objective,
+                starts=request.starts,
+                seed=request.seed,
+                agree=request.agree,
+            )
+        solves, found_by = (best.multistart.n_starts if best.multistart else 1), GLOBAL_SEARCH
     record: dict[str, Any] = {
         "index": task["index"],
         "values": list(task["values"]),
+        "round": 0,
+        "checked": True,
+        "warm_objective": None,
+        "improved": False,
+        "solves": solves,
+    }
+    record.update(_outcome(task, problem, best, shared, found_by))
+    record["jump"] = _jump(record)
+    record["time_s"] = time.perf_counter() - t0
+    return record
+
+
+def polish_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """A polish round at one point: one warm-started local solve from each neighbour's
+    design in ``task["from"]`` (``[[found_by name, record id], ...]``, in their order),
+    the best kept over the point's own record (:func:`polish_choice`). The record is the
+    point's, updated: its solves and time added, ``improved``, and where a neighbour won
+    its outcome and ``found_by``; ``warm_objective`` is what the start from the chain's
+    predecessor (``task["chain"]``) reached, when it was among the starts."""
+    t0 = time.perf_counter()
+    own = {k: v for k, v in deps[task["own"]].items() if k != "id"}
+    problem = _point_problem(task)
+    shared = _shared_solver(task)
+    tried: list[tuple[str, Any]] = []
+    for name, dep in task["from"]:
+        x0 = _design_vector(problem, deps[dep])
+        if x0 is not None:
+            tried.append((name, _warm(task, problem, shared, x0)))
+    record = dict(own)
+    record["round"] = task["round"]
+    record["solves"] = int(own["solves"]) + len(tried)
+    for name, result in tried:
+        if name == task.get("chain"):
+            record["warm_objective"] = _warm_value(result)
+    chosen = polish_choice(own, [_rank_of(r) for _, r in tried])
+    record["improved"] = chosen is not None
+    if chosen is not None:
+        name, result = tried[chosen]
+        record.update(_outcome(task, problem, result, shared, name))
+    record["jump"] = _jump(record)
+    record["time_s"] = float(own.get("time_s", 0.0)) + time.perf_counter() - t0
+    return record
+
+
+def polish_choice(
+    current: Mapping[str, Any], candidates: Sequence[Mapping[str, Any]]
+) -> int | None:
+    """The index of the candidate that replaces ``current`` (None: none does).
+
+    Each is a mapping with ``success``, ``objective`` and ``max_violation``. A candidate
+    replaces the best so far only when it is better beyond the tie tolerance
+    (:func:`better`), so ties keep ``current``, then the earliest candidate: the choice
+    depends on the values and their order alone."""
+    best, chosen = current, None
+    for k, cand in enumerate(candidates):
+        if better(cand, best):
+            best, chosen = cand, k
+    return chosen
+
+
+def better(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+    """``a`` is better than ``b`` beyond the tie tolerance: feasible over infeasible,
+    then the lower objective (two feasible) or the smaller violation (two infeasible),
+    by more than :data:`~optdesign.tolerances.OBJECTIVE_TIE_TOL` relative."""
+    a_ok, b_ok = _usable(a), _usable(b)
+    if a_ok != b_ok:
+        return a_ok
+    key = "objective" if a_ok else "max_violation"
+    va, vb = _finite(a.get(key)), _finite(b.get(key))
+    return va < vb - tie_width(vb)
+
+
+def _usable(r: Mapping[str, Any]) -> bool:
+    return bool(r.get("success")) and math.isfinite(_finite(r.get("objective")))
+
+
+def _finite(v: Any) -> float:
+    v = math.inf if v is None else float(v)
+    return v if math.isfinite(v) else math.inf
+
+
+def _rank_of(result) -> dict[str, Any]:
+    return {
+        "success": result.success,
+        "objective": float(result.objective),
+        "max_violation": float(result.max_violation),
+    }
+
+
+def _warm_value(result) -> float | None:
+    return float(result.objective) if _usable(_rank_of(result)) else None
+
+
+def _jump(record: Mapping[str, Any]) -> bool:
+    """A solved point whose optimum a polish round found (its own search had missed it),
+    or that is better than the warm start from its predecessor reached (continuation
+    alone would have stayed on a worse branch)."""
+    if not _usable(record):
+        return False
+    if record["found_by"] not in (GLOBAL_SEARCH, FORMULATION):
+        return True
+    warm = record.get("warm_objective")
+    return bool(warm is not None and record["objective"] < warm - tie_width(warm))
+
+
+def _outcome(task, problem: DesignProblem, best, shared, found_by: str) -> dict[str, Any]:
+    """The part of a point's record its best result sets."""
+    request: SolveRequest = task["request"]
+    viol = float(best.max_violation)
+    out: dict[str, Any] = {
         "status": best.status,
         "objective": float(best.objective),
         "design": {k: float(v) for k, v in best.design.items()},
-        "active": active,
+        "active": active_names(problem, best) if best.success else [],
         "violated": [] if best.success else _violated(problem, best),
-        "checked": bool(checked),
-        "jump": jump,
         "success": best.success,
-        "solves": solves,
-        "warm_objective": None if warm is None else float(warm.objective),
+        "max_violation": viol if math.isfinite(viol) else None,
+        "found_by": found_by,
         "sensitivities": {},
     }
     if (
@@ -368,22 +520,69 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
     ):
         from optdesign.studies.sensitivity import nlp_sensitivities
 
-        nlp = shared.nlp if task["continuation"] and shared is not None else None
+        nlp = shared.nlp if shared is not None else None
         try:  # a point solved by its formulation has its own (a catalogue's, a robust one's)
             sens = nlp_sensitivities(problem, best, nlp=nlp) if task["continuation"] else []
         except Exception:  # a report: never lose the point
             sens = []
         sens = sens or best.sensitivities
-        record["sensitivities"] = {
+        out["sensitivities"] = {
             s.name: s.log_sensitivity for s in sens if s.log_sensitivity is not None
         }
-    record["time_s"] = time.perf_counter() - t0
-    return record
+    return out
+
+
+#: Point problems kept per process and thread (their NLPs are cached by the problem's
+#: token): a point polished soon after its search reuses its NLP in mode "rebuild".
+_POINTS: OrderedDict[tuple, DesignProblem] = OrderedDict()
+_POINTS_SIZE = 16
+_POINTS_LOCK = threading.Lock()
+
+
+def _point_problem(task: Mapping[str, Any]) -> DesignProblem:
+    """The point's problem (the base problem at the point's values), the same object
+    for every task of the point in this process while it is among the last used."""
+    key = (
+        threading.get_ident(),
+        task["problem"].token,
+        tuple(task["paths"]),
+        tuple(task["values"]),
+    )
+    with _POINTS_LOCK:
+        if key in _POINTS:
+            _POINTS.move_to_end(key)
+            return _POINTS[key]
+    point = at_values(task["problem"], dict(zip(task["paths"], task["values"], strict=True)))
+    with _POINTS_LOCK:
+        _POINTS[key] = point
+        while len(_POINTS) > _POINTS_SIZE:
+            _POINTS.popitem(last=False)
+    return point
+
+
+def _design_vector(problem: DesignProblem, record: Mapping[str, Any]) -> np.ndarray | None:
+    """A record's design as a start of ``problem`` (None: it has no complete one)."""
+    design = record.get("design") or {}
+    try:
+        x = np.array([float(design[v.name]) for v in problem.free])
+    except (KeyError, TypeError, ValueError):
+        return None
+    return x if np.all(np.isfinite(x)) else None
+
+
+def _warm(task: Mapping[str, Any], problem: DesignProblem, shared, x0: np.ndarray):
+    """One local solve of the point from ``x0``, checked."""
+    if shared is not None:
+        return shared.warm(problem, x0)
+    from optdesign.studies.nlp_solve import solve_nlp
+
+    return solve_nlp(problem, task["request"].objective, starts=1, x0=x0)
 
 
 def _shared_solver(task: Mapping[str, Any]):
     """The sweep's one NLP (:mod:`optdesign.studies.sweep_solver`), built once per
-    process; None when each point builds its own (mode ``"rebuild"``)."""
+    process; None when each point builds its own (mode ``"rebuild"``) or is solved by
+    its formulation."""
     if task["mode"] != "shared":
         return None
     from optdesign.studies.runner import cached
@@ -393,14 +592,6 @@ def _shared_solver(task: Mapping[str, Any]):
     objective = task["request"].objective
     key = ("sweep-solver", base.token, tuple(task["paths"]), objective)
     return cached(key, lambda: SweepSolver(base, task["paths"], objective))
-
-
-def _better(a, b) -> bool:
-    if a.success != b.success:
-        return a.success
-    if not a.success:
-        return a.max_violation < b.max_violation
-    return a.objective < b.objective - OBJECTIVE_TIE_TOL * max(1.0, abs(b.objective))
 
 
 def _violated(problem: DesignProblem, result) -> list[str]:
@@ -424,7 +615,7 @@ def run_sweep(
     vary: Any,
     request: SolveRequest,
     *,
-    check_every: int = 10,
+    check_every: int | None = None,
     run: RunOptions | None = None,
 ) -> Sweep:
     """The sweep of :func:`optdesign.sweep` (arguments checked there).
@@ -434,83 +625,121 @@ def run_sweep(
     problem, vary
         The problem and ``{path: (start, stop, count)}`` (checked here: :func:`sweep_axes`).
     request
-        How each point is solved: its objective, the multistart (``starts``, ``seed``;
-        None: the problem file's), the sensitivities; a point a formulation solves (no
-        continuation) is solved with it as it is.
+        How each point is solved: its objective, the global search (``starts``: the most
+        starts, ``seed``: its draws, the same at every point; None: the problem file's),
+        the sensitivities; a point a formulation solves (no continuation) is solved with
+        it as it is.
     check_every
-        A full multistart every this many points along a row.
+        Ignored: every point gets its global search (kept so that older calls run).
     run
         Where and how the points run (store folder, resume, workers, progress).
     """
     from optdesign.studies.identity import problem_digest, solver_identity, version
-    from optdesign.studies.runner import run_tasks
+    from optdesign.studies.nlp_solve import planned_starts
+    from optdesign.studies.processes import process_pool
+    from optdesign.studies.runner import forks_workers, run_tasks
+    from optdesign.studies.sweep_solver import sweep_mode
 
     run = run if run is not None else RunOptions()
     t0 = time.perf_counter()
     axes = sweep_axes(problem, vary)
     objective = request.objective
     cont = continuable(problem)
-    from optdesign.studies.sweep_solver import sweep_mode
-
     paths = [a.path for a in axes]
     mode = sweep_mode(problem, paths, [(a.values[0], a.values[-1]) for a in axes])
     mode = mode if cont else "formulation"
-    starts = request.starts if request.starts is not None else problem.spec.solver.starts
+    # the file's, stated in the identity; a point its formulation solves gets the
+    # caller's starts as they are (None: the formulation's own default, as od.solve)
+    starts = planned_starts(problem, request.starts) if cont else request.starts
     seed = request.seed if request.seed is not None else problem.spec.solver.seed
-    request = replace(request, starts=starts, seed=seed)  # the file's, stated in the identity
+    agree = request.agree if request.agree is not None else problem.spec.solver.agree
+    request = replace(request, starts=starts, seed=seed, agree=agree if cont else request.agree)
     order = grid_order(axes)
-    tasks = []
-    n0 = len(axes[0].values)
-    for k, idx in enumerate(order):
-        before = neighbour(idx)
-        tasks.append(
-            {
-                "id": _point_id(idx),
-                "after": [_point_id(before)] if before is not None and cont else [],
-                "problem": problem,
-                "paths": paths,
-                "values": [a.values[i] for a, i in zip(axes, idx, strict=True)],
-                "index": k,
-                # the ends of every row and every check_every-th point along it
-                "scheduled_check": idx[0] % check_every == 0 or idx[0] == n0 - 1,
-                "request": request,
-                "continuation": cont,
-                "mode": mode,
-            }
-        )
+    shape = [len(a.values) for a in axes]
+    common = {
+        "problem": problem,
+        "paths": paths,
+        "request": request,
+        "continuation": cont,
+        "mode": mode,
+    }
+    points = {
+        idx: {
+            "values": [a.values[i] for a, i in zip(axes, idx, strict=True)],
+            "index": k,
+        }
+        for k, idx in enumerate(order)
+    }
     key = {
         "problem": problem_digest(problem),
         "objectives": [objective],
         "method": {
             "sweep": {a.path: list(a.values) for a in axes},
-            "check_every": check_every,
-            "continuation": cont,
+            "continuation": "global+polish" if cont else False,
             "mode": mode,
             "sensitivities": bool(request.sensitivities),
             "starts": starts,
             "seed": seed,
+            "agree": agree,
         },
         "solver": solver_identity(problem, default_solver("nlp")),
         "optdesign": version(),
     }
     store = run.folder("sweep") / "sweep.jsonl"
-    records = run_tasks(
-        tasks,
-        sweep_point,
-        store,
-        resume=run.resume,
-        overwrite=run.overwrite,
-        progress="sweep" if run.progress else False,
-        key=key,
-        check=sweep_store_check,
-        workers=run.workers,
-        scheduler=run.scheduler,
-    )
-    by_grid = sorted(order, key=lambda idx: tuple(reversed(idx)))
-    points = []
-    for idx in by_grid:
-        rec = records[_point_id(idx)]
-        points.append(
+    local = run.workers if run.scheduler is None else 1
+    if mode == "shared" and local > 1 and forks_workers():
+        _shared_solver({**common, "id": "", "values": []})  # the workers inherit it
+    notes = []
+    with process_pool(local) as pool:
+        phase = functools.partial(
+            run_tasks,
+            fn=sweep_point,
+            store_path=store,
+            key=key,
+            check=sweep_store_check,
+            workers=run.workers,
+            scheduler=run.scheduler,
+            pool=pool,
+            on_record=run.on_record,
+        )
+        first = [{**common, **points[idx], "id": _point_id(idx)} for idx in order]
+        done = phase(
+            first,
+            resume=run.resume,
+            overwrite=run.overwrite,
+            progress="sweep" if run.progress else False,
+        )
+        latest = {idx: done[_point_id(idx)] for idx in order}
+        if cont:
+            cap = max(shape)
+            moved = set(order)  # the points whose design is new since the last round
+            for r in range(1, cap + 1):
+                tasks = polish_tasks(r, order, shape, latest, moved, common, points)
+                if not tasks:
+                    break
+                done = phase(
+                    tasks,
+                    resume=True,
+                    progress=f"sweep: polish {r}" if run.progress else False,
+                )
+                moved = set()
+                for t in tasks:
+                    idx = tuple(t["point"])
+                    latest[idx] = done[t["id"]]
+                    if latest[idx]["improved"]:
+                        moved.add(idx)
+                if not moved:
+                    break
+            else:
+                if moved:
+                    notes.append(
+                        f"the polish rounds stopped at their cap ({cap}) with "
+                        f"{len(moved)} points still improving"
+                    )
+    swept = []
+    for idx in sorted(order, key=lambda idx: tuple(reversed(idx))):
+        rec = latest[idx]
+        swept.append(
             SweepPoint(
                 index=rec["index"],
                 values=tuple(rec["values"]),
@@ -521,13 +750,13 @@ def run_sweep(
                 violated=list(rec["violated"]),
                 checked=rec["checked"],
                 jump=rec["jump"],
-                active_change=_changed(problem, records, idx),
+                active_change=_changed(problem, latest, idx),
                 solves=rec["solves"],
                 time_s=rec["time_s"],
                 sensitivities=dict(rec.get("sensitivities") or {}),
+                found_by=rec.get("found_by", GLOBAL_SEARCH),
             )
         )
-    notes = []
     if not cont:
         notes.append(
             "catalogue variables or tolerances: every point solved by its formulation, "
@@ -535,7 +764,46 @@ def run_sweep(
         )
     if mode == "rebuild":
         notes.append("each point builds its own NLP (the swept parameter changes the model)")
-    return Sweep(problem, objective, axes, points, time.perf_counter() - t0, cont, store, notes)
+    return Sweep(problem, objective, axes, swept, time.perf_counter() - t0, cont, store, notes)
+
+
+def polish_tasks(
+    r: int,
+    order: Sequence[tuple[int, ...]],
+    shape: Sequence[int],
+    latest: Mapping[tuple[int, ...], Mapping[str, Any]],
+    moved: set[tuple[int, ...]],
+    common: Mapping[str, Any],
+    points: Mapping[tuple[int, ...], Mapping[str, Any]],
+) -> list[dict[str, Any]]:
+    """The tasks of polish round ``r``: every point with a neighbour in ``moved`` (the
+    points whose design changed in the round before; round 1: all), each warm-started
+    from those neighbours' latest records, in :func:`grid_neighbours` order. A task needs
+    only records of earlier rounds (``after``), so the round is the same whatever ran
+    first."""
+    tasks = []
+    for idx in order:
+        sources = [(name, nb) for name, nb in grid_neighbours(idx, shape) if nb in moved]
+        if not sources:
+            continue
+        before = neighbour(idx)
+        chain = next((name for name, nb in sources if nb == before), None)
+        own = latest[idx]["id"]
+        frm = [[name, latest[nb]["id"]] for name, nb in sources]
+        tasks.append(
+            {
+                **common,
+                **points[idx],
+                "id": f"{_point_id(idx)}-r{r}",
+                "after": [own, *(dep for _, dep in frm)],
+                "round": r,
+                "point": list(idx),
+                "own": own,
+                "from": frm,
+                "chain": chain,
+            }
+        )
+    return tasks
 
 
 def _changed(problem: DesignProblem, records, idx) -> bool:
@@ -543,7 +811,7 @@ def _changed(problem: DesignProblem, records, idx) -> bool:
     before = neighbour(idx)
     if before is None:
         return False
-    rec, prev = records[_point_id(idx)], records[_point_id(before)]
+    rec, prev = records[idx], records[before]
     if not (rec["success"] and prev["success"]):
         return False
     items = [v.name for v in problem.free if v.discrete]

@@ -1,5 +1,6 @@
 """The solver of a sweep's points: one NLP for the whole sweep where the swept parameters
-allow it, so that a point costs a warm-started solve, not a new formulation.
+allow it, so that a point's global search and its warm starts from its neighbours cost
+solves, not a new formulation (:meth:`SweepSolver.search`, :meth:`SweepSolver.warm`).
 
 - The hinge moment enters the model only as the load of every force
   (:attr:`optdesign.problem.quantities.Quantities.hinge_moment`): it becomes a parameter
@@ -87,7 +88,8 @@ def sweep_mode(problem: DesignProblem, paths: Sequence[str], ends) -> str:
 
 
 class SweepSolver:
-    """Ipopt on the one NLP of a sweep (mode ``"shared"``)."""
+    """Ipopt on the one NLP of a sweep (mode ``"shared"``): a point's global search and
+    its single warm-started solves, each on the point's bounds and parameters."""
 
     def __init__(self, problem: DesignProblem, paths: Sequence[str], objective: str):
         from optdesign.studies.nlp_solve import _objective_set, solver_for
@@ -137,20 +139,28 @@ class SweepSolver:
         start = self.nlp.start(x0=x0, parameters=bounds.parameters)
         return finish(point, self.backend.solve(start, self.target, bounds), self.objective)
 
-    def multistart(self, point: DesignProblem, starts: int, seed: int) -> Result:
-        """The point's full multistart (the problem's declared start, then Sobol
-        points; stops once the file's ``agree`` starts agree), checked."""
-        from optdesign.solvers.multistart import multistart
-        from optdesign.studies.nlp_solve import finish, start_points
+    def search(
+        self, point: DesignProblem, starts: int | None, seed: int, agree: int | None = None
+    ) -> Result:
+        """The point's global search on the shared NLP, checked: the search a cold solve
+        of the point runs (:func:`optdesign.studies.nlp_solve.solve_nlp`) - the point's
+        declared start, if any, then tilted random starts drawn on the point's own
+        problem with ``seed`` until the odds say stop (``starts``: the most starts, None:
+        :func:`~optdesign.studies.nlp_solve.planned_starts`; ``agree``: None, the file's)
+        - with the point's bounds and parameters in the shared NLP."""
+        from optdesign.search.global_phase import global_search, search_globality
+        from optdesign.studies.nlp_solve import finish, own_starts, planned_starts, tilted_starts
 
         bounds = self.bounds(point)
-        agree = point.spec.solver.agree
-        result = multistart(
+        result = global_search(
             lambda x: self.backend.solve(
                 self.nlp.start(x0=x, parameters=bounds.parameters), self.target, bounds
             ),
-            start_points(point, starts, seed),
+            tilted_starts(point, self.objective, seed),
+            own=own_starts(point),
+            max_starts=planned_starts(point, starts),
+            agree=agree if agree is not None else point.spec.solver.agree,
             seed=seed,
-            agree=agree or None,
         )
+        result.globality = search_globality(result.multistart)
         return finish(point, result, self.objective)

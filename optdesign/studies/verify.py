@@ -1,22 +1,30 @@
-"""Independent check of a design on the NumPy path of the same models."""
+"""Independent check of a design on the NumPy path of the same models: every
+requirement, every objective a number, and every model within its range of validity."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
+from optdesign.problem.validity import OutsideRange, outside_ranges
 from optdesign.solvers.result import ConstraintReport
 from optdesign.tolerances import FEASIBILITY_TOL
 
+#: How the name of a report on a model's range of validity begins.
+VALIDITY_PREFIX = "validity: "
+
 
 def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = FEASIBILITY_TOL):
-    """Re-evaluate every constraint of ``problem`` at free-variable vector ``x``.
+    """Re-evaluate every constraint of ``problem`` at free-variable vector ``x``, and the
+    quantities that the models' ranges of validity bound.
 
     Returns
     -------
     (ok, violated, objectives)
-        ``ok`` if no row is violated by more than ``tol`` (relative) and no objective
-        is NaN; the violated rows (and the NaN objectives) as
+        ``ok`` if no row is violated by more than ``tol`` (relative), no objective is
+        NaN and no model is used outside its range; the violated rows (the NaN
+        objectives, and each quantity outside its model's range as a row named
+        ``"validity: <model>: <quantity>[<angle>]"``, :func:`validity_report`) as
         :class:`ConstraintReport`; the objective values on the NumPy path.
     """
     ev = problem.evaluate(np.asarray(x, dtype=float))
@@ -35,7 +43,36 @@ def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = FEASIBILIT
         # e.g. a user's objective that is NaN here: the design is no verified result
         if np.isnan(value):
             violated.append(ConstraintReport(f"objective {name}", float(value), None, None, np.inf))
+    # a design whose models are used outside their ranges is no answer, whatever its rows
+    violated += [validity_report(o) for o in outside_ranges(problem, np.asarray(x, dtype=float))]
     return not violated, violated, ev.objectives
+
+
+def validity_report(found: OutsideRange) -> ConstraintReport:
+    """The row of a quantity outside its model's range, in the unit messages show it
+    (``validity: small-angle clearance: worst-case backlash[phi=+30.0deg] = 1.29e+07 deg
+    (<= 5), violated by ...``); the amount is inf for a NaN."""
+    record = found.record
+
+    def shown(v: float | None) -> float | None:
+        return None if v is None else float(v) * record.scale
+
+    value = shown(found.value)
+    lower, upper = shown(record.lower), shown(record.upper)
+    if np.isnan(value):
+        amount = np.inf
+    else:
+        amount = max(
+            (lower - value) if lower is not None else 0.0,
+            (value - upper) if upper is not None else 0.0,
+        )
+    name = found.name + (f"[{found.where}]" if found.where else "")
+    return ConstraintReport(name, value, lower, upper, float(amount), record.display_unit)
+
+
+def is_validity(report: ConstraintReport) -> bool:
+    """True for a report on a model's range of validity (:func:`validity_report`)."""
+    return report.name.startswith(VALIDITY_PREFIX)
 
 
 def nan_notes(problem: DesignProblem, objectives: dict[str, float], violated) -> list[str]:

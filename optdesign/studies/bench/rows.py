@@ -70,13 +70,20 @@ class BenchRow:
     time_s
         Wall time of the run (catalogue combinations summed).
     objective, violation, verified
-        The objective and the largest violation at the returned design on the NumPy path,
-        and whether the independent check passed (None: no design to check).
+        The objective and the largest violation on the NumPy path at the row's design, and
+        whether the independent check passed (None: no design to check). The check
+        covers the bounds, every requirement and every objective (a finite number within
+        its physical range, :attr:`~optdesign.problem.objectives.ObjectiveInfo.valid`):
+        a design it refuses is not recorded (objective and design None, the reason says
+        why), so a row never holds a NaN or a negative ripple as its objective.
     iterations, n_evals, n_subproblems
         Solver iterations, evaluation counters (summed over catalogue combinations), and
         the number of continuous problems solved (catalogue combinations).
     design, solver_objective
-        The returned design (internal units) and the objective the solver reported.
+        The design (internal units): the best solved one, else the best verified point of
+        an unfinished solve (time or iteration limit, a solver failure: not a success),
+        else None; and the objective the solver reported there, for a success only (an
+        unfinished iterate's epigraph variable is no objective).
     front
         A front run's objective vectors.
     id

@@ -14,10 +14,12 @@ import itertools
 import math
 import time
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from optdesign.errors import ProblemError
 from optdesign.problem import DesignProblem, problem_from_dict
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import Result
@@ -52,73 +54,172 @@ def _catalogue_combos(problem: DesignProblem) -> list[dict[str, float]]:
     ]
 
 
+@dataclass
+class Attempt:
+    """One continuous solve of a run (a catalogue combination, or the run itself) and what
+    the independent check made of the design it returned.
+
+    ``why`` is empty when the design passed: inside the bounds, every requirement met on
+    the NumPy path, every objective finite and within its physical range
+    (:meth:`~optdesign.problem.objectives.ObjectiveInfo.range_problem`); ``value`` and
+    ``violation`` are then the objective and the largest violation there, on the NumPy
+    path (never the solver's own value)."""
+
+    result: Result
+    combo: dict[str, float]
+    design: dict[str, float] | None = None
+    value: float | None = None
+    violation: float | None = None
+    why: str = "no design returned"
+
+    @property
+    def verified(self) -> bool:
+        return self.design is not None and not self.why
+
+    @property
+    def solved(self) -> bool:
+        """A solved status at a design the independent check confirmed."""
+        return self.verified and is_success(self.result.status, True)
+
+
+def check_design(problem: DesignProblem, objective: str, x: np.ndarray) -> tuple[str, Any, Any]:
+    """``(why, value, violation)`` of the free-variable vector ``x``: ``why`` is ``""`` when
+    ``x`` lies in the bounds, meets every requirement on the NumPy path and every objective
+    there is a finite number within its physical range; ``value`` is then ``objective`` on
+    the NumPy path and ``violation`` the largest (relative) violation, else both None."""
+    outside = _outside_bounds(problem, x)
+    if outside:
+        return f"returned a design outside the bounds: {outside}", None, None
+    ok, violated, objs = verify_design(problem, x)
+    if not ok:
+        return f"independent check failed: {violated[0].describe()}", None, None
+    why = objective_range_problem(problem, objs, objective)
+    if why:
+        return f"independent check failed: {why}", None, None
+    return "", float(objs[objective]), float(problem.evaluate(x).violation)
+
+
+def objective_range_problem(
+    problem: DesignProblem, values: Mapping[str, Any], first: str | None = None
+) -> str:
+    """Why one of the objective ``values`` (name -> value at a design, on the NumPy path)
+    cannot be a result, or ``""``: NaN, infinite, or outside the physical range its
+    declaration gives (``first`` is checked first: the objective minimised)."""
+    infos = problem.objectives
+    for name in sorted(values, key=lambda k: k != first):
+        info = infos.get(name)
+        if info is not None:
+            why = info.range_problem(values[name])
+        else:
+            why = "" if _finite(values[name]) else f"{name} is {values[name]!r}, not finite"
+        if why:
+            return why
+    return ""
+
+
+def _finite(v: Any) -> bool:
+    return is_number(v) and math.isfinite(v)
+
+
 def _solve_single(
     config: Config, inst: Instance, objective: str, time_limit: float
 ) -> dict[str, Any]:
-    """Run a single-objective configuration; catalogues enumerated for nlp/gp kinds."""
+    """Run a single-objective configuration; catalogues enumerated for nlp/gp kinds.
+
+    The row holds one design, checked on the NumPy path (:func:`check_design`): the best
+    solved one (an enumeration cut short by the time limit: status ``feasible``, the best
+    combination found is not proven best), else the best verified point of an unfinished
+    solve (time or iteration limit: its status, not a success), else none - the objective
+    of a row is never the solver's own value, nor one of a design the check refused.
+    """
     problem = inst.problem()
     combos = _catalogue_combos(problem) if config.kind in ("nlp", "gp") else [{}]
     t0 = time.perf_counter()
-    best: tuple[float, Result, dict] | None = None
-    last: tuple[Result, dict] | None = None
-    iters, evals, statuses, n_na = 0, {}, [], 0
+    attempts: list[Attempt] = []
+    iters, evals, n_na, n_items, cut = 0, {}, 0, 0, False
     for combo in combos:
         remaining = time_limit - (time.perf_counter() - t0)
         if remaining <= 0:
-            statuses.append("time_limit")
+            cut = True
             break
-        sub = _fix(inst, problem, combo) if combo else problem
+        try:
+            sub = _fix(inst, problem, combo) if combo else problem
+        except ProblemError:
+            # e.g. a screw catalogue's (d0, p): not every pair of its values is an item
+            n_items += 1
+            continue
         try:
             r = config.run(sub, objective, remaining)
         except NotApplicable:
             n_na += 1
             continue
-        statuses.append(r.status)
         iters += r.iterations or 0
         for k, v in (r.n_evals or {}).items():
             evals[k] = evals.get(k, 0) + int(v)
+        attempt = Attempt(r, combo)
+        attempts.append(attempt)
         if not r.design:
             continue
-        x = np.array([{**r.design, **combo}[v.name] for v in problem.free], dtype=float)
-        last = (r, combo)
-        outside = _outside_bounds(problem, x)
-        if outside:
+        design = {**r.design, **combo}
+        x = np.array([design[v.name] for v in problem.free], dtype=float)
+        attempt.design = {k: float(v) for k, v in design.items()}
+        attempt.why, attempt.value, attempt.violation = check_design(problem, objective, x)
+        if attempt.why.startswith("returned a design outside"):
             # The models reject such a design (e.g. a negative length): not a design.
-            r.status, r.message = "failed", f"returned a design outside the bounds: {outside}"
-            statuses[-1] = "failed"
-            continue
-        ok, _viol, objs = verify_design(problem, x)
-        if r.success and ok and math.isfinite(objs[objective]):
-            if best is None or objs[objective] < best[0]:
-                best = (float(objs[objective]), r, combo)
+            r.status = "failed"
     elapsed = time.perf_counter() - t0
-    if n_na == len(combos):
-        raise NotApplicable("not applicable to any catalogue combination")
-    chosen = (best[1], best[2]) if best is not None else last
+    if n_na + n_items == len(combos) and combos:
+        if n_na:
+            raise NotApplicable("not applicable to any catalogue combination")
+        raise ProblemError("no catalogue combination is an item of its catalogue")
     row: dict[str, Any] = {
         "time_s": elapsed,
         "iterations": iters,
         "n_evals": evals,
         "n_subproblems": len(combos),
     }
-    if chosen is None:
+    solved = [a for a in attempts if a.solved]
+    verified = [a for a in attempts if a.verified]
+    tried = f"{len(attempts)} of {len(combos) - n_items} catalogue combinations"
+    if solved:
+        chosen = min(solved, key=lambda a: a.value)
+        status, reason = chosen.result.status, chosen.result.message
+        if cut:
+            status = "feasible"
+            reason = f"time limit reached after {tried}: the best of them ({reason})"
+    elif verified:
+        chosen = min(verified, key=lambda a: a.value)
+        status = chosen.result.status
+        reason = f"{chosen.result.message}; not solved: its best verified point"
+    else:
+        last = attempts[-1] if attempts else None
+        status = "time_limit" if cut or last is None else last.result.status
+        why = last.why if last is not None else "no combination solved"
+        message = last.result.message if last is not None else f"time limit after {tried}"
         row.update(
-            status=statuses[-1] if statuses else "failed", reason="no design returned", design=None
+            status=status,
+            reason=f"{message}; no verified point: {why}" if message else why,
+            design=None,
+            solver_objective=None,
+            objective=None,
+            violation=None,
+            verified=False,
+            success=False,
         )
         return row
-    r, combo = chosen
-    design = {**r.design, **combo}
-    if best is None:
-        status = next(
-            (s for s in statuses if s != "optimal"), statuses[-1] if statuses else "failed"
-        )
-    else:
-        status = r.status
+    success = is_success(status, True)
+    r = chosen.result
     row.update(
         status=status,
-        reason=r.message,
-        design={k: float(v) for k, v in design.items()},
-        solver_objective=float(r.objective) if math.isfinite(r.objective) else None,
+        reason=reason,
+        design=chosen.design,
+        # the solver's own value only where it finished at a confirmed design (an
+        # unfinished iterate's epigraph variable is no objective)
+        solver_objective=float(r.objective) if success and _finite(r.objective) else None,
+        objective=chosen.value,
+        violation=chosen.violation,
+        verified=True,
+        success=success,
     )
     return row
 
@@ -142,18 +243,29 @@ def _solve_front(config: Config, inst: Instance, time_limit: float) -> dict[str,
     elapsed = time.perf_counter() - t0
     worst = 0.0
     F = []
+    why = ""
     for d in out["designs"]:
         x = np.array([d[v.name] for v in problem.free], dtype=float)
         ev = problem.evaluate(x)
-        worst = max(worst, float(ev.violation))
-        F.append([float(ev.objectives[k]) for k in inst.objectives])
-    ok = len(F) >= 2 and worst <= FEASIBILITY_TOL
+        v = float(ev.violation)
+        worst = max(worst, v) if not math.isnan(v) else math.inf
+        values = {k: ev.objectives[k] for k in inst.objectives}
+        why = why or objective_range_problem(problem, values)
+        F.append([float(values[k]) for k in inst.objectives])
+    ok = len(F) >= 2 and worst <= FEASIBILITY_TOL and not why
+    if ok:
+        reason = f"{len(F)} front points"
+    elif why:
+        reason = f"{len(F)} front points, one not a result: {why}"
+    else:
+        reason = f"{len(F)} front points (fewer than 2 or infeasible)"
     return {
         "time_s": elapsed,
         "status": "optimal" if ok else "failed",
-        "reason": f"{len(F)} front points" + ("" if ok else " (fewer than 2 or infeasible)"),
-        "front": F,
-        "violation": worst if F else None,
+        "reason": reason,
+        # JSON has no NaN: a value that is not a finite number is stored as null
+        "front": [[v if math.isfinite(v) else None for v in f] for f in F],
+        "violation": worst if F and math.isfinite(worst) else None,
         "success": ok,
         "iterations": out.get("iterations"),
         "n_evals": {},
@@ -167,26 +279,7 @@ def _execute(task: Mapping[str, Any]) -> dict[str, Any]:
     tl = float(task["time_limit"])
     if config.kind == "front":
         return _solve_front(config, inst, tl)
-    objective = inst.objectives[0]
-    row = _solve_single(config, inst, objective, tl)
-    problem = inst.problem()
-    x = None
-    if row.get("design"):
-        x = np.array([row["design"][v.name] for v in problem.free], dtype=float)
-        if _outside_bounds(problem, x):
-            x = None
-    if x is not None:
-        ok, violated, objs = verify_design(problem, x)
-        ev = problem.evaluate(x)
-        row["objective"] = float(objs[objective])
-        row["violation"] = float(ev.violation)
-        row["verified"] = bool(ok)
-        row["success"] = is_success(row["status"], bool(ok))
-        if row["status"] in SOLVED_STATUSES and not ok:
-            row["reason"] = f"independent check failed: {violated[0].describe()}"
-    else:
-        row.update(objective=None, violation=None, verified=False, success=False)
-    return row
+    return _solve_single(config, inst, inst.objectives[0], tl)
 
 
 _STRIKES: dict[tuple[str, str], int] = {}
@@ -331,12 +424,12 @@ def row_problem(
         return None
     if r.status not in SOLVED_STATUSES:
         return f"counts as a success with status {r.status!r}"
-    if get_config(task["config"]).kind == "front":
-        return _front_row_problem(r)
     inst = task_instance(task)
     if inst.id not in problems:
         problems[inst.id] = inst.problem()
     problem = problems[inst.id]
+    if get_config(task["config"]).kind == "front":
+        return _front_row_problem(r, problem, inst.objectives)
     objective = inst.objectives[0]
     design = r.design
     if r.verified is not True or not isinstance(design, dict):
@@ -355,13 +448,18 @@ def row_problem(
     ok, violated, objs = verify_design(problem, x)
     if not ok:
         return f"has a design that violates {violated[0].describe()}"
+    why = objective_range_problem(problem, {**objs, objective: r.objective}, objective)
+    if why:
+        return f"counts as a success where {why}"
     value = float(objs[objective])
     if abs(r.objective - value) > 1e-7 * max(abs(value), 1e-12):
         return f"has objective {r.objective:.10g}, but its design gives {value:.10g}"
     return None
 
 
-def _front_row_problem(row: BenchRow) -> str | None:
+def _front_row_problem(
+    row: BenchRow, problem: DesignProblem, objectives: tuple[str, ...]
+) -> str | None:
     front = row.front
     if not (
         isinstance(front, list)
@@ -375,4 +473,8 @@ def _front_row_problem(row: BenchRow) -> str | None:
     v = row.violation
     if not (is_number(v) and 0 <= v <= FEASIBILITY_TOL):
         return f"counts as a success with violation {v!r}"
+    for point in front:
+        why = objective_range_problem(problem, dict(zip(objectives, point, strict=False)))
+        if why:
+            return f"counts as a success where {why}"
     return None

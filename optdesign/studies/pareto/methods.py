@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -30,6 +30,7 @@ from optdesign.argument_checks import DEFAULT_FRONT_POINTS, ArgumentError
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.multistart import improves
 from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
@@ -40,6 +41,7 @@ from optdesign.studies.pareto.chains import (
     three_objective_tasks,
 )
 from optdesign.studies.pareto.front import Front
+from optdesign.studies.pareto.polish import MAX_ROUNDS, round_tasks
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.run_setup import (
     RunOptions,
@@ -89,7 +91,10 @@ class EpsilonConstraint(FrontMethod):
     retry_starts, extra_starts
         Sobol starts for a point that fails, worsens or jumps; at every point.
     deterministic
-        Chains meet in the middle whatever the timing (same front for any workers).
+        True (default): the chains meet in the middle whatever the timing, so the front
+        is the same for any number of workers and a resumed run equals an uninterrupted
+        one. False: they meet where timing makes them meet (faster with several workers;
+        the front may then depend on the workers).
     name
         Name of the method and of its store (``{name}.jsonl``).
     """
@@ -103,7 +108,7 @@ class EpsilonConstraint(FrontMethod):
     solver: str = FRONT_SOLVERS.primary
     retry_starts: int = 4
     extra_starts: int = 0
-    deterministic: bool = False
+    deterministic: bool = True
     name: str = "epsilon"
 
     honours_time_limit: ClassVar[bool] = True
@@ -159,6 +164,7 @@ class EpsilonConstraint(FrontMethod):
                 done = phase(anchor_list, resume=run.resume, expand=sweep)
                 anchors = _anchors(done, objectives, run)
                 tasks = sweep.tasks
+                done, latest = _polish(phase, done, tasks, self.name, common)
             else:
                 # Three objectives: the rows need every anchor (the nadir of B), so the
                 # anchors run first, then the rows in parallel.
@@ -170,8 +176,9 @@ class EpsilonConstraint(FrontMethod):
                 known = {f"anchor-{k}": done[f"anchor-{k}"] for k in objectives}
                 # the anchors are in the store already: resume over them
                 done = phase(tasks, resume=True, known=known)
+                latest = {}
         recs = [
-            PointRecord.from_dict(done[t["id"]])
+            PointRecord.from_dict(done[latest.get(t["id"], t["id"])])
             for t in sorted(tasks, key=lambda t: t["index"])
             if t["id"] in done  # a time limit leaves the points not begun out
         ]
@@ -184,6 +191,45 @@ class EpsilonConstraint(FrontMethod):
             )
         n_solves = sum(r.n_solves for r in recs) + sum(r.n_solves for r in anchors.values())
         return Traced(recs, anchors, n_solves, notes)
+
+
+def _polish(
+    phase: Callable[..., dict],
+    done: dict[str, Any],
+    tasks: Sequence[Mapping[str, Any]],
+    name: str,
+    common: Mapping[str, Any],
+) -> tuple[dict[str, Any], dict[str, str]]:
+    """The polish rounds of a two-objective front (:mod:`optdesign.studies.pareto.
+    polish`): the records with the rounds' added, and each point's latest record id."""
+    points = sorted((t for t in tasks if t["id"] in done), key=lambda t: t["index"])
+    if len(points) < len(tasks):  # a time limit left points out: nothing to polish
+        return done, {}
+    first = [t["id"] for t in points]
+    ids = list(first)
+    current = [PointRecord.from_dict(done[i]) for i in ids]
+    improved: set[int] | None = None
+    for round_no in range(1, MAX_ROUNDS + 1):
+        seen_ids = list(done)
+        seen = [PointRecord.from_dict(done[i]) for i in seen_ids]
+        round_list = round_tasks(current, ids, seen, seen_ids, improved, round_no, name, common)
+        if not round_list:
+            break
+        done = {**done, **phase(round_list, resume=True, known=done)}
+        if any(t["id"] not in done for t in round_list):
+            break  # the time limit: the points keep what they have
+        improved = set()
+        for t in round_list:
+            i, new = t["index"], PointRecord.from_dict(done[t["id"]])
+            if new.success and (
+                not current[i].success
+                or improves(new.objectives[new.target], current[i].objectives[new.target])
+            ):
+                improved.add(i)
+                current[i], ids[i] = new, t["id"]
+        if not improved:
+            break
+    return done, {a: b for a, b in zip(first, ids, strict=True) if a != b}
 
 
 def _deadline_passed() -> bool:

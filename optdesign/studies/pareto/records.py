@@ -53,13 +53,19 @@ class RawSolution:
 
 @dataclass
 class AnchorStarts:
-    """How an anchor's multistart went: starts planned, run, and agreeing on the best."""
+    """How an anchor's global search went: starts planned, run and agreeing on the best;
+    the distinct optima the counted starts reached, the estimated probability that a
+    better one exists, and why the search stopped (:mod:`optdesign.search`)."""
 
     n_starts: int
     n_planned: int
     n_at_best: int
     agree: int | None
     stopped_early: bool
+    optima: int = 0
+    counted: int = 0
+    p_better: float | None = None
+    stop: str = ""
 
 
 @dataclass(kw_only=True)

@@ -3,14 +3,16 @@
 A task is a dict (``id``, ``kind``, ``after``, settings); :func:`front_task` dispatches on
 ``kind`` and returns a :class:`PointRecord` as a dict. Kinds:
 
-- ``anchor-multistart``: the individual optimum of ``order[0]`` by seeded multistart, which
-  stops once ``agree`` starts agree on the best value;
+- ``anchor-multistart``: the individual optimum of ``order[0]`` by the global search
+  (:mod:`optdesign.search`), which stops when its odds say so;
 - ``anchor``: lexicographic tie-breaks from that optimum (an individual optimum is often
   not unique - the ripple of a crank-slider is invariant to scaling R, l, n, p together -
   and only the tie-broken point is on the front);
 - ``eps``: one epsilon-constraint point, warm-started from its neighbour, re-solved from
   Sobol starts if it fails, gets worse as its bound loosens, or jumps in design space;
-- ``weighted_sum``: one point of the weighted sum of normalised objectives.
+- ``weighted_sum``: one point of the weighted sum of normalised objectives;
+- ``polish``: a point solved again warm from designs the run holds
+  (:mod:`optdesign.studies.pareto.polish`).
 """
 
 from __future__ import annotations
@@ -22,8 +24,10 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.solvers.multistart import best_of, improves, sobol_starts
+from optdesign.search.global_phase import global_search
+from optdesign.solvers.multistart import improves, sobol_starts
 from optdesign.solvers.result import Result
+from optdesign.studies.nlp_solve import own_starts, tilted_starts
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_from_result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -47,38 +51,46 @@ def _record(task, solver: EpsSolver, result: Result, kind: str, target: str, eps
 
 
 def multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
-    """Individual optimum of ``order[0]`` by seeded multistart (first half of an anchor)."""
+    """Individual optimum of ``order[0]`` by the global search (first half of an anchor):
+    tilted random starts until the odds say stop (:mod:`optdesign.search`)."""
     problem: DesignProblem = task["problem"]
     order: list[str] = task["order"]
     agree = task.get("agree")
     t0 = time.perf_counter()
     solver = _solver(task)
     free = {k: np.inf for k in order[1:]}
-    pts = [problem.start()]
-    if task["starts"] > 1:
-        pts += list(
-            sobol_starts(problem.lower(), problem.upper(), task["starts"] - 1, task["seed"])
+    draws = tilted_starts(problem, order[0], task["seed"])
+
+    def run(fallback: bool) -> Result:
+        return global_search(
+            lambda x0: solver.solve(order[0], free, solver.nlp.start(x0=x0), fallback),
+            draws,
+            own=own_starts(problem),
+            max_starts=task["starts"],
+            agree=3 if agree is None else agree,
+            seed=task["seed"],
         )
 
-    def run(fallback: bool) -> tuple[list[Result], int]:
-        results: list[Result] = []
-        n_at_best = 0
-        for x0 in pts:
-            results.append(solver.solve(order[0], free, solver.nlp.start(x0=x0), fallback))
-            n_at_best = best_of(results)[1]
-            if agree and n_at_best >= agree:
-                break
-        return results, n_at_best
-
     # No per-start Ipopt fallback first: a start that fails is just a failed start.
-    results, n_at_best = run(False)
-    n_solves = len(results)
-    if n_at_best == 0 and solver.has_fallback:
-        results, n_at_best = run(True)
-        n_solves += len(results)
-    best, n_at_best = best_of(results)
+    best = run(False)
+    n_solves = best.multistart.n_starts
+    if best.multistart.n_at_best == 0 and solver.has_fallback:
+        best = run(True)
+        n_solves += best.multistart.n_starts
+    ms = best.multistart
     rec = _record(task, solver, best, "anchor-multistart", order[0], {})
-    rec.multistart = AnchorStarts(len(results), len(pts), n_at_best, agree, len(results) < len(pts))
+    odds = ms.odds
+    rec.multistart = AnchorStarts(
+        ms.n_starts,
+        ms.n_planned or ms.n_starts,
+        ms.n_at_best,
+        agree,
+        ms.stopped_early,
+        optima=len(ms.optima),
+        counted=ms.counted,
+        p_better=None if odds is None else odds.p_better,
+        stop=ms.stop,
+    )
     rec.order = list(order)
     rec.n_solves = n_solves
     rec.wall_time_s = time.perf_counter() - t0
@@ -236,12 +248,55 @@ def weighted_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str,
     return rec.to_dict()
 
 
+def polish_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]:
+    """A front point (``task["point"]``) solved again warm from each record of
+    ``task["sources"]`` in order (:mod:`optdesign.studies.pareto.polish`); the best is
+    kept, the point's own record on a tie. A source that meets the point's epsilon bound
+    and beats it, where the local solve from it fails, becomes the point itself (a design
+    the independent check passed, with the point's bound)."""
+    t0 = time.perf_counter()
+    records = _records(deps)
+    point = records[task["point"]]
+    rec, target, eps = point, point.target, dict(point.eps)
+    solver = _solver(task)
+    n_solves = 0
+    for src in task["sources"]:
+        other = records[src]
+        res = solver.solve(target, eps, solver.start_from(other))
+        n_solves += 1
+        cand = _record(task, solver, res, "eps", target, eps)
+        if not cand.success and _meets(other, eps) and other.success:
+            cand = PointRecord.from_dict({**other.to_dict(), "eps": eps, "id": task["id"]})
+            cand.fallback = f"kept {src}'s design: the solve from it failed ({res.status})"
+        if cand.success and (
+            not rec.success or improves(cand.objectives[target], rec.objectives[target])
+        ):
+            rec = cand
+            rec.warm = src
+            rec.retried = f"polished from {src}"
+    if rec is not point and rec.success and len(eps) == 1:
+        rec.slope = solver.slope(target, next(iter(eps)), rec)
+    rec.id = task["id"]
+    rec.kind = "eps"
+    rec.target = target
+    rec.n_solves = point.n_solves + n_solves
+    rec.wall_time_s = time.perf_counter() - t0
+    return rec.to_dict()
+
+
+def _meets(rec: PointRecord, eps: Mapping[str, float]) -> bool:
+    return all(
+        rec.objectives.get(k, np.inf) <= v * (1 + OBJECTIVE_TIE_TOL) + 1e-12 for k, v in eps.items()
+    )
+
+
 #: kind -> task function.
 TASK_KINDS = {
     "anchor-multistart": multistart_task,
     "anchor": tie_task,
     "eps": eps_task,
     "weighted_sum": weighted_task,
+    "polish": polish_task,
 }
 
 

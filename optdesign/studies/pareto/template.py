@@ -20,6 +20,7 @@ from typing import Any, ClassVar
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.studies.nlp_solve import planned_starts
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord
@@ -159,7 +160,7 @@ class FrontMethod:
         """The method's ``starts`` and ``seed``, else the problem file's."""
         starts = getattr(self, "starts", None)
         if starts is None:
-            starts = problem.spec.solver.starts
+            starts = planned_starts(problem)
             if self.max_default_starts is not None:
                 starts = min(starts, self.max_default_starts)
         seed = getattr(self, "seed", None)

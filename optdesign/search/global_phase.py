@@ -1,0 +1,294 @@
+"""The global search: local solves from tilted independent starts until the odds of a
+better optimum say stop.
+
+:func:`global_search` runs a local solver (an NLP back-end's ``solve``: anything
+``x0 -> Result``) from
+
+1. the caller's own starts, if any (a declared start, a neighbour's design): solved
+   first, never counted by the odds, since they are no random draw;
+2. starts drawn a chunk at a time from :class:`~optdesign.search.starts.TiltedStarts`.
+
+After each start it asks the stopping rule (:class:`StopRule`), on the starts so far in
+their order: stop once the counted starts' odds are settled (Boender and Rinnooy Kan's
+rule, :func:`optdesign.search.odds.settled`) and at least ``agree`` starts reached the best
+value; after :data:`FAILED_LIMIT` starts without a feasible end (no design to compare);
+at the time limit; or when ``max_starts`` have run. The rule reads the starts in their
+order, so the answer is the one a serial run gives whatever the number of workers
+(:func:`optdesign.studies.inherited_map.map_inherited`'s prefix contract).
+
+Local optima are told apart by value alone (:func:`distinct_optima`): two starts whose
+objectives differ by less than the tie tolerance (relative), or by less than what the
+local solver resolves on the objective's scale (absolute), reached the same optimum as far
+as the search is concerned, even where a flat valley lets them end at different designs.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from optdesign.search.odds import odds, settled
+from optdesign.search.starts import CHUNK, TiltedStarts
+from optdesign.solvers.blas import one_blas_thread
+from optdesign.solvers.deadline import deadline, passed
+from optdesign.solvers.multistart import (
+    NOT_STARTED,
+    best_of,
+    outcome_counts,
+    start_outcome,
+    tie_width,
+)
+from optdesign.solvers.result import Globality, MultistartInfo, Result
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
+
+#: Starts in a row without a feasible end after which a search stops (the problem may
+#: have no feasible design; the diagnosis takes it from there).
+FAILED_LIMIT = 8
+
+#: Most starts per free variable that a search with no cap of its own may run.
+STARTS_PER_DIMENSION = 12
+
+#: Fewest starts a search with no cap of its own may run.
+MIN_MAX_STARTS = 32
+
+
+#: Counted starts per free variable that must converge before the odds may stop a search.
+COUNTED_PER_DIMENSION = 2
+
+
+def min_counted_starts(dimension: int) -> int:
+    """The converged counted starts a search needs before its odds are read:
+    :data:`COUNTED_PER_DIMENSION` per free variable. Boender and Rinnooy Kan's rule alone
+    stops after 8 starts that agree, whatever the dimension; but the share of the starts
+    that reach the best optimum shrinks as the design space grows (a ten-variable knee
+    linkage's best basin takes a fifth to a quarter of them), and 8 starts then miss it in
+    one search of ten."""
+    return COUNTED_PER_DIMENSION * int(dimension)
+
+
+def default_max_starts(dimension: int) -> int:
+    """The cap on a search's starts when the caller gives none: grows with the number of
+    free variables (:data:`STARTS_PER_DIMENSION` each, at least :data:`MIN_MAX_STARTS`)."""
+    return max(MIN_MAX_STARTS, STARTS_PER_DIMENSION * int(dimension))
+
+
+def distinct_optima(
+    values: Sequence[float], rel_tol: float = OBJECTIVE_TIE_TOL, abs_tol: float = 0.0
+) -> list[float]:
+    """The distinct local optima among converged starts' objective values, best first:
+    sorted values chained while each is within ``rel_tol`` (relative) or ``abs_tol``
+    (absolute: what the local solver resolves, its tolerance on the objective's scale) of
+    the group's first."""
+    out: list[float] = []
+    for v in sorted(v for v in values if math.isfinite(v)):
+        if not out or v > out[-1] + max(tie_width(out[-1], rel_tol), abs_tol):
+            out.append(v)
+    return out
+
+
+@dataclass(frozen=True)
+class StopRule:
+    """When a search stops, read from its results so far, in start order.
+
+    ``counted_from``: the index of the first counted start (the caller's own starts come
+    before it); ``agree``: starts that must reach the best value before the odds may stop
+    the search (0: the odds never stop it, every start runs); ``target``: an estimated
+    probability of a better optimum the odds must also reach (None: Boender and Rinnooy
+    Kan's rule alone); ``rel_tol``, ``abs_tol``: two values closer than these are one
+    optimum (:func:`distinct_optima`); ``min_counted``: counted starts that must converge
+    before the odds are read (:func:`min_counted_starts`).
+    """
+
+    counted_from: int
+    agree: int
+    target: float | None = None
+    rel_tol: float = OBJECTIVE_TIE_TOL
+    abs_tol: float = 0.0
+    min_counted: int = 0
+
+    def reason(self, results: Sequence[Result]) -> str:
+        """Why a search with these results stops (``""``: it goes on)."""
+        if passed():
+            return "time limit"
+        if not self.agree:
+            return ""
+        if not any(_converged(r) for r in results):
+            # a failed start that ended at a feasible design shows one exists: go on
+            hopeless = len(results) >= FAILED_LIMIT and not any(r.verified for r in results)
+            return "no feasible start" if hopeless else ""
+        if best_of(results, self.rel_tol)[1] < self.agree:
+            return ""
+        counted = [r.objective for r in results[self.counted_from :] if _converged(r)]
+        if len(counted) < self.min_counted:
+            return ""
+        found = odds(len(counted), len(self.optima(counted)))
+        return "odds" if settled(found, self.target) else ""
+
+    def __call__(self, results: Sequence[Result]) -> bool:
+        return bool(self.reason(results))
+
+    def optima(self, values: Sequence[float]) -> list[float]:
+        """The distinct optima among ``values`` (:func:`distinct_optima`)."""
+        return distinct_optima(values, self.rel_tol, self.abs_tol)
+
+
+def _converged(r: Result) -> bool:
+    return bool(r.success) and math.isfinite(r.objective)
+
+
+MapFunction = Callable[..., list[Result]]
+
+
+def global_search(
+    solve: Callable[[np.ndarray], Result],
+    starts: TiltedStarts,
+    own: Sequence[np.ndarray] = (),
+    max_starts: int | None = None,
+    agree: int = 3,
+    target: float | None = None,
+    workers: int = 1,
+    seed: int = 0,
+    time_limit: float | None = None,
+    parallel_map: MapFunction | None = None,
+    rel_tol: float = OBJECTIVE_TIE_TOL,
+    abs_tol: float = 0.0,
+) -> Result:
+    """The best result of local solves from ``own`` then tilted starts, with its record.
+
+    Parameters
+    ----------
+    solve
+        x0 -> Result (a solver built once; forked workers inherit it).
+    starts
+        The tilted draws (:class:`~optdesign.search.starts.TiltedStarts`).
+    own
+        The caller's starts, solved first and never counted by the odds.
+    max_starts
+        The most starts in all, ``own`` included (None: :func:`default_max_starts`).
+    agree, target
+        The stopping rule's (:class:`StopRule`).
+    workers, parallel_map
+        Local processes and the map that runs starts on them (``parallel_map(solve,
+        starts, workers, stop=...)`` -> the shortest prefix on which ``stop`` holds).
+    time_limit
+        Wall-clock seconds for the whole search: no start begins after it.
+    rel_tol, abs_tol
+        Values closer than these are one optimum when the optima are counted (the best
+        start is chosen with ``rel_tol`` alone, :func:`~optdesign.solvers.multistart.
+        best_of`).
+
+    Returns
+    -------
+    Result
+        The best start's result (:func:`~optdesign.solvers.multistart.best_of`) with its
+        :class:`~optdesign.solvers.result.MultistartInfo`: counts, outcomes, the distinct
+        optima, the odds and why it stopped.
+    """
+    if workers > 1 and parallel_map is None:
+        raise ValueError("global_search: workers > 1 needs a parallel_map")
+    t0 = time.perf_counter()
+    own = [np.asarray(x, dtype=float) for x in own]
+    cap = max_starts if max_starts is not None else default_max_starts(len(starts.lower))
+    cap = max(1, int(cap))
+    dimension = len(starts.lower)
+    rule = StopRule(
+        min(len(own), cap), agree, target, rel_tol, abs_tol, min_counted_starts(dimension)
+    )
+    results: list[Result] = []
+    planned = 0
+    with one_blas_thread(), deadline(time_limit):
+        while len(results) < cap and (not results or not rule(results)):
+            n = min(cap, len(results) + (CHUNK if results or not own else len(own)))
+            batch = _starts_between(own, starts, len(results), n)
+            planned = n
+            before = list(results)
+
+            def stop(tail: list[Result], before=before) -> bool:
+                return rule(before + tail)
+
+            if workers > 1 and len(batch) > 1:
+                results = before + parallel_map(solve, list(batch), workers, stop=stop)
+            else:
+                for x0 in batch:
+                    results.append(solve(x0))
+                    if stop(results[len(before) :]):
+                        break
+        why = rule.reason(results) or "all starts run"
+    return _best_with_record(results, rule, why, planned, cap, seed, workers, time_limit, t0)
+
+
+def _starts_between(own: list[np.ndarray], tilted: TiltedStarts, a: int, b: int) -> np.ndarray:
+    """Starts ``a`` to ``b - 1`` of the search: the caller's, then the tilted draws."""
+    rows = [own[k] for k in range(a, min(b, len(own)))]
+    if b > len(own):
+        drawn = tilted.first(b - len(own))
+        rows += list(drawn[max(0, a - len(own)) :])
+    return np.array(rows)
+
+
+def _best_with_record(
+    results: list[Result],
+    rule: StopRule,
+    why: str,
+    planned: int,
+    cap: int,
+    seed: int,
+    workers: int,
+    time_limit: float | None,
+    t0: float,
+) -> Result:
+    best, n_at_best = best_of(results, rule.rel_tol)
+    outcomes = [start_outcome(r) for r in results]
+    timed_out = why == "time limit"
+    not_started = max(0, planned - len(results)) if timed_out else 0
+    counted = [r.objective for r in results[rule.counted_from :] if _converged(r)]
+    found = odds(len(counted), len(rule.optima(counted))) if counted else None
+    if timed_out:
+        stopped = sum(o == "time limit" for o in outcomes)
+        best.notes.append(
+            f"time limit of {time_limit:g} s reached: {len(results)} of {planned} starts run "
+            f"({stopped} stopped at the limit), {not_started} not started; the odds count "
+            "only the starts that converged"
+        )
+    best.multistart = MultistartInfo(
+        n_starts=len(results),
+        n_converged=sum(r.success for r in results),
+        n_at_best=n_at_best,
+        tolerance=rule.rel_tol,
+        objectives=[r.objective if r.success else math.nan for r in results],
+        seed=seed,
+        workers=workers,
+        n_planned=cap,
+        stopped_early=len(results) < cap,
+        outcomes=outcomes,
+        failed=outcome_counts(outcomes + [NOT_STARTED] * not_started),
+        optima=rule.optima([r.objective for r in results if _converged(r)]),
+        counted=len(counted),
+        odds=found,
+        stop=why,
+    )
+    best.wall_time_s = time.perf_counter() - t0
+    return best
+
+
+def search_globality(info: MultistartInfo | None) -> Globality:
+    """What a search's record says of its best value: never proved; its odds, and why
+    the search stopped where that limits them."""
+    if info is None:
+        return Globality(basis="no search")
+    if info.odds is None:
+        if info.n_converged:
+            return Globality(basis="only the caller's own starts converged: no random start")
+        return Globality(basis="no start converged")
+    basis = {
+        "time limit": "the time limit stopped the search",
+        "all starts run": (
+            f"the search ran all {info.n_starts} starts it was allowed"
+            + ("" if settled(info.odds) else " before the odds settled")
+        ),
+    }.get(info.stop, "")
+    return Globality(basis=basis, odds=info.odds)

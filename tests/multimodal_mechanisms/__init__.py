@@ -1,0 +1,1 @@
+"""Test plug-ins with multimodal design landscapes, each with an independent reference."""

@@ -1,0 +1,1 @@
+"""Tests of optdesign.search: the global search, its starts and its odds."""

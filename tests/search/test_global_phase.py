@@ -1,0 +1,158 @@
+"""optdesign.search.global_phase: the search on a made-up landscape whose regions of
+attraction are known - what it finds, when it stops, what it counts - and the same
+answer on one or two workers."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from optdesign.search.global_phase import (
+    FAILED_LIMIT,
+    StopRule,
+    default_max_starts,
+    distinct_optima,
+    global_search,
+    search_globality,
+)
+from optdesign.search.odds import odds
+from optdesign.search.starts import TiltedStarts
+from optdesign.solvers.result import Result
+from optdesign.studies.inherited_map import map_inherited
+
+#: Centres of the regions of attraction (nearest centre wins) and their optimum values.
+CENTRES = np.array([[0.1, 0.1], [0.9, 0.2], [0.5, 0.8], [0.95, 0.95]])
+VALUES = np.array([3.0, 2.0, 1.5, 1.0])  # the best optimum has the smallest region
+
+
+def _region(x):
+    return int(np.argmin(np.linalg.norm(CENTRES - np.asarray(x), axis=1)))
+
+
+def local_solve(x0):
+    """The local solver of the landscape: the optimum of the start's region."""
+    k = _region(x0)
+    return Result(
+        status="optimal",
+        objective=float(VALUES[k]),
+        design={"x": float(CENTRES[k, 0]), "y": float(CENTRES[k, 1])},
+        formulation="test",
+        verified=True,
+    )
+
+
+def failing_solve(x0):
+    return Result(status="failed", objective=float("nan"), formulation="test")
+
+
+def sample(points):
+    """The NumPy path's view of the landscape: a bowl around each centre, rising to the
+    region's edge, at the region's optimum value."""
+    d = np.linalg.norm(points[:, None, :] - CENTRES[None], axis=2)
+    k = np.argmin(d, axis=1)
+    return VALUES[k] + d[np.arange(len(points)), k], np.zeros(len(points))
+
+
+def starts(seed=0):
+    return TiltedStarts(sample, np.zeros(2), np.ones(2), seed)
+
+
+def test_uniform_starts_see_every_region_and_stop_on_their_odds():
+    uniform = TiltedStarts(sample, np.zeros(2), np.ones(2), 0, per_start=1)
+    best = global_search(local_solve, uniform, max_starts=200)
+    ms = best.multistart
+    assert best.objective == 1.0
+    assert ms.stop == "odds"
+    assert ms.optima == [1.0, 1.5, 2.0, 3.0]
+    assert ms.counted == ms.n_starts  # no start of the caller's
+    assert ms.odds == odds(ms.counted, 4)
+    assert ms.odds.expected_unseen < 0.5
+    assert ms.n_at_best == ms.objectives.count(1.0) >= 3
+
+
+def test_tilted_starts_reach_the_best_region_more_often_than_uniform_ones():
+    uniform = TiltedStarts(sample, np.zeros(2), np.ones(2), 0, per_start=1).first(256)
+    tilted = starts().first(256)
+    share = [np.mean([_region(x) == 3 for x in pts]) for pts in (uniform, tilted)]
+    assert share[0] < 0.15 and share[1] > 2 * share[0]
+    best = global_search(local_solve, starts(), max_starts=200)
+    assert best.objective == 1.0 and best.multistart.stop == "odds"
+    assert best.multistart.optima[0] == 1.0
+
+
+def test_the_callers_starts_come_first_and_are_not_counted():
+    own = [np.array([0.96, 0.96]), np.array([0.9, 0.9])]
+    best = global_search(local_solve, starts(), own=own, max_starts=40)
+    ms = best.multistart
+    assert ms.objectives[:2] == [1.0, 1.0]
+    assert ms.counted == ms.n_starts - 2
+
+
+def test_agree_zero_runs_every_start():
+    best = global_search(local_solve, starts(), max_starts=21, agree=0)
+    assert best.multistart.n_starts == 21 and best.multistart.stop == "all starts run"
+    assert not best.multistart.stopped_early
+
+
+def test_a_search_with_no_feasible_end_stops():
+    best = global_search(failing_solve, starts(), max_starts=100)
+    assert best.multistart.n_starts == FAILED_LIMIT
+    assert best.multistart.stop == "no feasible start"
+    assert best.multistart.odds is None
+    assert "no start converged" in search_globality(best.multistart).text()
+
+
+def test_a_time_limit_stops_the_search():
+    def slow(x0):
+        time.sleep(0.02)
+        return local_solve(x0)
+
+    best = global_search(slow, starts(), max_starts=500, agree=0, time_limit=0.1)
+    ms = best.multistart
+    assert ms.stop == "time limit" and ms.n_starts < 20
+    assert "time limit" in search_globality(ms).text()
+    assert any("time limit of 0.1 s" in n for n in best.notes)
+
+
+def test_a_cap_reached_before_the_odds_settle_is_said():
+    best = global_search(local_solve, starts(), max_starts=6)
+    text = search_globality(best.multistart).text()
+    assert text.startswith("not proved; ")
+    assert "ran all 6 starts it was allowed before the odds settled" in text
+
+
+def test_one_and_two_workers_give_the_same_search():
+    one = global_search(local_solve, starts(3), max_starts=200)
+    two = global_search(
+        local_solve, starts(3), max_starts=200, workers=2, parallel_map=map_inherited
+    )
+    a, b = one.multistart, two.multistart
+    assert (a.n_starts, a.objectives, a.optima, a.odds, a.stop) == (
+        b.n_starts,
+        b.objectives,
+        b.optima,
+        b.odds,
+        b.stop,
+    )
+    assert one.design == two.design
+
+
+def test_distinct_optima_chain_ties():
+    values = [1.0, 1.0 + 5e-7, 1.0 + 1.2e-6, 2.0, float("nan"), 2.0 - 1e-9]
+    assert distinct_optima(values) == [1.0, 1.0 + 1.2e-6, 2.0 - 1e-9]
+
+
+def test_the_stop_rule_needs_agreement_and_settled_odds():
+    rule = StopRule(counted_from=0, agree=3)
+    same = [local_solve(CENTRES[3])] * 7
+    assert rule.reason(same) == ""  # 2 / (7 - 3) = 0.5 optima expected unseen: not yet
+    assert rule.reason([*same, local_solve(CENTRES[3])]) == "odds"
+    assert StopRule(counted_from=0, agree=9).reason(same + same[:1]) == ""
+    assert StopRule(counted_from=0, agree=0).reason(same * 5) == ""
+
+
+@pytest.mark.parametrize(("d", "cap"), [(1, 32), (2, 32), (5, 60), (7, 84)])
+def test_the_cap_grows_with_the_dimension(d, cap):
+    assert default_max_starts(d) == cap
