@@ -167,9 +167,12 @@ def pareto(
     between exact anchors, evenly spread along the front; default), ``"uniform"``
     (epsilon evenly spaced), ``"weighted_sum"`` or ``"nsga2"``, or a method object.
     Options (all keywords; an option the method does not use is refused): ``out``
-    (folder of the resumable store; default: a new temporary folder
-    ``optdesign-pareto-*``, kept, named by ``Front.store``), ``workers``, ``scheduler``
-    (Dask), ``resume``, ``overwrite`` (start afresh over a stored run), ``progress``,
+    (folder of the resumable store, and of the files ``optdesign pareto`` writes:
+    ``front.csv``, ``front.json``, ``front.png``, ``report.html``; default: a new
+    temporary folder ``optdesign-pareto-*`` with the store alone, kept, named by
+    ``Front.store``), ``files`` (False: the store alone in ``out``), ``workers``,
+    ``scheduler`` (Dask), ``resume``, ``overwrite`` (start afresh over a stored run),
+    ``progress``,
     ``starts``, ``seed``,
     ``solver``, ``agree``, ``spacing``, ``eps_values``, ``retry_starts``,
     ``extra_starts``, ``deterministic``, ``time_limit`` (wall-clock seconds of a
@@ -185,6 +188,7 @@ def pareto(
         (hypervolume, spacing, spread); ``.summary()``, ``.to_frame()``, ``.plot()``.
     """
     from optdesign.studies.pareto import compute_front
+    from optdesign.studies.pareto.front import Front
 
     objectives, points, method, options = validation.pareto_arguments(
         objectives, points, method, options
@@ -193,7 +197,23 @@ def pareto(
     validation.front_objectives(problem, objectives)
     validation.method_for(problem, method)
     validation.front_time_limit(problem, [method], options.get("time_limit"))
-    return compute_front(problem, objectives, points, method, **options)
+    files = options.pop("files", True)
+    front = compute_front(problem, objectives, points, method, **options)
+    if files and options.get("out") is not None and isinstance(front, Front):
+        import time
+
+        from optdesign.reports.front_files import write_front_outputs
+
+        _, notes = write_front_outputs(
+            [front],
+            problem,
+            Path(options["out"]),
+            objectives=objectives,
+            points=points,
+            created=time.strftime("%Y-%m-%d %H:%M:%S"),
+        )
+        front.notes.extend(notes)
+    return front
 
 
 def bench(
@@ -219,7 +239,8 @@ def bench(
     stream to ``out`` (a new temporary folder by default) and can be resumed
     (``resume``) or started afresh (``overwrite``). ``time_limit``: soft wall-time limit
     of each solver call (s, at most a day); ``hard_timeout``: a run is killed after it
-    (default ``time_limit + 3``). ``scheduler``: address of a Dask scheduler.
+    (default ``time_limit + 3``; above ``time_limit``). ``scheduler``: address of a Dask
+    scheduler (``tcp://HOST:PORT``) or its ``distributed.Client``.
     ``update_readme``: a text file whose generated block (between the markers of
     ``benchmarks/README.md``) gets the summary; checked before any run. ``optdesign
     bench`` runs through this function.
@@ -339,6 +360,7 @@ def sweep(
     sensitivities: bool = False,
     workers: int = 1,
     scheduler: str | None = None,
+    files: bool = True,
 ):
     """How the optimum of ``problem`` moves when one or two parameters change.
 
@@ -347,13 +369,16 @@ def sweep(
     ``requirements.NAME`` (``requirements.mean_ratio.min`` inside a band),
     ``variables.NAME.lower`` / ``.upper`` (a free variable's bound) or ``variables.NAME``
     (a fixed variable); start and stop are quantities of the parameter's dimension
-    (a bare number only for a plain number), count 2..1000. Every point gets the global
-    search a cold solve of it runs (``starts``, ``seed``: that search's, default the
-    file's; the same seed at every point), then polish rounds warm-start each point from
+    (a bare number only for a plain number), count 2..1000, at most 2 500 points in all
+    (the product of the counts). Every point gets the global search a cold solve of it
+    runs (``starts``, ``seed``: that search's, default the file's; the same seed at every
+    point), then polish rounds warm-start each point from
     its neighbours' designs until no point improves (:mod:`optdesign.studies.sweep`).
     ``check_every`` is accepted and ignored (it set the interval of the multistart
     checks of an older method; every point is searched now). The points go to
-    ``out/sweep.jsonl`` as they finish (a new temporary folder by default); ``resume``
+    ``out/sweep.jsonl`` as they finish (a new temporary folder by default), and with
+    ``out`` given the files ``optdesign sweep`` writes (``sweep.csv``, ``sweep.json``,
+    ``sweep.png``, ``sweep.html``; ``files=False``: the store alone); ``resume``
     continues a stored sweep, ``overwrite`` starts afresh over one. ``workers`` (local
     processes) or ``scheduler`` (a Dask scheduler's address): the points of each round
     side by side (the records are the same for any number).
@@ -382,9 +407,10 @@ def sweep(
     resume = validation.flag("resume", resume)
     overwrite = validation.flag("overwrite", overwrite)
     progress = validation.flag("progress", progress)
+    files = validation.flag("files", files)
     sensitivities = validation.flag("sensitivities", sensitivities)
     workers = validation.workers("workers", workers)
-    scheduler = validation.text("scheduler", scheduler, optional=True)
+    scheduler = validation.scheduler("scheduler", scheduler)
     validation.run_folder(out, resume, overwrite)
     problem = load(problem)
     validation.objective_of(problem, objective)
@@ -407,4 +433,10 @@ def sweep(
         overwrite=overwrite,
         progress=progress,
     )
-    return run_sweep(problem, vary, request, check_every=check_every, run=run)
+    swept = run_sweep(problem, vary, request, check_every=check_every, run=run)
+    if out is not None and files:
+        from optdesign.reports.sweep_files import write_sweep_outputs
+
+        _, notes, _ = write_sweep_outputs(swept, Path(out))
+        swept.notes.extend(notes)
+    return swept

@@ -277,3 +277,59 @@ def odds(argument: str, value: Any) -> float | None:
 def seconds(argument: str, value: Any) -> float | None:
     """A time limit in seconds, at most a day (None: the default)."""
     return number(argument, value, 0.0, MAX_SECONDS, optional=True)
+
+
+#: Transports of a Dask scheduler's address (those distributed registers; ``inproc``: a
+#: scheduler inside this process, ``inproc://HOST/PID/N``).
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+_HOST = re.compile(r"[A-Za-z0-9](?:[A-Za-z0-9._-]*[A-Za-z0-9])?|\[[0-9A-Fa-f:.]+(?:%\w+)?\]")
+_INPROC = re.compile(r"[^\s/]+/\d+/\d+")
+
+
+def scheduler(argument: str, value: Any) -> Any:
+    """A Dask distributed scheduler: its address ``SCHEME://HOST:PORT`` (``HOST:PORT``
+    is ``tcp://HOST:PORT``, as distributed reads it; an IPv6 host in brackets; an
+    in-process scheduler's ``inproc://HOST/PID/N``) or, from Python, a
+    ``distributed.Client``; None: local processes. Only the form is checked
+    here; a scheduler that does not answer is refused when the run connects to it
+    (:func:`optdesign.studies.runner.run_tasks`)."""
+    if value is None:
+        return None
+    if not isinstance(value, str):
+        if hasattr(value, "submit") or hasattr(value, "scheduler_address"):  # a Client
+            return value  # (or a cluster, which the run makes its Client of)
+        raise ArgumentError(
+            argument,
+            f"expected a scheduler's address (e.g. 'tcp://127.0.0.1:8786') or a "
+            f"distributed.Client, got {shown(value)}",
+        )
+    form = "write SCHEME://HOST:PORT, e.g. tcp://127.0.0.1:8786"
+    scheme, sep, rest = value.partition("://")
+    if not sep:
+        scheme, rest = "tcp", value
+    if scheme not in SCHEDULER_SCHEMES:
+        raise ArgumentError(
+            argument,
+            f"{shown(value)} is not a scheduler's address: unknown transport {shown(scheme)} "
+            f"(known: {', '.join(SCHEDULER_SCHEMES)}; {form})",
+        )
+    if scheme == "inproc":
+        if not _INPROC.fullmatch(rest):
+            raise ArgumentError(
+                argument,
+                f"{shown(value)} is not a scheduler's address: an in-process scheduler's is "
+                "inproc://HOST/PID/N (its Client's scheduler.address)",
+            )
+        return value
+    host, colon, port = rest.rpartition(":")
+    if not colon or not port.isascii() or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise ArgumentError(
+            argument, f"{shown(value)} is not a scheduler's address: no port 1..65535 ({form})"
+        )
+    if not _HOST.fullmatch(host):
+        raise ArgumentError(
+            argument,
+            f"{shown(value)} is not a scheduler's address: {shown(host)} is not a host name "
+            f"({form})",
+        )
+    return value

@@ -114,7 +114,12 @@ def _reproduce(sub):
 
     p = sub.add_parser("reproduce", help="recompute a source paper's numbers and plots")
     p.add_argument("paper", choices=sorted(REPRODUCTIONS))
-    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument(
+        "--out",
+        type=checked(validation.out_path),
+        default=None,
+        help="output folder (default: new one)",
+    )
 
     def run(args):
         from optdesign import storage

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -76,10 +77,24 @@ class Parsed(NamedTuple):
     angle: int
 
 
+def check_ascii_digits(text: str, whole: str) -> None:
+    """Refused naming the first decimal digit of ``text`` that is not one of 0-9: Python's
+    ``float`` and ``re``'s ``\\d`` read every script's digits ("11\\u0660" as 110), so a
+    digit that looks like a letter or a space would change the number unseen."""
+    for ch in text:
+        if ch.isdecimal() and not ch.isascii():
+            name = unicodedata.name(ch, "a digit")
+            raise Refused(
+                f"{whole!r} has the digit {ch!r} (U+{ord(ch):04X} {name}): write numbers with "
+                "the digits 0-9"
+            )
+
+
 def parse(text: str) -> Parsed:
     """The number, unit and angle exponent of a quantity string; Refused saying why not."""
     if len(text) > MAX_LENGTH:
         raise Refused(f"too long for a quantity ({len(text)} characters)")
+    check_ascii_digits(text, text)
     m = _NUMBER.match(text)
     if m is None:
         raise Refused(
@@ -101,6 +116,7 @@ def parse(text: str) -> Parsed:
 def parse_unit_expression(text: str, whole: str) -> tuple[Any, int]:
     """(pint unit, angle exponent) of a unit expression (``whole``: the string shown in
     an error)."""
+    check_ascii_digits(text, whole)
     # "N-m", "lbf-ft": a hyphen between two unit names multiplies (engineering usage).
     text = re.sub(r"(?<=[^\W\d_])-(?=[^\W\d_])", "*", text)
     parser = _UnitParser(text, whole)

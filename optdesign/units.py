@@ -247,7 +247,7 @@ FAST_UNITS: dict[str, dict[str, float]] = {
     "rotational_stiffness": {"N*mm/rad": 1.0, "N*m/rad": 1e3, "kN*m/rad": 1e6},
 }
 
-_FAST = re.compile(r"([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(\S+)")
+_FAST = re.compile(r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)\s*(\S+)")
 
 
 def _fast_internal(text: str, dimension: str) -> float | None:

@@ -52,6 +52,7 @@ from optdesign.argument_checks import (  # noqa: F401
     path,
     points,
     pop_size,
+    scheduler,
     seconds,
     seed,
     shown,
@@ -107,12 +108,12 @@ def _optional_path(argument: str, value: Any):
     return path(argument, value, optional=True)
 
 
+def _optional_out(argument: str, value: Any):
+    return None if value is None else path(argument, out_path(argument, value))
+
+
 def _optional_function(argument: str, value: Any):
     return function(argument, value, optional=True)
-
-
-def _anything(argument: str, value: Any) -> Any:
-    return value
 
 
 def solve_arguments(**arguments: Any) -> dict[str, Any]:
@@ -170,6 +171,14 @@ SOLVE_ARGUMENTS = (
 )
 
 
+def vary_path(path: str) -> None:
+    """A sweep parameter's dotted path has no empty name (InputError ``vary``), the check
+    :func:`optdesign.sweep` makes, for the command line's ``--vary`` before its range."""
+    from optdesign.studies.sweep import check_path_names
+
+    check_path_names(path)
+
+
 def solver_options(argument: str, options: Any, solver: str) -> dict[str, Any] | None:
     """Options of a solver back-end (None: the registry's default for an NLP): a mapping
     with string keys, checked as the back-end declares (Ipopt's by Ipopt itself, the
@@ -200,6 +209,7 @@ RUN_OPTIONS = (
     "resume",
     "overwrite",
     "progress",
+    "files",
     "on_record",
     "time_limit",
 )
@@ -214,12 +224,13 @@ def _pareto_options() -> dict[str, tuple[Check, tuple[str, ...]]]:
         return integer(a, v, 0, MAX_STARTS)
 
     return {
-        "out": (_optional_path, ()),
+        "out": (_optional_out, ()),
         "workers": (workers, ()),
-        "scheduler": (_anything, ()),
+        "scheduler": (scheduler, ()),
         "resume": (flag, ()),
         "overwrite": (flag, ()),
         "progress": (flag, ()),
+        "files": (flag, ()),
         "on_record": (_optional_function, ()),
         "time_limit": (seconds, ()),  # refused by front_time_limit where not applied
         "starts": (starts, (*eps, "weighted_sum")),
@@ -294,12 +305,23 @@ def run_folder(out: Any, resume: bool, overwrite: bool) -> None:
         folder("out", out)
 
 
+def out_path(argument: str, value: Any):
+    """An output folder's path, as the command line's ``--out`` reads it: an empty word
+    names no folder (``Path("")`` is the working folder, which would receive every file)."""
+    from pathlib import Path
+
+    if isinstance(value, str) and not value.strip():
+        raise ArgumentError(argument, "an empty path names no folder: give the folder to write")
+    return Path(value)
+
+
 def folder(argument: str, out: Any) -> None:
     """``out`` can be (or become) a folder: the nearest part of the path that exists is
     a folder (a file there would fail only when the first result is written, after the
-    work)."""
+    work); an empty text is refused (:func:`out_path`)."""
     from pathlib import Path
 
+    out_path(argument, out)
     part = Path(out)
     while not os.path.lexists(part) and part != part.parent:
         part = part.parent
@@ -484,22 +506,38 @@ def bench_arguments(**arguments: Any) -> dict[str, Any]:
         {
             "suite": suite,
             "solvers": configs,
-            "out": _optional_path,
+            "out": _optional_out,
             "workers": workers,
             "resume": flag,
             "overwrite": flag,
             "time_limit": seconds,
             "hard_timeout": seconds,
             "progress": flag,
-            "scheduler": _optional_text,
+            "scheduler": scheduler,
         },
         arguments,
     )
     if checked["time_limit"] is None:
         raise ArgumentError("time_limit", "give a time limit in seconds")
+    bench_timeouts(checked["time_limit"], checked["hard_timeout"])
     run_folder(checked["out"], checked["resume"], checked["overwrite"])
     checked["problems"] = problems
     return checked
+
+
+def bench_timeouts(time_limit: float, hard_timeout: float | None) -> None:
+    """A benchmark run's hard timeout (None: ``time_limit + 3``) lies above its soft
+    time limit: the hard one kills the run, set-up included, so at or below the soft one
+    a run is killed before the soft limit can stop it with its best point."""
+    if hard_timeout is not None and not hard_timeout > time_limit:
+        raise ArgumentError(
+            "hard_timeout",
+            f"{hard_timeout:g} s is not above {{time_limit}} ({time_limit:g} s): the hard "
+            "timeout kills a run, set-up included, so a run that uses its time would be killed "
+            "before the soft limit stops it with its best point; give a larger {hard_timeout} "
+            "(default: the time limit + 3 s)",
+            ("time_limit", "hard_timeout"),
+        )
 
 
 def configs(argument: str, value: Any) -> list[str] | None:

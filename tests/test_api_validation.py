@@ -220,6 +220,20 @@ CASES = [
     bench("time_limit", 1e9, ["1e9"], "1e+09 is outside (0, 86400]"),
     bench("hard_timeout", 0, ["0"], "0 is outside (0, 86400]"),
     bench(
+        "scheduler",
+        "tcp://host:99999",
+        ["tcp://host:99999"],
+        "'tcp://host:99999' is not a scheduler's address: no port 1..65535 (write "
+        "SCHEME://HOST:PORT, e.g. tcp://127.0.0.1:8786)",
+    ),
+    pareto(
+        "scheduler",
+        "not a url",
+        "not a url",
+        "'not a url' is not a scheduler's address: no port 1..65535 (write "
+        "SCHEME://HOST:PORT, e.g. tcp://127.0.0.1:8786)",
+    ),
+    bench(
         "time_limit",
         10**400,
         ["1" + "0" * 400],
@@ -308,6 +322,23 @@ def test_every_command_line_option_is_an_api_argument():
         (lambda: od.solve(BACKLASH, agree=-1), "agree: -1 is outside 0..10000"),
         (lambda: od.solve(BACKLASH, ranges="no"), "ranges: 'no' is not True or False"),
         (
+            lambda: od.solve(BACKLASH, sensitivity=False),
+            "sensitivity: unknown argument of solve() (did you mean 'sensitivities'? known: "
+            "formulation, objective, starts, seed, workers, solver, options, ranges, agree, "
+            "diagnose, sensitivities, contact_models, time_limit, target_odds)",
+        ),
+        (lambda: od.solve(BACKLASH, target_odds=0.0), "target_odds: 0 is outside (0, 0.5]"),
+        (lambda: od.solve(BACKLASH, target_odds=0.9), "target_odds: 0.9 is outside (0, 0.5]"),
+        (lambda: od.solve(BACKLASH, sensitivities=1), "sensitivities: 1 is not True or False"),
+        (
+            lambda: od.sweep(RIPPLE, {"requirements.hinge_moment": ("2 N*m", "3 N*m", 2)}, out=""),
+            "out: an empty path names no folder: give the folder to write",
+        ),
+        (
+            lambda: od.pareto(RIPPLE, "ripple,size", out=" "),
+            "out: an empty path names no folder: give the folder to write",
+        ),
+        (
             lambda: od.solve(BACKLASH, options=[1]),
             "options: expected a dict of solver options, got [1]",
         ),
@@ -326,7 +357,7 @@ def test_every_command_line_option_is_an_api_argument():
         (
             lambda: od.pareto(RIPPLE, "ripple,size", pointz=5),
             "pointz: unknown option of pareto() (did you mean 'points'? known: out, workers, "
-            "scheduler, resume, overwrite, progress, on_record, time_limit, starts, seed, agree, "
+            "scheduler, resume, overwrite, progress, files, on_record, time_limit, starts, seed, agree, "
             "solver, spacing, eps_values, retry_starts, extra_starts, deterministic, pop_size, "
             "generations, name)",
         ),
@@ -437,3 +468,23 @@ def test_bench_configurations_are_the_command_lines_list(capsys):
     assert main(["bench", "--list"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert [line.split()[0] for line in lines] == [c[0] for c in configs]
+
+
+@pytest.mark.parametrize("command", ["solve", "sweep", "pareto", "bench", "reproduce"])
+def test_an_empty_out_is_refused_not_read_as_the_working_folder(
+    command, tmp_path, capsys, monkeypatch
+):
+    # Path("") is ".": every file of the run would land in the working folder
+    monkeypatch.chdir(tmp_path)
+    argv = {
+        "solve": ["solve", RIPPLE],
+        "sweep": ["sweep", RIPPLE, "--vary", "requirements.hinge_moment=200:300:2 N*m"],
+        "pareto": ["pareto", RIPPLE, "--objectives", "ripple,size"],
+        "bench": ["bench", "--suite", "quick"],
+        "reproduce": ["reproduce", "duan2017"],
+    }[command]
+    with pytest.raises(SystemExit) as caught:
+        main([*argv, "--out", ""])
+    assert caught.value.code == 2
+    assert "argument --out: an empty path names no folder" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

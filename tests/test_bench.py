@@ -353,3 +353,25 @@ def test_a_stored_row_without_its_identity_refuses_the_resume(tmp_path):
         StoreError, match=r"line 2: record .*debug-crash' has no text field 'family'"
     ):
         bench.run_bench("quick", ["debug-crash"], tmp_path, instances=[inst], resume=True, **kwargs)
+
+
+@pytest.mark.parametrize("hard", [2, 5])
+def test_a_hard_timeout_not_above_the_time_limit_is_refused_naming_both(tmp_path, capsys, hard):
+    """optdesign.validation.bench_timeouts: the hard timeout kills a run, set-up
+    included, so one at or below the soft time limit would kill a run before the soft
+    limit stops it; od.bench and optdesign bench refuse it before any work."""
+    import optdesign as od
+    from optdesign.cli import main
+    from optdesign.errors import InputError
+
+    out = tmp_path / "o"
+    with pytest.raises(InputError) as err:
+        od.bench(suite="quick", time_limit=5, hard_timeout=hard, out=out)
+    assert err.value.field == "hard_timeout"
+    assert str(err.value).startswith(f"hard_timeout: {hard} s is not above time_limit (5 s)")
+    argv = ["bench", "--suite", "quick", "--time-limit", "5", "--hard-timeout", str(hard)]
+    assert main([*argv, "--out", str(out)]) == 2
+    assert capsys.readouterr().err.startswith(
+        f"optdesign: error: --hard-timeout: {hard} s is not above --time-limit (5 s)"
+    )
+    assert not out.exists()

@@ -35,6 +35,26 @@ def test_loader_reads_the_iso_catalogues():
     assert problem.by_name["d"].values == (4, 5, 6, 8, 10, 12, 16, 20, 25)
 
 
+def test_values_and_a_catalogue_on_one_variable_are_refused_naming_both(tmp_path):
+    """The catalogue was silently dropped for the values before."""
+    text = CATALOGUE.read_text().replace(
+        'p = { catalogue = "ISO 3408", ',
+        'p = { values = ["2 mm", "5 mm"], catalogue = "ISO 3408", ',
+    )
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    with pytest.raises(ProblemError) as err:
+        load_problem(path)
+    assert str(err.value).startswith(
+        f"{path}: variables.p: values and catalogue both given: a variable takes its items "
+        "from one (values = [...] lists them; catalogue = NAME takes a named catalogue's)"
+    )
+    data = tomllib.loads(CATALOGUE.read_text())
+    data["variables"]["d"] = {"values": ["5 mm"], "catalogue": "ISO 2338"}
+    with pytest.raises(ProblemError, match=r"^variables\.d: values and catalogue both given"):
+        problem_from_dict(data)
+
+
 def test_branch_and_bound_equals_enumeration_small_catalogue():
     problem = _small_catalogue()
     enum = solve_catalogue(problem, method="enumerate", starts=2)

@@ -521,3 +521,28 @@ def test_efficiency_min_requirement():
     assert (stated.unit, stated.description) == ("", "forward efficiency of screw and gear")
     # 0.9 x 0.431 = 0.388 < 0.5: the design violates the requirement by that much
     assert ev.violation >= 0.5 - eta * 0.9 - 1e-12
+
+
+def test_catalogue_screw_values_the_catalogue_does_not_list_are_refused_when_read():
+    """optdesign.problem.consistency: d0 = { values = [...] } of a HIWIN screw with a
+    diameter the catalogue lacks (13 mm) found no item for it and ended as "failed ...
+    more starts" with NaN rows; it is refused when the problem is read, naming the
+    variable, the values and the catalogue's."""
+    from optdesign.errors import ProblemError
+
+    screw = {"kind": "ball", "catalogue": "HIWIN"}
+    d0 = {"d0": {"values": ["13 mm", "16 mm", "22 mm"]}}
+    with pytest.raises(ProblemError) as err:
+        problem_from_dict(_data(screw, {**d0, "p": {"catalogue": "HIWIN"}}))
+    assert str(err.value).startswith(
+        "variables.d0: catalogue 'HIWIN' lists no d0 of 13, 22 mm (its d0 values: 8, 14, 15, "
+        "16, 20, 25, 32, 38, 40 mm)"
+    )
+    p = {"p": {"values": ["5 mm", "6 mm"]}}
+    with pytest.raises(ProblemError, match=r"^variables\.p: catalogue 'HIWIN' lists no p of 6 mm"):
+        problem_from_dict(_data(screw, {"d0": {"catalogue": "HIWIN"}, **p}))
+    # values it lists are a catalogue screw
+    ok = problem_from_dict(
+        _data(screw, {"d0": {"values": ["16 mm", "25 mm"]}, "p": {"catalogue": "HIWIN"}})
+    )
+    assert ok.by_name["d0"].values == (16.0, 25.0)

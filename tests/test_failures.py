@@ -342,7 +342,12 @@ REFUSED = {
         f"\n[solver]\nipopt = {{ max_iter = {BIG} }}\n",
         ["solver.ipopt.max_iter", "out of range"],
     ),
-    "5000-digit integer": (CS, [], f"\nzz = {'9' * 5000}\n", ["not valid TOML"]),
+    "5000-digit integer": (
+        CS,
+        [],
+        f"\nzz = {'9' * 5000}\n",
+        ["objective.zz: a number of 5000 digits is out of range"],
+    ),
     "negative seed": (CS, [], "\n[solver]\nseed = -1\n", ["solver.seed"]),
     "seed above 32 bits": (CS, [], f"\n[solver]\nseed = {2**32}\n", ["solver.seed"]),
     "NUL in the name": (

@@ -12,11 +12,13 @@ import json
 import os
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
 from hostile_corpus import PROBLEMS, all_cases, handwritten_cases, run_case
 
+import optdesign as od
 from optdesign.errors import OptDesignError
 from optdesign.problem import load_problem
 from optdesign.units import to_internal
@@ -227,3 +229,116 @@ def test_nesting_counts_only_toml_structure(tmp_path):
     f = tmp_path / "p.toml"
     f.write_text(text)
     assert load_problem(f).name == "cs_min_backlash"
+
+
+def test_dotted_keys_deeper_than_the_limit_are_refused_naming_where(tmp_path):
+    """``a.a.a. ... = 1`` nests tables without a bracket: 5000 levels were a RecursionError
+    (from a file and from a dict given to od.load)."""
+    from optdesign.problem.load import MAX_NESTING
+
+    f = tmp_path / "p.toml"
+    f.write_text(BASE + "\n[extra]\n" + ".".join(["a"] * 5000) + " = 1\n")
+    with pytest.raises(OptDesignError) as exc:
+        load_problem(f)
+    where = "extra" + ".a" * MAX_NESTING
+    assert str(exc.value).startswith(
+        f"{f}: {where}: tables and arrays nested too deeply (at most {MAX_NESTING} levels; "
+        "a problem needs 3)"
+    )
+    deep: object = 1
+    for _ in range(5000):
+        deep = {"a": deep}
+    data = tomllib.loads(BASE)
+    data["variables"]["R"] = deep
+    with pytest.raises(OptDesignError) as exc:
+        od.load(data)
+    where = "variables.R" + ".a" * (MAX_NESTING - 1)
+    assert str(exc.value).startswith(f"problem: {where}: tables and arrays nested too deeply")
+    data["variables"]["R"] = [[[[[[[[[[[[[[1]]]]]]]]]]]]]]  # 14 lists: brackets as deep
+    with pytest.raises(OptDesignError, match=r"^problem: variables\.R\[0\]\[0\]"):
+        od.load(data)
+
+
+def test_a_problem_dict_that_contains_itself_is_refused_naming_where():
+    data = tomllib.loads(BASE)
+    data["x"] = data
+    with pytest.raises(OptDesignError) as exc:
+        od.load(data)
+    assert str(exc.value).startswith("problem: x: refers back to the problem (a table or list")
+    data = tomllib.loads(BASE)
+    data["variables"]["R"]["lower"] = data["variables"]
+    with pytest.raises(OptDesignError) as exc:
+        od.load(data)
+    assert str(exc.value).startswith(
+        "problem: variables.R.lower: refers back to variables (a table or list that contains "
+        "itself; a problem is a tree of tables, lists and values)"
+    )
+    shared = {"lower": "30 mm", "upper": "120 mm"}  # one table twice is no cycle
+    data = tomllib.loads(BASE)
+    data["variables"]["R"] = data["variables"]["l"] = shared
+    assert od.load(data).by_name["l"].upper == 120
+
+
+def test_a_byte_order_mark_is_read_as_utf8_and_utf16_is_named(tmp_path):
+    """A UTF-8 byte-order mark (Windows editors write one) only says the file is UTF-8:
+    the file loads. A UTF-16 file is refused naming its encoding."""
+    f = tmp_path / "p.toml"
+    f.write_bytes(b"\xef\xbb\xbf" + BASE.encode())
+    assert load_problem(f).name == "cs_min_backlash"
+    f.write_bytes(BASE.encode("utf-16"))
+    with pytest.raises(OptDesignError) as exc:
+        load_problem(f)
+    assert str(exc.value).startswith(
+        f"{f}: not a UTF-8 text file (it starts with a UTF-16 byte-order mark; TOML is UTF-8: "
+        "save it as UTF-8)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("value", "where", "digits"),
+    [
+        ("1" * 4301, "variables.i_a", 4301),
+        ("-" + "9" * 5000, "variables.i_a", 5000),
+        ("[1, " + "1_" * 4400 + "1]", "variables.i_a[1]", 4401),
+    ],
+)
+def test_an_integer_longer_than_python_converts_is_refused_naming_the_field(
+    tmp_path, value, where, digits
+):
+    """Python refuses to convert a text of more than 4300 digits ("Exceeds the limit"):
+    the message says what is wrong and where, not Python's words."""
+    f = tmp_path / "p.toml"
+    text = BASE.replace("i_a = 2", f"i_a = {value}", 1)
+    f.write_text(text.replace('description = "', f'description = "{"7" * 4400} ', 1))
+    with pytest.raises(OptDesignError) as exc:
+        load_problem(f)
+    assert str(exc.value).startswith(
+        f"{f}: {where}: a number of {digits} digits is out of range (an integer is at most "
+        "9,007,199,254,740,992)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            'mechanism = "crank_slider"',
+            'mechanism = "crank_slider"\nscrew = true',
+            "screw: expected a table (kind, friction, catalogue, nut, ...), got true",
+        ),
+        (
+            'mechanism = "crank_slider"',
+            'mechanism = "crank_slider"\nscrew = "HIWIN"',
+            "screw: expected a table (kind, friction, catalogue, nut, ...), got 'HIWIN'",
+        ),
+        (
+            'fit_clearance = "max"',
+            "fit_clearance = true",
+            "requirements.fit_clearance: expected one of 'min', 'max', got true",
+        ),
+    ],
+)
+def test_a_value_of_the_wrong_kind_says_what_the_field_takes(tmp_path, old, new, message):
+    with pytest.raises(OptDesignError) as exc:
+        _load(tmp_path, old, new)
+    assert str(exc.value).startswith(f"{tmp_path / 'p.toml'}: {message}")

@@ -60,6 +60,10 @@ ENTRY_POINTS = {
     # od.report(result_or_front_or_sweep, path): the public API's entry point to the pages
     ("optdesign.api", "optdesign.reports.html"),
     ("optdesign.api", "optdesign.reports.sweep_html"),
+    # od.pareto(..., out=DIR) writes the files optdesign pareto writes
+    ("optdesign.api", "optdesign.reports.front_files"),
+    # od.sweep(..., out=DIR) writes the files optdesign sweep writes
+    ("optdesign.api", "optdesign.reports.sweep_files"),
 }
 
 

@@ -216,6 +216,8 @@ def test_solve_api_summary_plot_and_frame(hostile_result):
     import matplotlib
     from matplotlib import cbook
 
+    from optdesign.plots import MAX_TITLE_NAME
+
     matplotlib.use("Agg")
     _, result = hostile_result
     summary = result.summary()
@@ -225,7 +227,8 @@ def test_solve_api_summary_plot_and_frame(hostile_result):
     title = fig.axes[0].get_title()
     assert not cbook.is_math_text(title)  # drawn as written, not as mathtext
     fig.canvas.draw()  # the name's "$\frac{$" failed here
-    assert title.replace("\\$", "$").startswith(printable(NAME))
+    # the name escaped, cut to MAX_TITLE_NAME characters (its "$\frac{$" is further on)
+    assert title.startswith(printable(NAME)[: MAX_TITLE_NAME - 3] + "...: ")
     frame = result.to_frame()
     assert "R" in frame.loc["variable"].index
     import matplotlib.pyplot as plt
@@ -496,3 +499,37 @@ def test_result_json_writes_null_for_values_that_are_not_finite(hostile_result):
     assert all(v["value"] is None for v in doc["objectives"].values())
     summary = result.summary()
     assert _unsafe(summary) == [] and "backlash = -" in summary
+
+
+def test_a_huge_name_is_drawn_shortened_and_quickly(tmp_path):
+    """optdesign.plots.plain: a user's text on a figure is cut to MAX_DRAWN characters (a
+    problem's name at the head of a title to MAX_TITLE_NAME) and ends with "...": a
+    900 kB name took matplotlib's text layout minutes, deaf to Ctrl-C."""
+    import time
+    import tomllib
+
+    import matplotlib
+
+    from optdesign.plots import MAX_DRAWN, MAX_TITLE_NAME, plain, write_figure
+    from optdesign.plots.solution import plot_designs
+
+    matplotlib.use("Agg")
+    huge = "N" * 900_000
+    assert plain(huge) == "N" * (MAX_DRAWN - 3) + "..."
+    escaped = plain("\x1b" * 500)  # an escape counts as the characters drawn
+    assert len(escaped) == MAX_DRAWN and escaped.startswith("\\x1b\\x1b")
+    assert escaped.endswith("...")
+    assert plain("$x$ " * 100).startswith(r"\$x\$ ") and plain("$x$") == r"\$x\$"
+    data = tomllib.loads((PROBLEMS / "cs_min_backlash.toml").read_text())
+    data["name"] = huge
+    problem = od.load(data)
+    design = problem.design_dict(problem.start())
+    figures = []
+    t0 = time.perf_counter()
+    note = write_figure(
+        lambda: figures.append(plot_designs(problem, {"start": design})) or figures[0],
+        tmp_path / "s.png",
+    )
+    assert note is None and time.perf_counter() - t0 < 30  # minutes before
+    title = figures[0].axes[0].get_title()
+    assert title == "N" * (MAX_TITLE_NAME - 3) + "...: ratio over the stroke"

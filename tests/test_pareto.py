@@ -426,3 +426,29 @@ def test_extra_cold_starts_at_every_point_keep_the_front(fork, tmp_path):
     # jump in design space, say) runs the larger of its retry starts and the extra ones
     assert all(r["n_solves"] == 4 for r in eps if not r["retried"])
     assert all(r["n_solves"] >= 4 for r in eps) and sum(not r["retried"] for r in eps) >= 4
+
+
+def test_a_front_given_out_writes_the_files_the_command_writes(tmp_path):
+    """optdesign.api.pareto with ``out``: front.csv, front.json, front.png and report.html
+    beside the store, as ``optdesign pareto`` writes them; ``files=False``: the store
+    alone. The CSV's rows are the front's points."""
+    import csv
+
+    front = od.pareto(
+        PROBLEMS / "cs_min_ripple.toml", ["ripple", "size"], points=4, out=tmp_path / "a"
+    )
+    names = {p.name for p in (tmp_path / "a").iterdir()}
+    assert {"front.csv", "front.json", "front.png", "report.html", "epsilon.jsonl"} <= names
+    with (tmp_path / "a" / "front.csv").open(newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["on_front"] == "True"]
+    assert len(rows) == len(front.points)
+    od.pareto(
+        PROBLEMS / "cs_min_ripple.toml",
+        ["ripple", "size"],
+        points=4,
+        out=tmp_path / "b",
+        files=False,
+    )
+    assert not {"front.csv", "front.png", "report.html"} & {
+        p.name for p in (tmp_path / "b").iterdir()
+    }

@@ -16,7 +16,7 @@ from optdesign.formulations.robust import (
     draw_samples,
     sampled_objective,
 )
-from optdesign.problem.load import problem_from_dict
+from optdesign.problem.load import load_problem, problem_from_dict
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.robust import (
     compare_nominal_robust,
@@ -64,6 +64,32 @@ def test_tolerance_errors_name_the_field():
         problem_from_dict(_data(phi0={"band": "0.1 mm"}))
     with pytest.raises(ProblemError, match=r"tolerances\.Q: unknown field"):
         problem_from_dict(_data(Q="1 mm"))
+
+
+def test_a_tolerances_table_that_names_no_tolerance_is_refused_on_load(tmp_path):
+    """An empty [tolerances] (or one of settings only) scatters nothing: refused naming
+    the table, not later as "need at least one sample"."""
+    hint = 'give a variable\'s band (e.g. R = "0.05 mm") or fit = "uniform", or leave the table out'
+    data = _data()
+    data["tolerances"] = {}
+    with pytest.raises(ProblemError) as err:
+        problem_from_dict(data)
+    assert str(err.value).startswith(
+        f"problem: tolerances: the table is empty: it names no tolerance; {hint}"
+    )
+    data["tolerances"] = {"samples": 8, "seed": 2}
+    with pytest.raises(ProblemError) as err:
+        problem_from_dict(data)
+    assert str(err.value).startswith(
+        f"problem: tolerances: names no tolerance, only settings (samples, seed); {hint}"
+    )
+    path = tmp_path / "p.toml"
+    path.write_text(FILE.read_text().split("[tolerances]")[0] + "[tolerances]\n")
+    with pytest.raises(ProblemError) as err:
+        load_problem(path)
+    assert str(err.value).startswith(f"{path}: tolerances: the table is empty")
+    data["tolerances"] = {"fit": "uniform"}  # the fits scatter: a tolerance
+    assert problem_from_dict(data).spec.tolerances.fit == "uniform"
 
 
 def test_draws_have_the_declared_spread(problem):

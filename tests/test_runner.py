@@ -283,3 +283,22 @@ def test_fork_call_returns_values_and_kinds():
     assert kind == "timeout" and "0.2 s" in reason
     assert fork_call(lambda: os._exit(0))[0] == "crash"
     assert fork_call(lambda: b"x" * 3_000_000) == ("ok", b"x" * 3_000_000)  # > a pipe buffer
+
+
+def test_a_scheduler_that_does_not_answer_is_an_input_error_naming_its_address(tmp_path):
+    """optdesign.studies.runner._connect: a well-formed address where no scheduler
+    answers is refused naming the address (it was distributed's traceback)."""
+    pytest.importorskip("distributed")
+    import dask
+
+    from optdesign.errors import InputError
+
+    with (
+        dask.config.set({"distributed.comm.timeouts.connect": "1s"}),
+        pytest.raises(InputError) as err,
+    ):
+        run_tasks(_tasks(), _chain_fn, tmp_path / "s.jsonl", scheduler="tcp://127.0.0.1:1")
+    assert err.value.field == "scheduler"
+    assert str(err.value).startswith(
+        "scheduler: cannot connect to the Dask scheduler at 'tcp://127.0.0.1:1': "
+    )

@@ -360,3 +360,52 @@ def test_an_atomic_write_gives_the_file_the_mode_of_a_plain_open(tmp_path):
     with open(tmp_path / "plain", "w") as fh:
         fh.write("x")
     assert (tmp_path / "plain").stat().st_mode & 0o777 == path.stat().st_mode & 0o777
+
+
+@pytest.mark.parametrize("writer", ["atomic_write_text", "atomic_output", "store"])
+def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys, writer):
+    """optdesign.storage.WriteError: "[Errno 28] No space left on device" named no file;
+    a failed write now names the file (an OSError still, with its errno), leaves the
+    old file and no temporary one, and the command line prints it as one line, exit 2."""
+    import errno
+
+    from optdesign.cli import run_guarded
+    from optdesign.storage import StoreWriter, WriteError, open_store
+
+    def full(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    target = tmp_path / ("sweep.jsonl" if writer == "store" else "sweep.csv")
+    if writer == "store":
+        open_store(target, "k", resume=False)
+        store = StoreWriter(target)
+    else:
+        target.write_text("old")
+    before = sorted(os.listdir(tmp_path))
+
+    def write():
+        if writer == "atomic_write_text":
+            atomic_write_text(target, "new")
+        elif writer == "atomic_output":  # a writer by name (savefig) fails in its own
+            with atomic_output(target) as tmp:  # write, naming no file or the temporary one
+                tmp.write_text("n")
+                full()
+        else:
+            store.write({"id": "t0", "value": 1})
+
+    with monkeypatch.context() as m:
+        m.setattr(os, "write", full)
+        with pytest.raises(WriteError) as err:
+            write()
+        assert run_guarded(write) == 2
+    assert str(err.value).startswith(f"cannot write {target}: No space left on device")
+    assert isinstance(err.value, OSError) and isinstance(err.value, StoreError)
+    assert (err.value.errno, err.value.filename) == (errno.ENOSPC, str(target))
+    assert capsys.readouterr().err == (
+        f"optdesign: error: cannot write {target}: No space left on device\n"
+    )
+    assert sorted(os.listdir(tmp_path)) == before  # no temporary file left
+    if writer == "store":
+        store.close()
+    else:
+        assert target.read_text() == "old"

@@ -251,6 +251,45 @@ def test_vary_text_of_the_command_line():
         parse_vary("requirements.hinge_moment=200:3")
 
 
+def test_a_path_with_an_empty_name_is_refused_naming_vary_and_where(tmp_path, capsys):
+    """A trailing dot (an AttributeError before), two dots in a row and a path below a
+    plain value: refused naming the argument, through od.sweep and the command line."""
+    with pytest.raises(od.InputError) as err:
+        od.sweep(FORK, {HINGE + ".": ("200 N*m", "300 N*m", 3)})
+    assert str(err.value).startswith(
+        "vary: 'requirements.hinge_moment.': an empty name after its last dot; give "
+        "requirements.NAME or variables.NAME[.lower|.upper]"
+    )
+    problem = od.load(FORK)
+    with pytest.raises(od.InputError) as err:
+        sweep_axes(problem, {"requirements..hinge_moment": ("200 N*m", "300 N*m", 3)})
+    assert str(err.value).startswith(
+        "vary: 'requirements..hinge_moment': an empty name between two dots (after requirements)"
+    )
+    with pytest.raises(od.InputError) as err:
+        sweep_axes(problem, {HINGE + ".min": ("200 N*m", "300 N*m", 3)})
+    assert str(err.value).startswith(
+        "vary: requirements.hinge_moment.min: requirements.hinge_moment is a value, not a table"
+    )
+    out = tmp_path / "o"
+    code = main(["sweep", str(FORK), "--vary", HINGE + ".=200:300:3", "--out", str(out)])
+    err_text = capsys.readouterr().err
+    assert code == 2
+    assert err_text.startswith(
+        "optdesign: error: --vary: 'requirements.hinge_moment.': an empty name after its last dot"
+    )
+    assert len(err_text.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_a_count_in_another_scripts_digits_is_refused_naming_the_digit():
+    with pytest.raises(od.InputError) as err:
+        parse_vary("requirements.hinge_moment=200..300N*m:\u0663")
+    assert str(err.value).startswith(
+        "--vary: requirements.hinge_moment: count '\u0663' has the digit '\u0663' (U+0663 "
+        "ARABIC-INDIC DIGIT THREE): write numbers with the digits 0-9"
+    )
+
+
 def test_cli_writes_the_table_chart_and_json(tmp_path, capsys):
     out = tmp_path / "o"
     args = [
@@ -503,3 +542,90 @@ def test_check_every_still_checked_by_od_sweep_naming_it(check_every, tmp_path):
         od.sweep(FORK, {HINGE: ("200 N*m", "300 N*m", 2)}, check_every=check_every, out=tmp_path)
     assert info.value.field == "check_every"
     assert not (tmp_path / "sweep.jsonl").exists()
+
+
+def test_sweep_csv_neutralises_text_a_spreadsheet_would_run(monkeypatch):
+    """optdesign.reports.sweep.sweep_csv: a text cell starting like a formula (a user's
+    text in ``what_fails``) is written with a leading quote, as front.csv writes it; a
+    negative number stays a number."""
+    import csv
+    import io
+
+    import optdesign.reports.sweep as report
+
+    rows = [[1.5, "infeasible", '=HYPERLINK("x")', -2.0], [2.5, "optimal", "", 3.0]]
+    monkeypatch.setattr(
+        report, "sweep_rows", lambda sweep: (["m", "status", "what_fails", "R"], rows)
+    )
+    table = list(csv.reader(io.StringIO(report.sweep_csv(object()))))
+    assert table[1] == ["1.5", "infeasible", '\'=HYPERLINK("x")', "-2"]
+    assert table[2] == ["2.5", "optimal", "", "3"]
+
+
+def test_a_grid_beyond_its_cap_is_refused_naming_vary_and_the_product(tmp_path, capsys):
+    """optdesign.studies.sweep.sweep_axes: the product of the axes' counts is at most
+    MAX_GRID (a 1000 x 1000 grid was accepted: about a day of global searches); od.sweep
+    and the command line refuse it before any work."""
+    from optdesign.studies.sweep import MAX_GRID
+
+    assert MAX_GRID == 2500
+    R = "variables.R.upper"
+    out = tmp_path / "o"
+    with pytest.raises(od.InputError) as err:
+        od.sweep(
+            FORK, {HINGE: ("200 N*m", "1000 N*m", 1000), R: ("90 mm", "110 mm", 1000)}, out=out
+        )
+    assert err.value.field == "vary"
+    assert str(err.value).startswith(
+        "vary: 1000 x 1000 = 1000000 points; a sweep's grid has at most 2500"
+    )
+    argv = ["sweep", str(FORK), "--vary", f"{HINGE}=200..1000N*m:51"]
+    assert main([*argv, "--vary", f"{R}=90..110mm:50", "--out", str(out)]) == 2
+    assert capsys.readouterr().err.startswith(
+        "optdesign: error: --vary: 51 x 50 = 2550 points; a sweep's grid has at most 2500"
+    )
+    assert not out.exists()
+    # the cap itself is a sweep: 50 x 50
+    axes = sweep_axes(
+        od.load(FORK), {HINGE: ("200 N*m", "1000 N*m", 50), R: ("90 mm", "110 mm", 50)}
+    )
+    assert [len(a.values) for a in axes] == [50, 50]
+
+
+def test_a_scheduler_that_is_no_address_is_refused_before_any_work(tmp_path, capsys):
+    """optdesign.argument_checks.scheduler: od.sweep's scheduler and --scheduler are an
+    address SCHEME://HOST:PORT (a garbage one ended as an internal error)."""
+    out = tmp_path / "o"
+    with pytest.raises(od.InputError) as err:
+        od.sweep(FORK, {HINGE: ("200 N*m", "300 N*m", 2)}, scheduler="not a url", out=out)
+    assert err.value.field == "scheduler"
+    assert str(err.value).startswith(
+        "scheduler: 'not a url' is not a scheduler's address: no port 1..65535 "
+        "(write SCHEME://HOST:PORT, e.g. tcp://127.0.0.1:8786)"
+    )
+    argv = ["sweep", str(FORK), "--vary", f"{HINGE}=200..300N*m:2", "--out", str(out)]
+    with pytest.raises(SystemExit) as caught:
+        main([*argv, "--scheduler", "tcp://my host:8786"])
+    assert caught.value.code == 2
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert last.startswith(
+        "optdesign sweep: error: argument --scheduler: 'tcp://my host:8786' is not a "
+        "scheduler's address: 'my host' is not a host name"
+    )
+    assert not out.exists()
+
+
+def test_a_sweep_given_out_writes_the_files_the_command_writes(tmp_path):
+    """optdesign.api.sweep with ``out``: sweep.csv, sweep.json, sweep.png and sweep.html
+    beside the store, as ``optdesign sweep`` writes them; the CSV has a row per point."""
+    import csv
+
+    swept = od.sweep(
+        PROBLEMS / "cs_min_ripple.toml",
+        {"requirements.hinge_moment": ("200 N*m", "300 N*m", 2)},
+        out=tmp_path / "s",
+    )
+    names = {p.name for p in (tmp_path / "s").iterdir()}
+    assert {"sweep.csv", "sweep.json", "sweep.png", "sweep.html", "sweep.jsonl"} <= names
+    with (tmp_path / "s" / "sweep.csv").open(newline="") as fh:
+        assert len(list(csv.DictReader(fh))) == len(swept.points) == 2

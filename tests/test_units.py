@@ -137,6 +137,30 @@ def test_malformed_strings_are_refused_with_the_field(text):
         to_internal(text, "length", "variables.R")
 
 
+@pytest.mark.parametrize(
+    ("text", "digit"),
+    [
+        ("11\u0660 mm", "'\u0660' (U+0660 ARABIC-INDIC DIGIT ZERO)"),  # read as 110 mm before
+        ("\u0661\u0662 mm", "'\u0661' (U+0661 ARABIC-INDIC DIGIT ONE)"),
+        ("1\u06f0", "'\u06f0' (U+06F0 EXTENDED ARABIC-INDIC DIGIT ZERO)"),
+        ("\uff15\uff10 mm", "'\uff15' (U+FF15 FULLWIDTH DIGIT FIVE)"),
+        ("1e\u0661 mm", "'\u0661' (U+0661 ARABIC-INDIC DIGIT ONE)"),
+        ("5 mm^\u0662", "'\u0662' (U+0662 ARABIC-INDIC DIGIT TWO)"),
+    ],
+)
+def test_digits_of_another_script_are_refused_naming_the_field_and_the_digit(text, digit):
+    """float() and re's \\d read any script's decimal digits: "11\u0660 mm" was 110 mm."""
+    with pytest.raises(InputError) as err:
+        to_internal(text, "length", "variables.R.upper")
+    assert str(err.value).startswith(
+        f"variables.R.upper: {text!r} has the digit {digit}: write numbers with the digits 0-9"
+    )
+
+
+def test_superscript_powers_are_not_digits_of_another_script():
+    assert to_internal("2 N/mm\u00b2", "pressure", "x") == pytest.approx(2.0)
+
+
 def test_pint_quantities_are_accepted():
     ureg = registry()
     assert to_internal(ureg.Quantity(500, "N*m"), "moment", "m") == pytest.approx(5e5)

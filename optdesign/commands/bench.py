@@ -53,11 +53,14 @@ def _bench(sub):
         help="local processes",
     )
     p.add_argument(
-        "--scheduler", default=None, help="Dask scheduler address (instead of local processes)"
+        "--scheduler",
+        type=checked(check.scheduler),
+        default=None,
+        help="Dask scheduler address, tcp://HOST:PORT (instead of local processes)",
     )
     p.add_argument(
         "--out",
-        type=Path,
+        type=checked(check.out_path),
         default=None,
         help="output folder (default: a new one under ./optdesign-out)",
     )
@@ -98,6 +101,7 @@ def run_bench_command(args) -> int:
         return 0
     with as_options(RENAMED):  # the checks of optdesign.bench, before the folder is made
         check.configs("solvers", args.solvers)
+        check.bench_timeouts(args.time_limit, args.hard_timeout)
         check.run_folder(args.out, args.resume, args.overwrite)
         if args.problems is not None and args.suite is not None:
             raise check.ArgumentError(

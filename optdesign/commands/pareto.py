@@ -39,7 +39,9 @@ def _pareto(sub):
         help="comma list of epsilon (default; evenly spread along the front), uniform "
         "(epsilon evenly spaced), weighted_sum, nsga2; or 'all'",
     )
-    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument(
+        "--out", type=checked(check.out_path), default=None, help="output folder (default: new one)"
+    )
     p.add_argument("--resume", action="store_true", help="continue the run stored in --out")
     p.add_argument(
         "--overwrite",
@@ -52,7 +54,12 @@ def _pareto(sub):
         default=os.cpu_count() or 1,
         help="local processes (default: the CPU count)",
     )
-    p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
+    p.add_argument(
+        "--scheduler",
+        type=checked(check.scheduler),
+        default=None,
+        help="address of a Dask distributed scheduler (tcp://HOST:PORT)",
+    )
     p.add_argument(
         "--starts",
         type=checked(check.starts, literal),
@@ -152,42 +159,29 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
     fronts = []
     for m in methods:
         with as_options(RENAMED):
+            # the files of all the methods together are written below, once
             front = pareto(
-                problem, objectives, args.points, m, **run, **_method_options(args, m, seed)
+                problem,
+                objectives,
+                args.points,
+                m,
+                **run,
+                **_method_options(args, m, seed),
+                files=False,
             )
         fronts.append(front)
-    from optdesign.reports.front_files import no_point_text, write_front_files
+    from optdesign.reports.front_files import no_point_text, write_front_outputs
 
-    wrote = write_front_files(
+    wrote, notes = write_front_outputs(
         fronts,
         problem,
         out,
         objectives=objectives,
         points=args.points,
         created=time.strftime("%Y-%m-%d %H:%M:%S"),
+        plot=not args.no_plot,
+        report=not args.no_report,
     )
-    notes = []
-    if not args.no_plot:
-        from optdesign.plots import write_figure
-        from optdesign.plots.front import plot_fronts
-
-        failed = write_figure(lambda: plot_fronts(problem, fronts), out / "front.png")
-        if failed is None:
-            wrote.append(out / "front.png")
-        else:  # the front's files are written; the report and the summary follow
-            notes.append(failed)
-    if not args.no_report and any(f.points for f in fronts):
-        from optdesign.errors import OptDesignError
-        from optdesign.reports.html import front_report
-        from optdesign.storage import atomic_write_text
-
-        try:
-            page = front_report(problem, fronts)
-        except OptDesignError as exc:  # a user's mechanism that cannot draw itself
-            notes.append(f"report.html not written: {exc}")
-        else:
-            atomic_write_text(out / "report.html", page)
-            wrote.append(out / "report.html")
     from optdesign.reports.front_text import front_summary
     from optdesign.text import printable
 

@@ -16,7 +16,9 @@ RENAMED = {"ranges": "--no-ranges", "problem": "file"}
 def _solve(sub):
     p = sub.add_parser("solve", help="find the optimal design of a problem file")
     p.add_argument("file", type=Path, help="problem file (TOML)")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument(
+        "--out", type=checked(check.out_path), default=None, help="output folder (default: new one)"
+    )
     p.add_argument("--json", action="store_true", help="print the result JSON to stdout")
     p.add_argument(
         "--formulation",

@@ -9,13 +9,12 @@ Writes ``sweep.csv`` (units in the headers), ``sweep.json``, the design chart
 from __future__ import annotations
 
 import contextlib
-import json
 import re
 from pathlib import Path
 
 from optdesign import validation as check
 from optdesign.cli import as_options, checked, command, literal, output_folder
-from optdesign.errors import InputError, OptDesignError
+from optdesign.errors import InputError
 
 _RANGE = re.compile(
     r"^\s*(?P<start>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<u0>[^.\s][^.]*?)?\s*"
@@ -34,12 +33,22 @@ def parse_vary(text: str) -> tuple[str, tuple[str, str, int]]:
             f"{text!r}: write PATH=START..STOP UNIT:COUNT, e.g. "
             "requirements.hinge_moment=200..1000N*m:20",
         )
+    from optdesign.unit_grammar import Refused, check_ascii_digits
+
+    try:  # the path's mistake first: it is what the word was meant to name
+        check.vary_path(path.strip())
+    except InputError as exc:
+        raise InputError("--vary", exc.reason) from None
     m = _RANGE.match(rng)
     if m is None:
         raise InputError(
             "--vary",
             f"{path.strip()}: {rng!r} is not START..STOP UNIT:COUNT (e.g. 200..1000N*m:20)",
         )
+    try:  # int() reads every script's digits (the start and stop are checked as quantities)
+        check_ascii_digits(m["count"], m["count"])
+    except Refused as exc:
+        raise InputError("--vary", f"{path.strip()}: count {exc}") from None
     u1 = (m["u1"] or "").strip()
     u0 = (m["u0"] or "").strip() or u1
     start = f"{m['start']} {u0}".strip()
@@ -80,8 +89,15 @@ def _sweep(sub):
         default=1,
         help="local processes: the points side by side (default 1)",
     )
-    p.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default: new one)")
+    p.add_argument(
+        "--scheduler",
+        type=checked(check.scheduler),
+        default=None,
+        help="address of a Dask distributed scheduler (tcp://HOST:PORT)",
+    )
+    p.add_argument(
+        "--out", type=checked(check.out_path), default=None, help="output folder (default: new one)"
+    )
     p.add_argument("--resume", action="store_true", help="continue the sweep stored in --out")
     p.add_argument(
         "--overwrite", action="store_true", help="start afresh over a stored sweep in --out"
@@ -116,7 +132,7 @@ def run_sweep_command(args) -> int:
     with output_folder(args.out, f"sweep-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         quiet = stdout_to_stderr() if args.json else contextlib.nullcontext()
-        with quiet:
+        with quiet, as_options():  # e.g. a --scheduler that does not answer
             sweep = od.sweep(
                 problem,
                 vary,
@@ -131,59 +147,16 @@ def run_sweep_command(args) -> int:
                 sensitivities=args.sensitivities,
                 workers=args.workers,
                 scheduler=args.scheduler,
+                files=False,  # written below, with the command's --no-plot
             )
         return _write(args, sweep, out)
 
 
-def sweep_document(sweep) -> dict:
-    """``sweep.json``: the axes, the table's columns with their units, the rows."""
-    from optdesign.reports.sweep import sweep_columns, sweep_rows
-    from optdesign.solvers.result import clean_json
-
-    headers, rows = sweep_rows(sweep)
-    return clean_json(
-        {
-            "schema": "optdesign.sweep/1",
-            "problem": sweep.problem.name,
-            "objective": sweep.objective,
-            "continuation": sweep.continuation,
-            "axes": [{"path": a.path, "unit": a.unit, "values": list(a.shown)} for a in sweep.axes],
-            "units": {c[0]: c[1] for c in sweep_columns(sweep) if c[1]},
-            "points": [dict(zip(headers, r, strict=True)) for r in rows],
-            "sensitivities": [p.sensitivities for p in sweep.points]
-            if any(p.sensitivities for p in sweep.points)
-            else None,
-            "wall_time": {"value": sweep.wall_time_s, "unit": "s"},
-            "notes": sweep.notes,
-        }
-    )
-
-
 def _write(args, sweep, out: Path) -> int:
-    from optdesign.reports.sweep import sweep_csv
-    from optdesign.storage import atomic_write_text
+    from optdesign.reports.sweep_files import write_sweep_outputs
     from optdesign.text import printable
 
-    text = json.dumps(sweep_document(sweep), indent=2)
-    atomic_write_text(out / "sweep.csv", sweep_csv(sweep))
-    atomic_write_text(out / "sweep.json", text)
-    wrote = [out / "sweep.csv", out / "sweep.json"]
-    notes = []
-    if not args.no_plot:
-        from optdesign.plots import write_figure
-
-        failed = write_figure(sweep.plot, out / "sweep.png")
-        if failed is None:
-            wrote.append(out / "sweep.png")
-        else:
-            notes.append(failed)
-        if any(p.design for p in sweep.points):
-            import optdesign as od
-
-            try:  # a user's mechanism that cannot draw itself: a note, not the sweep lost
-                wrote.append(od.report(sweep, out / "sweep.html"))
-            except OptDesignError as exc:
-                notes.append(f"sweep.html not written: {exc}")
+    wrote, notes, text = write_sweep_outputs(sweep, out, plot=not args.no_plot)
     if args.json:
         print(text)
     else:

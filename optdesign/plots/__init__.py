@@ -9,9 +9,11 @@ figures keeps none open. The command line selects the file-only Agg back-end for
 
 Text from a user (a problem's name, an objective's or a constraint's, a label) is drawn
 as plain text: :func:`plain` escapes the ``$`` that would start matplotlib's mathtext
-(``$\\frac{$`` in a name would otherwise fail when the figure is drawn) and shows
-control characters escaped. :func:`write_figure` makes a figure's failure a note
-instead of losing the command's other outputs.
+(``$\\frac{$`` in a name would otherwise fail when the figure is drawn), shows
+control characters escaped and shortens it to :data:`MAX_DRAWN` characters with an
+ellipsis (a 900 kB name took matplotlib's text layout minutes, deaf to Ctrl-C).
+:func:`write_figure` makes a figure's failure a note instead of losing the command's
+other outputs.
 """
 
 from __future__ import annotations
@@ -27,11 +29,29 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-def plain(text: object) -> str:
+#: Most characters of one user text drawn on a figure (a title's name, a label): more
+#: does not fit on a figure, and matplotlib lays text out in time that grows with its
+#: length, in C code that a Ctrl-C does not stop.
+MAX_DRAWN = 120
+#: Most characters of a problem's name at the head of a title (the rest of the title
+#: must still fit beside it).
+MAX_TITLE_NAME = 60
+#: What ends a shortened text.
+ELLIPSIS = "..."
+
+
+def plain(text: object, limit: int = MAX_DRAWN) -> str:
     """``text`` drawn literally by matplotlib: one line, control characters escaped
-    (:func:`~optdesign.text.printable`), every ``$`` escaped as ``\\$`` so that no part
-    of it is read as mathtext (an escaped dollar is drawn as ``$``)."""
-    return printable(text).replace("$", r"\$")
+    (:func:`~optdesign.text.printable`), at most ``limit`` characters (a longer text is
+    cut and ends with ``...``), every ``$`` escaped as ``\\$`` so that no part of it is
+    read as mathtext (an escaped dollar is drawn as ``$``)."""
+    s = str(text)
+    if len(s) > limit:  # cut before escaping: a 900 kB name is not escaped whole
+        s = s[: limit + 1]
+    s = printable(s)
+    if len(s) > limit:
+        s = s[: max(limit - len(ELLIPSIS), 0)] + ELLIPSIS
+    return s.replace("$", r"\$")
 
 
 def new_figure(figsize: tuple[float, float], dpi: int = 120, layout: str | None = None) -> Figure:

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from optdesign.plots import new_figure, plain
+from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
 from optdesign.user_code import call_method
 
 _STYLE = {
@@ -142,7 +142,9 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
     else:
         ax.grid(True, alpha=0.3)
     name = problem.name if problem is not None else ""
-    ax.set_title(f"{plain(name)}: Pareto front (A, B...: designs sketched)", fontsize=10)
+    ax.set_title(
+        f"{plain(name, MAX_TITLE_NAME)}: Pareto front (A, B...: designs sketched)", fontsize=10
+    )
     if ax.get_legend_handles_labels()[0]:  # a front with no point has nothing to list
         ax.legend(fontsize=7)
     if sketches and problem is not None:

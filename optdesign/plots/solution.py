@@ -9,7 +9,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from optdesign.plots import new_figure, plain
+from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.reports.limits import binding_angles, bound_limits, limits_of
 from optdesign.studies.verify import constraint_rows
@@ -84,7 +84,7 @@ def plot_designs(
                 label=f"{plain(name)} binds",
             )
     axes[0].set_ylabel("reduction ratio i (motor rad / output rad)")
-    axes[0].set_title(f"{plain(problem.name)}: ratio over the stroke")
+    axes[0].set_title(f"{plain(problem.name, MAX_TITLE_NAME)}: ratio over the stroke")
     if has_pin:
         axes[1].set_ylabel("worst-case backlash (deg)")
         axes[1].set_title("output backlash over the stroke")
@@ -94,7 +94,7 @@ def plot_designs(
         a.legend(fontsize=7)
     if limits:
         text = "what limits the design: " + "; ".join(lim.text() for lim in limits[:6])
-        fig.supxlabel(_wrap(plain(text), 170), fontsize=7, x=0.01, ha="left")
+        fig.supxlabel(_wrap(plain(text, 6 * 170), 170), fontsize=7, x=0.01, ha="left")
     return fig
 
 

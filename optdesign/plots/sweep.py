@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.plots import new_figure, plain
+from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
 from optdesign.reports.frames import objective_column, variable_column
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
@@ -58,10 +58,8 @@ def plot_sweep(sweep: Any):
         ax.set_visible(False)
     changes = sum(p.active_change for p in pts)
     fig.suptitle(
-        plain(
-            f"{problem.name}: optimum against {axis.label} "
-            f"(dotted: binding set or item changes ({changes}); grey: infeasible)"
-        ),
+        f"{plain(problem.name, MAX_TITLE_NAME)}: optimum against {plain(axis.label)} "
+        f"(dotted: binding set or item changes ({changes}); grey: infeasible)",
         fontsize=9,
     )
     return fig
@@ -96,5 +94,6 @@ def _contours(sweep: Any):
             ax.plot(a0.shown[k % n0], a1.shown[k // n0], "o", mfc="none", color="C3", ms=7)
     ax.set_xlabel(plain(a0.label))
     ax.set_ylabel(plain(a1.label))
-    ax.set_title(plain(f"{problem.name}: {col.header} (circles: binding set changes)"), fontsize=9)
+    name = plain(problem.name, MAX_TITLE_NAME)
+    ax.set_title(f"{name}: {plain(col.header)} (circles: binding set changes)", fontsize=9)
     return fig

@@ -12,8 +12,9 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
   where it does not assemble);
 - ``[screw] catalogue`` with a ``kind`` the catalogue does not sell (HIWIN: ball screws);
 - a ``[screw]`` section without ``d0`` (its efficiency needs the mean diameter); a
-  catalogue screw whose ``d0`` or ``p`` is missing, continuous, or whose declared values
-  (fixed, or the bounds of ``catalogue = ...``) hold no pair of the catalogue;
+  catalogue screw whose ``d0`` or ``p`` is missing, continuous, given ``values`` the
+  catalogue does not list, or whose declared values (fixed, or the bounds of
+  ``catalogue = ...``) hold no pair of the catalogue;
 - ``screw.nut_offset`` not shorter than ``screw.length`` (the nut outside the shaft);
 - a ``[reference]`` value of a positive variable (a length, a lead) that is not positive
   or outside the range of validity of the models it feeds (the pin's), or a
@@ -169,6 +170,8 @@ def _screw(problem: Any, screw: Any) -> None:
                 f'{screw.catalogue!r}: write {name} = {{ catalogue = "{screw.catalogue}", '
                 "lower = ..., upper = ... }, or a fixed catalogue value"
             )
+        if var.free:
+            _catalogue_values(screw, name, var.values)
         box[name] = (var.value, var.value) if not var.free else (var.lower, var.upper)
     from optdesign.problem.drive import box_has_item
 
@@ -180,6 +183,26 @@ def _screw(problem: Any, screw: Any) -> None:
         raise ProblemError(
             f"variables.d0: catalogue {screw.catalogue!r} has no screw with {shown} (its "
             "(d0, p) pairs: see optdesign/data/ball_screws.csv)"
+        )
+
+
+def _catalogue_values(screw: Any, name: str, values: Any) -> None:
+    """Each of a catalogue screw's ``values`` of ``name`` (``d0`` or ``p``, mm) is one its
+    catalogue lists: an item lookup of another value finds no screw, and every
+    combination with it would fail as if more starts could find one."""
+    from optdesign.problem.drive import catalogue_values
+
+    listed = catalogue_values(screw.catalogue, name, screw.nut)
+    keys = {float(np.round(v, 9)) for v in listed}  # as the item lookup rounds
+    off = [v for v in values if float(np.round(v, 9)) not in keys]
+    if off:
+        nut = f" with {screw.nut} nuts" if screw.nut else ""
+        raise ProblemError(
+            f"variables.{name}: catalogue {screw.catalogue!r} lists no {name} of "
+            f"{', '.join(f'{v:g}' for v in off)} mm (its {name} values{nut}: "
+            f"{', '.join(f'{v:g}' for v in listed)} mm); write {name} = "
+            f'{{ catalogue = "{screw.catalogue}", lower = ..., upper = ... }}, or values it '
+            "lists"
         )
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import difflib
 import re
 import stat
+import sys
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -33,7 +34,9 @@ def read_problem_text(path: Path) -> str:
     """The text of a problem file: a regular, UTF-8 file of at most MAX_FILE_BYTES.
 
     A named pipe, a device (``/dev/zero``) or a folder is refused before it is opened,
-    so that reading can neither block nor grow without bound.
+    so that reading can neither block nor grow without bound. A UTF-8 byte-order mark at
+    the start (as Windows editors write one) is dropped: it says only that the file is
+    UTF-8, which TOML requires anyway. A UTF-16 file is refused naming its encoding.
     """
     try:
         st = path.stat()
@@ -53,10 +56,15 @@ def read_problem_text(path: Path) -> str:
         raise ProblemError(f"{path}: cannot read problem file ({exc.strerror})") from None
     if len(raw) > MAX_FILE_BYTES:
         raise ProblemError(f"{path}: problem file too large (at most {MAX_FILE_BYTES} bytes)")
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ProblemError(
+            f"{path}: not a UTF-8 text file (it starts with a UTF-16 byte-order mark; "
+            "TOML is UTF-8: save it as UTF-8)"
+        )
     if b"\x00" in raw:
         raise ProblemError(f"{path}: not a text file (a binary file; TOML is UTF-8 text)")
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
         raise ProblemError(
             f"{path}: not a text file (byte {exc.start} is not UTF-8; TOML must be UTF-8)"
@@ -104,6 +112,73 @@ def _nesting(text: str) -> int:
     return deepest
 
 
+#: An integer's digits in a TOML text (not a float's: no point or exponent next to them).
+_LONG_RUN = re.compile(r"(?<![\w.])[+-]?[0-9][0-9_]*(?![\w.])")
+
+
+def _too_many_digits(text: str, error: str) -> str | None:
+    """What is wrong, and where, when tomllib failed on an integer longer than Python
+    converts (``sys.get_int_max_str_digits()``, 4300 by default); None for any other
+    error. TOML's integers are 64-bit, a problem's at most :data:`MAX_INTEGER`.
+
+    The field is found by parsing the text again with each such number replaced by an
+    inline table ``{optdesign_long_number_K = 0}``: a value where the number was a value,
+    plain text where it was inside a string or a comment.
+    """
+    m = re.search(r"value has (\d+) digits", error)
+    if m is None:
+        return None
+    limit = sys.get_int_max_str_digits() or int(m.group(1)) - 1
+    runs = [r for r in _LONG_RUN.finditer(text) if _digits(r.group()) > limit]
+    if not runs:
+        return None
+    marked, end = [], 0
+    for k, run in enumerate(runs):
+        marked += [text[end : run.start()], f"{{optdesign_long_number_{k} = 0}}"]
+        end = run.end()
+    found = _marked(_toml_or_none("".join(marked) + text[end:]), len(runs))
+    if found is None:  # (a long number in a bare key, say): the first one's line
+        where = f"line {text.count(chr(10), 0, runs[0].start()) + 1}"
+        count = _digits(runs[0].group())
+    else:
+        where, k = found
+        count = _digits(runs[k].group())
+    return (
+        f"{where}: a number of {count} digits is out of range (an integer is at most "
+        f"{MAX_INTEGER:,})"
+    )
+
+
+def _digits(run: str) -> int:
+    return len(run.replace("_", "").lstrip("+-"))
+
+
+def _toml_or_none(text: str) -> dict[str, Any] | None:
+    try:
+        return tomllib.loads(text)
+    except (ValueError, RecursionError):  # TOMLDecodeError is a ValueError
+        return None
+
+
+def _marked(data: Any, marks: int) -> tuple[str, int] | None:
+    """(dotted path, K) of the first ``{optdesign_long_number_K = 0}`` in ``data``
+    (0 <= K < ``marks``)."""
+    stack: list[tuple[str, Any]] = [("", data)]
+    while stack:  # depth first, in the file's order
+        path, value = stack.pop()
+        if isinstance(value, dict):
+            mark = re.fullmatch(r"optdesign_long_number_([0-9]{1,9})", "".join(value))
+            if mark is not None and int(mark.group(1)) < marks:
+                return path, int(mark.group(1))
+            children = [(f"{path}.{k}" if path else k, v) for k, v in value.items()]
+        elif isinstance(value, list):
+            children = [(f"{path}[{k}]", v) for k, v in enumerate(value)]
+        else:
+            continue
+        stack += reversed(children)
+    return None
+
+
 def load_problem(path: str | Path) -> DesignProblem:
     """Read, validate and build the problem in the TOML file ``path``.
 
@@ -119,6 +194,9 @@ def load_problem(path: str | Path) -> DesignProblem:
     except tomllib.TOMLDecodeError as exc:
         raise ProblemError(f"{path}: not valid TOML ({exc})") from None
     except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        too_long = _too_many_digits(text, str(exc))
+        if too_long is not None:
+            raise ProblemError(f"{path}: {too_long}") from None
         raise ProblemError(f"{path}: not valid TOML ({' '.join(str(exc).split())[:120]})") from None
     except RecursionError:
         raise ProblemError(f"{path}: arrays or tables nested too deeply") from None
@@ -136,8 +214,8 @@ def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProbl
     """
     if isinstance(problem, DesignProblem):
         return problem
-    if isinstance(problem, Mapping):
-        return problem_from_dict(dict(problem))
+    if isinstance(problem, Mapping):  # a dict as given: a cycle is named from its root
+        return problem_from_dict(problem if isinstance(problem, dict) else dict(problem))
     try:
         path = validation.path("problem", problem)
     except validation.ArgumentError:
@@ -209,17 +287,35 @@ def problem_from_dict(
 MAX_INTEGER = 2**53
 
 
-def _check_raw(data: Any, source: str, path: str = "") -> None:
+def _check_raw(
+    data: Any, source: str, path: str = "", depth: int = 0, inside: dict[int, str] | None = None
+) -> None:
     """What no field accepts, refused before the schema sees it: an integer beyond
-    :data:`MAX_INTEGER` (a 400-digit number overflows the conversion to float) and a NUL
-    character in a key or a string (no name, unit or option contains one)."""
+    :data:`MAX_INTEGER` (a 400-digit number overflows the conversion to float), a NUL
+    character in a key or a string (no name, unit or option contains one), tables and
+    arrays nested deeper than :data:`MAX_NESTING` (``a.a.a. ... = 1`` in a file, whose
+    dotted keys no bracket count sees) and a table or list that contains itself (a dict
+    from Python). Recursion stops at that depth, so no input reaches Python's limit."""
+    inside = {id(data): path or "the problem"} if inside is None else inside
     items = data.items() if isinstance(data, Mapping) else enumerate(data)
     for key, value in items:
         here = f"{path}[{key}]" if isinstance(key, int) else f"{path}.{key}" if path else key
         if isinstance(key, str) and "\x00" in key:
             raise ProblemError(f"{source}: {here!r}: a NUL character in a key")
         if isinstance(value, Mapping | list | tuple):
-            _check_raw(value, source, here)
+            if id(value) in inside:
+                raise ProblemError(
+                    f"{source}: {here}: refers back to {inside[id(value)]} (a table or list "
+                    "that contains itself; a problem is a tree of tables, lists and values)"
+                )
+            if depth + 1 > MAX_NESTING:
+                raise ProblemError(
+                    f"{source}: {here}: tables and arrays nested too deeply (at most "
+                    f"{MAX_NESTING} levels; a problem needs 3)"
+                )
+            inside[id(value)] = here
+            _check_raw(value, source, here, depth + 1, inside)
+            del inside[id(value)]
         elif isinstance(value, str) and "\x00" in value:
             raise ProblemError(f"{source}: {here}: a NUL character in the text")
         elif isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:

@@ -160,6 +160,20 @@ class Tolerances(_Model):
     alpha: Dimensionless = Field(0.9, ge=0.0, lt=1.0)
     k: Dimensionless = Field(2.0, ge=0.0)
 
+    @model_validator(mode="after")
+    def _names_a_tolerance(self):
+        # A section that scatters nothing would make robust design draw no sample at all.
+        if self.variables() or self.fit != "fixed":
+            return self
+        hint = (
+            'give a variable\'s band (e.g. R = "0.05 mm") or fit = "uniform", '
+            "or leave the table out"
+        )
+        given = sorted(self.model_fields_set)
+        if not given:
+            raise ValueError(f"the table is empty: it names no tolerance; {hint}")
+        raise ValueError(f"names no tolerance, only settings ({', '.join(given)}); {hint}")
+
     def variables(self) -> dict[str, Any]:
         """Variable name -> tolerance, for the variables that have one."""
         own = set(Tolerances.model_fields)

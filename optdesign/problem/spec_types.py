@@ -74,10 +74,41 @@ class _Model(BaseModel):
                 if info is None:
                     continue
                 if isinstance(value, bool) and not _takes_bool(info.annotation):
-                    raise ValueError(f"{key}: expected a number or a string, got {value}")
+                    shown = str(value).lower()  # as the file wrote it
+                    raise ValueError(f"{key}: expected {expected(info.annotation)}, got {shown}")
                 if info.annotation is bool and not isinstance(value, bool | np.bool_):
                     raise ValueError(f"{key}: expected true or false, got {value!r}")
         return data
+
+
+def expected(annotation: Any) -> str:
+    """What a field of type ``annotation`` takes, for a refusal: ``a table (kind,
+    friction, catalogue, nut, ...)`` for a table such as ``screw``, ``one of 'ball',
+    'roller'`` for a choice, ``a number or a string`` for a quantity."""
+    model = _model_in(annotation)
+    if model is not None:
+        names = list(model.model_fields)
+        more = ", ..." if len(names) > 4 else ""
+        return f"a table ({', '.join(names[:4])}{more})"
+    leaves = _flat_args(annotation)
+    choices = [a for a in leaves if isinstance(a, str)]
+    if choices:
+        number = "a number or " if float in leaves or int in leaves else ""
+        return number + "one of " + ", ".join(repr(c) for c in choices)
+    return "a string" if annotation is str else "a number or a string"
+
+
+def _model_in(annotation: Any) -> Any:
+    """The pydantic model inside ``annotation`` (``X``, ``X | None``, ``Annotated[X, ...]``)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    return next((m for a in get_args(annotation) if (m := _model_in(a)) is not None), None)
+
+
+def _flat_args(annotation: Any) -> list[Any]:
+    # The leaves of an annotation: Literal["a", "b"] | None -> ["a", "b", NoneType].
+    args = get_args(annotation)
+    return [leaf for a in args for leaf in _flat_args(a)] if args else [annotation]
 
 
 def _takes_bool(annotation: Any) -> bool:

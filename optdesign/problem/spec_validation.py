@@ -13,6 +13,7 @@ from pydantic import ValidationError
 
 from optdesign.errors import ProblemError
 from optdesign.problem.spec import ProblemSpec, spec_model
+from optdesign.problem.spec_types import expected
 from optdesign.units import Bare
 
 
@@ -46,6 +47,10 @@ def validate_spec(
                 msg = "missing (a required field)"
             if err["type"] == "extra_forbidden":
                 msg = "unknown field" + _did_you_mean(model, parts)
+            if err["type"] in ("model_type", "dict_type"):  # `screw = 5`: say what it takes
+                target = _model_at(model, parts)
+                what = expected(target) if target is not None else "a table"
+                msg = f"expected {what}, got {_shown(err['input'])}"
             head = re.match(r"(\w+): ", msg)  # a table's check naming its own field
             if head is not None:
                 loc, msg = f"{loc}.{head.group(1)}" if loc else head.group(1), msg[head.end() :]
@@ -68,6 +73,23 @@ def _did_you_mean(model: type, parts: list[str]) -> str:
     close = difflib.get_close_matches(parts[-1], names, n=1, cutoff=0.6)
     hint = f"; did you mean {close[0]!r}?" if close else ""
     return f"{hint} (valid: {', '.join(names)})" if len(names) <= 40 else hint
+
+
+def _model_at(model: type, parts: list[str]) -> type | None:
+    """The pydantic model of the table at ``parts`` of ``model``'s schema, if any."""
+    for key in parts:
+        field = getattr(model, "model_fields", {}).get(key)
+        found = None if field is None else _model_of(field.annotation)
+        if found is None:
+            return None
+        model = found
+    return model
+
+
+def _shown(value: Any) -> str:
+    """A value as a problem file writes it (``true``, ``5``, ``'HIWIN'``), cut short."""
+    text = str(value).lower() if isinstance(value, bool) else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _model_of(annotation: Any) -> type | None:

@@ -157,6 +157,11 @@ def parse_variable(
         value = q(raw["value"], "value")
         positive(value, field)
         return Variable(**make, value=value)
+    if "values" in raw and "catalogue" in raw:
+        raise ProblemError(
+            f"{field}: values and catalogue both given: a variable takes its items from one "
+            "(values = [...] lists them; catalogue = NAME takes a named catalogue's)"
+        )
     lower = q(raw["lower"], "lower") if "lower" in raw else None
     upper = q(raw["upper"], "upper") if "upper" in raw else None
     if lower is not None:  # also when a catalogue narrows the bounds to its items below

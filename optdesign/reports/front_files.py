@@ -40,6 +40,50 @@ def write_front_files(
     return [out / "front.csv", out / "front.json"]
 
 
+def write_front_outputs(
+    fronts: Sequence[Any],
+    problem: Any,
+    out: Path,
+    *,
+    objectives: Sequence[str],
+    points: int,
+    created: str,
+    plot: bool = True,
+    report: bool = True,
+) -> tuple[list[Path], list[str]]:
+    """Everything ``optdesign pareto`` writes beside the stores, in folder ``out``:
+    ``front.csv``, ``front.json`` (:func:`write_front_files`), ``front.png`` (``plot``)
+    and ``report.html`` (``report``, when a front has a point). Returns the files written
+    and the notes of the outputs that could not be drawn (a figure or a page that fails
+    is a note, not an error: the other files are kept)."""
+    wrote = write_front_files(
+        fronts, problem, out, objectives=objectives, points=points, created=created
+    )
+    notes: list[str] = []
+    if plot:
+        from optdesign.plots import write_figure
+        from optdesign.plots.front import plot_fronts
+
+        failed = write_figure(lambda: plot_fronts(problem, fronts), out / "front.png")
+        if failed is None:
+            wrote.append(out / "front.png")
+        else:  # the front's files are written; the report and the summary follow
+            notes.append(failed)
+    if report and any(f.points for f in fronts):
+        from optdesign.errors import OptDesignError
+        from optdesign.reports.html import front_report
+        from optdesign.storage import atomic_write_text
+
+        try:
+            page = front_report(problem, fronts)
+        except OptDesignError as exc:  # a user's mechanism that cannot draw itself
+            notes.append(f"report.html not written: {exc}")
+        else:
+            atomic_write_text(out / "report.html", page)
+            wrote.append(out / "report.html")
+    return wrote, notes
+
+
 def no_point_text(problem: Any, front: Any) -> str:
     """Why a front has no point: the requirements its least violating design violates."""
     head = f"{front.method}: no feasible design"

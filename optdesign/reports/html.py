@@ -32,7 +32,7 @@ from optdesign.reports.display_units import (
 from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.html_page import render
 from optdesign.reports.limits import binding_angles, bound_limits, limits_of
-from optdesign.reports.solve_text import objective_value
+from optdesign.reports.solve_text import feasibility_text, objective_value
 from optdesign.studies.verify import constraint_rows
 from optdesign.user_code import call_method
 
@@ -149,12 +149,21 @@ def solve_report(result: Any) -> str:
         "kind": "solve",
         "status": result.status + _starts_text(result.multistart),
         "objective": f"{name} = {objective_shown(problem, name, objective_value(result)).text(8)}",
+        "claims": _claims(result),
         "designs": [initial, best],
         "reference": 0,
         "selected": 1,
         "front": None,
     }
     return render(data, title=f"optdesign: {problem.name}")
+
+
+def _claims(result: Any) -> list[str]:
+    """What the result claims, as the summary's ``feasible`` and ``global`` lines say it."""
+    lines = [f"feasible: {feasibility_text(result)}"]
+    if result.globality is not None and result.success:
+        lines.append(f"global: {result.globality.text()}")
+    return lines
 
 
 def _starts_text(ms: Any) -> str:

@@ -202,6 +202,7 @@ def render(data: dict[str, Any], title: str) -> str:
 </head><body>
 <h1>{e(data["problem"])} ({e(data["mechanism"])})</h1>
 <p class="meta">status {e(data["status"])}; objective {e(data["objective"])}</p>
+{"".join(f'<p class="meta">{e(line)}</p>' for line in data.get("claims", []))}
 <p class="meta">size, where shown, is the {e(data["size"])}; angles in {e(data["angle_unit"])},
 moments in N*m, ripple in %.</p>
 <details><summary>requirements (as read from the file)</summary><ul>{reqs}</ul></details>

@@ -123,6 +123,8 @@ def result_document(result: Result) -> dict[str, Any]:
             "lower_bound": objective_shown(problem, name, cert.lower_bound).to_json(),
             "gap": Shown(100.0 * cert.gap_rel, "%").to_json(),
         }
+    if result.globality is not None:
+        doc["globality"] = {**asdict(result.globality), "text": result.globality.text()}
     if result.multistart is not None:
         doc["multistart"] = asdict(result.multistart)
     doc["notes"] = list(result.notes)

@@ -8,7 +8,7 @@ import io
 from typing import Any
 
 from optdesign.reports.frames import objective_column, variable_column
-from optdesign.text import printable
+from optdesign.text import csv_cell, printable
 
 
 def sweep_columns(sweep: Any) -> list[tuple[str, str, Any]]:
@@ -57,13 +57,15 @@ def sweep_frame(sweep: Any):
 
 
 def sweep_csv(sweep: Any) -> str:
-    """``sweep.csv``: the table, units in the headers (``"hinge_moment [N*m]"``)."""
+    """``sweep.csv``: the table, units in the headers (``"hinge_moment [N*m]"``); a text
+    cell a spreadsheet would read as a formula (a user's name starting with ``=``) gets
+    a leading ``'``, as in ``front.csv``."""
     headers, rows = sweep_rows(sweep)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(headers)
+    w.writerow([csv_cell(printable(h)) for h in headers])
     for row in rows:
-        w.writerow([printable(v) if isinstance(v, str) else _num(v) for v in row])
+        w.writerow([csv_cell(printable(v)) if isinstance(v, str) else _num(v) for v in row])
     return buf.getvalue()
 
 
@@ -137,3 +139,26 @@ def _cell(v: Any) -> str:
     if isinstance(v, float):
         return f"{v:.6g}"
     return printable(v)
+
+
+def sweep_document(sweep) -> dict:
+    """``sweep.json``: the axes, the table's columns with their units, the rows."""
+    from optdesign.solvers.result import clean_json
+
+    headers, rows = sweep_rows(sweep)
+    return clean_json(
+        {
+            "schema": "optdesign.sweep/1",
+            "problem": sweep.problem.name,
+            "objective": sweep.objective,
+            "continuation": sweep.continuation,
+            "axes": [{"path": a.path, "unit": a.unit, "values": list(a.shown)} for a in sweep.axes],
+            "units": {c[0]: c[1] for c in sweep_columns(sweep) if c[1]},
+            "points": [dict(zip(headers, r, strict=True)) for r in rows],
+            "sensitivities": [p.sensitivities for p in sweep.points]
+            if any(p.sensitivities for p in sweep.points)
+            else None,
+            "wall_time": {"value": sweep.wall_time_s, "unit": "s"},
+            "notes": sweep.notes,
+        }
+    )

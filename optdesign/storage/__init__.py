@@ -34,6 +34,7 @@ One job a module: :mod:`optdesign.storage.files` (atomic files, a writable folde
 from optdesign.storage.files import (
     FolderInUseError,
     StoreError,
+    WriteError,
     atomic_output,
     atomic_write_bytes,
     atomic_write_text,
@@ -64,6 +65,7 @@ __all__ = [
     "StoreError",
     "StoreScan",
     "StoreWriter",
+    "WriteError",
     "_lock_holder",
     "atomic_output",
     "atomic_write_bytes",

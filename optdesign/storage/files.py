@@ -25,6 +25,26 @@ class FolderInUseError(StoreError):
     """Another process holds the lock of an output folder."""
 
 
+class WriteError(StoreError, OSError):
+    """A file that could not be written (a full disk, no permission, a quota): its
+    message names the file, ``cannot write out/sweep.csv: No space left on device``.
+
+    Also an :class:`OSError` with the failure's ``errno``, ``strerror`` and the file as
+    ``filename``, so that code treating I/O errors apart (a figure's failure is a note,
+    a full disk is not) still does. Built by :func:`write_error`.
+    """
+
+    def __str__(self) -> str:
+        return f"cannot write {self.filename}: {self.strerror}"
+
+
+def write_error(path: Path | str, exc: OSError) -> WriteError:
+    """``exc`` (raised while writing ``path``) as a :class:`WriteError` naming ``path``
+    (also one naming a temporary file of ``path``: a writer that writes atomically
+    itself, inside :func:`atomic_output`)."""
+    return WriteError(exc.errno, exc.strerror or str(exc) or type(exc).__name__, str(path))
+
+
 # --- atomic files ------------------------------------------------------------------------
 def _umask() -> int:
     # os.umask can only be read by setting it; do it once (at first use, not at import).
@@ -62,7 +82,7 @@ def _temp_file(path: Path) -> tuple[int, Path]:
             prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent
         )
     except OSError as exc:
-        raise StoreError(f"cannot write {path}: {exc.strerror}") from None
+        raise write_error(path, exc) from None
     return fd, Path(tmp)
 
 
@@ -93,14 +113,17 @@ def atomic_output(path: Path | str) -> Iterator[Path]:
     fd, tmp = _temp_file(path)
     os.close(fd)
     try:
-        yield tmp
-        # The writer wrote by name (it may even have replaced the file, atomically):
-        # reopened without following a link, made durable, put in place.
-        fd = os.open(tmp, os.O_RDWR | NOFOLLOW | CLOEXEC)
         try:
-            _commit(fd, tmp, path)
-        finally:
-            os.close(fd)
+            yield tmp
+            # The writer wrote by name (it may even have replaced the file, atomically):
+            # reopened without following a link, made durable, put in place.
+            fd = os.open(tmp, os.O_RDWR | NOFOLLOW | CLOEXEC)
+            try:
+                _commit(fd, tmp, path)
+            finally:
+                os.close(fd)
+        except OSError as exc:  # the writer's too: it names the temporary file, or none
+            raise write_error(path, exc) from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -123,10 +146,13 @@ def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
     _make_folder(path.parent)
     fd, tmp = _temp_file(path)
     try:
-        view = memoryview(data)
-        while view:
-            view = view[os.write(fd, view) :]
-        _commit(fd, tmp, path)
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view) :]
+            _commit(fd, tmp, path)
+        except OSError as exc:  # "[Errno 28] No space left on device" names no file
+            raise write_error(path, exc) from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)

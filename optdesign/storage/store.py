@@ -22,7 +22,7 @@ from typing import Any
 
 from optdesign.interrupts import deferred
 from optdesign.safe_io import open_file, read_file
-from optdesign.storage.files import StoreError, atomic_write_text
+from optdesign.storage.files import StoreError, atomic_write_text, write_error
 
 Record = dict[str, Any]
 
@@ -284,6 +284,8 @@ def _repair_tail(path: Path, scan: StoreScan) -> None:
         else:
             os.ftruncate(fd, scan.good_bytes)
         os.fsync(fd)
+    except OSError as exc:
+        raise write_error(path, exc) from exc
     finally:
         os.close(fd)
 
@@ -329,8 +331,11 @@ class StoreWriter:
         data = (json.dumps(obj, allow_nan=True) + "\n").encode()
         with deferred():  # the whole line, and counted (the CLI reports the count)
             view = memoryview(data)
-            while view:
-                view = view[os.write(self.fd, view) :]
+            try:
+                while view:
+                    view = view[os.write(self.fd, view) :]
+            except OSError as exc:  # a full disk: the message names the store
+                raise write_error(self.path, exc) from exc
             self.count += 1
         self._dirty.set()
 

@@ -55,7 +55,9 @@ def solve_gp_problem(
         Also solve the exact NLP (exact Hertz), warm-started from the GP design, and
         report its optimum and the gap (``details.gp.nlp_exact``, ``details.gp.gap_gp_nlp_rel``).
     nlp_starts, seed
-        Multistart of that NLP (default: the problem file's).
+        Starts of that NLP (default: the GP design alone - a local refinement of the GP's
+        certified optimum, whose gap to it is reported; a global search there would look
+        again for what the certificate already covers, up to the model difference).
     solver
         Registered GP back-end (:func:`optdesign.solver_names` ``("gp")``; None: the
         registry's default for a GP).
@@ -101,7 +103,7 @@ def solve_gp_problem(
         )
     if compare_nlp and result.design:
         x0 = np.array([result.design[v.name] for v in problem.free])
-        nlp = solve_nlp(problem, objective=objective, starts=nlp_starts, seed=seed, x0=x0)
+        nlp = solve_nlp(problem, objective=objective, starts=nlp_starts or 1, seed=seed, x0=x0)
         gap = (gp_objective - nlp.objective) / abs(nlp.objective) if nlp.success else float("nan")
         details.nlp_exact = ExactNLP(
             status=nlp.status,

@@ -478,7 +478,7 @@ def _executor(
         from distributed import Client
 
         own = not hasattr(scheduler, "submit")
-        client = Client(scheduler) if own else scheduler
+        client = _connect(Client, scheduler) if own else scheduler
         try:
             yield _Dask(fn, client, isolate)
         finally:
@@ -491,6 +491,23 @@ def _executor(
             yield _Pool(fn, own_pool, isolate)
     else:
         yield _Serial(fn, isolate)
+
+
+def _connect(client_class: Any, scheduler: Any) -> Any:
+    """A Client of the scheduler at ``scheduler`` (an address, or a cluster); a scheduler
+    that does not answer in distributed's connect timeout, or a transport that cannot be
+    set up (TLS without its configuration, UCX not installed), is an
+    :class:`~optdesign.argument_checks.ArgumentError` naming the address, not a traceback."""
+    from optdesign.argument_checks import ArgumentError, shown
+
+    try:
+        return client_class(scheduler)
+    except (OSError, TypeError, ValueError, ImportError) as exc:
+        where = shown(scheduler, 200) if isinstance(scheduler, str) else type(scheduler).__name__
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise ArgumentError(
+            "scheduler", f"cannot connect to the Dask scheduler at {where}: {reason}"
+        ) from exc
 
 
 #: Per-process (and per-thread, for threaded Dask workers) cache of expensive objects.

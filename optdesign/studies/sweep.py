@@ -69,6 +69,12 @@ from optdesign.studies.sensitivity import at_values
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2
 MAX_POINTS = 1000
+#: Most points of a sweep's grid (the product of its axes' counts). Every point gets its
+#: own global search (about 1 to 2 s on the shipped problems) and then its polish
+#: rounds' warm starts, so 2 500 points are an hour or two on one process, and 50 x 50
+#: is finer than a design chart shows; a 1000 x 1000 grid (a typo, or a count meant for
+#: one axis) would be weeks. One axis keeps its MAX_POINTS.
+MAX_GRID = 2500
 
 
 @dataclass(frozen=True)
@@ -169,10 +175,30 @@ class Sweep:
 
 
 # --- parameters ----------------------------------------------------------------------
+def check_path_names(path: str) -> None:
+    """InputError ``vary`` when a name of the dotted ``path`` is empty: a dot at its start
+    or its end, or two dots in a row (``requirements.hinge_moment.``)."""
+    names = path.split(".")
+    empty = next((k for k, name in enumerate(names) if not name.strip()), None)
+    if empty is None:
+        return
+    if empty == 0:
+        at = "before its first dot" if len(names) > 1 else "(no name at all)"
+    elif empty == len(names) - 1:
+        at = "after its last dot"
+    else:
+        at = f"between two dots (after {'.'.join(names[:empty])})"
+    raise InputError(
+        "vary",
+        f"{path!r}: an empty name {at}; give requirements.NAME or variables.NAME[.lower|.upper]",
+    )
+
+
 def parameter_dimension(problem: DesignProblem, path: str) -> str:
     """The dimension of the parameter at ``path`` (InputError ``vary`` when unknown)."""
     from optdesign.reports.display_units import _dimension
 
+    check_path_names(path)
     head, _, rest = path.partition(".")
     if head == "variables":
         name, _, side = rest.partition(".")
@@ -204,6 +230,9 @@ def parameter_dimension(problem: DesignProblem, path: str) -> str:
         if depth < len(keys) - 1:
             if value is None:
                 raise InputError("vary", f"{path}: requirements.{key} is not set in the problem")
+            if not hasattr(type(value), "model_fields"):
+                inner = ".".join(keys[: depth + 1])
+                raise InputError("vary", f"{path}: requirements.{inner} is a value, not a table")
             model = value
             continue
         info = fields[key]
@@ -286,6 +315,14 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
         axes.append(Axis(path, values, shown[0].unit, tuple(float(s.value) for s in shown)))
     if len({a.path for a in axes}) < len(axes):
         raise InputError("vary", "the same parameter twice")
+    total = math.prod(len(a.values) for a in axes)
+    if total > MAX_GRID:
+        counts = " x ".join(str(len(a.values)) for a in axes)
+        raise InputError(
+            "vary",
+            f"{counts} = {total} points; a sweep's grid has at most {MAX_GRID} (each point "
+            "is a global search): give fewer points",
+        )
     return axes
 
 

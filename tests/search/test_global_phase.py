@@ -15,6 +15,7 @@ from optdesign.search.global_phase import (
     default_max_starts,
     distinct_optima,
     global_search,
+    min_counted_starts,
     search_globality,
 )
 from optdesign.search.odds import odds
@@ -156,3 +157,29 @@ def test_the_stop_rule_needs_agreement_and_settled_odds():
 @pytest.mark.parametrize(("d", "cap"), [(1, 32), (2, 32), (5, 60), (7, 84)])
 def test_the_cap_grows_with_the_dimension(d, cap):
     assert default_max_starts(d) == cap
+
+
+def test_the_stop_rule_waits_for_two_counted_starts_per_variable():
+    # ten free variables: the odds alone would stop after 8 agreeing starts
+    rule = StopRule(counted_from=0, agree=3, min_counted=min_counted_starts(10))
+    same = [local_solve(CENTRES[3])] * 19
+    assert min_counted_starts(10) == 20
+    assert rule.reason(same) == ""
+    assert rule.reason([*same, local_solve(CENTRES[3])]) == "odds"
+
+
+def test_failed_starts_at_a_feasible_design_keep_the_search_going():
+    # a start may stop on its iteration limit at a design the NumPy model finds
+    # feasible: a feasible design exists, the search must not call it hopeless
+    def stopped_at_a_feasible_design(x0):
+        return Result(status="max_iterations", objective=2.0, formulation="test", verified=True)
+
+    best = global_search(stopped_at_a_feasible_design, starts(), max_starts=20)
+    assert best.multistart.n_starts == 20 and best.multistart.stop == "all starts run"
+    rule = StopRule(counted_from=0, agree=3)
+    assert rule.reason([failing_solve(None)] * FAILED_LIMIT) == "no feasible start"
+
+
+def test_agree_zero_runs_every_start_even_when_none_converges():
+    best = global_search(failing_solve, starts(), max_starts=12, agree=0)
+    assert best.multistart.n_starts == 12 and best.multistart.stop == "all starts run"
