@@ -52,7 +52,13 @@ def browser():
 
     options = webdriver.ChromeOptions()
     options.binary_location = CHROMIUM
-    profile = tempfile.mkdtemp(prefix="optdesign-chromium-")
+    # Chromium's singleton socket lives under TMPDIR and the profile: a Unix socket's path
+    # has at most 107 bytes, which the suite's nested temporary folders (CI's, pytest's,
+    # an xdist worker's) exceed - Chromium then exits at once ("session not created").
+    short = "/tmp" if os.access("/tmp", os.W_OK) else tempfile.gettempdir()
+    profile = tempfile.mkdtemp(prefix="odc-", dir=short)
+    saved_tmpdir = os.environ.get("TMPDIR")
+    os.environ["TMPDIR"] = short  # inherited by chromedriver and Chromium
     for arg in (
         "--headless",
         "--no-sandbox",
@@ -67,7 +73,13 @@ def browser():
     ):
         options.add_argument(arg)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(DRIVER), options=options)
+    try:
+        driver = webdriver.Chrome(service=Service(DRIVER), options=options)
+    finally:
+        if saved_tmpdir is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = saved_tmpdir
     driver.set_page_load_timeout(60)
     try:
         yield driver

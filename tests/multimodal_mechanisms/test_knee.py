@@ -184,7 +184,9 @@ def test_stored_optima_are_feasible_on_both_models():
         entry = STORED[objective]
         theirs = ref.evaluate(entry["design"], objective)
         assert theirs["max_violation"] <= 1e-8
-        assert theirs["objective"] == pytest.approx(entry["value"], rel=1e-12)
+        # the reference's own model, at the stored design: its value again, to the
+        # rounding of another NumPy/SciPy release (1.6e-11 with NumPy 1.26)
+        assert theirs["objective"] == pytest.approx(entry["value"], rel=1e-9)
         x = np.array([entry["design"][k] for k in ref.NAMES])
         mine = PROBLEMS[objective].evaluate(x)
         assert mine.objectives[objective] == pytest.approx(entry["value"], rel=1e-7)
