@@ -120,6 +120,7 @@ def test_failures_are_recorded_and_the_run_goes_on(tmp_path):
     assert [r.status for r in again.rows] == [r.status for r in res.rows]
 
 
+@pytest.mark.slow  # every configuration on the quick suite: 20-24 s; test_bench's other cases run single configurations
 def test_quick_suite_every_configuration_and_consistent_metrics(tmp_path):
     res = bench.run_bench(
         "quick", None, tmp_path, workers=2, progress=False, time_limit=2.0, hard_timeout=4.0

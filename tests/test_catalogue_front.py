@@ -66,6 +66,7 @@ def test_each_end_is_the_optimum_of_its_own_limit(small_front):
         assert end["objectives"]["motor_torque"] == pytest.approx(again.objective, rel=1e-6)
 
 
+@pytest.mark.slow  # two catalogue anchors searched twice: 8-24 s
 def test_an_anchors_first_stage_leaves_the_ties_to_its_tie_break():
     """fin_actuator's motor torque does not depend on the pin: its catalogue optimum ties
     over the pins the requirements allow. The anchor's first stage only needs the value

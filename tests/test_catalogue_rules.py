@@ -250,6 +250,7 @@ def test_dn_rules_name_the_diameter_and_the_limit():
     ].upper == pytest.approx(90_000.0)
 
 
+@pytest.mark.slow  # a catalogue solve of fin_actuator: 9.5 s with the oldest releases
 def test_dn_rule_is_stated_in_the_summary_where_it_binds():
     import optdesign as od
 

@@ -220,6 +220,7 @@ def enumerated_4x5():
     return problem, catalogue.solve_catalogue(problem, method="enumerate", starts=2)
 
 
+@pytest.mark.slow  # its fixture enumerates a 4 x 5 catalogue: 9-17 s
 def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x5):
     """4 leads x 5 pins: branch and bound equals enumeration, and its counts are those of
     the node solves it made (counted here by a wrapper around the node solver)."""
@@ -275,6 +276,7 @@ def test_a_catalogue_result_keeps_the_callers_seed_and_objective_even_when_infea
     assert starved.status == "infeasible" and starved.objective_name == "ripple"
 
 
+@pytest.mark.slow  # the same enumerated 4 x 5 catalogue
 def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5):
     """The diagnosis's depth-first search (reached only when no item combination near the
     relaxation works, so no other fast test calls it): a leaf on the catalogue whose

@@ -48,6 +48,7 @@ def test_the_candidates_are_the_violated_by_amount_then_the_binding(infeasible):
     assert all(r.at == "" for r in rel)
 
 
+@pytest.mark.slow  # two relaxations re-solved on either side: 8-16 s; the candidates test keeps the fixture in the fast suite
 def test_the_relaxation_is_feasible_and_a_little_less_is_not(infeasible):
     """Independent check: solve again with the requirement moved."""
     problem, result = infeasible
@@ -58,6 +59,7 @@ def test_the_relaxation_is_feasible_and_a_little_less_is_not(infeasible):
     assert short.status == "infeasible"
 
 
+@pytest.mark.slow  # relaxations under three caps: 5-13 s
 def test_the_caps_on_requirements_and_bisection_steps(infeasible):
     problem, result = infeasible
     assert [r.name for r in relaxations(problem, result, max_requirements=1)] == ["mean_ratio"]
@@ -102,6 +104,7 @@ def test_a_record_states_the_written_and_the_needed_bound():
     assert _record(row, True, None, 2).needed is None
 
 
+@pytest.mark.slow  # a relaxation's bisection at every item combination: 9-26 s; test_failures' catalogue case diagnoses one in the fast suite
 def test_a_relaxation_at_catalogue_items_uses_the_items_parameters():
     """At items p = 2 mm, d = 10 mm the pin's fit takes its ISO 286 table clearance, a
     parameter of the NLP (0.94 of the formula's here): the backlash limit that site

@@ -142,6 +142,7 @@ def test_resume_reuses_the_stored_points(fork_sweep):
         od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out)
 
 
+@pytest.mark.slow  # a sweep with an infeasible point and its diagnosis: 4-10 s
 def test_an_infeasible_point_says_what_fails(tmp_path):
     sweep = od.sweep(CRANK, {HINGE: ("10 kN*m", "15 kN*m", 2)}, out=tmp_path)
     ok, bad = sweep.points
