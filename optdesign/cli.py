@@ -152,7 +152,10 @@ PLUGIN_MODULES: list[str] = [
 def literal(text: str) -> int | float | str:
     """A command-line word as the value a Python caller would pass: an int, else a float,
     else the text itself (the checks of :mod:`optdesign.validation` then say what is
-    wrong with it, as they do for the API)."""
+    wrong with it, as they do for the API). A word with digits of another script stays
+    text: ``int`` would read ``"\u0663"`` (ARABIC-INDIC DIGIT THREE) as 3, unseen."""
+    if any(ch.isdecimal() and not ch.isascii() for ch in text):
+        return text
     for kind in (int, float):
         try:
             return kind(text)

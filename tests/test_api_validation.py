@@ -488,3 +488,13 @@ def test_an_empty_out_is_refused_not_read_as_the_working_folder(
     assert caught.value.code == 2
     assert "argument --out: an empty path names no folder" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_command_line_number_in_another_scripts_digits_is_refused(tmp_path, capsys, monkeypatch):
+    # optdesign.cli.literal: int("\u0663") is 3; the option must not read it as a number
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as caught:
+        main(["solve", RIPPLE, "--starts", "\u0663", "--out", str(tmp_path / "o")])
+    assert caught.value.code == 2
+    assert "argument --starts: '\u0663' is not an integer" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
