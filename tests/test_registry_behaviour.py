@@ -143,6 +143,11 @@ def test_an_unknown_name_lists_the_registered_ones():
     names = registered()
     assert {"crank_slider", "fork", "pivoting_screw"} <= set(names)
     assert f"unknown mechanism 'no_such_linkage' (registered: {', '.join(names)})" in str(err.value)
+    # how to add one: in Python, or as a package's entry point
+    assert "@od.register_mechanism(NAME)" in str(err.value)
+    assert "entry point of the group 'optdesign.mechanisms'" in str(err.value)
+    with pytest.raises(InputError, match=r"; did you mean 'crank_slider'\? a mechanism of your"):
+        get_mechanism("crank_slidr")
 
 
 class _EntryPoint:

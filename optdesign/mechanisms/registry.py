@@ -147,8 +147,17 @@ def get_mechanism(name: str) -> type[Mechanism]:
         _load_entry_points()
         cls = _REGISTRY.get(name)
     if cls is None:
+        from difflib import get_close_matches
+
+        known = registered()
+        close = get_close_matches(str(name), known, n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
         raise InputError(
-            "mechanism", f"unknown mechanism {name!r} (registered: {', '.join(registered())})"
+            "mechanism",
+            f"unknown mechanism {name!r} (registered: {', '.join(known)}); {hint}a mechanism "
+            "of your own is registered by @od.register_mechanism(NAME) on its class, in "
+            f"Python, or by an entry point of the group {ENTRY_POINT_GROUP!r} in its "
+            "package's pyproject.toml (docs/mechanisms.md)",
         )
     return cls
 
