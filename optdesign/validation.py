@@ -174,7 +174,7 @@ SOLVE_ARGUMENTS = (
 def vary_path(path: str) -> None:
     """A sweep parameter's dotted path has no empty name (InputError ``vary``), the check
     :func:`optdesign.sweep` makes, for the command line's ``--vary`` before its range."""
-    from optdesign.studies.sweep import check_path_names
+    from optdesign.studies.sweep_grid import check_path_names
 
     check_path_names(path)
 
@@ -395,7 +395,7 @@ def front_problem(problem: Any) -> None:
 def sweep_parameters(problem: Any, vary: Mapping[str, Any], field: str = "vary") -> None:
     """The parameters of a sweep (``{path: (start, stop, count)}``) of ``problem``:
     refused, naming ``field`` and the path, before any work."""
-    from optdesign.studies.sweep import sweep_axes
+    from optdesign.studies.sweep_grid import sweep_axes
 
     try:
         sweep_axes(problem, vary)

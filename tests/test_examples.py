@@ -55,7 +55,7 @@ def test_the_fin_actuator_sweep_example_states_a_valid_sweep():
     problem and parameters od.sweep takes: the lock of 60 N, both axes of the right
     dimension, 7 x 3 points."""
     import optdesign as od
-    from optdesign.studies.sweep import parameter_dimension
+    from optdesign.studies.sweep_grid import parameter_dimension
 
     module = runpy.run_path(str(EXAMPLES / "fin_actuator_sweep.py"), run_name="example")
     problem = od.load(module["strong_lock_actuator"]())

@@ -14,15 +14,10 @@ from optdesign.commands.sweep import parse_vary
 from optdesign.problem.request import SolveRequest
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.run_options import RunOptions
-from optdesign.studies.sweep import (
-    at_values,
-    grid_neighbours,
-    grid_order,
-    neighbour,
-    polish_choice,
-    run_sweep,
-    sweep_axes,
-)
+from optdesign.studies.sensitivity import at_values
+from optdesign.studies.sweep import run_sweep
+from optdesign.studies.sweep_grid import grid_order, neighbour, sweep_axes
+from optdesign.studies.sweep_point import grid_neighbours, polish_choice
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 FORK = PROBLEMS / "fork_min_backlash.toml"
@@ -564,10 +559,10 @@ def test_sweep_csv_neutralises_text_a_spreadsheet_would_run(monkeypatch):
 
 
 def test_a_grid_beyond_its_cap_is_refused_naming_vary_and_the_product(tmp_path, capsys):
-    """optdesign.studies.sweep.sweep_axes: the product of the axes' counts is at most
+    """optdesign.studies.sweep_grid.sweep_axes: the product of the axes' counts is at most
     MAX_GRID (a 1000 x 1000 grid was accepted: about a day of global searches); od.sweep
     and the command line refuse it before any work."""
-    from optdesign.studies.sweep import MAX_GRID
+    from optdesign.studies.sweep_grid import MAX_GRID
 
     assert MAX_GRID == 2500
     R = "variables.R.upper"
