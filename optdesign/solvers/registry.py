@@ -25,7 +25,7 @@ from typing import Any
 
 from optdesign.errors import InputError
 from optdesign.solvers.deadline import DEADLINE_OPTION
-from optdesign.solvers.ipopt_options import IPOPT_NODE, IPOPT_TIE, IPOPT_WARM
+from optdesign.solvers.ipopt_options import IPOPT_NODE, IPOPT_RANGE, IPOPT_TIE, IPOPT_WARM
 
 
 @dataclass(frozen=True)
@@ -35,6 +35,9 @@ class SolverHints:
 
     #: options of a warm start from a nearby primal-dual solution (None: takes none)
     warm_start_options: Mapping[str, Any] | None = None
+    #: options of the ranges of the optimal set, each solve started warm at the optimum
+    #: (None: the warm-start options)
+    range_options: Mapping[str, Any] | None = None
     #: options of a solve started at a feasible point close to its optimum (a front's
     #: lexicographic tie-breaks)
     restart_options: Mapping[str, Any] | None = None
@@ -303,6 +306,7 @@ def _builtins() -> None:
     _BUILTINS_DONE = True
     ipopt = SolverHints(
         warm_start_options=IPOPT_WARM,
+        range_options=IPOPT_RANGE,
         restart_options=IPOPT_TIE,
         node_options=IPOPT_NODE,
         infeasible_verdicts=("Infeasible_Problem_Detected",),

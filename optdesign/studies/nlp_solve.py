@@ -359,7 +359,8 @@ def optimal_ranges(
     scale together). A search that fails keeps the optimal value on its side.
     """
     objective = result.objective_name or problem.objective_names[0]
-    warm_options = solver_hints(solver).warm_start_options
+    hints = solver_hints(solver)
+    warm_options = hints.range_options or hints.warm_start_options
     warm = warm_options is not None and "lam_g" in result.raw
     if warm:
         # Primal and dual start at the optimum (benchmarks/README.md, "Overhead").
