@@ -174,15 +174,19 @@ def summary() -> str:
 
 
 def main() -> None:
+    global RESULTS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10)
     parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--case", action="append", help="only these cases")
     parser.add_argument("--summary", action="store_true")
+    parser.add_argument("--results", type=Path, help=f"the record (default {RESULTS.name})")
     parser.add_argument(
         "--no-plain", action="store_true", help="skip the plain multistart beside each run"
     )
     args = parser.parse_args()
+    if args.results is not None:
+        RESULTS = args.results.resolve()
     if args.summary:
         print(summary())
         return

@@ -48,6 +48,13 @@ from optdesign.solvers.result import Result, TerminationCondition
 #: minimax epigraph's hundreds of inequality rows, multipliers of 1 put the first
 #: iterates far from the central path; 17 instead of 41 iterations on cs_min_backlash,
 #: same optima and no more failed starts over 32 Sobol starts of each shipped problem.
+#: The Hessian's regularisation is capped at 1e4 (``max_hessian_perturbation``, Ipopt's
+#: default 1e20): on the scaled problem (variables in [0, 1], rows ~1) a larger one only
+#: comes from a start stuck at a linkage's singular position, where Ipopt refactorised up
+#: to 1e20 at each of 500 iterations (30 s for one start of a crank-slider asked to turn
+#: +-120 deg); capped, such a start fails in tens of milliseconds. Same optima on the
+#: shipped problems and on the multimodal linkages, whose searches ran 2-12x faster
+#: (benchmarks/README.md, "Starts stuck at a singular position").
 IPOPT_DEFAULTS: dict[str, Any] = {
     "print_level": 0,
     "sb": "yes",
@@ -58,6 +65,7 @@ IPOPT_DEFAULTS: dict[str, Any] = {
     "mu_strategy": "adaptive",
     "mumps_pivot_order": 0,
     "bound_mult_init_method": "mu-based",
+    "max_hessian_perturbation": 1e4,
 }
 
 _IPOPT_STATUS = {
