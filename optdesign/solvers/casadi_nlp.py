@@ -36,25 +36,21 @@ from optdesign.solvers.deadline import passed as deadline_passed
 from optdesign.solvers.ipopt_options import IPOPT_WARM  # noqa: F401 (its users import it here)
 from optdesign.solvers.result import Result, TerminationCondition
 
-#: Ipopt defaults: quiet, tight tolerances (the tests compare optima to 1e-4 relative and
-#: constraints to 1e-6). Converging starts need well under 100 iterations; a start still
-#: running at 500 is stuck near a toggle position, and multistart has better ones.
-#: MUMPS with the AMD ordering (``mumps_pivot_order=0``) instead of its default: the
-#: step system is ~440 x 440 and very sparse, where the default ordering's analysis
-#: costs more than the factorisation; same iterations and optima, one solve 1.7-4x
-#: faster (benchmarks/README.md, "Overhead"; CasADi's sqpmethod with qrqp/osqp and
-#: Ipopt with SPRAL were slower or failed, ma27 is not installed). Bound multipliers
-#: start from mu / slack (``bound_mult_init_method="mu-based"``) instead of 1: with the
-#: minimax epigraph's hundreds of inequality rows, multipliers of 1 put the first
-#: iterates far from the central path; 17 instead of 41 iterations on cs_min_backlash,
-#: same optima and no more failed starts over 32 Sobol starts of each shipped problem.
-#: The Hessian's regularisation is capped at 1e4 (``max_hessian_perturbation``, Ipopt's
-#: default 1e20): on the scaled problem (variables in [0, 1], rows ~1) a larger one only
-#: comes from a start stuck at a linkage's singular position, where Ipopt refactorised up
-#: to 1e20 at each of 500 iterations (30 s for one start of a crank-slider asked to turn
-#: +-120 deg); capped, such a start fails in tens of milliseconds. Same optima on the
-#: shipped problems and on the multimodal linkages, whose searches ran 2-12x faster
-#: (benchmarks/README.md, "Starts stuck at a singular position").
+#: Ipopt defaults, each chosen for the shape of these problems (a few scaled design
+#: variables, hundreds of inequality rows over the grid angles); the measurements behind
+#: each are in benchmarks/README.md, "Figures behind comments in the code".
+#:
+#: - quiet, tight tolerances: optima are compared to 1e-4 relative, constraints to 1e-6;
+#: - 500 iterations: converging starts need well under 100, and a start still running is
+#:   stuck near a toggle position, where the search has better starts;
+#: - MUMPS with the AMD ordering: the step system is small and very sparse, and the default
+#:   ordering's analysis costs more than the factorisation;
+#: - bound multipliers started from mu / slack: multipliers of 1 on the epigraph's many rows
+#:   put the first iterates far from the central path;
+#: - the Hessian's regularisation capped at 1e4: on the scaled problem (variables in
+#:   [0, 1], rows ~1) a larger one only comes from a start stuck at a linkage's singular
+#:   position, where Ipopt would refactorise up to 1e20 at every iteration; capped, such a
+#:   start fails at once and the search goes on.
 IPOPT_DEFAULTS: dict[str, Any] = {
     "print_level": 0,
     "sb": "yes",
