@@ -1,5 +1,6 @@
 """Ipopt's options that the solver registry declares (no CasADi import: listing a
-back-end's capabilities loads no solver library)."""
+back-end's capabilities loads no solver library). The figures behind each choice are in
+benchmarks/README.md, "Figures behind comments in the code"."""
 
 from __future__ import annotations
 
@@ -7,8 +8,7 @@ from typing import Any
 
 #: Ipopt options of a warm start from a nearby solution (primal and dual): take its
 #: multipliers and start close to the central path instead of pushing the point back
-#: into the interior. The ranges of the optimal set from the optimum: 179 iterations
-#: instead of 244 (cs_min_backlash), 135 instead of 257 (cs_min_ripple), same ranges.
+#: into the interior.
 IPOPT_WARM: dict[str, Any] = {
     "warm_start_init_point": "yes",
     "warm_start_bound_push": 1e-9,
@@ -22,21 +22,17 @@ IPOPT_WARM: dict[str, Any] = {
 #: Ipopt options of the ranges of the optimal set (a warm start from the optimum, each
 #: solve moving one variable as far as the objective's tie band lets it): the warm start's,
 #: with the dual tolerance at 1e-7 instead of 1e-10, since a range end is shown to six
-#: digits and its constraint rows keep their own tolerance (1e-9). pivot_min_backlash:
-#: 240 iterations instead of 372, the ends equal to 7e-7 relative
-#: (benchmarks/README.md, "The ranges of the optimal set at a looser dual tolerance").
+#: digits and its constraint rows keep their own tolerance (1e-9).
 IPOPT_RANGE: dict[str, Any] = {**IPOPT_WARM, "tol": 1e-7}
 
 #: Ipopt options of a solve started at a feasible point close to its optimum (a front's
 #: lexicographic tie-breaks, started at an optimum of the objective fixed before): a
 #: small initial barrier parameter and bound push keep Ipopt there instead of pushing it
-#: back into the interior (cs_min_backlash, backlash anchor: 25-48 iterations instead of
-#: 62-101, and no failure from any of 6 multistart optima).
+#: back into the interior.
 IPOPT_TIE: dict[str, Any] = {"mu_init": 1e-5, "bound_push": 1e-6, "bound_frac": 1e-6}
 
 #: Ipopt options of a catalogue node. Many nodes of a catalogue search are infeasible
 #: boxes, and Ipopt's default filter spends ~120 iterations before its restoration phase
 #: proves it; ``expect_infeasible_problem`` enters restoration sooner, with the same nodes
-#: infeasible and the same optima (figures: benchmarks/README.md, "Catalogue searches:
-#: infeasible nodes").
+#: infeasible and the same optima.
 IPOPT_NODE: dict[str, Any] = {"expect_infeasible_problem": "yes"}
