@@ -186,17 +186,6 @@ def time_limit_option(parser: argparse.ArgumentParser, help: str, default: float
     )
 
 
-def bounded_int(lo: int, hi: int) -> Callable[[str], int]:
-    """An argparse type: an integer from ``lo`` to ``hi`` (sizes are capped, so that a
-    typo cannot start unbounded work)."""
-    return checked(lambda a, v: validation.integer(a, v, lo, hi), literal)
-
-
-def bounded_float(lo: float, hi: float) -> Callable[[str], float]:
-    """An argparse type: a finite number with ``lo < value <= hi``."""
-    return checked(lambda a, v: validation.number(a, v, lo, hi), literal)
-
-
 def option(argument: str, renamed: Mapping[str, str] | None = None) -> str:
     """The command-line option of an API argument: ``--time-limit`` for ``time_limit``
     (``renamed`` for options spelt otherwise, e.g. ``{"pop_size": "--pop"}``)."""

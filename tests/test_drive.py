@@ -350,8 +350,9 @@ def test_fin_actuator_optimum_confirmed_by_a_global_search():
     """The shipped whole-actuator problem: catalogue search (branch and bound over Ipopt
     relaxations) against differential evolution over the catalogue indices and the
     continuous variables on the NumPy path (no CasADi, no Ipopt)."""
+    from independent_global import differential_evolution_optimum
+
     import optdesign as od
-    from optdesign.studies.global_check import differential_evolution_optimum
 
     problem = load_problem(FIN)
     res = od.solve(problem)

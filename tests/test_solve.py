@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from independent_global import differential_evolution_optimum
 
 import optdesign as od
 from optdesign.cli import main
@@ -15,7 +16,6 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem, problem_from_dict
 from optdesign.solvers.casadi_nlp import IPOPT_WARM, CasadiNLPSolver
-from optdesign.studies.global_check import differential_evolution_optimum
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.verify import verify_design
 

@@ -179,11 +179,3 @@ def _principal(r, r_u, r_v, n, I1, I2) -> SurfacePoint:
     dirs = np.array([r_u * X[0, k] + r_v * X[1, k] for k in range(2)])
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     return SurfacePoint(r, r_u, r_v, n, I1, I2, w, dirs, X.T)
-
-
-def principal_curvatures(builder: Callable, u: float, v: float, p=(), n_params: int = 0):
-    """Principal curvatures (descending) of a surface built by ``builder`` at (u, v).
-
-    Convenience for one-off evaluations; reuse a :class:`Surface` in loops.
-    """
-    return Surface(builder, n_params).evaluate(u, v, p).kappa

@@ -253,11 +253,6 @@ class ThreadContact:
         E_star = effective_modulus(STEEL_E, STEEL_NU) if E_star is None else E_star
         return hertz_point_contact(*self.rho1, *self.rho2, self.omega, Q, E_star)
 
-    @property
-    def omega_nearest(self) -> float:
-        """Angle (rad) from plane 1 of body 1 to the *nearer* principal plane of body 2."""
-        return min(self.omega, 0.5 * math.pi - self.omega)
-
     def hertz_aligned(
         self, Q: float, E_star: float | None = None, pairing: str = "index"
     ) -> HertzPointContact:
