@@ -452,3 +452,82 @@ def test_a_front_given_out_writes_the_files_the_command_writes(tmp_path):
     assert not {"front.csv", "front.png", "report.html"} & {
         p.name for p in (tmp_path / "b").iterdir()
     }
+
+
+# --- what each limit costs at a front point --------------------------------------------------
+def _resolved_log_sensitivity(problem, front, point, name, rel=1e-3):
+    """d log(target) / d log(limit ``name``) at ``point``: its own epsilon problem (its
+    target, the others held at its epsilon bounds) solved again by Ipopt from its design
+    with the limit moved by ``rel`` to either side."""
+    from optdesign.studies.pareto.eps_solver import EpsSolver
+    from optdesign.studies.sensitivity import limit_value, perturbed
+
+    p = limit_value(problem, name)
+    h = rel * abs(p)
+    values = []
+    for q in (p + h, p - h):
+        other = perturbed(problem, name, q)
+        solver = EpsSolver(other, front.objectives, "ipopt")
+        x0 = np.array([point.design[v.name] for v in other.free])
+        r = solver.solve(point.target, point.eps, solver.nlp.start(x0=x0), use="fallback")
+        assert r.success, (name, q, r.status)
+        values.append(r.objective)
+    return (values[0] - values[1]) / (2 * h) * p / point.objectives[point.target]
+
+
+def test_each_front_points_page_shows_what_its_limits_cost(cs_front, tmp_path):
+    """Issue 35: a front point's page listed the limits that bind it, then "what each
+    limit costs: none". Each point now shows the costs of its own solve, and says of what."""
+    import json
+
+    page = od.report(cs_front, tmp_path / "report.html").read_text()
+    start = page.index(">", page.index('id="report-data"')) + 1
+    data = json.loads(page[start : page.index("</script>", start)])
+    assert len(data["designs"]) == len(cs_front.points)
+    for point, view in zip(cs_front.points, data["designs"], strict=True):
+        assert view["costs_note"].startswith(f"costs in {point.target}, from this point's own")
+        assert view["limits"] and view["sensitivities"]
+        assert all(f" -> {point.target} " in line for line in view["sensitivities"])
+        assert any(line.startswith("nut_travel_max 110 mm: ") for line in view["sensitivities"])
+
+
+def test_a_front_points_costs_equal_resolves_of_its_own_problem(cs):
+    """The costs at a point of a ripple-size front (SLSQP's points: the rows' multipliers
+    from SLSQP, the bounds' from stationarity) equal re-solves of the point's own epsilon
+    problem with the requirement or bound moved."""
+    from optdesign.studies.pareto.costs import point_costs
+
+    front = epsilon_constraint_front(cs, ["ripple", "size"], 3, starts=2)
+    checked = set()
+    for point in front.points[1:]:
+        costs = point_costs(cs, front.objectives, point)
+        assert costs.why == "" and costs.target == point.target == "size"
+        assert costs.held == point.eps and set(point.eps) == {"ripple"}
+        for s in costs.sensitivities:
+            fd = _resolved_log_sensitivity(cs, front, point, s.name)
+            assert s.log_sensitivity == pytest.approx(fd, rel=0.01, abs=1e-4), s.name
+            checked.add(s.name)
+    # a bound that SLSQP returned no multiplier for, and a requirement
+    assert {"variables.p.lower", "requirements.mean_ratio.min"} <= checked
+
+
+def test_a_front_point_whose_costs_cannot_be_known_says_why(cs, cs_front):
+    from dataclasses import replace
+
+    from optdesign.reports.costs import front_point_costs
+
+    point = cs_front.points[len(cs_front.points) // 2]
+    shown = front_point_costs(cs, cs_front.objectives, replace(point, multipliers=None))
+    assert shown == {
+        "sensitivities": [],
+        "costs_note": "not known for this point: the point's record keeps no multipliers of "
+        "its solve",
+    }
+    # multipliers that leave the gradient of its Lagrangian far from zero: no KKT point's
+    raw = point.multipliers
+    wrong = replace(point, multipliers=replace(raw, lam_g=3 * raw.lam_g))
+    shown = front_point_costs(cs, cs_front.objectives, wrong)
+    assert shown["sensitivities"] == []
+    assert shown["costs_note"].startswith(
+        "not known for this point: its solve's multipliers do not satisfy the optimality"
+    )

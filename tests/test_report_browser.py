@@ -162,9 +162,56 @@ def test_front_report_click_shows_that_design(browser, front_dir):
     assert float(phi0.text) == pytest.approx(points[k]["design"]["phi0"], rel=1e-5, abs=1e-6)
     label = browser.find_element(By.ID, "selected-label").text
     assert label == f"epsilon point {k + 1}"
+    # what each limit costs there, from the point's own solve (issue 35: it said "none")
+    costs = browser.find_element(By.ID, "costs").text
+    assert costs.startswith("costs in ") and " -> " in costs
     assert browser.find_elements(By.CSS_SELECTOR, "#sketch .scatterlayer .trace")
     assert browser.find_elements(By.CSS_SELECTOR, "#curves .scatterlayer .trace")
     assert _console_errors(browser) == []
+    assert _not_blank(browser) > 10.0
+
+
+def test_three_objective_front_report_draws_each_pair_and_a_click_shows_that_design(
+    browser, tmp_path
+):
+    """The page's plotly.js is the basic bundle (no 3-D scatter): a front of three
+    objectives is drawn as its three pairwise projections, each point in each, and a
+    click on a point in any of them shows that design."""
+    args = [
+        "pareto",
+        str(PROBLEMS / "cs_min_backlash.toml"),
+        "--objectives",
+        "ripple,backlash,size",
+    ]
+    args += ["--points", "4", "--workers", "1", "--starts", "1", "--no-plot"]
+    assert main([*args, "--out", str(tmp_path)]) == 0
+    points = json.loads((tmp_path / "front.json").read_text())["fronts"][0]["points"]
+    _open(browser, tmp_path / "report.html")
+    assert _console_errors(browser) == []
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    markers = browser.find_elements(By.CSS_SELECTOR, "#front .scatterlayer .trace .points path")
+    assert len(markers) == 3 * len(points) >= 9
+    titles = browser.execute_script(
+        "return Array.from(document.querySelectorAll('#front .g-xtitle, #front .g-x2title,"
+        " #front .g-x3title'), (e) => e.textContent)"
+    )
+    assert titles == ["ripple (%)", "ripple (%)", "backlash (deg)"]
+    shown = int(browser.execute_script("return document.body.dataset.selected"))
+    # a point not shown yet, and where no other point lies (a front may hold a design
+    # twice, digits apart: plotly picks the one on top)
+    F = np.array([[p["objectives"][o] for o in ("ripple", "backlash", "size")] for p in points])
+    apart = [
+        all(np.max(np.abs(F[i] / F[j] - 1)) > 0.01 for i in range(len(F)) if i != j)
+        for j in range(len(F))
+    ]
+    k = next(j for j in range(len(F)) if j != shown and apart[j])
+    # the point's marker in the last panel (backlash against size)
+    ActionChains(browser).move_to_element(markers[2 * len(points) + k]).click().perform()
+    assert int(browser.execute_script("return document.body.dataset.selected")) == k
+    cell = browser.find_element(By.CSS_SELECTOR, '#design td[data-var="R"]')
+    assert float(cell.text) == pytest.approx(points[k]["design"]["R"], rel=1e-5)
     assert _not_blank(browser) > 10.0
 
 

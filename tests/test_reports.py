@@ -257,3 +257,38 @@ def test_a_bare_deflection_rate_is_echoed_in_degrees_per_second():
     assert echo["deflection_rate"] == f"{math.degrees(2.0):.6g} deg/s"
     data["requirements"]["deflection_rate"] = "120 deg/s"  # as the file wrote it
     assert dict(requirement_echo(od.load(data)))["deflection_rate"] == "120 deg/s"
+
+
+def test_solve_report_html_stays_under_one_megabyte_and_self_contained(tmp_path):
+    """Issue 35: a solve's report.html was 4.8 MB, of which 4.8 MB was plotly's whole
+    bundle inlined; the page carries the basic bundle packed (reports/plotly_js.py)."""
+    from optdesign.reports import plotly_js
+
+    result = od.solve(od.load(PROBLEMS / "cs_min_backlash.toml"), starts=2, ranges=False)
+    page = od.report(result, tmp_path / "report.html")
+    assert page.stat().st_size < 1_000_000
+    text = page.read_text()
+    assert "<script src=" not in text and "<link" not in text  # opens without a network
+    assert plotly_js.packed() in text  # the library is in the page, whole
+    start = text.index(">", text.index('id="report-data"')) + 1
+    data = json.loads(text[start : text.index("</script>", start)])
+    optimum = data["designs"][1]
+    assert optimum["label"] == "optimum" and optimum["sketch"] and optimum["curves"]["ratio"]
+    # the drawn numbers at 7 digits, the design's values whole
+    R = next(row for row in optimum["design"] if row["name"] == "R")
+    assert R["value"] == result.design["R"]
+
+
+def test_report_pages_carry_the_shipped_plotly_bundle_unchanged():
+    import base64
+    import gzip
+    import hashlib
+
+    from optdesign.reports import plotly_js
+
+    packed = plotly_js.BUNDLE.read_bytes()
+    bundle = gzip.decompress(packed)
+    assert hashlib.sha256(bundle).hexdigest() == plotly_js.SHA256
+    assert f"plotly.js (basic - minified) v{plotly_js.VERSION}".encode() in bundle[:200]
+    assert base64.b64decode(plotly_js.packed()) == packed
+    assert "'" not in plotly_js.packed() and "<" not in plotly_js.packed()

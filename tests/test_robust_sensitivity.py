@@ -10,6 +10,7 @@ import pytest
 
 import optdesign as od
 from optdesign.formulations.robust import draw_samples
+from optdesign.reports.costs import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.studies.robust import solve_robust
 from optdesign.studies.sensitivity import limit_value, perturbed
@@ -90,6 +91,6 @@ def test_shipped_robust_problem(tmp_path):
     tol = problem.spec.tolerances
     _check_against_resolves(problem, result, draw_samples(problem, tol.samples, tol.seed, tol))
     first = result.sensitivities[0]
-    assert first.text() in result.summary()
+    assert cost_text(first) in result.summary()
     assert result_document(result)["sensitivities"][0]["name"] == first.name
     assert json.loads(result.to_json())["sensitivities"][0]["name"] == first.name

@@ -8,8 +8,10 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.reports.costs import cost_text
 from optdesign.reports.result_json import result_document
-from optdesign.studies.sensitivity import finite_difference, nlp_sensitivities
+from optdesign.solvers.result import Sensitivity
+from optdesign.studies.sensitivity import finite_difference, nlp_sensitivities, perturbed
 
 PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
 
@@ -58,7 +60,7 @@ def test_sensitivities_in_summary_json_and_report(fork, tmp_path):
     _problem, result = fork
     text = result.summary()
     assert "what each limit costs" in text
-    assert result.sensitivities[0].text() in text
+    assert cost_text(result.sensitivities[0]) in text
     doc = result_document(result)
     first = doc["sensitivities"][0]
     assert first["name"] == "requirements.nut_travel_max"
@@ -67,7 +69,8 @@ def test_sensitivities_in_summary_json_and_report(fork, tmp_path):
     assert first["log_sensitivity"] == pytest.approx(result.sensitivities[0].log_sensitivity)
     assert json.loads(result.to_json())["sensitivities"][0]["name"] == first["name"]
     page = od.report(result, tmp_path / "r.html").read_text()
-    assert "what each limit costs" in page and "nut_travel_max 110 mm: +1 %" in page
+    assert "what each limit costs" in page
+    assert "nut_travel_max 110 mm: raising it by 1 % to 111.1 mm -\\u003e backlash" in page
 
 
 def test_active_bounds_and_a_scalar_objective():
@@ -148,3 +151,70 @@ def test_the_gps_own_duals_agree(fork):
     )
     assert duals["pin_shear_stress"] < 1e-6  # not binding: no cost in either
     assert "requirements.pin_shear_stress_max" not in ours
+
+
+def _cost(name: str, limit: float, unit: str, log: float | None, d: float = 0.0) -> str:
+    return cost_text(Sensitivity(name, "backlash", limit, unit, d, "deg", log))
+
+
+def test_cost_text_says_which_way_each_limit_moves_for_either_sign_and_side():
+    """Issue 35: "gx.lower -150 mm: +1 %" did not say that 1 % moves a negative bound
+    down, nor whether that widens the bounds: each line says both, whatever the sign."""
+    gx = "variables.gx"
+    assert _cost(f"{gx}.lower", -150.0, "mm", 1.0) == (
+        f"{gx}.lower -150 mm: lowering it by 1 % to -151.5 mm (widens the bounds) -> backlash +1 %"
+    )
+    assert _cost(f"{gx}.lower", 150.0, "mm", 1.0) == (
+        f"{gx}.lower 150 mm: raising it by 1 % to 151.5 mm (narrows the bounds) -> backlash +1 %"
+    )
+    assert _cost(f"{gx}.upper", -150.0, "mm", -0.5) == (
+        f"{gx}.upper -150 mm: lowering it by 1 % to -151.5 mm (narrows the bounds) "
+        "-> backlash -0.5 %"
+    )
+    assert _cost(f"{gx}.upper", 150.0, "mm", -0.5) == (
+        f"{gx}.upper 150 mm: raising it by 1 % to 151.5 mm (widens the bounds) -> backlash -0.5 %"
+    )
+    # a requirement: which way and where to, no "wider" (its meaning is the requirement's)
+    assert _cost("requirements.deflection.min", -30.0, "deg", 0.666) == (
+        "deflection.min -30 deg: lowering it by 1 % to -30.3 deg -> backlash +0.666 %"
+    )
+    assert _cost("requirements.hinge_moment", 500.0, "N*m", 0.235) == (
+        "hinge_moment 500 N*m: raising it by 1 % to 505 N*m -> backlash +0.235 %"
+    )
+    # at a zero limit 1 % moves nothing: the derivative, for the limit raised
+    assert _cost("variables.n.lower", 0.0, "mm", 0.0, d=0.002) == (
+        "variables.n.lower 0 mm: raising it (narrows the bounds) -> "
+        "dbacklash/dvariables.n.lower = +0.002 deg/mm"
+    )
+
+
+def test_a_negative_bounds_cost_moves_it_the_way_its_line_says(tmp_path):
+    """The pivoting screw's trunnion sits behind the horn (a_T < 0): with its upper
+    bound at -150 mm the smallest linkage sits on it. The line says 1 % lowers the bound
+    to -151.5 mm and narrows the bounds; the re-solve there costs what the line says."""
+    from optdesign.studies.nlp_solve import solve_nlp
+
+    src = (PROBLEMS / "pivot_min_backlash.toml").read_text()
+    old = 'a_T = { lower = "-300 mm", upper = "-40 mm" }'
+    assert old in src
+    path = tmp_path / "pivot.toml"
+    path.write_text(src.replace(old, 'a_T = { lower = "-300 mm", upper = "-150 mm" }'))
+    problem = od.load(path)
+    result = od.solve(problem, objective="size", starts=2, ranges=False)
+    lines = {s.name: cost_text(s) for s in result.sensitivities}
+    s = next(s for s in result.sensitivities if s.name == "variables.a_T.upper")
+    assert lines[s.name] == (
+        "variables.a_T.upper -150 mm: lowering it by 1 % to -151.5 mm (narrows the bounds) "
+        f"-> size {s.log_sensitivity:+.3g} %"
+    )
+    assert s.log_sensitivity > 0.1  # a narrower box: a larger linkage
+    assert lines["variables.p.lower"].startswith(
+        "variables.p.lower 2 mm: raising it by 1 % to 2.02 mm (narrows the bounds) -> size +"
+    )
+    assert lines[s.name] in result.summary()
+    # the bound where the line puts it, solved again: the change the line states
+    x0 = [result.design[v.name] for v in problem.free]
+    moved = solve_nlp(perturbed(problem, s.name, -151.5), "size", starts=1, x0=x0)
+    assert moved.success
+    change = 100 * (moved.objective / result.objective - 1)
+    assert change == pytest.approx(s.log_sensitivity, rel=0.02)

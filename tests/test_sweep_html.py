@@ -75,3 +75,21 @@ def test_the_command_writes_sweep_html(nasty, capsys):
     assert "sweep.html" in capsys.readouterr().out
     data = _data((out / "sweep.html").read_text())
     assert [row[1] for row in data["table"]["rows"]] == ["300", "700"]
+
+
+def test_a_points_costs_say_which_way_each_limit_moves(tmp_path):
+    """Issue 35: a point's line read "requirements.deflection.min: +1 % -> backlash
+    +0.7 %", not saying that 1 % of -30 deg moves it down; it says so, with the value
+    on the point's own problem (the swept hinge moment at the point's)."""
+    vary = {"requirements.hinge_moment": ("400 N*m", "600 N*m", 2)}
+    sweep = od.sweep(PROBLEMS / "cs_min_backlash.toml", vary, starts=1, sensitivities=True)
+    data = _data(od.report(sweep, tmp_path / "sweep.html").read_text())
+    for view, moment in zip(data["designs"], ("400", "600"), strict=True):
+        lines = view["sensitivities"]
+        assert any(
+            line.startswith("deflection.min -30 deg: lowering it by 1 % to -30.3 deg -> backlash ")
+            for line in lines
+        ), lines
+        assert any(
+            line.startswith(f"hinge_moment {moment} N*m: raising it by 1 % to ") for line in lines
+        ), lines

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.reports.costs import cost_text, front_point_costs
 from optdesign.reports.display_units import (
     angle_unit,
     objective_shown,
@@ -81,11 +82,11 @@ def _sketch(problem: Any, design: dict[str, float]) -> list[dict[str, Any]]:
             return []
         out.append(
             {
-                "phi": math.degrees(float(phi)),
-                "links": [[[float(x), float(y)] for x, y in link] for link in sk.links],
-                "pivots": [[float(x), float(y)] for x, y in sk.pivots],
-                "slider": None if sk.slider is None else [float(c) for c in sk.slider],
-                "axis": None if sk.axis is None else [[float(c) for c in p] for p in sk.axis],
+                "phi": _plotted(math.degrees(float(phi))),
+                "links": [[[_plotted(x), _plotted(y)] for x, y in link] for link in sk.links],
+                "pivots": [[_plotted(x), _plotted(y)] for x, y in sk.pivots],
+                "slider": None if sk.slider is None else [_plotted(c) for c in sk.slider],
+                "axis": None if sk.axis is None else [[_plotted(c) for c in p] for p in sk.axis],
             }
         )
     return out
@@ -99,14 +100,18 @@ def _curves(problem: Any, design: dict[str, float]) -> dict[str, Any]:
             np.asarray(q.backlash.worst_case, dtype=float).ravel() if problem.has("d") else None
         )
     return {
-        "phi": np.degrees(problem.phi).tolist(),
-        "ratio": _finite(ratio),
-        "backlash": None if backlash is None else _finite(backlash),
+        "phi": [_plotted(v) for v in np.degrees(problem.phi)],
+        "ratio": [_plotted(v) for v in ratio],
+        "backlash": None if backlash is None else [_plotted(v) for v in backlash],
     }
 
 
-def _finite(a: np.ndarray) -> list[float | None]:
-    return [float(v) if math.isfinite(v) else None for v in a]
+def _plotted(v: float) -> float | None:
+    """A number that is only drawn (a curve's point, a sketch's joint) at 7 significant
+    digits, finer than any plot shows it: ``-29.999999999999996`` took 19 characters of
+    the page for each of the ~200 numbers of every design (None: not finite)."""
+    v = float(v)
+    return float(f"{v:.7g}") if math.isfinite(v) else None
 
 
 def _bands(problem: Any) -> dict[str, Any]:
@@ -141,7 +146,7 @@ def solve_report(result: Any) -> str:
     if initial["violated"]:
         initial["label"] = "initial design (violates the requirements)"
     best = design_view(problem, result.design, "optimum" if result.success else "best point found")
-    best["sensitivities"] = [s.text() for s in result.sensitivities]
+    best["sensitivities"] = [cost_text(s) for s in result.sensitivities]
     best["item_steps"] = [s.text() for s in result.item_steps]
     name = result.objective_name
     data = {
@@ -190,7 +195,10 @@ def front_report(problem: Any, fronts: Sequence[Any]) -> str:
         coords: list[list[float]] = [[] for _ in objectives]
         for k, p in enumerate(f.points):
             label = f"{f.method} point {k + 1}"
-            designs.append(design_view(problem, p.design, label))
+            view = design_view(problem, p.design, label)
+            # what each limit costs there, from the point's own solve (or why unknown)
+            view.update(front_point_costs(problem, f.objectives, p))
+            designs.append(view)
             idx.append(len(designs) - 1)
             for j, o in enumerate(objectives):
                 coords[j].append(objective_shown(problem, o, p.objectives[o]).value)

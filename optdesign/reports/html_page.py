@@ -1,5 +1,7 @@
 """The page of ``report.html``: HTML, CSS and the script that draws the embedded data
-with plotly (inlined: the page opens without a network).
+with plotly.js (its basic bundle, inlined packed: the page opens without a network; see
+:mod:`optdesign.reports.plotly_js`). A front of three objectives is drawn as its three
+projections on the pairs of objectives (the basic bundle draws no 3-D scatter).
 
 Every string of the data is shown as text, whatever it holds: the header is escaped
 here (``&``, ``<``, ``>``, ``"`` and ``'``; control characters shown as escapes); the
@@ -18,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.reports.plotly_js import loader_script
 from optdesign.solvers.result import clean_json
 from optdesign.text import printable
 
@@ -112,6 +115,8 @@ _SCRIPT = r"""
     return out;
   }
   const config = { responsive: true, displaylogo: false };
+  const COLOURS = ['#1f77b4', '#ff7f0e', '#2ca02c', '#d62728', '#9467bd', '#8c564b'];
+  const PLOTS = { ok: true };
   function show(i) {
     const d = DATA.designs[i];
     const ref = DATA.reference === null ? null : DATA.designs[DATA.reference];
@@ -120,12 +125,16 @@ _SCRIPT = r"""
     el('design').innerHTML = table(d, ref && ref !== d ? ref : null);
     el('objectives').innerHTML = list(d.objectives.map((o) => o.text).concat(d.facts.map((f) => f.text)));
     el('limits').innerHTML = list(d.limits);
-    el('costs').innerHTML = list(d.sensitivities || []);
+    // a note says what the costs are of, or why they cannot be known (then no list)
+    const costs = d.sensitivities || [];
+    el('costs').innerHTML = (d.costs_note ? '<p class="meta">' + esc(d.costs_note) + '</p>' : '')
+      + (costs.length || !d.costs_note ? list(costs) : '');
     el('steps').innerHTML = (d.item_steps || []).length
       ? '<h3>the neighbouring catalogue items (the rest re-solved)</h3>' + list(d.item_steps) : '';
     el('violated').innerHTML = list(d.violated, 'violated');
     el('reference').innerHTML = ref && ref !== d
       ? '<h3>' + esc(ref.label) + ': violated requirements</h3>' + list(ref.violated, 'violated') : '';
+    if (!PLOTS.ok) return;
     let sk = sketchTraces(d, false);
     if (ref && ref !== d) sk = sketchTraces(ref, true).concat(sk);
     if (sk.length) {
@@ -144,16 +153,32 @@ _SCRIPT = r"""
       margin: { t: 40 }, legend: { font: { size: 10 }, orientation: 'h', y: -0.25 } }, config);
   }
   function drawFront() {
-    const f = DATA.front, three = f.axes.length === 3, axes = f.axes.map(ptext);
-    const traces = f.traces.map((t) => ({
-      x: t.coords[0], y: t.coords[1], z: three ? t.coords[2] : undefined,
-      customdata: t.index, type: three ? 'scatter3d' : 'scatter', mode: t.mode || ('markers' + (three ? '' : '+lines')),
-      marker: { size: three ? 4 : 8 }, name: ptext(t.method + ' (' + t.index.length + ' points)'),
-      hovertemplate: axes[0] + ' %{x}<br>' + axes[1] + ' %{y}' + (three ? '<br>' + axes[2] + ' %{z}' : '') + '<extra>%{fullData.name}</extra>' }));
+    // one panel per pair of objectives: two objectives, one panel; three, the three
+    // projections (each point in each), side by side
+    const f = DATA.front, axes = f.axes.map(ptext), three = axes.length === 3;
+    const pairs = three ? [[0, 1], [0, 2], [1, 2]] : [[0, 1]];
     const layout = { title: { text: ptext(f.title || 'Pareto front: hover or click a point') }, hovermode: 'closest', margin: { t: 40 },
       legend: { font: { size: 10 } } };
-    if (three) layout.scene = { xaxis: { title: { text: axes[0] } }, yaxis: { title: { text: axes[1] } }, zaxis: { title: { text: axes[2] } } };
-    else { layout.xaxis = { title: { text: axes[0] } }; layout.yaxis = { title: { text: axes[1] } }; }
+    const traces = [];
+    pairs.forEach(([a, b], k) => {
+      const n = k ? String(k + 1) : '', w = 1 / pairs.length;
+      layout['xaxis' + n] = { title: { text: axes[a] }, domain: [k * w + (k ? 0.05 : 0), (k + 1) * w - (k < pairs.length - 1 ? 0.05 : 0)], anchor: 'y' + n };
+      layout['yaxis' + n] = { title: { text: axes[b] }, anchor: 'x' + n };
+      f.traces.forEach((t, j) => {
+        const name = ptext(t.method + ' (' + t.index.length + ' points)');
+        const trace = { x: t.coords[a], y: t.coords[b], xaxis: 'x' + n, yaxis: 'y' + n, customdata: t.index, type: 'scatter',
+          mode: t.mode || (three ? 'markers' : 'markers+lines'), marker: { size: three ? 6 : 8, color: COLOURS[j % COLOURS.length] },
+          line: { color: COLOURS[j % COLOURS.length] }, name: name, legendgroup: 'm' + j, showlegend: k === 0 };
+        if (three) {
+          // the hover names all three objectives, whichever panel the point is in
+          trace.text = t.index.map((_, i) => axes.map((ax, m) => ax + ' ' + fmt(t.coords[m][i])).join('<br>'));
+          trace.hovertemplate = '%{text}<extra>%{fullData.name}</extra>';
+        } else {
+          trace.hovertemplate = axes[0] + ' %{x}<br>' + axes[1] + ' %{y}<extra>%{fullData.name}</extra>';
+        }
+        traces.push(trace);
+      });
+    });
     return Plotly.newPlot('front', traces, layout, config).then((gd) => {
       const pick = (ev) => { if (ev && ev.points && ev.points.length) show(ev.points[0].customdata); };
       gd.on('plotly_click', pick);
@@ -176,16 +201,22 @@ _SCRIPT = r"""
       tr.addEventListener('click', pick);
     });
   }
-  if (DATA.table) drawTable();
-  const ready = DATA.front ? drawFront() : Promise.resolve();
-  ready.then(() => { if (DATA.selected !== null) show(DATA.selected); document.body.dataset.ready = '1'; });
+  // The plots wait for plotly.js to be unpacked; a browser that cannot unpack it still
+  // shows every table and list, and says why the plots are missing.
+  window.plotlyReady.then(() => true, (err) => {
+    PLOTS.ok = false;
+    ['front', 'sketch', 'curves'].forEach((id) => { if (el(id)) el(id).textContent = 'no plots: ' + err.message; });
+    return false;
+  }).then((ok) => {
+    if (DATA.table) drawTable();
+    return ok && DATA.front ? drawFront() : null;
+  }).then(() => { if (DATA.selected !== null) show(DATA.selected); document.body.dataset.ready = '1'; });
 })();
 """
 
 
 def render(data: dict[str, Any], title: str) -> str:
     """The whole page for ``data`` (see :mod:`optdesign.reports.html`)."""
-    from plotly.offline import get_plotlyjs
 
     def e(text: object) -> str:  # one line of text, escaped for element content
         return html.escape(printable(text), quote=True)
@@ -198,7 +229,7 @@ def render(data: dict[str, Any], title: str) -> str:
 <html lang="en"><head><meta charset="utf-8">
 <title>{e(title)}</title>
 <style>{_CSS}</style>
-<script>{get_plotlyjs()}</script>
+<script>{loader_script()}</script>
 </head><body>
 <h1>{e(data["problem"])} ({e(data["mechanism"])})</h1>
 <p class="meta">status {e(data["status"])}; objective {e(data["objective"])}</p>

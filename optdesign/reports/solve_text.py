@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+from optdesign.reports.costs import cost_text
 from optdesign.reports.display_units import objective_shown, requirement_echo, variable_shown
 from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.limits import (
@@ -141,7 +142,7 @@ def result_summary(result: Result) -> str:
         lines += [f"  {lim.text()}" for lim in (limits + bounds)[:30]]
     if result.sensitivities:
         lines += ["", "what each limit costs (sensitivity of the optimum, most costly first):"]
-        lines += [f"  {printable(s.text())}" for s in result.sensitivities[:30]]
+        lines += [f"  {printable(cost_text(s))}" for s in result.sensitivities[:30]]
     if result.item_steps:
         lines += ["", "the neighbouring catalogue items (other items kept, the rest re-solved):"]
         lines += [f"  {printable(s.text())}" for s in result.item_steps]

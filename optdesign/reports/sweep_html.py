@@ -13,12 +13,15 @@ data (a problem's or a variable's name, a binding row's label) is embedded by
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
+from optdesign.reports.costs import cost_text
 from optdesign.reports.display_units import objective_shown
 from optdesign.reports.html import _header, design_view
 from optdesign.reports.html_page import render
 from optdesign.reports.sweep import _cell, sweep_rows
+from optdesign.solvers.result import Sensitivity
 
 #: What the page says of a point's sensitivities when the sweep did not compute them
 #: (an empty list would read "none": nothing binds).
@@ -28,6 +31,19 @@ NOT_COMPUTED = "not computed (od.sweep(..., sensitivities=True), optdesign sweep
 def _shown_value(axis: Any, value: float) -> float:
     table = dict(zip(axis.values, axis.shown, strict=True))
     return float(table.get(value, value))
+
+
+def _cost(problem: Any, objective: str, name: str, log: float) -> str:
+    """The line of a point's log-sensitivity ``log`` to the limit ``name``, with the
+    limit's value on the point's ``problem`` (which way 1 % moves it, where to)."""
+    from optdesign.studies.sensitivity import limit_shown, limit_value
+
+    try:
+        limit = limit_shown(problem, name, limit_value(problem, name))
+    except (KeyError, IndexError, ValueError, AttributeError):  # a name it lacks
+        return f"{name}: 1.01 x the limit -> {objective} {log:+.3g} %"
+    record = Sensitivity(name, objective, limit.value, limit.unit, math.nan, "", log)
+    return cost_text(record)
 
 
 def sweep_report(sweep: Any) -> str:
@@ -50,7 +66,7 @@ def sweep_report(sweep: Any) -> str:
         label = f"point {p.index}: {where}" + ("" if p.success else f" ({p.status}, best found)")
         view = design_view(at, {**p.design, **at.fixed_values}, label)
         view["sensitivities"] = [
-            f"{name}: +1 % -> {sweep.objective} {value:+.3g} %"
+            _cost(at, sweep.objective, name, value)
             for name, value in sorted(p.sensitivities.items(), key=lambda kv: -abs(kv[1]))
         ] or [NOT_COMPUTED]
         of_point[p.index] = len(designs)

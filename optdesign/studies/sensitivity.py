@@ -155,21 +155,9 @@ def _record(
     problem: DesignProblem, objective: str, path: str, p: float, dvdp: float, v: float
 ) -> tuple[Sensitivity, float]:
     """The record of ``dv*/dp`` at limit ``p`` (both internal), in the user's units."""
-    from optdesign.reports.display_units import (
-        Shown,
-        objective_shown,
-        requirement_values,
-        variable_shown,
-    )
+    from optdesign.reports.display_units import objective_shown
 
-    if path.startswith("variables."):
-        var = problem.by_name[path.split(".")[1]]
-        limit = variable_shown(problem, var, p)
-    else:
-        node: Any = requirement_values(problem)
-        for key in path.split(".")[1:]:
-            node = node.get(key) if isinstance(node, dict) else None
-        limit = node if isinstance(node, Shown) else Shown(p, "")
+    limit = limit_shown(problem, path, p)
     factor = limit.value / p if p != 0 and limit.value else 1.0
     obj = objective_shown(problem, objective, v)
     obj_factor = obj.value / v if v != 0 else objective_shown(problem, objective, 1.0).value
@@ -186,23 +174,41 @@ def _record(
     return record, float(dvdp * p * 0.01) if p != 0 else float(dvdp)
 
 
+def limit_shown(problem: DesignProblem, path: str, p: float) -> Any:
+    """The limit ``path`` of a :class:`Sensitivity` of ``problem`` (``"requirements.
+    hinge_moment"``, ``"variables.R.upper"``) as the user reads it (a :class:`~optdesign.
+    reports.display_units.Shown`); ``p``: its internal value (a requirement is shown as
+    the problem holds it, in its written unit; ``p`` bare when that is unknown)."""
+    from optdesign.reports.display_units import Shown, requirement_values, variable_shown
+
+    if path.startswith("variables."):
+        return variable_shown(problem, problem.by_name[path.split(".")[1]], p)
+    node: Any = requirement_values(problem)
+    for key in path.split(".")[1:]:
+        node = node.get(key) if isinstance(node, dict) else None
+    return node if isinstance(node, Shown) else Shown(p, "")
+
+
 class _RowModel:
     """The Lagrangian's parameter-dependent part at a fixed design: ``v(p)`` for a
     scalar objective plus ``sum mu_i (g_i(p) - b_i(p))`` over the NLP's rows, from the
-    NumPy path (rows matched to the NLP's by block name and order)."""
+    NumPy path (rows matched to the NLP's by block name and order). ``eps``: the epsilon
+    bounds of the solve (a front's point), which :meth:`NLP.bounds` tightened each
+    epsilon row to; a bound of the front's is no requirement and moves with none."""
 
-    def __init__(self, nlp, objective: str, mu: np.ndarray):
+    def __init__(self, nlp, objective: str, mu: np.ndarray, eps: Mapping[str, float] | None = None):
         self.nlp = nlp
         self.objective = objective
         self.mu = mu
+        self.eps = dict(eps or {})
         self.rows = np.flatnonzero(mu != 0.0)
-        eps = set(nlp.eps_rows.values())
+        eps_rows = set(nlp.eps_rows.values())
         self.eps_name = {row: name for name, row in nlp.eps_rows.items()}
         # (block name, index within the block) of every row the NLP has, in its order
         self.where: list[tuple[str, int]] = []
         seen: dict[str, int] = {}
         for i, name in enumerate(nlp.g_names):
-            base = name.split("[", 1)[0] if i not in eps else name
+            base = name.split("[", 1)[0] if i not in eps_rows else name
             k = seen.get(base, 0)
             seen[base] = k + 1
             self.where.append((base, k))
@@ -230,7 +236,10 @@ class _RowModel:
                     name = self.eps_name[i]
                     t = ex.objectives[name]
                     g = float(np.ravel(np.asarray(t.expr, float))[0]) if t.kind == "scalar" else 0.0
-                    lo, hi = None, limits.get(name)
+                    hi = limits.get(name)
+                    if name in self.eps and (hi is None or self.eps[name] < hi):
+                        hi = None  # the epsilon bound binds: a constant, no requirement's
+                    lo = None
                 else:
                     base, k = self.where[i]
                     values, lo, hi = blocks[base]

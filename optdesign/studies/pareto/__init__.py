@@ -8,7 +8,8 @@
 - :mod:`.chains` and :mod:`.tasks`: the epsilon method's task graph (anchors, chains);
 - :mod:`.eps_solver`: every solve of a front on one formulation;
 - :mod:`.records`: typed records as stored; :mod:`.front`: the :class:`Front`;
-- :mod:`.metrics`: hypervolume, spacing, spread; :mod:`.io`: CSV and JSON files.
+- :mod:`.metrics`: hypervolume, spacing, spread; :mod:`.io`: CSV and JSON files;
+- :mod:`.costs`: what each limit costs at a point, from the point's own solve.
 """
 
 from optdesign.studies.pareto.front import Front, FrontPoint, common_hypervolumes, make_front

@@ -11,7 +11,7 @@ import numpy as np
 from optdesign.solvers.result import clean_json
 from optdesign.solvers.solved_point import SolvedPoint
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
-from optdesign.studies.pareto.records import PointRecord
+from optdesign.studies.pareto.records import PointRecord, RawSolution
 
 
 @dataclass(kw_only=True)
@@ -27,10 +27,15 @@ class FrontPoint(PointRecord):
         The front method that produced it.
     rejected
         Why the point is not on the front ("" when it is).
+    multipliers
+        The primal-dual solution of the point's own solve (the record's ``raw``), kept
+        for what each limit costs there (:mod:`optdesign.studies.pareto.costs`) and
+        never as a warm start; None when the record kept none. Not written to files.
     """
 
     method: str = ""
     rejected: str = ""
+    multipliers: RawSolution | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_record(cls, rec: PointRecord, method: str) -> FrontPoint:
@@ -42,7 +47,7 @@ class FrontPoint(PointRecord):
             eps=dict(rec.eps or rec.weights),
             raw=None,
         )
-        return cls(**kw, method=method)
+        return cls(**kw, method=method, multipliers=rec.raw)
 
     def to_dict(self) -> dict[str, Any]:
         """The point as ``front.json`` writes it."""

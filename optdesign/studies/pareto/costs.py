@@ -1,0 +1,154 @@
+"""What each limit costs at a point of a front, from the point's own solve.
+
+A point of an epsilon front is the optimum of ``min target s.t. others <= eps`` (the
+record's ``target`` and ``eps``) on the front's one formulation, and its record keeps that
+solve's multipliers. The envelope theorem of :mod:`optdesign.studies.sensitivity` holds
+there as at a single optimum: each cost is d(target)/d(limit) with the other objectives
+held at the point's epsilon bounds (the front moves; the point keeps its trade-off). An
+epsilon row enters with the bound it had in that solve, ``min(eps, the requirement's own
+limit)``: a requirement that caps an objective (``ripple_max``) costs only where it, not
+the epsilon bound, binds.
+
+SLSQP, the front's primary back-end, returns the rows' multipliers but none of the bounds
+(``lam_x`` zero). They follow from stationarity, ``grad f + J' lam_g + lam_x = 0``: at a
+variable on a bound ``lam_x = -(grad f + J' lam_g)``, with the sign of that bound. What
+stationarity leaves at the other variables tells whether the multipliers are those of a
+KKT point at all (:data:`KKT_TOL`); when they are not, the costs are not shown.
+
+A point whose costs cannot be known says why (:attr:`PointCosts.why`): a point of
+NSGA-II (no gradient solver, no multipliers), of a weighted sum (its multipliers price the
+weighted sum, not one objective), of a catalogue front (its record keeps none), or one
+read back from a file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.solvers.result import Sensitivity
+
+#: Largest stationarity residual ``|grad f + J' lam_g + lam_x|`` (scaled problem, relative
+#: to ``max(1, |grad f|)``) at which the multipliers are taken as a KKT point's. SLSQP's
+#: points of the shipped problems leave ~1e-6.
+KKT_TOL = 1e-3
+
+#: A scaled variable this close to a bound (its span is 1) sits on it.
+ON_BOUND = 1e-7
+
+
+@dataclass
+class PointCosts:
+    """The costs of one front point's limits.
+
+    Attributes
+    ----------
+    target
+        The objective the point's solve minimised (the costs are of it).
+    held
+        The other objectives held at their epsilon bounds in that solve (internal units).
+    sensitivities
+        Ranked as :func:`~optdesign.studies.sensitivity.from_multipliers` ranks them.
+    why
+        Why the costs cannot be known ("" when they are).
+    """
+
+    target: str = ""
+    held: dict[str, float] = field(default_factory=dict)
+    sensitivities: list[Sensitivity] = field(default_factory=list)
+    why: str = ""
+
+
+def point_costs(problem: DesignProblem, objectives: Sequence[str], point: Any) -> PointCosts:
+    """The costs at ``point`` (a :class:`~optdesign.studies.pareto.front.FrontPoint` of a
+    front of ``objectives`` on ``problem``), or why they cannot be known."""
+    costs = PointCosts(target=point.target, held=dict(point.eps))
+    raw = getattr(point, "multipliers", None)
+    if point.kind == "nsga2":
+        costs.why = "NSGA-II evolves its designs without a gradient solver: no multipliers"
+    elif point.kind == "weighted_sum":
+        costs.why = "its multipliers price the weighted sum of the objectives, not one of them"
+    elif raw is None:
+        costs.why = "the point's record keeps no multipliers of its solve"
+    if costs.why:
+        return costs
+    try:
+        _from_multipliers(problem, objectives, point, raw, costs)
+    except Exception as exc:  # a report: never lose the page for a point's costs
+        text = " ".join(str(exc).split())[:200]
+        costs.sensitivities = []
+        costs.why = f"they could not be computed ({type(exc).__name__}: {text})"
+    return costs
+
+
+def _from_multipliers(
+    problem: DesignProblem, objectives: Sequence[str], point: Any, raw: Any, costs: PointCosts
+) -> None:
+    """Fill ``costs`` from the point's multipliers ``raw`` (or say why not)."""
+    from optdesign.studies.nlp_solve import formulation_for
+    from optdesign.studies.sensitivity import _RowModel, from_multipliers
+
+    target, eps = costs.target, costs.held
+    nlp = formulation_for(problem, tuple(sorted(objectives)))
+    if raw.nlp != nlp.fingerprint or len(raw.lam_g) != len(nlp.g_names):
+        costs.why = "its multipliers belong to another formulation than the front's"
+        return
+    lam_x = np.asarray(raw.lam_x, dtype=float)
+    lam_g = np.asarray(raw.lam_g, dtype=float)
+    derived, residual = bound_multipliers(
+        nlp, target, nlp.bounds(eps=eps), np.asarray(raw.z, dtype=float), lam_g
+    )
+    if residual > KKT_TOL:
+        costs.why = (
+            f"its solve's multipliers do not satisfy the optimality conditions "
+            f"(residual {residual:.2g} of the scaled gradient)"
+        )
+        return
+    if not lam_x.any():  # the back-end returned no bound multipliers (SLSQP)
+        lam_x = derived
+    solved = SimpleNamespace(
+        raw={"lam_g": lam_g, "lam_x": lam_x},
+        design=point.design,
+        objective=point.objectives[target],
+    )
+    costs.sensitivities = from_multipliers(
+        problem,
+        solved,  # type: ignore[arg-type]  # the fields from_multipliers reads
+        nlp,
+        target,
+        target,
+        lambda mu: _RowModel(nlp, target, mu, eps=eps),
+    )
+
+
+_KKT: dict[str, Any] = {}
+
+
+def bound_multipliers(
+    nlp: Any, target: str, bounds: Any, z: np.ndarray, lam_g: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """The bound multipliers that stationarity gives at ``z`` with the rows' ``lam_g``
+    (CasADi's signs: > 0 on an upper bound, < 0 on a lower one) and the residual that
+    stationarity leaves, relative to ``max(1, |grad f|)`` (scaled problem)."""
+    import casadi as ca
+
+    fun = _KKT.get(nlp.fingerprint)
+    if fun is None:  # one per formulation: the gradient and the rows' Jacobian in z
+        fun = ca.Function(
+            "kkt", [nlp.z, nlp.p], [ca.gradient(nlp.f, nlp.z), ca.jacobian(nlp.g, nlp.z)]
+        )
+        _KKT[nlp.fingerprint] = fun
+    grad, jac = fun(z, nlp.params(nlp.target(target), bounds.parameters))
+    grad = np.asarray(grad.full(), dtype=float).ravel()
+    r = grad + np.asarray(jac.full(), dtype=float).T @ lam_g
+    # a bound takes the part of the gradient that pushes through it, and only that part
+    upper = (z >= bounds.ubz - ON_BOUND) & (r < 0)
+    lower = (z <= bounds.lbz + ON_BOUND) & (r > 0)
+    lam_x = np.where(upper | lower, -r, 0.0)
+    left = r + lam_x
+    return lam_x, float(np.max(np.abs(left), initial=0.0) / max(1.0, np.max(np.abs(grad))))
