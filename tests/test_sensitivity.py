@@ -52,7 +52,10 @@ def test_sensitivity_in_the_users_units(fork):
     assert s.d_objective_d_limit == pytest.approx(
         s.log_sensitivity * result.objective / 500.0, rel=1e-3
     )
-    assert s.text() == f"hinge_moment 500 N*m: +1 % -> backlash {s.log_sensitivity:+.3g} %"
+    assert s.text() == (
+        f"hinge_moment 500 N*m: raising it by 1 % to 505 N*m -> backlash "
+        f"{s.log_sensitivity:+.3g} %"
+    )
     assert s.log_sensitivity == pytest.approx(0.2359, abs=5e-4)
 
 

@@ -21,7 +21,6 @@ cannot be known.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -33,37 +32,10 @@ from optdesign.solvers.result import Sensitivity
 NOTHING_BINDS = "none: no requirement or bound moves this optimum (by 1e-6 of it or more)"
 
 
-def _number(value: float, unit: str) -> str:
-    return f"{value:.6g} {unit}".rstrip()
-
-
-def _bound_move(name: str, up: bool) -> str:
-    """`` (widens the bounds)`` or `` (narrows the bounds)`` for a variable's bound
-    moved up (``up``) or down; "" for a requirement (which way is looser depends on
-    what it limits: a stroke's lower end moved down asks for more)."""
-    if not name.startswith("variables."):
-        return ""
-    upper = name.endswith(".upper")
-    return " (widens the bounds)" if up == upper else " (narrows the bounds)"
-
-
 def cost_text(s: Sensitivity) -> str:
-    """One line of what the limit of ``s`` costs, saying which way the limit moves."""
-    what = s.name.removeprefix("requirements.")
-    limit = _number(s.limit, s.unit)
-    log = s.log_sensitivity
-    if log is not None and s.limit != 0 and math.isfinite(s.limit):
-        up = s.limit > 0  # 1.01 x the limit: up for a positive limit, down for a negative
-        move = f"{'raising' if up else 'lowering'} it by 1 % to {_number(1.01 * s.limit, s.unit)}"
-        return f"{what} {limit}: {move}{_bound_move(s.name, up)} -> {s.objective} {log:+.3g} %"
-    d = s.d_objective_d_limit
-    if not math.isfinite(d):  # a sweep keeps the log-sensitivity only
-        return f"{what} {limit}: its cost per {s.unit or 'unit'} is not kept here"
-    per = f"{s.objective_unit}/{s.unit}" if s.unit else s.objective_unit
-    return (
-        f"{what} {limit}: raising it{_bound_move(s.name, True)} -> "
-        f"d{s.objective}/d{what} = {d:+.3g} {per}".rstrip()
-    )
+    """One line of what the limit of ``s`` costs (:meth:`Sensitivity.text`: one wording
+    for the summary, the pages and the API)."""
+    return s.text()
 
 
 def front_point_costs(problem: Any, objectives: Sequence[str], point: Any) -> dict[str, Any]:

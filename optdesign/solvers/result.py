@@ -292,13 +292,48 @@ class Sensitivity:
     log_sensitivity: float | None = None
 
     def text(self) -> str:
-        """``"hinge_moment 500 N*m: +1 % -> backlash +0.62 %"``."""
-        what = self.name.split(".", 1)[1] if self.name.startswith("requirements.") else self.name
-        limit = f"{self.limit:.6g} {self.unit}".rstrip()
-        if self.log_sensitivity is not None:
-            return f"{what} {limit}: +1 % -> {self.objective} {self.log_sensitivity:+.3g} %"
+        """One line of what the limit costs, saying which way the limit moves (1.01 x a
+        negative limit lowers it; for a variable's bound, whether the box widens)::
+
+            hinge_moment 500 N*m: raising it by 1 % to 505 N*m -> backlash +0.235 %
+            variables.gx.lower -150 mm: lowering it by 1 % to -151.5 mm (widens the
+                bounds) -> backlash -1.2 %
+
+        A limit at 0 (1 % is no move) or an objective at 0 (no % of it): the derivative
+        per unit instead, with the limit raised."""
+        what = self.name.removeprefix("requirements.")
+        limit = _number(self.limit, self.unit)
+        log = self.log_sensitivity
+        if log is not None and self.limit != 0 and math.isfinite(self.limit):
+            up = self.limit > 0  # 1.01 x the limit: up when positive, down when negative
+            to = _number(1.01 * self.limit, self.unit)
+            move = f"{'raising' if up else 'lowering'} it by 1 % to {to}"
+            return (
+                f"{what} {limit}: {move}{_bound_move(self.name, up)} -> "
+                f"{self.objective} {log:+.3g} %"
+            )
+        d = self.d_objective_d_limit
+        if not math.isfinite(d):  # a sweep keeps the log-sensitivity only
+            return f"{what} {limit}: its cost per {self.unit or 'unit'} is not kept here"
         per = f"{self.objective_unit}/{self.unit}" if self.unit else self.objective_unit
-        return f"{what} {limit}: d{self.objective}/d{what} = {self.d_objective_d_limit:+.3g} {per}"
+        return (
+            f"{what} {limit}: raising it{_bound_move(self.name, True)} -> "
+            f"d{self.objective}/d{what} = {d:+.3g} {per}".rstrip()
+        )
+
+
+def _number(value: float, unit: str) -> str:
+    return f"{value:.6g} {unit}".rstrip()
+
+
+def _bound_move(name: str, up: bool) -> str:
+    """`` (widens the bounds)`` or `` (narrows the bounds)`` for a variable's bound
+    moved up (``up``) or down; "" for a requirement (which way is looser depends on
+    what it limits: a stroke's lower end moved down asks for more)."""
+    if not name.startswith("variables."):
+        return ""
+    upper = name.endswith(".upper")
+    return " (widens the bounds)" if up == upper else " (narrows the bounds)"
 
 
 @dataclass
