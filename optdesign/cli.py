@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import re
 import signal
 import sys
 import threading
@@ -194,6 +195,27 @@ def option(argument: str, renamed: Mapping[str, str] | None = None) -> str:
     return "--" + argument.replace("_", "-")
 
 
+#: The API's arguments that the library's own messages name (``more starts (starts=)``,
+#: ``formulation='nlp'``, ``resume=True``): the command line shows them as its options.
+MENTIONED_ARGUMENTS = ("starts", "formulation", "resume", "overwrite")
+
+_MENTION = re.compile(
+    r"\b(" + "|".join(MENTIONED_ARGUMENTS) + r")=(True\b|'([^'\s]*)'|(?=[\s),;]|$))"
+)
+
+
+def flags(text: str) -> str:
+    """A library message in the command line's words: each mention of an API argument
+    (``starts=``, ``formulation='catalogue'``, ``resume=True``) shown as its option
+    (``--starts``, ``--formulation catalogue``, ``--resume``)."""
+
+    def shown(match: re.Match) -> str:
+        flag = option(match[1])
+        return f"{flag} {match[3]}" if match[3] is not None else flag
+
+    return _MENTION.sub(shown, text)
+
+
 @contextlib.contextmanager
 def as_options(renamed: Mapping[str, str] | None = None):
     """Refusals of the shared checks (:class:`~optdesign.validation.ArgumentError`)
@@ -284,7 +306,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         with interrupts_as_exceptions():
             code = func()
     except InfeasibleRequirementsError as exc:  # no feasible design: a result, exit 1
-        print(f"optdesign: infeasible: {printable(exc)}", file=sys.stderr)
+        print(f"optdesign: infeasible: {printable(flags(str(exc)))}", file=sys.stderr)
         return 1
     except OptDesignError as exc:
         if os.environ.get("OPTDESIGN_DEBUG") and exc.__cause__ is not None:
@@ -293,7 +315,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
             import traceback
 
             traceback.print_exception(exc, file=sys.stderr)
-        print(f"optdesign: error: {printable(exc)}", file=sys.stderr)
+        print(f"optdesign: error: {printable(flags(str(exc)))}", file=sys.stderr)
         return 2
     except OSError as exc:  # e.g. no space left while writing the results
         print(f"optdesign: error: {printable(exc)}", file=sys.stderr)

@@ -498,3 +498,27 @@ def test_a_command_line_number_in_another_scripts_digits_is_refused(tmp_path, ca
     assert caught.value.code == 2
     assert "argument --starts: '\u0663' is not an integer" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_library_messages_name_api_arguments_and_the_command_line_shows_its_options(
+    tmp_path, capsys
+):
+    """A refusal raised by the library speaks the API's words (``formulation='gp'``); the
+    command line prints the same refusal with its own option (``--formulation gp``)."""
+    from optdesign.cli import flags
+
+    problem = od.load(BACKLASH)
+    with pytest.raises(od.ProblemError) as refused:
+        od.solve(problem, formulation="catalogue")
+    assert str(refused.value).startswith("formulation='catalogue': no variable takes")
+    assert flags(str(refused.value)).startswith("--formulation catalogue: no variable takes")
+    assert flags("more starts (starts=) may find it; restarts=3 starts=5") == (
+        "more starts (--starts) may find it; restarts=3 starts=5"
+    )
+    assert flags("resume=True: x; start over with overwrite=True") == (
+        "--resume: x; start over with --overwrite"
+    )
+    code = main(["solve", str(BACKLASH), "--formulation", "catalogue", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "optdesign: error: --formulation catalogue: no variable takes catalogue" in err

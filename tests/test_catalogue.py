@@ -295,7 +295,7 @@ def test_the_catalogue_search_refuses_a_problem_without_catalogue_variables():
     from optdesign.studies.catalogue import solve_catalogue
 
     problem = od.load(Path(__file__).resolve().parents[1] / "problems" / "cs_min_backlash.toml")
-    message = "--formulation catalogue: no variable takes catalogue values"
+    message = "formulation='catalogue': no variable takes catalogue values"
     for call in (lambda: od.solve(problem, "catalogue"), lambda: solve_catalogue(problem)):
         with pytest.raises(ProblemError) as refused:
             call()

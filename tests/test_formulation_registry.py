@@ -59,16 +59,16 @@ def test_auto_takes_a_users_formulation_after_the_built_ins_and_before_nlp(singl
 
 
 def test_a_named_formulation_that_does_not_apply_is_refused_with_its_reason(single):
-    with pytest.raises(ProblemError, match=r"^--formulation single: runs one start, 4 asked$"):
+    with pytest.raises(ProblemError, match=r"^formulation='single': runs one start, 4 asked$"):
         od.solve(CS, "single", starts=4)
     assert single.seen == []  # refused before any work
     with pytest.raises(
-        ProblemError, match="--formulation single: a catalogue variable needs the catalogue"
+        ProblemError, match="formulation='single': a catalogue variable needs the catalogue"
     ):
         od.solve(CATALOGUE, "single")
-    with pytest.raises(ProblemError, match=r"--formulation robust: robust design needs a \["):
+    with pytest.raises(ProblemError, match=r"formulation='robust': robust design needs a \["):
         od.solve(CS, "robust")
-    with pytest.raises(ProblemError, match="--formulation catalogue: no variable takes catalogue"):
+    with pytest.raises(ProblemError, match="formulation='catalogue': no variable takes catalogue"):
         od.solve(CS, "catalogue")
 
 

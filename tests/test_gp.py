@@ -182,7 +182,7 @@ def test_a_catalogue_variable_is_no_gp_variable_and_the_check_says_what_to_use()
     assert not check.ok
     assert check.reason == (
         "takes catalogue values [2, 2.5, 3, 4, 5, 6, 8, 10]; a GP is "
-        "continuous (use --formulation catalogue)"
+        "continuous (use formulation='catalogue')"
     )
 
 

@@ -370,8 +370,8 @@ def test_resuming_a_store_whose_identity_line_was_torn_says_it_has_none(cs_min_b
     with pytest.raises(StoreError) as caught:
         od.pareto(cs_min_backlash, ["backlash", "size"], 3, out=tmp_path, resume=True, starts=1)
     assert str(caught.value) == (
-        f"--resume: {store} cannot be resumed: it has no identity line; start over with "
-        "--overwrite or use another output folder"
+        f"resume=True: {store} cannot be resumed: it has no identity line; start over with "
+        "overwrite=True or use another output folder"
     )
     assert store.read_text() == '{"__store__": 2, "identity": {"objec'
 

@@ -99,7 +99,7 @@ def test_the_anchor_message_when_nothing_is_violated_suggests_more_starts(proble
     rec = PointRecord.from_dict(_rec("a", 1, 2, status="failed", design=design, message="maxiter"))
     assert anchor_message("A", rec, problem) == (
         "anchor A: no feasible design found (status failed): no requirement is violated at "
-        "the best point found (the solver stopped: maxiter); more starts (--starts) may find one"
+        "the best point found (the solver stopped: maxiter); more starts (starts=) may find one"
     )
     rec.message = ""
     assert "(the solver stopped: failed)" in anchor_message("A", rec, problem)

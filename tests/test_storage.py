@@ -172,8 +172,8 @@ def test_a_new_run_does_not_silently_empty_an_earlier_store(tmp_path):
     with pytest.raises(StoreError) as err:
         run_tasks(_tasks(), _double, store, key="k")
     assert str(err.value) == (
-        f"{store} holds 3 records of an earlier run; continue it with --resume, start over "
-        "with --overwrite, or use another output folder"
+        f"{store} holds 3 records of an earlier run; continue it with resume=True, start "
+        "over with overwrite=True, or use another output folder"
     )
     assert store.read_bytes() == data
     run_tasks(_tasks(), _double, store, key="new", overwrite=True)

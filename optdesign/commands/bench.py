@@ -14,7 +14,15 @@ import os
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder, time_limit_option
+from optdesign.cli import (
+    as_options,
+    checked,
+    command,
+    flags,
+    literal,
+    output_folder,
+    time_limit_option,
+)
 
 #: Options spelt otherwise than their API argument (optdesign.bench).
 RENAMED = {"problems": "--problem"}
@@ -135,7 +143,7 @@ def _run_locked(args, problems, out: Path) -> int:
             overwrite=args.overwrite,
             update_readme=args.update_readme,
         )
-    print(printable(report.summary(), newlines=True))
+    print(printable(flags(report.summary()), newlines=True))
     paths = report.paths
     written = [out / "bench_runs.jsonl", paths["csv"], paths["profiles"], paths["summary"]]
     print("wrote " + ", ".join(printable(p) for p in written))

@@ -13,7 +13,15 @@ import time
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder, time_limit_option
+from optdesign.cli import (
+    as_options,
+    checked,
+    command,
+    flags,
+    literal,
+    output_folder,
+    time_limit_option,
+)
 
 METHOD_NAMES = ("epsilon", "uniform", "weighted_sum", "nsga2")
 #: Options spelt otherwise than their API argument (optdesign.pareto).
@@ -185,16 +193,16 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
     from optdesign.reports.front_text import front_summary
     from optdesign.text import printable
 
-    print(front_summary(fronts))
+    print(flags(front_summary(fronts)))
     for note in notes:
-        print(f"note: {printable(note)}")
+        print(f"note: {printable(flags(note))}")
     print("\nwrote " + ", ".join(printable(w) for w in wrote))
     for front in fronts:
         if not front.points and front.notes and not front.rejected:
             # the time limit left every point out: not an infeasible front
-            line = printable(f"{front.method}: {front.notes[0]}")
+            line = printable(flags(f"{front.method}: {front.notes[0]}"))
             print(f"optdesign: {line}", file=sys.stderr)
         elif not front.points:
-            line = printable(no_point_text(problem, front))
+            line = printable(flags(no_point_text(problem, front)))
             print(f"optdesign: infeasible: {line}", file=sys.stderr)
     return 0 if all(f.points for f in fronts) else 1

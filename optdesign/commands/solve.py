@@ -6,7 +6,15 @@ import contextlib
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder, time_limit_option
+from optdesign.cli import (
+    as_options,
+    checked,
+    command,
+    flags,
+    literal,
+    output_folder,
+    time_limit_option,
+)
 
 #: Options spelt otherwise than their API argument (optdesign.solve).
 RENAMED = {"ranges": "--no-ranges", "problem": "file"}
@@ -150,7 +158,7 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
     if args.json:
         print(text)
     else:
-        print(result.summary())
+        print(flags(result.summary()))
         if wrote:
             print("\nwrote " + ", ".join(printable(w) for w in wrote))
     return 0 if result.success else 1

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, literal, output_folder
+from optdesign.cli import as_options, checked, command, flags, literal, output_folder
 from optdesign.errors import InputError
 
 _RANGE = re.compile(
@@ -160,8 +160,8 @@ def _write(args, sweep, out: Path) -> int:
     if args.json:
         print(text)
     else:
-        print(sweep.summary())
+        print(flags(sweep.summary()))
         for note in notes:
-            print(f"note: {printable(note)}")
+            print(f"note: {printable(flags(note))}")
         print("\nwrote " + ", ".join(printable(w) for w in wrote))
     return 0 if any(p.success for p in sweep.points) else 1

@@ -333,7 +333,7 @@ def build_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
                     v.name,
                     False,
                     f"takes catalogue values {list(v.values)}; a GP is continuous "
-                    "(use --formulation catalogue)",
+                    "(use formulation='catalogue')",
                     v.name,
                 )
             )

@@ -179,7 +179,7 @@ def result_summary(result: Result) -> str:
                 "next: relax one of the violated requirements, or widen a bound at its limit"
             )
         elif not relax:
-            lines.append("next: more starts (--starts), or widen a bound at its limit")
+            lines.append("next: more starts (starts=), or widen a bound at its limit")
     elif bounds:
         names = ", ".join(sorted({printable(b.name) for b in bounds}))
         lines += ["", f"next: widening the bounds of {names} may improve the objective"]

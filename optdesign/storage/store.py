@@ -213,11 +213,11 @@ def open_store(
     if resume and scan.exists:
         problem = scan.problem or _version_problem(scan)
         if problem is not None:
-            raise StoreError(f"--resume: {path} cannot be resumed: {problem}; {_START_OVER}")
+            raise StoreError(f"resume=True: {path} cannot be resumed: {problem}; {_START_OVER}")
         if scan.key != key_text:
             diff = describe_difference(scan.identity, scan.key, components, key_text)
             raise StoreError(
-                f"--resume: the store {path} belongs to another run: {diff}; resume with the "
+                f"resume=True: the store {path} belongs to another run: {diff}; resume with the "
                 f"same settings, or {_START_OVER}"
             )
         if scan.torn_record is not None:
@@ -236,7 +236,7 @@ def open_store(
     return {}
 
 
-_START_OVER = "start over with --overwrite or use another output folder"
+_START_OVER = "start over with overwrite=True or use another output folder"
 
 
 def _check_records(scan: StoreScan, check: RecordCheck) -> None:
@@ -246,7 +246,7 @@ def _check_records(scan: StoreScan, check: RecordCheck) -> None:
     if bad is not None:
         rid, line, why = bad
         raise StoreError(
-            f"--resume: {scan.path} line {line}: record {rid!r} {why}; it cannot be "
+            f"resume=True: {scan.path} line {line}: record {rid!r} {why}; it cannot be "
             f"trusted: {_START_OVER}"
         )
 
@@ -259,7 +259,7 @@ def _refuse_replacing(scan: StoreScan) -> None:
             else f"holds data that is not a usable store ({scan.problem})"
         )
         raise StoreError(
-            f"{scan.path} {what}; continue it with --resume, start over with --overwrite, "
+            f"{scan.path} {what}; continue it with resume=True, start over with overwrite=True, "
             "or use another output folder"
         )
 

@@ -411,7 +411,7 @@ def solve_catalogue(
     t0 = time.perf_counter()
     dvars = discrete_variables(problem)
     if not dvars:
-        raise ProblemError("--formulation catalogue: no variable takes catalogue values")
+        raise ProblemError("formulation='catalogue': no variable takes catalogue values")
     n_comb = n_combinations(problem)
     minlp_solver, minlp_options = None, None
     if method == "minlp" or (method == "auto" and solver_hints(solver).minlp):

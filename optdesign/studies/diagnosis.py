@@ -95,7 +95,7 @@ def diagnose(
         found = (
             f"a design meeting every requirement as written exists{where} (found while "
             f"relaxing {missed[0].name}): the solve missed it ({result.status}); more starts "
-            "(--starts) may find it"
+            "(starts=) may find it"
         )
         old = result.diagnosis.note
         result.diagnosis.note = f"{found}; {old}" if old else found
@@ -118,7 +118,7 @@ def _nothing_violated(result: Result) -> str:
     return (
         f"no requirement is violated at the best point found: the solver stopped "
         f"({result.status}: {result.message or result.termination.value}) without proving "
-        "the problem infeasible; more starts (--starts) may find a feasible design"
+        "the problem infeasible; more starts (starts=) may find a feasible design"
     )
 
 
@@ -163,7 +163,7 @@ def _gp(problem: DesignProblem, result: Result, relax: bool) -> Diagnosis:
             basis=basis,
             note=(
                 f"the exact NLP found a feasible design ({objective} = {nlp.objective:.8g}) "
-                "although the GP (first-order Hertz) has none: solve with --formulation nlp"
+                "although the GP (first-order Hertz) has none: solve with formulation='nlp'"
             ),
         )
     if not nlp.violated:
@@ -244,7 +244,7 @@ def _catalogue(
             basis=basis,
             note=(
                 f"the catalogue items {shown} give a design that violates no requirement: "
-                "the search missed it; more starts (--starts) may find it"
+                "the search missed it; more starts (starts=) may find it"
             ),
         )
     if not relax:

@@ -133,7 +133,7 @@ def pick_formulation(problem: DesignProblem, request: SolveRequest) -> Formulati
         formulation = FORMULATIONS[requested]
         reason = why_not(formulation, problem, request) if problem.free else None
         if reason is not None:
-            raise ProblemError(f"--formulation {requested}: {reason}")
+            raise ProblemError(f"formulation={requested!r}: {reason}")
         return formulation
     reasons = []
     for name, formulation in FORMULATIONS.items():
@@ -141,7 +141,7 @@ def pick_formulation(problem: DesignProblem, request: SolveRequest) -> Formulati
         if reason is None:
             return formulation
         reasons.append(f"{name}: {reason}")
-    raise ProblemError("--formulation auto: no formulation applies (" + "; ".join(reasons) + ")")
+    raise ProblemError("formulation='auto': no formulation applies (" + "; ".join(reasons) + ")")
 
 
 def choose_formulation(

@@ -26,7 +26,7 @@ def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
     """The GP of ``problem``; raise ProblemError naming what breaks DGP form otherwise."""
     gp = build_gp(problem, objective)
     if not gp.is_gp:
-        raise ProblemError(f"--formulation gp: {not_gp(problem, gp)}")
+        raise ProblemError(f"formulation='gp': {not_gp(problem, gp)}")
     return gp
 
 

@@ -308,7 +308,7 @@ def _objective_set(problem: DesignProblem, objective: str) -> tuple[str, ...]:
 def _no_catalogue(problem: DesignProblem, name: str) -> None:
     reason = nlp_applies(problem)
     if reason is not True:
-        raise ProblemError(f"--formulation {name}: {reason}")
+        raise ProblemError(f"formulation={name!r}: {reason}")
 
 
 def continuous_only(problem: DesignProblem, advice: str) -> bool | str:
@@ -321,7 +321,7 @@ def continuous_only(problem: DesignProblem, advice: str) -> bool | str:
 def nlp_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
     """The ``nlp`` formulation's predicate: True unless a variable takes catalogue
     values (then the reason)."""
-    return continuous_only(problem, "use --formulation catalogue (or auto)")
+    return continuous_only(problem, "use formulation='catalogue' or formulation='auto'")
 
 
 def solve_nlp_formulation(problem: DesignProblem, request: SolveRequest) -> Result:

@@ -75,7 +75,7 @@ def anchor_message(objective: str, rec: PointRecord, problem: Any = None) -> str
     if not shown:
         return (
             f"{head}: no requirement is violated at the best point found (the solver "
-            f"stopped: {rec.message or rec.status}); more starts (--starts) may find one"
+            f"stopped: {rec.message or rec.status}); more starts (starts=) may find one"
         )
     return (
         f"{head}; at the best point found: {shown}; `optdesign solve` gives the smallest "
