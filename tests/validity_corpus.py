@@ -352,6 +352,45 @@ def run_case(case: Case) -> Verdict:
     return Verdict(case.name, "clean", message, seconds, detail)
 
 
+def run_case_cli(case: Case, json_mode: bool, out: Path) -> Verdict:
+    """Judge one case through ``optdesign solve`` (``--json`` on stdout, or the summary
+    and files under ``out``): a refused case exits 2 with one line on stderr naming the
+    field and the range; a flagged one exits 1 and names each model it leaves, in the
+    JSON document's violated rows or in the summary."""
+    from hostile_corpus import dumps, run_main
+
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "problem.toml"
+    path.write_text(dumps(problem_data(case)))
+    argv = ["solve", str(path), "--starts", "1", "--no-ranges"]
+    argv += ["--json"] if json_mode else ["--no-plot", "--out", str(out / "run")]
+    code, stdout, stderr, seconds = run_main(argv, timeout=60)
+    lines = [ln for ln in stderr.strip().splitlines() if ln.strip()]
+    if case.expect == "refused":
+        message = lines[0] if lines else ""
+        if code != 2 or len(lines) != 1 or stdout:
+            return Verdict(case.name, f"exit {code}, {len(lines)} lines", stderr[-300:], seconds)
+        missing = [n for n in case.names if n not in message]
+        if missing or "is outside" not in message:
+            return Verdict(case.name, f"message lacks {missing or 'the range'}", message, seconds)
+        return Verdict(case.name, "clean", message, seconds)
+    if code != 1:
+        return Verdict(case.name, f"exit {code}", (stderr or stdout)[-300:], seconds)
+    if json_mode:
+        import json
+
+        doc = json.loads(stdout)
+        shown = "; ".join(str(r.get("name", "")) for r in doc.get("violated", []))
+        if doc.get("verified") is not False or doc.get("status") == "optimal":
+            return Verdict(case.name, f"json says {doc.get('status')}", shown, seconds)
+    else:
+        shown = stdout
+    missing = [n for n in case.names if n not in shown]
+    if "validity: " not in shown or missing:
+        return Verdict(case.name, f"flagged without {missing or 'a model'}", shown[-300:], seconds)
+    return Verdict(case.name, "clean", "", seconds)
+
+
 if __name__ == "__main__":  # pragma: no cover - a report for a person
     sys.path.insert(0, str(ROOT))
     for c in all_cases():
