@@ -112,13 +112,47 @@ fabs = _unary(ca.fabs, np.abs)
 def sqrt_domain(x):
     """Square root for a quantity that is non-negative wherever the model is valid.
 
-    NumPy path: plain ``sqrt`` (NaN outside the domain, so invalid designs show up).
-    CasADi path: ``sqrt(fmax(x, 1e-12))`` so that a solver's iterate outside the domain
-    never produces NaN, in the value or in its derivatives (sqrt'(0) is infinite, and
-    infinity times the zero derivative of fmax is NaN); a constraint of the problem keeps
-    the solution inside, where the guard is inactive.
+    NumPy path: plain ``sqrt``, NaN outside the domain, so invalid designs show up (a
+    linkage that does not assemble there); the NaN is the answer, so NumPy's "invalid
+    value" RuntimeWarning is not printed. CasADi path: ``sqrt(fmax(x, 1e-12))`` so that
+    a solver's iterate outside the domain never produces NaN, in the value or in its
+    derivatives (sqrt'(0) is infinite, and infinity times the zero derivative of fmax is
+    NaN); a constraint of the problem keeps the solution inside, where the guard is
+    inactive.
     """
-    return ca.sqrt(ca.fmax(x, SQRT_GUARD)) if isinstance(x, _CASADI_TYPES) else np.sqrt(x)
+    if isinstance(x, _CASADI_TYPES):
+        return ca.sqrt(ca.fmax(x, SQRT_GUARD))
+    with np.errstate(invalid="ignore"):
+        return np.sqrt(x)
+
+
+def divide_domain(a, b, tiny: float = RATE_GUARD):
+    """``a / b`` for a divisor that is non-zero wherever the model is valid (a rate, the
+    sine of a transmission angle, a loop's Jacobian determinant): the division's
+    counterpart of :func:`sqrt_domain`.
+
+    NumPy path: ``a / b``, NaN where ``b == 0`` (the design is found invalid there, as a
+    root of a negative is), without NumPy's "divide by zero" RuntimeWarning. CasADi
+    path: ``a / away_from_zero(b, tiny)``, so that a solver's iterate where the divisor
+    passes through zero gets a huge, finite value and derivatives instead of inf and NaN;
+    ``tiny`` is in the divisor's own unit (default :data:`RATE_GUARD`, 1e-9). Other
+    values (the GP diagnosis's tracers) are divided as they are.
+    """
+    if is_symbolic(a, b):
+        return a / away_from_zero(b, tiny)
+    if not (_is_numeric(a) and _is_numeric(b)):
+        return a / b
+    b = np.asarray(b, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(b == 0.0, np.nan, np.divide(a, b))
+    return out[()]  # a NumPy scalar for scalar arguments, as the other functions
+
+
+def _is_numeric(x) -> bool:
+    """A number or a NumPy array of numbers (not a CasADi symbol nor a tracer)."""
+    return (
+        isinstance(x, int | float | np.number | np.ndarray) and np.asarray(x).dtype.kind in "fiub"
+    )
 
 
 def away_from_zero(x, tiny: float = RATE_GUARD):

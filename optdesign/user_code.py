@@ -317,13 +317,21 @@ def call_method(mechanism: Any, method: str, *args: Any, doing: str = "", **kwar
     its construction with ``method="__init__"``); a user's mechanism that fails -
     raises, or returns None or text for a quantity - gives a :class:`UserCodeError`
     naming its class and method. The built-in mechanisms' errors pass unchanged
-    (internal errors)."""
+    (internal errors). Every mechanism's method runs with NumPy's invalid-value and
+    divide-by-zero warnings off: its NaN is reported, not warned about."""
     cls = mechanism if inspect.isclass(mechanism) else type(mechanism)
     fn = cls if method == "__init__" else getattr(mechanism, method)
+    # On the NumPy path a linkage that does not assemble at some design or angle gives
+    # NaN (a root of a negative, a division by zero): that is its answer, which the
+    # checks report ("cannot assemble", not verified), so NumPy's RuntimeWarning is not
+    # printed. CasADi is not affected.
+    quiet = np.errstate(invalid="ignore", divide="ignore")
     if not is_users(cls):
-        return fn(*args, **kwargs)
+        with quiet:
+            return fn(*args, **kwargs)
     try:
-        value = fn(*args, **kwargs)
+        with quiet:
+            value = fn(*args, **kwargs)
     except OptDesignError:
         raise
     except Exception as exc:

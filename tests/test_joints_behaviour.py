@@ -262,6 +262,18 @@ def test_the_backlash_is_each_joints_rotation_in_degrees_summed_and_root_summed(
     assert np.allclose(b.rss, np.sqrt(a**2 + bb**2 + s**2))
 
 
+def test_two_joints_of_one_name_are_refused_instead_of_one_lost_from_the_backlash():
+    """A pin joining three links has two running clearances; named both after the pin,
+    the per-joint table kept one and the sums lost the other (issue 35)."""
+    eye = Joint("knee pin", sensitivity=np.array([0.1, 0.2]), clearance=0.01)
+    with pytest.raises(
+        InputError,
+        match=r"joints: two joints of the clearance chain are "
+        r"named 'knee pin': .* one joint per eye that turns on it",
+    ):
+        backlash_of([eye, Joint("A", sensitivity=1.0), eye], np.array([0.0, 0.1]))
+
+
 # --- the chain a problem sees -------------------------------------------------------------
 
 

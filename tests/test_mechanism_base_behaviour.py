@@ -352,6 +352,14 @@ def test_the_automatic_derivative_on_symbolic_numeric_and_population_paths():
     assert float(lever().nut_velocity(0)) == pytest.approx(40.0)
 
 
+@pytest.mark.parametrize("name", ["_Lever", "Lever__v2", "_"])
+def test_the_automatic_derivative_of_a_class_whose_name_casadi_would_refuse(name):
+    """CasADi names take no leading nor doubled underscore: a user's class named so gets
+    its derivative all the same (it was refused: "Function name is not valid")."""
+    cls = type(name, (Lever,), {})
+    assert np.allclose(cls(R=40.0, p=5.0).nut_velocity(PHI), 40.0 * np.cos(PHI), rtol=1e-12)
+
+
 def test_the_automatic_derivative_refuses_values_it_cannot_see_through():
     lev = lever()
     lev.values["R"] = np.array([object()], dtype=object)  # as the GP diagnosis's tracers

@@ -20,6 +20,7 @@ problem, not here.
 from __future__ import annotations
 
 import inspect
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -455,7 +456,10 @@ def _derivative(mech: Mechanism, phi):
         probe.values = dict(syms)
         probe.guarded = mech.guarded
         x = call_method(probe, "nut_position", phi_s, doing="while differentiating it (CasADi)")
-        fun = ca.Function(f"dx_{cls.__name__}", [phi_s, *syms.values()], [ca.jacobian(x, phi_s)])
+        # CasADi takes letters, digits and single underscores in a name: a class named
+        # _Yoke or Yoke__v2 would otherwise be refused when its derivative is built
+        name = "_".join(["dx", *re.findall(r"[A-Za-z0-9]+", cls.__name__)])
+        fun = ca.Function(name, [phi_s, *syms.values()], [ca.jacobian(x, phi_s)])
         _DERIVATIVES[key] = fun
     args = [mech.values[k] for k in names]
     if m.is_symbolic(phi, *args):

@@ -250,7 +250,20 @@ class Backlash:
 
 def backlash_of(joints: Sequence[Joint], phi) -> Backlash:
     """Backlash of a clearance chain: each joint's output rotation in degrees, their sum
-    (worst case) and root-sum-square (statistical estimate)."""
+    (worst case) and root-sum-square (statistical estimate). Each joint counts under its
+    own name: two joints of one name (the two eyes turning on a pin that joins three
+    links, both called after the pin) are refused, naming the name, since one of them
+    would otherwise be lost from the sums."""
+    names = [j.name for j in joints]
+    repeated = next((n for n in names if names.count(n) > 1), None)
+    if repeated is not None:
+        raise InputError(
+            "joints",
+            f"two joints of the clearance chain are named {repeated!r}: the backlash counts "
+            "each joint by its name, so one would be lost; give each running clearance a "
+            "name of its own (a pin joining three links: one joint per eye that turns on "
+            "it, e.g. 'knee pin (coupler eye)', 'knee pin (pushrod eye)')",
+        )
     per_joint = {j.name: j.rotation(phi) * (180.0 / np.pi) for j in joints}
     parts = list(per_joint.values())
     return Backlash(per_joint, worst_case(parts), root_sum_square(parts))

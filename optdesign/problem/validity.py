@@ -85,7 +85,10 @@ def _pin_ranges(q: Quantities) -> list[RangeQuantity]:
     pin = q.pin
     req = q.requirements
     d, L = pin.d, pin.L
-    out = [RangeQuantity(PIN_SLENDERNESS, L / d)]
+    # a pin given by its length ratio has that L/d: (5 d)/d is 5.000000000000001 for some
+    # d, which left the range [0.2, 5] that the file's ratio of 5 was accepted in
+    ratio = q.design.get("pin_length_ratio")
+    out = [RangeQuantity(PIN_SLENDERNESS, L / d if ratio is None else ratio)]
     size = _size(q)
     if size is not None:
         out.append(RangeQuantity(PIN_LENGTH_OVER_SIZE, L / size))

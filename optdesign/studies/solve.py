@@ -121,7 +121,10 @@ def solve(problem: DesignProblem, request: SolveRequest) -> Result:
         what = "the diagnosis" if not result.success else "the ranges of the optimal set"
         result.notes.append(f"{what} not computed: the time limit of {time_limit:g} s was reached")
         return result
-    return _evidence(problem, result, request)
+    result = _evidence(problem, result, request)
+    # the diagnosis may give a failed result its best point (a GP's, the exact NLP's)
+    name_outside_ranges(problem, result)
+    return result
 
 
 def name_outside_ranges(problem: DesignProblem, result: Result) -> None:
