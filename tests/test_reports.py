@@ -292,3 +292,20 @@ def test_report_pages_carry_the_shipped_plotly_bundle_unchanged():
     assert f"plotly.js (basic - minified) v{plotly_js.VERSION}".encode() in bundle[:200]
     assert base64.b64decode(plotly_js.packed()) == packed
     assert "'" not in plotly_js.packed() and "<" not in plotly_js.packed()
+
+
+def test_an_objective_the_model_cannot_evaluate_is_not_shown_as_a_number(user_result):
+    """At a design where the model gives NaN (a linkage that does not assemble), the
+    summary says the objective is not defined there instead of showing the solver's
+    bound variable as its value."""
+    import copy
+    import math
+
+    result = copy.copy(user_result[1])
+    name = result.objective_name
+    result.objectives = {**result.objectives, name: math.nan}
+    result.status = "failed"
+    line = next(ln for ln in result.summary().splitlines() if ln.startswith("objective "))
+    assert line.startswith(f"objective {name} = not defined at this design (the model gives NaN)")
+    shown = f"{result.objective:.6g}"
+    assert shown not in line

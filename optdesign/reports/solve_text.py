@@ -99,7 +99,13 @@ def result_summary(result: Result) -> str:
     if result.globality is not None and result.success:
         lines.append(f"global    {printable(result.globality.text())}")
     name = result.objective_name
-    value = objective_shown(problem, name, objective_value(result)).text(8)
+    phys = result.objectives.get(name)
+    if phys is not None and not math.isfinite(phys):
+        # the model is undefined there (a linkage that does not assemble): the solver's
+        # bound variable is no value of it
+        value = "not defined at this design (the model gives NaN)"
+    else:
+        value = objective_shown(problem, name, objective_value(result)).text(8)
     where = ""
     if not result.success:
         met = "feasible; the solver did not converge" if result.verified else "requirements not met"
