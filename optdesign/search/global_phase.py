@@ -56,6 +56,14 @@ STARTS_PER_DIMENSION = 12
 MIN_MAX_STARTS = 32
 
 
+#: Two starts whose values are closer than this (relative) are a tie when the search
+#: picks its answer (the first of them wins, :func:`~optdesign.solvers.multistart.best_of`);
+#: tighter than the tie that counts them as one optimum (``rel_tol``), so that of the starts
+#: at one optimum that a solver resolves only to ~1e-6 (a ripple of 1e-4 held by its
+#: epigraph rows to their constraint tolerance) the least is the answer, while starts that
+#: differ by round-off alone still keep the first.
+CHOICE_TOL = 1e-9
+
 #: Counted starts per free variable that must converge before the odds may stop a search.
 COUNTED_PER_DIMENSION = 2
 
@@ -241,7 +249,8 @@ def _best_with_record(
     time_limit: float | None,
     t0: float,
 ) -> Result:
-    best, n_at_best = best_of(results, rule.rel_tol)
+    _, n_at_best = best_of(results, rule.rel_tol)
+    best, _ = best_of(results, CHOICE_TOL)
     outcomes = [start_outcome(r) for r in results]
     timed_out = why == "time limit"
     not_started = max(0, planned - len(results)) if timed_out else 0
