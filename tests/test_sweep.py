@@ -133,7 +133,7 @@ def test_resume_reuses_the_stored_points(fork_sweep):
     with pytest.raises(od.OptDesignError, match="method"):
         od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out, resume=True)
     # and a new run does not silently replace the stored one
-    with pytest.raises(od.OptDesignError, match="--resume"):
+    with pytest.raises(od.OptDesignError, match="resume=True"):
         od.sweep(FORK, {HINGE: ("200 N*m", "900 N*m", 5)}, out=out)
 
 

@@ -28,6 +28,7 @@ multiplier in the problem's units is ``lam_x * T / x_span`` and ``dv*/d(bound) =
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from collections.abc import Iterator, Mapping
 from typing import Any
 
@@ -63,10 +64,30 @@ def requirement_paths(problem: DesignProblem) -> Iterator[tuple[str, float]]:
     yield from walk(problem.spec.requirements, "")
 
 
+#: The copies of problems with one requirement moved, by (problem state, path, value): the
+#: points of a front share their problem and its limits, so each copy is validated once per
+#: front, not once per point.
+_MOVED: OrderedDict[tuple[str, str, float], DesignProblem] = OrderedDict()
+_MOVED_SIZE = 64
+
+
 def with_requirement(problem: DesignProblem, path: str, value: float) -> DesignProblem:
     """A copy of ``problem`` whose requirement ``path`` (``"hinge_moment"``,
     ``"mean_ratio.min"``) is ``value`` (internal units), validated like a file; the
-    original is left as it was (its solver caches stay valid)."""
+    original is left as it was (its solver caches stay valid). Copies are remembered
+    per problem state, so the caller must not change the copy it gets."""
+    key = (problem.token, path, float(value))
+    if key in _MOVED:
+        _MOVED.move_to_end(key)
+        return _MOVED[key]
+    new = _moved(problem, path, value)
+    _MOVED[key] = new
+    while len(_MOVED) > _MOVED_SIZE:
+        _MOVED.popitem(last=False)
+    return new
+
+
+def _moved(problem: DesignProblem, path: str, value: float) -> DesignProblem:
     from optdesign.problem.spec_validation import validate_spec
 
     data = problem.spec.model_dump(mode="python")
