@@ -37,6 +37,8 @@ MODEL_MODULES = (
     "thread_surface",
     "differential_geometry",
     "prsm",
+    "motor",
+    "motor_catalogue",
 )
 
 
