@@ -53,8 +53,7 @@ def test_sensitivity_in_the_users_units(fork):
         s.log_sensitivity * result.objective / 500.0, rel=1e-3
     )
     assert s.text() == (
-        f"hinge_moment 500 N*m: raising it by 1 % to 505 N*m -> backlash "
-        f"{s.log_sensitivity:+.3g} %"
+        f"hinge_moment 500 N*m: raising it by 1 % to 505 N*m -> backlash {s.log_sensitivity:+.3g} %"
     )
     assert s.log_sensitivity == pytest.approx(0.2359, abs=5e-4)
 
@@ -221,3 +220,27 @@ def test_a_negative_bounds_cost_moves_it_the_way_its_line_says(tmp_path):
     assert moved.success
     change = 100 * (moved.objective / result.objective - 1)
     assert change == pytest.approx(s.log_sensitivity, rel=0.02)
+
+
+def test_a_limit_that_moves_no_model_function_costs_what_a_full_evaluation_says():
+    """The sensitivities reuse the design's evaluation for a requirement that only sets a
+    limit (a band's ends, a maximum), and evaluate the model again for one the physics
+    reads (the hinge moment, the stroke): both give the same derivatives."""
+    from optdesign.studies import sensitivity as S
+
+    problem = od.load(PROBLEMS / "cs_min_backlash.toml")
+    result = od.solve(problem, ranges=False, sensitivities=False)
+    p = dict(S.requirement_paths(problem))
+    assert S.moved_limits(problem, "mean_ratio.min", p["mean_ratio.min"] * 1.001, 199.0)
+    assert S.moved_limits(problem, "hinge_moment", p["hinge_moment"] * 1.001, 4.9e5) is None
+    fast = {s.name: s.d_objective_d_limit for s in S.nlp_sensitivities(problem, result)}
+    original = S.moved_limits
+    try:
+        S.moved_limits = lambda *args: None  # every move evaluated in full
+        full = {s.name: s.d_objective_d_limit for s in S.nlp_sensitivities(problem, result)}
+    finally:
+        S.moved_limits = original
+    assert fast.keys() == full.keys() and "requirements.hinge_moment" in full
+    assert any(k.startswith("requirements.mean_ratio") or "max" in k for k in full)
+    for name, d in full.items():
+        assert fast[name] == pytest.approx(d, rel=1e-12), name

@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -147,15 +148,22 @@ def from_multipliers(
     x = np.array([result.design[v.name] for v in problem.free])
     v = float(result.objective)
     rows = row_model(mu)
-    base = rows.value(problem, x)
+    # a row model that can reuse the design's evaluation (the NLP's rows) moves a limit that
+    # changes no model function without evaluating the model again
+    evaluated = rows.evaluate(problem, x) if isinstance(rows, _RowModel) else None
+    base = rows.total(evaluated) if evaluated is not None else rows.value(problem, x)
     out: list[tuple[Sensitivity, float]] = []  # with the effect of +1 % (or +1 unit at 0)
     for path, p in requirement_paths(problem):
         h = STEP * max(abs(p), 1e-9)
         try:
-            up = rows.value(with_requirement(problem, path, p + h), x)
-            down = rows.value(with_requirement(problem, path, p - h), x)
+            moved = [with_requirement(problem, path, p + h), with_requirement(problem, path, p - h)]
         except Exception:  # a step the schema refuses (a band's min at its max): skip it
             continue
+        limits = None if evaluated is None else moved_limits(problem, path, p + h, p - h)
+        if limits is not None:
+            up, down = (rows.total(evaluated.with_limits(lim)) for lim in limits)
+        else:
+            up, down = (rows.value(q, x) for q in moved)
         if not (math.isfinite(up) and math.isfinite(down) and math.isfinite(base)):
             continue
         out.append(_record(problem, objective, f"requirements.{path}", p, (up - down) / (2 * h), v))
@@ -235,39 +243,139 @@ class _RowModel:
             self.where.append((base, k))
 
     def value(self, problem: DesignProblem, x: np.ndarray) -> float:
+        return self.total(self.evaluate(problem, x))
+
+    def evaluate(self, problem: DesignProblem, x: np.ndarray) -> _Evaluated:
+        """The model's blocks and scalar objectives at design ``x``, with their limits."""
         with np.errstate(all="ignore"):
             ex = problem.expressions(problem.design_dict(x))
-            blocks: dict[str, tuple[np.ndarray, float | None, float | None]] = {}
-            for name, term in ex.objectives.items():
-                e = np.ravel(np.asarray(term.expr, dtype=float))
-                blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
-                blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
-                blocks[f"{name}_envelope"] = (-e, 0.0, None)
-            for block in ex.constraints:
-                e = np.ravel(np.asarray(block.expr, dtype=float))
-                blocks[block.name] = (e, block.lower, block.upper)
-            limits = problem.objective_limits()
-            total = 0.0
-            term = ex.objectives.get(self.objective)
-            if term is not None and term.kind == "scalar":
-                total += float(np.ravel(np.asarray(term.expr, dtype=float))[0])
-            for i in self.rows:
-                mu = float(self.mu[i])
-                if i in self.eps_name:
-                    name = self.eps_name[i]
-                    t = ex.objectives[name]
-                    g = float(np.ravel(np.asarray(t.expr, float))[0]) if t.kind == "scalar" else 0.0
-                    hi = limits.get(name)
-                    if name in self.eps and (hi is None or self.eps[name] < hi):
-                        hi = None  # the epsilon bound binds: a constant, no requirement's
-                    lo = None
-                else:
-                    base, k = self.where[i]
-                    values, lo, hi = blocks[base]
-                    g = float(values[k] if values.size > 1 else values[0])
-                b = hi if mu > 0 else lo
-                total += mu * (g - (b if b is not None and math.isfinite(b) else 0.0))
+            blocks, scalars = _blocks(ex)
+        return _Evaluated(blocks, scalars, problem.objective_limits())
+
+    def total(self, ev: _Evaluated) -> float:
+        """``v(p) + sum mu_i (g_i - b_i)`` from an evaluation."""
+        total = 0.0
+        if self.objective in ev.scalars:
+            total += ev.scalars[self.objective]
+        for i in self.rows:
+            mu = float(self.mu[i])
+            if i in self.eps_name:
+                name = self.eps_name[i]
+                g = ev.scalars.get(name, 0.0)
+                hi = ev.limits.get(name)
+                if name in self.eps and (hi is None or self.eps[name] < hi):
+                    hi = None  # the epsilon bound binds: a constant, no requirement's
+                lo = None
+            else:
+                base, k = self.where[i]
+                values, lo, hi = ev.blocks[base]
+                g = float(values[k] if values.size > 1 else values[0])
+            b = hi if mu > 0 else lo
+            total += mu * (g - (b if b is not None and math.isfinite(b) else 0.0))
         return total
+
+
+@dataclass(frozen=True)
+class _Evaluated:
+    """The rows of a problem at one design: block name -> (values, lower, upper), the
+    scalar objectives' values, the objectives' limits."""
+
+    blocks: dict[str, tuple[np.ndarray, Any, Any]]
+    scalars: dict[str, float]
+    limits: dict[str, float]
+
+    def with_limits(self, other: _Limits) -> _Evaluated:
+        """The same values under another problem's limits."""
+        blocks = {
+            name: (values, *other.blocks.get(name, (lo, hi)))
+            for name, (values, lo, hi) in self.blocks.items()
+        }
+        return _Evaluated(blocks, self.scalars, other.objectives)
+
+
+@dataclass(frozen=True)
+class _Limits:
+    """A problem's limits: block name -> (lower, upper), and the objectives' limits."""
+
+    blocks: dict[str, tuple[Any, Any]]
+    objectives: dict[str, float]
+
+
+def _blocks(ex) -> tuple[dict[str, tuple[np.ndarray, Any, Any]], dict[str, float]]:
+    blocks: dict[str, tuple[np.ndarray, Any, Any]] = {}
+    scalars: dict[str, float] = {}
+    for name, term in ex.objectives.items():
+        e = np.ravel(np.asarray(term.expr, dtype=float))
+        blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
+        blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
+        blocks[f"{name}_envelope"] = (-e, 0.0, None)
+        if term.kind == "scalar":
+            scalars[name] = float(e[0])
+    for block in ex.constraints:
+        blocks[block.name] = (
+            np.ravel(np.asarray(block.expr, dtype=float)),
+            block.lower,
+            block.upper,
+        )
+    return blocks, scalars
+
+
+#: Whether moving a requirement changes only limits (no model function), and the moved
+#: problems' limits, by (problem state, path, values).
+_LIMIT_ONLY: OrderedDict[tuple[str, str, float, float], tuple[_Limits, _Limits] | None] = (
+    OrderedDict()
+)
+
+
+def moved_limits(
+    problem: DesignProblem, path: str, up: float, down: float
+) -> tuple[_Limits, _Limits] | None:
+    """The limits of ``problem`` with requirement ``path`` at ``up`` and at ``down``, when
+    that move changes no model function (the rows' values and the objectives are equal at
+    two designs, and the limits do not depend on the design); None when it does (a
+    requirement the physics reads: a hinge moment, a stroke)."""
+    key = (problem.token, path, float(up), float(down))
+    if key not in _LIMIT_ONLY:
+        _LIMIT_ONLY[key] = _limits_if_only_limits(problem, path, up, down)
+        while len(_LIMIT_ONLY) > _MOVED_SIZE:
+            _LIMIT_ONLY.popitem(last=False)
+    return _LIMIT_ONLY[key]
+
+
+def _limits_if_only_limits(
+    problem: DesignProblem, path: str, up: float, down: float
+) -> tuple[_Limits, _Limits] | None:
+    lo, hi = problem.lower(), problem.upper()
+    designs = [lo + 0.5 * (hi - lo), lo + 0.3 * (hi - lo)]
+    found = []
+    for q in (with_requirement(problem, path, up), with_requirement(problem, path, down)):
+        limits = None
+        for x in designs:
+            with np.errstate(all="ignore"):
+                mine, _ = _blocks(problem.expressions(problem.design_dict(x)))
+                theirs, _ = _blocks(q.expressions(q.design_dict(x)))
+            if mine.keys() != theirs.keys():
+                return None
+            for name, (values, _, _) in theirs.items():
+                if not np.array_equal(values, mine[name][0], equal_nan=True):
+                    return None
+            here = {name: (b[1], b[2]) for name, b in theirs.items()}
+            if limits is not None and not _same_limits(limits, here):
+                return None  # a limit that moves with the design is a function of it
+            limits = here
+        found.append(_Limits(limits, q.objective_limits()))
+    return found[0], found[1]
+
+
+def _same_limits(a: dict[str, tuple[Any, Any]], b: dict[str, tuple[Any, Any]]) -> bool:
+    def same(u: Any, v: Any) -> bool:
+        if u is None or v is None:
+            return u is v
+        return bool(np.array_equal(np.asarray(u, float), np.asarray(v, float), equal_nan=True))
+
+    return a.keys() == b.keys() and all(
+        same(a[k][0], b[k][0]) and same(a[k][1], b[k][1]) for k in a
+    )
 
 
 def with_bound(problem: DesignProblem, name: str, side: str, value: float) -> DesignProblem:
