@@ -523,11 +523,25 @@ def test_a_front_point_whose_costs_cannot_be_known_says_why(cs, cs_front):
         "costs_note": "not known for this point: the point's record keeps no multipliers of "
         "its solve",
     }
-    # multipliers that leave the gradient of its Lagrangian far from zero: no KKT point's
+    # multipliers that leave the gradient of its Lagrangian far from zero: no KKT point's;
+    # the point's problem is solved again from its design, and its costs are that solve's
     raw = point.multipliers
     wrong = replace(point, multipliers=replace(raw, lam_g=3 * raw.lam_g))
-    shown = front_point_costs(cs, cs_front.objectives, wrong)
+    again = front_point_costs(cs, cs_front.objectives, wrong)
+    right = front_point_costs(cs, cs_front.objectives, point)
+    assert again["costs_note"].startswith(
+        f"costs in {point.target}, from its problem solved again from its design (the "
+        "front's solve left multipliers that miss the optimality conditions by "
+    )
+    assert right["costs_note"].startswith(f"costs in {point.target}, from this point's own solve")
+    assert [ln.split(" -> ")[0] for ln in again["sensitivities"]] == [
+        ln.split(" -> ")[0] for ln in right["sensitivities"]
+    ]
+    # ... unless that solve ends elsewhere: then the costs are not known, and it says why
+    elsewhere = {**wrong.objectives, wrong.target: 2 * wrong.objectives[wrong.target]}
+    shown = front_point_costs(cs, cs_front.objectives, replace(wrong, objectives=elsewhere))
     assert shown["sensitivities"] == []
     assert shown["costs_note"].startswith(
         "not known for this point: its solve's multipliers do not satisfy the optimality"
     )
+    assert shown["costs_note"].endswith("nor did a solve again from its design reach its value")

@@ -50,7 +50,7 @@ def front_point_costs(problem: Any, objectives: Sequence[str], point: Any) -> di
         f"{name} <= {objective_shown(problem, name, value).text(6)}"
         for name, value in sorted(costs.held.items())
     ]
-    note = f"costs in {costs.target}, from this point's own solve" + (
+    note = f"costs in {costs.target}, from {costs.basis}" + (
         f", with {', '.join(held)} held (its epsilon bound{'s' if len(held) > 1 else ''})"
         if held
         else ""

@@ -56,12 +56,16 @@ class PointCosts:
         Ranked as :func:`~optdesign.studies.sensitivity.from_multipliers` ranks them.
     why
         Why the costs cannot be known ("" when they are).
+    basis
+        Whose multipliers the costs come from: the point's own solve, or its problem
+        solved again by the NLP back-end from its design (:func:`_resolved`).
     """
 
     target: str = ""
     held: dict[str, float] = field(default_factory=dict)
     sensitivities: list[Sensitivity] = field(default_factory=list)
     why: str = ""
+    basis: str = "this point's own solve"
 
 
 def point_costs(problem: DesignProblem, objectives: Sequence[str], point: Any) -> PointCosts:
@@ -103,17 +107,26 @@ def _from_multipliers(
     derived, residual = bound_multipliers(
         nlp, target, nlp.bounds(eps=eps), np.asarray(raw.z, dtype=float), lam_g
     )
+    design = point.design
     if residual > KKT_TOL:
-        costs.why = (
-            f"its solve's multipliers do not satisfy the optimality conditions "
-            f"(residual {residual:.2g} of the scaled gradient)"
+        again = _resolved(problem, objectives, nlp, target, eps, raw.z, point.objectives[target])
+        if again is None:
+            costs.why = (
+                f"its solve's multipliers do not satisfy the optimality conditions "
+                f"(residual {residual:.2g} of the scaled gradient), nor did a solve again "
+                "from its design reach its value"
+            )
+            return
+        design, lam_g, lam_x = again
+        costs.basis = (
+            "its problem solved again from its design (the front's solve left multipliers "
+            f"that miss the optimality conditions by {residual:.2g})"
         )
-        return
-    if not lam_x.any():  # the back-end returned no bound multipliers (SLSQP)
+    elif not lam_x.any():  # the back-end returned no bound multipliers (SLSQP)
         lam_x = derived
     solved = SimpleNamespace(
         raw={"lam_g": lam_g, "lam_x": lam_x},
-        design=point.design,
+        design=design,
         objective=point.objectives[target],
     )
     costs.sensitivities = from_multipliers(
@@ -124,6 +137,41 @@ def _from_multipliers(
         target,
         lambda mu: _RowModel(nlp, target, mu, eps=eps),
     )
+
+
+#: A point's value and its solve again from its design agree within this (relative):
+#: the multipliers of the second solve are then the point's.
+SAME_POINT = 1e-6
+
+
+def _resolved(
+    problem: DesignProblem,
+    objectives: Sequence[str],
+    nlp: Any,
+    target: str,
+    eps: dict[str, float],
+    z: Any,
+    value: float,
+) -> tuple[dict[str, float], np.ndarray, np.ndarray] | None:
+    """The point's problem (``target`` with the others held at ``eps``) solved again from
+    its ``z`` by the default NLP back-end, when that back-end returns multipliers and
+    ends at the point's ``value``: (design, lam_g, lam_x); else None."""
+    from optdesign.solvers.registry import default_solver, solver_hints
+    from optdesign.studies.nlp_solve import solver_for
+
+    name = default_solver("nlp")
+    if not solver_hints(name).multipliers:
+        return None
+    backend = solver_for(problem, name, None, tuple(sorted(objectives)))
+    if backend.nlp.fingerprint != nlp.fingerprint:
+        return None
+    r = backend.solve(nlp.start(z0=np.asarray(z, dtype=float)), target, nlp.bounds(eps=eps))
+    if not r.success or "lam_g" not in r.raw or not np.isfinite(r.objective):
+        return None
+    if abs(r.objective - value) > SAME_POINT * max(abs(value), 1e-300):
+        return None
+    design = {**dict(r.design)}
+    return design, np.asarray(r.raw["lam_g"], float), np.asarray(r.raw["lam_x"], float)
 
 
 _KKT: dict[str, Any] = {}
