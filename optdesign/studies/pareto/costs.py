@@ -114,13 +114,15 @@ def _from_multipliers(
             costs.why = (
                 f"its solve's multipliers do not satisfy the optimality conditions "
                 f"(residual {residual:.2g} of the scaled gradient), nor did a solve again "
-                "from its design reach its value"
+                "from its design end at its value or just below"
             )
             return
-        design, lam_g, lam_x = again
+        design, lam_g, lam_x, lower = again
         costs.basis = (
             "its problem solved again from its design (the front's solve left multipliers "
-            f"that miss the optimality conditions by {residual:.2g})"
+            f"that miss the optimality conditions by {residual:.2g}"
+            + (f"; the solve again ended {lower:.2g} lower" if lower > SAME_POINT else "")
+            + ")"
         )
     elif not lam_x.any():  # the back-end returned no bound multipliers (SLSQP)
         lam_x = derived
@@ -143,6 +145,11 @@ def _from_multipliers(
 #: the multipliers of the second solve are then the point's.
 SAME_POINT = 1e-6
 
+#: A solve again that ends lower than the point by at most this (relative) improved a
+#: point its front's solver left short of its optimum (SLSQP's tie-breaks at an anchor):
+#: its costs are shown, saying by how much it ended lower.
+NEARBY = 1e-3
+
 
 def _resolved(
     problem: DesignProblem,
@@ -152,10 +159,11 @@ def _resolved(
     eps: dict[str, float],
     z: Any,
     value: float,
-) -> tuple[dict[str, float], np.ndarray, np.ndarray] | None:
+) -> tuple[dict[str, float], np.ndarray, np.ndarray, float] | None:
     """The point's problem (``target`` with the others held at ``eps``) solved again from
     its ``z`` by the default NLP back-end, when that back-end returns multipliers and
-    ends at the point's ``value``: (design, lam_g, lam_x); else None."""
+    ends at the point's ``value`` or at most :data:`NEARBY` below it: (design, lam_g,
+    lam_x, how much lower, relative); else None."""
     from optdesign.solvers.registry import default_solver, solver_hints
     from optdesign.studies.nlp_solve import solver_for
 
@@ -168,10 +176,16 @@ def _resolved(
     r = backend.solve(nlp.start(z0=np.asarray(z, dtype=float)), target, nlp.bounds(eps=eps))
     if not r.success or "lam_g" not in r.raw or not np.isfinite(r.objective):
         return None
-    if abs(r.objective - value) > SAME_POINT * max(abs(value), 1e-300):
+    scale = max(abs(value), 1e-300)
+    if r.objective > value + SAME_POINT * scale or r.objective < value - NEARBY * scale:
         return None
     design = {**dict(r.design)}
-    return design, np.asarray(r.raw["lam_g"], float), np.asarray(r.raw["lam_x"], float)
+    return (
+        design,
+        np.asarray(r.raw["lam_g"], float),
+        np.asarray(r.raw["lam_x"], float),
+        ((value - r.objective) / scale),
+    )
 
 
 _KKT: dict[str, Any] = {}
