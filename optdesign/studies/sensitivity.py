@@ -347,12 +347,13 @@ def _limits_if_only_limits(
 ) -> tuple[_Limits, _Limits] | None:
     lo, hi = problem.lower(), problem.upper()
     designs = [lo + 0.5 * (hi - lo), lo + 0.3 * (hi - lo)]
+    with np.errstate(all="ignore"):
+        own = [_blocks(problem.expressions(problem.design_dict(x)))[0] for x in designs]
     found = []
     for q in (with_requirement(problem, path, up), with_requirement(problem, path, down)):
         limits = None
-        for x in designs:
+        for x, mine in zip(designs, own, strict=True):
             with np.errstate(all="ignore"):
-                mine, _ = _blocks(problem.expressions(problem.design_dict(x)))
                 theirs, _ = _blocks(q.expressions(q.design_dict(x)))
             if mine.keys() != theirs.keys():
                 return None

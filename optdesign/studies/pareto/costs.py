@@ -179,12 +179,11 @@ def _resolved(
     scale = max(abs(value), 1e-300)
     if r.objective > value + SAME_POINT * scale or r.objective < value - NEARBY * scale:
         return None
-    design = {**dict(r.design)}
     return (
-        design,
+        dict(r.design),
         np.asarray(r.raw["lam_g"], float),
         np.asarray(r.raw["lam_x"], float),
-        ((value - r.objective) / scale),
+        (value - r.objective) / scale,
     )
 
 
