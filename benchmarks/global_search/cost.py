@@ -1,5 +1,5 @@
 """What the global search costs on the shipped problems: ``od.solve`` and a 50-point
-front, and the whole ``optdesign solve`` command, timed for this tree and for a baseline
+front (with its files, and without), and the whole ``optdesign solve`` command, timed for this tree and for a baseline
 tree (an earlier commit checked out elsewhere, e.g. ``git worktree add /tmp/base
 f433943``), interleaved round by round in one run so that both see the same machine.
 
@@ -50,6 +50,18 @@ print(json.dumps({"t": dt, "points": len(front.points), "ends": ends}))
 """
 
 
+FRONT_ALONE_SNIPPET = """
+import json, time
+import optdesign as od
+p = od.load("problems/cs_min_backlash.toml")
+t = time.perf_counter()
+front = od.pareto(p, ["ripple", "backlash"], points=50)
+dt = time.perf_counter() - t
+ends = [front.points[0].objectives, front.points[-1].objectives]
+print(json.dumps({"t": dt, "points": len(front.points), "ends": ends}))
+"""
+
+
 def _python(tree: Path, *args: str) -> dict:
     env = {**os.environ, "PYTHONPATH": str(tree), "MPLBACKEND": "Agg"}
     done = subprocess.run(
@@ -88,6 +100,9 @@ def main() -> None:
             rec = _python(tree, "-c", FRONT_SNIPPET)
             rows.setdefault(("50-point front cs_min_backlash", label), []).append(rec["t"])
             print(json.dumps({"tree": label, "case": "front", **rec}), flush=True)
+            rec = _python(tree, "-c", FRONT_ALONE_SNIPPET)
+            rows.setdefault(("the same front, no files", label), []).append(rec["t"])
+            print(json.dumps({"tree": label, "case": "front alone", **rec}), flush=True)
             t = _command(tree, "cs_min_ripple")
             rows.setdefault(("optdesign solve cs_min_ripple (command)", label), []).append(t)
             print(json.dumps({"tree": label, "case": "command", "t": t}), flush=True)

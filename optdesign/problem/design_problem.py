@@ -365,6 +365,25 @@ class DesignProblem:
             reqs[name] = value
         self._revalidate({**data, "requirements": reqs})
 
+    def with_requirement(self, path: str, value: Any) -> DesignProblem:
+        """A copy whose requirement ``path`` (``"hinge_moment"``, ``"mean_ratio.min"``,
+        ``"deflection.points"``) is ``value`` in internal units, validated like a file; this
+        problem is left as it is (its solver caches stay valid). The copy shares this
+        problem's mechanism, variables and added objectives and constraints."""
+        data = self.spec.model_dump(mode="python")
+        node = data["requirements"]
+        keys = path.split(".")
+        for key in keys[:-1]:
+            node = node[key]
+        node[keys[-1]] = value
+        new = object.__new__(type(self))  # not copy.copy: that would pickle the user code
+        new.__dict__.update(self.__dict__)
+        new.spec = validate_spec(data, self.mechanism, source=self.name, internal=True)
+        new._grid()
+        new._check_consistency()
+        new._touch()
+        return new
+
     def set_objective(self, *names: str) -> None:
         """Change the objective(s) the problem minimises."""
         data = self.spec.model_dump(mode="python")

@@ -119,6 +119,14 @@ def result_summary(result: Result) -> str:
             f"starts    {ms.n_starts} run, {ms.n_converged} converged, {ms.n_at_best} at the "
             f"best value (within {ms.tolerance:g} relative; seed {ms.seed}{stop})"
         )
+        if ms.polished:
+            again = f"best {ms.polished} local optim{'um' if ms.polished == 1 else 'a'}"
+            if not ms.n_converged:
+                again = f"{ms.polished} least violated"
+            lines.append(
+                f"          the starts solved on {ms.search_points} of the {ms.grid_points} grid "
+                f"angles; the {again} solved again on all of them"
+            )
         if ms.failed:  # the starts that cost time and gave nothing: how many and why
             lines.append(f"          {ms.failure_text()}")
     for note in result.notes:

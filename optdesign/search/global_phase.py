@@ -144,6 +144,10 @@ class StopRule:
         return distinct_optima(values, self.rel_tol, self.abs_tol)
 
 
+def _violation(r: Result) -> float:
+    return r.max_violation if math.isfinite(r.max_violation) else math.inf
+
+
 def _converged(r: Result) -> bool:
     return bool(r.success) and math.isfinite(r.objective)
 
@@ -164,6 +168,7 @@ def global_search(
     parallel_map: MapFunction | None = None,
     rel_tol: float = OBJECTIVE_TIE_TOL,
     abs_tol: float = 0.0,
+    polish: Callable[[np.ndarray, Result], Result] | None = None,
 ) -> Result:
     """The best result of local solves from ``own`` then tilted starts, with its record.
 
@@ -188,6 +193,11 @@ def global_search(
         Values closer than these are one optimum when the optima are counted (the best
         start is chosen with ``rel_tol`` alone, :func:`~optdesign.solvers.multistart.
         best_of`).
+    polish
+        (start point, its result) -> the problem itself solved again from the result's end
+        (a converged start) or from the start point (a failed one), when ``solve`` solves
+        a cheaper stand-in (the problem on fewer grid angles): the answer is then the best
+        of the polished starts (:func:`polish_optima`), never a stand-in's result.
 
     Returns
     -------
@@ -207,12 +217,14 @@ def global_search(
         min(len(own), cap), agree, target, rel_tol, abs_tol, min_counted_starts(dimension)
     )
     results: list[Result] = []
+    points: list[np.ndarray] = []  # each start's point, in start order
     planned = 0
     with one_blas_thread(), deadline(time_limit):
         while len(results) < cap and (not results or not rule(results)):
             n = min(cap, len(results) + (CHUNK if results or not own else len(own)))
             batch = _starts_between(own, starts, len(results), n)
             planned = n
+            points += list(batch)
             before = list(results)
 
             def stop(tail: list[Result], before=before) -> bool:
@@ -226,7 +238,71 @@ def global_search(
                     if stop(results[len(before) :]):
                         break
         why = rule.reason(results) or "all starts run"
-    return _best_with_record(results, rule, why, planned, cap, seed, workers, time_limit, t0)
+    polished = None
+    if polish is not None:
+        polished = polish_optima(results, lambda k: polish(points[k], results[k]), rule)
+    return _best_with_record(
+        results, rule, why, planned, cap, seed, workers, time_limit, t0, polished
+    )
+
+
+#: Most local optima of a stand-in search solved again on the problem itself.
+MAX_POLISHED = 4
+
+#: How far (relative) above the best polished value a stand-in optimum may lie, beyond
+#: the largest rise seen from stand-in to problem, and still be polished: the stand-in's
+#: values are not an exact lower bound where an objective averages over the grid.
+POLISH_SLACK = 1e-3
+
+
+@dataclass
+class Polished:
+    """The answer of a stand-in search: the best polished result and how many of the
+    stand-in's local optima were polished."""
+
+    best: Result
+    count: int
+
+
+def polish_optima(
+    results: Sequence[Result], polish: Callable[[int], Result], rule: StopRule
+) -> Polished:
+    """The stand-in search's local optima solved again on the problem itself, best first,
+    until the next one cannot beat the best polished value: its stand-in value lies above
+    that value by more than the largest rise from stand-in to problem seen so far (a
+    stand-in on a subset of the grid angles is a relaxation, so its value is below the
+    problem's near each optimum), plus :data:`POLISH_SLACK`; at most :data:`MAX_POLISHED`.
+    Starts at an optimum already polished (within the rule's tie) are skipped. No start
+    converged: the least violated starts (at most :data:`MAX_POLISHED`) are solved again
+    and the least violated of those is the answer, so that it belongs to the problem.
+    ``polish(k)`` solves again from start ``k``."""
+    order = sorted(range(len(results)), key=lambda k: results[k].objective)
+    ok = [k for k in order if _converged(results[k])]
+    if not ok:  # no optimum: the least violated starts, solved again
+        least = sorted(range(len(results)), key=lambda k: _violation(results[k]))
+        again = [polish(k) for k in least[:MAX_POLISHED]]
+        return Polished(best_of(again, CHOICE_TOL)[0], len(again))
+    best: Result | None = None
+    first: Result | None = None
+    rise, seen = 0.0, []
+    for k in ok:
+        r = results[k]
+        if any(abs(r.objective - v) <= max(tie_width(v, rule.rel_tol), rule.abs_tol) for v in seen):
+            continue
+        if best is not None:
+            reach = best.objective + rise + tie_width(best.objective, POLISH_SLACK)
+            if len(seen) >= MAX_POLISHED or r.objective > reach:
+                break
+        fine = polish(k)
+        seen.append(r.objective)
+        first = first or fine
+        if _converged(fine):
+            rise = max(rise, fine.objective - r.objective)
+            if best is None or fine.objective < best.objective - tie_width(
+                best.objective, CHOICE_TOL
+            ):
+                best = fine
+    return Polished(best or first, len(seen))
 
 
 def _starts_between(own: list[np.ndarray], tilted: TiltedStarts, a: int, b: int) -> np.ndarray:
@@ -248,9 +324,10 @@ def _best_with_record(
     workers: int,
     time_limit: float | None,
     t0: float,
+    polished: Polished | None = None,
 ) -> Result:
     _, n_at_best = best_of(results, rule.rel_tol)
-    best, _ = best_of(results, CHOICE_TOL)
+    best = polished.best if polished is not None else best_of(results, CHOICE_TOL)[0]
     outcomes = [start_outcome(r) for r in results]
     timed_out = why == "time limit"
     not_started = max(0, planned - len(results)) if timed_out else 0
@@ -279,6 +356,7 @@ def _best_with_record(
         counted=len(counted),
         odds=found,
         stop=why,
+        polished=polished.count if polished is not None else 0,
     )
     best.wall_time_s = time.perf_counter() - t0
     return best

@@ -28,8 +28,15 @@ IPOPT_RANGE: dict[str, Any] = {**IPOPT_WARM, "tol": 1e-7}
 #: Ipopt options of a solve started at a feasible point close to its optimum (a front's
 #: lexicographic tie-breaks, started at an optimum of the objective fixed before): a
 #: small initial barrier parameter and bound push keep Ipopt there instead of pushing it
-#: back into the interior.
-IPOPT_TIE: dict[str, Any] = {"mu_init": 1e-5, "bound_push": 1e-6, "bound_frac": 1e-6}
+#: back into the interior. A tie-break that converges takes a few dozen iterations; one
+#: that stalls on the degenerate set is given up at 150 (the caller then tries Ipopt's
+#: defaults) rather than at the default 500.
+IPOPT_TIE: dict[str, Any] = {
+    "mu_init": 1e-5,
+    "bound_push": 1e-6,
+    "bound_frac": 1e-6,
+    "max_iter": 150,
+}
 
 #: Ipopt options of a catalogue node. Many nodes of a catalogue search are infeasible
 #: boxes, and Ipopt's default filter spends ~120 iterations before its restoration phase

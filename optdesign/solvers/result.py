@@ -186,6 +186,12 @@ class MultistartInfo:
     counted: int = 0
     odds: Odds | None = None
     stop: str = ""
+    #: Starts solved on a stand-in of the problem (its grid thinned) whose local optima
+    #: were solved again on the problem itself: how many were (0: the starts solved the
+    #: problem itself), and the stand-in's grid angles against the problem's.
+    polished: int = 0
+    search_points: int = 0
+    grid_points: int = 0
 
     def failure_text(self) -> str:
         """``"5 failed: 3 restoration failed, 2 iteration limit"``; "" when none failed."""

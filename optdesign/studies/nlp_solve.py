@@ -87,13 +87,15 @@ def solver_for(
     form: str = "epigraph",
 ):
     """The back-end ``name`` (None: the registry's default for an NLP) of the problem's
-    NLP, built once per process and problem state, shared by every start, range and
-    front point."""
+    NLP, built once per process and NLP, shared by every start, range and front point.
+    Keyed on the NLP's content (its fingerprint), not on the problem object: a problem
+    loaded again, or a copy that changes nothing the NLP holds, reuses the back-end
+    (CasADi's ``nlpsol`` costs 40-60 ms, more than a start)."""
     name = name or default_solver("nlp")
     nlp = formulation_for(problem, objectives, form)
     opts = dict(solver_options(problem, name))
     opts.update(options or {})
-    key = (problem.token, nlp.fingerprint, name, json.dumps(opts, sort_keys=True, default=str))
+    key = (nlp.fingerprint, name, json.dumps(opts, sort_keys=True, default=str))
     return _remember(_SOLVERS, key, lambda: make_solver(nlp, name, opts))
 
 
@@ -197,24 +199,81 @@ def solve_nlp(
     if time_limit is not None and watch:
         options = {**(options or {}), **watch}
     backend = solver_for(problem, solver, options, objectives)
-    target = backend.nlp.target(objective)
-    target_index = backend.nlp.targets.index(objective)
+    own = own_starts(problem, x0)
+    cap = planned_starts(problem, starts)
+    stand_in = search_stand_in(problem) if cap > 1 else problem
+    search = backend if stand_in is problem else solver_for(stand_in, solver, options, objectives)
+    target = search.nlp.target(objective)
+    target_index = search.nlp.targets.index(objective)
+    polish = None
+    if stand_in is not problem:
+        full = backend.nlp.target(objective)
+
+        def polish(x0: np.ndarray, end: Result) -> Result:
+            # a failed start's end point may lie far from the problem's least violated
+            # point: the problem starts where the failed start did
+            x = np.array([end.design[v.name] for v in problem.free]) if end.success else x0
+            return checked_start(problem, backend.solve(backend.nlp.start(x0=x), full), objective)
+
     result = global_search(
-        lambda x: checked_start(problem, backend.solve(x, target), objective),
+        lambda x: checked_start(stand_in, search.solve(x, target), objective),
         tilted_starts(problem, objective, seed),
-        own=own_starts(problem, x0),
-        max_starts=planned_starts(problem, starts),
+        own=own,
+        max_starts=cap,
         agree=agree,
         target=target_odds,
         workers=workers,
         seed=seed,
         time_limit=time_limit,
         parallel_map=map_inherited,
-        abs_tol=SOLVER_RESOLUTION * float(backend.nlp.target_scales[target_index]),
+        abs_tol=SOLVER_RESOLUTION * float(search.nlp.target_scales[target_index]),
+        polish=polish,
     )
+    if polish is not None and result.multistart is not None:
+        result.multistart.search_points = len(stand_in.phi)
+        result.multistart.grid_points = len(problem.phi)
     result = refine(problem, backend, result, objective)
     result.globality = search_globality(result.multistart)
     return finish(problem, result, objective)
+
+
+#: Grid angles of the stand-in on which a search solves its starts (about; a subset of the
+#: problem's angles): a start's cost grows with the rows, one or more per grid angle, and
+#: the local optima of a thinned grid lie next to the problem's, where each is polished.
+SEARCH_POINTS = 13
+
+#: A problem with fewer grid angles than this is searched on its own grid.
+THIN_ABOVE = 2 * SEARCH_POINTS
+
+
+def search_points(points: int) -> int:
+    """The grid angles of a search's stand-in for a problem of ``points`` angles: every
+    k-th angle, ends included, k a divisor of ``points - 1`` giving the count nearest to
+    :data:`SEARCH_POINTS` (at least 9); ``points`` itself when the grid is small or no
+    divisor fits."""
+    if points < THIN_ABOVE:
+        return points
+    counts = [(points - 1) // k + 1 for k in range(2, points) if (points - 1) % k == 0]
+    fits = [c for c in counts if 9 <= c < points]
+    return min(fits, key=lambda c: (abs(c - SEARCH_POINTS), -c)) if fits else points
+
+
+_STAND_INS: OrderedDict[tuple, DesignProblem] = OrderedDict()
+
+
+def search_stand_in(problem: DesignProblem) -> DesignProblem:
+    """The problem on a subset of its grid angles (:func:`search_points`), on which the
+    global search solves its starts before it polishes their optima on the problem
+    itself; the problem itself when its grid is small. Built once per problem state."""
+    points = len(problem.phi)
+    thinned = search_points(points)
+    if thinned == points:
+        return problem
+    return _remember(
+        _STAND_INS,
+        (problem.token,),
+        lambda: problem.with_requirement("deflection.points", thinned),
+    )
 
 
 #: What a local solve resolves of an objective, relative to the objective's scale (the

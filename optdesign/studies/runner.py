@@ -216,6 +216,8 @@ def run_tasks(
         n}`` tells the CLI what was saved.
     """
     path = Path(store_path)
+    if check is not None and known:
+        check = _unless_known(check, known)
     with lock_folder(path.parent):
         stored = open_store(path, key, resume, overwrite, check)
         return _run(
@@ -234,6 +236,20 @@ def run_tasks(
             isolate,
             stop,
         )
+
+
+def _unless_known(check: Callable[[Record], str | None], known: Mapping[str, Record]):
+    """``check`` for the stored records that are not the caller's own: a record equal to
+    one in ``known`` (computed by this process in an earlier phase of the same run, and
+    checked when it was resumed or computed) is not checked again."""
+
+    def checked(record: Record) -> str | None:
+        rid = record.get("id") if isinstance(record, Mapping) else None
+        if rid is not None and known.get(rid) == record:
+            return None
+        return check(record)
+
+    return checked
 
 
 def _run(

@@ -72,37 +72,17 @@ _MOVED: OrderedDict[tuple[str, str, float], DesignProblem] = OrderedDict()
 _MOVED_SIZE = 64
 
 
-def with_requirement(problem: DesignProblem, path: str, value: float) -> DesignProblem:
-    """A copy of ``problem`` whose requirement ``path`` (``"hinge_moment"``,
-    ``"mean_ratio.min"``) is ``value`` (internal units), validated like a file; the
-    original is left as it was (its solver caches stay valid). Copies are remembered
-    per problem state, so the caller must not change the copy it gets."""
+def moved_copy(problem: DesignProblem, path: str, value: float) -> DesignProblem:
+    """:meth:`DesignProblem.with_requirement`, remembered per problem state, so the
+    caller must not change the copy it gets."""
     key = (problem.token, path, float(value))
     if key in _MOVED:
         _MOVED.move_to_end(key)
         return _MOVED[key]
-    new = _moved(problem, path, value)
+    new = problem.with_requirement(path, value)
     _MOVED[key] = new
     while len(_MOVED) > _MOVED_SIZE:
         _MOVED.popitem(last=False)
-    return new
-
-
-def _moved(problem: DesignProblem, path: str, value: float) -> DesignProblem:
-    from optdesign.problem.spec_validation import validate_spec
-
-    data = problem.spec.model_dump(mode="python")
-    node = data["requirements"]
-    keys = path.split(".")
-    for key in keys[:-1]:
-        node = node[key]
-    node[keys[-1]] = value
-    new = object.__new__(type(problem))
-    new.__dict__.update(problem.__dict__)
-    new.spec = validate_spec(data, problem.mechanism, source=problem.name, internal=True)
-    new._grid()
-    new._check_consistency()
-    new._touch()
     return new
 
 
@@ -156,7 +136,7 @@ def from_multipliers(
     for path, p in requirement_paths(problem):
         h = STEP * max(abs(p), 1e-9)
         try:
-            moved = [with_requirement(problem, path, p + h), with_requirement(problem, path, p - h)]
+            moved = [moved_copy(problem, path, p + h), moved_copy(problem, path, p - h)]
         except Exception:  # a step the schema refuses (a band's min at its max): skip it
             continue
         limits = None if evaluated is None else moved_limits(problem, path, p + h, p - h)
@@ -350,7 +330,7 @@ def _limits_if_only_limits(
     with np.errstate(all="ignore"):
         own = [_blocks(problem.expressions(problem.design_dict(x)))[0] for x in designs]
     found = []
-    for q in (with_requirement(problem, path, up), with_requirement(problem, path, down)):
+    for q in (moved_copy(problem, path, up), moved_copy(problem, path, down)):
         limits = None
         for x, mine in zip(designs, own, strict=True):
             with np.errstate(all="ignore"):
@@ -399,7 +379,7 @@ def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProb
     for path, value in values.items():
         head, _, rest = path.partition(".")
         if head == "requirements":
-            problem = with_requirement(problem, rest, value)
+            problem = moved_copy(problem, rest, value)
         else:
             name, _, side = rest.partition(".")
             problem = with_bound(problem, name, side or "value", value)
@@ -420,7 +400,7 @@ def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:
     if head == "variables":
         var, _, side = rest.partition(".")
         return with_bound(problem, var, side, value)
-    return with_requirement(problem, rest, value)
+    return moved_copy(problem, rest, value)
 
 
 def limit_value(problem: DesignProblem, name: str) -> float:

@@ -42,7 +42,10 @@ def test_knee_ripple_one_seed_reaches_the_reference_with_the_odds_recorded():
     ms = result.multistart
     # ten free variables: at least twenty counted starts converged before the odds stopped
     assert ms.stop == "odds" and ms.counted >= 20 and ms.odds.starts == ms.counted
-    assert ms.optima[0] == pytest.approx(result.objective, rel=REL)
+    # the starts solved a thinned grid (a relaxation): its best optimum lies at or below
+    # the answer, which is that optimum solved again on the whole grid
+    assert ms.polished >= 1 and ms.search_points < ms.grid_points
+    assert ms.optima[0] <= result.objective * (1 + REL)
     assert 0.0 < ms.odds.p_better < 0.05
     assert result.globality.proved is False and "probability" in result.globality.text()
 

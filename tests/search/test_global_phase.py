@@ -11,6 +11,7 @@ import pytest
 
 from optdesign.search.global_phase import (
     FAILED_LIMIT,
+    MAX_POLISHED,
     StopRule,
     default_max_starts,
     distinct_optima,
@@ -183,3 +184,89 @@ def test_failed_starts_at_a_feasible_design_keep_the_search_going():
 def test_agree_zero_runs_every_start_even_when_none_converges():
     best = global_search(failing_solve, starts(), max_starts=12, agree=0)
     assert best.multistart.n_starts == 12 and best.multistart.stop == "all starts run"
+
+
+# --- a search on a stand-in (the grid thinned), its optima polished on the problem -----
+#: The stand-in's optimum in each region: at or below the problem's (a relaxation), and
+#: ranked otherwise - its best region (1) is the problem's third.
+STAND_IN = np.array([3.0, 0.9, 1.5, 0.99])
+PROBLEM = np.array([3.0, 2.0, 1.5, 1.0])
+
+
+def stand_in_solve(x0):
+    result = local_solve(x0)
+    result.objective = float(STAND_IN[_region(x0)])
+    return result
+
+
+def polish_in_region(x0, end):
+    """The problem solved again from a start's end (converged) or its point (failed)."""
+    point = [end.design["x"], end.design["y"]] if end.success else x0
+    result = local_solve(point)
+    result.objective = float(PROBLEM[_region(point)])
+    return result
+
+
+def test_polishing_reaches_the_problems_best_optimum_where_the_stand_in_ranks_another_first():
+    polished = []
+
+    def polish(x0, end):
+        polished.append(_region([end.design["x"], end.design["y"]]))
+        return polish_in_region(x0, end)
+
+    uniform = TiltedStarts(sample, np.zeros(2), np.ones(2), 1, per_start=1)
+    r = global_search(stand_in_solve, uniform, max_starts=60, agree=0, polish=polish)
+    assert r.objective == 1.0 and r.design == {"x": 0.95, "y": 0.95}
+    # best stand-in first (0.9, region 1: rises by 1.1 to 2.0), then 0.99 (to 1.0, the
+    # best), then 1.5 (still below 1.0 + 1.1); region 0's 3.0 is above that reach
+    assert polished == [1, 3, 2] and r.multistart.polished == 3
+    # the record's values are the stand-in's
+    assert min(r.multistart.objectives) == 0.9 and r.multistart.optima[0] == 0.9
+
+
+def test_polishing_stops_after_the_best_when_the_stand_in_equals_the_problem():
+    # the next optimum (1.5) lies above the best (1.0) by more than the slack: not polished
+    def exact(x0, end):
+        return local_solve([end.design["x"], end.design["y"]])
+
+    r = global_search(local_solve, starts(2), max_starts=60, agree=0, polish=exact)
+    assert r.objective == 1.0 and r.multistart.polished == 1
+
+
+def test_with_no_converged_start_the_least_violated_starts_are_solved_again_from_their_points():
+    seen, again = [], []
+
+    def failed_near(x0):
+        result = failing_solve(x0)
+        result.max_violation = float(np.linalg.norm(np.asarray(x0) - CENTRES[2]))
+        return result
+
+    def polish(x0, end):
+        seen.append((tuple(x0), end.max_violation))
+        again.append(polish_in_region(x0, end))
+        return again[-1]
+
+    r = global_search(failed_near, starts(0), max_starts=10, agree=0, polish=polish)
+    assert len(seen) == MAX_POLISHED == r.multistart.polished
+    # the four least violated, least first, each from its own start point
+    violations = [v for _, v in seen]
+    assert violations == sorted(violations)
+    assert all(v == pytest.approx(np.linalg.norm(np.array(x) - CENTRES[2])) for x, v in seen)
+    assert r.success and r.objective == min(a.objective for a in again)
+
+
+def test_a_stand_in_search_gives_the_same_answer_on_one_and_two_workers():
+    one = global_search(stand_in_solve, starts(4), max_starts=40, polish=polish_in_region)
+    two = global_search(
+        stand_in_solve,
+        starts(4),
+        max_starts=40,
+        polish=polish_in_region,
+        workers=2,
+        parallel_map=map_inherited,
+    )
+    assert (one.objective, one.design, one.multistart.polished) == (
+        two.objective,
+        two.design,
+        two.multistart.polished,
+    )

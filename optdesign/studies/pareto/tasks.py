@@ -27,7 +27,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.search.global_phase import global_search
 from optdesign.solvers.multistart import improves, sobol_starts
 from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import own_starts, tilted_starts
+from optdesign.studies.nlp_solve import own_starts, search_stand_in, tilted_starts
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_from_result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -60,23 +60,33 @@ def multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
     solver = _solver(task)
     free = {k: np.inf for k in order[1:]}
     draws = tilted_starts(problem, order[0], task["seed"])
+    # the starts on the grid thinned (the stand-in), their optima polished on the whole
+    stand_in = search_stand_in(problem) if task["starts"] > 1 else problem
+    search = (
+        solver if stand_in is problem else EpsSolver(stand_in, solver.objectives, solver.method)
+    )
 
     def run(fallback: bool) -> Result:
+        def polish(x0: np.ndarray, end: Result) -> Result:
+            x = np.array([end.design[v.name] for v in problem.free]) if end.success else x0
+            return solver.solve(order[0], free, solver.nlp.start(x0=x), fallback)
+
         return global_search(
-            lambda x0: solver.solve(order[0], free, solver.nlp.start(x0=x0), fallback),
+            lambda x0: search.solve(order[0], free, search.nlp.start(x0=x0), fallback),
             draws,
             own=own_starts(problem),
             max_starts=task["starts"],
             agree=3 if agree is None else agree,
             seed=task["seed"],
+            polish=None if search is solver else polish,
         )
 
     # No per-start Ipopt fallback first: a start that fails is just a failed start.
     best = run(False)
-    n_solves = best.multistart.n_starts
+    n_solves = best.multistart.n_starts + best.multistart.polished
     if best.multistart.n_at_best == 0 and solver.has_fallback:
         best = run(True)
-        n_solves += best.multistart.n_starts
+        n_solves += best.multistart.n_starts + best.multistart.polished
     ms = best.multistart
     rec = _record(task, solver, best, "anchor-multistart", order[0], {})
     odds = ms.odds
@@ -117,15 +127,21 @@ def tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
         # fixed before: degenerate, and SLSQP was measured to stall there or stop 2e-4
         # short of Ipopt's value (cs_min_backlash, anchor backlash). Ipopt solves it.
         start = solver.nlp.start(x0=np.asarray(rec.x))
-        res = solver.solve(name, {**fixed, **rest}, start, use="tie")
-        n_solves += 1
-        cand = _record(task, solver, res, "anchor", name, fixed)
-        # The start is feasible for the tie-break (the bound is its own value plus slack):
-        # a result worse than the start is a solver failure, not a tie-break (default
-        # Ipopt once returned ripple 0.99996 "optimal" from a start at 0.0555).
-        if cand.success and cand.objectives[name] <= rec.objectives[name] * (1 + 1e-9) + 1e-15:
-            cand.multistart = rec.multistart
-            rec = cand
+        # Ipopt with a small barrier first; where it stalls on the degenerate set (500
+        # iterations from a crank-slider's backlash anchor whose lead differs from
+        # another's by 0.5 mm, both optimal), Ipopt with its default options
+        for use in ("tie", "fallback"):
+            res = solver.solve(name, {**fixed, **rest}, start, use=use)
+            n_solves += 1
+            cand = _record(task, solver, res, "anchor", name, fixed)
+            # The start is feasible for the tie-break (the bound is its own value plus
+            # slack): a result worse than the start is a solver failure, not a tie-break
+            # (default Ipopt once returned ripple 0.99996 "optimal" from a start at 0.0555).
+            limit = rec.objectives[name] * (1 + 1e-9) + 1e-15
+            if cand.success and cand.objectives[name] <= limit:
+                cand.multistart = rec.multistart
+                rec = cand
+                break
     rec.id = task["id"]
     rec.kind = "anchor"
     rec.order = list(order)
