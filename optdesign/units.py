@@ -82,6 +82,13 @@ INTERNAL_UNITS: dict[str, str] = {
     "time": "h",
     "angular_speed": "rad/s",
     "rotational_stiffness": "N*mm/rad",
+    # the drive's dynamics (issue 37): with mm and N, a mass is in tonnes (N*s^2/mm) and
+    # an inertia in t*mm^2 (N*mm*s^2), so that inertia x angular acceleration is N*mm
+    "inertia": "t*mm**2",
+    "mass": "t",
+    "rotational_damping": "N*mm*s/rad",
+    "frequency": "Hz",
+    "angular_acceleration": "rad/s**2",
 }
 
 #: The unit suggested to a user for each dimension (error messages, ``bare="refuse"``).
@@ -97,6 +104,11 @@ SUGGESTED_UNITS: dict[str, str] = {
     "time": "h",
     "angular_speed": "deg/s",
     "rotational_stiffness": "N*m/rad",
+    "inertia": "kg*m^2",
+    "mass": "kg",
+    "rotational_damping": "N*m*s/rad",
+    "frequency": "Hz",
+    "angular_acceleration": "deg/s^2",
 }
 
 #: How a dimension is named in messages ("expected a moment").
@@ -112,6 +124,11 @@ _DIMENSION_NAMES: dict[str, str] = {
     "time": "a time",
     "angular_speed": "an angular speed, an angle per time",
     "rotational_stiffness": "a rotational stiffness, a moment per angle",
+    "inertia": "a moment of inertia, a mass times a length squared",
+    "mass": "a mass",
+    "rotational_damping": "a rotational damping, a moment per angular speed",
+    "frequency": "a frequency (cycles per time, or an angle per time)",
+    "angular_acceleration": "an angular acceleration, an angle per time squared",
 }
 
 #: The angle exponents a quantity of each dimension may have (see the module docstring).
@@ -129,6 +146,12 @@ ANGLE_EXPONENTS: dict[str, tuple[int, ...]] = {
     "time": (0,),
     "angular_speed": (1,),
     "rotational_stiffness": (-1,),
+    "inertia": (0,),
+    "mass": (0,),
+    "rotational_damping": (-1,),
+    # cycles per time (Hz) or an angle per time (rad/s: one cycle is 2 pi rad)
+    "frequency": (0, 1),
+    "angular_acceleration": (1,),
 }
 
 #: Largest magnitude accepted in internal units: 1e15 mm is a billion kilometres; beyond
@@ -242,9 +265,14 @@ FAST_UNITS: dict[str, dict[str, float]] = {
     "angle": {"rad": 1.0, "deg": _DEG, "degree": _DEG, "°": _DEG},
     "stiffness": {"N/mm": 1.0, "kN/mm": 1e3, "N/um": 1e3, "N/µm": 1e3},
     "speed": {"1/min": 1.0, "rpm": 1.0},
-    "time": {"h": 1.0, "min": 1.0 / 60.0, "s": 1.0 / 3600.0},
+    "time": {"h": 1.0, "min": 1.0 / 60.0, "s": 1.0 / 3600.0, "ms": 1.0 / 3600e3},
     "angular_speed": {"rad/s": 1.0, "deg/s": _DEG},
     "rotational_stiffness": {"N*mm/rad": 1.0, "N*m/rad": 1e3, "kN*m/rad": 1e6},
+    "inertia": {"kg*m^2": 1e3, "kg*cm^2": 0.1, "kg*mm^2": 1e-3, "t*mm^2": 1.0},
+    "mass": {"kg": 1e-3, "g": 1e-6, "t": 1.0},
+    "rotational_damping": {"N*m*s/rad": 1e3, "N*mm*s/rad": 1.0},
+    "frequency": {"Hz": 1.0, "kHz": 1e3},
+    "angular_acceleration": {"rad/s^2": 1.0, "deg/s^2": _DEG},
 }
 
 _FAST = re.compile(r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)\s*(\S+)")
@@ -310,6 +338,8 @@ def _convert(q: Any, angle: float, shown: object, dimension: str, field: str) ->
     unit = INTERNAL_UNITS[dimension]
     if dimension == "speed" and angle == 1:
         unit = "turn/min"  # rpm and rad/s count turns: internal 1/min is turns per minute
+    if dimension == "frequency" and angle == 1:
+        unit = "turn/s"  # an angle per time counts cycles of 2 pi rad: internal Hz
     result = float(q.to(unit).magnitude)
     if not math.isfinite(result):
         raise InputError(field, f"{shown!r} is out of range")

@@ -292,6 +292,12 @@ class Mechanism:
         algorithmic differentiation, on both paths (override with a closed form)."""
         return _derivative(self, phi)
 
+    def nut_acceleration(self, phi):
+        """d2x/dphi2 (mm/rad^2): how the ratio changes along the stroke, which makes the
+        motor accelerate at a constant fin rate. Default: exact second derivative of
+        :meth:`nut_position` by CasADi algorithmic differentiation, on both paths."""
+        return _derivative(self, phi, order=2)
+
     def ratio(self, phi):
         """Exact reduction ratio i(phi) = 2 pi i_a (dx/dphi) / p."""
         return ratio_from_nut_velocity(self.nut_velocity(phi), self.p, self.i_a)
@@ -438,16 +444,17 @@ def _short(v: Any) -> str:
 _DERIVATIVES: dict[tuple, ca.Function] = {}
 
 
-def _derivative(mech: Mechanism, phi):
-    """dx/dphi of ``mech.nut_position`` by CasADi AD, evaluated like the model itself.
+def _derivative(mech: Mechanism, phi, order: int = 1):
+    """dx/dphi (``order`` 1) or d2x/dphi2 (2) of ``mech.nut_position`` by CasADi AD,
+    evaluated like the model itself.
 
-    One CasADi Function ``(phi, v_1..v_k) -> dx/dphi`` is built per mechanism class (on
-    scalar symbols) and cached; it is called element-wise with the design's values: CasADi
-    symbols give an expression per grid angle, NumPy arrays are broadcast.
+    One CasADi Function ``(phi, v_1..v_k) -> derivative`` is built per mechanism class and
+    order (on scalar symbols) and cached; it is called element-wise with the design's
+    values: CasADi symbols give an expression per grid angle, NumPy arrays are broadcast.
     """
     cls = type(mech)
     names = list(mech.values)
-    key = (cls, tuple(names), mech.guarded)
+    key = (cls, tuple(names), mech.guarded, order)
     fun = _DERIVATIVES.get(key)
     if fun is None:
         phi_s = ca.SX.sym("phi")
@@ -458,8 +465,11 @@ def _derivative(mech: Mechanism, phi):
         x = call_method(probe, "nut_position", phi_s, doing="while differentiating it (CasADi)")
         # CasADi takes letters, digits and single underscores in a name: a class named
         # _Yoke or Yoke__v2 would otherwise be refused when its derivative is built
-        name = "_".join(["dx", *re.findall(r"[A-Za-z0-9]+", cls.__name__)])
-        fun = ca.Function(name, [phi_s, *syms.values()], [ca.jacobian(x, phi_s)])
+        name = "_".join([f"d{order}x", *re.findall(r"[A-Za-z0-9]+", cls.__name__)])
+        dx = ca.jacobian(x, phi_s)
+        if order == 2:
+            dx = ca.jacobian(dx, phi_s)
+        fun = ca.Function(name, [phi_s, *syms.values()], [dx])
         _DERIVATIVES[key] = fun
     args = [mech.values[k] for k in names]
     if m.is_symbolic(phi, *args):

@@ -218,6 +218,21 @@ def _hinge_compliance(q):
     return q.output_compliance
 
 
+def _motor_peak_torque(q):
+    if q.problem.spec.motor is None or q.motion is None:
+        return None
+    return q.motor_peak_torque
+
+
+def _motor_rms_torque(q):
+    return None if not q.problem.spec.requirements.duty_cycle else q.motor_rms_torque
+
+
+def _natural_period(q):
+    spec = q.problem.spec
+    return None if spec.load is None or spec.screw is None else q.natural_period
+
+
 def _backlash(q):
     return None if q.pin is None else q.backlash.worst_case
 
@@ -331,6 +346,39 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "sum over the chain of (sensitivity^2 / member stiffness)",
             display_unit="urad/(N*m)",
             display_scale=1e9,
+            valid=NON_NEGATIVE,
+        ),
+        ObjectiveInfo(
+            "motor_peak_torque",
+            _motor_peak_torque,
+            "max",
+            "N*mm",
+            "largest torque the motion asks of the motor",
+            "max over the stroke of J_m (f' alpha + |f''| omega^2) + M_out / (f' eta) + T_f",
+            display_unit="N*m",
+            display_scale=1e-3,
+            valid=NON_NEGATIVE,
+        ),
+        ObjectiveInfo(
+            "motor_rms_torque",
+            _motor_rms_torque,
+            "scalar",
+            "N*mm",
+            "RMS motor torque of the duty cycle",
+            "sqrt(sum T_i^2 t_i / sum t_i), T_i = M_i / (f'(phi_i) eta) + T_f",
+            display_unit="N*m",
+            display_scale=1e-3,
+            valid=NON_NEGATIVE,
+        ),
+        ObjectiveInfo(
+            "natural_period",
+            _natural_period,
+            "max",
+            "s",
+            "longest period of the fin on the chain, motor held (1 / natural frequency)",
+            "max over the stroke of 2 pi sqrt(J_fin / (k_chain + k_hinge))",
+            display_unit="ms",
+            display_scale=1e3,
             valid=NON_NEGATIVE,
         ),
         ObjectiveInfo(

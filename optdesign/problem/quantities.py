@@ -26,7 +26,7 @@ from optdesign.mechanisms.joints import (
     with_sampled_fits,
 )
 from optdesign.models.lug_flexibility import Lug
-from optdesign.problem import drive
+from optdesign.problem import drive, motor_drive
 from optdesign.user_code import call_method, stage
 
 if TYPE_CHECKING:
@@ -253,6 +253,62 @@ class Quantities:
     def backlash(self) -> Backlash:
         """Output backlash over the grid (deg): per joint, worst case, RSS."""
         return self.call_mechanism("backlash", self.phi, self.joints)
+
+    # --- the motor, the fin's inertia and frequencies (optdesign.problem.motor_drive) -------
+    @cached_property
+    def motion(self) -> motor_drive.MotionDemand | None:
+        """The fin's top rate and acceleration (``[motion]``), or None without a rate."""
+        return motor_drive.motion_demand(self.problem.spec)
+
+    @cached_property
+    def natural_period(self):
+        """2 pi / omega of the fin on the chain, motor held, over the grid (s)."""
+        return motor_drive.natural_period(self)
+
+    @cached_property
+    def ratio_rate(self):
+        """f''(phi) = d(ratio)/d(phi) over the grid (1/rad)."""
+        return motor_drive.ratio_rate(self)
+
+    @cached_property
+    def motor_side_inertia(self):
+        """Inertia at the motor of what turns with it or moves with the nut (t*mm^2)."""
+        return motor_drive.motor_side_inertia(self)
+
+    @cached_property
+    def inertia_at_motor(self):
+        """Total inertia at the motor, J_m + J_fin / ratio^2, over the grid (t*mm^2)."""
+        return motor_drive.inertia_at_motor(self)
+
+    @cached_property
+    def inertia_ratio(self):
+        """Load inertia at the motor over the rotor's, over the grid."""
+        return motor_drive.inertia_ratio(self)
+
+    @cached_property
+    def motor_speed(self):
+        """Motor speed at the fin's top rate over the grid (rad/s)."""
+        return motor_drive.motor_speed(self)
+
+    @cached_property
+    def motor_peak_torque(self):
+        """Torque the motion asks of the motor over the grid (N*mm), inertia included."""
+        return motor_drive.motor_peak_torque(self)
+
+    @cached_property
+    def motor_rms_torque(self):
+        """RMS motor torque of the duty cycle (N*mm)."""
+        return motor_drive.motor_rms_torque(self)
+
+    @cached_property
+    def locked_frequency_squared(self):
+        """Squared natural frequency of the fin on the chain, motor held (rad^2/s^2)."""
+        return motor_drive.locked_frequency_squared(self)
+
+    @cached_property
+    def two_mass_frequency_squared(self):
+        """Squared frequency of the drive's mode, motor free (rad^2/s^2)."""
+        return motor_drive.two_mass_frequency_squared(self)
 
     # --- drive extras ----------------------------------------------------------------------
     @cached_property

@@ -41,6 +41,7 @@ from optdesign.problem.spec_drive import (  # noqa: F401 - the names of optdesig
     Screw,
     ScrewSizing,
 )
+from optdesign.problem.spec_motor import Load, Motion, Motor
 from optdesign.problem.spec_requirements import (
     Requirements,
 )
@@ -207,6 +208,9 @@ class ProblemSpec(_Model):
     tolerances: Tolerances | None = None
     reference: Reference | None = None
     screw: Screw | None = None
+    motor: Motor | None = None
+    load: Load | None = None
+    motion: Motion | None = None
 
 
 def _requirement_field(info) -> tuple[Any, Any]:

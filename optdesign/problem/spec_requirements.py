@@ -28,6 +28,7 @@ from optdesign.problem.spec_types import (
     Band,
     Deflection,
     Dimensionless,
+    Frequency,
     Length,
     Moment,
     Pressure,
@@ -76,6 +77,8 @@ class Requirements(_Model):
     f_w: Dimensionless = Field(1.0, ge=1.0, le=3.0)
     stiffness_min: RotationalStiffness | None = None
     stiffness_load: Literal["hinge", "duty-mean"] = "hinge"
+    inertia_ratio_max: Dimensionless | None = None
+    natural_frequency_min: Frequency | None = None
 
     @model_validator(mode="after")
     def _physical(self):

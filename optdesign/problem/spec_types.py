@@ -47,6 +47,12 @@ Stiffness = Annotated[float, _quantity("stiffness")]
 RotationalStiffness = Annotated[float, _quantity("rotational_stiffness")]
 AngularSpeed = Annotated[float, _quantity("angular_speed")]
 Time = Annotated[float, _quantity("time")]
+Inertia = Annotated[float, _quantity("inertia")]
+Mass = Annotated[float, _quantity("mass")]
+RotationalDamping = Annotated[float, _quantity("rotational_damping")]
+Frequency = Annotated[float, _quantity("frequency")]
+Speed = Annotated[float, _quantity("speed")]
+AngularAcceleration = Annotated[float, _quantity("angular_acceleration")]
 
 #: dimension name -> annotated type of a parsed quantity.
 QUANTITY_TYPES: dict[str, Any] = {
@@ -185,6 +191,8 @@ POSITIVE_REQUIREMENTS: dict[str, tuple[str, float]] = {
     "life_min": ("h", 1.0),
     "stiffness_min": ("N*m/rad", 1e-3),
     "dn_max": ("mm/min", 1.0),
+    "inertia_ratio_max": ("", 1.0),
+    "natural_frequency_min": ("Hz", 1.0),
 }
 
 

@@ -220,8 +220,9 @@ def _tidy(x: float) -> float:
 
 
 #: Units of the input table that pint converts otherwise (it reads "rpm" as revolutions,
-#: and neither "Nm" nor "Nmm" as a moment): pint decides, as before.
-_NOT_FAST_SHOWN = {("speed", "rpm"), ("moment", "Nm"), ("moment", "Nmm")}
+#: and neither "Nm" nor "Nmm" as a moment), or whose inverse factor is not pint's to the
+#: last bit (ms in hours): pint decides, as before.
+_NOT_FAST_SHOWN = {("speed", "rpm"), ("moment", "Nm"), ("moment", "Nmm"), ("time", "ms")}
 
 
 def _shown_factor(dim: str, unit: str) -> float | None:

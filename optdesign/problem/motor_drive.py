@@ -1,0 +1,380 @@
+"""The motor in the design: inertia reflected through the stroke, the torque, speed and
+RMS torque the motion asks of the motor, and the fin's natural frequencies, over the
+deflection grid, for any mechanism (built from its ``nut_velocity`` and
+``nut_acceleration``); and the requirements they make.
+
+Mechanism-free: everything here reads the design's quantities (the ratio f'(phi) and
+its rate f''(phi), the drive's efficiency and stiffness) and the problem's ``[motor]``,
+``[load]`` and ``[motion]`` sections (:mod:`optdesign.problem.spec_motor`); the
+physics is :mod:`optdesign.models.motor`'s. Internal units: mm, N, s, rad; inertia in
+t*mm^2 (= N*mm*s^2), mass in t (docs/motor.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from optdesign import math as m
+from optdesign.errors import ProblemError
+from optdesign.models import motor as mo
+from optdesign.problem.objectives import ConstraintBlock
+
+#: The closed-loop step's rise time is the first time it reaches this share of the step.
+RISE_LEVEL = 0.95
+
+
+@dataclass(frozen=True)
+class MotorData:
+    """The motor of a problem (internal units: t*mm^2, N*mm, rad/s, t)."""
+
+    designation: str
+    rotor_inertia: float
+    peak_torque: float
+    rated_torque: float | None
+    max_speed: float
+    mass: float | None
+    gear_inertia: float
+    friction_torque: float
+
+
+def motor_data(spec) -> MotorData | None:
+    """The ``[motor]`` section's motor: a catalogue row (``designation``) or its data."""
+    motor = spec.motor
+    if motor is None:
+        return None
+    if motor.designation is not None:
+        from optdesign.models.motor_catalogue import by_designation
+
+        row = by_designation(motor.designation)
+        return MotorData(
+            row.designation,
+            row.rotor_inertia,
+            row.peak_torque,
+            row.rated_torque,
+            row.max_speed,  # rad/s
+            row.mass,
+            motor.gear_inertia,
+            motor.friction_torque,
+        )
+    return MotorData(
+        "",
+        motor.rotor_inertia,
+        motor.peak_torque,
+        motor.rated_torque,
+        motor.max_speed * 2.0 * np.pi / 60.0,  # 1/min -> rad/s
+        motor.mass,
+        motor.gear_inertia,
+        motor.friction_torque,
+    )
+
+
+@dataclass(frozen=True)
+class MotionDemand:
+    """The fin's top rate (rad/s) and acceleration (rad/s^2), and where they come from."""
+
+    rate: float
+    acceleration: float
+    source: str
+
+
+def motion_demand(spec) -> MotionDemand | None:
+    """What the fin must do (``[motion]``, else ``requirements.deflection_rate`` alone):
+    the top rate is the larger of the given rate and the closed-loop step's peak rate; the
+    top acceleration is the step's (its initial value, step x wn^2) or the given one.
+    None when the problem gives no rate at all."""
+    motion, req = spec.motion, spec.requirements
+    given = motion.rate if motion is not None and motion.rate is not None else None
+    rate = given if given is not None else req.deflection_rate
+    if motion is None:
+        return None if rate is None else MotionDemand(rate, 0.0, "requirements.deflection_rate")
+    if motion.step is not None:
+        zeta, step = motion.damping_ratio, abs(motion.step)
+        wn = None if motion.natural_frequency is None else 2.0 * np.pi * motion.natural_frequency
+        if wn is None:
+            rise = motion.rise_time * 3600.0  # h -> s
+            wn = float(mo.natural_frequency_for_rise_time(zeta, rise, RISE_LEVEL))
+            how = f"95 % at {rise * 1e3:g} ms, wn = {wn:.4g} rad/s"
+        else:
+            how = f"wn = {wn:.4g} rad/s"
+        peak = float(mo.step_peak_rate(wn, zeta, step))
+        acc = float(mo.step_peak_acceleration(wn, zeta, step))
+        source = f"a {np.degrees(step):g} deg step, {how}, damping ratio {zeta:g}"
+        return MotionDemand(max(peak, rate or 0.0), acc, source)
+    if rate is None:
+        return None
+    return MotionDemand(rate, motion.acceleration or 0.0, "[motion]")
+
+
+def _need(value, what: str, field: str):
+    if value is None:
+        raise ProblemError(f"{field}: needs {what}")
+    return value
+
+
+# --- quantities of a design (functions of its Quantities q) -------------------------------
+def ratio_rate(q):
+    """f''(phi) = d2theta/dphi2 over the grid: the ratio's rate along the stroke,
+    f' x (d2x/dphi2) / (dx/dphi) (the map from the nut's rate to the motor's is linear)."""
+    acc = q.call_mechanism("nut_acceleration", q.phi)
+    return q.ratio * acc / q.mechanism._divisor(q.nut_velocity)
+
+
+def motor_side_inertia(q):
+    """J_m at the motor shaft: the rotor, the gear's ``gear_inertia``, the screw shaft
+    (a solid steel shaft of d0 over the support length, when ``[screw]`` gives them)
+    through the gear, and the nut's mass through the lead (t*mm^2; over the grid, since
+    the nut's share is m (dx/dphi / f')^2)."""
+    motor = _need(motor_data(q.problem.spec), "a [motor] section", "the motor's inertia")
+    J = motor.rotor_inertia + motor.gear_inertia
+    J_screw = _screw_inertia(q)
+    if J_screw is not None:
+        i_a = q.design.get("i_a", 1.0)
+        J = J + J_screw / i_a**2
+    load = q.problem.spec.load
+    if load is not None and load.nut_mass:
+        # m (lead / 2 pi i_a)^2 = m (dx/dphi / f')^2
+        J = J + load.nut_mass * (q.nut_velocity / q.ratio) ** 2
+    return J
+
+
+def _screw_inertia(q):
+    """The screw shaft's inertia about its axis (t*mm^2), or None without its size."""
+    from optdesign.models.screw_sizing import shaft_inertia
+
+    screw, data = q.problem.spec.screw, q.screw
+    if screw is None or screw.length is None or data is None or data.d0 is None:
+        return None
+    return shaft_inertia(data.d0, screw.length) * mo.KG_MM2
+
+
+def fin_inertia(q) -> float:
+    """The fin's inertia about its hinge (t*mm^2)."""
+    load = _need(q.problem.spec.load, "a [load] section (the fin's inertia)", "[load]")
+    return load.inertia
+
+
+def inertia_at_motor(q):
+    """J_m + J_fin / f'^2 over the grid (t*mm^2)."""
+    return mo.inertia_at_motor(q.motor_side_inertia, fin_inertia(q), q.ratio)
+
+
+def inertia_ratio(q):
+    """The load's inertia at the motor over the rotor's, over the grid."""
+    rotor = motor_data(q.problem.spec).rotor_inertia
+    return mo.inertia_ratio(q.inertia_at_motor - rotor, rotor)
+
+
+def motor_speed(q):
+    """The motor's speed at the fin's top rate, f' x rate (rad/s), over the grid."""
+    demand = _need(
+        motion_demand(q.problem.spec),
+        "the fin's rate: [motion] rate or a step, or requirements.deflection_rate",
+        "the motor's speed",
+    )
+    return mo.motor_rate(q.ratio, demand.rate)
+
+
+def output_demand(q, rate, acceleration):
+    """The torque the drive applies to the fin (N*mm) at the top rate and acceleration,
+    over the grid: J_fin alpha + c omega + |k phi| + M_h, every term against the drive (an
+    upper bound: the step's peak acceleration and peak rate come at different times)."""
+    load = q.problem.spec.load
+    J = 0.0 if load is None else load.inertia
+    c = 0.0 if load is None else load.damping
+    k = 0.0 if load is None else load.hinge_spring
+    spring = np.abs(k * np.asarray(q.phi, dtype=float))
+    return mo.output_torque(J, acceleration, c, rate, 0.0, 0.0, q.hinge_moment) + _column(q, spring)
+
+
+def motor_peak_torque(q):
+    """The torque the motor must give at each grid angle (N*mm): J_m (f' alpha + |f''|
+    omega^2) + M_out / (f' eta) + T_f, at the top rate omega and acceleration alpha of the
+    fin (:func:`motion_demand`), M_out by :func:`output_demand`; an upper bound of the
+    torque along the motion (docs/motor.md)."""
+    spec = q.problem.spec
+    motor = motor_data(spec)
+    demand = _need(
+        motion_demand(spec),
+        "the fin's rate: [motion] rate or a step, or requirements.deflection_rate",
+        "the motor's torque",
+    )
+    w, a = demand.rate, demand.acceleration
+    inertial = q.motor_side_inertia * (q.ratio * a + m.fabs(q.ratio_rate) * w**2)
+    through = mo.torque_at_motor(output_demand(q, w, a), q.ratio, q.drive_efficiency)
+    return inertial + through + motor.friction_torque
+
+
+def motor_rms_torque(q):
+    """The RMS torque of the duty cycle (N*mm): each step's hinge moment held at its
+    deflection through the ratio there and the forward efficiency, plus the drive's
+    friction, weighted by the step's share of the time (THK's equation (54))."""
+    spec = q.problem.spec
+    steps = _need(spec.requirements.duty_cycle, "requirements.duty_cycle", "the RMS torque")
+    motor = motor_data(spec)
+    friction = 0.0 if motor is None else motor.friction_torque
+    phis = np.array([s.deflection for s in steps])
+    ratio = q.call_mechanism("ratio", phis)
+    torques = [
+        mo.torque_at_motor(s.hinge_moment, _at(ratio, k), q.drive_efficiency) + friction
+        for k, s in enumerate(steps)
+    ]
+    return mo.rms_torque(torques, [s.time for s in steps])
+
+
+def chain_stiffness(q):
+    """The chain's stiffness at the fin with the motor held (N*mm/rad), over the grid."""
+    if q.problem.spec.screw is None:
+        raise ProblemError(
+            "the natural frequency: needs a [screw] section (the chain's stiffness: its "
+            "bearings, nut and shaft)"
+        )
+    return q.output_stiffness
+
+
+def locked_frequency_squared(q):
+    """omega^2 of the fin on the chain with the motor held, (k_chain + k_hinge) / J_fin
+    (rad^2/s^2), over the grid; <= 0 where the fin diverges."""
+    load = q.problem.spec.load
+    spring = 0.0 if load is None else load.hinge_spring
+    return mo.locked_frequency_squared(chain_stiffness(q), fin_inertia(q), spring)
+
+
+def two_mass_frequency_squared(q):
+    """omega^2 of the drive's own mode with the motor free (rad^2/s^2), over the grid:
+    the motor side J_1 = J_m f'^2 at the fin and the fin J_2 on the chain's stiffness k,
+    the fin on its hinge spring k_h: the larger root of J_1 J_2 w^4 - (k (J_1 + J_2) +
+    k_h J_1) w^2 + k k_h = 0 (with k_h = 0, k (J_1 + J_2) / (J_1 J_2))."""
+    load = q.problem.spec.load
+    kh = 0.0 if load is None else load.hinge_spring
+    k = chain_stiffness(q)
+    J1 = q.motor_side_inertia * q.ratio**2
+    J2 = fin_inertia(q)
+    A = J1 * J2
+    B = k * (J1 + J2) + kh * J1
+    C = k * kh
+    return (B + m.sqrt(m.fmax(B**2 - 4.0 * A * C, 0.0))) / (2.0 * A)
+
+
+def _at(v, k):
+    return v[k] if m.is_symbolic(v) else np.asarray(v)[..., k : k + 1]
+
+
+def _column(q, values):
+    """A grid of numbers shaped like the design's grid quantities (a CasADi column, or the
+    last axis of NumPy arrays)."""
+    if m.is_symbolic(q.ratio):
+        import casadi as ca
+
+        return ca.DM(np.asarray(values, dtype=float))
+    return np.asarray(values, dtype=float)
+
+
+def _hz(omega_squared):
+    return np.sqrt(np.maximum(np.asarray(omega_squared, dtype=float), 0.0)) / (2.0 * np.pi)
+
+
+# --- requirements ---------------------------------------------------------------------------
+def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
+    """The motor's and the fin's requirements: peak torque, speed and (with a duty cycle
+    and a rated torque) RMS torque within the motor's, the inertia ratio, the natural
+    frequencies. None without ``[motor]`` and without those requirements."""
+    spec = q.problem.spec
+    req = spec.requirements
+    motor = motor_data(spec)
+    out: list[ConstraintBlock] = []
+    if motor is not None:
+        _need(
+            motion_demand(spec),
+            "the fin's rate: [motion] rate or a step, or requirements.deflection_rate",
+            "[motor]",
+        )
+        name = f" {motor.designation}" if motor.designation else ""
+        out.append(
+            ConstraintBlock(
+                "motor_peak_torque",
+                q.motor_peak_torque,
+                None,
+                motor.peak_torque,
+                labels,
+                "N*mm",
+                f"torque the motion asks of the motor{name}, at most its peak",
+            )
+        )
+        out.append(
+            ConstraintBlock(
+                "motor_speed",
+                q.motor_speed,
+                None,
+                motor.max_speed,
+                labels,
+                "rad/s",
+                f"speed of the motor{name} at the fin's top rate, at most its top speed",
+                display=lambda v: np.asarray(v) * 60.0 / (2.0 * np.pi),
+                display_unit="1/min",
+            )
+        )
+        if motor.rated_torque is not None and req.duty_cycle:
+            out.append(
+                ConstraintBlock(
+                    "motor_rms_torque",
+                    q.motor_rms_torque,
+                    None,
+                    motor.rated_torque,
+                    [""],
+                    "N*mm",
+                    f"RMS torque of the duty cycle, at most the motor{name}'s rated torque",
+                )
+            )
+    if req.inertia_ratio_max is not None:
+        _need(motor, "a [motor] section (the rotor's inertia)", "requirements.inertia_ratio_max")
+        out.append(
+            ConstraintBlock(
+                "inertia_ratio",
+                q.inertia_ratio,
+                None,
+                req.inertia_ratio_max,
+                labels,
+                "",
+                "load inertia at the motor / rotor inertia",
+            )
+        )
+    if req.natural_frequency_min is not None:
+        low = (2.0 * np.pi * req.natural_frequency_min) ** 2
+        out.append(
+            ConstraintBlock(
+                "natural_frequency",
+                q.locked_frequency_squared,
+                low,
+                None,
+                labels,
+                "rad^2/s^2",
+                "squared natural frequency of the fin on the chain, motor held",
+                display=_hz,
+                display_unit="Hz",
+            )
+        )
+        if motor is not None:
+            out.append(
+                ConstraintBlock(
+                    "drive_mode_frequency",
+                    q.two_mass_frequency_squared,
+                    low,
+                    None,
+                    labels,
+                    "rad^2/s^2",
+                    "squared frequency of the drive's mode, motor free",
+                    display=_hz,
+                    display_unit="Hz",
+                )
+            )
+    return out
+
+
+def natural_period(q) -> Any:
+    """2 pi / omega of the fin on the chain, motor held (s), over the grid: minimised, it
+    raises the lowest natural frequency (NaN where the fin diverges)."""
+    w2 = q.locked_frequency_squared
+    return 2.0 * m.pi / m.sqrt(w2)

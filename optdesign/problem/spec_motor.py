@@ -1,0 +1,142 @@
+"""The motor, the load and the motion of a problem file (:mod:`optdesign.problem.spec`):
+``[motor]``, ``[load]`` and ``[motion]``. Values in internal units once parsed (mm, N, s,
+rad; a mass in t, an inertia in t*mm^2 = N*mm*s^2; README "Units")."""
+
+from __future__ import annotations
+
+import math
+
+from pydantic import Field, model_validator
+
+from optdesign.errors import InputError
+from optdesign.problem.spec_types import (
+    Angle,
+    AngularAcceleration,
+    AngularSpeed,
+    Dimensionless,
+    Frequency,
+    Inertia,
+    Mass,
+    Moment,
+    RotationalDamping,
+    RotationalStiffness,
+    Speed,
+    Time,
+    _Model,
+    _shown,
+)
+
+#: The motor's data a problem needs, with what each is for.
+MOTOR_DATA = {
+    "rotor_inertia": "the rotor's inertia (the torque to accelerate it, the inertia ratio)",
+    "peak_torque": "the instantaneous maximum torque (the peak demand's limit)",
+    "max_speed": "the top speed (the speed limit)",
+}
+
+
+class Motor(_Model):
+    """The drive's motor (``max_speed`` in 1/min, turns per minute, as ISO's n): one motor of the shipped catalogue (``designation``), or one
+    given by its data. ``rated_torque`` (the continuous torque) limits the RMS torque of
+    the duty cycle, ``mass`` is only reported. ``gear_inertia`` is what else turns with
+    the motor (gear, coupling), at the motor shaft; ``friction_torque`` the drive's own
+    friction at the motor shaft."""
+
+    designation: str | None = None
+    rotor_inertia: Inertia | None = None
+    peak_torque: Moment | None = None
+    rated_torque: Moment | None = None
+    max_speed: Speed | None = None
+    mass: Mass | None = None
+    gear_inertia: Inertia = 0.0
+    friction_torque: Moment = 0.0
+
+    @model_validator(mode="after")
+    def _data(self):
+        given = [k for k in (*MOTOR_DATA, "rated_torque", "mass") if getattr(self, k) is not None]
+        if self.designation is not None:
+            if given:
+                raise ValueError(
+                    f"designation: gives the motor's data; do not give {', '.join(given)} too"
+                )
+            from optdesign.models.motor_catalogue import by_designation
+
+            try:
+                by_designation(self.designation)
+            except InputError as exc:
+                raise ValueError(f"designation: {exc.reason}") from None
+            return self
+        missing = [k for k in MOTOR_DATA if getattr(self, k) is None]
+        if missing:
+            raise ValueError(
+                f"{missing[0]}: needed ({MOTOR_DATA[missing[0]]}); give the motor's data or "
+                'a designation of the shipped catalogue (e.g. designation = "SGM7J-04A")'
+            )
+        for name in ("rotor_inertia", "peak_torque", "rated_torque", "max_speed", "mass"):
+            value = getattr(self, name)
+            if value is not None and not value > 0:
+                raise ValueError(f"{name}: must be positive, got {value:g} (internal units)")
+        for name in ("gear_inertia", "friction_torque"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name}: cannot be negative, got {getattr(self, name):g}")
+        if self.rated_torque is not None and self.rated_torque > self.peak_torque:
+            raise ValueError(
+                f"rated_torque: {_shown('motor_torque_max', self.rated_torque)} is above the "
+                f"peak torque {_shown('motor_torque_max', self.peak_torque)}"
+            )
+        return self
+
+
+class Load(_Model):
+    """The control surface as the drive sees it: its inertia about the hinge, its
+    aerodynamic hinge spring dM/d(deflection) (either sign: negative for a statically
+    unstable fin) and a structural damping."""
+
+    inertia: Inertia
+    hinge_spring: RotationalStiffness = 0.0
+    damping: RotationalDamping = 0.0
+    nut_mass: Mass = 0.0
+
+    @model_validator(mode="after")
+    def _physical(self):
+        if not self.inertia > 0:
+            raise ValueError(f"inertia: must be positive, got {self.inertia:g} t*mm^2")
+        if self.damping < 0:
+            raise ValueError(f"damping: cannot be negative, got {self.damping:g} N*mm*s/rad")
+        if self.nut_mass < 0:
+            raise ValueError(f"nut_mass: cannot be negative, got {self.nut_mass:g} t")
+        return self
+
+
+class Motion(_Model):
+    """What the fin must do (internal units: a frequency in Hz, a time in h, as every
+    file's): its top rate, and a step of the closed loop (a second-order
+    response of natural frequency ``natural_frequency``, or reaching 95 % of the step at
+    ``rise_time``, with ``damping_ratio``), whose peak rate and acceleration
+    (:func:`optdesign.models.motor.step_peak_rate`, ``step_peak_acceleration``) the
+    motor must give. Without a step, ``acceleration`` is the fin's top acceleration."""
+
+    rate: AngularSpeed | None = None
+    acceleration: AngularAcceleration | None = None
+    step: Angle | None = None
+    natural_frequency: Frequency | None = None
+    rise_time: Time | None = None
+    damping_ratio: Dimensionless = Field(0.7, gt=0.0, lt=1.0)
+
+    @model_validator(mode="after")
+    def _one_response(self):
+        if self.natural_frequency is not None and self.rise_time is not None:
+            raise ValueError("give natural_frequency or rise_time, not both")
+        response = self.natural_frequency is not None or self.rise_time is not None
+        if response and self.step is None:
+            raise ValueError("step: a closed-loop response needs the step it answers")
+        if self.step is not None and not response:
+            raise ValueError("step: give natural_frequency or rise_time with it")
+        if self.step is not None and self.acceleration is not None:
+            raise ValueError("acceleration: the step's response gives it; give one of the two")
+        if self.step is not None and not 0 < abs(self.step) <= math.pi:
+            raise ValueError(f"step: must lie in (0, 180] deg, got {math.degrees(self.step):g}")
+        for name in ("rate", "acceleration", "natural_frequency", "rise_time"):
+            value = getattr(self, name)
+            if value is not None and not value > 0:
+                raise ValueError(f"{name}: must be positive, got {value:g}")
+        return self
