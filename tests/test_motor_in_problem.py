@@ -257,3 +257,65 @@ def test_requirements_that_need_what_the_file_lacks_say_what():
     data["requirements"]["inertia_ratio_max"] = 10
     with pytest.raises(od.OptDesignError, match=r"inertia_ratio_max: needs a \[motor\] section"):
         od.solve(od.load(data), starts=1, ranges=False)
+
+
+# --- the motor as a catalogue variable ------------------------------------------------------
+def _catalogue_case(motor: dict) -> dict:
+    data = _with_motor("cs_min_backlash", motor=motor)
+    data["load"] = {"inertia": "0.5 kg*m^2", "hinge_spring": "-500 N*m/rad",
+                    "damping": "5 N*m*s/rad", "nut_mass": "0.6 kg"}  # fmt: skip
+    data["motion"] = {"step": "3 deg", "rise_time": "72 ms", "damping_ratio": 0.7,
+                      "rate": "120 deg/s"}  # fmt: skip
+    return data
+
+
+def test_the_catalogue_motor_is_the_smallest_that_reaches_the_optimum():
+    """Motors numbered by rated torque (4: SGM7J-02A, 5: -04A, 6: -06A, 7: -08A): the
+    02A cannot give the step's torque, the 04A can; the search over 4..7 ties every motor
+    that can on the backlash optimum and keeps the smallest, the answer of the 04A named."""
+    from optdesign.problem.motor_catalogue_variable import motor_by_number
+
+    catalogue = {"catalogue": "Yaskawa Sigma-7"}
+    data = _catalogue_case(catalogue)
+    data["variables"]["motor"] = {"catalogue": "Yaskawa Sigma-7", "lower": 4, "upper": 7}
+    problem = od.load(data)
+    assert problem.by_name["motor"].values == (4.0, 5.0, 6.0, 7.0)
+    searched = od.solve(problem, ranges=False, sensitivities=False)
+    assert searched.status == "optimal" and searched.design["motor"] == 5
+    assert motor_by_number("Yaskawa Sigma-7", 5).designation == "SGM7J-04A"
+    named = od.solve(od.load(_catalogue_case({"designation": "SGM7J-04A"})), ranges=False)
+    assert searched.objective == pytest.approx(named.objective, rel=1e-7)
+    weaker = od.solve(
+        od.load(_catalogue_case({"designation": "SGM7J-02A"})), ranges=False, starts=4
+    )
+    assert not weaker.success
+    assert "SGM7J-04A" in searched.summary()
+
+
+@pytest.mark.slow  # fourteen solves, four of them infeasible verdicts: ~30 s
+def test_the_catalogue_search_equals_an_enumeration_over_every_motor():
+    from optdesign.problem.motor_catalogue_variable import motors
+
+    results = []
+    for row in motors("Yaskawa Sigma-7"):
+        r = od.solve(od.load(_catalogue_case({"designation": row.designation})), ranges=False)
+        results.append(r.objective if r.success else math.inf)
+    best = min(results)
+    first = next(k for k, v in enumerate(results, 1) if v <= best * (1 + 1e-6))
+    searched = od.solve(od.load(_catalogue_case({"catalogue": "Yaskawa Sigma-7"})), ranges=False)
+    assert searched.design["motor"] == first
+    assert searched.objective == pytest.approx(best, rel=1e-6)
+
+
+def test_a_motor_catalogue_is_refused_with_a_designation_or_data_or_without_its_variable():
+    for motor, reason in [
+        ({"catalogue": "Yaskawa Sigma-7", "designation": "SGM7J-04A"}, "do not give designation"),
+        ({"catalogue": "Yaskawa Sigma-7", "peak_torque": "5 N*m"}, "do not give peak_torque"),
+        ({"catalogue": "Acme"}, "catalogue: unknown 'Acme'"),
+    ]:
+        with pytest.raises(od.OptDesignError, match=reason):
+            od.load(_catalogue_case(motor))
+    data = _catalogue_case({"designation": "SGM7J-04A"})
+    data["variables"]["motor"] = {"catalogue": "Yaskawa Sigma-7"}
+    with pytest.raises(od.OptDesignError, match=r"variables.motor: the motor variable needs"):
+        od.load(data)

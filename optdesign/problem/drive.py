@@ -35,6 +35,7 @@ from optdesign.models import screw_sizing as sizing
 from optdesign.models.screw_catalogue import BallScrew, load_ball_screws
 from optdesign.models.screw_efficiency import MU_BALL_DEFAULT, MU_SLIDING_DEFAULT, screw_efficiency
 from optdesign.models.stiffness import G_STEEL, polar_moment
+from optdesign.problem import motor_catalogue_variable
 
 #: HIWIN's design value of the forward efficiency for torque sizing, the lower end of its
 #: 0.85-0.95 (BS-08-2-EN-1704-K, F 3.15).
@@ -166,6 +167,7 @@ def parameter_defaults(problem) -> dict[str, float]:
     if screw is not None and screw.catalogue is not None:
         for field in SCREW_FIELDS:
             out[f"screw_{field}"] = 1.0
+    out.update(motor_catalogue_variable.parameter_defaults(problem))
     return out
 
 
@@ -179,6 +181,7 @@ def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, 
         values.update(_fit_ratios(problem, box))
     if "screw_d1" in defaults:
         values.update(_screw_values(problem, box))
+    values.update(motor_catalogue_variable.parameter_values(problem, box))
     return values
 
 
@@ -243,8 +246,12 @@ def _screw_values(problem, box) -> dict[str, float]:
 
 
 def box_has_item(problem, box) -> bool:
-    """Whether a box of the discrete variables holds a catalogue screw (always True when
-    the screw is not a catalogue item)."""
+    """Whether a box of the discrete variables holds a catalogue screw and a catalogue
+    motor (always True for one that is not a catalogue item)."""
+    if motor_catalogue_variable.catalogue_of(problem) is not None and not (
+        motor_catalogue_variable.parameter_values(problem, box)
+    ):
+        return False
     screw = problem.spec.screw
     if screw is None or screw.catalogue is None:
         return True

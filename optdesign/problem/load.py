@@ -255,7 +255,7 @@ def problem_from_dict(
     spec = validate_spec(data, cls, source, bare=bare)
     table = variable_table(cls)
     variables = []
-    for var_name, raw in spec.variables.items():
+    for var_name, raw in _with_motor_variable(spec).items():
         if var_name not in table:
             close = difflib.get_close_matches(var_name, list(table), n=1, cutoff=0.6)
             hint = f"did you mean {close[0]!r}? " if close else ""
@@ -280,6 +280,27 @@ def problem_from_dict(
     # Reports show numbers in the units the file wrote (degrees in, degrees out).
     problem.written_units = written_units(data)
     return problem
+
+
+def _with_motor_variable(spec) -> dict[str, Any]:
+    """The file's variables, with the motor's when ``[motor] catalogue`` names one (the
+    variable ``motor``, every motor of the catalogue, unless the file declares it itself,
+    e.g. with bounds on the motors' numbers); a ``motor`` variable needs that catalogue."""
+    variables = dict(spec.variables)
+    catalogue = spec.motor.catalogue if spec.motor is not None else None
+    if "motor" in variables and catalogue is None:
+        raise ProblemError(
+            'variables.motor: the motor variable needs [motor] catalogue = "Yaskawa Sigma-7" '
+            "(the catalogue whose motors it numbers)"
+        )
+    if catalogue is not None:
+        raw = variables.setdefault("motor", {"catalogue": catalogue})
+        if not isinstance(raw, dict) or raw.get("catalogue") != catalogue:
+            raise ProblemError(
+                f"variables.motor: with [motor] catalogue = {catalogue!r}, declare it as "
+                f'{{ catalogue = "{catalogue}" }} (bounds on the motors\' numbers allowed)'
+            )
+    return variables
 
 
 #: Largest integer a problem accepts: every integer of the file is also used as a float

@@ -20,6 +20,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import motor as mo
+from optdesign.problem import motor_catalogue_variable as mcv
 from optdesign.problem.objectives import ConstraintBlock
 
 #: The closed-loop step's rise time is the first time it reaches this share of the step.
@@ -28,22 +29,33 @@ RISE_LEVEL = 0.95
 
 @dataclass(frozen=True)
 class MotorData:
-    """The motor of a problem (internal units: t*mm^2, N*mm, rad/s, t)."""
+    """The motor of a design (internal units: t*mm^2, N*mm, rad/s, t): numbers for a
+    motor the problem names, the catalogue's parameters (solver path) or looked-up values
+    (NumPy path) for a motor the search chooses. ``rotor_inertia`` is the one that costs
+    torque, ``rotor_inertia_max`` the one that divides the load's inertia: equal for one
+    motor, the least and the largest of a relaxation node's motors otherwise."""
 
     designation: str
-    rotor_inertia: float
-    peak_torque: float
-    rated_torque: float | None
-    max_speed: float
+    rotor_inertia: Any
+    peak_torque: Any
+    rated_torque: Any
+    max_speed: Any
     mass: float | None
     gear_inertia: float
     friction_torque: float
+    rotor_inertia_max: Any = None
+    on_catalogue: Any = None
+
+    @property
+    def inertia_for_ratio(self) -> Any:
+        return self.rotor_inertia if self.rotor_inertia_max is None else self.rotor_inertia_max
 
 
 def motor_data(spec) -> MotorData | None:
-    """The ``[motor]`` section's motor: a catalogue row (``designation``) or its data."""
+    """The motor the ``[motor]`` section names: a catalogue row (``designation``) or its
+    data; None without a section, or when the search chooses the motor (:func:`motor_of`)."""
     motor = spec.motor
-    if motor is None:
+    if motor is None or motor.catalogue is not None:
         return None
     if motor.designation is not None:
         from optdesign.models.motor_catalogue import by_designation
@@ -78,6 +90,28 @@ class MotionDemand:
     rate: float
     acceleration: float
     source: str
+
+
+def motor_of(q) -> MotorData | None:
+    """The motor of design ``q``: :func:`motor_data`, or the catalogue motor its variable
+    ``motor`` numbers (:mod:`optdesign.problem.motor_catalogue_variable`)."""
+    spec = q.problem.spec
+    fixed = motor_data(spec)
+    if fixed is not None or spec.motor is None:
+        return fixed
+    values, on = mcv.design_values(q.problem, q.design)
+    return MotorData(
+        "",
+        values["rotor_inertia"],
+        values["peak_torque"],
+        values["rated_torque"],
+        values["max_speed"],
+        None,
+        spec.motor.gear_inertia,
+        spec.motor.friction_torque,
+        values["rotor_inertia_max"],
+        on,
+    )
 
 
 def motion_demand(spec) -> MotionDemand | None:
@@ -127,7 +161,7 @@ def motor_side_inertia(q):
     (a solid steel shaft of d0 over the support length, when ``[screw]`` gives them)
     through the gear, and the nut's mass through the lead (t*mm^2; over the grid, since
     the nut's share is m (dx/dphi / f')^2)."""
-    motor = _need(motor_data(q.problem.spec), "a [motor] section", "the motor's inertia")
+    motor = _need(q.motor_data, "a [motor] section", "the motor's inertia")
     J = motor.rotor_inertia + motor.gear_inertia
     J_screw = _screw_inertia(q)
     if J_screw is not None:
@@ -163,8 +197,8 @@ def inertia_at_motor(q):
 
 def inertia_ratio(q):
     """The load's inertia at the motor over the rotor's, over the grid."""
-    rotor = motor_data(q.problem.spec).rotor_inertia
-    return mo.inertia_ratio(q.inertia_at_motor - rotor, rotor)
+    motor = q.motor_data
+    return mo.inertia_ratio(q.inertia_at_motor - motor.rotor_inertia, motor.inertia_for_ratio)
 
 
 def motor_speed(q):
@@ -195,7 +229,7 @@ def motor_peak_torque(q):
     fin (:func:`motion_demand`), M_out by :func:`output_demand`; an upper bound of the
     torque along the motion (docs/motor.md)."""
     spec = q.problem.spec
-    motor = motor_data(spec)
+    motor = q.motor_data
     demand = _need(
         motion_demand(spec),
         "the fin's rate: [motion] rate or a step, or requirements.deflection_rate",
@@ -213,7 +247,7 @@ def motor_rms_torque(q):
     friction, weighted by the step's share of the time (THK's equation (54))."""
     spec = q.problem.spec
     steps = _need(spec.requirements.duty_cycle, "requirements.duty_cycle", "the RMS torque")
-    motor = motor_data(spec)
+    motor = q.motor_data
     friction = 0.0 if motor is None else motor.friction_torque
     phis = np.array([s.deflection for s in steps])
     ratio = q.call_mechanism("ratio", phis)
@@ -279,11 +313,12 @@ def _hz(omega_squared):
 # --- requirements ---------------------------------------------------------------------------
 def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
     """The motor's and the fin's requirements: peak torque, speed and (with a duty cycle
-    and a rated torque) RMS torque within the motor's, the inertia ratio, the natural
-    frequencies. None without ``[motor]`` and without those requirements."""
+    and a rated torque) RMS torque within the motor's, as ratios to the motor's limits
+    (which are parameters when the search chooses the motor), the inertia ratio, the
+    natural frequencies. None without ``[motor]`` and without those requirements."""
     spec = q.problem.spec
     req = spec.requirements
-    motor = motor_data(spec)
+    motor = q.motor_data
     out: list[ConstraintBlock] = []
     if motor is not None:
         _need(
@@ -292,40 +327,50 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
             "[motor]",
         )
         name = f" {motor.designation}" if motor.designation else ""
+        if motor.on_catalogue is not None:
+            out.append(
+                ConstraintBlock(
+                    "motor_catalogue_membership",
+                    motor.on_catalogue,
+                    1.0,
+                    None,
+                    [""],
+                    "",
+                    "motor is a motor of the catalogue",
+                )
+            )
         out.append(
             ConstraintBlock(
                 "motor_peak_torque",
-                q.motor_peak_torque,
+                q.motor_peak_torque / motor.peak_torque,
                 None,
-                motor.peak_torque,
+                1.0,
                 labels,
-                "N*mm",
-                f"torque the motion asks of the motor{name}, at most its peak",
+                "",
+                f"torque the motion asks of the motor{name} / its peak torque",
             )
         )
         out.append(
             ConstraintBlock(
                 "motor_speed",
-                q.motor_speed,
+                q.motor_speed / motor.max_speed,
                 None,
-                motor.max_speed,
+                1.0,
                 labels,
-                "rad/s",
-                f"speed of the motor{name} at the fin's top rate, at most its top speed",
-                display=lambda v: np.asarray(v) * 60.0 / (2.0 * np.pi),
-                display_unit="1/min",
+                "",
+                f"speed of the motor{name} at the fin's top rate / its top speed",
             )
         )
         if motor.rated_torque is not None and req.duty_cycle:
             out.append(
                 ConstraintBlock(
                     "motor_rms_torque",
-                    q.motor_rms_torque,
+                    q.motor_rms_torque / motor.rated_torque,
                     None,
-                    motor.rated_torque,
+                    1.0,
                     [""],
-                    "N*mm",
-                    f"RMS torque of the duty cycle, at most the motor{name}'s rated torque",
+                    "",
+                    f"RMS torque of the duty cycle / the motor{name}'s rated torque",
                 )
             )
     if req.inertia_ratio_max is not None:

@@ -219,7 +219,7 @@ def _hinge_compliance(q):
 
 
 def _motor_peak_torque(q):
-    if q.problem.spec.motor is None or q.motion is None:
+    if q.motor_data is None or q.motion is None:
         return None
     return q.motor_peak_torque
 

@@ -256,6 +256,11 @@ class Quantities:
 
     # --- the motor, the fin's inertia and frequencies (optdesign.problem.motor_drive) -------
     @cached_property
+    def motor_data(self) -> motor_drive.MotorData | None:
+        """The design's motor: its data, or the catalogue's motor its variable numbers."""
+        return motor_drive.motor_of(self)
+
+    @cached_property
     def motion(self) -> motor_drive.MotionDemand | None:
         """The fin's top rate and acceleration (``[motion]``), or None without a rate."""
         return motor_drive.motion_demand(self.problem.spec)

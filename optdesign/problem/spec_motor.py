@@ -35,13 +35,16 @@ MOTOR_DATA = {
 
 
 class Motor(_Model):
-    """The drive's motor (``max_speed`` in 1/min, turns per minute, as ISO's n): one motor of the shipped catalogue (``designation``), or one
-    given by its data. ``rated_torque`` (the continuous torque) limits the RMS torque of
-    the duty cycle, ``mass`` is only reported. ``gear_inertia`` is what else turns with
-    the motor (gear, coupling), at the motor shaft; ``friction_torque`` the drive's own
-    friction at the motor shaft."""
+    """The drive's motor (``max_speed`` in 1/min, turns per minute, as ISO's n): one motor
+    of the shipped catalogue (``designation``), one given by its data, or a catalogue
+    whose motors the search chooses from (``catalogue``: the variable ``motor``,
+    :mod:`optdesign.problem.motor_catalogue_variable`). ``rated_torque`` (the continuous
+    torque) limits the RMS torque of the duty cycle, ``mass`` is only reported.
+    ``gear_inertia`` is what else turns with the motor (gear, coupling), at the motor
+    shaft; ``friction_torque`` the drive's own friction at the motor shaft."""
 
     designation: str | None = None
+    catalogue: str | None = None
     rotor_inertia: Inertia | None = None
     peak_torque: Moment | None = None
     rated_torque: Moment | None = None
@@ -53,6 +56,18 @@ class Motor(_Model):
     @model_validator(mode="after")
     def _data(self):
         given = [k for k in (*MOTOR_DATA, "rated_torque", "mass") if getattr(self, k) is not None]
+        if self.catalogue is not None:
+            from optdesign.problem.motor_catalogue_variable import MOTOR_CATALOGUES
+
+            if self.catalogue not in MOTOR_CATALOGUES:
+                known = ", ".join(repr(k) for k in MOTOR_CATALOGUES)
+                raise ValueError(f"catalogue: unknown {self.catalogue!r} (known: {known})")
+            mine = given + (["designation"] if self.designation is not None else [])
+            if mine:
+                raise ValueError(
+                    f"catalogue: the search picks the motor; do not give {', '.join(mine)} too"
+                )
+            return self
         if self.designation is not None:
             if given:
                 raise ValueError(
@@ -68,8 +83,9 @@ class Motor(_Model):
         missing = [k for k in MOTOR_DATA if getattr(self, k) is None]
         if missing:
             raise ValueError(
-                f"{missing[0]}: needed ({MOTOR_DATA[missing[0]]}); give the motor's data or "
-                'a designation of the shipped catalogue (e.g. designation = "SGM7J-04A")'
+                f"{missing[0]}: needed ({MOTOR_DATA[missing[0]]}); give the motor's data, a "
+                'designation of the shipped catalogue (e.g. designation = "SGM7J-04A") or a '
+                'catalogue to choose from (catalogue = "Yaskawa Sigma-7")'
             )
         for name in ("rotor_inertia", "peak_torque", "rated_torque", "max_speed", "mass"):
             value = getattr(self, name)

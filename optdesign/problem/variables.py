@@ -28,6 +28,9 @@ PIN_VARIABLES: dict[str, VariableInfo] = {
         "dimensionless", "pin length ratio L/d", valid=PIN_SLENDERNESS
     ),
     "d0": VariableInfo("length", "screw nominal (mean) diameter"),
+    "motor": VariableInfo(
+        "dimensionless", "motor: its number in the catalogue, smallest rated torque first"
+    ),
 }
 
 #: Internal unit of each variable dimension (for tables).
@@ -103,7 +106,13 @@ def catalogue_items(catalogue: str, variable: str, field: str, screw=None) -> li
                 "are pairs of one catalogue item)"
             )
         return list(catalogue_values(catalogue, variable, screw.nut))
-    known = ", ".join([*CATALOGUES, "HIWIN"])
+    from optdesign.problem.motor_catalogue_variable import MOTOR_CATALOGUES, motor_numbers
+
+    if catalogue in MOTOR_CATALOGUES:
+        if variable != "motor":
+            raise ProblemError(f"{field}: a motor catalogue gives the variable motor only")
+        return motor_numbers(catalogue)
+    known = ", ".join([*CATALOGUES, "HIWIN", *MOTOR_CATALOGUES])
     raise ProblemError(f"{field}: unknown catalogue {catalogue!r} (known: {known})")
 
 

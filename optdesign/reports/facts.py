@@ -59,7 +59,34 @@ def design_facts(problem: Any, design: dict[str, float]) -> list[Fact]:
     if req.eta_screw == 1.0 and req.eta_gear == 1.0 and problem.spec.screw is None:
         source = "lossless: the file gives no eta_screw, eta_gear or [screw]"
     out.append(Fact("drive_efficiency", Shown(100.0 * float(np.min(eta)), "%"), source))
+    out += _motor_facts(problem, q)
     return out
+
+
+def _motor_facts(problem: Any, q: Any) -> list[Fact]:
+    """The motor of the design, named, with its data and how much of each it uses."""
+    from optdesign.problem.motor_catalogue_variable import catalogue_of, motor_by_number
+
+    if problem.spec.motor is None:
+        return []
+    catalogue = catalogue_of(problem)
+    name = problem.spec.motor.designation or ""
+    if catalogue is not None:
+        try:
+            name = motor_by_number(catalogue, float(q.design["motor"])).designation
+        except Exception:  # a number that is no motor's: the membership row says so
+            return []
+    motor = q.motor_data
+    peak = float(motor.peak_torque)
+    with np.errstate(all="ignore"):
+        demand = float(np.max(np.asarray(q.motor_peak_torque, dtype=float))) if q.motion else None
+    used = f", {100.0 * demand / peak:.3g} % of it used by the motion" if demand else ""
+    text = (
+        f"peak torque of the motor{' ' + name if name else ''}{used}; rotor "
+        f"{float(motor.rotor_inertia) * 10:.4g} kg*cm^2, top speed "
+        f"{float(motor.max_speed) * 60 / (2 * np.pi):.5g} 1/min"
+    )
+    return [Fact("motor", Shown(peak * 1e-3, "N*m"), text)]
 
 
 def objective_facts(problem: Any, objectives: dict[str, float]) -> list[Fact]:

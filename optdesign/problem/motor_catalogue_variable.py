@@ -1,0 +1,125 @@
+"""The motor as a catalogue variable: ``[motor] catalogue = "Yaskawa Sigma-7"`` makes the
+design variable ``motor`` (the motor's number in the catalogue, 1 for the smallest rated
+torque) one more catalogue variable of the branch and bound, beside the screw and the
+pins.
+
+Like the screw's items (:mod:`optdesign.problem.drive`), the motor's data are the
+problem's *parameters* on the solver path: a leaf's motor's own values, and at a
+relaxation node the most favourable values of the motors in the node's box - the least
+rotor inertia where it costs torque or lowers the drive's mode, the largest where it
+divides the load's inertia (the inertia ratio), the largest peak torque, rated torque and
+top speed, the least mass - so that the relaxation stays a valid bound. On the NumPy path
+they are looked up from the design's number (a number that is no motor's gives NaN and
+fails ``motor_catalogue_membership``).
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from typing import Any
+
+import numpy as np
+
+from optdesign.errors import ProblemError
+from optdesign.models.motor_catalogue import ServoMotor, load_motors
+
+#: The motor catalogues a problem may name, and their files (None: the shipped one).
+MOTOR_CATALOGUES: dict[str, str | None] = {"Yaskawa Sigma-7": None}
+
+#: Motor fields that are parameters, with the direction favourable to a relaxation (+1:
+#: the largest value of the node's motors, -1: the least) and the record's attribute.
+MOTOR_FIELDS: dict[str, tuple[int, str]] = {
+    "rotor_inertia": (-1, "rotor_inertia"),
+    "rotor_inertia_max": (+1, "rotor_inertia"),
+    "peak_torque": (+1, "peak_torque"),
+    "rated_torque": (+1, "rated_torque"),
+    "max_speed": (+1, "max_speed"),
+}
+
+#: Prefix of the motor's parameters (``param:motor_peak_torque``...).
+PREFIX = "motor_"
+
+
+@cache
+def motors(catalogue: str) -> tuple[ServoMotor, ...]:
+    """The catalogue's motors, smallest rated torque first (then by designation): motor
+    number k is ``motors(catalogue)[k - 1]``."""
+    if catalogue not in MOTOR_CATALOGUES:
+        known = ", ".join(MOTOR_CATALOGUES)
+        raise ProblemError(f"motor.catalogue: unknown catalogue {catalogue!r} (known: {known})")
+    rows = load_motors(MOTOR_CATALOGUES[catalogue])
+    return tuple(sorted(rows, key=lambda r: (r.rated_torque, r.designation)))
+
+
+def motor_numbers(catalogue: str) -> list[float]:
+    """The values of the variable ``motor``: 1, 2, ... n."""
+    return [float(k) for k in range(1, len(motors(catalogue)) + 1)]
+
+
+def motor_by_number(catalogue: str, number: float) -> ServoMotor:
+    """Motor number ``number`` of the catalogue."""
+    k = int(round(number))
+    rows = motors(catalogue)
+    if not (1 <= k <= len(rows)) or abs(number - k) > 1e-9:
+        raise ProblemError(f"variables.motor: {number:g} is no motor of {catalogue!r}")
+    return rows[k - 1]
+
+
+def catalogue_of(problem) -> str | None:
+    """The problem's motor catalogue when its motor is a catalogue variable, else None."""
+    motor = problem.spec.motor
+    var = problem.by_name.get("motor")
+    if motor is None or motor.catalogue is None or var is None or not var.discrete:
+        return None
+    return motor.catalogue
+
+
+def parameter_defaults(problem) -> dict[str, float]:
+    """Placeholders (1) of the motor's parameters, replaced by every catalogue solve."""
+    if catalogue_of(problem) is None:
+        return {}
+    return {PREFIX + field: 1.0 for field in MOTOR_FIELDS}
+
+
+def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, float]:
+    """The motor's parameters over the motors whose number lies in ``box["motor"]`` (the
+    variable's bounds when the box leaves it out): exact for one motor, favourable over
+    several. Empty when the box holds no motor."""
+    catalogue = catalogue_of(problem)
+    if catalogue is None:
+        return {}
+    var = problem.by_name["motor"]
+    lo, hi = box.get("motor", (var.lower, var.upper))
+    rows = [r for k, r in enumerate(motors(catalogue), 1) if lo - 1e-9 <= k <= hi + 1e-9]
+    if not rows:
+        return {}
+    out = {}
+    for field, (sign, attribute) in MOTOR_FIELDS.items():
+        values = [float(getattr(r, attribute)) for r in rows]
+        out[PREFIX + field] = max(values) if sign > 0 else min(values)
+    return out
+
+
+def design_values(problem, design: dict[str, Any]) -> tuple[dict[str, Any], Any]:
+    """The motor's fields of ``design`` (parameters on the solver path; looked up from its
+    number on the NumPy path, element-wise) and where the number is a motor's (1.0) or
+    not (0.0; None on the solver path)."""
+    from optdesign.problem.drive import PARAM
+
+    catalogue = catalogue_of(problem)
+    if PARAM + PREFIX + "peak_torque" in design:
+        return {f: design[PARAM + PREFIX + f] for f in MOTOR_FIELDS}, None
+    number = np.asarray(design["motor"], dtype=float)
+    rows = motors(catalogue)
+    out = {f: np.full(number.shape, np.nan) for f in MOTOR_FIELDS}
+    on = np.zeros(number.shape)
+    for idx in np.ndindex(number.shape):
+        k = int(np.rint(number[idx])) if np.isfinite(number[idx]) else 0
+        if not 1 <= k <= len(rows):
+            continue
+        on[idx] = float(abs(number[idx] - k) <= 1e-9)
+        for field, (_, attribute) in MOTOR_FIELDS.items():
+            out[field][idx] = float(getattr(rows[k - 1], attribute))
+    if not number.ndim:
+        return {f: float(v) for f, v in out.items()}, float(on)
+    return out, on
