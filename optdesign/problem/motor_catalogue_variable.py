@@ -58,7 +58,7 @@ def motor_numbers(catalogue: str) -> list[float]:
 
 def motor_by_number(catalogue: str, number: float) -> ServoMotor:
     """Motor number ``number`` of the catalogue."""
-    k = int(round(number))
+    k = int(np.rint(float(number)))
     rows = motors(catalogue)
     if not (1 <= k <= len(rows)) or abs(number - k) > 1e-9:
         raise ProblemError(f"variables.motor: {number:g} is no motor of {catalogue!r}")
