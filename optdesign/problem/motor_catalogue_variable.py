@@ -104,11 +104,10 @@ def design_values(problem, design: dict[str, Any]) -> tuple[dict[str, Any], Any]
     """The motor's fields of ``design`` (parameters on the solver path; looked up from its
     number on the NumPy path, element-wise) and where the number is a motor's (1.0) or
     not (0.0; None on the solver path)."""
-    from optdesign.problem.drive import PARAM
-
     catalogue = catalogue_of(problem)
-    if PARAM + PREFIX + "peak_torque" in design:
-        return {f: design[PARAM + PREFIX + f] for f in MOTOR_FIELDS}, None
+    keys = {f: next(iter(problem.parameter_design({PREFIX + f: 0.0}))) for f in MOTOR_FIELDS}
+    if keys["peak_torque"] in design:
+        return {f: design[key] for f, key in keys.items()}, None
     number = np.asarray(design["motor"], dtype=float)
     rows = motors(catalogue)
     out = {f: np.full(number.shape, np.nan) for f in MOTOR_FIELDS}
