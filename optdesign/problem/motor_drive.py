@@ -396,7 +396,7 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 None,
                 labels,
                 "rad^2/s^2",
-                "squared natural frequency of the fin on the chain, motor held",
+                "natural frequency of the fin on the chain, motor held (the row holds its square)",
                 display=_hz,
                 display_unit="Hz",
             )
@@ -410,7 +410,7 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                     None,
                     labels,
                     "rad^2/s^2",
-                    "squared frequency of the drive's mode, motor free",
+                    "frequency of the drive's own mode, motor free (the row holds its square)",
                     display=_hz,
                     display_unit="Hz",
                 )
