@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 import pytest
-from test_catalogue_ties import _infeasible as _failed
-from test_catalogue_ties import _Problem, _Var  # the stand-in problem of catalogue items
+from studies.test_catalogue_bnb import _infeasible as _failed
+from studies.test_catalogue_bnb import _Problem, _Var  # the stand-in problem of catalogue items
 
 from optdesign.errors import ProblemError
 from optdesign.solvers.result import MultistartInfo, Result

@@ -26,7 +26,7 @@ import pytest
 
 psutil = pytest.importorskip("psutil")
 
-from test_signals import _alive, _env, _group, signal_inside  # noqa: E402  (shared helpers)
+from test_interrupts import _alive, _env, _group, signal_inside  # noqa: E402  (shared helpers)
 
 from optdesign.storage import read_store  # noqa: E402
 

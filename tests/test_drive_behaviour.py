@@ -18,7 +18,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from test_drive import CATALOGUE_CSV, FIN, FIN_DESIGN, HINGE, _dx, _x
+from problem.test_drive import CATALOGUE_CSV, FIN, FIN_DESIGN, HINGE, _dx, _x
 
 from optdesign.errors import ProblemError
 from optdesign.problem import drive, problem_from_dict
@@ -328,7 +328,7 @@ def test_stiffness_description_for_the_duty_cycles_mean_load():
 
 
 def test_back_drive_and_life_without_a_screw_section_are_refused_naming_the_field():
-    from test_drive import _data
+    from problem.test_drive import _data
 
     with pytest.raises(ProblemError) as e:
         problem = problem_from_dict(_data(None, None, back_drive="required"))
@@ -582,7 +582,7 @@ def test_box_has_item():
     assert not drive.box_has_item(problem, {"d0": (13.0, 13.9), "p": (2.0, 10.0)})
     # 25 x 2 and 25 x 5 exist, no lead between: the box's lead ends are its own
     assert not drive.box_has_item(problem, {"d0": (25.0, 25.0), "p": (3.0, 4.0)})
-    from test_drive import _data
+    from problem.test_drive import _data
 
     continuous = problem_from_dict(_data({"kind": "ball"}, {"d0": "20 mm"}))
     assert drive.box_has_item(continuous, {"d0": (13.0, 13.9)})
@@ -624,7 +624,7 @@ def test_screw_data_of_a_catalogue_design_on_the_numpy_path():
 
 
 def test_screw_data_of_a_continuous_screw_and_of_the_legacy_root_diameter():
-    from test_drive import DESIGN, _data
+    from problem.test_drive import DESIGN, _data
 
     def data_of(d):
         problem = problem_from_dict(d)
@@ -659,7 +659,7 @@ def test_efficiencies_of_the_friction_model_and_of_hiwins_design_value():
 
 
 def test_efficiencies_without_a_screw_section_are_the_requirements_constants():
-    from test_drive import DESIGN, _data
+    from problem.test_drive import DESIGN, _data
 
     def of(**req):
         problem = problem_from_dict(_data(None, None, **req))
@@ -737,7 +737,7 @@ def test_nut_stiffness_rule_defaults():
     assert drive.nut_stiffness_rule(_fin().spec) == "load"
     assert drive.nut_stiffness_rule(_fin(drop_screw=["nut_stiffness_rule"]).spec) == "load"
     assert drive.nut_stiffness_rule(_fin({"nut_stiffness_rule": "table"}).spec) == "table"
-    from test_drive import _data
+    from problem.test_drive import _data
 
     continuous = problem_from_dict(_data({"nut_stiffness": "200 N/um"}, {"d0": "20 mm"}))
     assert drive.nut_stiffness_rule(continuous.spec) == "table"
@@ -777,7 +777,7 @@ def test_nut_stiffness_at_the_duty_cycles_mean_load():
 
 
 def test_axial_compliance_keeps_only_the_members_the_file_gives():
-    from test_drive import DESIGN, _data
+    from problem.test_drive import DESIGN, _data
 
     def compliance(screw):
         problem = problem_from_dict(_data(screw, {"d0": "20 mm"}))
@@ -801,7 +801,7 @@ def test_axial_compliance_keeps_only_the_members_the_file_gives():
 
 
 def test_a_continuous_screw_and_the_solver_path_have_no_membership_block():
-    from test_drive import DESIGN, _data
+    from problem.test_drive import DESIGN, _data
 
     screw = {"length": "400 mm", "nut_stiffness": "200 N/um"}
     problem = problem_from_dict(
@@ -835,7 +835,7 @@ def test_a_fit_whose_smooth_clearance_is_zero_keeps_the_ratio_one():
     ("nut", "text"), [({"nut_stiffness": "200 N/um"}, "as given"), ({}, "rigid")]
 )
 def test_stiffness_description_of_a_continuous_screws_nut(nut, text):
-    from test_drive import DESIGN, _data
+    from problem.test_drive import DESIGN, _data
 
     screw = {"length": "400 mm", "check_buckling": False, **nut}
     problem = problem_from_dict(_data(screw, {"d0": "20 mm"}, stiffness_min="10 kN*m/rad"))

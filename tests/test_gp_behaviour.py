@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_signomial_behaviour import _terms, _vars
+from formulations.test_signomial import _terms, _vars
 
 from optdesign.formulations import gp as gpmod
 from optdesign.formulations.gp import (
@@ -508,7 +508,7 @@ def test_the_cvxpy_problem_of_a_constant_objective_is_its_value():
 def test_a_crank_slider_with_its_linkage_fixed_keeps_its_constant_angle_rows_out_of_the_gp():
     """Constant rows are checked, not sent to cvxpy: the transmission angle's 61 rows
     leave no row; the lead and pin rows remain."""
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     data = copy.deepcopy(CS_FIXED)
     data["requirements"]["transmission_angle"] = {"min": "30 deg", "max": "150 deg"}
@@ -537,7 +537,7 @@ def test_an_objective_that_is_zero_at_every_design_is_no_gp_and_auto_takes_the_n
 
 
 def _cs_fixed():
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     return problem_from_dict(copy.deepcopy(CS_FIXED))
 
@@ -599,7 +599,7 @@ def test_a_limit_on_a_non_spread_objective_is_an_upper_bounded_block(fork, monke
 
 def test_a_positive_lower_bound_at_or_below_one_is_a_gp_variable():
     """Only a lower bound <= 0 breaks the log change of variables: 1 mm and 0.5 mm do not."""
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     for lower in (1.0, 0.5):
         data = copy.deepcopy(CS_FIXED)

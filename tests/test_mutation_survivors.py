@@ -307,7 +307,7 @@ def test_a_gp_objective_with_a_negative_term_is_not_a_gp():
     names the term, and cvxpy agrees; the problem's own objective stays a GP."""
     import copy
 
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     from optdesign.formulations.gp import build_gp
 
@@ -491,7 +491,7 @@ def test_a_ratio_ripple_limit_is_not_a_gp_and_the_diagnosis_says_why():
     posynomials over a sum: the GP diagnosis names it as a constraint that is not DGP."""
     import copy
 
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     from optdesign.formulations.gp import build_gp
 
@@ -510,7 +510,7 @@ def test_a_ratio_ripple_limit_is_not_a_gp_and_the_diagnosis_says_why():
 def test_an_objective_the_gp_cannot_trace_is_a_failed_check_not_an_unknown_one():
     import copy
 
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     from optdesign import math as m
     from optdesign.formulations.gp import build_gp
@@ -525,7 +525,7 @@ def test_the_default_clearance_chain_reads_each_fixed_clearance_under_its_key():
     """A mechanism with the default chain (screw bearings A, screw/nut B, output shaft O):
     the file's clearances reach the backlash, c / (dx/dphi) rad each on the screw's line;
     for the yoke x = R sin(phi), dx/dphi = R cos(phi)."""
-    from test_framework import yoke_data
+    from test_api import yoke_data
 
     from optdesign import math as m
 
@@ -617,7 +617,7 @@ def test_a_design_independent_ripple_limit_is_checked_by_the_gp_against_its_valu
     named as the infeasible requirement at 0.2."""
     import copy
 
-    from test_gp import CS_FIXED
+    from formulations.test_gp import CS_FIXED
 
     from optdesign.formulations.gp import build_gp
 
