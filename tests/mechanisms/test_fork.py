@@ -9,9 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from optdesign.errors import AssemblyError
-from optdesign.mechanisms import PinJoint
-from optdesign.mechanisms.fork import ShiftingFork
+from optdesign.errors import AssemblyError, InputError
+from optdesign.mechanisms import PinJoint, ShiftingFork
 
 R, PHI0 = 60.0, 0.1
 PHI = np.radians(np.linspace(-30.0, 30.0, 7))
@@ -133,3 +132,21 @@ def test_the_declarations_and_the_benchmarks_template():
         "fork_front": ("backlash", "size"),
     }
     assert (ShiftingFork.name, ShiftingFork.title) == ("fork", "shifting fork")
+
+
+def test_fork_slot_backlash():
+    fork = ShiftingFork(R=90, p=5, i_a=2)
+    phi = np.radians(np.linspace(-30, 30, 61))
+    pin = PinJoint(12, 18, "H7/g6")
+    b = fork.backlash(phi, [j for j in fork.joints(phi, 500e3, pin) if j.pin is not None])
+    F = 500e3 * np.cos(phi) / 90
+    np.testing.assert_allclose(
+        b.worst_case, np.degrees(pin.clearance(F) * np.cos(phi) / 90), rtol=1e-12
+    )
+    # worst at 0 deg where the pin is nearest and the load largest
+    assert np.argmax(b.worst_case) == 30
+
+
+def test_fork_zero_lead_rejected():
+    with pytest.raises(InputError, match=r"^p:"):
+        ShiftingFork(R=90, p=0.0, i_a=2)

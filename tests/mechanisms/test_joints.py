@@ -332,3 +332,12 @@ def test_a_wrong_count_of_fit_draws_is_refused_naming_both_counts():
     assert "1 fit draws for 2 pin joints" in str(err.value)
     with pytest.raises(InputError, match="3 fit draws for 2 pin joints"):
         with_sampled_fits(chain, [0.5, 0.5, 0.5])
+
+
+# Clearance chains against brute-force re-assembly, and errors that name the field.
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.5, -0.1, 0.7])
+def test_poisson_ratio_out_of_range(nu):
+    with pytest.raises(InputError, match=r"pin\.nu"):
+        PinJoint(10, 15, nu=nu)

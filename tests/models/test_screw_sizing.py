@@ -1,5 +1,9 @@
 """Ball-screw sizing (physics.md 8): the catalogue examples and the constraint forms."""
 
+import math
+import tomllib
+from pathlib import Path
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -8,6 +12,8 @@ from hypothesis import strategies as st
 
 from optdesign.errors import InputError
 from optdesign.models import screw, screw_sizing
+from optdesign.models import screw_sizing as sizing
+from optdesign.problem import load_problem, problem_from_dict
 
 
 def test_buckling_catalogue_example():
@@ -196,3 +202,110 @@ def test_fixed_fixed_stiffness_is_least_at_mid_span(x):
     k = screw_sizing.shaft_stiffness(16.0, L, "fixed-fixed", x=x * L)
     assert k >= screw_sizing.shaft_stiffness(16.0, L, "fixed-fixed") * (1 - 1e-12)
     assert k > screw_sizing.shaft_stiffness(16.0, L, "fixed-supported", x=x * L)
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+FIN = ROOT / "problems" / "fin_actuator.toml"
+
+
+#: The shipped fin_actuator optimum (docs/drive.md section 6).
+OPT = dict(R=105.571, l=59.7942, n=102.087, phi0=math.radians(13.132), d0=25.0, p=5.0, d=6.0)
+
+
+def _x(R, l, n, phi0, phi):
+    """Crank-slider nut abscissa, seed 000 eq. 2, written out (mm)."""
+    a = phi + phi0
+    return R * np.sin(a) - np.sqrt(l**2 - (R * np.cos(a) - n) ** 2)
+
+
+def _dx(R, l, n, phi0, phi, h=1e-6):
+    return (_x(R, l, n, phi0, phi + h) - _x(R, l, n, phi0, phi - h)) / (2 * h)
+
+
+def _fin(**changes):
+    data = tomllib.loads(FIN.read_text())
+    for section, values in changes.items():
+        data[section].update(values)
+    return problem_from_dict(data)
+
+
+# --- nut stiffness ---------------------------------------------------------------------------
+def test_nut_stiffness_formulas_of_the_catalogue():
+    """F 3.35: 0.8 K at the reference load 0.28 Ca, growing as the cube root of the load;
+    F 3.34: 0.8 K at the catalogue's preload of 0.1 Ca."""
+    K, Ca = 480e3, 17730.0  # R25-5T6-FSI: 480 N/um, Ca 17 730 N
+    assert sizing.nut_stiffness_at_load(K, Ca, 0.28 * Ca) == pytest.approx(384e3, rel=1e-12)
+    # at the load the table is calculated for (30 % of Ca) the rule gives 0.8186 K
+    assert sizing.nut_stiffness_at_load(K, Ca, -0.3 * Ca) / K == pytest.approx(
+        0.8 * (0.3 / 0.28) ** (1 / 3), rel=1e-12
+    )
+    assert sizing.nut_stiffness_at_load(K, Ca, 0.28 * Ca / 8) == pytest.approx(192e3)
+    assert sizing.nut_stiffness_preloaded(K, Ca, 0.1 * Ca) == pytest.approx(384e3)
+    assert sizing.nut_stiffness_preloaded(K, Ca, 0.0125 * Ca) == pytest.approx(192e3)
+    with pytest.raises(InputError, match="Ca"):
+        sizing.nut_stiffness_at_load(K, 0.0, 1000.0)
+
+
+# --- mounting factors --------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "mounting, fk, fn",
+    [
+        ("fixed-fixed", 1.0, 1.0),
+        ("fixed-supported", 0.5, 0.692),
+        ("supported-supported", 0.25, 0.446),
+        ("fixed-free", 0.0625, 0.147),
+    ],
+)
+def test_hiwin_buckling_and_critical_speed_by_mounting(mounting, fk, fn):
+    """HIWIN F 3.25-3.28 with its printed constants and factors f_k, f_n: F_kmax =
+    0.5 x 4.072e5 f_k dk^4 / ls^2 and n_kmax = 0.8 x 2.71e8 f_n dk / ls^2."""
+    dk, ls = 22.32, 300.0
+    P = 0.5 * 4.072e5 * fk * dk**4 / ls**2
+    N = 0.8 * 2.71e8 * fn * dk / ls**2
+    assert sizing.buckling_load(dk, ls, mounting, rule="HIWIN") == pytest.approx(P, rel=1e-12)
+    assert sizing.critical_speed(dk, ls, mounting, rule="HIWIN") == pytest.approx(N, rel=1e-12)
+    # the default (conservative) never exceeds HIWIN's nor the common rounded factors
+    for rule in ("HIWIN", "common"):
+        assert sizing.buckling_load(dk, ls, mounting) <= sizing.buckling_load(
+            dk, ls, mounting, rule=rule
+        )
+        assert sizing.critical_speed(dk, ls, mounting) <= sizing.critical_speed(
+            dk, ls, mounting, rule
+        )
+    # the common factors agree with HIWIN's within 1.8 %, except fixed-free
+    common_b = sizing.buckling_load(dk, ls, mounting, rule="common") / P
+    common_n = sizing.critical_speed(dk, ls, mounting, "common") / N
+    if mounting == "fixed-free":
+        assert common_b == pytest.approx(1.3 / 1.2725, rel=1e-12)  # +2.2 %, unsafe side
+        assert common_n == pytest.approx(3.4 / 3.18696, rel=1e-12)  # +6.7 %
+        assert sizing.BUCKLING_FACTOR[mounting] == pytest.approx(1.2725)
+        assert sizing.CRITICAL_SPEED_FACTOR[mounting] == pytest.approx(3.18696)
+    else:
+        assert abs(common_b - 1) < 0.018 and abs(common_n - 1) < 0.018
+    with pytest.raises(InputError, match="rule"):
+        sizing.critical_speed(dk, ls, mounting, "THK")
+
+
+# --- DN rules ------------------------------------------------------------------------------------
+def test_dn_rules_name_the_diameter_and_the_limit():
+    assert sizing.dn_rule("HIWIN", "ground") == ("nominal", 90_000.0)
+    assert sizing.dn_rule("HIWIN", "rolled") == ("nominal", 70_000.0)
+    assert sizing.dn_rule("ball-centre", "ground") == ("ball-centre", 70_000.0)
+    assert sizing.dn_rule("ball-centre", "high-speed") == ("ball-centre", 70_000.0)
+    with pytest.raises(InputError, match="dn_rule"):
+        sizing.dn_rule("NSK", "ground")
+    # the default is the conservative rule: 70 000 for the fin_actuator's ground screw
+    problem = load_problem(FIN)
+    ev = problem.evaluate(np.array([OPT[x.name] for x in problem.free]))
+    assert ev.constraints["dn"].upper == 70_000.0
+    R, l, n, phi0 = OPT["R"], OPT["l"], OPT["n"], OPT["phi0"]
+    v = np.abs(_dx(R, l, n, phi0, np.radians(np.linspace(-30, 30, 61))))
+    dn = 25.0 * (v * math.radians(120.0) / 5.0 * 60.0).max()
+    assert np.max(ev.constraints["dn"].values) == pytest.approx(dn, rel=1e-6)
+    assert dn / 70_000.0 == pytest.approx(0.9904, abs=1e-4)  # 99 % of the limit
+    hiwin = _fin(requirements={"dn_rule": "HIWIN"})
+    assert hiwin.evaluate(np.array([OPT[x.name] for x in hiwin.free])).constraints[
+        "dn"
+    ].upper == pytest.approx(90_000.0)
