@@ -65,7 +65,7 @@ def _tests_in(path: Path) -> set[str]:
 
 
 ALL_TESTS = {name for f in (ROOT / "tests").rglob("*.py") for name in _tests_in(f)} | {
-    f.stem for f in (ROOT / "tests").glob("test_*.py")
+    f.stem for f in (ROOT / "tests").rglob("test_*.py")
 }
 
 

@@ -9,7 +9,7 @@ holds no ``<``, ``>``, ``&``, U+2028/U+2029; CSV is written by the csv module wi
 formula-leading text cells prefixed by ``'``; plots draw ``$`` literally; JSON writes
 ``null`` for a value that is not finite. Each is checked in the default output mode, with
 ``--json`` and through the Python API. The page in a real browser:
-tests/test_report_browser.py.
+tests/reports/test_html_page.py.
 """
 
 from __future__ import annotations
@@ -307,7 +307,7 @@ def hostile_front():
 
     problem = _hostile_objective_problem()
     # A method's name names its store file, so it must be a plain file name
-    # (tests/test_file_safety.py); the CSV test gives the front a hostile one afterwards.
+    # (tests/test_safe_io.py); the CSV test gives the front a hostile one afterwards.
     method = EpsilonConstraint(points=3, starts=1, name="method-1")
     return problem, od.pareto(problem, ["backlash", OBJ], method=method, workers=1)
 

@@ -14,8 +14,9 @@ import time
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
-from hostile_corpus import dumps
+from hostile_corpus import PROBLEMS, dumps
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from units_corpus import (
@@ -35,7 +36,8 @@ from units_corpus import (
 import optdesign as od
 from optdesign import units
 from optdesign.cli import main
-from optdesign.errors import InputError
+from optdesign.errors import InputError, OptDesignError
+from optdesign.problem import load_problem
 from optdesign.units import (
     FAST_UNITS,
     INTERNAL_UNITS,
@@ -785,3 +787,174 @@ def test_documented_quantities_read_as_pint_reads_them():
         assert to_internal(text, dimension, "f") == pytest.approx(
             _pint_value(text, dimension), rel=1e-14
         ), text
+
+
+# --- units ------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("written", "suggested"),
+    [
+        ("999999999999999 s", '"999999999999999 mm"'),
+        ("1e15 s", '"1000000000000000.0 mm"'),
+        ("-1e15 s", '"-1000000000000000.0 mm"'),
+        ("2.5 s", '"2.5 mm"'),
+    ],
+)
+def test_a_wrong_dimension_suggests_the_number_whole_below_1e15_and_as_a_float_from_it(
+    written, suggested
+):
+    with pytest.raises(InputError) as caught:
+        units.to_internal(written, "length", "f")
+    assert str(caught.value) == (
+        f"f: {written!r} is a time, expected a length (write e.g. {suggested})"
+    )
+
+
+EXAMPLES = '(e.g. "N*mm", "rad/s"; "" for a plain number)'
+
+
+def _refusal(call, *args) -> str:
+    with pytest.raises(InputError) as caught:
+        call(*args)
+    return str(caught.value)
+
+
+# --- units: every refusal names its field and says why ----------------------------------
+@pytest.mark.parametrize(
+    ("unit", "message"),
+    [
+        (5, 'f.unit: a unit is a string such as "N*mm", got 5'),
+        ("m" * 101, "f.unit: too long for a unit (101 characters)"),
+        # 100 characters is not too long: the grammar reads it (and finds no such unit)
+        ("m" * 100, f"f.unit: cannot read '{'m' * 100}' as a unit: unknown unit '{'m' * 100}'"),
+        ("N*foo", f"f.unit: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+        ("N**", "f.unit: cannot read 'N**' as a unit: a power must be a whole number"),
+    ],
+)
+def test_parse_unit_refusals_name_the_field_and_the_reason(unit, message):
+    assert _refusal(units.parse_unit, unit, "f.unit").startswith(message)
+
+
+@pytest.mark.parametrize(
+    ("value", "unit", "message"),
+    [
+        (
+            "5 N*m",
+            "N*mm/rad",
+            "c.upper: '5 N*m' is a moment, expected a moment per angle ('N*mm/rad')",
+        ),
+        ("5 N*m", "", "c.upper: '5 N*m' is a moment, expected a plain number"),
+        (
+            "5 xyz",
+            "N",
+            "c.upper: cannot read '5 xyz' as a quantity: unknown unit 'xyz' (write a number "
+            'and a unit, e.g. "500 N*m"; no arithmetic)',
+        ),
+        ("1e308 kN", "N", "c.upper: '1e308 kN' is out of range"),
+        (float("nan"), "N", "c.upper: nan is not a finite number"),
+        (5, "N*foo", f"c.upper: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+    ],
+)
+def test_convert_refusals_name_the_field_and_the_reason(value, unit, message):
+    assert _refusal(units.convert, value, unit, "c.upper") == message
+
+
+def test_convert_reads_strings_and_pint_quantities_in_the_target_unit():
+    registry = units.registry()
+    assert units.convert("2 kN", "N", "c") == 2000.0
+    assert units.convert(registry.Quantity(3.0, "deg"), "rad", "c") == pytest.approx(
+        math.radians(3.0), rel=1e-15
+    )
+    assert units.convert(7, "N", "c") == 7.0  # a bare number: already in the unit
+
+
+def test_convert_refuses_pint_quantities_that_are_not_one_finite_number():
+    registry = units.registry()
+    vector = registry.Quantity(np.array([1.0, 2.0]), "N")
+    assert _refusal(units.convert, vector, "N", "c.upper") == (
+        f"c.upper: expected a scalar quantity, got {vector!r}"
+    )
+    infinite = registry.Quantity(float("inf"), "N")
+    assert _refusal(units.convert, infinite, "N", "c.upper") == (
+        f"c.upper: {infinite!r} is not a finite number"
+    )
+
+
+def test_an_object_with_units_that_is_not_pints_is_no_quantity():
+    class LooksLikeAQuantity:
+        units = "N"
+        magnitude = 1.0
+
+    value = LooksLikeAQuantity()
+    assert _refusal(units.convert, value, "N", "c.upper") == (
+        f"c.upper: expected a number or a quantity string, got {value!r}"
+    )
+
+
+@pytest.mark.parametrize(
+    ("unit", "to", "message"),
+    [
+        (
+            "N*mm",
+            "N*m/deg",
+            "d.unit: 'N*m/deg' is a moment per angle and 'N*mm' a moment: a unit of the "
+            "same dimension is needed",
+        ),
+        (
+            "",
+            "N",
+            "d.unit: 'N' is a force and no unit a plain number: a unit of the same dimension is needed",
+        ),
+        (
+            "N",
+            "",
+            "d.unit: no unit is a plain number and 'N' a force: a unit of the same dimension is needed",
+        ),
+        ("N", "N*foo", f"d.unit: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+        ("N*foo", "N", f"d.unit: cannot read 'N*foo' as a unit: unknown unit 'foo' {EXAMPLES}"),
+    ],
+)
+def test_unit_factor_refusals_name_the_field(unit, to, message):
+    assert _refusal(units.unit_factor, unit, to, "d.unit") == message
+
+
+def test_unit_factor_values():
+    assert units.unit_factor("kN", "N", "d") == 1000.0
+    assert units.unit_factor("deg", "rad", "d") == pytest.approx(math.pi / 180, rel=1e-15)
+
+
+def test_parse_quantity_names_the_quantity():
+    assert _refusal(units.parse_quantity, "5 foo").startswith(
+        "quantity: cannot read '5 foo' as a quantity: unknown unit 'foo'"
+    )
+
+
+BASE = (PROBLEMS / "cs_min_backlash.toml").read_text()
+
+
+# --- input that helps (issue 16) -------------------------------------------------------
+def _load(tmp_path: Path, old: str, new: str):
+    assert old in BASE
+    f = tmp_path / "p.toml"
+    f.write_text(BASE.replace(old, new, 1))
+    return load_problem(f)
+
+
+def test_bare_number_refused_with_the_unit_to_write(tmp_path):
+    with pytest.raises(OptDesignError) as exc:
+        _load(tmp_path, 'hinge_moment = "500 N*m"', "hinge_moment = 300")
+    assert str(exc.value).endswith('requirements.hinge_moment: 300 has no unit; write "300 N*m"')
+    with pytest.raises(OptDesignError, match=r'variables.R.lower: 30 has no unit; write "30 mm"'):
+        _load(tmp_path, 'lower = "30 mm"', "lower = 30")
+
+
+@pytest.mark.parametrize("spelling", ["500 Nm", "0.5 kNm", "500 N.m", "500 N-m", "500 N m"])
+def test_common_moment_spellings(tmp_path, spelling):
+    # 500 N*m = 5e5 N*mm (internal unit).
+    p = _load(tmp_path, 'hinge_moment = "500 N*m"', f'hinge_moment = "{spelling}"')
+    assert p.spec.requirements.hinge_moment == pytest.approx(5e5)
+
+
+def test_hyphen_only_joins_unit_names():
+    assert to_internal("2 lbf-ft", "moment", "m") == pytest.approx(2 * 4.4482216 * 304.8, rel=1e-6)
+    with pytest.raises(OptDesignError):
+        to_internal("5 mm-2", "length", "x")  # not a power, not a product

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import optdesign as od
 from formulations.test_signomial import _terms, _vars
 from optdesign.errors import ProblemError
 from optdesign.formulations import gp as gpmod
@@ -356,7 +357,6 @@ def test_auto_decides_with_the_chosen_objective():
     sum): ``auto`` with ``objective="backlash_rss"`` takes the NLP, where it used to
     pick gp and refuse "not a geometric program"."""
 
-    import optdesign as od
     from optdesign.studies.formulation_registry import choose_formulation
 
     problem = od.load(FORK)
@@ -417,7 +417,7 @@ def test_a_bound_that_puts_a_sum_of_terms_above_a_constant_is_named_with_its_sid
 # Issue 21 (mutation deliverable): every value, name and message that
 # :mod:`optdesign.formulations.gp` produces - each branch of a row's classification, the
 # pruning, the diagnosis, the fork's rows, the cvxpy problem - against hand computations or
-# the NumPy model. The signomial tracer is pinned in ``test_signomial_behaviour.py``.
+# the NumPy model. The signomial tracer is pinned in ``test_signomial.py``.
 
 
 def _row(terms: dict, name: str = "blk") -> GPRow:
@@ -908,7 +908,6 @@ def test_a_crank_slider_with_its_linkage_fixed_keeps_its_constant_angle_rows_out
 def test_an_objective_that_is_zero_at_every_design_is_no_gp_and_auto_takes_the_nlp(fork):
     """The fork has no drive: its drive_loss is 0 whatever the design. The GP refuses it
     (cvxpy's min t over no row was reported "failed: unbounded"); auto solves the NLP."""
-    import optdesign as od
 
     gp = build_gp(fork, "drive_loss")
     check = next(c for c in gp.checks if c.what == "objective")
@@ -1017,3 +1016,81 @@ def test_a_spread_objective_that_depends_on_the_design_is_not_dgp():
         "divided by a sum is not log-log convex"
     )
     assert gp.objective_rows == []
+
+
+# --- survivors of the sampled mutation run of issue 21 (docs/testing.md) -----------------
+def test_a_gp_objective_with_a_negative_term_is_not_a_gp():
+    """A user objective that is a signomial (12 mm - p): the GP diagnosis refuses it,
+    names the term, and cvxpy agrees; the problem's own objective stays a GP."""
+    import copy
+
+    from optdesign.formulations.gp import build_gp
+
+    problem = problem_from_dict(copy.deepcopy(CS_FIXED))
+    problem.add_objective("lead_margin", lambda q: 12.0 - q.design["p"], unit="mm")
+    gp = build_gp(problem, "lead_margin")
+    check = {c.name: c for c in gp.checks}["lead_margin"]
+    assert not gp.is_gp and check in gp.failures() and check.what == "objective"
+    assert check.reason == "lead_margin[] has a negative term: -p + 12 (a signomial)"
+    assert check.cvxpy_is_dgp is False
+    assert build_gp(problem, "backlash").is_gp
+
+
+def test_a_ratio_ripple_limit_is_not_a_gp_and_the_diagnosis_says_why():
+    """ripple_max bounds (max - min)/(max + min) over the grid, a difference of
+    posynomials over a sum: the GP diagnosis names it as a constraint that is not DGP."""
+    import copy
+
+    from optdesign.formulations.gp import build_gp
+
+    data = copy.deepcopy(CS_FIXED)
+    data["requirements"]["ripple_max"] = 0.2
+    data["variables"]["R"] = {"lower": 60, "upper": 120}  # the ratio's shape depends on R
+    gp = build_gp(problem_from_dict(data))
+    check = {c.name: c for c in gp.checks}["ripple_max"]
+    assert (check.what, check.ok, check.cvxpy_is_dgp) == ("constraint", False, False)
+    assert check.reason == (
+        "ripple = (max - min)/(max + min) over the grid is a ratio of a difference of posynomials"
+    )
+    assert not gp.is_gp and check in gp.failures()
+
+
+def test_an_objective_the_gp_cannot_trace_is_a_failed_check_not_an_unknown_one():
+    import copy
+
+    from optdesign import math as m
+    from optdesign.formulations.gp import build_gp
+
+    problem = problem_from_dict(copy.deepcopy(CS_FIXED))
+    problem.add_objective("wavy", lambda q: m.sin(q.design["p"]), unit="")
+    check = next(c for c in build_gp(problem, "wavy").checks if c.what == "objective")
+    assert check.name == "wavy" and check.ok is False and check.reason
+
+
+def test_a_design_independent_ripple_limit_is_checked_by_the_gp_against_its_value():
+    """With the linkage fixed the ripple does not depend on the design: the GP checks
+    ripple_max against the value itself (the NumPy model's at any design) - met at 0.3,
+    named as the infeasible requirement at 0.2."""
+    import copy
+
+    from optdesign.formulations.gp import build_gp
+
+    ripple = None
+    for limit, lead in ((0.3, None), (0.2, None), (0.2, 5.0)):
+        data = copy.deepcopy(CS_FIXED)
+        data["requirements"]["ripple_max"] = limit
+        if lead is not None:  # the ratio then depends on no free variable at all
+            data["variables"]["p"] = lead
+        problem = problem_from_dict(data)
+        if ripple is None:
+            q = problem.quantities(problem.design_dict(problem.midpoint()))
+            ratio = np.asarray(q.ratio, dtype=float).ravel()
+            ripple = (ratio.max() - ratio.min()) / (ratio.max() + ratio.min())
+            assert ripple == pytest.approx(0.238162, abs=1e-6)
+        gp = build_gp(problem)
+        assert gp.is_gp and "ripple_max" not in {c.name for c in gp.checks}
+        expected = [] if limit > ripple else [f"ripple = {ripple:.6g} > ripple_max = 0.2"]
+        assert gp.infeasible == expected
+        # the ripple as the objective: a constant, the GP a feasibility check
+        check = next(c for c in build_gp(problem, "ripple").checks if c.what == "objective")
+        assert (check.ok, check.reason) == (True, f"constant {ripple:.6g} (design-independent)")

@@ -5,7 +5,7 @@ Issue 21 (mutation deliverable): every array, name and message that
 units, the auxiliary variables and their starts, the targets and their scales, the
 epsilon rows, the bounds of a solve, the starts, the refusals - against the NumPy path
 of the same problem (:meth:`DesignProblem.expressions` / :meth:`DesignProblem.evaluate`)
-and hand formulas. The robust formulation is pinned in ``test_robust_behaviour.py``.
+and hand formulas. The robust formulation is pinned in ``test_robust.py``.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import (
     VAR,
@@ -28,6 +29,7 @@ from optdesign.formulations.nlp import (
     typical,
 )
 from optdesign.problem import load_problem, problem_from_dict
+from optdesign.problem.load import load
 
 ROOT = Path(__file__).resolve().parents[2]
 CS = ROOT / "problems" / "cs_min_backlash.toml"
@@ -457,3 +459,58 @@ def test_a_variables_target_scale_is_its_middles_magnitude_even_below_one():
     assert nlp.targets[3:5] == ["var:n", "var:p"]
     assert nlp.target_scales[3] == pytest.approx(0.25, rel=1e-12)
     assert nlp.target_scales[5] == pytest.approx(0.2, rel=1e-12)
+
+
+PROBLEMS = ROOT / "problems"
+
+
+# --- NLP rows: both bounds scaled by the row's divisor -------------------------------------
+def test_nlp_rows_are_scaled_on_both_sides():
+    from optdesign.studies.nlp_solve import formulation_for
+
+    problem = od.load(PROBLEMS / "cs_min_backlash.toml")
+    nlp = formulation_for(problem)
+    names = list(nlp.g_names)
+    # requirements of the file, in internal units (mm, MPa, dimensionless)
+    limits = {
+        "nut_travel": (None, 110.0),
+        "pin_bearing_pressure": (None, 100.0),
+        "pin_shear_stress": (None, 200.0),
+        "mean_ratio": (200.0, 260.0),
+    }
+    seen = set()
+    for k, name in enumerate(names):
+        base = name.split("[")[0]
+        if base not in limits:
+            continue
+        seen.add(base)
+        lo, hi = limits[base]
+        scale = float(nlp.g_scale[k])
+        assert scale > 1.0, name  # a divisor that is not 1: an unscaled bound would show
+        if hi is not None:
+            assert float(nlp.ubg[k]) * scale == pytest.approx(hi, rel=1e-12), name
+        if lo is not None:
+            assert float(nlp.lbg[k]) * scale == pytest.approx(lo, rel=1e-12), name
+    assert seen == set(limits)
+
+
+def test_an_nlp_of_one_objective_named_by_a_string_holds_that_objective():
+    from optdesign.formulations.nlp import build_nlp
+
+    fork = load(ROOT / "problems" / "fork_min_backlash.toml")
+    assert list(build_nlp(fork, "size").objective_values) == ["size"]
+    assert list(build_nlp(fork, ["size", "backlash"]).objective_values) == ["size", "backlash"]
+
+
+def test_an_epsilon_bound_on_a_quantity_the_formulation_lacks_is_refused_naming_them():
+    from optdesign.errors import ProblemError
+    from optdesign.problem import load_problem
+    from optdesign.studies.nlp_solve import formulation_for
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
+    nlp = formulation_for(problem, ("backlash", "ripple"))
+    with pytest.raises(ProblemError) as caught:
+        nlp.bounds(eps={"size": 1.0})
+    assert str(caught.value) == (
+        "epsilon bound on 'size': not an objective of this formulation (backlash, ripple)"
+    )

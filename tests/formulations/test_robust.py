@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
+from types import SimpleNamespace
 
 import casadi as ca
 import numpy as np
@@ -270,7 +271,7 @@ def test_the_robust_nlp_is_finite_everywhere_inside_the_bounds(problem):
 # per-sample epigraph rows and variables, the risk measures (CVaR, mean + k std) and
 # their starts, the nominal target, the refusals - against a NumPy recomputation from the
 # same draws (:meth:`DesignProblem.expressions` with the sampled fit fractions) and hand
-# formulas. The nominal NLP is pinned in ``test_nlp_behaviour.py``.
+# formulas. The nominal NLP is pinned in ``test_nlp.py``.
 
 
 X = np.array([107.2, 54.3, 102.9, 5.16, 0.205, 5.74])
@@ -785,3 +786,45 @@ def test_a_requirement_bound_below_one_is_its_own_scale_in_every_sample(samples)
     assert nlp.ubg[rows].tolist() == [1.0] * (S + 1) and nlp.lbg[rows].tolist() == [-np.inf] * (
         S + 1
     )
+
+
+def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
+    """``build_robust_nlp(..., risk=...)`` (od.solve's robust formulation with a risk of
+    the caller's): the caller's measure is minimised, the file's only by default."""
+    from optdesign.formulations.robust import build_robust_nlp
+    from optdesign.problem import load_problem
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")  # risk = "cvar"
+    assert build_robust_nlp(problem).default_target == "CVaR_0.9(backlash)"
+    assert build_robust_nlp(problem, risk="mean_std").default_target == "mean+2std(backlash)"
+    # and the caller's k of mean + k std, and alpha of CVaR, over the file's (2 and 0.9)
+    assert build_robust_nlp(problem, risk="mean_std", k=3.0).default_target == (
+        "mean+3std(backlash)"
+    )
+    assert build_robust_nlp(problem, alpha=0.8).default_target == "CVaR_0.8(backlash)"
+
+
+def test_a_robust_nlp_of_no_sample_is_refused_naming_the_field():
+
+    from optdesign.errors import ProblemError
+    from optdesign.formulations.robust import build_robust_nlp
+    from optdesign.problem import load_problem
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")
+    with pytest.raises(ProblemError) as caught:
+        build_robust_nlp(problem, samples=SimpleNamespace(n=0))
+    assert str(caught.value) == "tolerances.samples: need at least one sample"
+
+
+def test_a_robust_ripple_names_every_samples_envelope_variables():
+    """A spread objective (the ratio ripple) under scatter: two envelope variables per
+    sample, each named, as many names as auxiliary variables."""
+    from optdesign.formulations.robust import build_robust_nlp, draw_samples
+    from optdesign.problem import load_problem
+
+    problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")
+    samples = draw_samples(problem, 3, 0)
+    nlp = build_robust_nlp(problem, "ripple", samples=samples)
+    assert nlp.z.shape[0] == nlp.n_design + len(nlp.aux_names)
+    for s in range(3):
+        assert {f"ripple_lo[s{s}]", f"ripple_hi[s{s}]"} <= set(nlp.aux_names)

@@ -3,7 +3,7 @@
 Issue 21 (mutation deliverable): the terms, texts and refusals of
 :mod:`optdesign.formulations.signomial` - construction, arithmetic, powers, ``abs``, the
 NumPy protocol and grid reductions - against hand computations. The GP builder that
-reads them is pinned in ``test_gp_behaviour.py``.
+reads them is pinned in the GP part of ``test_gp.py``.
 """
 
 from __future__ import annotations

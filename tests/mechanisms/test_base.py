@@ -10,6 +10,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign import math as m
 from optdesign.errors import AssemblyError, InputError
 from optdesign.mechanisms.base import (
@@ -369,3 +370,48 @@ def test_the_automatic_derivative_refuses_values_it_cannot_see_through():
         r"CasADi or NumPy values; write nut_velocity in closed form to trace it \(GP diagnosis\)",
     ):
         lev.nut_velocity(PHI)
+
+
+def test_the_default_clearance_chain_reads_each_fixed_clearance_under_its_key():
+    """A mechanism with the default chain (screw bearings A, screw/nut B, output shaft O):
+    the file's clearances reach the backlash, c / (dx/dphi) rad each on the screw's line;
+    for the yoke x = R sin(phi), dx/dphi = R cos(phi)."""
+    from test_api import yoke_data
+
+    from optdesign import math as m
+
+    class ChainYoke(od.Mechanism):
+        name = "t21_chain_yoke"
+        variables = {"R": od.VariableInfo("length", "crank radius")}  # noqa: RUF012
+        pin_joints = ("crank pin",)
+
+        def nut_position(self, phi):
+            return self.R * m.sin(phi)
+
+    od.register_mechanism(ChainYoke, replace=True)
+    data = yoke_data("t21_chain_yoke")
+    data["clearances"] = {"A": "0.02 mm", "B": "0.01 mm", "O": "0.005 deg"}
+    problem = od.load(data)
+    R = 80.0
+    backlash = problem.quantities({"R": R, "p": 5.0, "i_a": 2.0}).backlash
+    phi = np.asarray(problem.phi)
+    expected = np.degrees(0.03 / (R * np.cos(phi))) + 0.005
+    assert np.asarray(backlash.worst_case, dtype=float).ravel() == pytest.approx(expected, rel=1e-9)
+    assert sorted(backlash.per_joint) == ["A screw bearings", "B screw/nut", "O output shaft"]
+
+
+def test_a_mechanism_without_its_kinematics_or_pins_says_what_to_write():
+    import optdesign as od
+    from optdesign.errors import InputError
+
+    class Bare(od.Mechanism):
+        name = "t32_bare"
+        variables = {"R": od.VariableInfo("length", "lever")}  # noqa: RUF012
+
+    bare = Bare(R=50.0, p=5.0)
+    with pytest.raises(NotImplementedError, match=r"^Bare must define nut_position\(phi\)$"):
+        bare.nut_position(0.1)
+    with pytest.raises(InputError) as caught:
+        bare.joints(np.zeros(3), 1.0e5, None)
+    assert caught.value.field == "pin_joints"
+    assert caught.value.reason.endswith("declares no pins: set pin_joints or write joints()")

@@ -1,11 +1,14 @@
 """Kinematics checked against independent computations: CasADi derivatives vs finite
 differences of the position equations, loop closure, virtual work, symmetry."""
 
+import math
+
 import casadi as ca
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from independent_physics import _fd, cs_loop
 from scipy.optimize import brentq
 
 from optdesign.errors import AssemblyError, InputError
@@ -200,3 +203,248 @@ def test_non_physical_inputs_name_the_field(kwargs, field):
     with pytest.raises(InputError) as exc:
         CrankSlider(**args)
     assert exc.value.field == field
+
+
+def test_crank_slider_ratio_from_finite_differences_of_the_loop():
+    # The nut pin C = (m, n) on the screw's line at distance n from O; the arm pin B at
+    # angle a = phi0 + phi from the normal to that line; rod |BC| = l. Solve the loop for
+    # m (the nut on the near side of B) and differentiate by central differences.
+    R, l, n, phi0, p, i_a = 90.0, 80.0, 50.0, 0.3, 5.0, 2.0
+
+    def m_of(phi):
+        return cs_loop(phi, R, l, n, phi0)[1][0]
+
+    mech = CrankSlider(R=R, l=l, n=n, phi0=phi0, p=p, i_a=i_a)
+    for phi in (-0.2, 0.0, 0.25):
+        v = _fd(m_of, phi)
+        i_num = abs(2 * math.pi * i_a * v / p)
+        # the ratio's sign convention is the mechanism's; the magnitude is geometry
+        assert abs(float(mech.ratio(phi))) == pytest.approx(i_num, rel=1e-6), phi
+
+
+# --- the crank-slider mechanism, against the loop solved here ------------------------------
+CS = {"R": 90.0, "l": 80.0, "n": 50.0, "phi0": 0.2, "p": 5.0, "i_a": 2.0}
+
+
+def _phi_holding_nut(m_target, n, guess, l=80.0):
+    """Output angle at which the loop closes with the nut at m_target (secant)."""
+    x0, x1 = guess, guess + 1e-3
+    f = lambda p: cs_loop(p, n=n, l=l)[1][0] - m_target  # noqa: E731
+    for _ in range(60):
+        f0, f1 = f(x0), f(x1)
+        if f1 == f0:
+            break
+        x0, x1 = x1, x1 - f1 * (x1 - x0) / (f1 - f0)
+    return x1
+
+
+def test_crank_slider_geometry_against_the_loop():
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    mech = CrankSlider(**CS)
+    for phi in (-0.3, 0.1, 0.4):
+        (Bx, By), (Cx, Cy) = cs_loop(phi)
+        B, C = mech.pin_positions(phi)
+        assert [float(v) for v in B] == pytest.approx([Bx, By], rel=1e-9)
+        assert [float(v) for v in C] == pytest.approx([Cx, Cy], rel=1e-9)
+        assert float(mech.rod_run(phi)) == pytest.approx(Bx - Cx, rel=1e-9)
+        u = By - 50.0
+        assert float(mech.assembly_margin(phi)) == pytest.approx(80.0**2 - u**2, rel=1e-9)
+        assert float(mech.rod_inclination(phi)) == pytest.approx(math.atan2(u, Bx - Cx))
+        # transmission angle: between B->O and B->C
+        bo, bc = (-Bx, -By), (Cx - Bx, Cy - By)
+        cos_mu = (bo[0] * bc[0] + bo[1] * bc[1]) / (90.0 * 80.0)
+        assert float(mech.transmission_angle(phi)) == pytest.approx(math.acos(cos_mu))
+        # d|BC|/dphi with the nut held, by central differences
+        h = 1e-6
+
+        def dist(f, C=(Cx, Cy)):
+            (bx, by), _ = cs_loop(f)
+            return math.hypot(C[0] - bx, C[1] - by)
+
+        rate = (dist(phi + h) - dist(phi - h)) / (2 * h)
+        assert float(mech.rod_length_rate(phi)) == pytest.approx(rate, rel=1e-5)
+        assert float(mech.sensitivity_rod_length(phi)) == pytest.approx(1 / rate, rel=1e-5)
+        assert float(mech.rod_force(phi, 5e5)) == pytest.approx(5e5 / rate, rel=1e-5)
+        # the nut slide: C moved across the screw by dn with the nut held
+        dn = 1e-4
+        dphi = (_phi_holding_nut(Cx, 50.0 + dn, phi) - _phi_holding_nut(Cx, 50.0 - dn, phi)) / (
+            2 * dn
+        )
+        assert float(mech.sensitivity_lateral(phi)) == pytest.approx(abs(dphi), rel=1e-4)
+    assert mech.size() == 170.0  # R + l
+
+
+def test_crank_slider_guarded_path_stays_finite_past_the_toggle():
+    import numpy as np
+
+    from optdesign.mechanisms.crank_slider import ASSEMBLY_FLOOR, CrankSlider
+
+    # n = 200 mm: the rod (80 mm) cannot reach the nut line (u = R cos a - n < -80 mm)
+    bad = {**CS, "n": 200.0}
+    assert CrankSlider(**bad).floor is None and ASSEMBLY_FLOOR == 1e-6
+    with np.errstate(invalid="ignore"):
+        assert np.isnan(float(CrankSlider(**bad).rod_run(0.0)))
+        assert np.isnan(float(CrankSlider(**bad).transmission_angle(0.0)))
+        assert np.isnan(float(CrankSlider(**bad).rod_inclination(0.0)))
+    guarded = CrankSlider(bad, guarded=True)
+    assert guarded.floor == 1e-6
+    assert float(guarded.rod_run(0.0)) == pytest.approx(1e-3)  # sqrt of the floor
+    u = 90.0 * math.cos(0.2) - 200.0  # a = phi0 + 0 = 0.2 rad
+    assert float(guarded.rod_inclination(0.0)) == pytest.approx(math.atan2(u, 1e-3))
+    # the nut position R sin a - s with s = 1e-3 mm, and the nut-slide sensitivity
+    # |u| / (s |dm/dphi|) stay finite on the guarded path, NaN on the plain one
+    assert float(guarded.nut_position(0.0)) == pytest.approx(90.0 * math.sin(0.2) - 1e-3)
+    assert np.isfinite(float(guarded.sensitivity_lateral(0.0)))
+    with np.errstate(invalid="ignore"):
+        assert np.isnan(float(CrankSlider(**bad).nut_position(0.0)))
+        assert np.isnan(float(CrankSlider(**bad).sensitivity_lateral(0.0)))
+
+
+def test_crank_slider_joints_are_the_papers_chain():
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    mech = CrankSlider(**CS)
+    phi, M = 0.1, 5e5
+    joints = mech.joints(phi, M)
+    assert [(j.name, j.key, j.angular) for j in joints] == [
+        ("A screw bearings", "A", False),
+        ("B screw/nut", "B", False),
+        ("C nut slide", "C", False),
+        ("O output shaft", "O", True),
+        ("D rod pin (arm)", "", False),
+        ("E rod pin (nut)", "", False),
+    ]
+    axial = float(mech.sensitivity_axial(phi))
+    rod = float(mech.sensitivity_rod_length(phi))
+    assert [float(j.sensitivity) for j in joints[:3]] == pytest.approx(
+        [axial, axial, float(mech.sensitivity_lateral(phi))]
+    )
+    for j in joints[4:]:
+        assert float(j.sensitivity) == pytest.approx(rod)
+        assert float(j.force) == pytest.approx(float(mech.rod_force(phi, M)))
+    assert float(mech.pin_force(phi, M)) == pytest.approx(float(mech.rod_force(phi, M)))
+    assert CrankSlider.pin_shear_planes == 2  # a rod pin in a fork end: double shear
+
+
+def test_crank_slider_requirement_rows_by_hand():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    mech = CrankSlider(**CS)
+    phi = np.array([-0.3, 0.1, 0.4])
+    loops = [cs_loop(f) for f in phi]
+    u = np.array([B[1] - 50.0 for B, _ in loops])
+    (margin,) = mech.requirement_rows("assembly_margin_min", 0.05, phi)
+    assert margin.name == "assembly_margin"
+    assert np.asarray(margin.expr) == pytest.approx((80.0**2 - u**2) / 80.0**2)
+    assert (margin.lower, margin.upper) == (0.05, None)
+    band = SimpleNamespace(min=math.radians(40), max=math.radians(140))
+    (ta,) = mech.requirement_rows("transmission_angle", band, phi)
+    assert ta.name == "transmission_angle" and ta.display_unit == "deg"
+    mu = np.asarray(mech.transmission_angle(phi))
+    assert np.asarray(ta.expr) == pytest.approx(np.cos(mu))
+    # cos is decreasing: 40..140 deg <=> cos in [cos 140, cos 40] = [-0.766044, 0.766044]
+    assert ta.lower == pytest.approx(-0.7660444) and ta.upper == pytest.approx(0.7660444)
+    assert ta.display(np.asarray(ta.expr)) == pytest.approx(np.degrees(mu))
+    assert ta.display(np.array([1.0 + 1e-12, -1.0 - 1e-12])) == pytest.approx([0.0, 180.0])
+    half = SimpleNamespace(min=None, max=math.radians(120))
+    (ta2,) = mech.requirement_rows("transmission_angle", half, phi)
+    assert ta2.lower == pytest.approx(-0.5) and ta2.upper is None
+    (inc,) = mech.requirement_rows("rod_inclination_max", math.radians(30), phi)
+    assert inc.name == "rod_inclination" and inc.display_unit == "deg"
+    assert np.asarray(inc.expr) == pytest.approx(u / 80.0)
+    assert (inc.lower, inc.upper) == (pytest.approx(-0.5), pytest.approx(0.5))
+    assert inc.display(np.array([0.5, 1.0 + 1e-12])) == pytest.approx([30.0, 90.0])
+    with pytest.raises(NotImplementedError, match="CrankSlider declares 'nosuch'"):
+        mech.requirement_rows("nosuch", 1.0, phi)
+
+
+def test_crank_slider_drawing_and_bench_family():
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    mech = CrankSlider(**CS)
+    (Bx, By), (Cx, Cy) = cs_loop(0.1)
+    sk = mech.sketch(0.1)
+    assert sk.links[0][0] == (0.0, 0.0) and sk.links[0][1] == pytest.approx((Bx, By))
+    assert sk.links[1][0] == pytest.approx((Bx, By)) and sk.links[1][1] == pytest.approx((Cx, Cy))
+    assert sk.pivots == [(0.0, 0.0)] and sk.slider == pytest.approx((Cx, Cy))
+    # the screw axis from half a rod before the nearer end to 10 mm past the farther one
+    lo, hi = min(0.0, Cx), max(0.0, Cx)
+    assert sk.axis[0] == pytest.approx((lo - 40.0, 50.0))
+    assert sk.axis[1] == pytest.approx((hi + 10.0, 50.0))
+    # the benchmark's crank-slider family (benchmarks/README.md): its boxes and limits
+    variables, requirements = CrankSlider.bench_template()
+    assert variables == {
+        "R": {"lower": "30 mm", "upper": "120 mm"},
+        "l": {"lower": "40 mm", "upper": "200 mm"},
+        "n": {"lower": "0 mm", "upper": "150 mm"},
+        "p": None,
+        "phi0": {"lower": "-0.6 rad", "upper": "0.6 rad"},
+    }
+    assert requirements == {
+        "transmission_angle": {"min": "40 deg", "max": "140 deg"},
+        "rod_inclination_max": "30 deg",
+    }
+
+
+def test_crank_slider_guarded_transmission_angle_past_the_toggle():
+    import numpy as np
+
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    # a = 1.2 rad, n = 113.6 mm: u = 90 cos 1.2 - 113.6 = -81.0 mm, |u| > l = 80 mm (no
+    # assembly); the guarded path uses s = sqrt(1e-6) = 1e-3 mm and stays finite:
+    # cos mu = (s sin a + u cos a) / l = -0.36682
+    bad = {"R": 90.0, "l": 80.0, "n": 113.6, "phi0": 0.0, "p": 5.0, "i_a": 2.0}
+    a = 1.2
+    u = 90.0 * math.cos(a) - 113.6
+    cos_mu = (1e-3 * math.sin(a) + u * math.cos(a)) / 80.0
+    assert u == pytest.approx(-80.988, abs=1e-3) and cos_mu == pytest.approx(-0.36682, abs=1e-4)
+    guarded = CrankSlider(bad, guarded=True)
+    assert float(guarded.transmission_angle(a)) == pytest.approx(math.acos(cos_mu))
+    band = type("Band", (), {"min": None, "max": None})()
+    (row,) = guarded.requirement_rows("transmission_angle", band, np.array([a]))
+    assert float(np.asarray(row.expr)[0]) == pytest.approx(cos_mu)
+    assert row.lower is None and row.upper is None  # no limit given: none set
+    with np.errstate(invalid="ignore"):
+        assert np.isnan(float(CrankSlider(**bad).transmission_angle(a)))
+
+
+def test_crank_slider_rows_describe_themselves():
+    # the rows' unit and description are what a report prints next to the values
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    mech = CrankSlider(**CS)
+    phi = np.array([0.0])
+    (margin,) = mech.requirement_rows("assembly_margin_min", 0.05, phi)
+    band = SimpleNamespace(min=math.radians(40), max=math.radians(140))
+    (ta,) = mech.requirement_rows("transmission_angle", band, phi)
+    (inc,) = mech.requirement_rows("rod_inclination_max", math.radians(30), phi)
+    assert [(r.unit, r.description) for r in (margin, ta, inc)] == [
+        ("", "(l^2 - u^2)/l^2: the rod reaches the nut line"),
+        ("", "transmission angle"),
+        ("", "rod inclination to the screw axis"),
+    ]
+    # below -1 the display clips to -90 deg instead of NaN
+    assert inc.display(np.array([-1.0 - 1e-12])) == pytest.approx([-90.0])
+
+
+def test_crank_slider_drawing_with_the_nut_right_of_the_axis():
+    from optdesign.mechanisms.crank_slider import CrankSlider
+
+    # phi = 1.0 with phi0 = 0.2 (a = 1.2): B = (83.88, 32.61), C = (5.80, 50): the axis
+    # runs from 0 - l/2 = -40 mm to 5.80 + 10 mm
+    mech = CrankSlider(**CS)
+    _, (Cx, _) = cs_loop(1.0)
+    assert Cx == pytest.approx(5.80, abs=0.01)
+    sk = mech.sketch(1.0)
+    assert sk.axis[0] == pytest.approx((-40.0, 50.0))
+    assert sk.axis[1] == pytest.approx((Cx + 10.0, 50.0))

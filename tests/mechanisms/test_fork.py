@@ -8,9 +8,17 @@ import math
 
 import numpy as np
 import pytest
+from independent_physics import (
+    _fd,
+    _fork_pin_x,
+)
 
 from optdesign.errors import AssemblyError, InputError
 from optdesign.mechanisms import PinJoint, ShiftingFork
+from optdesign.models import fork as fork_model
+from optdesign.models.loads import (
+    fork_pin_normal_force,
+)
 
 R, PHI0 = 60.0, 0.1
 PHI = np.radians(np.linspace(-30.0, 30.0, 7))
@@ -150,3 +158,122 @@ def test_fork_slot_backlash():
 def test_fork_zero_lead_rejected():
     with pytest.raises(InputError, match=r"^p:"):
         ShiftingFork(R=90, p=0.0, i_a=2)
+
+
+@pytest.mark.parametrize("phi0", [0.25, -0.4])
+@pytest.mark.parametrize("phi", [-0.3, 0.0, 0.35])
+def test_fork_ratio_with_a_neutral_angle_from_finite_differences(phi0, phi):
+    R, p, i_a = 70.0, 4.0, 2.0
+    v = _fd(lambda f: _fork_pin_x(R, phi0 + f), phi)  # dx/dphi, mm/rad
+    # motor angle per output angle: 2 pi i_a / p motor radians per mm of nut travel
+    expected = 2 * math.pi * i_a * v / p
+    mech = ShiftingFork(R=R, phi0=phi0, p=p, i_a=i_a)
+    assert float(mech.ratio(phi)) == pytest.approx(expected, rel=1e-7)
+    assert float(fork_model.ratio(R, p, i_a, phi, phi0)) == pytest.approx(expected, rel=1e-7)
+    assert float(mech.nut_position(phi)) == pytest.approx(_fork_pin_x(R, phi0 + phi), rel=1e-12)
+    # the output rotation per slot-normal clearance: the pin's lever arm is R / cos a
+    assert float(mech.sensitivity_slot_normal(phi)) == pytest.approx(
+        math.cos(phi0 + phi) / R, rel=1e-12
+    )
+    # axial sensitivity is the inverse of the finite-difference nut velocity
+    assert float(mech.sensitivity_axial(phi)) == pytest.approx(1.0 / v, rel=1e-7)
+
+
+def test_fork_neutral_angle_written_out():
+    # R = 50 mm, phi0 = 20 deg, phi = 10 deg: a = 30 deg, cos^2 a = 3/4,
+    # ds/dphi = 50 / 0.75 = 66.667 mm/rad; i = 2 pi * 2 * 66.667 / 5 = 167.552.
+    mech = ShiftingFork(R=50.0, phi0=math.radians(20), p=5.0, i_a=2.0)
+    assert float(mech.ratio(math.radians(10))) == pytest.approx(167.5516, rel=1e-6)
+    # the pin's normal force M cos a / R: 500 N*m -> 5e5 * 0.866025 / 50 = 8660.25 N
+    assert float(mech.pin_force(math.radians(10), 5e5)) == pytest.approx(8660.254, rel=1e-6)
+    assert float(fork_pin_normal_force(5e5, 50.0, 0.1, 0.2)) == pytest.approx(
+        5e5 * 0.9553365 / 50.0, rel=1e-6
+    )
+
+
+def test_motor_torque_by_virtual_work_through_the_fork():
+    # Power balance: T_m * dtheta_m = M_h * dphi with dtheta_m = i * dphi, so T_m = M_h / i,
+    # i from the finite-difference ratio of the geometry (no call into the load model).
+    R, phi0, p, i_a, M_h = 80.0, 0.15, 5.0, 2.0, 5e5
+    mech = ShiftingFork(R=R, phi0=phi0, p=p, i_a=i_a)
+    for phi in (-0.4, 0.1, 0.4):
+        i = 2 * math.pi * i_a * _fd(lambda f: _fork_pin_x(R, phi0 + f), phi) / p
+        assert float(mech.motor_torque(phi, M_h)) == pytest.approx(M_h / i, rel=1e-7)
+        # and with a screw efficiency the motor supplies 1/eta times more
+        assert float(mech.motor_torque(phi, M_h, 0.8)) == pytest.approx(M_h / i / 0.8, rel=1e-7)
+
+
+# --- the fork mechanism: its clearance chain, drawing and bench variables ------------------
+def test_fork_joints_are_the_papers_chain_with_phi0():
+    # seed 000 Fig. 9: A screw bearings, B screw/nut (axial, 1/(dx/dphi)), O the output
+    # shaft (angular), C the pin in the slot (cos a / R, loaded by M cos a / R).
+    from optdesign.mechanisms.fork import ShiftingFork
+
+    R, phi0, phi, M = 60.0, 0.2, 0.3, 4e5
+    mech = ShiftingFork(R=R, phi0=phi0, p=5.0, i_a=2.0)
+    h = 1e-6
+    v = (_fork_pin_x(R, phi0 + phi + h) - _fork_pin_x(R, phi0 + phi - h)) / (2 * h)
+    joints = mech.joints(phi, M)
+    assert [(j.name, j.key, j.angular) for j in joints] == [
+        ("A screw bearings", "A", False),
+        ("B screw/nut", "B", False),
+        ("O output shaft", "O", True),
+        ("C pin in slot", "", False),
+    ]
+    for j in joints[:2]:
+        assert float(j.sensitivity) == pytest.approx(1 / v, rel=1e-7)
+    a = phi0 + phi  # 0.5 rad: cos a = 0.8775826
+    assert float(joints[3].sensitivity) == pytest.approx(0.8775826 / R, rel=1e-6)
+    assert float(joints[3].force) == pytest.approx(M * 0.8775826 / R, rel=1e-6)
+    assert math.cos(a) == pytest.approx(0.8775826, rel=1e-7)
+
+
+def test_fork_drawing_and_margin():
+    from optdesign.mechanisms.fork import ShiftingFork
+
+    R, phi0, phi = 50.0, 0.1, 0.3
+    mech = ShiftingFork(R=R, phi0=phi0, p=5.0, i_a=2.0)
+    x = _fork_pin_x(R, phi0 + phi)  # 50 tan 0.4 = 21.1396 mm
+    assert x == pytest.approx(21.13966, rel=1e-6)
+    end, pin = mech.pin_positions(phi)
+    assert [float(v) for v in end] == pytest.approx([x, R])
+    assert [float(v) for v in pin] == pytest.approx([x, R])
+    sk = mech.sketch(phi)
+    assert sk.links == [[(0.0, 0.0), pytest.approx((x, R))]]
+    assert sk.pivots == [(0.0, 0.0)] and sk.slider == pytest.approx((x, R))
+    # the screw axis drawn from 0.3 R before the nearer end to 0.3 R past the farther one
+    assert sk.axis[0] == pytest.approx((-0.3 * R, R)) and sk.axis[1] == pytest.approx(
+        (x + 0.3 * R, R)
+    )
+    sk_neg = mech.sketch(-0.6)  # a = -0.5: the pin left of the axis
+    xn = _fork_pin_x(R, -0.5)
+    assert sk_neg.axis[0] == pytest.approx((xn - 0.3 * R, R))
+    assert sk_neg.axis[1] == pytest.approx((0.3 * R, R))
+    # the slot holds the pin while cos a > 0: margin cos(a) R^2
+    assert float(mech.assembly_margin(phi)) == pytest.approx(math.cos(0.4) * 2500.0)
+    assert float(mech.assembly_margin(1.6)) < 0  # a = 1.7 rad: past perpendicular
+
+
+def test_fork_bench_template_and_size():
+    from optdesign.mechanisms.fork import ShiftingFork
+
+    variables, requirements = ShiftingFork.bench_template()
+    assert variables == {"R": {"lower": "30 mm", "upper": "120 mm"}, "p": None}
+    assert requirements == {}
+    assert ShiftingFork(R=42.0, p=5.0, i_a=2.0).size() == 42.0
+    assert ShiftingFork.pin_shear_planes == 1  # one pin in one slot: single shear
+    assert ShiftingFork.variables["phi0"].default == 0.0
+
+
+def test_fork_pin_positions_on_a_grid_through_zero():
+    import numpy as np
+
+    from optdesign.mechanisms.fork import ShiftingFork
+
+    mech = ShiftingFork(R=40.0, p=5.0, i_a=2.0)
+    phi = np.array([-0.2, 0.0, 0.2])
+    with np.errstate(all="raise"):  # no 0/0 anywhere on the grid
+        end, pin = mech.pin_positions(phi)
+    assert np.asarray(pin[1]) == pytest.approx([40.0, 40.0, 40.0])
+    assert np.asarray(end[1]) == pytest.approx([40.0, 40.0, 40.0])
+    assert np.asarray(pin[0]) == pytest.approx(40.0 * np.tan(phi))

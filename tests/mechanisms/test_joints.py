@@ -4,11 +4,15 @@ clearance), the refusals at both sides of every bound, and the chain's bookkeepi
 (fixed clearances by key, sampled fits, backlash in degrees)."""
 
 import math
+import tomllib
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
 import pytest
+from independent_physics import cs_loop  # the crank-slider loop solved by bisection
 
+import optdesign as od
 from optdesign.errors import InputError
 from optdesign.fits import clearance as iso_clearance
 from optdesign.mechanisms.joints import (
@@ -341,3 +345,185 @@ def test_a_wrong_count_of_fit_draws_is_refused_naming_both_counts():
 def test_poisson_ratio_out_of_range(nu):
     with pytest.raises(InputError, match=r"pin\.nu"):
         PinJoint(10, 15, nu=nu)
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+PROBLEMS = ROOT / "problems"
+
+
+#: Fixed clearances, all different, so that a joint reading another's value shows.
+CLEARANCES = {"A": "0.011 mm", "B": "0.037 mm", "C": "0.023 mm", "O": "0.0013 deg"}
+
+
+def _problem(stem: str, **sections) -> od.DesignProblem:
+    data = tomllib.loads((PROBLEMS / f"{stem}.toml").read_text())
+    data.update(sections)
+    return od.load(data)
+
+
+def _fd(f, x: float, h: float = 1e-6) -> float:
+    return (f(x + h) - f(x - h)) / (2 * h)
+
+
+# --- the clearance chain: each fixed clearance reaches its own joint -----------------------
+def _crank_slider_nut(d):
+    return lambda phi: cs_loop(phi, d["R"], d["l"], d["n"], d["phi0"])[1][0]
+
+
+def _fork_nut(d):
+    # the pin on the line y = R at angle phi0 + phi from the normal: x = R tan(phi0 + phi)
+    return lambda phi: d["R"] * math.tan(d["phi0"] + phi)
+
+
+def _pivot_nut(d):
+    def length(phi):
+        a = d["phi0"] + phi
+        return math.hypot(d["R"] * math.sin(a) - d["a_T"], d["R"] * math.cos(a) - d["b_T"])
+
+    return length
+
+
+@pytest.mark.parametrize(
+    ("stem", "nut", "design"),
+    [
+        ("cs_min_backlash", _crank_slider_nut, {"R": 90.0, "l": 80.0, "n": 50.0, "phi0": 0.2}),
+        ("fork_min_backlash", _fork_nut, {"R": 70.0, "phi0": 0.0}),
+        ("pivot_min_backlash", _pivot_nut, {"R": 90.0, "a_T": -220.0, "b_T": 40.0, "phi0": 0.1}),
+    ],
+)
+def test_each_fixed_clearance_reaches_its_own_joint(stem, nut, design):
+    problem = _problem(stem)
+    keys = set(problem.mechanism.fixed_clearances)
+    problem = _problem(stem, clearances={k: CLEARANCES[k] for k in keys})
+    x = problem.midpoint()
+    values = problem.design_dict(x)
+    values.update({k: v for k, v in design.items() if k in values})
+    q = problem.quantities(values)
+    per_joint = q.backlash.per_joint
+    k_grid = [0, 17, len(problem.phi) - 1]
+    f = nut({**{"phi0": 0.0}, **design})
+    for k in k_grid:
+        phi = float(problem.phi[k])
+        s_axial = 1.0 / abs(_fd(f, phi))  # rad/mm: output rotation per axial clearance
+        for name, key in (("A screw bearings", "A"), ("B screw/nut", "B")):
+            mm = float(CLEARANCES[key].split()[0])
+            assert float(np.ravel(per_joint[name])[k]) == pytest.approx(
+                math.degrees(s_axial * mm), rel=1e-6
+            ), (name, phi)
+        assert float(np.ravel(per_joint["O output shaft"])[k]) == pytest.approx(0.0013, rel=1e-12)
+    if "C" in keys:  # the crank-slider's nut slide: move the screw's line by dn
+        d = design
+
+        def phi_at(n_shift, m_target, guess):
+            from scipy.optimize import brentq
+
+            def g(phi):
+                return cs_loop(phi, d["R"], d["l"], d["n"] + n_shift, d["phi0"])[1][0] - m_target
+
+            return brentq(g, guess - 0.05, guess + 0.05, xtol=1e-14)
+
+        for k in k_grid:
+            phi = float(problem.phi[k])
+            m0 = f(phi)
+            h = 1e-4
+            s_lat = abs(phi_at(h, m0, phi) - phi_at(-h, m0, phi)) / (2 * h)
+            assert float(np.ravel(per_joint["C nut slide"])[k]) == pytest.approx(
+                math.degrees(s_lat * 0.023), rel=1e-5
+            )
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.5, -0.1, 0.7])
+def test_a_pin_poisson_ratio_outside_its_range_is_refused_with_the_value(nu):
+    from optdesign.mechanisms.joints import PinJoint
+
+    with pytest.raises(InputError) as caught:
+        PinJoint(8.0, 12.0, nu=nu)
+    assert caught.value.field == "pin.nu"
+    assert caught.value.reason == f"Poisson ratio must lie in (0, 0.5), got {nu!r}"
+
+
+def test_a_symbolic_poisson_ratio_is_not_range_checked_and_reaches_the_clearance():
+    """The joint model takes symbolic material data (a CasADi symbol): only a number is
+    checked against (0, 0.5); the symbol is kept for the contact clearance."""
+    import casadi as ca
+
+    from optdesign.mechanisms.joints import PinJoint
+
+    nu = ca.SX.sym("nu")
+    pin = PinJoint(8.0, 12.0, nu=nu)
+    assert pin.nu is nu
+    with pytest.raises(InputError):
+        PinJoint(8.0, 12.0, nu=0.5)
+
+
+def test_only_palmgrens_contact_is_restricted_to_steel():
+    from optdesign.mechanisms.joints import PinJoint
+
+    titanium = 1.1e5  # MPa
+    for contact in ("duan2017", "conforming"):
+        assert PinJoint(8.0, 12.0, E=titanium, contact=contact).E == titanium
+    with pytest.raises(InputError, match="Palmgren's approach is an empirical law of steel"):
+        PinJoint(8.0, 12.0, E=titanium, contact="palmgren")
+    assert PinJoint(8.0, 12.0, E=2.1e5, contact="palmgren").contact == "palmgren"
+    # the steel band 1.9e5-2.2e5 MPa, both ends included
+    for steel in (1.9e5, 2.2e5):
+        assert PinJoint(8.0, 12.0, E=steel, contact="palmgren").E == steel
+    for not_steel in (1.89e5, 2.21e5):
+        with pytest.raises(InputError, match=r"^materials\.pin\.E: Palmgren's approach"):
+            PinJoint(8.0, 12.0, E=not_steel, contact="palmgren")
+
+
+def test_a_keyed_pin_joint_adds_its_fixed_clearance_to_the_pins():
+    """docs/mechanisms.md: a joint's ``key`` names its fixed clearance in the problem's
+    ``[clearances]`` table; on a sized pin joint the value adds to the pin's own."""
+    from optdesign.mechanisms.joints import Joint, PinJoint, with_fixed_clearances
+
+    pin = Joint("P lever pin", "P", sensitivity=0.01, force=100.0, pin=PinJoint(8.0, 12.0))
+    slide = Joint("A slide", "A", sensitivity=0.01)
+    unkeyed = Joint("Q other pin", "", sensitivity=0.01, force=100.0, pin=PinJoint(8.0, 12.0))
+    out = with_fixed_clearances([pin, slide, unkeyed], {"P": 0.004, "A": 0.002})
+    assert [j.name for j in out] == ["P lever pin", "A slide", "Q other pin"]
+    assert [j.clearance for j in out] == [0.004, 0.002, 0.0]
+    assert out[0].pin is pin.pin  # the pin itself is kept: its fit adds on top
+    # a joint with neither a pin nor a fixed clearance is dropped from the chain
+    assert with_fixed_clearances([slide], {}) == []
+
+
+def test_a_joint_a_plug_in_declares_wrongly_is_refused_naming_it():
+    """A mechanism's clearance chain (docs/mechanisms.md): each joint needs a sensitivity
+    unless it is angular, a pin joint the force it carries, and no clearance is negative."""
+    from optdesign.mechanisms.joints import Joint, PinJoint
+
+    cases = [
+        (dict(name="C slide", key="C"), "joint C slide", "needs a sensitivity (rad/mm)"),
+        (
+            dict(name="D pin", sensitivity=0.01, pin=PinJoint(8.0, 12.0)),
+            "joint D pin",
+            "a pin joint needs the force it carries",
+        ),
+        (dict(name="A", sensitivity=0.01, clearance=-0.001), "joint A.clearance", "must be >= 0"),
+    ]
+    for kwargs, field, reason in cases:
+        with pytest.raises(InputError) as caught:
+            Joint(**kwargs)
+        assert (caught.value.field, caught.value.reason) == (field, reason)
+    assert Joint(name="O shaft", angular=True).sensitivity is None  # an angle needs none
+
+
+def test_the_conforming_contact_pressure_uses_the_pin_radius():
+    """The conforming solution's peak pressure scales as E* dR / R (R the pin's radius,
+    dR the radial clearance): checked against the model's dimensionless pressure."""
+    from optdesign.mechanisms.joints import PinJoint
+    from optdesign.models import pin_contact as pc
+
+    pin = PinJoint(8.0, 12.0, contact="conforming")
+    F = 2000.0
+    dR = 0.5 * float(pin.fit_clearance())
+    E_s = pc.effective_modulus_similar(pin.E, pin.nu)
+    P_star = pc.load_parameter(F, pin.L, dR, pin.E, pin.nu)
+    expected = E_s * dR / 4.0 * pc.max_pressure_star(P_star)  # R = d / 2 = 4 mm
+    assert float(pin.contact_pressure(F)) == pytest.approx(expected, rel=1e-12)
+    wider = PinJoint(16.0, 12.0, contact="conforming", extra=0.0)
+    assert float(wider.contact_pressure(F)) < float(pin.contact_pressure(F))

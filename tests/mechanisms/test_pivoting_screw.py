@@ -4,6 +4,10 @@ products, and property tests."""
 
 from __future__ import annotations
 
+import math
+import tomllib
+from pathlib import Path
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -11,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
+import optdesign as od
 from optdesign.mechanisms import Mechanism, PinJoint, PivotingScrew
 
 DESIGN = {"R": 90.0, "a_T": -220.0, "b_T": 40.0, "phi0": 0.1, "p": 5.0, "i_a": 2.0}
@@ -214,3 +219,40 @@ def test_the_requirements_declared_ranges_and_the_benchmarks_template():
     }
     assert PivotingScrew.pin_shear_planes == 2
     assert PivotingScrew.bench_families == {"pivot_backlash": ("backlash",)}
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+PROBLEMS = ROOT / "problems"
+
+
+def _problem(stem: str, **sections) -> od.DesignProblem:
+    data = tomllib.loads((PROBLEMS / f"{stem}.toml").read_text())
+    data.update(sections)
+    return od.load(data)
+
+
+def _pivot_nut(d):
+    def length(phi):
+        a = d["phi0"] + phi
+        return math.hypot(d["R"] * math.sin(a) - d["a_T"], d["R"] * math.cos(a) - d["b_T"])
+
+    return length
+
+
+# --- the pivoting screw's dead length ------------------------------------------------------
+def test_pivot_dead_length_is_length_minus_the_whole_stroke():
+    problem = _problem("pivot_min_backlash")
+    d = {"R": 90.0, "a_T": -220.0, "b_T": 40.0, "phi0": 0.1}
+    values = problem.design_dict(problem.midpoint())
+    values.update(d)
+    ex = problem.expressions(values)
+    block = next(b for b in ex.constraints if b.name == "dead_length")
+    L = _pivot_nut(d)
+    lengths = np.array([L(float(phi)) for phi in problem.phi])
+    stroke = L(math.radians(30.0)) - L(math.radians(-30.0))
+    assert stroke == pytest.approx(lengths[-1] - lengths[0], rel=1e-12)
+    assert stroke > 5.0  # far from one grid step's travel (about stroke / 60)
+    np.testing.assert_allclose(np.ravel(block.expr), lengths - stroke, rtol=1e-12)
+    assert block.lower == pytest.approx(60.0) and block.upper is None

@@ -1,5 +1,7 @@
 """Planetary roller screw efficiency (seed 003 eq. 14, physics.md 6) and the selector."""
 
+import math
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -84,3 +86,20 @@ def test_bad_inputs():
         rs.efficiency(0.1, 0.0, 40.0, 10.0, 0.05, 0.01)
     with pytest.raises(InputError, match="f_k"):
         rs.efficiency(0.1, 0.5, 40.0, 10.0, -0.05, 0.01)
+
+
+# --- screw efficiency: the selector's defaults and wiring ---------------------------------
+def test_roller_screw_through_the_selector_is_seed_003s_value():
+    # physics.md 6: alpha_s = 10 deg, beta = 45 deg, r_s = 40 mm, r_RP = 10 mm,
+    # f_k = 0.055, f_r = 0.01 mm give eta = 0.974796. Lead for a 10 deg helix on
+    # d_m = 2 r_s = 80 mm: p = pi * 80 * tan 10 deg = 44.31579 mm.
+    from optdesign.models import roller_screw as rs
+    from optdesign.models.screw_efficiency import screw_efficiency
+
+    p = math.pi * 80.0 * math.tan(math.radians(10.0))
+    assert p == pytest.approx(44.31579, rel=1e-6)
+    assert float(screw_efficiency("roller", p, 80.0)) == pytest.approx(0.974796, abs=1e-6)
+    back = float(screw_efficiency("roller", p, 80.0, direction="back"))
+    lam = math.radians(10.0)
+    expected = rs.efficiency_backdrive(lam, math.radians(45.0), 40.0, 10.0, 0.055, 0.01)
+    assert back == pytest.approx(float(expected), rel=1e-9)

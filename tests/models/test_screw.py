@@ -87,3 +87,11 @@ def test_flattening_first_order_is_a_lower_bound(D, F, L):
     b2 = first * D
     if b2 < 1e-3 * D**2:
         assert exact == pytest.approx(first, rel=2e-3)
+
+
+def test_series_stiffness_needs_a_member():
+    from optdesign.models.screw import series_stiffness
+
+    with pytest.raises(ValueError, match=r"^series_stiffness needs at least one stiffness$"):
+        series_stiffness()
+    assert series_stiffness(3.0, 6.0) == pytest.approx(2.0)  # 1/(1/3 + 1/6)

@@ -1,5 +1,7 @@
 """Screw efficiency by kind (ball, sliding Tr/Acme, roller), forward and back-driving."""
 
+import math
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -174,3 +176,84 @@ def test_bad_inputs_name_the_field():
         screw_efficiency("ball", 5.0, 20.0, -0.1)
     with pytest.raises(InputError, match=r"^d_m"):
         screw_efficiency("ball", 5.0, 0.0)
+
+
+def test_ball_and_sliding_defaults_by_hand():
+    from optdesign.models.screw_efficiency import (
+        equivalent_friction_angle,
+        is_back_drivable,
+        screw_efficiency,
+        self_locking_margin,
+    )
+
+    # ball screw, mu = 0.003 by default: lam = atan(5 / (20 pi)) = 0.0794101 rad,
+    # eta = tan(lam) / tan(lam + atan 0.003) = 0.963440
+    lam = math.atan(5.0 / (20.0 * math.pi))
+    eta = math.tan(lam) / math.tan(lam + math.atan(0.003))
+    assert eta == pytest.approx(0.963440, abs=1e-6)
+    assert float(screw_efficiency("ball", 5.0, 20.0)) == pytest.approx(eta, rel=1e-12)
+    # trapezoidal = sliding with Tr's 15 deg flank, mu = 0.1 by default; acme 14.5 deg
+    for kind, flank in (("trapezoidal", 15.0), ("acme", 14.5), ("sliding", 15.0)):
+        alpha_n = math.atan(math.tan(math.radians(flank)) * math.cos(lam))
+        phi = math.atan(0.1 / math.cos(alpha_n))
+        assert float(equivalent_friction_angle(kind, 5.0, 20.0)) == pytest.approx(phi), kind
+        # without the normal section the axial flank angle is used
+        phi_axial = math.atan(0.1 / math.cos(math.radians(flank)))
+        assert float(
+            equivalent_friction_angle(kind, 5.0, 20.0, normal_section=False)
+        ) == pytest.approx(phi_axial), kind
+        assert float(self_locking_margin(kind, 5.0, 20.0, normal_section=False)) == pytest.approx(
+            phi_axial - lam
+        ), kind
+    # a Tr 20x4 (p = 4, d_m = 18) self-locks at mu = 0.1; a 5/20 ball screw does not
+    assert not is_back_drivable("trapezoidal", 4.0, 18.0)
+    assert is_back_drivable("ball", 5.0, 20.0)
+    # exactly at the locking limit (eta' = 0) the screw is not back-drivable: mu = tan(lam)
+    lam_b = math.atan(5.0 / (20.0 * math.pi))
+    assert not is_back_drivable("ball", 5.0, 20.0, mu=math.tan(lam_b) * (1 + 1e-12))
+    # keyword arguments reach the friction angle: a 45 deg flank raises it
+    assert not is_back_drivable("sliding", 5.0, 20.0, 0.07, flank_angle=math.radians(45))
+    assert is_back_drivable("sliding", 5.0, 20.0, 0.07)
+
+
+def test_screw_efficiency_errors_name_the_field():
+    import casadi as ca
+
+    from optdesign.errors import InputError
+    from optdesign.models.screw_efficiency import (
+        equivalent_friction_angle,
+        is_back_drivable,
+        screw_efficiency,
+    )
+
+    with pytest.raises(InputError, match=r"^kind: 'nut' not in \("):
+        screw_efficiency("nut", 5.0, 20.0)
+    with pytest.raises(InputError, match=r"^direction: 'up' not in \("):
+        screw_efficiency("ball", 5.0, 20.0, direction="up")
+    with pytest.raises(InputError, match=r"^p: must be positive"):
+        screw_efficiency("ball", 0.0, 20.0)
+    with pytest.raises(InputError, match=r"^d_m: must be positive"):
+        screw_efficiency("ball", 5.0, -1.0)
+    with pytest.raises(InputError, match=r"^mu: must be >= 0"):
+        equivalent_friction_angle("ball", 5.0, 20.0, -0.01)
+    with pytest.raises(InputError, match=r"^mu: must be >= 0"):
+        equivalent_friction_angle("sliding", 5.0, 20.0, -0.01)
+    with pytest.raises(
+        InputError, match=r"^kind: a roller screw has no single friction angle; use screw_eff"
+    ):
+        equivalent_friction_angle("roller", 5.0, 20.0)
+    for args in (
+        (ca.SX.sym("p"), 20.0, 0.1),
+        (5.0, ca.SX.sym("d"), 0.1),
+        (5.0, 20.0, ca.SX.sym("mu")),
+    ):
+        with pytest.raises(InputError, match=r"^p: is_back_drivable needs numbers"):
+            is_back_drivable("sliding", *args)
+
+
+def test_back_drivable_exactly_at_the_locking_limit_is_not():
+    from optdesign.models.screw_efficiency import is_back_drivable
+
+    # mu = tan(lambda) exactly (the same expression): lambda - phi = 0, eta' = 0: locked
+    mu = 5.0 / (math.pi * 20.0)
+    assert not is_back_drivable("ball", 5.0, 20.0, mu)

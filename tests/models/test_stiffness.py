@@ -135,3 +135,31 @@ def test_casadi_matches_numpy_on_a_grid():
             )
         ) / (2 * h)
         assert dR == pytest.approx(fd, rel=1e-5)
+
+
+# --- stiffness and screw: errors name the field --------------------------------------------
+def test_stiffness_inputs_are_named():
+    from optdesign.errors import InputError
+    from optdesign.models import stiffness
+
+    with pytest.raises(InputError, match=r"^d1: must be positive"):
+        stiffness.shaft_torsional_stiffness(-1.0, 100.0)
+    with pytest.raises(InputError, match=r"^L: must be positive"):
+        stiffness.shaft_torsional_stiffness(10.0, 0.0)
+    with pytest.raises(InputError, match=r"^p: must be positive"):
+        stiffness.torsion_to_axial(1e6, 0.0)
+    with pytest.raises(InputError, match=r"^p: must be positive"):
+        stiffness.axial_to_torsion(1e5, -5.0)
+    with pytest.raises(
+        InputError, match=r"^terms: output_stiffness needs at least one \(K, rate\) pair$"
+    ):
+        stiffness.output_stiffness([])
+
+
+def test_output_stiffness_of_one_and_two_members_by_hand():
+    from optdesign.models.stiffness import output_stiffness
+
+    # one member: K r^2 = 1e5 N/mm * (50 mm/rad)^2 = 2.5e8 N*mm/rad
+    assert output_stiffness([(1e5, 50.0)]) == pytest.approx(2.5e8)
+    # two in series: 1 / (1/2.5e8 + 1/(2e5 * 25^2 = 1.25e8)) = 8.3333e7
+    assert output_stiffness([(1e5, 50.0), (2e5, 25.0)]) == pytest.approx(2.5e8 / 3)

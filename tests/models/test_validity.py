@@ -350,7 +350,7 @@ def test_every_impossible_input_of_the_corpus_ends_cleanly():
 # The validity corpus (tests/validity_corpus.py: impossible inputs within the schema's
 # types, written from the models' assumptions) through the command line, in both output
 # modes: each case refused with its field and range, or solved into a result that names
-# each model it leaves - as through the API (tests/test_validity.py).
+# each model it leaves - as through the API (tests/models/test_validity.py).
 
 
 CASES = {c.name: c for c in all_cases()}

@@ -20,9 +20,12 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+import optdesign as od
 from optdesign.errors import ProblemError
 from optdesign.problem import drive, load_problem, problem_from_dict
+from optdesign.problem.load import load
 from optdesign.studies.nlp_solve import solve_nlp
+from optdesign.studies.verify import verify_design
 
 ROOT = Path(__file__).resolve().parents[2]
 FIN = ROOT / "problems" / "fin_actuator.toml"
@@ -228,7 +231,6 @@ def test_buckling_limits_the_nut_force_to_the_buckling_load(fin):
     long_screw = problem_from_dict(data)
     row = long_screw.evaluate(x).constraints["screw_buckling"]
     assert np.max(row.values) > 1.0 and row.upper == 1.0
-    from optdesign.studies.verify import verify_design
 
     ok, violated, _ = verify_design(long_screw, x)
     assert not ok and "screw_buckling" in {v.name.split("[")[0] for v in violated}
@@ -356,8 +358,6 @@ def test_fin_actuator_optimum_confirmed_by_a_global_search():
     continuous variables on the NumPy path (no CasADi, no Ipopt)."""
     from independent_global import differential_evolution_optimum
 
-    import optdesign as od
-
     problem = load_problem(FIN)
     res = od.solve(problem)
     assert res.status == "optimal" and res.verified
@@ -377,8 +377,6 @@ def test_catalogue_front_backlash_against_motor_torque():
     """A front over catalogue designs (every point a catalogue item with its fit from the
     ISO 286-2 table): the backlash end is the catalogue optimum, the points trade."""
     import tomllib
-
-    import optdesign as od
 
     data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
     data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
@@ -1543,7 +1541,6 @@ def test_mounting_rule_reaches_the_problem_and_its_summary_text():
 
 @pytest.mark.slow  # a catalogue solve of fin_actuator: 9.5 s with the oldest releases
 def test_dn_rule_is_stated_in_the_summary_where_it_binds():
-    import optdesign as od
 
     data = tomllib.loads(FIN.read_text())
     data["requirements"]["dn_max"] = 69000.0
@@ -1606,3 +1603,38 @@ def test_dn_max_that_is_neither_a_number_nor_a_grade_is_refused_in_one_message(v
     text = str(caught.value)
     assert "requirements.dn_max: a number (d x n in mm x 1/min, e.g. 70000) or a grade " in text
     assert f"got {value!r}" in text and "literal" not in text and "float" not in text
+
+
+def test_the_table_fit_ratio_of_a_catalogue_node_is_iso_286_over_the_formula():
+    """H7/g6 at 6 mm in ISO 286-2's tables: hole +12/0 um, shaft -4/-12 um, so 24 um
+    largest and 4 um smallest clearance; the node's parameter is that over the smooth
+    (IT formula) clearance, the smallest ratio over the node's pins."""
+    from optdesign.fits import clearance
+    from optdesign.problem.drive import _fit_ratios
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    problem = problem_from_dict(data)
+    at6 = _fit_ratios(problem, {"d": (6.0, 6.0)})
+    assert at6["fit_ratio_max"] == pytest.approx(0.024 / clearance("H7/g6", 6.0, "max", "smooth"))
+    assert at6["fit_ratio_min"] == pytest.approx(0.004 / clearance("H7/g6", 6.0, "min", "smooth"))
+    assert at6["fit_ratio_max"] < 0.95  # the table is tighter than the formula here
+    wide = _fit_ratios(problem, {"d": (5.0, 8.0)})
+    ratios = [
+        clearance("H7/g6", D, "max", "table") / clearance("H7/g6", D, "max", "smooth")
+        for D in (5.0, 6.0, 8.0)
+    ]
+    assert wide["fit_ratio_max"] == pytest.approx(min(ratios))
+
+
+def test_an_off_catalogue_screw_takes_the_nearest_items_data():
+    """A (d0, p) pair the catalogue lacks (an off-catalogue point of a relaxation) reads
+    the nearest row by relative distance in both: d0 = 21 mm, p = 5 mm is the
+    R20-05 row, marked as not an item."""
+    from optdesign.problem.drive import _nearest, catalogue_items
+
+    fin = load(ROOT / "problems" / "fin_actuator.toml")
+    items = catalogue_items(fin.spec.screw.catalogue, fin.spec.screw.nut)
+    row, on = _nearest(items, 21.0, 5.0)
+    assert (row.d0, row.p, on) == (20.0, 5.0, False)
+    row, on = _nearest(items, 25.0, 10.0)
+    assert (row.d0, row.p, on) == (25.0, 10.0, True)

@@ -1,8 +1,12 @@
 """Screw sizing and motor-shaft lock (issue 7) as requirements and objectives of problems."""
 
+import tomllib
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign.errors import ProblemError
 from optdesign.mechanisms import CrankSlider
 from optdesign.models.lock import PinLock, motor_shaft_lock_load
@@ -80,8 +84,6 @@ def test_a_rating_requirement_without_a_catalogue_screw_is_refused_naming_it(kep
     import tomllib
     from pathlib import Path
 
-    import optdesign as od
-
     root = Path(__file__).resolve().parents[2]
     data = tomllib.loads((root / "problems" / "fin_actuator.toml").read_text())
     for key in ("catalogue", "nut_stiffness_rule", "mounting_factors"):
@@ -103,7 +105,6 @@ def test_the_screw_yield_row_is_the_nut_force_over_the_permissible_load_with_no_
     import tomllib
     from pathlib import Path
 
-    import optdesign as od
     from optdesign.models import screw_sizing
     from optdesign.problem.drive_requirements import drive_blocks
 
@@ -122,3 +123,28 @@ def test_the_screw_yield_row_is_the_nut_force_over_the_permissible_load_with_no_
     force = np.abs(np.asarray(q.nut_force, dtype=float)).ravel()
     expected = force / float(screw_sizing.yield_load(float(q.screw.d1)))
     assert np.asarray(row.expr, dtype=float).ravel() == pytest.approx(expected, rel=1e-12)
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_the_dn_row_names_the_diameter_of_its_rule():
+    from optdesign.problem.drive_requirements import drive_blocks
+
+    def dn_text(rule, limit=None):
+        data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+        data["requirements"]["dn_rule"] = rule
+        if limit is not None:
+            data["requirements"]["dn_max"] = limit
+        problem = problem_from_dict(data)
+        q = problem.quantities(problem.design_dict(problem.midpoint()))
+        return next(b for b in drive_blocks(q, problem.phi_labels) if b.name == "dn").description
+
+    assert dn_text("ball-centre").startswith("d_m x screw speed (DN value; rule ball-centre")
+    assert dn_text("HIWIN") == (
+        "d0 x screw speed (DN value; rule HIWIN: ground limit 90,000 on the nominal diameter)"
+    )
+    # a limit given as a number names no grade
+    assert dn_text("HIWIN", 70000) == (
+        "d0 x screw speed (DN value; rule HIWIN: limit 70,000 on the nominal diameter)"
+    )

@@ -12,6 +12,8 @@ from types import SimpleNamespace
 import pytest
 
 import optdesign as od
+from optdesign.problem import problem_from_dict
+from optdesign.problem.load import load
 from optdesign.reports.display_units import (
     Shown,
     angle_unit,
@@ -156,3 +158,44 @@ def test_a_plain_number_written_in_percent_is_shown_in_percent():
     assert requirement_values(_problem(ripple_max="7 percent"))["ripple_max"] == Shown(7.0, "%")
     assert requirement_values(_problem(ripple_max=0.05))["ripple_max"] == 0.05
     assert dict(requirement_echo(_problem(ripple_max=0.05)))["ripple_max"] == "0.05"
+
+
+# --- the input echo of a report -------------------------------------------------------
+def test_a_bare_zero_angle_is_echoed_in_the_one_angle_unit_the_file_wrote():
+    """A bare 0 has no unit of its own: a file that wrote every angle in rad sees it in
+    rad too, one that wrote them in degrees in deg."""
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash.toml").read_text())
+    req = data["requirements"]
+    req["deflection"] = {"min": 0, "max": "0.5 rad", "points": 11}
+    req["transmission_angle"] = {"min": "0.7 rad", "max": "2.4 rad"}
+    req["rod_inclination_max"] = "0.5 rad"
+    echo = dict(requirement_echo(problem_from_dict(data)))
+    assert echo["deflection"] == "{min = 0 rad, max = 0.5 rad, points = 11}"
+    req["deflection"] = {"min": 0, "max": "30 deg", "points": 11}
+    req["transmission_angle"] = {"min": "40 deg", "max": "140 deg"}
+    req["rod_inclination_max"] = "30 deg"
+    data["variables"]["phi0"] = {"lower": "-30 deg", "upper": "30 deg"}
+    echo = dict(requirement_echo(problem_from_dict(data)))
+    assert echo["deflection"] == "{min = 0 deg, max = 30 deg, points = 11}"
+
+
+def test_an_objective_without_a_problem_or_a_declaration_is_shown_bare():
+    """An objective value shown with no problem (a record read alone) or under a name the
+    problem does not declare: the number as it is, with no unit."""
+    from optdesign.reports.display_units import Shown, objective_shown
+
+    assert objective_shown(None, "backlash", 0.5) == Shown(0.5, "")
+    assert objective_shown(None, "backlash", 0.5).text() == "0.5"
+    problem = load(Path(__file__).resolve().parents[2] / "problems" / "cs_min_backlash.toml")
+    assert objective_shown(problem, "not_an_objective", 2.0) == Shown(2.0, "")
+    shown = objective_shown(problem, "CVaR_0.9(backlash)", 0.03)  # a statistic of it
+    assert shown.unit == "deg" and shown.value == pytest.approx(0.03)
+
+
+def test_an_angle_is_shown_in_the_unit_the_file_wrote_it_in():
+    from optdesign.reports.display_units import shown
+
+    as_rad = shown(0.5, "rad", "rad")
+    assert (as_rad.value, as_rad.unit) == (0.5, "rad")
+    as_deg = shown(0.5, "rad")
+    assert as_deg.unit == "deg" and as_deg.value == pytest.approx(math.degrees(0.5), rel=1e-15)

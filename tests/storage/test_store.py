@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+import optdesign as od
+from optdesign.safe_io import UnsafeFileError
 from optdesign.storage import (
     STORE_VERSION,
     FolderInUseError,
@@ -23,6 +25,7 @@ from optdesign.storage import (
     ensure_writable,
     holds_lock,
     lock_folder,
+    open_store,
     read_store,
 )
 from optdesign.studies.runner import run_tasks
@@ -409,3 +412,60 @@ def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys,
         store.close()
     else:
         assert target.read_text() == "old"
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+def test_resuming_a_store_whose_identity_line_was_torn_says_it_has_none(cs_min_backlash, tmp_path):
+    """A store holding only a torn first line (a run stopped while writing its identity)
+    is no store of any run: the resume is refused, saying so and how to start over."""
+    from optdesign.storage import StoreError
+
+    store = tmp_path / "epsilon.jsonl"
+    store.write_text('{"__store__": 2, "identity": {"objec')
+    with pytest.raises(StoreError) as caught:
+        od.pareto(cs_min_backlash, ["backlash", "size"], 3, out=tmp_path, resume=True, starts=1)
+    assert str(caught.value) == (
+        f"resume=True: {store} cannot be resumed: it has no identity line; start over with "
+        "overwrite=True or use another output folder"
+    )
+    assert store.read_text() == '{"__store__": 2, "identity": {"objec'
+
+
+def test_a_torn_store_with_another_hard_link_is_not_repaired_in_place(tmp_path):
+    store = tmp_path / "s.jsonl"
+    run_tasks([{"id": f"t{i}", "n": i} for i in range(3)], _double, store, key="k")
+    torn = store.read_bytes()[:-3]
+    store.write_bytes(torn)
+    other = tmp_path / "elsewhere.jsonl"
+    os.link(store, other)
+    with pytest.raises(UnsafeFileError) as caught:
+        open_store(store, "k", resume=True)
+    assert str(caught.value).startswith(
+        f"the store {store} has 2 hard links (changing it would change another file too)"
+    )
+    assert other.read_bytes() == torn  # the file the other link names is untouched
+
+
+def test_a_store_left_open_never_keeps_the_process_alive(tmp_path):
+    """A store writer's fsync thread is a daemon: a program that exits (or dies) with a
+    store still open ends all the same, its records on disk."""
+    import subprocess
+    import sys
+    import textwrap
+
+    store = tmp_path / "s.jsonl"
+    store.write_text("")
+    code = textwrap.dedent(
+        f"""
+        from optdesign.storage.store import StoreWriter
+        w = StoreWriter({str(store)!r})
+        w.write({{"id": "a", "value": 1}})
+        """
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert store.read_text() == '{"id": "a", "value": 1}\n'

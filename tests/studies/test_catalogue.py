@@ -2,20 +2,25 @@
 
 from __future__ import annotations
 
+import csv
 import itertools
 import math
 import os
 import time
 import tomllib
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.formulations.discrete import discrete_variables
 from optdesign.problem import load_problem, problem_from_dict
+from optdesign.problem.load import load
 from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.studies import catalogue_bnb
+from optdesign.studies import catalogue, catalogue_bnb
 from optdesign.studies.catalogue import (
     NodeSolver,
     _no_item,
@@ -50,6 +55,7 @@ from optdesign.studies.catalogue_bnb import (
 )
 from optdesign.studies.inherited_map import InheritedWorkers
 from optdesign.studies.processes import forks_workers
+from optdesign.studies.verify import verify_design
 from studies.test_catalogue_bnb import _infeasible as _failed
 from studies.test_catalogue_bnb import _Problem, _Var  # the stand-in problem of catalogue items
 
@@ -1474,3 +1480,193 @@ def test_a_failed_relaxation_is_said_so_beside_the_items_found(monkeypatch):
     assert result.success and result.bound is None
     note = next(n for n in result.notes if n.startswith("catalogue items chosen"))
     assert "; continuous relaxation: failed; enumerate," in note and "nan" not in note
+
+
+PROBLEMS = ROOT / "problems"
+
+
+# --- the catalogue relaxation takes the most favourable items of a box ---------------------
+def _strongest_nuts() -> dict[tuple[float, float], dict[str, float]]:
+    """(d0, p) -> the strongest nut of the catalogue's CSV (highest Ca, then C0a, then
+    rigidity), read with the csv module; rigidity converted from N/um to N/mm."""
+    path = ROOT / "optdesign" / "data" / "ball_screws.csv"
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(line for line in fh if not line.startswith("#")))
+    best: dict[tuple[float, float], dict[str, float]] = {}
+    for r in rows:
+        item = {
+            "d1": float(r["d1"]),
+            "Ca": float(r["Ca"]),
+            "C0a": float(r["C0a"]),
+            "K_nut": 1000.0 * float(r["rigidity_N_per_um"]),
+        }
+        key = (float(r["d0"]), float(r["p"]))
+        old = best.get(key)
+        rank = (item["Ca"], item["C0a"], item["K_nut"])
+        if old is None or rank > (old["Ca"], old["C0a"], old["K_nut"]):
+            best[key] = item
+    return best
+
+
+# --- branch and bound: what may be pruned --------------------------------------------------
+def test_prune_tolerance_is_relative_one_in_a_million():
+    from optdesign.studies.catalogue import PRUNE_TOL, cannot_improve
+
+    assert PRUNE_TOL == pytest.approx(1e-6)
+    incumbent = 2.0
+    # a node whose bound is 0.1 % below the incumbent can still hold a better item
+    assert not cannot_improve(incumbent * (1 - 1e-3), incumbent)
+    assert not cannot_improve(incumbent * (1 - 1e-5), incumbent)
+    assert cannot_improve(incumbent * (1 - 1e-7), incumbent)
+    assert cannot_improve(incumbent * 1.01, incumbent)
+    # negative objectives: the tolerance is relative to the magnitude
+    assert not cannot_improve(-2.0 * (1 + 1e-4), -2.0)
+    assert cannot_improve(-2.0 * (1 + 1e-7), -2.0)
+
+
+def test_catalogue_relaxation_takes_the_most_favourable_items_of_the_box():
+    problem = od.load(PROBLEMS / "fin_actuator.toml")
+    box = {"d0": (16.0, 20.0), "p": (2.0, 5.0)}
+    values = problem.parameter_values(box)
+    items = [v for (d0, p), v in _strongest_nuts().items() if 16 <= d0 <= 20 and 2 <= p <= 5]
+    assert len(items) >= 3  # several items: the choice of the value matters
+    for key in ("d1", "Ca", "C0a", "K_nut"):
+        column = [item[key] for item in items]
+        assert max(column) > min(column), key
+        assert values[f"screw_{key}"] == pytest.approx(max(column), rel=1e-12), key
+    # a box holding one item gives that item's own values
+    one = problem.parameter_values({"d0": (20.0, 20.0), "p": (5.0, 5.0)})
+    item = _strongest_nuts()[(20.0, 5.0)]
+    for key in ("d1", "Ca", "C0a", "K_nut"):
+        assert one[f"screw_{key}"] == pytest.approx(item[key], rel=1e-12), key
+    # the table-fit ratio of the pins: the smallest of the box's items (the smaller
+    # clearance is the favourable one for a backlash bound)
+    from optdesign.fits import clearance
+
+    box_d = {"d": (5.0, 8.0)}
+    pins = [v for v in problem.by_name["d"].values if 5.0 <= v <= 8.0]
+    assert len(pins) >= 2
+    fit = problem.spec.requirements.fit
+    for which in ("max", "min"):
+        ratios = [
+            float(clearance(fit, D, which, values="table"))
+            / float(clearance(fit, D, which, values="smooth"))
+            for D in pins
+        ]
+        assert max(ratios) > min(ratios)
+        got = problem.parameter_values(box_d)[f"fit_ratio_{which}"]
+        assert got == pytest.approx(min(ratios), rel=1e-12), which
+
+
+def _catalogue(leads, pins):
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": [f"{p} mm" for p in leads]}
+    data["variables"]["d"] = {"values": [f"{d} mm" for d in pins]}
+    return problem_from_dict(data)
+
+
+@pytest.fixture(scope="module")
+def enumerated_4x5():
+    """4 leads x 5 pins and the enumeration of its 20 item pairs (two starts a node)."""
+    problem = _catalogue((4, 5, 6, 8), (4, 5, 6, 8, 10))
+    return problem, catalogue.solve_catalogue(problem, method="enumerate", starts=2)
+
+
+# --- catalogue search -----------------------------------------------------------------
+def test_relaxation_bound_without_a_bound_is_nan():
+    assert math.isnan(relaxation_bound(SimpleNamespace(bound=None)))
+    assert relaxation_bound(SimpleNamespace(bound=np.float64(0.25))) == 0.25
+
+
+def test_is_on_catalogue_takes_only_the_items_themselves():
+    problem = load(ROOT / "problems" / "fin_actuator.toml")
+    variables = discrete_variables(problem)
+    assert variables
+    design = {v.name: float(v.values[0]) for v in variables}
+    assert is_on_catalogue(problem, design)
+    first = variables[0]
+    nearly = dict(design, **{first.name: float(first.values[0]) * (1 + 1e-10)})
+    assert not is_on_catalogue(problem, nearly)  # 1e-10 off an item is off the catalogue
+    between = dict(design, **{first.name: float(first.values[0]) + 0.5})
+    assert not is_on_catalogue(problem, between)
+
+
+@pytest.mark.slow  # its fixture enumerates a 4 x 5 catalogue: 9-17 s
+def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x5):
+    """4 leads x 5 pins: branch and bound equals enumeration, and its counts are those of
+    the node solves it made (counted here by a wrapper around the node solver)."""
+    problem, enum = enumerated_4x5
+    solves: list[bool] = []
+    original = catalogue.NodeSolver.solve
+
+    def counted(self, box, *args, **kwargs):
+        result = original(self, box, *args, **kwargs)
+        solves.append(bool(result.success))
+        return result
+
+    monkeypatch.setattr(catalogue.NodeSolver, "solve", counted)
+    bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
+    info = bnb.details.catalogue
+    # the relaxation, 7 boxes of 20 item pairs, and the box whose warm bound (one start)
+    # would prune it, solved again with the full multistart before it is pruned
+    assert info.nodes == len(solves) == 9
+    assert info.infeasible == solves.count(False) == 2
+    # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
+    assert (info.leaves, info.pruned) == (1, 1)
+    assert len(enum.details.catalogue.enumerated) == 20
+    assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
+    assert bnb.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
+
+
+def test_the_catalogue_formulation_takes_the_callers_settings():
+    """od.solve(..., "catalogue", objective=, starts=, options=) reaches the search."""
+    problem = _catalogue((5, 6), (5, 6, 8))
+    ripple = od.solve(problem, "catalogue", objective="ripple", starts=2, ranges=False)
+    direct = catalogue.solve_catalogue(problem, objective="ripple", starts=2)
+    assert ripple.objective == pytest.approx(direct.objective, rel=1e-9)
+    assert ripple.details.catalogue.items == {"p": 5, "d": 8}  # not backlash's 6 / 6
+    assert ripple.details.catalogue.starts_per_node == 2
+    assert ripple.details.catalogue.method == "enumerate"
+    # an iteration limit of 1 leaves even the relaxation unsolved: the options arrive
+    starved = od.solve(problem, "catalogue", options={"max_iter": 1}, ranges=False, diagnose=False)
+    assert starved.status == "infeasible"
+    assert "relaxation has no feasible design" in starved.message
+
+
+def test_a_catalogue_result_keeps_the_callers_seed_and_objective_even_when_infeasible():
+    """The seed of a node's multistart is the caller's (the report prints it), and a
+    search that finds nothing still names the objective it was asked for."""
+    problem = _catalogue((5, 6), (5, 6, 8))
+    assert problem.objective_names[0] == "backlash"
+    seeded = od.solve(problem, "catalogue", objective="ripple", starts=2, seed=7, ranges=False)
+    assert seeded.multistart.seed == 7 and seeded.objective_name == "ripple"
+    starved = od.solve(
+        problem, "catalogue", objective="ripple", options={"max_iter": 1}, ranges=False,
+        diagnose=False,
+    )  # fmt: skip
+    assert starved.status == "infeasible" and starved.objective_name == "ripple"
+
+
+@pytest.mark.slow  # the same enumerated 4 x 5 catalogue
+def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5):
+    """The diagnosis's depth-first search (reached only when no item combination near the
+    relaxation works, so no other fast test calls it): a leaf on the catalogue whose
+    design the independent check finds feasible; None when no item pair is feasible."""
+    problem, enum = enumerated_4x5
+    found = catalogue.first_feasible(catalogue.NodeSolver(problem, starts=2))
+    assert found is not None and found.success
+    assert is_on_catalogue(problem, found.design)
+    x = np.array([found.design[v.name] for v in problem.free])
+    assert verify_design(problem, x)[0]
+    # the better child first: the leaf is no worse than the worst of the feasible items
+    feasible = {
+        (row.items["p"], row.items["d"]): row.objective
+        for row in enum.details.catalogue.enumerated
+        if row.status == "optimal"
+    }
+    items = (found.design["p"], found.design["d"])
+    assert found.objective == pytest.approx(feasible[items], rel=1e-6)  # that item pair's optimum
+    assert found.objective <= max(feasible.values())
+    # pins of 4 mm only: too weak for the hinge moment whatever the lead (every pair fails)
+    weak = _catalogue((4, 5, 6, 8), (4,))
+    assert catalogue.first_feasible(catalogue.NodeSolver(weak, starts=2)) is None

@@ -13,6 +13,7 @@ a relaxation sitting on items does not settle its box, whose other combinations 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -359,3 +360,17 @@ def test_a_node_kept_on_a_one_start_bound_and_found_infeasible_is_counted():
     low = [box for box in ns.boxes if box.get("b") == (1.0, 2.0)]
     assert len(low) == 2  # its warm start, then the full multistart that finds no design
     assert stats["infeasible"] == 1
+
+
+def test_a_tie_in_distance_from_the_items_branches_on_the_first_declared_variable():
+
+    from optdesign.studies.catalogue_bnb import on_items
+
+    a = SimpleNamespace(name="a", values=(1.0, 2.0))
+    b = SimpleNamespace(name="b", values=(10.0, 20.0))
+    box = {"a": (1.0, 2.0), "b": (10.0, 20.0)}
+    res = SimpleNamespace(design={"a": 1.5, "b": 15.0})  # both halfway: the same distance
+    worst, items = on_items([a, b], box, res)
+    assert worst is a and items == {"a": 1.0, "b": 10.0}
+    on = SimpleNamespace(design={"a": 2.0, "b": 10.0})
+    assert on_items([a, b], box, on)[0] is None

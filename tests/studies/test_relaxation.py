@@ -104,7 +104,7 @@ def test_a_record_states_the_written_and_the_needed_bound():
     assert _record(row, True, None, 2).needed is None
 
 
-@pytest.mark.slow  # a relaxation's bisection at every item combination: 9-26 s; test_failures' catalogue case diagnoses one in the fast suite
+@pytest.mark.slow  # a relaxation's bisection at every item combination: 9-26 s; test_diagnosis' catalogue case diagnoses one in the fast suite
 def test_a_relaxation_at_catalogue_items_uses_the_items_parameters():
     """At items p = 2 mm, d = 10 mm the pin's fit takes its ISO 286 table clearance, a
     parameter of the NLP (0.94 of the formula's here): the backlash limit that site
@@ -125,3 +125,39 @@ def test_a_relaxation_at_catalogue_items_uses_the_items_parameters():
 
     table, formula = needed(params), needed(None)
     assert 0.9 * formula < table < 0.99 * formula
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+# --- the relaxation's measure of a violation ----------------------------------------------
+def test_relaxation_need_is_the_worst_point_of_the_row():
+    from types import SimpleNamespace
+
+    from optdesign.studies.relaxation import _need
+
+    g = np.array([3.0, 7.5, 5.0, 1.0])
+    upper = SimpleNamespace(upper=4.0, lower=None)
+    lower = SimpleNamespace(upper=None, lower=2.5)
+    assert _need(g, upper, hi_side=True) == pytest.approx(3.5)  # 7.5 - 4
+    assert _need(g, lower, hi_side=False) == pytest.approx(1.5)  # 2.5 - 1
+    assert _need(np.array([1.0, 2.0]), upper, hi_side=True) == 0.0
+    assert _need(np.array([3.0, 4.0]), lower, hi_side=False) == 0.0
+
+
+def test_a_relaxation_site_starts_from_the_design_clipped_into_its_box_only():
+    """At a site (catalogue items held in a sub-box) the solves start from the given
+    design with the held variables clipped into the box and the others unchanged."""
+    from optdesign.formulations.nlp import build_nlp
+    from optdesign.studies.relaxation import Site, _Prepared
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    nlp = build_nlp(problem)
+    names = [v.name for v in problem.free]
+    x = 0.5 * (problem.lower() + problem.upper())
+    held = (problem.upper()[names.index("R")] - 1.0, problem.upper()[names.index("R")])
+    site = _Prepared(problem, nlp, Site(box={"R": held}, x_start=x))
+    start = nlp.x_from_z(site.starts[-1].z0)
+    expected = x.copy()
+    expected[names.index("R")] = held[0]
+    np.testing.assert_allclose(start, expected, rtol=1e-12)

@@ -1,6 +1,7 @@
 """Issue 3: problem files, the NLP formulation and `optdesign solve`."""
 
 import json
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from independent_global import differential_evolution_optimum
+from independent_physics import _fork_data
 
 import optdesign as od
 from optdesign.cli import main
@@ -73,7 +75,7 @@ def test_known_optimum_values(solved):
 
 
 # The fork's optimum by hand (ISO 286 formulas and Hertz written out, no call into the
-# code under test): tests/test_physics_independent.py.
+# code under test): tests/independent_physics.py.
 
 
 @pytest.mark.parametrize("name", SHIPPED)
@@ -423,3 +425,49 @@ def test_a_feasible_point_where_the_solver_stopped_is_not_called_infeasible(ripp
     assert "(feasible; the solver did not converge)" in text
     assert "a feasible design, but no optimum: the solver stopped (max_iterations)" in text
     assert "no feasible design found" not in text
+
+
+def test_fork_pin_sized_by_single_shear():
+    # With the shear limit at 150 MPa (and the pressure limit relaxed) the smallest pin
+    # that holds wins: at phi = 0 (the largest normal force) with R at its travel limit
+    # 55 / tan 30 deg = 95.2627944 mm, F = 5e5 / 95.2627944 = 5248.6393 N and
+    # d = sqrt(4 F / (pi tau)) = sqrt(4 * 5248.6393 / (pi * 150)) = 6.6746797 mm.
+    problem = problem_from_dict(
+        _fork_data(pin_shear_stress_max="150 MPa", pin_bearing_pressure_max="1000 MPa")
+    )
+    res = solve_nlp(problem, starts=2, seed=1)
+    assert res.status == "optimal"
+    assert res.design["R"] == pytest.approx(95.2627944, rel=1e-6)
+    assert res.design["d"] == pytest.approx(6.6746797, rel=1e-5)
+    assert any(a.name.startswith("pin_shear_stress") for a in res.active)
+
+
+# --- the fork's backlash optimum, derived by hand ------------------------------------------
+def test_fork_optimum_backlash_from_the_iso_formula_and_hertz_by_hand():
+    """fork_min_backlash at its optimum, every term recomputed from the standards.
+
+    R = 55 / tan 30 deg = 95.2627944 mm (nut travel 110 mm over +-30 deg), F = M/R at
+    phi = 0; the bearing pressure F/(1.5 d^2) = 100 MPa fixes d. The clearance is H7/g6
+    from the ISO 286-1 formulas (tolerance factor i = 0.45 D^(1/3) + 0.001 D um, IT7 = 16 i,
+    IT6 = 10 i, g: es = -2.5 D^0.34 um): c_max = IT7 + IT6 - es. Hertz line contact
+    (seed 000 eq. 10-11): b^2 = 4 D (F/L)(1 - nu^2)/(pi E), Delta = D/2 - sqrt(D^2/4 - b^2)
+    for each of pin and bore. The backlash is (c_max + 2 Delta) / R at phi = 0.
+    """
+    R = 55.0 / math.tan(math.radians(30.0))
+    F = 5e5 / R
+    d = math.sqrt(F / (1.5 * 100.0))
+    assert R == pytest.approx(95.2627944, rel=1e-9)
+    assert d == pytest.approx(5.9153128, rel=1e-7)
+    i_um = 0.45 * d ** (1 / 3) + 0.001 * d
+    c_max = (16 * i_um + 10 * i_um + 2.5 * d**0.34) * 1e-3  # mm
+    b2 = 4 * d * (F / (1.5 * d)) * (1 - 0.3**2) / (math.pi * 2.1e5)
+    delta = d / 2 - math.sqrt(d**2 / 4 - b2)
+    expected = math.degrees((c_max + 2 * delta) / R)
+    # the same numbers written out: i = 0.819754 um, IT7 + IT6 = 26 i = 21.3136 um,
+    # -es = 4.5752 um, c_max = 0.0258888 mm; b^2 = 0.0193058 mm^2, 2 Delta = 0.0065310 mm
+    assert c_max == pytest.approx(0.0258888, rel=1e-5)
+    assert 2 * delta == pytest.approx(0.0065310, rel=1e-5)
+    assert expected == pytest.approx(0.0194989, rel=1e-5)
+    res = solve_nlp(load_problem(PROBLEMS / "fork_min_backlash.toml"), starts=2, seed=1)
+    assert res.design["d"] == pytest.approx(d, rel=1e-6)
+    assert res.objective == pytest.approx(expected, rel=1e-6)

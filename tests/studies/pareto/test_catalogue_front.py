@@ -14,9 +14,12 @@ from optdesign.errors import InputError
 from optdesign.problem import problem_from_dict
 from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.catalogue import solve_catalogue
-from optdesign.studies.pareto import catalogue_front
+from optdesign.studies.pareto import (
+    PointRecord,
+    catalogue_front,
+    compute_front,
+)
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, catalogue_task
-from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 from optdesign.studies.pareto.template import FrontRun
 from optdesign.studies.run_options import RunOptions
@@ -318,3 +321,123 @@ def test_one_local_worker_chains_the_points_and_shares_a_memo(problem):
     assert planned["kw"] == {"progress": "epsilon-catalogue: points"}
     planned, _ = _trace(problem, RunOptions(workers=1, scheduler="tcp://x:1"), points=3)
     assert not any("memo" in t for t in planned["tasks"])
+
+
+def _small_catalogue():
+    """cs_min_backlash_catalogue cut to 2 leads x 2 pins on an 11-point grid: a catalogue
+    front of it takes about 20 NLP solves."""
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["5 mm", "8 mm"]}
+    data["requirements"]["deflection"]["points"] = 11
+    return problem_from_dict(data)
+
+
+@pytest.fixture(scope="module")
+def small_catalogue():
+    return _small_catalogue()
+
+
+def test_a_catalogue_front_of_three_objectives_is_refused_saying_it_takes_two():
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    with pytest.raises(InputError) as caught:
+        od.pareto(problem, ["backlash", "motor_torque", "size"], 3)
+    assert caught.value.field == "objectives"
+    assert str(caught.value) == "objectives: a catalogue front takes two objectives"
+
+
+# --- catalogue fronts: the shared memo ----------------------------------------------------
+def test_a_catalogue_front_task_without_a_shared_memo_finds_the_searchs_optimum(
+    small_catalogue,
+):
+    """A parallel catalogue front's tasks carry no memo (each worker runs one alone): such
+    a task is the plain catalogue search."""
+    problem = small_catalogue
+    task = {
+        "problem": problem,
+        "starts": 1,
+        "seed": 3,
+        "id": "anchor-backlash-ms",
+        "kind": "anchor-multistart",
+        "target": "backlash",
+    }
+    rec = PointRecord.from_dict(catalogue_task(task, {}))
+    alone = solve_catalogue(problem, starts=1, seed=3, objective="backlash")
+    assert rec.success and alone.success
+    assert rec.objectives["backlash"] == pytest.approx(alone.objective, rel=1e-6)
+
+
+def test_a_sequential_catalogue_fronts_inner_point_reuses_the_proofs_before_it(
+    small_catalogue, tmp_path
+):
+    """Run one after another, a catalogue front's points share one memo of boxes proved
+    infeasible: the inner point takes fewer NLP solves than the same search (same limit,
+    same first incumbents) without it, for the same answer."""
+    problem = small_catalogue
+    od.pareto(problem, ["backlash", "motor_torque"], points=3, starts=1, out=tmp_path)
+    lines = (tmp_path / "epsilon-catalogue.jsonl").read_text().splitlines()[1:]
+    recs = {r["id"]: PointRecord.from_dict(r) for r in map(json.loads, lines)}
+    inner = recs["epsilon-catalogue-0001"]
+    # the first incumbents the point was given: the looser point before it, then the anchors
+    before = ("epsilon-catalogue-0002", "anchor-backlash", "anchor-motor_torque")
+    alone = solve_catalogue(
+        problem,
+        starts=1,
+        seed=problem.spec.solver.seed,
+        objective="motor_torque",
+        eps=inner.eps,
+        incumbents=[dict(recs[k].design) for k in before],
+    )
+    assert inner.success and alone.success
+    assert inner.objectives["motor_torque"] == pytest.approx(alone.objective, rel=1e-6)
+    assert inner.n_solves < alone.details.catalogue.nlp_solves
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- catalogue fronts ---------------------------------------------------------------------
+def test_a_catalogue_front_of_fewer_than_two_points_is_refused_naming_the_count():
+    """A catalogue front needs two points at least: ``points=1`` is refused, naming the
+    field and the count, before any search."""
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    with pytest.raises(InputError) as caught:
+        compute_front(problem, ["backlash", "motor_torque"], 1)
+    assert caught.value.field == "points"
+    assert str(caught.value) == "points: a front needs at least 2 points, got 1"
+
+
+def test_a_catalogue_front_of_a_problem_without_catalogue_variables_is_refused_first(
+    cs_min_backlash, tmp_path
+):
+    """``CatalogueEpsilon`` given to ``od.pareto`` on a continuous problem is refused
+    naming the field, before its store is opened (it used to write the store and fail in
+    its first task on a message naming ``--formulation catalogue``)."""
+    from optdesign.studies.pareto import CatalogueEpsilon
+
+    with pytest.raises(InputError) as caught:
+        od.pareto(cs_min_backlash, ["backlash", "size"], method=CatalogueEpsilon(), out=tmp_path)
+    assert str(caught.value) == "method: epsilon-catalogue: no variable takes catalogue values"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_every_search_of_a_catalogue_front_takes_the_fronts_seed(monkeypatch, tmp_path):
+    from optdesign.studies.pareto import catalogue_front
+
+    data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
+    data["variables"]["p"] = {"values": ["5 mm", "6 mm"]}
+    data["variables"]["d"] = {"values": ["6 mm", "8 mm"]}
+    problem = problem_from_dict(data)
+    assert problem.spec.solver.seed != 5
+    seeds = []
+    search = catalogue_front.solve_catalogue
+
+    def spy(*args, **kwargs):
+        seeds.append(kwargs.get("seed"))
+        return search(*args, **kwargs)
+
+    monkeypatch.setattr(catalogue_front, "solve_catalogue", spy)
+    od.pareto(problem, ["backlash", "motor_torque"], 3, out=tmp_path, starts=1, seed=5)
+    assert seeds and set(seeds) == {5}

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.problem.load import load
 from optdesign.studies.pareto.chains import (
     NoFeasibleAnchor,
     TwoChains,
@@ -303,3 +304,85 @@ def test_three_objective_rows_heads_then_chains_from_the_tightest_limit():
         assert t["jump"] is None
     # at least a 2 x 2 grid
     assert len(three_objective_tasks(anchors, ["A", "B", "C"], 1, "g", {})) == 2 * 3
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def test_three_objective_tasks_are_indexed_row_by_row():
+    """The index of a three-objective front's tasks is their row-major order (each row's
+    head, then its points): the front lists its points, and seeds their retry starts,
+    by it."""
+    from optdesign.studies.pareto.chains import three_objective_tasks
+    from optdesign.studies.pareto.records import PointRecord
+
+    names = ["size", "backlash", "ripple"]
+    anchors = {
+        k: PointRecord(
+            id=f"anchor-{k}",
+            kind="anchor",
+            status="optimal",
+            verified=True,
+            target=k,
+            objectives=values,
+        )
+        for k, values in (
+            ("size", {"size": 1.0, "backlash": 3.0, "ripple": 3.0}),
+            ("backlash", {"size": 3.0, "backlash": 1.0, "ripple": 2.0}),
+            ("ripple", {"size": 2.0, "backlash": 2.0, "ripple": 1.0}),
+        )
+    }
+    tasks = three_objective_tasks(anchors, names, 9, "t", {})
+    assert [t["index"] for t in tasks] == list(range(len(tasks))) and len(tasks) == 12
+    assert [t["id"] for t in tasks[:5]] == [
+        "t-000-head",
+        "t-000-000",
+        "t-000-001",
+        "t-000-002",
+        "t-001-head",
+    ]
+
+
+def test_a_failed_tie_break_of_the_far_anchor_names_what_its_point_violates(tmp_path):
+    """The two-chain sweep checks anchor B's tie-break before the last point: a failed
+    one raises NoFeasibleAnchor naming, in the file's units, what its best point violates
+    (the problem reaches the check)."""
+    import json
+
+    from optdesign.studies.diagnosis import violated_text
+    from optdesign.studies.pareto.chains import NoFeasibleAnchor, TwoChains
+
+    fork = load(ROOT / "problems" / "fork_min_backlash.toml")
+    od.pareto(fork, ["size", "backlash"], 3, out=tmp_path, starts=1)
+    lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
+    done = {r["id"]: r for r in map(json.loads, lines)}
+    chains = TwoChains(["size", "backlash"], 3, "epsilon", {"problem": fork}, "arc", None)
+    first = {k: done[k] for k in ("anchor-size", "anchor-backlash-ms")}
+    assert chains({"id": "anchor-backlash-ms"}, {}, first)  # the frame and point 0
+    failed = dict(done["anchor-backlash"], status="failed", verified=False)
+    # its best point: the anchor's design with every free variable at its lower bound
+    failed["design"] = {**failed["design"], **{v.name: v.lower for v in fork.free}}
+    failed["x"] = [v.lower for v in fork.free]
+    shown = violated_text(fork, np.array(failed["x"]))
+    assert shown  # that point violates something
+    with pytest.raises(NoFeasibleAnchor) as caught:
+        chains({"id": "anchor-backlash"}, {}, {**first, "anchor-backlash": failed})
+    assert "anchor backlash: no feasible design found (status failed)" in str(caught.value)
+    assert f"at the best point found: {shown}" in str(caught.value)
+
+
+def test_an_anchor_message_without_the_problem_lists_the_records_violations():
+    """Without the problem the message of a failed anchor falls back on the record's own
+    list of violated rows, whatever design it holds."""
+    from optdesign.studies.pareto.chains import anchor_message
+    from optdesign.studies.pareto.records import PointRecord
+
+    rec = PointRecord(
+        id="anchor-size", kind="anchor", status="failed", verified=False, target="size", design={"R": 50.0},
+        violated=["nut_travel", "mean_ratio"],
+    )  # fmt: skip
+    assert anchor_message("size", rec) == (
+        "anchor size: no feasible design found (status failed); violated: nut_travel, mean_ratio"
+    )
+    rec.violated = []
+    assert anchor_message("size", rec).endswith("violated: none reported")

@@ -10,6 +10,7 @@ scripted results, so no solve runs."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -227,3 +228,38 @@ def test_no_slope_without_the_multipliers_of_this_formulation(cs, nlp):
     assert solver.slope("size", "backlash", _neighbour()) is None
     other = RawSolution(np.zeros(len(nlp.lbz)), np.zeros(len(nlp.lbz)), np.ones(len(nlp.lbg)), "x")
     assert solver.slope("size", "backlash", _neighbour(raw=other)) is None
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- the front's back-ends ----------------------------------------------------------------
+def test_an_ipopt_front_warm_starts_its_sweep_solves(cs_min_backlash):
+    """With Ipopt throughout (``solver="ipopt"``) the sweep's solves are warm-started
+    (primal and dual, a small barrier); the plain fallback is not."""
+    from optdesign.studies.pareto.eps_solver import EpsSolver
+
+    eps = EpsSolver(cs_min_backlash, ["backlash", "size"], "ipopt")
+    assert not eps.has_fallback
+    for use in ("primary", "warm"):
+        options = eps.backend(use).options["ipopt"]
+        assert options["warm_start_init_point"] == "yes"
+        assert options["mu_init"] == 1e-6
+    assert "warm_start_init_point" not in eps.backend("fallback").options["ipopt"]
+
+
+def test_a_front_solvers_back_end_is_its_primary_by_default(cs_min_backlash):
+    """``EpsSolver.backend()`` with no use named is the primary back-end (the registry's
+    front primary, SLSQP), the one every sweep solve tries first."""
+    from optdesign.studies.pareto.eps_solver import EpsSolver
+
+    eps = EpsSolver(cs_min_backlash, ["backlash", "size"])
+    assert eps.has_fallback
+    assert eps.backend() is eps.backend("primary")
+    assert eps.backend().name == "scipy-slsqp-exact"
+    assert eps.backend("fallback").name == "ipopt"

@@ -209,3 +209,34 @@ def test_the_anchors_values_are_copied_per_anchor():
     rec.objectives["x"] = 2.0
     assert out["x"]["x"] == 1.0
     assert Front(OBJ, "m", []).anchors == {}
+
+
+def test_common_hypervolumes_of_two_fronts_against_their_shared_reference_point():
+    """Two fronts measured against the reference point of both together: each front's
+    common hypervolume is its hypervolume against that point (the larger front's is
+    larger), not against its own."""
+    from optdesign.studies.pareto.front import Front, FrontPoint, common_hypervolumes
+    from optdesign.studies.pareto.metrics import hypervolume, reference_point
+
+    def front(F):
+        points = [
+            FrontPoint(
+                id=f"p{k}",
+                kind="eps",
+                status="optimal",
+                verified=True,
+                target="a",
+                objectives={"a": a, "b": b},
+            )
+            for k, (a, b) in enumerate(F)
+        ]
+        return Front(["a", "b"], "m", points)
+
+    small, large = front([[1.0, 2.0], [2.0, 1.0]]), front([[0.5, 3.0], [3.0, 0.5], [1.0, 1.0]])
+    common_hypervolumes([small, large])
+    ref = reference_point(np.vstack([small.F, large.F]))
+    for f in (small, large):
+        assert f.metrics["common_reference_point"] == pytest.approx(ref.tolist())
+        assert f.metrics["hypervolume_common"] == pytest.approx(hypervolume(f.F, ref))
+    assert small.metrics["hypervolume_common"] != pytest.approx(hypervolume(small.F))
+    assert large.metrics["hypervolume_common"] > small.metrics["hypervolume_common"]

@@ -2,9 +2,11 @@
 solve): front.csv's rows, headings, digits and units, written and read back through the
 csv module, several fronts in one file, the unit checks on reading, front.json."""
 
+import copy
 import csv
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -161,3 +163,65 @@ def test_front_json_holds_every_front_with_meta_and_null_for_non_finite(problem,
     assert data["fronts"][0]["metrics"]["hv"] is None
     assert [p["id"] for p in data["fronts"][0]["points"]] == ["made-0", "made-1"]
     assert "Infinity" not in path.read_text() and "NaN" not in path.read_text()
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+# --- resuming a stored front ------------------------------------------------------------
+@pytest.fixture(scope="module")
+def weighted_run(tmp_path_factory):
+    """A finished 3-point weighted-sum front of cs_min_backlash (its output folder)."""
+    out = tmp_path_factory.mktemp("weighted")
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
+    assert len(front.points) >= 2
+    return problem, out, front
+
+
+def test_front_csv_lists_the_rejected_points_off_the_front(weighted_run, tmp_path):
+    """front.csv holds every point, the rejected ones (dominated, failed) marked off it."""
+    problem, _, front = weighted_run
+    front = copy.deepcopy(front)
+    front.rejected = [replace(front.points[0], id="r-0", rejected="dominated")]
+    path = write_front_csv(front, problem, tmp_path / "front.csv")
+    with path.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["id"] for r in rows] == [*(p.id for p in front.points), "r-0"]
+    assert [r["on_front"] for r in rows] == ["True"] * len(front.points) + ["False"]
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+def _front_of_midpoints(problem, objectives=("backlash", "size")):
+    """A two-point front over the problem's mid-box design (no solve): enough to draw."""
+    design = problem.design_dict(problem.midpoint())
+    points = [
+        FrontPoint(
+            id=f"eps-{k}",
+            kind="eps",
+            target="backlash",
+            objectives=dict(zip(objectives, values, strict=True)),
+            design=dict(design),
+            status="optimal",
+            verified=True,
+            method="epsilon",
+        )
+        for k, values in enumerate([(0.1, 30.0), (0.2, 20.0)])
+    ]
+    return make_front(points, list(objectives), "epsilon", problem=problem)
+
+
+# --- files of a front ---------------------------------------------------------------------
+def test_an_empty_fronts_csv_has_the_heading_every_front_csv_starts_with(cs_min_backlash, tmp_path):
+    """A front with no point still writes front.csv: the one heading ``method``, the
+    first heading of a front with points."""
+    empty = make_front([], ["backlash", "size"], "epsilon", problem=cs_min_backlash)
+    path = write_front_csv(empty, cs_min_backlash, tmp_path / "empty.csv")
+    assert path.read_text() == "method\n"
+    full = _front_of_midpoints(cs_min_backlash)
+    text = write_front_csv(full, cs_min_backlash, tmp_path / "full.csv").read_text()
+    assert text.split(",")[0] == "method"

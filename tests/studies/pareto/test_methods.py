@@ -8,23 +8,29 @@ short runs of each method on the crank-slider, their records checked one by one.
 
 from __future__ import annotations
 
+import json
+import math
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign.argument_checks import ArgumentError
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem import load_problem
-from optdesign.studies.pareto import compute_front
-from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
-from optdesign.studies.pareto.methods import (
+from optdesign.studies.pareto import (
     NSGA2,
     EpsilonConstraint,
+    compute_front,
+    make_method,
+)
+from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
+from optdesign.studies.pareto.methods import (
     WeightedSum,
     _weight_grid,
     check_time_limit,
-    make_method,
     pymoo_problem,
 )
 
@@ -443,7 +449,6 @@ def test_a_front_stopped_by_its_time_limit_names_the_points_left_out(cs, tmp_pat
 def test_a_weighted_sum_without_a_feasible_anchor_names_what_its_best_point_violates(tmp_path):
     """The anchors of a weighted-sum front are checked with the problem: the refusal
     evaluates the best point found, not only the record's list of violated rows."""
-    import tomllib
 
     import optdesign as od
     from optdesign.studies.pareto.chains import NoFeasibleAnchor
@@ -463,3 +468,143 @@ def test_a_weighted_sum_without_a_feasible_anchor_names_what_its_best_point_viol
     assert err.value.objective == "backlash"
     assert "at the best point found: mean ratio over the stroke (mean_ratio) = " in str(err.value)
     assert ", min 250: short by " in str(err.value)
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+# --- resuming a stored front ------------------------------------------------------------
+@pytest.fixture(scope="module")
+def weighted_run(tmp_path_factory):
+    """A finished 3-point weighted-sum front of cs_min_backlash (its output folder)."""
+    out = tmp_path_factory.mktemp("weighted")
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
+    assert len(front.points) >= 2
+    return problem, out, front
+
+
+# --- what a stored front holds ----------------------------------------------------------
+def _stored(out: Path, name: str) -> dict[str, dict]:
+    lines = (out / f"{name}.jsonl").read_text().splitlines()[1:]
+    return {r["id"]: r for r in map(json.loads, lines)}
+
+
+def test_nsga2_is_a_front_method_of_a_catalogue_problem():
+    """NSGA-II searches catalogue variables as item indices: it is not refused on a
+    catalogue problem, and every point it gives is a catalogue design."""
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    assert make_method(problem, "nsga2", 7, pop_size=8) == NSGA2(pop_size=8)
+    front = od.pareto(
+        problem, ["backlash", "motor_torque"], method="nsga2", pop_size=8, generations=3, seed=1
+    )
+    # a population of 8 over 3 generations may find no feasible design (it depends on
+    # the releases' random streams): every design it gave, on the front or not, is read
+    assert front.method == "nsga2"
+    leads = {2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0}
+    designs = [point.design for point in [*front.points, *front.rejected] if point.design]
+    assert designs and all(design["p"] in leads for design in designs)
+    assert all(point.verified for point in front.points)
+
+
+def test_a_method_object_with_settings_beside_it_is_refused_naming_them():
+    """Settings go into a method object, not beside it: the library front refuses them,
+    naming each, before any work."""
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    method = EpsilonConstraint(points=3)
+    with pytest.raises(ProblemError, match=r"options \['seed', 'starts'\] go into the method"):
+        make_method(problem, method, 7, starts=2, seed=1)
+    with pytest.raises(ProblemError, match=r"options \['starts'\] go into the method object"):
+        compute_front(problem, ["backlash", "size"], 3, method, starts=2)
+    assert make_method(problem, method, 7) is method
+
+
+def test_a_weighted_sum_fronts_points_are_stored_as_weighted_sum_records(weighted_run):
+    _, out, _ = weighted_run
+    records = _stored(out, "weighted_sum")
+    points = [r for r in records.values() if r["id"].startswith("ws-")]
+    assert len(points) == 3
+    assert {r["kind"] for r in points} == {"weighted_sum"}
+    assert {r["kind"] for k, r in records.items() if k.startswith("anchor-")} == {
+        "anchor-multistart",
+        "anchor",
+    }
+
+
+def test_an_epsilon_front_solves_the_limits_it_is_given(tmp_path):
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    method = EpsilonConstraint(eps_values=[0.05, 0.1, 0.15], starts=1)
+    front = od.pareto(problem, ["backlash", "size"], method=method, out=tmp_path)
+    records = _stored(tmp_path, "epsilon")
+    assert [records[f"epsilon-{i:04d}"]["eps"] for i in range(3)] == [
+        {"backlash": 0.05},
+        {"backlash": 0.1},
+        {"backlash": 0.15},
+    ]
+    # each limit is active at its point: backlash on it, to the solver's tolerance
+    got = sorted(p.objectives["backlash"] for p in front.points)
+    assert got == pytest.approx([0.05, 0.1, 0.15], rel=1e-6)
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- the work a front reports ---------------------------------------------------------------
+def test_a_weighted_sum_front_counts_the_solves_of_its_points_and_anchors(
+    cs_min_backlash, tmp_path
+):
+    """A weighted-sum front's ``n_solves`` is one solve a point plus every solve behind its
+    anchors (their multistarts and tie-breaks), as its store records them."""
+    front = od.pareto(
+        cs_min_backlash, ["backlash", "size"], 4, method="weighted_sum", out=tmp_path, starts=1
+    )
+    lines = (tmp_path / "weighted_sum.jsonl").read_text().splitlines()[1:]
+    records = list(map(json.loads, lines))
+    points = [r for r in records if r["kind"] == "weighted_sum"]
+    anchors = [r for r in records if r["kind"] == "anchor"]
+    assert len(points) == 4 and len(anchors) == 2
+    assert all(r["n_solves"] >= 2 for r in anchors)  # the multistart's solve and the tie's
+    assert front.n_solves == 4 + sum(r["n_solves"] for r in anchors)
+
+
+def test_nsga2_runs_the_generations_it_is_given(cs_min_backlash, monkeypatch):
+    """NSGA-II evaluates one population a generation, for exactly ``generations``."""
+    from optdesign.studies.pareto import methods
+
+    calls = []
+    real = methods.pymoo_problem
+
+    def counted(problem, objectives):
+        inner = real(problem, objectives)
+        evaluate = inner._evaluate
+
+        def _evaluate(X, out, *args, **kwargs):
+            calls.append(len(X))
+            if len(calls) > 10:
+                raise RuntimeError("NSGA-II ran past the generations it was given")
+            return evaluate(X, out, *args, **kwargs)
+
+        inner._evaluate = _evaluate
+        return inner
+
+    monkeypatch.setattr(methods, "pymoo_problem", counted)
+    front = od.pareto(
+        cs_min_backlash, ["backlash", "size"], method="nsga2", pop_size=8, generations=3, seed=1
+    )
+    assert calls == [8, 8, 8]
+    assert front.settings == {"pop_size": 8, "generations": 3, "seed": 1}
+
+
+def test_three_objective_weights_are_the_smallest_triangle_holding_the_points():
+    """A 3-objective weighted sum: the weights lie on a triangular grid of side s, the
+    smallest with s (s + 1) / 2 >= points, and sum to 1."""
+    from optdesign.studies.pareto.methods import _weight_grid
+
+    for points, side in ((3, 2), (6, 3), (10, 4), (11, 5), (15, 5)):
+        grid = _weight_grid(3, points)
+        assert len(grid) == side * (side + 1) // 2
+        assert all(min(w) >= 0 and math.isclose(sum(w), 1.0) for w in grid)
+        assert len({tuple(round(x, 12) for x in w) for w in grid}) == len(grid)
+    assert _weight_grid(2, 5) == [(w, 1 - w) for w in np.linspace(0.0, 1.0, 5)]

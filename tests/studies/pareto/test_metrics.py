@@ -197,3 +197,13 @@ def test_every_pair_of_a_front_is_mutually_non_dominated():
     F = np.array(list(itertools.product(range(4), range(4))), dtype=float)
     P = F[non_dominated(F)]
     assert P.tolist() == [[0.0, 0.0]]
+
+
+# --- metrics ------------------------------------------------------------------------------
+def test_the_spread_of_coincident_or_evenly_spaced_points_is_zero():
+    """Points that all coincide have no uneven gap: their spread is 0, not NaN."""
+    from optdesign.studies.pareto.metrics import spread
+
+    F = np.array([[1.0, 2.0], [1.0, 2.0], [1.0, 2.0]])
+    assert spread(F) == 0.0
+    assert spread(np.array([[0.0, 2.0], [1.0, 1.0], [2.0, 0.0]])) == 0.0  # even gaps

@@ -2,6 +2,7 @@
 three objectives, the CLI."""
 
 import csv
+import itertools
 import json
 import time
 from pathlib import Path
@@ -13,8 +14,10 @@ import optdesign as od
 import optdesign.solvers.casadi_nlp
 import optdesign.solvers.multistart
 from optdesign.cli import main
+from optdesign.errors import InputError
 from optdesign.problem import load_problem
 from optdesign.problem.design_problem import relative_violation
+from optdesign.problem.load import load
 from optdesign.solvers import deadline
 from optdesign.studies.pareto import compute_front
 from optdesign.studies.pareto.methods import pymoo_problem
@@ -646,3 +649,81 @@ def test_pareto_time_limit_on_the_command_line(tmp_path, monkeypatch, capsys):
     assert "of 10 points not computed" in text
     data = json.loads((out / "front.json").read_text())
     assert any("time limit of 30 s reached" in n for f in data["fronts"] for n in f["notes"])
+
+
+# --- a three-objective front, fast -----------------------------------------------------------
+def test_three_objective_front_small(tmp_path):
+    """The crank-slider's (ripple, backlash, size) front on a 2 x 2 grid.
+
+    Checked against properties an epsilon-constraint front must have, not its own
+    output: three columns; every point meets its epsilons; the ripple and backlash ends
+    are the single-objective optima found (and checked against a global search) in
+    test_solve (0.0121114, 0.0362197 deg); within a row (same ripple bound) a looser
+    backlash bound never gives a larger size; no point is dominated by another.
+    """
+    from optdesign.studies.pareto import compute_front
+    from optdesign.studies.pareto.metrics import non_dominated
+
+    cs = load_problem(PROBLEMS / "cs_min_backlash.toml")
+    front = compute_front(
+        cs, ["ripple", "backlash", "size"], 3, "epsilon", out=tmp_path, starts=2, workers=1
+    )
+    F = front.F
+    assert F.shape[1] == 3 and len(F) >= 4
+    assert all(p.verified for p in front.points)
+    for p in front.points:
+        for k, e in p.eps.items():
+            assert p.objectives[k] <= e * (1 + 1e-6) + 1e-12, (p.eps, p.objectives)
+    assert F[:, 0].min() == pytest.approx(0.0121114, rel=1e-4)
+    assert F[:, 1].min() == pytest.approx(0.0362197, rel=1e-4)
+    # the smallest linkage of the box is on the front
+    assert F[:, 2].min() == pytest.approx(front.anchors["size"]["size"], rel=1e-6)
+    # rows: points with both a ripple and a backlash bound, grouped by the ripple bound
+    rows: dict[float, list] = {}
+    for p in front.points:
+        if "ripple" in p.eps and "backlash" in p.eps:
+            rows.setdefault(round(p.eps["ripple"], 9), []).append(p)
+    assert len(rows) == 2 and all(len(r) >= 2 for r in rows.values())
+    for row in rows.values():
+        row.sort(key=lambda p: p.eps["backlash"])
+        sizes = [p.objectives["size"] for p in row]
+        assert all(b <= a * (1 + 1e-6) for a, b in itertools.pairwise(sizes)), sizes
+    # distinct points only: near-duplicates (same point reached twice) are not dominated
+    uniq = np.unique(np.round(F / np.abs(F).max(axis=0), 6), axis=0)
+    assert non_dominated(uniq).all()
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- the front's objectives ---------------------------------------------------------------
+def test_a_library_front_of_a_repeated_objective_is_refused_naming_the_field(cs_min_backlash):
+    """``compute_front`` (below the API's own check) refuses an objective given twice,
+    naming the field and the list, before any solve."""
+    with pytest.raises(InputError) as caught:
+        compute_front(cs_min_backlash, ["backlash", "backlash"], 3)
+    assert caught.value.field == "objectives"
+    assert str(caught.value) == "objectives: repeated objective in ['backlash', 'backlash']"
+
+
+def test_a_library_front_of_an_unknown_method_is_refused_naming_the_known_ones(cs_min_backlash):
+    """``compute_front`` refuses a method name it does not know, listing the known ones."""
+    with pytest.raises(InputError) as caught:
+        compute_front(cs_min_backlash, ["backlash", "size"], 3, method="simplex")
+    assert caught.value.field == "method"
+    assert str(caught.value).startswith("method: unknown method 'simplex' (known: epsilon, ")
+
+
+def test_the_library_front_refuses_a_wrong_number_of_objectives_naming_the_field():
+    """``compute_front`` (the studies layer, under od.pareto's own checks) refuses one or
+    four objectives itself, naming ``objectives``."""
+    from optdesign.studies.pareto import compute_front
+
+    fork = load(ROOT / "problems" / "fork_min_backlash.toml")
+    for objectives in (["size"], ["size", "backlash", "ripple", "motor_torque"]):
+        with pytest.raises(InputError) as caught:
+            compute_front(fork, objectives, 3)
+        assert caught.value.field == "objectives"
+        assert caught.value.reason == f"give two or three objectives, got {objectives}"

@@ -11,21 +11,27 @@ always passes, so only the check under test can refuse.
 
 from __future__ import annotations
 
+import json
 import math
+import shutil
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+import optdesign as od
 from optdesign.problem import load_problem
 from optdesign.solvers.result import ConstraintReport, Result
-from optdesign.studies.pareto import records
+from optdesign.storage import StoreError
+from optdesign.studies.pareto import (
+    PointRecord,
+    records,
+)
 from optdesign.studies.pareto.records import (
     BOUNDS_RTOL,
     RECHECK_RTOL,
     AnchorStarts,
-    PointRecord,
     RawSolution,
     json_vector,
     record_from_result,
@@ -528,3 +534,125 @@ def test_a_stored_catalogue_variable_must_be_on_an_item(stand):
     )
     # a continuous variable between two of the catalogue's values is fine
     assert record_problem(stand, _solution(a=2.5 + 0.5, c=1.0)) is None
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+# --- resuming a stored front ------------------------------------------------------------
+@pytest.fixture(scope="module")
+def weighted_run(tmp_path_factory):
+    """A finished 3-point weighted-sum front of cs_min_backlash (its output folder)."""
+    out = tmp_path_factory.mktemp("weighted")
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
+    assert len(front.points) >= 2
+    return problem, out, front
+
+
+def _resume_weighted(problem, out, points=3, starts=1):
+    return od.pareto(
+        problem,
+        ["backlash", "size"],
+        points,
+        method="weighted_sum",
+        starts=starts,
+        out=out,
+        resume=True,
+    )
+
+
+@pytest.mark.parametrize("status", [None, "failed"])
+def test_a_stored_record_whose_verified_flag_is_not_a_boolean_refuses_the_resume(
+    weighted_run, tmp_path, status
+):
+    """A record's ``verified`` is true, false or null; anything else refuses the resume,
+    a failed record's too (a failed record is otherwise not checked further)."""
+    problem, finished, _ = weighted_run
+    out = shutil.copytree(finished, tmp_path / "out")
+    store = out / "weighted_sum.jsonl"
+    lines = [json.loads(x) for x in store.read_text().splitlines()]
+    k = next(k for k, r in enumerate(lines) if k and r.get("verified") is True)
+    lines[k]["verified"] = "yes"
+    if status is not None:
+        lines[k]["status"] = status
+    store.write_text("".join(json.dumps(x) + "\n" for x in lines))
+    with pytest.raises(StoreError, match=f"line {k + 1}: record") as caught:
+        _resume_weighted(problem, out)
+    assert "field 'verified' is not true, false or null" in str(caught.value)
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- stored records -----------------------------------------------------------------------
+def test_a_stored_anchor_whose_multistart_is_not_a_multistart_record_is_not_trusted(
+    cs_min_backlash,
+):
+    """A stored record's ``multistart`` is null or the anchor's multistart record (every
+    field); anything else is named as the reason the record cannot be trusted."""
+    record = PointRecord(
+        id="anchor-backlash-ms",
+        kind="anchor-multistart",
+        target="backlash",
+        status="failed",
+        multistart=AnchorStarts(
+            n_starts=2, n_planned=2, n_at_best=0, agree=None, stopped_early=False
+        ),
+    ).to_dict()
+    assert record_problem(cs_min_backlash, record) is None
+    for broken in ({"n_starts": 2}, [2, 2, 0, None, False], "2 starts"):
+        why = record_problem(cs_min_backlash, {**record, "multistart": broken})
+        assert why == "field 'multistart' is not a multistart record"
+
+
+def test_a_stored_record_whose_lists_are_not_lists_of_names_is_not_trusted(cs_min_backlash):
+    """A stored record's ``active``, ``violated`` and ``order`` are lists of names; a
+    number among them is named as the reason the record cannot be trusted."""
+    record = PointRecord(
+        id="epsilon-0001", kind="eps", target="size", status="failed", active=["backlash"]
+    ).to_dict()
+    assert record_problem(cs_min_backlash, record) is None
+    for name in ("active", "violated", "order"):
+        why = record_problem(cs_min_backlash, {**record, name: ["backlash", 5]})
+        assert why == f"field {name!r} is not a list of names"
+
+
+def test_a_failed_points_record_keeps_the_names_of_its_first_twenty_violated_rows(
+    cs_min_backlash,
+):
+    """A front's record names at most 20 violated rows (the first ones, in the
+    solver's order): a point violating a whole grid does not fill the store."""
+    import math
+
+    from optdesign.solvers.result import ConstraintReport, Result
+    from optdesign.studies.pareto.records import record_from_result
+
+    rows = [
+        ConstraintReport(name=f"deflection[{i}]", value=1.0, lower=None, upper=0.5, amount=0.5)
+        for i in range(25)
+    ]
+    result = Result(
+        status="infeasible", solver="ipopt", objective=math.nan, formulation="nlp", violated=rows
+    )
+    rec = record_from_result(cs_min_backlash, result, "eps", "size", {"backlash": 0.01}, "e-1")
+    assert rec.violated == [f"deflection[{i}]" for i in range(20)]
+    assert not rec.success
+
+
+def test_a_sparse_vector_round_trips_exactly_through_the_store():
+    """Warm starts are stored as sparse vectors when most entries are zero (inactive
+    multipliers): the nonzero entries with their indices - a 1.0 (a scaled variable at
+    its upper bound) among them - and every value comes back bit for bit."""
+    from optdesign.studies.pareto.records import json_vector, vector
+
+    v = np.zeros(10)
+    v[3], v[6] = 1.0, -2.5
+    stored = json_vector(v)
+    assert stored == {"size": 10, "index": [3, 6], "value": [1.0, -2.5]}
+    assert vector(stored).tolist() == v.tolist()
+    dense = np.array([1.0, 0.0, 1e-300, np.inf])
+    assert json_vector(dense) == [1.0, 0.0, 1e-300, None]
+    assert vector(json_vector(dense))[:3].tolist() == [1.0, 0.0, 1e-300]

@@ -4,6 +4,8 @@ message), the store's path, the run's identity and the check of a stored record.
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -11,8 +13,12 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
+from optdesign.storage import StoreError
 from optdesign.studies.nlp_solve import formulation_for
-from optdesign.studies.pareto.records import PointRecord, RawSolution
+from optdesign.studies.pareto import (
+    PointRecord,
+)
+from optdesign.studies.pareto.records import RawSolution
 from optdesign.studies.pareto.run_setup import (
     check_front_problem,
     check_objectives,
@@ -147,3 +153,52 @@ def test_a_stored_record_is_checked_against_the_problem_and_the_fronts_formulati
     # a warm start of another formulation is not this front's: not checked for size
     failed.raw.nlp = formulation_for(cs, ("size", "backlash")).fingerprint
     assert failed.raw.nlp != nlp.fingerprint and check(failed.to_dict()) is None
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+# --- resuming a stored front ------------------------------------------------------------
+@pytest.fixture(scope="module")
+def weighted_run(tmp_path_factory):
+    """A finished 3-point weighted-sum front of cs_min_backlash (its output folder)."""
+    out = tmp_path_factory.mktemp("weighted")
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
+    assert len(front.points) >= 2
+    return problem, out, front
+
+
+def _resume_weighted(problem, out, points=3, starts=1):
+    return od.pareto(
+        problem,
+        ["backlash", "size"],
+        points,
+        method="weighted_sum",
+        starts=starts,
+        out=out,
+        resume=True,
+    )
+
+
+def test_resuming_a_weighted_sum_front_with_other_settings_names_the_setting(
+    weighted_run, tmp_path
+):
+    problem, finished, _ = weighted_run
+    out = shutil.copytree(finished, tmp_path / "out")
+    with pytest.raises(
+        StoreError, match=r"method's settings changed \(method.n: stored 3, now 4\)"
+    ):
+        _resume_weighted(problem, out, points=4)
+    with pytest.raises(StoreError, match=r"\(method.starts: stored 1, now 2\)"):
+        _resume_weighted(problem, out, starts=2)
+
+
+def test_a_front_without_an_output_folder_keeps_its_store_in_a_named_temporary_folder():
+    """No ``out``: the store goes to a new temporary folder whose name says what it is."""
+    from optdesign.studies.pareto.run_setup import store_path
+
+    path = store_path(None, "epsilon")
+    assert path.name == "epsilon.jsonl" and path.parent.is_dir()
+    assert path.parent.name.startswith("optdesign-pareto-")
+    path.parent.rmdir()

@@ -7,21 +7,28 @@ start and every branch (agreeing starts, the fallback re-run, a tie-break kept o
 point retried and why, the cold starts and which of them wins) is checked against values
 worked out by hand. The record of a result is the stand-in too (it logs what the task
 hands it: problem, kind, target, limits, id, fingerprint); the real records of real
-solves are the pareto tests' (tests/test_pareto.py, tests/test_mutation_sample4.py).
+solves are the pareto tests' (tests/studies/pareto/test_pareto.py, test_methods.py).
 """
 
 from __future__ import annotations
 
+import json
 import math
+from dataclasses import replace
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+import optdesign as od
+from optdesign.problem.load import load
 from optdesign.solvers.multistart import sobol_starts
 from optdesign.solvers.result import Result
-from optdesign.studies.pareto import tasks
-from optdesign.studies.pareto.records import PointRecord
+from optdesign.studies.pareto import (
+    PointRecord,
+    tasks,
+)
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps, front_task, row_eps
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
@@ -756,3 +763,300 @@ def test_a_polish_whose_solve_fails_from_a_better_design_takes_that_design(fake)
     assert record["x"] == [7.0, 2.0] and record["objectives"] == {"a": 2.5, "b": 5.0}
     assert record["eps"] == {"a": 3.0} and record["retried"] == "polished from seen"
     assert record["fallback"].startswith("kept seen's design: the solve from it failed")
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+# --- resuming a stored front ------------------------------------------------------------
+@pytest.fixture(scope="module")
+def weighted_run(tmp_path_factory):
+    """A finished 3-point weighted-sum front of cs_min_backlash (its output folder)."""
+    out = tmp_path_factory.mktemp("weighted")
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "size"], 3, method="weighted_sum", starts=1, out=out)
+    assert len(front.points) >= 2
+    return problem, out, front
+
+
+# --- what a stored front holds ----------------------------------------------------------
+def _stored_records(out: Path, name: str) -> dict[str, dict]:
+    lines = (out / f"{name}.jsonl").read_text().splitlines()[1:]
+    return {r["id"]: r for r in map(json.loads, lines)}
+
+
+def test_an_anchors_tie_break_minimises_its_second_objective_within_its_first(weighted_run):
+    """The anchor of backlash holds backlash at its optimum (plus the anchors' slack) and
+    then minimises size: no design the front found within that backlash is smaller."""
+    _, out, _ = weighted_run
+    records = _stored_records(out, "weighted_sum")
+    anchor, first = records["anchor-backlash"], records["anchor-backlash-ms"]
+    assert anchor["order"] == ["backlash", "size"]
+    # the bound, to the solver's feasibility tolerance
+    bound = (first["objectives"]["backlash"] * (1 + ANCHOR_SLACK) + 1e-12) * (1 + 1e-6)
+    assert anchor["objectives"]["backlash"] <= bound
+    within = [r for r in records.values() if r["objectives"]["backlash"] <= bound]
+    assert len(within) >= 3  # the first stage and a weighted point too
+    assert all(anchor["objectives"]["size"] <= r["objectives"]["size"] for r in within)
+
+
+def test_a_three_objective_grid_point_lies_at_its_fraction_between_the_row_head_and_b_max():
+    head = PointRecord(
+        id="row-head",
+        kind="eps",
+        status="optimal",
+        verified=True,
+        target="size",
+        objectives={"backlash": 1.0, "size": 2.0, "ripple": 0.1},
+    )
+    task = {"b_name": "size", "b_hi": 10.0, "frac": 0.25, "eps_row": {"backlash": 1.5}}
+    lo = 2.0 * (1 + ANCHOR_SLACK) + 1e-12
+    assert row_eps(task, head) == {"backlash": 1.5, "size": pytest.approx(lo + 0.25 * (10 - lo))}
+    # a failed head gives no lower end: the point sits at B_max
+    failed = replace(head, status="failed", verified=None)
+    assert row_eps(task, failed) == {"backlash": 1.5, "size": 10.0}
+
+
+def test_an_arc_step_from_a_neighbour_without_a_slope_takes_the_frames_slope():
+    """The next limit of an arc-spaced sweep is a Newton step along the front's arc; a
+    neighbour whose multiplier gave no slope steps with the frame's mean slope rb / ra."""
+    frame = {"a0": 0.0, "b0": 1.0, "ra": 1.0, "rb": 2.0, "a_lo": 0.0, "a_hi": 1.0}
+    task = {"frame": frame, "eps_name": "a", "target": "b", "arc": 1.0, "fallback_eps": 0.9}
+    nb = PointRecord(
+        id="p",
+        kind="eps",
+        status="optimal",
+        verified=True,
+        target="b",
+        objectives={"a": 0.2, "b": 1.6},
+        eps={"a": 0.2},
+    )
+    # s1 = 0.2 / 1 + (1 - 1.6) / 2 = -0.1; slope 2 / 1 = 2; ds/da = 1 + 2 / 2 = 2
+    assert arc_eps(task, nb) == {"a": pytest.approx(0.2 + 1.1 / 2)}
+    # the neighbour's own slope -6: ds/da = 1 + 6 / 2 = 4
+    assert arc_eps(task, replace(nb, slope=-6.0)) == {"a": pytest.approx(0.2 + 1.1 / 4)}
+    # no neighbour's design: the task's fallback limit
+    assert arc_eps(task, None) == {"a": 0.9}
+
+
+def test_a_point_far_from_its_neighbours_design_is_retried_saying_so():
+    """An epsilon point whose design lies more than a fifth of the box from its warm
+    neighbour's is re-solved from cold starts, and its record says why."""
+    from optdesign.studies.pareto.tasks import front_task
+
+    problem = od.load(ROOT / "problems" / "fork_min_backlash.toml")
+    common = {"problem": problem, "objectives": ["backlash", "size"], "solver": "ipopt"}
+    first = {**common, "id": "p-0", "kind": "eps", "target": "backlash", "index": 0}
+    solo = front_task({**first, "eps": {"size": 1e9}}, {})
+    assert solo["retried"] == ""
+    # a neighbour no better (so not the "worse" retry) at the far corner of the box
+    neighbour = {**solo, "id": "p-1", "objectives": {**solo["objectives"]}}
+    neighbour["objectives"]["backlash"] *= 1.1
+    neighbour["eps"], neighbour["x"] = {"size": 5e8}, [float(v) for v in problem.lower()]
+    task = {**first, "eps": {"size": 1e9}, "warm": "p-1", "retry_starts": 1, "seed": 3}
+    rec = front_task(task, {"p-1": neighbour})
+    assert rec["retried"] == "jump in design space"
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- the chains of an epsilon front -------------------------------------------------------
+def _record(id_, kind, objectives):
+    return PointRecord(
+        id=id_,
+        kind=kind,
+        target="size",
+        status="optimal",
+        verified=True,
+        objectives=objectives,
+    ).to_dict()
+
+
+def _arc_chain():
+    """The first two tasks of a 5-point arc sweep between anchor A (backlash 1, size 10)
+    and B's multistart optimum (backlash 5, size 2)."""
+    from optdesign.studies.pareto.chains import TwoChains
+
+    chains = TwoChains(["backlash", "size"], 5, "epsilon", {}, "arc", None)
+    done = {
+        "anchor-backlash": _record("anchor-backlash", "anchor", {"backlash": 1.0, "size": 10.0}),
+        "anchor-size-ms": _record(
+            "anchor-size-ms", "anchor-multistart", {"backlash": 5.0, "size": 2.0}
+        ),
+    }
+    (first,) = chains({"id": "anchor-size-ms"}, done["anchor-size-ms"], done)
+    (second,) = chains(first, {}, done)
+    return first, second
+
+
+# --- the sweep's solves -------------------------------------------------------------------
+def test_an_epsilon_point_that_needs_no_retry_is_solved_once(cs_min_backlash, tmp_path):
+    """Without extra starts, a point whose warm start succeeds (not worse than its
+    neighbour, no jump) costs one solve, and its record says so."""
+    od.pareto(cs_min_backlash, ["backlash", "size"], 5, out=tmp_path, starts=1)
+    lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
+    eps = [r for r in map(json.loads, lines) if r["kind"] == "eps" and "polish" not in r["id"]]
+    plain = [r for r in eps if not r["retried"]]
+    assert len(eps) == 5 and len(plain) >= 3
+    assert [r["n_solves"] for r in plain] == [1] * len(plain)
+
+
+def test_a_weighted_sum_point_whose_neighbour_failed_restarts_from_its_chains_anchor(
+    cs_min_backlash, tmp_path, monkeypatch
+):
+    """The weighted-sum chain starts at the last objective's anchor (weight 0 on the
+    first); a point whose neighbour failed starts again from that anchor's design."""
+    from optdesign.studies.pareto import tasks
+
+    real = tasks.TASK_KINDS["weighted_sum"]
+    given = {}
+
+    def weighted(task, deps):
+        given[task["id"]] = task["x0"]
+        if task["id"] == "ws-0001":  # a failed point: the next one starts without it
+            return PointRecord(
+                id=task["id"], kind="weighted_sum", target="backlash", status="failed"
+            ).to_dict()
+        return real(task, deps)
+
+    monkeypatch.setitem(tasks.TASK_KINDS, "weighted_sum", weighted)
+    front = od.pareto(
+        cs_min_backlash, ["backlash", "size"], 3, method="weighted_sum", out=tmp_path, starts=1
+    )
+    lines = (tmp_path / "weighted_sum.jsonl").read_text().splitlines()[1:]
+    anchors = {r["id"]: r["x"] for r in map(json.loads, lines) if r["kind"] == "anchor"}
+    assert anchors["anchor-size"] != anchors["anchor-backlash"]
+    assert given == {f"ws-000{i}": anchors["anchor-size"] for i in range(3)}
+    assert "ws-0002" in {p.id for p in front.points}
+
+
+def test_an_arc_point_whose_neighbour_failed_takes_the_evenly_spaced_limit():
+    """An arc-spaced point whose neighbour has no design cannot predict its limit from
+    the neighbour: it takes its place on an even spacing between the frame's ends."""
+    from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps
+
+    first, second = _arc_chain()
+    assert second["index"] == 1 and second["eps_name"] == "backlash"
+    lo = 1.0 * (1 + ANCHOR_SLACK) + 1e-12
+    assert first["eps"] == {"backlash": lo}
+    failed = PointRecord(id=first["id"], kind="eps", target="size", status="failed")
+    assert arc_eps(second, failed) == {"backlash": pytest.approx(lo + (5.0 - lo) / 4, rel=1e-12)}
+    assert arc_eps(second, None) == arc_eps(second, failed)
+
+
+def test_an_arc_step_never_asks_below_the_first_anchors_limit():
+    """A neighbour already past the point's arc position steps back, but never below
+    the frame's lower end (anchor A's optimum plus the anchors' slack): no limit
+    tighter than the best A can reach."""
+    from optdesign.studies.pareto.tasks import ANCHOR_SLACK, arc_eps
+
+    _, second = _arc_chain()
+    lo = 1.0 * (1 + ANCHOR_SLACK) + 1e-12
+    past = PointRecord(
+        id="epsilon-0000",
+        kind="eps",
+        target="size",
+        status="optimal",
+        verified=True,
+        objectives={"backlash": 1.0, "size": 2.0},
+    )
+    assert arc_eps(second, past) == {"backlash": lo}
+
+
+# --- anchors ------------------------------------------------------------------------------
+def test_an_anchor_whose_starts_succeed_solves_each_start_once(cs_min_backlash, tmp_path):
+    """An anchor's multistart re-runs its starts with the fallback back-end only when no
+    start reached a solution: starts that succeed cost one solve each (on the thinned
+    grid), plus one for their optimum solved again on the whole grid."""
+    od.pareto(cs_min_backlash, ["backlash", "size"], 3, out=tmp_path, starts=2)
+    lines = (tmp_path / "epsilon.jsonl").read_text().splitlines()[1:]
+    ms = [r for r in map(json.loads, lines) if r["kind"] == "anchor-multistart"]
+    assert len(ms) == 2
+    for r in ms:
+        assert r["status"] == "optimal" and r["multistart"]["n_at_best"] >= 1
+        assert r["multistart"]["n_starts"] == 2 and r["n_solves"] == 3
+
+
+def test_an_anchor_multistart_whose_starts_succeed_is_not_solved_again_with_the_fallback():
+    """The fallback re-run is for a search none of whose starts succeeded: one start
+    that reaches the optimum is one solve, and the search stops on its odds (8 starts at
+    one optimum leave fewer than half an optimum expected unseen; six free variables ask
+    for 12 counted starts)."""
+    from optdesign.studies.pareto.tasks import multistart_task
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    order = ["backlash", "size"]
+    # one start solves the problem itself; a search its thinned grid, then polishes
+    for starts, agree, n_starts, solves in [(1, None, 1, 1), (20, 3, 12, 13)]:
+        task = {"problem": problem, "order": order, "objectives": order, "starts": starts,
+                "seed": 0, "agree": agree, "id": "anchor-backlash-ms"}  # fmt: skip
+        record = multistart_task(task, {})
+        assert record["status"] == "optimal" and record["n_solves"] == solves
+        assert record["multistart"]["n_starts"] == n_starts
+        assert record["objectives"]["backlash"] == pytest.approx(0.0362197, rel=1e-5)
+
+
+def test_an_arc_step_back_starts_from_the_tighter_of_the_neighbours_value_and_limit():
+    """Stepping back along the arc (the target lies before the neighbour), the new limit
+    is a step below the lower of the neighbour's value and its own limit."""
+    from dataclasses import replace
+
+    from optdesign.studies.pareto.records import PointRecord
+    from optdesign.studies.pareto.tasks import arc_eps
+
+    frame = {"a0": 0.0, "b0": 1.0, "ra": 1.0, "rb": 2.0, "a_lo": 0.0, "a_hi": 1.0}
+    task = {"frame": frame, "eps_name": "a", "target": "b", "arc": 0.0, "fallback_eps": 0.9}
+    nb = PointRecord(id="p", kind="eps", status="optimal", verified=True, target="b",
+                     objectives={"a": 0.5, "b": 1.2}, eps={"a": 0.45})  # fmt: skip
+    # s1 = 0.5 + (1 - 1.2) / 2 = 0.4; ds/da = 1 + 2 / 2 = 2; step = (0 - 0.4) / 2 = -0.2
+    assert arc_eps(task, nb) == {"a": pytest.approx(0.45 - 0.2)}
+    assert arc_eps(task, replace(nb, eps={"a": 0.7})) == {"a": pytest.approx(0.5 - 0.2)}
+
+
+# --- survivors of the second sample (docs/testing.md, "The second sample") ------------------
+def test_a_point_worse_than_its_looser_neighbour_is_retried_on_its_own_target(monkeypatch):
+    """An epsilon point whose warm solve is worse than a neighbour with a tighter bound is
+    re-solved from cold starts, every solve on the point's own objective, and the record
+    says why."""
+    from optdesign.studies.pareto import tasks
+    from optdesign.studies.pareto.eps_solver import EpsSolver
+    from optdesign.studies.pareto.records import PointRecord
+
+    problem = load(ROOT / "problems" / "fork_min_backlash.toml")
+    common = {"problem": problem, "objectives": ["backlash", "size"], "solver": "ipopt"}
+    first = {**common, "id": "p-0", "kind": "eps", "target": "backlash", "index": 0}
+    solo = tasks.front_task({**first, "eps": {"size": 1e9}}, {})
+    assert PointRecord.from_dict(solo).success and solo["retried"] == ""
+    # a neighbour claiming a better backlash under a tighter size bound: the point, whose
+    # bound is looser, cannot be worse, so it doubts its warm solve
+    neighbour = {**solo, "id": "p-1", "objectives": {**solo["objectives"]}}
+    neighbour["objectives"]["backlash"] *= 0.9
+    neighbour["eps"] = {"size": 5e8}
+    targets = []
+    original = EpsSolver.solve
+
+    def spy(self, target, eps, start):
+        targets.append(target)
+        return original(self, target, eps, start)
+
+    monkeypatch.setattr(EpsSolver, "solve", spy)
+    boxes = []
+    sobol = tasks.sobol_starts
+
+    def drawn(lo, hi, n, seed):
+        boxes.append((np.array(lo), np.array(hi), n, seed))
+        return sobol(lo, hi, n, seed)
+
+    monkeypatch.setattr(tasks, "sobol_starts", drawn)
+    task = {**first, "eps": {"size": 1e9}, "warm": "p-1", "retry_starts": 2, "seed": 3}
+    rec = tasks.front_task(task, {"p-1": neighbour})
+    assert rec["retried"] == "worse than its neighbour with a looser bound"
+    assert rec["n_solves"] == 4 and targets == ["backlash"] * 4  # warm, neighbour, 2 Sobol
+    # the cold starts are drawn over the whole box, seeded by the point's index
+    ((lo, hi, n, seed),) = boxes
+    assert np.array_equal(lo, problem.lower()) and np.array_equal(hi, problem.upper())
+    assert (n, seed) == (2, 3)
+    assert rec["objectives"]["backlash"] == pytest.approx(solo["objectives"]["backlash"], rel=1e-6)

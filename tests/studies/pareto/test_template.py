@@ -1,6 +1,7 @@
 """One front-method template (studies/pareto/template.py): a new method is a small
 subclass giving its step; the command line and od.pareto build methods by one function."""
 
+import json
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,6 +18,7 @@ from optdesign.studies.pareto import (
     EpsilonConstraint,
     FrontMethod,
     PointRecord,
+    compute_front,
     make_method,
     template,
 )
@@ -85,7 +87,6 @@ def test_a_new_front_method_is_a_small_subclass_of_the_template(tmp_path):
 def test_the_command_line_builds_methods_as_od_pareto_does(tmp_path):
     """The same front, point for point, from ``optdesign pareto`` and from od.pareto with
     the same settings (both build the method by make_method)."""
-    import json
 
     from optdesign.cli import main
 
@@ -117,7 +118,6 @@ def test_the_command_line_builds_methods_as_od_pareto_does(tmp_path):
 def test_a_front_takes_the_callers_seed_and_makes_its_nested_folder(tmp_path):
     """``seed`` reaches the method (its settings, the store's identity) in place of the
     file's; ``out`` may name a folder whose parents do not exist yet."""
-    import json
 
     fork = od.load(FORK)
     assert fork.spec.solver.seed != 7
@@ -382,3 +382,48 @@ def test_the_runs_tasks_go_through_the_runner_with_the_runs_settings(monkeypatch
     }
     ctx.tasks([], abs, workers=1, check=None)
     assert calls[-1][3]["workers"] == 1 and calls[-1][3]["check"] is None
+
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+# --- the front-method template ----------------------------------------------------------
+@dataclass
+class _NoSettings(FrontMethod):
+    """A plug-in front method that declares neither ``starts`` nor ``seed``."""
+
+    name: str = "plain"
+
+
+def test_a_front_method_without_starts_or_seed_takes_the_problem_files():
+    problem = od.load(ROOT / "problems" / "fork_min_backlash.toml")
+    solver = problem.spec.solver
+    # the file sets no starts: the global search's cap, chosen from the dimension
+    assert solver.starts is None
+    assert _NoSettings().starts_and_seed(problem) == (12 * len(problem.free), solver.seed)
+
+
+@pytest.fixture(scope="module")
+def cs_min_backlash():
+    return od.load(ROOT / "problems" / "cs_min_backlash.toml")
+
+
+# --- the catalogue refusal of the front-method template -----------------------------------
+@dataclass
+class _CatalogueOnly(FrontMethod):
+    """A plug-in front method that needs catalogue variables."""
+
+    name: str = "catalogue-only"
+    designs: ClassVar[str] = "catalogue"
+
+
+def test_a_front_method_that_needs_catalogue_variables_refuses_a_continuous_problem(
+    cs_min_backlash, tmp_path
+):
+    """A method declaring ``designs = "catalogue"`` is refused on a problem without
+    catalogue variables, naming the field and the method, before any store is written."""
+    with pytest.raises(InputError) as caught:
+        compute_front(cs_min_backlash, ["backlash", "size"], 3, _CatalogueOnly(), out=tmp_path)
+    assert caught.value.field == "method"
+    assert str(caught.value) == "method: catalogue-only: no variable takes catalogue values"
+    assert list(tmp_path.iterdir()) == []

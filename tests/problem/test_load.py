@@ -1,151 +1,46 @@
-"""Hostile input through the real command line (issue 13) and input that helps (issue 16).
-
-The corpus (tests/hostile_corpus.py: generated mutations of every shipped problem file,
-hand-written files, bad command lines) runs in one child process through
-``optdesign.cli.main``; a handful of cases run as true subprocesses (a named pipe, a
-device, ``--json`` purity, ``--version``).
-"""
+"""Reading a problem (optdesign/problem/load.py): every refusal names its field, hostile
+structure (nesting, a dict that contains itself, byte-order marks, huge integers) is refused
+naming where, and a value of the wrong kind says what the field takes."""
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 import tomllib
 from pathlib import Path
 
 import pytest
-from hostile_corpus import PROBLEMS, all_cases, handwritten_cases, run_case
+from hostile_corpus import PROBLEMS
 
 import optdesign as od
 from optdesign.errors import OptDesignError
 from optdesign.problem import load_problem
-from optdesign.units import to_internal
 
-HERE = Path(__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize(
+    ("where", "value", "message"),
+    [
+        (("requirements", "hinge_moment"), "1e308 kN*m", "'1e308 kN*m' is out of range"),
+        (
+            ("variables", "d"),
+            {"catalogue": "HIWIN"},
+            "the HIWIN screw catalogue gives d0 and p only",
+        ),
+    ],
+)
+def test_fin_actuator_inputs_refused_naming_their_field(where, value, message):
+    """A hinge moment that overflows in internal units, a catalogue screw asked for a
+    variable it does not give: each refused naming the field."""
+    from optdesign.errors import OptDesignError
+
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+    data[where[0]][where[1]] = value
+    with pytest.raises(OptDesignError) as caught:
+        od.load(data)
+    assert f"{where[0]}.{where[1]}: {message}" in str(caught.value)
+
+
 BASE = (PROBLEMS / "cs_min_backlash.toml").read_text()
-
-
-def _env() -> dict[str, str]:
-    env = dict(os.environ)
-    root = str(HERE.parent)
-    env["PYTHONPATH"] = root + os.pathsep + env.get("PYTHONPATH", "")
-    env.pop("OPTDESIGN_DEBUG", None)
-    return env
-
-
-def _cli(*args: str, timeout: float = 60, cwd: Path | None = None):
-    return subprocess.run(
-        [sys.executable, "-m", "optdesign", *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env=_env(),
-        cwd=cwd,
-    )
-
-
-def test_corpus_is_refused_cleanly(tmp_path):
-    """Every case of the corpus: exit 2 (or 1 where infeasible), the field named, no
-    traceback, no internal error, no hang; the counts go to the issue's closing note."""
-    report = tmp_path / "corpus.json"
-    proc = subprocess.run(
-        [sys.executable, str(HERE / "hostile_corpus.py"), str(report), str(tmp_path / "cases")],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=_env(),
-    )
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    data = json.loads(report.read_text())
-    counts = data["counts"]
-    print("hostile corpus:", counts)
-    failures = [
-        f"{o['name']}: {o['verdict']} (exit {o['code']}): {o['message']}"
-        for o in data["outcomes"]
-        if o["verdict"] != "refused"
-    ]
-    assert not failures, "\n".join(failures[:30])
-    assert counts["tried"] >= 150
-    assert counts["refused"] == counts["tried"]
-    # One line per refusal (argparse adds its usage line).
-    long = [
-        o["name"]
-        for o in data["outcomes"]
-        if not o["name"].startswith("argv:") and o["detail"]["stderr_lines"] > 1
-    ]
-    assert not long
-
-
-def test_corpus_covers_each_class():
-    names = [c.name for c in all_cases()]
-    for needle in ("=nan", "=inf", "=1e400", "=arith", "=bool", "=list", "typo ", "bogus_key"):
-        assert sum(needle in n for n in names) >= 8, needle
-    assert sum(n.startswith("argv:") for n in names) >= 30
-    assert sum(n.startswith("file:") for n in names) >= 80
-
-
-def test_a_case_that_succeeds_is_caught(tmp_path):
-    """The judge is not blind: a valid file counts as a wrong success."""
-    case = handwritten_cases()[0]
-    case.text = BASE
-    case.name = "valid"
-    outcome = run_case(case, tmp_path)
-    assert outcome.verdict == "wrong success"
-
-
-@pytest.mark.parametrize("kind", ["fifo", "dev_zero", "folder"])
-def test_special_files_are_refused_without_blocking(tmp_path, kind):
-    if kind == "fifo":
-        path = tmp_path / "pipe.toml"
-        os.mkfifo(path)
-    elif kind == "dev_zero":
-        path = Path("/dev/zero")
-    else:
-        path = tmp_path
-    proc = _cli("solve", str(path), "--json", timeout=30)
-    assert proc.returncode == 2
-    assert "not a regular file" in proc.stderr or "a folder" in proc.stderr
-    assert "Traceback" not in proc.stderr
-    assert len(proc.stderr.strip().splitlines()) == 1
-
-
-def test_json_stdout_holds_only_the_json_with_a_verbose_solver(tmp_path):
-    """[solver] ipopt print_level = 5: Ipopt's log goes to stderr, stdout parses as JSON
-    (two workers: their output too)."""
-    f = tmp_path / "p.toml"
-    f.write_text(BASE + "\n[solver]\nipopt = { print_level = 5 }\n")
-    proc = _cli("solve", str(f), "--json", "--starts", "2", "--workers", "2", "--no-ranges")
-    assert proc.returncode == 0, proc.stderr[-1000:]
-    result = json.loads(proc.stdout)
-    assert result["status"] == "optimal"
-    assert "EXIT: Optimal Solution Found" in proc.stderr
-
-
-def test_version():
-    from optdesign import __version__
-
-    proc = _cli("--version")
-    assert proc.returncode == 0
-    assert proc.stdout.strip() == f"optdesign {__version__}"
-
-
-def test_an_unforeseen_error_is_one_line(monkeypatch, capsys):
-    """The last-resort handler: a bug is a message and exit 1, the traceback only with
-    OPTDESIGN_DEBUG."""
-    from optdesign.cli import run_guarded
-
-    def boom():
-        raise ZeroDivisionError("division by zero")
-
-    monkeypatch.delenv("OPTDESIGN_DEBUG", raising=False)
-    assert run_guarded(boom) == 1
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "internal error: ZeroDivisionError" in err
-    monkeypatch.setenv("OPTDESIGN_DEBUG", "1")
-    with pytest.raises(ZeroDivisionError):
-        run_guarded(boom)
 
 
 # --- input that helps (issue 16) -------------------------------------------------------
@@ -154,27 +49,6 @@ def _load(tmp_path: Path, old: str, new: str):
     f = tmp_path / "p.toml"
     f.write_text(BASE.replace(old, new, 1))
     return load_problem(f)
-
-
-def test_bare_number_refused_with_the_unit_to_write(tmp_path):
-    with pytest.raises(OptDesignError) as exc:
-        _load(tmp_path, 'hinge_moment = "500 N*m"', "hinge_moment = 300")
-    assert str(exc.value).endswith('requirements.hinge_moment: 300 has no unit; write "300 N*m"')
-    with pytest.raises(OptDesignError, match=r'variables.R.lower: 30 has no unit; write "30 mm"'):
-        _load(tmp_path, 'lower = "30 mm"', "lower = 30")
-
-
-@pytest.mark.parametrize("spelling", ["500 Nm", "0.5 kNm", "500 N.m", "500 N-m", "500 N m"])
-def test_common_moment_spellings(tmp_path, spelling):
-    # 500 N*m = 5e5 N*mm (internal unit).
-    p = _load(tmp_path, 'hinge_moment = "500 N*m"', f'hinge_moment = "{spelling}"')
-    assert p.spec.requirements.hinge_moment == pytest.approx(5e5)
-
-
-def test_hyphen_only_joins_unit_names():
-    assert to_internal("2 lbf-ft", "moment", "m") == pytest.approx(2 * 4.4482216 * 304.8, rel=1e-6)
-    with pytest.raises(OptDesignError):
-        to_internal("5 mm-2", "length", "x")  # not a power, not a product
 
 
 @pytest.mark.parametrize(
