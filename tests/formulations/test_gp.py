@@ -1018,7 +1018,7 @@ def test_a_spread_objective_that_depends_on_the_design_is_not_dgp():
     assert gp.objective_rows == []
 
 
-# --- survivors of the sampled mutation run of issue 21 (docs/testing.md) -----------------
+# --- what is not a GP: a negative term, a ratio ripple limit, an objective the tracer cannot read
 def test_a_gp_objective_with_a_negative_term_is_not_a_gp():
     """A user objective that is a signomial (12 mm - p): the GP diagnosis refuses it,
     names the term, and cvxpy agrees; the problem's own objective stays a GP."""

@@ -1016,7 +1016,7 @@ def test_an_arc_step_back_starts_from_the_tighter_of_the_neighbours_value_and_li
     assert arc_eps(task, replace(nb, eps={"a": 0.7})) == {"a": pytest.approx(0.5 - 0.2)}
 
 
-# --- survivors of the second sample (docs/testing.md, "The second sample") ------------------
+# --- a point worse than its looser neighbour is solved again on its own target
 def test_a_point_worse_than_its_looser_neighbour_is_retried_on_its_own_target(monkeypatch):
     """An epsilon point whose warm solve is worse than a neighbour with a tighter bound is
     re-solved from cold starts, every solve on the point's own objective, and the record
