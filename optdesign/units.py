@@ -255,8 +255,8 @@ _DEG = math.pi / 180.0
 
 #: The common units of each dimension, as written in problem files, and their factor to
 #: the internal unit. Building pint's registry is most of a short command's time
-#: (benchmarks/README.md); these strings never need it (``tests/test_units_fast.py`` checks every factor against
-#: pint). Anything else, and every error, takes the pint path.
+#: (benchmarks/README.md, "Figures behind comments in the code"); these strings never need it (``tests/test_units.py`` checks
+#: every factor against pint). Anything else, and every error, takes the pint path.
 FAST_UNITS: dict[str, dict[str, float]] = {
     "length": {"mm": 1.0, "m": 1e3, "cm": 10.0, "um": 1e-3, "µm": 1e-3, "μm": 1e-3},
     "force": {"N": 1.0, "kN": 1e3},

@@ -1,4 +1,4 @@
-"""A solver back-end written outside the package, for tests/test_solver_capabilities.py:
+"""A solver back-end written outside the package, for tests/solvers/test_registry.py:
 Ipopt with a limited-memory Hessian, declaring its own warm-start and node options. A
 new back-end is this module and one ``register_solver`` line; no study changes."""
 

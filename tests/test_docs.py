@@ -65,7 +65,7 @@ def _tests_in(path: Path) -> set[str]:
 
 
 ALL_TESTS = {name for f in (ROOT / "tests").rglob("*.py") for name in _tests_in(f)} | {
-    f.stem for f in (ROOT / "tests").glob("test_*.py")
+    f.stem for f in (ROOT / "tests").rglob("test_*.py")
 }
 
 
@@ -110,7 +110,7 @@ def test_the_check_finds_what_is_stale(tmp_path):
     page = tmp_path / "page.md"
     page.write_text(
         "`optdesign/studies/front_metrics.py`, `optdesign.studies.nothing`,\n"
-        "`tests/test_solve.py::test_fork_optimum_by_hand`, `::test_known_optimum_values`\n"
+        "`tests/studies/test_solve.py::test_fork_optimum_by_hand`, `::test_known_optimum_values`\n"
         "`models/_math.py`, `optdesign/math.py`, `optdesign.math.grid_max`, `test_no_such`\n"
     )
     assert _stale(page) == [
@@ -118,5 +118,5 @@ def test_the_check_finds_what_is_stale(tmp_path):
         "path models/_math.py",
         "path optdesign/studies/front_metrics.py",
         "test test_no_such",
-        "test tests/test_solve.py::test_fork_optimum_by_hand",
+        "test tests/studies/test_solve.py::test_fork_optimum_by_hand",
     ]

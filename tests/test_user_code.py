@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_framework import yoke_data
+from test_api import yoke_data
 
 import optdesign as od
 from optdesign import math as m

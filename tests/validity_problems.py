@@ -1,7 +1,7 @@
 """Random design problems drawn from the shipped ones, and the quantities the models'
 ranges bound, computed by hand (issue 35, "No answer that cannot be true").
 
-Shared by the property tests of tests/test_validity.py and the 1 000-problem run of
+Shared by the property tests of tests/models/test_validity.py and the 1 000-problem run of
 benchmarks/validity/run.py:
 
 - :func:`variant` and :data:`VARIANTS`: a shipped problem as written, or with the

@@ -70,7 +70,11 @@ def main() -> int:
         function = re.sub(r"__mutmut_\d+$", "", name)
         tests = sorted(
             [] if args.no_covering else covering.get(function, []),
-            key=lambda t: (not t.startswith("tests/test_gp.py"), duration.get(t, 0.0), t),
+            key=lambda t: (
+                not t.startswith("tests/formulations/test_gp.py"),
+                duration.get(t, 0.0),
+                t,
+            ),
         )
         cmd = ["nice", "-n", "10", args.python, "-m", "pytest", "-q", "-x"]
         cmd += ["-p", "no:cacheprovider", *args.extra, *tests]

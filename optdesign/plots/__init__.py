@@ -104,7 +104,8 @@ def save_figure(fig, path: str | Path, dpi: int = 120, tight: bool = True) -> Pa
         if engine is None:
             # fig.tight_layout()'s own computation, without the placeholder layout engine
             # it leaves on the figure: with one, savefig lays the figure out once more
-            # (the PNG is byte-identical; figures: benchmarks/README.md).
+            # (the PNG is byte-identical; the time it saves: benchmarks/README.md,
+            # "Figures behind comments in the code").
             TightLayoutEngine(rect=None).execute(fig)
         elif not isinstance(engine, ConstrainedLayoutEngine):  # savefig runs that one
             fig.tight_layout()

@@ -1,7 +1,7 @@
 """Scrambled Sobol' points without importing ``scipy.stats``.
 
-``scipy.stats.qmc`` pulls in all of ``scipy.stats`` (~0.9 s of a ~3 s ``optdesign solve``
-command, see benchmarks/README.md) for a handful of points. This module draws the same
+``scipy.stats.qmc`` pulls in all of ``scipy.stats`` (much of a short ``optdesign solve``
+command's time: benchmarks/README.md, "Figures behind comments in the code") for a handful of points. This module draws the same
 points as ``scipy.stats.qmc.Sobol(d, scramble=True, seed=seed).random_base2(m)``
 (Joe-Kuo direction numbers read from SciPy's own data file, linear matrix scrambling
 and a digital shift from ``numpy.random.default_rng(seed)`` in SciPy's order), so the

@@ -82,7 +82,7 @@ class NodeSolver:
     own verdict of local infeasibility (:meth:`verdicts_decide`) end the multistart: the
     node is infeasible on those two starts (over the catalogue instance family, no later
     start or retry ever found a feasible point after two such verdicts:
-    benchmarks/README.md, "Catalogue searches (issue 25)"). As the problem's own
+    benchmarks/README.md, "Catalogue searches"). As the problem's own
     multistart, a node's multistart stops once :attr:`agree` starts agree on the best
     value (the file's ``[solver] agree``, 3 by default, through :func:`solve_catalogue`;
     over the same cases no later start beat a value that 3 starts agreed on:

@@ -90,7 +90,7 @@ def solver_for(
     NLP, built once per process and NLP, shared by every start, range and front point.
     Keyed on the NLP's content (its fingerprint), not on the problem object: a problem
     loaded again, or a copy that changes nothing the NLP holds, reuses the back-end
-    (CasADi's ``nlpsol`` costs 40-60 ms, more than a start)."""
+    (building CasADi's ``nlpsol`` costs more than a start: benchmarks/README.md, "Figures behind comments in the code")."""
     name = name or default_solver("nlp")
     nlp = formulation_for(problem, objectives, form)
     opts = dict(solver_options(problem, name))

@@ -47,11 +47,9 @@ class WorkerPool:
     """Local worker processes, each fed through its own pipe.
 
     Why not :class:`concurrent.futures.ProcessPoolExecutor`: a task there passes through
-    two helper threads on its way to a worker; for the ~10 ms points of a Pareto chain
-    that cost 1.6 ms median (3.5 ms at the 90th percentile) between submitting a point
-    and its worker starting it, and 0.7 ms back - a fifth of a 2-worker front's chain
-    time. One pipe per worker, written from the scheduling thread, costs ~0.3 ms for
-    the round trip (measured with the same ~29 kB task).
+    two helper threads on its way to a worker and back, a large share of the time of the
+    short points of a Pareto chain; one pipe per worker, written from the scheduling
+    thread, makes the round trip several times quicker (the figures: benchmarks/README.md, "Figures behind comments in the code").
 
     A task that raises re-raises in :meth:`wait` (the same exception when it pickles, a
     :class:`OptDesignError` with the worker's traceback otherwise); a worker that dies is

@@ -141,7 +141,7 @@ def _dumps(data: dict[str, Any]) -> str:
 def crank_slider_ripple(result: Any, ctx: Any) -> list[str]:
     """The ripple of the optimum from the loop solved by bisection and differentiated by
     central differences (no model of the package)."""
-    from test_physics_independent import cs_loop
+    from independent_physics import cs_loop
 
     d = result.design
     phi = np.linspace(-math.pi / 6, math.pi / 6, 61)

@@ -13,7 +13,7 @@ Determinism: ``pareto --deterministic`` and ``solve`` with 1 and with 2 workers 
 the same front / design (relative 1e-9), as ``--deterministic`` promises and "ties
 decided by value and index" requires. They run with the default BLAS / OpenMP threads,
 as a user's shell has them (with one thread each, the fork front of
-tests/test_pareto.py comes out equal; with the default two it does not).
+tests/studies/pareto/test_pareto.py comes out equal; with the default two it does not).
 """
 
 from __future__ import annotations
@@ -328,7 +328,7 @@ print(json.dumps(fronts))
 
 def api_one_process(root: Path) -> dict[str, Any]:
     """od.pareto(deterministic=True) with 1 then 2 workers in one process (as
-    tests/test_pareto.py does): the same front."""
+    tests/studies/pareto/test_pareto.py does): the same front."""
     workspace.prepare(root, base("fork_min_backlash"))
     t0 = time.monotonic()
     proc = subprocess.run(

@@ -1,4 +1,4 @@
-"""Benchmark configurations of the catalogue searches (issue 25), by name.
+"""Benchmark configurations of the catalogue searches, by name.
 
 Not in the default selection (each solves a catalogue problem many NLPs deep); name them
 with ``--solvers``: ``catalogue-bnb`` (optdesign's default search), ``catalogue-enumerate``

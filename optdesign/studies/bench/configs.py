@@ -342,7 +342,7 @@ def _register_defaults() -> None:
             preload=PYMOO_MODULES,
         )
     )
-    # the catalogue searches (issue 25): optdesign's own, and Bonmin's algorithms
+    # the catalogue searches: optdesign's own, and Bonmin's algorithms
     catalogue: list[tuple[str, str, str | None, dict[str, Any] | None, str]] = [
         ("catalogue-bnb", "bnb", None, None, "optdesign catalogue branch and bound (warm nodes)"),
         ("catalogue-enumerate", "enumerate", None, None, "every catalogue combination's NLP"),

@@ -9,8 +9,8 @@ any other solve.
 The back-ends of each role are the solver registry's
 (:data:`~optdesign.solvers.registry.FRONT_SOLVERS`), with the options each back-end
 declares (:class:`~optdesign.solvers.registry.SolverHints`). The primary back-end is SLSQP
-with exact CasADi first derivatives and its sweep options (~0.03 s to build, 3-6x faster
-per solve than Ipopt on these NLPs); a start it does not solve (failure, or an iterate
+with exact CasADi first derivatives and its sweep options (quick to build, and several
+times faster per solve than Ipopt on these NLPs: benchmarks/README.md, "Figures behind comments in the code"); a start it does not solve (failure, or an iterate
 that violates a row) is solved again by the fallback, Ipopt (exact Hessian), from the same
 start. The lexicographic tie-breaks use the tie back-end (Ipopt) with its restart options.
 ``method`` = the fallback (``"ipopt"``) uses it throughout, warm-started primal and dual

@@ -124,8 +124,8 @@ def tie_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, Any]
         fixed[prev] = rec.objectives[prev] * (1 + ANCHOR_SLACK) + 1e-12
         rest = {o: np.inf for o in order if o not in fixed and o != name}
         # The tie-break's feasible set is (almost) the set of optima of the objectives
-        # fixed before: degenerate, and SLSQP was measured to stall there or stop 2e-4
-        # short of Ipopt's value (cs_min_backlash, anchor backlash). Ipopt solves it.
+        # fixed before: degenerate, and SLSQP stalls there or stops short of Ipopt's
+        # value (benchmarks/README.md, "Figures behind comments in the code"). Ipopt solves it.
         start = solver.nlp.start(x0=np.asarray(rec.x))
         # Ipopt with a small barrier first; where it stalls on the degenerate set (500
         # iterations from a crank-slider's backlash anchor whose lead differs from
