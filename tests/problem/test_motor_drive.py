@@ -22,7 +22,7 @@ import optdesign as od
 from optdesign.cli import main
 from optdesign.problem.motor_drive import motion_demand, motor_data
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"
 
 MOTOR = {"rotor_inertia": "0.5 kg*cm^2", "peak_torque": "5 N*m", "rated_torque": "1.5 N*m",
