@@ -272,7 +272,8 @@ def _catalogue_case(motor: dict) -> dict:
 def test_the_catalogue_motor_is_the_smallest_that_reaches_the_optimum():
     """Motors numbered by rated torque (4: SGM7J-02A, 5: -04A, 6: -06A, 7: -08A): the
     02A cannot give the step's torque, the 04A can; the search over 4..7 ties every motor
-    that can on the backlash optimum and keeps the smallest, the answer of the 04A named."""
+    that can on the backlash optimum and keeps the smallest, the answer of the 04A named
+    (the enumeration over every motor, the 02A's infeasible verdict included: below)."""
     from optdesign.problem.motor_catalogue_variable import motor_by_number
 
     catalogue = {"catalogue": "Yaskawa Sigma-7"}
@@ -285,11 +286,7 @@ def test_the_catalogue_motor_is_the_smallest_that_reaches_the_optimum():
     assert motor_by_number("Yaskawa Sigma-7", 5).designation == "SGM7J-04A"
     named = od.solve(od.load(_catalogue_case({"designation": "SGM7J-04A"})), ranges=False)
     assert searched.objective == pytest.approx(named.objective, rel=1e-7)
-    weaker = od.solve(
-        od.load(_catalogue_case({"designation": "SGM7J-02A"})), ranges=False, starts=4
-    )
-    assert not weaker.success
-    assert "SGM7J-04A" in searched.summary()
+    assert "SGM7J-04A" in searched.summary()  # the 02A's infeasibility: the slow test below
 
 
 @pytest.mark.slow  # fourteen solves, four of them infeasible verdicts: ~30 s
