@@ -156,7 +156,10 @@ def from_multipliers(
         d = -lam * T / nlp.x_span[k]
         out.append(_record(problem, objective, f"variables.{var.name}.{side}", bound, d, v))
     kept = [s for s, effect in out if abs(effect) > NEGLIGIBLE * max(abs(v), 1e-300)]
-    kept.sort(key=lambda s: (-abs(s.log_sensitivity or 0.0), s.name))
+    # ranked by the size of the effect to 6 digits, then by name: two limits that cost the
+    # same (the two ends of a symmetric stroke) keep one order whatever the last digits of
+    # the solve that gave their multipliers
+    kept.sort(key=lambda s: (-float(f"{abs(s.log_sensitivity or 0.0):.6g}"), s.name))
     return kept
 
 

@@ -31,8 +31,8 @@ def infeasible():
 
 def test_the_candidates_are_the_violated_by_amount_then_the_binding(infeasible):
     problem, result = infeasible
-    # the least violated point the search found (its starts solved again on the whole
-    # grid) stopped at Ipopt's iteration limit, with both requirements short of their limits
+    # the least violated point the search found stopped at Ipopt's iteration limit, with
+    # both requirements short of their limits (the other start: locally infeasible)
     assert result.status == "max_iterations" and not result.success
     amounts = {v.name: v.amount for v in result.violated}
     assert set(amounts) == {"mean_ratio", "nut_travel"}

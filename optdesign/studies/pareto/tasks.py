@@ -27,7 +27,12 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.search.global_phase import global_search
 from optdesign.solvers.multistart import improves, sobol_starts
 from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import own_starts, search_stand_in, tilted_starts
+from optdesign.studies.nlp_solve import (
+    THIN_FROM_STARTS,
+    own_starts,
+    search_stand_in,
+    tilted_starts,
+)
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_from_result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -61,7 +66,7 @@ def multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
     free = {k: np.inf for k in order[1:]}
     draws = tilted_starts(problem, order[0], task["seed"])
     # the starts on the grid thinned (the stand-in), their optima polished on the whole
-    stand_in = search_stand_in(problem) if task["starts"] > 1 else problem
+    stand_in = search_stand_in(problem) if task["starts"] >= THIN_FROM_STARTS else problem
     search = (
         solver if stand_in is problem else EpsSolver(stand_in, solver.objectives, solver.method)
     )
