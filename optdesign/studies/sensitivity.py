@@ -419,8 +419,8 @@ def finite_difference(
     problem: DesignProblem, result: Result, name: str, rel: float = 1e-3
 ) -> tuple[float, float]:
     """d(optimal objective)/d(limit) of ``result`` by re-solves: the limit ``name`` moved
-    by ``rel`` (relative) to both sides, each re-solved from the optimum (one start),
-    central difference; returns (derivative in internal units, the limit's internal
+    by ``rel`` (relative) to both sides, each re-solved from the optimum (one start; four,
+    the optimum first, where that one fails), central difference; returns (derivative in internal units, the limit's internal
     value). The check of :func:`nlp_sensitivities` (tests, benchmarks)."""
     from optdesign.studies.nlp_solve import solve_nlp
 
@@ -431,6 +431,8 @@ def finite_difference(
     for q in (p + h, p - h):
         other = perturbed(problem, name, q)
         r = solve_nlp(other, result.objective_name or None, starts=1, x0=x0)
+        if not r.success:  # from the optimum alone it may stall: a few more starts
+            r = solve_nlp(other, result.objective_name or None, starts=4, x0=x0)
         if not r.success:
             raise RuntimeError(f"{name} = {q:g}: the re-solve ended {r.status}")
         values.append(r.objective)
