@@ -258,6 +258,15 @@ def box_has_item(problem, box) -> bool:
     return bool(_screw_values(problem, box))
 
 
+def screw_shaft_inertia(q):
+    """The screw shaft's inertia about its axis (kg*mm^2): a solid steel shaft of d0 over
+    the support length; None when ``[screw]`` does not give them."""
+    screw, data = q.problem.spec.screw, q.screw
+    if screw is None or screw.length is None or data is None or data.d0 is None:
+        return None
+    return sizing.shaft_inertia(data.d0, screw.length)
+
+
 # --- screw data and efficiency ------------------------------------------------------------
 def screw_data(q) -> ScrewData | None:
     """The screw of design ``q`` (None when the problem says nothing of the screw)."""
@@ -341,7 +350,7 @@ def duty_cycle_means(q) -> tuple[Any, Any]:
     steps = req.duty_cycle
     phis = np.array([s.deflection for s in steps])
     v = q.mechanism.nut_velocity(phis)
-    v = [_at(v, k) for k in range(len(steps))]
+    v = [at_angle(v, k) for k in range(len(steps))]
     forces = [m.fabs(s.hinge_moment / v[k]) for k, s in enumerate(steps)]
     speeds = [m.fabs(v[k]) * req.deflection_rate / q.screw.p * 60.0 for k in range(len(steps))]
     times = [s.time for s in steps]
@@ -357,7 +366,7 @@ def life_hours(q):
     return (q.screw.Ca / (q.requirements.f_w * F_m)) ** 3 * 1e6 / (60.0 * n_m)
 
 
-def _at(v, k):
+def at_angle(v, k):
     # the k-th angle: a CasADi column's row; on NumPy the last axis, kept as an axis so
     # that a population's (pop, 1) columns broadcast with the catalogue data (pop, 1)
     return v[k] if m.is_symbolic(v) else np.asarray(v)[..., k : k + 1]
@@ -378,7 +387,7 @@ def axial_compliance(q):
     if K_nut is not None:
         total = total + 1.0 / K_nut
     if screw.nut_offset is not None:
-        x = screw.nut_offset + m.fabs(q.nut_position - _at(q.nut_position, 0))
+        x = screw.nut_offset + m.fabs(q.nut_position - at_angle(q.nut_position, 0))
         area = np.pi * data.d1**2 / 4.0
         total = total + x / (area * sizing.E_STEEL)
         # motor held: the torsion of the shaft between the drive end and the nut, as a

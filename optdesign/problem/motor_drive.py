@@ -20,6 +20,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import motor as mo
+from optdesign.problem import drive
 from optdesign.problem import motor_catalogue_variable as mcv
 from optdesign.problem.objectives import ConstraintBlock
 
@@ -163,25 +164,15 @@ def motor_side_inertia(q):
     the nut's share is m (dx/dphi / f')^2)."""
     motor = _need(q.motor_data, "a [motor] section", "the motor's inertia")
     J = motor.rotor_inertia + motor.gear_inertia
-    J_screw = _screw_inertia(q)
+    J_screw = drive.screw_shaft_inertia(q)
     if J_screw is not None:
         i_a = q.design.get("i_a", 1.0)
-        J = J + J_screw / i_a**2
+        J = J + J_screw * mo.KG_MM2 / i_a**2
     load = q.problem.spec.load
     if load is not None and load.nut_mass:
         # m (lead / 2 pi i_a)^2 = m (dx/dphi / f')^2
         J = J + load.nut_mass * (q.nut_velocity / q.ratio) ** 2
     return J
-
-
-def _screw_inertia(q):
-    """The screw shaft's inertia about its axis (t*mm^2), or None without its size."""
-    from optdesign.models.screw_sizing import shaft_inertia
-
-    screw, data = q.problem.spec.screw, q.screw
-    if screw is None or screw.length is None or data is None or data.d0 is None:
-        return None
-    return shaft_inertia(data.d0, screw.length) * mo.KG_MM2
 
 
 def fin_inertia(q) -> float:
@@ -252,7 +243,7 @@ def motor_rms_torque(q):
     phis = np.array([s.deflection for s in steps])
     ratio = q.call_mechanism("ratio", phis)
     torques = [
-        mo.torque_at_motor(s.hinge_moment, _at(ratio, k), q.drive_efficiency) + friction
+        mo.torque_at_motor(s.hinge_moment, drive.at_angle(ratio, k), q.drive_efficiency) + friction
         for k, s in enumerate(steps)
     ]
     return mo.rms_torque(torques, [s.time for s in steps])
@@ -290,10 +281,6 @@ def two_mass_frequency_squared(q):
     B = k * (J1 + J2) + kh * J1
     C = k * kh
     return (B + m.sqrt(m.fmax(B**2 - 4.0 * A * C, 0.0))) / (2.0 * A)
-
-
-def _at(v, k):
-    return v[k] if m.is_symbolic(v) else np.asarray(v)[..., k : k + 1]
 
 
 def _column(q, values):

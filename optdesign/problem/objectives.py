@@ -203,12 +203,13 @@ def _screw_mass(q):
 
 def _motor_inertia(q):
     """Screw shaft inertia reflected to the motor shaft through the gear, kg*mm^2."""
-    from optdesign.models.screw_sizing import reflected_inertia, shaft_inertia
+    from optdesign.models.screw_sizing import reflected_inertia
+    from optdesign.problem.drive import screw_shaft_inertia
 
-    screw, data = q.problem.spec.screw, q.screw
-    if screw is None or screw.length is None or data is None or data.d0 is None:
+    J_screw = screw_shaft_inertia(q)
+    if J_screw is None:
         return None
-    return reflected_inertia(shaft_inertia(data.d0, screw.length), 0.0, data.p, q.mechanism.i_a)
+    return reflected_inertia(J_screw, 0.0, q.screw.p, q.mechanism.i_a)
 
 
 def _hinge_compliance(q):

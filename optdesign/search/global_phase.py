@@ -41,6 +41,7 @@ from optdesign.solvers.multistart import (
     outcome_counts,
     start_outcome,
     tie_width,
+    violation,
 )
 from optdesign.solvers.result import Globality, MultistartInfo, Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -142,10 +143,6 @@ class StopRule:
     def optima(self, values: Sequence[float]) -> list[float]:
         """The distinct optima among ``values`` (:func:`distinct_optima`)."""
         return distinct_optima(values, self.rel_tol, self.abs_tol)
-
-
-def _violation(r: Result) -> float:
-    return r.max_violation if math.isfinite(r.max_violation) else math.inf
 
 
 def _converged(r: Result) -> bool:
@@ -279,7 +276,7 @@ def polish_optima(
     order = sorted(range(len(results)), key=lambda k: results[k].objective)
     ok = [k for k in order if _converged(results[k])]
     if not ok:  # no optimum: the least violated starts, solved again
-        least = sorted(range(len(results)), key=lambda k: _violation(results[k]))
+        least = sorted(range(len(results)), key=lambda k: violation(results[k]))
         again = [polish(k) for k in least[:MAX_POLISHED]]
         return Polished(best_of(again, CHOICE_TOL)[0], len(again))
     best: Result | None = None

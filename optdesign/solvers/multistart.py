@@ -42,7 +42,7 @@ def best_of(results: Sequence[Result], rel_tol: float = OBJECTIVE_TIE_TOL) -> tu
     ok = [r for r in results if r.success and math.isfinite(r.objective)]
     if not ok:
         # No feasible start: report the least violated one.
-        viol = [r.max_violation if math.isfinite(r.max_violation) else math.inf for r in results]
+        viol = [violation(r) for r in results]
         least = min(viol)
         first = next(k for k, v in enumerate(viol) if v <= least + tie_width(least, rel_tol))
         return results[first], 0
@@ -50,6 +50,11 @@ def best_of(results: Sequence[Result], rel_tol: float = OBJECTIVE_TIE_TOL) -> tu
     tol = tie_width(least, rel_tol)
     at_best = [r for r in ok if r.objective <= least + tol]
     return at_best[0], len(at_best)
+
+
+def violation(r: Result) -> float:
+    """A result's largest violation, inf where it has none to compare (NaN)."""
+    return r.max_violation if math.isfinite(r.max_violation) else math.inf
 
 
 def tie_width(value: float, rel_tol: float = OBJECTIVE_TIE_TOL) -> float:
