@@ -32,6 +32,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.objectives import unavailable_objective
 
 #: Prefix of the targets that are design variables (``"var:R"``).
 VAR = "var:"
@@ -388,10 +389,7 @@ def build_nlp(
         ref = problem.expressions(problem.design_dict(mid), first_order=first_order)
     for name in names:
         if name not in ex.objectives:
-            raise ProblemError(
-                f"objective {name!r} is not available for this problem "
-                f"(available: {', '.join(ex.objectives)})"
-            )
+            raise unavailable_objective(problem, name, ex.objectives)
 
     aux: list[tuple[Any, float]] = []  # (symbol, scale)
     aux_names: list[str] = []

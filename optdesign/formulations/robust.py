@@ -40,7 +40,7 @@ from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
 from optdesign.problem.design_problem import DesignProblem, Expressions
-from optdesign.problem.objectives import ObjectiveTerm
+from optdesign.problem.objectives import ObjectiveTerm, unavailable_objective
 from optdesign.problem.spec import Tolerances
 
 #: Variance guard of the mean + k std measure (in scaled units, objective ~1).
@@ -154,10 +154,7 @@ def sampled_objective(
     """
     ex = problem.expressions(design, guarded=guarded, fit_fractions=fit_fraction)
     if objective not in ex.objectives:
-        raise ProblemError(
-            f"objective {objective!r} is not available for this problem "
-            f"(available: {', '.join(ex.objectives)})"
-        )
+        raise unavailable_objective(problem, objective, ex.objectives)
     return ex.objectives[objective], ex
 
 

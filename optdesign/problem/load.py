@@ -201,7 +201,7 @@ def load_problem(path: str | Path) -> DesignProblem:
     except RecursionError:
         raise ProblemError(f"{path}: arrays or tables nested too deeply") from None
     data.setdefault("name", path.stem)
-    return problem_from_dict(data, source=str(path), bare="refuse")
+    return problem_from_dict(data, source=str(path), bare="refuse", folder=str(path.parent))
 
 
 def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProblem:
@@ -228,12 +228,17 @@ def load(problem: str | Path | Mapping[str, Any] | DesignProblem) -> DesignProbl
 
 
 def problem_from_dict(
-    data: dict[str, Any], source: str = "problem", bare: Bare = "internal"
+    data: dict[str, Any],
+    source: str = "problem",
+    bare: Bare = "internal",
+    folder: str | None = None,
 ) -> DesignProblem:
     """Validate a problem given as a dict (the parsed TOML).
 
     ``bare``: a number without a unit for a dimensioned field is taken in internal units
     (``"internal"``, a dict from Python) or refused (``"refuse"``, a problem file).
+    ``folder``: where the files the problem names are read from (None: the working
+    folder).
     """
     if not isinstance(data, dict):
         raise ProblemError(f"{source}: a problem is a table of sections, got {type(data).__name__}")
@@ -252,7 +257,7 @@ def problem_from_dict(
         cls = get_mechanism(name)
     except InputError as exc:
         raise ProblemError(f"{source}: {exc}") from None
-    spec = validate_spec(data, cls, source, bare=bare)
+    spec = validate_spec(data, cls, source, bare=bare, folder=folder)
     table = variable_table(cls)
     variables = []
     for var_name, raw in _with_motor_variable(spec).items():
@@ -300,6 +305,12 @@ def _with_motor_variable(spec) -> dict[str, Any]:
                 f"variables.motor: with [motor] catalogue = {catalogue!r}, declare it as "
                 f'{{ catalogue = "{catalogue}" }} (bounds on the motors\' numbers allowed)'
             )
+        if spec.motor.catalogue_text is not None:  # a user's CSV: its motors' numbers
+            from optdesign.problem.motor_catalogue_variable import motor_numbers, spec_catalogue
+
+            numbers = motor_numbers(spec_catalogue(spec.motor))
+            variables["motor"] = {k: v for k, v in raw.items() if k != "catalogue"}
+            variables["motor"]["values"] = numbers
     return variables
 
 

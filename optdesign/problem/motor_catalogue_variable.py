@@ -15,13 +15,15 @@ fails ``motor_catalogue_membership``).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import cache
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.models.motor_catalogue import ServoMotor, load_motors
+from optdesign.models.motor_catalogue import ServoMotor, load_motors, parse_motors
 
 #: The motor catalogues a problem may name, and their files (None: the shipped one).
 MOTOR_CATALOGUES: dict[str, str | None] = {"Yaskawa Sigma-7": None}
@@ -34,44 +36,80 @@ MOTOR_FIELDS: dict[str, tuple[int, str]] = {
     "peak_torque": (+1, "peak_torque"),
     "rated_torque": (+1, "rated_torque"),
     "max_speed": (+1, "max_speed"),
+    "mass": (-1, "mass"),
 }
 
 #: Prefix of the motor's parameters (``param:motor_peak_torque``...).
 PREFIX = "motor_"
 
 
+@dataclass(frozen=True)
+class MotorCatalogue:
+    """A problem's motor catalogue: its name as the file writes it (a shipped catalogue's
+    or a CSV file's) and, for a file, the text read when the problem loaded."""
+
+    name: str
+    text: str | None = None
+
+
+def _field(row: ServoMotor, attribute: str) -> float:
+    # A motor without a printed mass has none to relax over: 0 (the objective motor_mass
+    # is refused for such a catalogue, so the value is never used).
+    value = getattr(row, attribute)
+    return 0.0 if value is None else float(value)
+
+
 @cache
-def motors(catalogue: str) -> tuple[ServoMotor, ...]:
+def motors(catalogue: MotorCatalogue | str) -> tuple[ServoMotor, ...]:
     """The catalogue's motors, smallest rated torque first (then by designation): motor
-    number k is ``motors(catalogue)[k - 1]``."""
-    if catalogue not in MOTOR_CATALOGUES:
+    number k is ``motors(catalogue)[k - 1]``. A string is a shipped catalogue's name."""
+    if isinstance(catalogue, str):
+        catalogue = MotorCatalogue(catalogue)
+    if catalogue.text is not None:
+        rows = parse_motors(catalogue.text, Path(catalogue.name).name)
+    elif catalogue.name in MOTOR_CATALOGUES:
+        rows = load_motors(MOTOR_CATALOGUES[catalogue.name])
+    else:
         known = ", ".join(MOTOR_CATALOGUES)
-        raise ProblemError(f"motor.catalogue: unknown catalogue {catalogue!r} (known: {known})")
-    rows = load_motors(MOTOR_CATALOGUES[catalogue])
+        raise ProblemError(
+            f"motor.catalogue: unknown catalogue {catalogue.name!r} (known: {known})"
+        )
     return tuple(sorted(rows, key=lambda r: (r.rated_torque, r.designation)))
 
 
-def motor_numbers(catalogue: str) -> list[float]:
+def motor_numbers(catalogue: MotorCatalogue | str) -> list[float]:
     """The values of the variable ``motor``: 1, 2, ... n."""
     return [float(k) for k in range(1, len(motors(catalogue)) + 1)]
 
 
-def motor_by_number(catalogue: str, number: float) -> ServoMotor:
+def motor_by_number(catalogue: MotorCatalogue | str, number: float) -> ServoMotor:
     """Motor number ``number`` of the catalogue."""
     k = int(np.rint(float(number)))
     rows = motors(catalogue)
     if not (1 <= k <= len(rows)) or abs(number - k) > 1e-9:
-        raise ProblemError(f"variables.motor: {number:g} is no motor of {catalogue!r}")
+        name = catalogue if isinstance(catalogue, str) else catalogue.name
+        raise ProblemError(f"variables.motor: {number:g} is no motor of {name!r}")
     return rows[k - 1]
 
 
-def catalogue_of(problem) -> str | None:
-    """The problem's motor catalogue when its motor is a catalogue variable, else None."""
-    motor = problem.spec.motor
-    var = problem.by_name.get("motor")
-    if motor is None or motor.catalogue is None or var is None or not var.discrete:
+def spec_catalogue(motor) -> MotorCatalogue | None:
+    """The catalogue of a ``[motor]`` section (None without one)."""
+    if motor is None or motor.catalogue is None:
         return None
-    return motor.catalogue
+    return MotorCatalogue(motor.catalogue, motor.catalogue_text)
+
+
+def catalogue_of(problem) -> MotorCatalogue | None:
+    """The problem's motor catalogue when its motor is a catalogue variable, else None."""
+    var = problem.by_name.get("motor")
+    if var is None or not var.discrete:
+        return None
+    return spec_catalogue(problem.spec.motor)
+
+
+def masses_missing(catalogue: MotorCatalogue) -> list[str]:
+    """The designations of the catalogue's motors without a mass."""
+    return [r.designation for r in motors(catalogue) if r.mass is None]
 
 
 def parameter_defaults(problem) -> dict[str, float]:
@@ -95,7 +133,7 @@ def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, 
         return {}
     out = {}
     for field, (sign, attribute) in MOTOR_FIELDS.items():
-        values = [float(getattr(r, attribute)) for r in rows]
+        values = [_field(r, attribute) for r in rows]
         out[PREFIX + field] = max(values) if sign > 0 else min(values)
     return out
 
@@ -118,7 +156,7 @@ def design_values(problem, design: dict[str, Any]) -> tuple[dict[str, Any], Any]
             continue
         on[idx] = float(abs(number[idx] - k) <= 1e-9)
         for field, (_, attribute) in MOTOR_FIELDS.items():
-            out[field][idx] = float(getattr(rows[k - 1], attribute))
+            out[field][idx] = _field(rows[k - 1], attribute)
     if not number.ndim:
         return {f: float(v) for f, v in out.items()}, float(on)
     return out, on

@@ -41,7 +41,7 @@ class MotorData:
     peak_torque: Any
     rated_torque: Any
     max_speed: Any
-    mass: float | None
+    mass: Any
     gear_inertia: float
     friction_torque: float
     rotor_inertia_max: Any = None
@@ -107,7 +107,7 @@ def motor_of(q) -> MotorData | None:
         values["peak_torque"],
         values["rated_torque"],
         values["max_speed"],
-        None,
+        values["mass"],
         spec.motor.gear_inertia,
         spec.motor.friction_torque,
         values["rotor_inertia_max"],

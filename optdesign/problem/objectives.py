@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from optdesign.errors import InputError
+from optdesign.errors import InputError, ProblemError
 
 #: Objective kinds: how a grid quantity becomes one number.
 #: ``spread``: (max - min)/(max + min) over the grid (the ratio ripple);
@@ -65,6 +65,9 @@ class ObjectiveInfo:
         solver reports (an epigraph variable or an iterate where the mechanism does not
         assemble gives one): :meth:`range_problem` says why. None (the default, and a
         user's objective) declares no range: the value must only be finite.
+    needs
+        ``needs(problem)``: why a problem lacks this objective (``fn`` gives None), in
+        the words of its file (``""``: no reason known beyond the objective's own data).
     """
 
     name: str
@@ -76,6 +79,7 @@ class ObjectiveInfo:
     display_unit: str | None = None
     display_scale: float = 1.0
     valid: tuple[float | None, float | None] | None = None
+    needs: Callable[[Any], str] | None = None
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -234,6 +238,55 @@ def _natural_period(q):
     return None if spec.load is None or spec.screw is None else q.natural_period
 
 
+def _motor_mass(q):
+    motor = q.motor_data
+    if motor is None or motor.mass is None or _motor_mass_needs(q.problem):
+        return None
+    return motor.mass
+
+
+def _motor_mass_needs(problem: Any) -> str:
+    """What a problem must give for the objective motor_mass (``""``: it gives it)."""
+    from optdesign.problem import motor_catalogue_variable as mcv
+
+    motor = problem.spec.motor
+    if motor is None:
+        return "needs a [motor] section with the motor's mass"
+    catalogue = mcv.spec_catalogue(motor)
+    if catalogue is not None:
+        missing = mcv.masses_missing(catalogue)
+        if missing:
+            more = f" and {len(missing) - 3} more" if len(missing) > 3 else ""
+            return (
+                f"the motor catalogue {catalogue.name!r} prints no mass for "
+                f"{', '.join(missing[:3])}{more}: give a catalogue CSV whose mass_kg column "
+                "is filled (catalogue = FILE)"
+            )
+        return ""
+    if motor.designation is not None:
+        from optdesign.models.motor_catalogue import by_designation
+
+        if by_designation(motor.designation).mass is None:
+            return (
+                f"the shipped catalogue prints no mass for {motor.designation}: give the "
+                "motor's data with its mass, or a catalogue CSV with mass_kg"
+            )
+        return ""
+    return "" if motor.mass is not None else "give [motor] mass"
+
+
+def unavailable_objective(problem: Any, name: str, available: Any) -> ProblemError:
+    """The error for objective ``name`` that the problem's expressions lack: its own
+    reason where the objective declares one, and the objectives the problem has."""
+    info = problem.objectives.get(name)
+    reason = info.needs(problem) if info is not None and info.needs is not None else ""
+    why = f": {reason}" if reason else ""
+    return ProblemError(
+        f"objective {name!r} is not available for this problem{why} "
+        f"(available: {', '.join(available)})"
+    )
+
+
 def _backlash(q):
     return None if q.pin is None else q.backlash.worst_case
 
@@ -381,6 +434,18 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="ms",
             display_scale=1e3,
             valid=NON_NEGATIVE,
+        ),
+        ObjectiveInfo(
+            "motor_mass",
+            _motor_mass,
+            "scalar",
+            "t",
+            "mass of the motor",
+            "the catalogue's or the file's motor mass",
+            display_unit="kg",
+            display_scale=1e3,
+            valid=NON_NEGATIVE,
+            needs=_motor_mass_needs,
         ),
         ObjectiveInfo(
             "lock_force",

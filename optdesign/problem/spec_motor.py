@@ -5,8 +5,10 @@ rad; a mass in t, an inertia in t*mm^2 = N*mm*s^2; README "Units")."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
+from typing import Any
 
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationInfo, model_validator
 
 from optdesign.errors import InputError
 from optdesign.problem.spec_types import (
@@ -26,6 +28,51 @@ from optdesign.problem.spec_types import (
     _shown,
 )
 
+#: Largest motor CSV a problem may name (the shipped one is 4 kB).
+MAX_CATALOGUE_BYTES = 1 << 20
+
+
+def is_catalogue_file(catalogue: str) -> bool:
+    """True when ``[motor] catalogue`` names a CSV file rather than a shipped catalogue."""
+    return catalogue.lower().endswith(".csv")
+
+
+def read_catalogue_file(catalogue: str, folder: str | None) -> str:
+    """The text of a user's motor CSV: ``catalogue`` relative to ``folder`` (the problem
+    file's folder; the working folder for a problem given as a dict), checked by parsing
+    it, so that a wrong row is refused when the problem loads (ValueError naming the
+    file, the line and the column)."""
+    from optdesign.errors import OptDesignError
+    from optdesign.safe_io import read_file
+
+    path = Path(catalogue)
+    if not path.is_absolute() and folder is not None:
+        path = Path(folder) / path
+    try:
+        raw = read_file(path, what="the motor catalogue", limit=MAX_CATALOGUE_BYTES, follow=True)
+    except (OSError, OptDesignError) as exc:
+        raise ValueError(f"catalogue: cannot read {path} ({exc})") from None
+    if raw is None:
+        raise ValueError(f"catalogue: no file {path}")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise ValueError(f"catalogue: {path} is not a UTF-8 text file") from None
+    return checked_catalogue(text, path.name)
+
+
+def checked_catalogue(text: str, file: str) -> str:
+    """``text`` when it parses as a motor CSV; else ValueError naming the file, the line
+    and the column."""
+    from optdesign.models.motor_catalogue import parse_motors
+
+    try:
+        parse_motors(text, file)
+    except InputError as exc:
+        raise ValueError(f"catalogue: {exc}") from None
+    return text
+
+
 #: The motor's data a problem needs, with what each is for.
 MOTOR_DATA = {
     "rotor_inertia": "the rotor's inertia (the torque to accelerate it, the inertia ratio)",
@@ -39,12 +86,17 @@ class Motor(_Model):
     of the shipped catalogue (``designation``), one given by its data, or a catalogue
     whose motors the search chooses from (``catalogue``: the variable ``motor``,
     :mod:`optdesign.problem.motor_catalogue_variable`). ``rated_torque`` (the continuous
-    torque) limits the RMS torque of the duty cycle, ``mass`` is only reported.
+    torque) limits the RMS torque of the duty cycle; ``mass`` is reported and is the
+    objective ``motor_mass``. ``catalogue`` is a shipped catalogue's name or a CSV file
+    with the shipped one's columns (relative to the problem file's folder); the file's
+    text is read once, when the problem loads, into ``catalogue_text`` (so a problem
+    carries its motors to every worker, and a changed file is a changed problem).
     ``gear_inertia`` is what else turns with the motor (gear, coupling), at the motor
     shaft; ``friction_torque`` the drive's own friction at the motor shaft."""
 
     designation: str | None = None
     catalogue: str | None = None
+    catalogue_text: str | None = Field(None, repr=False)
     rotor_inertia: Inertia | None = None
     peak_torque: Moment | None = None
     rated_torque: Moment | None = None
@@ -53,15 +105,38 @@ class Motor(_Model):
     gear_inertia: Inertia = 0.0
     friction_torque: Moment = 0.0
 
+    @model_validator(mode="before")
+    @classmethod
+    def _read_file(cls, data: Any, info: ValidationInfo) -> Any:
+        # A CSV named by the file is read here, once: a dump of the spec re-validated
+        # elsewhere (a worker, a changed copy) carries the text and reads no file.
+        if not isinstance(data, dict):
+            return data
+        catalogue = data.get("catalogue")
+        if isinstance(catalogue, str) and is_catalogue_file(catalogue):
+            text = data.get("catalogue_text")
+            if text is None:
+                folder = (info.context or {}).get("folder")
+                text = read_catalogue_file(catalogue, folder)
+            elif isinstance(text, str):
+                text = checked_catalogue(text, Path(catalogue).name)
+            data = {**data, "catalogue_text": text}
+        elif data.get("catalogue_text") is not None:
+            raise ValueError("catalogue_text: only with a catalogue CSV file (catalogue = FILE)")
+        return data
+
     @model_validator(mode="after")
     def _data(self):
         given = [k for k in (*MOTOR_DATA, "rated_torque", "mass") if getattr(self, k) is not None]
         if self.catalogue is not None:
             from optdesign.problem.motor_catalogue_variable import MOTOR_CATALOGUES
 
-            if self.catalogue not in MOTOR_CATALOGUES:
+            if self.catalogue not in MOTOR_CATALOGUES and self.catalogue_text is None:
                 known = ", ".join(repr(k) for k in MOTOR_CATALOGUES)
-                raise ValueError(f"catalogue: unknown {self.catalogue!r} (known: {known})")
+                raise ValueError(
+                    f"catalogue: unknown {self.catalogue!r} (known: {known}, or a CSV file "
+                    'with the shipped catalogue\'s columns, e.g. catalogue = "motors.csv")'
+                )
             mine = given + (["designation"] if self.designation is not None else [])
             if mine:
                 raise ValueError(

@@ -23,16 +23,19 @@ def validate_spec(
     source: str = "problem",
     internal: bool = False,
     bare: Bare = "internal",
+    folder: str | None = None,
 ) -> ProblemSpec:
     """Validate ``data`` against the schema of ``mechanism``; ProblemError naming fields.
 
     ``internal``: ``data`` is a validated spec's own dump (numbers in internal units).
     ``bare``: a bare number for a dimensioned field is internal, or refused (files).
+    ``folder``: where a file the problem names (a motor CSV) is read from (the problem
+    file's folder; None: the working folder).
     The error is one line: every invalid field with its reason, an unknown field with the
     nearest valid name.
     """
     model = spec_model(mechanism)
-    context = {"internal": internal, "bare": "internal" if internal else bare}
+    context = {"internal": internal, "bare": "internal" if internal else bare, "folder": folder}
     try:
         return model.model_validate(data, context=context)
     except ValidationError as exc:

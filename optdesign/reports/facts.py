@@ -86,6 +86,8 @@ def _motor_facts(problem: Any, q: Any) -> list[Fact]:
         f"{float(motor.rotor_inertia) * 10:.4g} kg*cm^2, top speed "
         f"{float(motor.max_speed) * 60 / (2 * np.pi):.5g} 1/min"
     )
+    if motor.mass is not None and float(motor.mass) > 0:
+        text += f", mass {float(motor.mass) * 1e3:.4g} kg"
     return [Fact("motor", Shown(peak * 1e-3, "N*m"), text)]
 
 
