@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -12,6 +12,9 @@ from optdesign.solvers.result import clean_json
 from optdesign.solvers.solved_point import SolvedPoint
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord, RawSolution
+
+if TYPE_CHECKING:
+    from optdesign.studies.pareto.costs import PointCosts
 
 
 @dataclass(kw_only=True)
@@ -49,7 +52,7 @@ class FrontPoint(PointRecord):
         )
         return cls(**kw, method=method, multipliers=rec.raw)
 
-    def costs(self, problem: Any, objectives: Sequence[str]) -> Any:
+    def costs(self, problem: Any, objectives: Sequence[str]) -> PointCosts:
         """What each limit costs at this point of a front of ``objectives`` on
         ``problem``, from the point's own solve, or why that cannot be known (a
         :class:`~optdesign.studies.pareto.costs.PointCosts`). Worked out on call, not
