@@ -18,7 +18,8 @@ import time
 from pathlib import Path
 
 from optdesign.problem import load_problem
-from optdesign.studies.pareto import EpsilonConstraint, compute_front, write_front_csv
+from optdesign.reports.front_files import write_front_csv
+from optdesign.studies.pareto import EpsilonConstraint, compute_front
 
 ROOT = Path(__file__).resolve().parents[1]
 CSV = ROOT / "benchmarks" / "data" / "cs_min_backlash_reference_front.csv"

@@ -200,20 +200,46 @@ def pareto(
     files = options.pop("files", True)
     front = compute_front(problem, objectives, points, method, **options)
     if files and options.get("out") is not None and isinstance(front, Front):
-        import time
-
-        from optdesign.reports.front_files import write_front_outputs
-
-        _, notes = write_front_outputs(
-            [front],
-            problem,
-            Path(options["out"]),
-            objectives=objectives,
-            points=points,
-            created=time.strftime("%Y-%m-%d %H:%M:%S"),
-        )
+        _, notes = front_outputs([front], problem, options["out"], objectives, points)
         front.notes.extend(notes)
     return front
+
+
+def front_outputs(
+    fronts: Sequence[Any],
+    problem: DesignProblem,
+    out: str | Path,
+    objectives: Sequence[str],
+    points: int,
+    plot: bool = True,
+    report: bool = True,
+) -> tuple[list[Path], list[str]]:
+    """The files ``optdesign pareto`` writes of the fronts of one problem in folder
+    ``out`` (``front.csv``, ``front.json``, ``front.png``, ``report.html``:
+    :func:`optdesign.reports.front_files.write_front_outputs`); the files written and
+    the notes of the outputs that could not be drawn.
+
+    Several methods' fronts first get their hypervolumes against one reference point
+    (comparable, in ``front.json`` and the summary): a computation of the study, done
+    here so that the report only writes what the fronts hold.
+    """
+    import time
+
+    from optdesign.reports.front_files import write_front_outputs
+    from optdesign.studies.pareto import common_hypervolumes
+
+    if len(fronts) > 1:
+        common_hypervolumes(fronts)
+    return write_front_outputs(
+        fronts,
+        problem,
+        Path(out),
+        objectives=objectives,
+        points=points,
+        created=time.strftime("%Y-%m-%d %H:%M:%S"),
+        plot=plot,
+        report=report,
+    )
 
 
 def bench(

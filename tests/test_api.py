@@ -346,3 +346,45 @@ def test_a_second_class_under_a_registered_name_needs_replace():
     od.register_mechanism(Fresh)
     info = get_mechanism("t21_fresh_yoke").variable_table()["R"]
     assert (info.dimension, info.description) == ("length", "")
+
+
+def test_the_files_of_several_fronts_compare_their_hypervolumes_against_one_point(tmp_path):
+    """``front_outputs`` (what ``optdesign pareto`` writes of its methods' fronts): the
+    fronts of several methods get hypervolumes against one reference point before
+    front.json is written; a front alone keeps its own."""
+    import json
+
+    from optdesign.api import front_outputs
+    from optdesign.studies.pareto.front import FrontPoint, make_front
+
+    problem = od.load(PROBLEMS / "cs_min_backlash.toml")
+    design = problem.design_dict(problem.midpoint())
+
+    def front(method, values):
+        points = [
+            FrontPoint(
+                id=f"{method}-{k}",
+                kind="eps",
+                target="backlash",
+                objectives={"backlash": a, "size": b},
+                design=dict(design),
+                status="optimal",
+                verified=True,
+                method=method,
+            )
+            for k, (a, b) in enumerate(values)
+        ]
+        return make_front(points, ["backlash", "size"], method, problem=problem)
+
+    fronts = [front("a", [(0.1, 30.0), (0.2, 20.0)]), front("b", [(0.15, 25.0), (0.3, 10.0)])]
+    wrote, notes = front_outputs(
+        fronts, problem, tmp_path, ["backlash", "size"], 2, plot=False, report=False
+    )
+    assert [p.name for p in wrote] == ["front.csv", "front.json"] and notes == []
+    written = json.loads((tmp_path / "front.json").read_text())["fronts"]
+    assert [f["metrics"]["common_reference_point"] for f in written] == [
+        fronts[0].metrics["common_reference_point"]
+    ] * 2
+    alone = front("a", [(0.1, 30.0), (0.2, 20.0)])
+    front_outputs([alone], problem, tmp_path, ["backlash", "size"], 2, plot=False, report=False)
+    assert "hypervolume_common" not in alone.metrics

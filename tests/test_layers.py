@@ -239,6 +239,22 @@ def test_the_commands_enter_through_the_public_api():
     assert "optdesign.api" in graph["optdesign.commands.bench"]
 
 
+def test_reports_and_plots_import_no_study():
+    """The reports and plots read records (a result, a front, a sweep) and the display
+    primitives below the studies: none imports a study, the global search or a
+    formulation (at module top or inside a function) to work out what a page shows."""
+    graph = import_graph()
+    above = ("optdesign.studies", "optdesign.search", "optdesign.formulations")
+    found = [
+        f"{m}:{line} imports {t}"
+        for m, arrows in sorted(graph.items())
+        if m.partition(".")[2].split(".")[0] in ("reports", "plots")
+        for t, line in sorted(arrows.items())
+        if t.startswith(above)
+    ]
+    assert found == [], "reports or plots importing a study:\n" + "\n".join(found)
+
+
 def test_the_entry_points_are_still_there():
     # an allowed arrow that no longer exists is a stale exception: remove it from the list
     graph = import_graph()

@@ -313,7 +313,7 @@ def hostile_front():
 
 
 def test_front_csv_reads_back_with_formulas_neutralised(hostile_front, tmp_path):
-    from optdesign.studies.pareto.io import read_front_csv, write_front_csv
+    from optdesign.reports.front_files import read_front_csv, write_front_csv
 
     problem, front = hostile_front
     # a constraint name that a plug-in chose, active at a point; a method's name as a

@@ -318,7 +318,7 @@ def run_case(case: Case) -> Verdict:
     """Judge one case through the Python API (module docstring)."""
     import optdesign as od
     from optdesign.errors import OptDesignError
-    from optdesign.studies.verify import is_validity
+    from optdesign.problem.validity import is_validity
 
     t0 = time.perf_counter()
     data = problem_data(case)

@@ -46,7 +46,7 @@ from optdesign.models.pin_contact import LOAD_PARAMETER
 from optdesign.models.ratio import RATIO
 from optdesign.models.screw import LEAD_ANGLE
 from optdesign.models.validity import Validity
-from optdesign.studies.verify import is_validity
+from optdesign.problem.validity import is_validity
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"

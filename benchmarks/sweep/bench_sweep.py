@@ -37,7 +37,7 @@ def main() -> None:
     args = ap.parse_args()
 
     import optdesign as od
-    from optdesign.studies.sensitivity import at_values
+    from optdesign.problem.parameters import at_values
 
     problem = od.load(ROOT / "problems" / f"{args.problem}.toml")
     od.solve(problem)  # imports and first-use costs paid before either side is timed

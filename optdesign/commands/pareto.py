@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 
 from optdesign import validation as check
@@ -151,7 +150,7 @@ def _method_options(args, method: str, seed: int) -> dict:
 
 
 def _run_locked(args, problem, objectives, methods, out: Path) -> int:
-    from optdesign.api import pareto
+    from optdesign.api import front_outputs, pareto
 
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
     run = dict(
@@ -178,15 +177,12 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
                 files=False,
             )
         fronts.append(front)
-    from optdesign.reports.front_files import no_point_text, write_front_outputs
-
-    wrote, notes = write_front_outputs(
+    wrote, notes = front_outputs(
         fronts,
         problem,
         out,
-        objectives=objectives,
-        points=args.points,
-        created=time.strftime("%Y-%m-%d %H:%M:%S"),
+        objectives,
+        args.points,
         plot=not args.no_plot,
         report=not args.no_report,
     )
@@ -203,6 +199,6 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
             line = printable(flags(f"{front.method}: {front.notes[0]}"))
             print(f"optdesign: {line}", file=sys.stderr)
         elif not front.points:
-            line = printable(flags(no_point_text(problem, front)))
+            line = printable(flags(front.no_point_text(problem)))
             print(f"optdesign: infeasible: {line}", file=sys.stderr)
     return 0 if all(f.points for f in fronts) else 1

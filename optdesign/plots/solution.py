@@ -12,7 +12,7 @@ import numpy as np
 from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.reports.limits import binding_angles, bound_limits, limits_of
-from optdesign.studies.verify import constraint_rows
+from optdesign.solvers.constraint_rows import constraint_rows
 
 
 def plot_designs(

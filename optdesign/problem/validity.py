@@ -34,6 +34,16 @@ if TYPE_CHECKING:
     from optdesign.problem.quantities import Quantities
 
 
+#: How the name of a row on a model's range of validity begins (:attr:`OutsideRange.name`).
+VALIDITY_PREFIX = "validity: "
+
+
+def is_validity(report: Any) -> bool:
+    """True for a constraint row (a :class:`~optdesign.solvers.result.ConstraintReport`)
+    on a model's range of validity (:attr:`OutsideRange.name`)."""
+    return report.name.startswith(VALIDITY_PREFIX)
+
+
 @dataclass(frozen=True)
 class RangeQuantity:
     """A quantity of one design that a model's range bounds.
@@ -60,7 +70,7 @@ class OutsideRange:
     def name(self) -> str:
         """``"validity: small-angle clearance: worst-case backlash"`` (and the part)."""
         quantity = f"{self.record.quantity}, {self.what}" if self.what else self.record.quantity
-        return f"validity: {self.record.model}: {quantity}"
+        return f"{VALIDITY_PREFIX}{self.record.model}: {quantity}"
 
     def text(self) -> str:
         """``"small-angle clearance: worst-case backlash 1.29e+07 deg > 5 deg at

@@ -14,7 +14,8 @@ whether that widens or narrows the bounds::
 A limit at 0 (where 1 % is no move) or an objective at 0 (no % of it) gives the
 derivative per unit instead, with the limit raised.
 
-A front's point shows the costs of its own solve (:mod:`optdesign.studies.pareto.costs`):
+A front's point shows the costs of its own solve (:meth:`~optdesign.studies.pareto.front.
+FrontPoint.costs`, :mod:`optdesign.studies.pareto.costs`):
 of its target objective with the others held at the point's epsilon bounds, or why they
 cannot be known.
 """
@@ -41,9 +42,7 @@ def cost_text(s: Sensitivity) -> str:
 def front_point_costs(problem: Any, objectives: Sequence[str], point: Any) -> dict[str, Any]:
     """What the page shows of a front point's costs: ``sensitivities`` (lines, most
     costly first) and ``costs_note`` (what they are of, or why they cannot be known)."""
-    from optdesign.studies.pareto.costs import point_costs
-
-    costs = point_costs(problem, objectives, point)
+    costs = point.costs(problem, objectives)  # the study's, through the record
     if costs.why:
         return {"sensitivities": [], "costs_note": f"not known for this point: {costs.why}"}
     held = [

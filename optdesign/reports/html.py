@@ -34,7 +34,7 @@ from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.html_page import render
 from optdesign.reports.limits import binding_angles, bound_limits, limits_of
 from optdesign.reports.solve_text import feasibility_text, objective_value
-from optdesign.studies.verify import constraint_rows
+from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.user_code import call_method
 
 

@@ -137,7 +137,7 @@ def validity_document(result: Result) -> dict[str, Any]:
     (model, quantity, worst value, range, angle) - such a design is never verified
     (``within`` null: nothing was checked, no design)."""
     from optdesign.models.validity_registry import declared_ranges
-    from optdesign.studies.verify import is_validity
+    from optdesign.problem.validity import is_validity
 
     records = declared_ranges().values()
     outside = []

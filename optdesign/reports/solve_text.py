@@ -50,7 +50,7 @@ def feasibility_text(result: Result) -> str:
     of validity)"``, ``"NOT verified: ..."`` - naming each model used outside its range
     (``"small-angle clearance: worst-case backlash 1.29e+07 deg > 5 deg at
     phi=+30.0deg"``), whose design is no answer whatever its requirements."""
-    from optdesign.studies.verify import is_validity
+    from optdesign.problem.validity import is_validity
 
     if result.verified is None:
         return "not checked (no design)"

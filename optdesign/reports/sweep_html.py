@@ -36,7 +36,7 @@ def _shown_value(axis: Any, value: float) -> float:
 def _cost(problem: Any, objective: str, name: str, log: float) -> str:
     """The line of a point's log-sensitivity ``log`` to the limit ``name``, with the
     limit's value on the point's ``problem`` (which way 1 % moves it, where to)."""
-    from optdesign.studies.sensitivity import limit_shown, limit_value
+    from optdesign.problem.parameters import limit_shown, limit_value
 
     try:
         limit = limit_shown(problem, name, limit_value(problem, name))
@@ -48,7 +48,7 @@ def _cost(problem: Any, objective: str, name: str, log: float) -> str:
 
 def sweep_report(sweep: Any) -> str:
     """The page of ``sweep``: the design chart, the table, the design of each point."""
-    from optdesign.studies.sensitivity import at_values
+    from optdesign.problem.parameters import at_values
 
     problem = sweep.problem
     paths = [a.path for a in sweep.axes]

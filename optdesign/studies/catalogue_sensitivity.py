@@ -99,8 +99,8 @@ def fixed_item_difference(
     fixed: the limit ``name`` moved by ``rel`` to both sides, each side's continuous
     part re-solved from the optimum; (derivative in internal units, the limit's internal
     value). The check of :func:`catalogue_sensitivities` (tests)."""
+    from optdesign.problem.parameters import limit_value, perturbed
     from optdesign.studies.catalogue import NodeSolver, _fixed
-    from optdesign.studies.sensitivity import limit_value, perturbed
 
     items = {v.name: float(result.design[v.name]) for v in discrete_variables(problem)}
     p = limit_value(problem, name)

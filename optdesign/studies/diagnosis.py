@@ -38,13 +38,14 @@ import numpy as np
 
 from optdesign.formulations.discrete import discrete_variables, nearest_item
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.validity import is_validity
 from optdesign.reports.limits import limits_of
+from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.registry import solver_for_kind, solver_hints
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Result
 from optdesign.studies.catalogue import NodeSolver, first_feasible
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.relaxation import Site, relaxations
-from optdesign.studies.verify import constraint_rows, is_validity
 
 #: Items of each catalogue variable tried around the continuous best point, and the most
 #: combinations of them solved (nearest first).

@@ -29,14 +29,21 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.parameters import (
+    MOVED_SIZE,
+    limit_shown,
+    limit_value,
+    moved_copy,
+    perturbed,
+    requirement_paths,
+)
 from optdesign.solvers.result import Result, Sensitivity
 
 #: Relative step of the central differences of the model (a smooth function evaluated,
@@ -46,44 +53,6 @@ STEP = 1e-5
 #: Sensitivities whose log-sensitivity (or, for a zero limit or objective, whose effect
 #: of a 1 % change relative to the objective) is below this are left out: not binding.
 NEGLIGIBLE = 1e-6
-
-
-def requirement_paths(problem: DesignProblem) -> Iterator[tuple[str, float]]:
-    """Every numeric requirement of ``problem`` (path below ``requirements``, internal
-    value): plain numbers and quantities, inside bands (``mean_ratio.min``) and tables
-    (``lock.force_max``); counts, switches, texts and lists are not limits."""
-
-    def walk(model: Any, prefix: str) -> Iterator[tuple[str, float]]:
-        for name in type(model).model_fields:
-            value = getattr(model, name)
-            path = f"{prefix}{name}"
-            if hasattr(type(value), "model_fields"):
-                yield from walk(value, path + ".")
-            elif isinstance(value, float) and math.isfinite(value):
-                yield path, value
-
-    yield from walk(problem.spec.requirements, "")
-
-
-#: The copies of problems with one requirement moved, by (problem state, path, value): the
-#: points of a front share their problem and its limits, so each copy is validated once per
-#: front, not once per point.
-_MOVED: OrderedDict[tuple[str, str, float], DesignProblem] = OrderedDict()
-_MOVED_SIZE = 64
-
-
-def moved_copy(problem: DesignProblem, path: str, value: float) -> DesignProblem:
-    """:meth:`DesignProblem.with_requirement`, remembered per problem state, so the
-    caller must not change the copy it gets."""
-    key = (problem.token, path, float(value))
-    if key in _MOVED:
-        _MOVED.move_to_end(key)
-        return _MOVED[key]
-    new = problem.with_requirement(path, value)
-    _MOVED[key] = new
-    while len(_MOVED) > _MOVED_SIZE:
-        _MOVED.popitem(last=False)
-    return new
 
 
 def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[Sensitivity]:
@@ -184,21 +153,6 @@ def _record(
         log_sensitivity=None if log is None else float(log),
     )
     return record, float(dvdp * p * 0.01) if p != 0 else float(dvdp)
-
-
-def limit_shown(problem: DesignProblem, path: str, p: float) -> Any:
-    """The limit ``path`` of a :class:`Sensitivity` of ``problem`` (``"requirements.
-    hinge_moment"``, ``"variables.R.upper"``) as the user reads it (a :class:`~optdesign.
-    reports.display_units.Shown`); ``p``: its internal value (a requirement is shown as
-    the problem holds it, in its written unit; ``p`` bare when that is unknown)."""
-    from optdesign.reports.display_units import Shown, requirement_values, variable_shown
-
-    if path.startswith("variables."):
-        return variable_shown(problem, problem.by_name[path.split(".")[1]], p)
-    node: Any = requirement_values(problem)
-    for key in path.split(".")[1:]:
-        node = node.get(key) if isinstance(node, dict) else None
-    return node if isinstance(node, Shown) else Shown(p, "")
 
 
 class _RowModel:
@@ -320,7 +274,7 @@ def moved_limits(
     key = (problem.token, path, float(up), float(down))
     if key not in _LIMIT_ONLY:
         _LIMIT_ONLY[key] = _limits_if_only_limits(problem, path, up, down)
-        while len(_LIMIT_ONLY) > _MOVED_SIZE:
+        while len(_LIMIT_ONLY) > MOVED_SIZE:
             _LIMIT_ONLY.popitem(last=False)
     return _LIMIT_ONLY[key]
 
@@ -360,59 +314,6 @@ def _same_limits(a: dict[str, tuple[Any, Any]], b: dict[str, tuple[Any, Any]]) -
     return a.keys() == b.keys() and all(
         same(a[k][0], b[k][0]) and same(a[k][1], b[k][1]) for k in a
     )
-
-
-def with_bound(problem: DesignProblem, name: str, side: str, value: float) -> DesignProblem:
-    """A copy of ``problem`` whose free variable ``name`` has its ``side`` ("lower" or
-    "upper") bound at ``value`` (internal units)."""
-    import dataclasses
-
-    new = object.__new__(type(problem))
-    new.__dict__.update(problem.__dict__)
-    new.variables = [
-        dataclasses.replace(v, **{side: value}) if v.name == name else v for v in problem.variables
-    ]
-    new.by_name = {v.name: v for v in new.variables}
-    new._touch()
-    return new
-
-
-def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProblem:
-    """A copy of ``problem`` with each parameter path at its value (internal units)."""
-    for path, value in values.items():
-        head, _, rest = path.partition(".")
-        if head == "requirements":
-            problem = moved_copy(problem, rest, value)
-        else:
-            name, _, side = rest.partition(".")
-            problem = with_bound(problem, name, side or "value", value)
-            var = problem.by_name[name]
-            if var.free and not var.lower < var.upper:
-                raise InputError(
-                    f"vary.{path}",
-                    f"{name}'s lower bound {var.lower:g} is not below its upper "
-                    f"bound {var.upper:g} {var.unit}",
-                )
-    return problem
-
-
-def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:
-    """``problem`` with the limit ``name`` of a :class:`Sensitivity` at ``value``
-    (internal units)."""
-    head, _, rest = name.partition(".")
-    if head == "variables":
-        var, _, side = rest.partition(".")
-        return with_bound(problem, var, side, value)
-    return moved_copy(problem, rest, value)
-
-
-def limit_value(problem: DesignProblem, name: str) -> float:
-    """The internal value of the limit ``name`` of a :class:`Sensitivity`."""
-    head, _, rest = name.partition(".")
-    if head == "variables":
-        var, _, side = rest.partition(".")
-        return float(getattr(problem.by_name[var], side))
-    return dict(requirement_paths(problem))[rest]
 
 
 def finite_difference(

@@ -23,8 +23,9 @@ import numpy as np
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
-from optdesign.problem.validity import outside_ranges
+from optdesign.problem.validity import is_validity, outside_ranges
 from optdesign.safe_io import refuse_file_options
+from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.deadline import deadline, passed
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import (
@@ -37,7 +38,7 @@ from optdesign.solvers.result import (
 from optdesign.studies.diagnosis import diagnose as diagnose_result
 from optdesign.studies.formulation_registry import Formulation, pick_formulation
 from optdesign.studies.nlp_solve import optimal_ranges, solver_options
-from optdesign.studies.verify import constraint_rows, is_validity, validity_report, verify_design
+from optdesign.studies.verify import validity_report, verify_design
 
 
 def check_fixed_design(problem: DesignProblem, objective: str | None = None) -> Result:

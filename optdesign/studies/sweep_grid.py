@@ -15,7 +15,7 @@ import numpy as np
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.studies.sensitivity import at_values
+from optdesign.problem.parameters import at_values
 
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2

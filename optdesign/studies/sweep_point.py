@@ -14,10 +14,10 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.parameters import at_values
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.multistart import tie_width
 from optdesign.solvers.registry import solver_hints
-from optdesign.studies.sensitivity import at_values
 from optdesign.studies.sweep_grid import (  # noqa: F401 - the grid's names, as before
     MAX_AXES,
     MAX_GRID,

@@ -75,7 +75,7 @@ def sweep_mode(problem: DesignProblem, paths: Sequence[str], ends) -> str:
     """``"shared"`` (one NLP for every point) or ``"rebuild"`` (each point its own).
 
     ``ends``: for each path, the two values at the ends of its range (internal units)."""
-    from optdesign.studies.sensitivity import at_values
+    from optdesign.problem.parameters import at_values
 
     for path, (lo, hi) in zip(paths, ends, strict=True):
         if path == HINGE:

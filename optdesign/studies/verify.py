@@ -7,11 +7,9 @@ import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem, relative_violation
 from optdesign.problem.validity import OutsideRange, outside_ranges
+from optdesign.solvers.constraint_rows import violation_amount
 from optdesign.solvers.result import ConstraintReport
 from optdesign.tolerances import FEASIBILITY_TOL
-
-#: How the name of a report on a model's range of validity begins.
-VALIDITY_PREFIX = "validity: "
 
 
 def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = FEASIBILITY_TOL):
@@ -36,7 +34,7 @@ def verify_design(problem: DesignProblem, x: np.ndarray, tol: float = FEASIBILIT
         labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
         for k in np.flatnonzero(rel > tol):
             v = float(values[k])
-            amount = max((lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0)
+            amount = violation_amount(v, lo, hi)
             label = f"{name}[{labels[k]}]" if labels[k] else name
             violated.append(ConstraintReport(label, v, lo, hi, float(amount)))
     for name, value in ev.objectives.items():
@@ -62,17 +60,9 @@ def validity_report(found: OutsideRange) -> ConstraintReport:
     if np.isnan(value):
         amount = np.inf
     else:
-        amount = max(
-            (lower - value) if lower is not None else 0.0,
-            (value - upper) if upper is not None else 0.0,
-        )
+        amount = violation_amount(value, lower, upper)
     name = found.name + (f"[{found.where}]" if found.where else "")
     return ConstraintReport(name, value, lower, upper, float(amount), record.display_unit)
-
-
-def is_validity(report: ConstraintReport) -> bool:
-    """True for a report on a model's range of validity (:func:`validity_report`)."""
-    return report.name.startswith(VALIDITY_PREFIX)
 
 
 def nan_notes(problem: DesignProblem, objectives: dict[str, float], violated) -> list[str]:
@@ -101,38 +91,3 @@ def nan_notes(problem: DesignProblem, objectives: dict[str, float], violated) ->
         if name in user:
             notes.append(whose("constraint", name, user[name].fn))
     return notes
-
-
-def constraint_rows(problem: DesignProblem, design, rel: float = 1e-5, ev=None):
-    """(active, violated) constraint reports of any design on the NumPy path: a row is
-    active within ``rel`` of its bound (relative to max(1, |bound|)), violated beyond.
-
-    ``design``: a full design dict (name -> value) or the free-variable vector; ``ev``:
-    the design's ``problem.evaluate`` when the caller has it already.
-    """
-    import math
-
-    if ev is None:
-        if isinstance(design, dict):
-            design = [design[v.name] for v in problem.free]
-        ev = problem.evaluate(np.asarray(design, dtype=float))
-    active, violated = [], []
-    for name, block in ev.constraints.items():
-        values = np.atleast_1d(np.asarray(block.values, dtype=float))
-        lo, hi = block.lower, block.upper
-        labels = problem.phi_labels if len(values) == len(problem.phi) else [""] * len(values)
-        viol = relative_violation(values, lo, hi)
-        for k, v in enumerate(values):
-            label = f"{name}[{labels[k]}]" if labels[k] else name
-            gap = min(
-                abs(v - lo) / max(1.0, abs(lo)) if lo is not None else math.inf,
-                abs(v - hi) / max(1.0, abs(hi)) if hi is not None else math.inf,
-            )
-            if viol[k] > rel:
-                amount = max(
-                    (lo - v) if lo is not None else 0.0, (v - hi) if hi is not None else 0.0
-                )
-                violated.append(ConstraintReport(label, float(v), lo, hi, float(amount)))
-            elif gap <= rel:
-                active.append(ConstraintReport(label, float(v), lo, hi, 0.0))
-    return active, violated

@@ -321,8 +321,8 @@ def _csv_cases() -> list[Case]:
     def run(objective: str, constraint: str):
         def api(ctx: Any) -> Any:
             import optdesign as od
+            from optdesign.reports.front_files import write_front_csv, write_front_json
             from optdesign.reports.html import front_report
-            from optdesign.studies.pareto import write_front_csv, write_front_json
 
             problem = od.load(ctx.data())
             problem.add_objective(objective, lambda q: q.R + q.l + q.n, unit="mm", kind="scalar")

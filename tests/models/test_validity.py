@@ -30,9 +30,9 @@ import optdesign as od
 from optdesign.errors import ProblemError
 from optdesign.models import validity_registry
 from optdesign.models.validity import ELASTIC_MODULUS, Validity
-from optdesign.problem.validity import outside_ranges
+from optdesign.problem.validity import is_validity, outside_ranges
 from optdesign.reports.result_json import result_document
-from optdesign.studies.verify import is_validity, verify_design
+from optdesign.studies.verify import verify_design
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"

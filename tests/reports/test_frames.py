@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.studies.pareto import read_front_csv, write_front_csv
+from optdesign.reports.front_files import read_front_csv, write_front_csv
 
 PROBLEM = Path(__file__).resolve().parents[2] / "problems" / "cs_min_backlash.toml"
 

@@ -10,10 +10,10 @@ import pytest
 
 import optdesign as od
 from optdesign.formulations.robust import draw_samples
+from optdesign.problem.parameters import limit_value, perturbed
 from optdesign.reports.costs import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.studies.robust import solve_robust
-from optdesign.studies.sensitivity import limit_value, perturbed
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 FILE = PROBLEMS / "cs_min_backlash_robust.toml"

@@ -8,10 +8,11 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.problem.parameters import perturbed, requirement_paths
 from optdesign.reports.costs import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.solvers.result import Sensitivity
-from optdesign.studies.sensitivity import finite_difference, nlp_sensitivities, perturbed
+from optdesign.studies.sensitivity import finite_difference, nlp_sensitivities
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 
@@ -230,7 +231,7 @@ def test_a_limit_that_moves_no_model_function_costs_what_a_full_evaluation_says(
 
     problem = od.load(PROBLEMS / "cs_min_backlash.toml")
     result = od.solve(problem, ranges=False, sensitivities=False)
-    p = dict(S.requirement_paths(problem))
+    p = dict(requirement_paths(problem))
     assert S.moved_limits(problem, "mean_ratio.min", p["mean_ratio.min"] * 1.001, 199.0)
     assert S.moved_limits(problem, "hinge_moment", p["hinge_moment"] * 1.001, 4.9e5) is None
     fast = {s.name: s.d_objective_d_limit for s in S.nlp_sensitivities(problem, result)}

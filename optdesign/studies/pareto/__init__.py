@@ -8,12 +8,12 @@
 - :mod:`.chains` and :mod:`.tasks`: the epsilon method's task graph (anchors, chains);
 - :mod:`.eps_solver`: every solve of a front on one formulation;
 - :mod:`.records`: typed records as stored; :mod:`.front`: the :class:`Front`;
-- :mod:`.metrics`: hypervolume, spacing, spread; :mod:`.io`: CSV and JSON files;
+- :mod:`.metrics`: hypervolume, spacing, spread (the CSV and JSON files of a front are
+  the reports', :mod:`optdesign.reports.front_files`);
 - :mod:`.costs`: what each limit costs at a point, from the point's own solve.
 """
 
 from optdesign.studies.pareto.front import Front, FrontPoint, common_hypervolumes, make_front
-from optdesign.studies.pareto.io import read_front_csv, write_front_csv, write_front_json
 from optdesign.studies.pareto.methods import (
     METHODS,
     NSGA2,
@@ -42,7 +42,4 @@ __all__ = [
     "compute_front",
     "make_front",
     "make_method",
-    "read_front_csv",
-    "write_front_csv",
-    "write_front_json",
 ]

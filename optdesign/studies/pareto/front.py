@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -12,6 +12,9 @@ from optdesign.solvers.result import clean_json
 from optdesign.solvers.solved_point import SolvedPoint
 from optdesign.studies.pareto.metrics import front_metrics, non_dominated
 from optdesign.studies.pareto.records import PointRecord, RawSolution
+
+if TYPE_CHECKING:
+    from optdesign.studies.pareto.costs import PointCosts
 
 
 @dataclass(kw_only=True)
@@ -48,6 +51,16 @@ class FrontPoint(PointRecord):
             raw=None,
         )
         return cls(**kw, method=method, multipliers=rec.raw)
+
+    def costs(self, problem: Any, objectives: Sequence[str]) -> PointCosts:
+        """What each limit costs at this point of a front of ``objectives`` on
+        ``problem``, from the point's own solve, or why that cannot be known (a
+        :class:`~optdesign.studies.pareto.costs.PointCosts`). Worked out on call, not
+        at the front's solve: only a page that shows a point needs them, and they may
+        take a solve again; the report reads them here without importing the study."""
+        from optdesign.studies.pareto.costs import point_costs
+
+        return point_costs(problem, objectives, self)
 
     def to_dict(self) -> dict[str, Any]:
         """The point as ``front.json`` writes it."""
@@ -139,6 +152,21 @@ class Front:
                 "rejected": [p.to_dict() for p in self.rejected],
             }
         )
+
+    def no_point_text(self, problem: Any) -> str:
+        """Why the front has no point: the requirements its least violating design
+        violates (the command line's line for an infeasible front)."""
+        from optdesign.studies.diagnosis import violated_text
+
+        head = f"{self.method}: no feasible design"
+        designs = [p.design for p in self.rejected if p.design]
+        if not designs:
+            return head
+        X = np.array([[d[v.name] for v in problem.free] for d in designs])
+        worst = np.asarray(problem.evaluate(X).violation, dtype=float)
+        best = X[int(np.argmin(np.where(np.isfinite(worst), worst, np.inf)))]
+        shown = violated_text(problem, best)
+        return f"{head} among {len(designs)} designs; the least violating one: {shown or 'none'}"
 
     def summary(self) -> str:
         """Metrics and a table of (a selection of) the points, with units."""

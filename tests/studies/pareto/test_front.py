@@ -240,3 +240,31 @@ def test_common_hypervolumes_of_two_fronts_against_their_shared_reference_point(
         assert f.metrics["hypervolume_common"] == pytest.approx(hypervolume(f.F, ref))
     assert small.metrics["hypervolume_common"] != pytest.approx(hypervolume(small.F))
     assert large.metrics["hypervolume_common"] > small.metrics["hypervolume_common"]
+
+
+def test_a_front_without_points_names_what_its_least_violating_design_violates():
+    """``Front.no_point_text``: the command line's line for an infeasible front names the
+    requirements that the least violating of its rejected designs violates."""
+    from pathlib import Path
+
+    import optdesign as od
+    from optdesign.studies.diagnosis import violated_text
+
+    problem = od.load(Path(__file__).resolve().parents[3] / "problems" / "cs_min_backlash.toml")
+    mid = problem.design_dict(problem.midpoint())
+    low = {**mid, **{v.name: v.lower for v in problem.free}}
+    X = np.array([[d[v.name] for v in problem.free] for d in (low, mid)])
+    worst = np.asarray(problem.evaluate(X).violation, dtype=float)
+    assert worst[0] != worst[1]  # one design violates less than the other
+    least = X[int(np.argmin(worst))]
+    rejected = []
+    for k, design in enumerate((low, mid)):
+        rejected.append(_pt(k, 0.1, 1.0, status="infeasible"))
+        rejected[-1].design = design
+    front = make_front(rejected, OBJ, "epsilon", problem=problem)
+    text = front.no_point_text(problem)
+    assert text == (
+        "epsilon: no feasible design among 2 designs; the least violating one: "
+        + (violated_text(problem, least) or "none")
+    )
+    assert make_front([], OBJ, "nsga2").no_point_text(problem) == "nsga2: no feasible design"

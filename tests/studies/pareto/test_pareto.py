@@ -467,8 +467,8 @@ def _resolved_log_sensitivity(problem, front, point, name, rel=1e-3):
     """d log(target) / d log(limit ``name``) at ``point``: its own epsilon problem (its
     target, the others held at its epsilon bounds) solved again by Ipopt from its design
     with the limit moved by ``rel`` to either side."""
+    from optdesign.problem.parameters import limit_value, perturbed
     from optdesign.studies.pareto.eps_solver import EpsSolver
-    from optdesign.studies.sensitivity import limit_value, perturbed
 
     p = limit_value(problem, name)
     h = rel * abs(p)

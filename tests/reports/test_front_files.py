@@ -1,4 +1,4 @@
-"""optdesign/studies/pareto/io.py as a whole, on a front made up of known points (no
+"""optdesign/reports/front_files.py's files, on a front made up of known points (no
 solve): front.csv's rows, headings, digits and units, written and read back through the
 csv module, several fronts in one file, the unit checks on reading, front.json."""
 
@@ -13,15 +13,11 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.reports.frames import front_table
+from optdesign.reports.front_files import read_front_csv, write_front_csv, write_front_json
 from optdesign.studies.pareto.front import FrontPoint, make_front
-from optdesign.studies.pareto.io import (
-    front_rows,
-    read_front_csv,
-    write_front_csv,
-    write_front_json,
-)
 
-PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 OBJ = ["ripple", "backlash"]
 
 
@@ -58,9 +54,9 @@ def _read(path):
 
 def test_the_rows_are_the_points_then_the_rejected_ones_on_request(problem):
     front = _front(problem)
-    rows = front_rows(front, problem)
+    rows = front_table(front, problem)
     assert [r["id"] for r in rows] == ["made-0", "made-1"]
-    with_rejected = front_rows(front, problem, rejected=True)
+    with_rejected = front_table(front, problem, rejected=True)
     assert [(r["id"], r["on_front"]) for r in with_rejected] == [
         ("made-0", True),
         ("made-1", True),
@@ -165,7 +161,7 @@ def test_front_json_holds_every_front_with_meta_and_null_for_non_finite(problem,
     assert "Infinity" not in path.read_text() and "NaN" not in path.read_text()
 
 
-ROOT = Path(__file__).resolve().parents[3]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # --- resuming a stored front ------------------------------------------------------------
