@@ -65,7 +65,8 @@ def _sweep(sub):
         action="append",
         required=True,
         help="PATH=START..STOP UNIT:COUNT, e.g. requirements.hinge_moment=200..1000N*m:20 "
-        "(once or twice; PATH: requirements.NAME, variables.NAME.lower|upper, variables.NAME)",
+        "(once or twice; PATH: requirements.NAME, motion.NAME, load.NAME, "
+        "variables.NAME.lower|upper, variables.NAME)",
     )
     p.add_argument("--objective", default=None, help="objective (default: the file's first)")
     p.add_argument(

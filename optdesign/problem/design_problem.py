@@ -73,6 +73,11 @@ class Evaluation:
     violation: Any
 
 
+#: The sections of a problem whose numbers :meth:`DesignProblem.with_setting` moves (and a
+#: sweep varies): the requirements, the motion the fin must make and the load it drives.
+SETTING_SECTIONS = ("requirements", "motion", "load")
+
+
 class DesignProblem:
     """A validated design problem.
 
@@ -370,9 +375,24 @@ class DesignProblem:
         ``"deflection.points"``) is ``value`` in internal units, validated like a file; this
         problem is left as it is (its solver caches stay valid). The copy shares this
         problem's mechanism, variables and added objectives and constraints."""
+        return self.with_setting(f"requirements.{path}", value)
+
+    def with_setting(self, path: str, value: Any) -> DesignProblem:
+        """A copy whose value at ``path`` - a requirement (``"requirements.hinge_moment"``)
+        or a number of the motion or the load (``"motion.rise_time"``,
+        ``"load.inertia"``; :data:`SETTING_SECTIONS`) - is ``value`` in internal units,
+        validated like a file; as :meth:`with_requirement` otherwise. ProblemError when
+        the problem has no such section."""
+        section, _, rest = path.partition(".")
+        if section not in SETTING_SECTIONS or not rest:
+            raise ProblemError(
+                f"{path}: not a setting (give {', '.join(s + '.NAME' for s in SETTING_SECTIONS)})"
+            )
         data = self.spec.model_dump(mode="python")
-        node = data["requirements"]
-        keys = path.split(".")
+        node = data[section]
+        if node is None:
+            raise ProblemError(f"{path}: the problem has no [{section}] section")
+        keys = rest.split(".")
         for key in keys[:-1]:
             node = node[key]
         node[keys[-1]] = value

@@ -18,7 +18,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any
 
 from optdesign.errors import InputError
-from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.design_problem import SETTING_SECTIONS, DesignProblem
 
 
 def requirement_paths(problem: DesignProblem) -> Iterator[tuple[str, float]]:
@@ -95,6 +95,8 @@ def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProb
         head, _, rest = path.partition(".")
         if head == "requirements":
             problem = moved_copy(problem, rest, value)
+        elif head in SETTING_SECTIONS:
+            problem = problem.with_setting(path, value)
         else:
             name, _, side = rest.partition(".")
             problem = with_bound(problem, name, side or "value", value)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import InputError, OptDesignError
-from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.design_problem import SETTING_SECTIONS, DesignProblem
 from optdesign.problem.parameters import at_values
 
 #: Most parameters of one sweep, and most points along one parameter.
@@ -54,6 +54,10 @@ class Axis:
         return f"{name} [{self.unit}]" if self.unit else name
 
 
+#: What a sweep may vary, as its refusals say it.
+WHAT_TO_VARY = "requirements.NAME, motion.NAME, load.NAME or variables.NAME[.lower|.upper]"
+
+
 def check_path_names(path: str) -> None:
     """InputError ``vary`` when a name of the dotted ``path`` is empty: a dot at its start
     or its end, or two dots in a row (``requirements.hinge_moment.``)."""
@@ -69,7 +73,7 @@ def check_path_names(path: str) -> None:
         at = f"between two dots (after {'.'.join(names[:empty])})"
     raise InputError(
         "vary",
-        f"{path!r}: an empty name {at}; give requirements.NAME or variables.NAME[.lower|.upper]",
+        f"{path!r}: an empty name {at}; give {WHAT_TO_VARY}",
     )
 
 
@@ -93,25 +97,26 @@ def parameter_dimension(problem: DesignProblem, path: str) -> str:
                 f"{path}: {name} is {'free' if var.free else 'fixed'}: sweep variables.{want}",
             )
         return var.dimension
-    if head != "requirements" or not rest:
-        raise InputError(
-            "vary", f"{path!r}: give requirements.NAME or variables.NAME[.lower|.upper]"
-        )
-    model: Any = problem.spec.requirements
+    if head not in SETTING_SECTIONS or not rest:
+        raise InputError("vary", f"{path!r}: give {WHAT_TO_VARY}")
+    model: Any = getattr(problem.spec, head)
+    if model is None:
+        raise InputError("vary", f"{path}: the problem has no [{head}] section")
+    what = "requirement" if head == "requirements" else f"field of [{head}]"
     keys = rest.split(".")
     for depth, key in enumerate(keys):
         fields = type(model).model_fields
         if key not in fields:
             close = difflib.get_close_matches(key, list(fields), n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise InputError("vary", f"{path}: unknown requirement{hint}")
+            raise InputError("vary", f"{path}: unknown {what}{hint}")
         value = getattr(model, key)
         if depth < len(keys) - 1:
             if value is None:
-                raise InputError("vary", f"{path}: requirements.{key} is not set in the problem")
+                raise InputError("vary", f"{path}: {head}.{key} is not set in the problem")
             if not hasattr(type(value), "model_fields"):
                 inner = ".".join(keys[: depth + 1])
-                raise InputError("vary", f"{path}: requirements.{inner} is a value, not a table")
+                raise InputError("vary", f"{path}: {head}.{inner} is a value, not a table")
             model = value
             continue
         info = fields[key]

@@ -214,6 +214,8 @@ def test_two_parameters_snake_through_the_grid(tmp_path):
             "at most 2",
         ),
         ({"variables.R.lower": ("100 mm", "130 mm", 2)}, "vary.variables.R.lower", "not below"),
+        ({"motion.rise_time": ("90 ms", "40 ms", 3)}, "vary", "no [motion] section"),
+        ({"motor.peak_torque": ("5 N*m", "6 N*m", 3)}, "vary", "give requirements.NAME, motion"),
     ],
 )
 def test_bad_sweeps_are_refused_naming_the_field(vary, field, reason):
@@ -625,3 +627,35 @@ def test_a_sweep_given_out_writes_the_files_the_command_writes(tmp_path):
     assert {"sweep.csv", "sweep.json", "sweep.png", "sweep.html", "sweep.jsonl"} <= names
     with (tmp_path / "s" / "sweep.csv").open(newline="") as fh:
         assert len(list(csv.DictReader(fh))) == len(swept.points) == 2
+
+
+def _motor_data(rise_time: str) -> dict:
+    import tomllib
+
+    data = tomllib.loads(CRANK.read_text())
+    data["motor"] = {"rotor_inertia": "0.5 kg*cm^2", "peak_torque": "5 N*m",
+                     "rated_torque": "1.5 N*m", "max_speed": "6000 rpm"}  # fmt: skip
+    data["load"] = {"inertia": "0.2 kg*m^2", "nut_mass": "0.5 kg"}
+    data["motion"] = {"step": "3 deg", "rise_time": rise_time, "rate": "90 deg/s"}
+    return data
+
+
+def test_a_moved_rise_time_is_the_problem_written_with_it():
+    """at_values (what a sweep's point solves) on [motion]: the same motor torque at a
+    design as the problem loaded from a file that writes that rise time."""
+    problem = od.load(_motor_data("72 ms"))
+    x = problem.lower() + 0.4 * (problem.upper() - problem.lower())
+    moved = at_values(problem, {"motion.rise_time": 0.05 / 3600})  # 50 ms, internal hours
+    written = od.load(_motor_data("50 ms"))
+    torque = [p.evaluate(x).objectives["motor_peak_torque"] for p in (problem, moved, written)]
+    assert torque[1] == pytest.approx(torque[2], rel=1e-12)
+    assert torque[1] > 1.1 * torque[0]  # a faster step asks more torque (of the rotor, the fin)
+    assert problem.spec.motion.rise_time == pytest.approx(0.072 / 3600)  # the original kept
+
+
+def test_the_motion_is_swept_like_a_requirement(tmp_path):
+    sweep = od.sweep(
+        od.load(_motor_data("72 ms")), {"motion.rise_time": ("90 ms", "60 ms", 2)}, out=tmp_path
+    )
+    assert [p.success for p in sweep.points] == [True, True]
+    assert sweep.axes[0].label == "rise_time [ms]" and sweep.axes[0].shown == (90.0, 60.0)
