@@ -422,9 +422,9 @@ def sweep(
     -----
     The arguments, checked, travel down as one :class:`optdesign.SolveRequest` (how each
     point is solved; a point a formulation solves receives it) and one
-    :class:`~optdesign.studies.run_options.RunOptions` (where and how the points run).
+    :class:`~optdesign.runtime.run_options.RunOptions` (where and how the points run).
     """
-    from optdesign.studies.run_options import RunOptions
+    from optdesign.runtime.run_options import RunOptions
     from optdesign.studies.sweep import run_sweep
 
     starts = validation.starts("starts", starts)

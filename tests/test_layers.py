@@ -3,7 +3,7 @@ an optdesign module in optdesign/ - at module top or inside a function - is an a
 the arrows form no circle and never point up the layers of the architecture:
 
 shared utilities -> models -> mechanisms -> problem -> formulations -> solvers ->
-search -> studies -> api -> cli, commands, plots, reports, reproduce.
+runtime -> search -> studies -> api -> cli, commands, plots, reports, reproduce.
 
 Imports under ``if TYPE_CHECKING:`` are annotations, not arrows, and are left out.
 """
@@ -39,6 +39,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("problem",),
     ("formulations",),
     ("solvers",),
+    ("runtime",),  # the execution engine: tasks, worker processes, stores' identity
     ("search",),  # the global search: starts, stopping rule, odds
     ("studies",),
     ("api", "validation"),

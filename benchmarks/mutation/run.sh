@@ -84,7 +84,7 @@ cat >>"$WORK/tests/conftest.py" <<'PY'
 
 @pytest.fixture(autouse=True)
 def _empty_formulation_caches():
-    from optdesign.studies import runner as _runner
+    from optdesign.runtime import runner as _runner
     from optdesign.studies import nlp_solve as _solve
 
     _solve._NLPS.clear()

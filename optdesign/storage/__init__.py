@@ -13,7 +13,7 @@ two runs by mistake, or receive from someone else. This module makes each of tho
   locks. The lock is re-entrant within a process (a command holds it for the whole run,
   the task runner takes it again for each store);
 - :func:`open_store` / :class:`StoreWriter` / :func:`read_store`: the append-only JSON
-  Lines store of :func:`optdesign.studies.runner.run_tasks`. Its first line is the run's
+  Lines store of :func:`optdesign.runtime.runner.run_tasks`. Its first line is the run's
   identity ``{"__store__": 2, "key": ..., "identity": {...}}``, written with the file's
   creation (the file appears complete with it, atomically), so a store without its
   identity is never ours. Resuming checks the format version, the identity (naming the

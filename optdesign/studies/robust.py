@@ -36,11 +36,11 @@ from optdesign.formulations.robust import (
 from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
 from optdesign.problem.request import SolveRequest
 from optdesign.reports.tables import format_table
+from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Globality, Result
-from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.nlp_solve import (
     continuous_only,
     finish,

@@ -1,7 +1,7 @@
 """The task graph of an epsilon-constraint front: anchors, then warm-started chains.
 
 Two objectives: :class:`TwoChains` adds the sweep's tasks as records come in (the
-``expand`` hook of :func:`~optdesign.studies.runner.run_tasks`): one chain ascends from
+``expand`` hook of :func:`~optdesign.runtime.runner.run_tasks`): one chain ascends from
 anchor A, the other descends from anchor B, and they meet wherever they meet. Three
 objectives: :func:`three_objective_tasks` builds the rows of a grid once the anchors are
 in.

@@ -18,6 +18,7 @@ from optdesign.errors import InputError
 from optdesign.problem import load_problem
 from optdesign.problem.design_problem import relative_violation
 from optdesign.problem.load import load
+from optdesign.runtime.runner import read_store
 from optdesign.solvers import deadline
 from optdesign.studies.pareto import compute_front
 from optdesign.studies.pareto.methods import pymoo_problem
@@ -29,7 +30,6 @@ from optdesign.studies.pareto.metrics import (
     spacing,
     spread,
 )
-from optdesign.studies.runner import read_store
 from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
