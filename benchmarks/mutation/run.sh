@@ -60,6 +60,7 @@ if [ "${SUBSET:-0}" = "1" ]; then
     tests/models/test_stiffness.py
     tests/models/test_lock.py
     tests/models/test_error_budget.py
+    tests/reproduce/test_monte_carlo.py
     tests/reproduce/test_duan2017.py
     tests/problem/test_design_problem.py
     tests/problem/test_drive.py
