@@ -56,7 +56,7 @@ ENTRY_POINTS = {
     ("optdesign.studies.pareto.front", "optdesign.reports.front_text"),
     ("optdesign.studies.pareto.front", "optdesign.reports.frames"),
     ("optdesign.studies.pareto.front", "optdesign.plots.front"),
-    ("optdesign.studies.sweep", "optdesign.reports.sweep"),
+    ("optdesign.studies.sweep", "optdesign.reports.sweep_text"),
     ("optdesign.studies.sweep", "optdesign.plots.sweep"),
     # od.report(result_or_front_or_sweep, path): the public API's entry point to the pages
     ("optdesign.api", "optdesign.reports.html"),

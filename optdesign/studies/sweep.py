@@ -120,14 +120,14 @@ class Sweep:
 
     def summary(self) -> str:
         """The plain-text table the command line prints."""
-        from optdesign.reports.sweep import sweep_summary
+        from optdesign.reports.sweep_text import sweep_summary
 
         return sweep_summary(self)
 
     def to_frame(self):
         """A pandas DataFrame, one row per point: the parameters, the status, the
         objective and every free variable (columns ``"name [unit]"``), the binding set."""
-        from optdesign.reports.sweep import sweep_frame
+        from optdesign.reports.sweep_text import sweep_frame
 
         return sweep_frame(self)
 

@@ -541,13 +541,13 @@ def test_check_every_still_checked_by_od_sweep_naming_it(check_every, tmp_path):
 
 
 def test_sweep_csv_neutralises_text_a_spreadsheet_would_run(monkeypatch):
-    """optdesign.reports.sweep.sweep_csv: a text cell starting like a formula (a user's
+    """optdesign.reports.sweep_text.sweep_csv: a text cell starting like a formula (a user's
     text in ``what_fails``) is written with a leading quote, as front.csv writes it; a
     negative number stays a number."""
     import csv
     import io
 
-    import optdesign.reports.sweep as report
+    import optdesign.reports.sweep_text as report
 
     rows = [[1.5, "infeasible", '=HYPERLINK("x")', -2.0], [2.5, "optimal", "", 3.0]]
     monkeypatch.setattr(

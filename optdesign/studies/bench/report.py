@@ -22,7 +22,8 @@ import numpy as np
 from optdesign.solvers.result import clean_json
 from optdesign.storage import atomic_output, atomic_write_text
 from optdesign.studies.bench.configs import get_config
-from optdesign.studies.bench.metrics import (
+from optdesign.studies.bench.rows import BenchRow
+from optdesign.studies.bench.scoring import (
     GAP_FLOOR,
     SOLVED_GAP,
     ConfigStats,
@@ -32,7 +33,6 @@ from optdesign.studies.bench.metrics import (
     paired_time_ratio,
     performance_profile,
 )
-from optdesign.studies.bench.rows import BenchRow
 from optdesign.text import csv_cell, printable
 from optdesign.tolerances import FEASIBILITY_TOL
 

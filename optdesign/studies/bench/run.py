@@ -20,9 +20,9 @@ from optdesign.store_identity import identity_key
 from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
 from optdesign.studies.bench.instances import Instance, coverage, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
-from optdesign.studies.bench.metrics import ConfigStats, add_gaps, config_stats
 from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.sandbox import run_task
+from optdesign.studies.bench.scoring import ConfigStats, add_gaps, config_stats
 
 
 @dataclass

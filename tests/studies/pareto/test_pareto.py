@@ -522,7 +522,7 @@ def test_a_front_points_costs_equal_resolves_of_its_own_problem(cs):
 def test_a_front_point_whose_costs_cannot_be_known_says_why(cs, cs_front):
     from dataclasses import replace
 
-    from optdesign.reports.costs import front_point_costs
+    from optdesign.reports.costs_text import front_point_costs
 
     point = cs_front.points[len(cs_front.points) // 2]
     shown = front_point_costs(cs, cs_front.objectives, replace(point, multipliers=None))
