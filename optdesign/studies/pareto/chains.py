@@ -78,8 +78,8 @@ def anchor_message(objective: str, rec: PointRecord, problem: Any = None) -> str
             f"stopped: {rec.message or rec.status}); more starts (starts=) may find one"
         )
     return (
-        f"{head}; at the best point found: {shown}; `optdesign solve` gives the smallest "
-        "relaxation of each"
+        f"{head}; at the best point found: {shown}; od.solve (optdesign solve) gives the "
+        "smallest relaxation of each"
     )
 
 

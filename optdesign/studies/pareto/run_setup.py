@@ -27,7 +27,7 @@ def check_front_problem(problem: DesignProblem) -> None:
         raise InputError(
             "variables",
             "no free variable: a front trades objectives by moving the design, and this "
-            "problem's design is fixed (optdesign solve checks it)",
+            "problem's design is fixed (od.solve, optdesign solve, checks it)",
         )
 
 
