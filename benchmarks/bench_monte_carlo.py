@@ -21,7 +21,7 @@ import numpy as np
 from optdesign.mechanisms import CrankSlider
 from optdesign.models import error_budget as eb
 from optdesign.models import screw_sizing
-from optdesign.studies.monte_carlo import run_monte_carlo
+from optdesign.reproduce.monte_carlo import run_monte_carlo
 
 
 def design_sources(mech: CrankSlider):

@@ -55,7 +55,7 @@ def timed_front(problem, points, workers, tag, **kw):
 def _solver_counts(front) -> dict:
     """How the epsilon front's records were solved (from its store): solver of each
     record, Ipopt fallbacks, and the anchors' multistart evidence."""
-    from optdesign.studies.runner import read_store
+    from optdesign.runtime.runner import read_store
 
     _, recs = read_store(front.store)
     solvers: dict[str, int] = {}

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from optdesign import validation
+from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.load import load
 from optdesign.problem.request import SolveRequest
@@ -312,7 +313,13 @@ def bench(
     if readme is not None:
         from optdesign.studies.bench.report import update_readme as paste
 
-        if not paste(readme, report.summary()):  # its markers gone during the runs
+        try:
+            pasted = paste(readme, report.summary())
+        except validation.ArgumentError:
+            raise
+        except InputError as exc:  # the file gone or changed during the runs
+            raise validation.ArgumentError("update_readme", exc.reason) from None
+        if not pasted:  # its markers gone during the runs
             raise validation.ArgumentError(
                 "update_readme", f"{readme} has no generated-block markers"
             )
@@ -422,9 +429,9 @@ def sweep(
     -----
     The arguments, checked, travel down as one :class:`optdesign.SolveRequest` (how each
     point is solved; a point a formulation solves receives it) and one
-    :class:`~optdesign.studies.run_options.RunOptions` (where and how the points run).
+    :class:`~optdesign.runtime.run_options.RunOptions` (where and how the points run).
     """
-    from optdesign.studies.run_options import RunOptions
+    from optdesign.runtime.run_options import RunOptions
     from optdesign.studies.sweep import run_sweep
 
     starts = validation.starts("starts", starts)

@@ -292,7 +292,7 @@ def scheduler(argument: str, value: Any) -> Any:
     in-process scheduler's ``inproc://HOST/PID/N``) or, from Python, a
     ``distributed.Client``; None: local processes. Only the form is checked
     here; a scheduler that does not answer is refused when the run connects to it
-    (:func:`optdesign.studies.runner.run_tasks`)."""
+    (:func:`optdesign.runtime.runner.run_tasks`)."""
     if value is None:
         return None
     if not isinstance(value, str):

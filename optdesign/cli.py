@@ -334,7 +334,7 @@ def run_guarded(func: Callable[[], int | None]) -> int:
         return 1
     except KeyboardInterrupt as exc:
         _, code = exit_code(exc)
-        line = interrupts.message(code - 128, saved_store(exc))
+        line = interrupts.message(code - 128, saved_store(exc), resume=option("resume"))
         with interrupts.exit_lock():  # not interleaved with the watchdog's line
             print(line, file=sys.stderr)
         return code
@@ -386,7 +386,7 @@ def _finish_interrupted(signum: int) -> None:
     cannot unwind (a signal before or after the command, or one that finds it stuck in
     native solver code - see :func:`optdesign.interrupts.start_watchdog`). Every output
     is complete (written atomically, or not yet begun) and no record half-written."""
-    line = interrupts.message(signum, saved_store(None)) + "\n"
+    line = interrupts.message(signum, saved_store(None), resume=option("resume")) + "\n"
     # Flushed from a helper thread: the main thread may hold a stream's lock (stuck in
     # native code that prints); what it had buffered is not worth a hang.
     flusher = threading.Thread(target=_flush_streams, daemon=True)

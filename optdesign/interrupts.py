@@ -435,13 +435,14 @@ def exit_code(exc: KeyboardInterrupt) -> tuple[str, int]:
     return signal.Signals(signum).name, 128 + int(signum)
 
 
-def message(signum: int, store: dict[str, object] | None) -> str:
-    """The one line of an interrupted command (naming the saved store when there is one)."""
+def message(signum: int, store: dict[str, object] | None, resume: str = "resume=True") -> str:
+    """The one line of an interrupted command (naming the saved store when there is one,
+    and ``resume``, how the caller continues it: the command line passes ``--resume``)."""
     name = signal.Signals(signum).name
     if not store:
         return f"optdesign: interrupted ({name})"
     n = store["records"]
     return (
         f"optdesign: interrupted ({name}); {n} record{'' if n == 1 else 's'} saved in "
-        f"{printable(str(store['path']))}, --resume continues"
+        f"{printable(str(store['path']))}, {resume} continues"
     )

@@ -27,7 +27,7 @@ import pytest
 
 psutil = pytest.importorskip("psutil")
 
-from optdesign.studies.runner import Isolation, read_store, run_tasks  # noqa: E402
+from optdesign.runtime.runner import Isolation, read_store, run_tasks  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 N_TASKS = 16
@@ -35,7 +35,7 @@ N_TASKS = 16
 SCRIPT = """
 import os, sys, time
 from optdesign.cli import run_guarded
-from optdesign.studies.runner import Isolation, run_tasks
+from optdesign.runtime.runner import Isolation, run_tasks
 
 def work(task, deps):
     time.sleep(task["sleep"])
@@ -354,7 +354,7 @@ def test_a_signal_while_the_program_exits_gives_the_same_line(tmp_path, sig):
     code = f"""
 import os, signal, sys, time
 from optdesign.cli import _late_signals_exit, run_guarded
-from optdesign.studies.runner import run_tasks
+from optdesign.runtime.runner import run_tasks
 
 def work(task, deps):
     return {{"value": task["n"]}}

@@ -3,7 +3,7 @@ an optdesign module in optdesign/ - at module top or inside a function - is an a
 the arrows form no circle and never point up the layers of the architecture:
 
 shared utilities -> models -> mechanisms -> problem -> formulations -> solvers ->
-search -> studies -> api -> cli, commands, plots, reports, reproduce.
+runtime -> search -> studies -> api -> cli, commands, plots, reports, reproduce.
 
 Imports under ``if TYPE_CHECKING:`` are annotations, not arrows, and are left out.
 """
@@ -39,6 +39,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("problem",),
     ("formulations",),
     ("solvers",),
+    ("runtime",),  # the execution engine: tasks, worker processes, stores' identity
     ("search",),  # the global search: starts, stopping rule, odds
     ("studies",),
     ("api", "validation"),
@@ -55,7 +56,7 @@ ENTRY_POINTS = {
     ("optdesign.studies.pareto.front", "optdesign.reports.front_text"),
     ("optdesign.studies.pareto.front", "optdesign.reports.frames"),
     ("optdesign.studies.pareto.front", "optdesign.plots.front"),
-    ("optdesign.studies.sweep", "optdesign.reports.sweep"),
+    ("optdesign.studies.sweep", "optdesign.reports.sweep_text"),
     ("optdesign.studies.sweep", "optdesign.plots.sweep"),
     # od.report(result_or_front_or_sweep, path): the public API's entry point to the pages
     ("optdesign.api", "optdesign.reports.html"),

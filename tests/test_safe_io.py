@@ -426,7 +426,7 @@ def test_a_store_with_another_hard_link_is_never_appended_to(tmp_path):
     victim_dir.mkdir()
     store = tmp_path / "out" / "s.jsonl"
     tasks = [{"id": f"t{i}", "n": i} for i in range(3)]
-    from optdesign.studies.runner import run_tasks
+    from optdesign.runtime.runner import run_tasks
 
     run_tasks(tasks[:2], _double, store, key="k")
     os.link(store, victim_dir / "linked.jsonl")

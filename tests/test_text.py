@@ -429,7 +429,7 @@ def test_bench_refusal_of_a_hostile_configuration_is_one_line(tmp_path, capfd):
 def test_progress_bar_description_is_printable(tmp_path, monkeypatch):
     import tqdm.auto
 
-    from optdesign.studies.runner import run_tasks
+    from optdesign.runtime.runner import run_tasks
 
     seen = []
 

@@ -60,6 +60,7 @@ if [ "${SUBSET:-0}" = "1" ]; then
     tests/models/test_stiffness.py
     tests/models/test_lock.py
     tests/models/test_error_budget.py
+    tests/reproduce/test_monte_carlo.py
     tests/reproduce/test_duan2017.py
     tests/problem/test_design_problem.py
     tests/problem/test_drive.py
@@ -84,7 +85,7 @@ cat >>"$WORK/tests/conftest.py" <<'PY'
 
 @pytest.fixture(autouse=True)
 def _empty_formulation_caches():
-    from optdesign.studies import runner as _runner
+    from optdesign.runtime import runner as _runner
     from optdesign.studies import nlp_solve as _solve
 
     _solve._NLPS.clear()

@@ -16,7 +16,7 @@ mm/rev, an encoder angle in rad at the motor, a nut-side displacement in mm, a r
 change in mm, an output angle in rad), a distribution and whether eq. 6 counts it as
 systematic or random. :func:`contribution` maps a value of a source to the output through
 the model functions of this module and the mechanism's sensitivities; the deterministic
-:func:`budget` and the Monte Carlo (optdesign.studies.monte_carlo) both call it, so the
+:func:`budget` and the Monte Carlo (optdesign.reproduce.monte_carlo) both call it, so the
 formulas exist once. All terms are linear in their uncertain input, so "gain x value" is
 exact.
 

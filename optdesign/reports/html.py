@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.reports.costs import cost_text, front_point_costs
+from optdesign.reports.costs_text import cost_text, front_point_costs
 from optdesign.reports.display_units import (
     angle_unit,
     objective_shown,

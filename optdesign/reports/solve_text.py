@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from optdesign.reports.costs import cost_text
+from optdesign.reports.costs_text import cost_text
 from optdesign.reports.display_units import objective_shown, requirement_echo, variable_shown
 from optdesign.reports.facts import design_facts, objective_facts
 from optdesign.reports.limits import (

@@ -8,8 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from optdesign.errors import OptDesignError
-from optdesign.reports.sweep import sweep_csv, sweep_document
 from optdesign.reports.sweep_html import sweep_report
+from optdesign.reports.sweep_text import sweep_csv, sweep_document
 from optdesign.storage import atomic_write_text
 
 

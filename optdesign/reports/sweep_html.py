@@ -2,7 +2,7 @@
 
 The chart is the objective against the (first) parameter, one trace per value of a
 second one, the points where the binding set or a catalogue item changes marked; the
-table below it is the sweep's (:func:`~optdesign.reports.sweep.sweep_rows`, in the
+table below it is the sweep's (:func:`~optdesign.reports.sweep_text.sweep_rows`, in the
 summary's units). Hovering or clicking a point of the chart, or a row of the table,
 shows that point's design as ``report.html`` shows a front's: its values, sketch, curves
 and what binds, evaluated on the point's own problem (the swept requirement at the
@@ -16,11 +16,11 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from optdesign.reports.costs import cost_text
+from optdesign.reports.costs_text import cost_text
 from optdesign.reports.display_units import objective_shown
 from optdesign.reports.html import _header, design_view
 from optdesign.reports.html_page import render
-from optdesign.reports.sweep import _cell, sweep_rows
+from optdesign.reports.sweep_text import _cell, sweep_rows
 from optdesign.solvers.result import Sensitivity
 
 #: What the page says of a point's sensitivities when the sweep did not compute them

@@ -33,7 +33,7 @@ from optdesign.models.hertz_point import (
 )
 from optdesign.models.prsm import STEEL_E, STEEL_NU, PRSMContact
 from optdesign.reports.tables import Comparison, comparison_table, format_table
-from optdesign.studies.prsm_contact import (
+from optdesign.reproduce.prsm_contact_sweeps import (
     SIDES,
     area_vs_load,
     omega_vs_position,

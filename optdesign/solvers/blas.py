@@ -3,7 +3,7 @@
 Why: the libraries an NLP solve calls (CasADi's bundled OpenBLAS under MUMPS, SciPy's
 under SLSQP, NumPy's) split some reductions among their threads, and the split changes
 the rounding. A solve in the main process (as many BLAS threads as cores) and the same
-solve in a worker process (one thread, :func:`optdesign.studies.processes` sets it) then
+solve in a worker process (one thread, :func:`optdesign.runtime.processes` sets it) then
 differ in the last bits, and a chain of warm-started solves (a Pareto front) carries the
 difference to ~1e-5. With the same thread count everywhere, one worker and several do the
 same arithmetic, bit for bit; one thread is also the faster choice for these small

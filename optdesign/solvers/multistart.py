@@ -2,7 +2,7 @@
 
 Reports how many starts reached the best objective (evidence of a global optimum). Starts
 run in-process, or through the ``parallel_map`` a study passes (the studies' process
-engine, :func:`optdesign.studies.inherited_map.map_inherited`: local worker processes that
+engine, :func:`optdesign.runtime.inherited_map.map_inherited`: local worker processes that
 inherit the solver built once in this process). The solver layer knows no process pool.
 """
 

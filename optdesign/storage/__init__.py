@@ -13,7 +13,7 @@ two runs by mistake, or receive from someone else. This module makes each of tho
   locks. The lock is re-entrant within a process (a command holds it for the whole run,
   the task runner takes it again for each store);
 - :func:`open_store` / :class:`StoreWriter` / :func:`read_store`: the append-only JSON
-  Lines store of :func:`optdesign.studies.runner.run_tasks`. Its first line is the run's
+  Lines store of :func:`optdesign.runtime.runner.run_tasks`. Its first line is the run's
   identity ``{"__store__": 2, "key": ..., "identity": {...}}``, written with the file's
   creation (the file appears complete with it, atomically), so a store without its
   identity is never ours. Resuming checks the format version, the identity (naming the
@@ -27,7 +27,7 @@ appended to or read through them. An ``--out`` that is itself a link, given on t
 command line, is the user's choice and is used as given.
 
 One job a module: :mod:`optdesign.storage.files` (atomic files, a writable folder),
-:mod:`optdesign.storage.lock` (one writer per folder), :mod:`optdesign.storage.store`
+:mod:`optdesign.storage.folder_lock` (one writer per folder), :mod:`optdesign.storage.store`
 (the JSONL store); every name is imported from ``optdesign.storage`` as before.
 """
 
@@ -40,7 +40,7 @@ from optdesign.storage.files import (
     atomic_write_text,
     ensure_writable,
 )
-from optdesign.storage.lock import LOCK_NAME, _lock_holder, holds_lock, lock_folder
+from optdesign.storage.folder_lock import LOCK_NAME, _lock_holder, holds_lock, lock_folder
 from optdesign.storage.store import (
     STORE_MAX_BYTES,
     STORE_VERSION,

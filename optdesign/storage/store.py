@@ -1,4 +1,4 @@
-"""The append-only JSON Lines store of :func:`optdesign.studies.runner.run_tasks`
+"""The append-only JSON Lines store of :func:`optdesign.runtime.runner.run_tasks`
 (:mod:`optdesign.storage`).
 
 Its first line is the run's identity ``{"__store__": 2, "key": ..., "identity": {...}}``,

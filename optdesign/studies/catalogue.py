@@ -38,6 +38,7 @@ from optdesign.formulations.nlp import Bounds
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
 from optdesign.problem.request import SolveRequest
+from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
 from optdesign.solvers.details import CatalogueCombination, CatalogueDetails
 from optdesign.solvers.multistart import (
     best_of,
@@ -53,7 +54,6 @@ from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
-from optdesign.studies.inherited_map import InheritedWorkers, map_serial
 from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
 from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -147,7 +147,7 @@ class NodeSolver:
         """Inside it, a node's starts run on :attr:`workers` local processes forked once
         (they inherit the built solver). Each node keeps its serial answer: its starts
         in their order up to the one that settles it or the verdicts that end it
-        (:class:`~optdesign.studies.inherited_map.InheritedWorkers`), so any number of
+        (:class:`~optdesign.runtime.inherited_map.InheritedWorkers`), so any number of
         workers solves the same nodes to the same values and records."""
         if self.workers <= 1:
             yield

@@ -23,6 +23,7 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.nlp import NLP, VAR, build_nlp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
+from optdesign.runtime.inherited_map import map_inherited
 from optdesign.search.global_phase import default_max_starts, global_search, search_globality
 from optdesign.search.starts import TiltedStarts, problem_evaluator
 from optdesign.solvers.multistart import sobol_starts
@@ -33,7 +34,6 @@ from optdesign.solvers.result import (
     TerminationCondition,
 )
 from optdesign.solvers.solved_point import SOLVED_STATUSES
-from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.reference import attach_reference
 from optdesign.studies.verify import nan_notes, verify_design
 from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL

@@ -11,12 +11,12 @@ Monte Carlo.
 - :func:`compare_nominal_robust`: both optima, the same Monte Carlo samples for both
   (common random numbers: the difference is not blurred by sampling noise), a table.
 
-Run: ``python -m optdesign.studies.robust problems/cs_min_backlash_robust.toml``.
+The comparison's table: ``python benchmarks/robust_compare.py FILE``; the robust optimum
+alone: ``optdesign solve FILE --formulation robust``.
 """
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -36,11 +36,11 @@ from optdesign.formulations.robust import (
 from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
 from optdesign.problem.request import SolveRequest
 from optdesign.reports.tables import format_table
+from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Globality, Result
-from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.nlp_solve import (
     continuous_only,
     finish,
@@ -434,34 +434,3 @@ def compare_nominal_robust(
     )
     label = robust.details.robust.risk_label
     return RobustComparison(nominal, robust, mc_nom, mc_rob, objective, label, nominal_saa)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """``python -m optdesign.studies.robust FILE``: print the nominal-vs-robust table."""
-    from optdesign.problem import load_problem
-
-    ap = argparse.ArgumentParser(prog="python -m optdesign.studies.robust")
-    ap.add_argument("file")
-    ap.add_argument("--mc", type=int, default=MC_SAMPLES, help="independent MC samples")
-    ap.add_argument("--mc-seed", type=int, default=MC_SEED)
-    ap.add_argument("--q", type=float, default=0.95, help="quantile level reported")
-    ap.add_argument("--starts", type=int, default=None, help="nominal multistart count")
-    ap.add_argument("--robust-starts", type=int, default=1)
-    args = ap.parse_args(argv)
-    problem = load_problem(args.file)
-    t0 = time.perf_counter()
-    cmp = compare_nominal_robust(
-        problem, args.mc, args.mc_seed, args.q, args.starts, args.robust_starts
-    )
-    print(cmp.table())
-    print(
-        f"\nnominal {cmp.nominal.status}, robust {cmp.robust.status} "
-        f"(independent check {'passed' if cmp.robust.verified else 'FAILED'}); "
-        f"SAA statistic recomputed on the NumPy path: {cmp.robust.details.robust.saa_check:.6g}; "
-        f"total {time.perf_counter() - t0:.1f} s"
-    )
-    return 0 if cmp.robust.success else 1
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

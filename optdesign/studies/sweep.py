@@ -24,7 +24,7 @@ better. Two kinds of work make it:
    says when the cap stopped them): a better branch found at one point so spreads along
    the sweep as far as it is better.
 
-Each round is one :func:`optdesign.studies.runner.run_tasks` call on the sweep's JSONL
+Each round is one :func:`optdesign.runtime.runner.run_tasks` call on the sweep's JSONL
 store, its tasks depending only on the records of the rounds before it: the sweep is
 the same for any number of workers, every record goes to the store as it finishes, and
 a killed sweep resumes where it stopped (a resume with other settings is refused naming
@@ -54,9 +54,9 @@ from typing import Any
 
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
+from optdesign.runtime.run_options import RunOptions
 from optdesign.solvers.registry import default_solver
 from optdesign.solvers.solved_point import is_success
-from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sweep_grid import Axis, grid_order, neighbour, sweep_axes
 from optdesign.studies.sweep_point import (
     GLOBAL_SEARCH,
@@ -120,14 +120,14 @@ class Sweep:
 
     def summary(self) -> str:
         """The plain-text table the command line prints."""
-        from optdesign.reports.sweep import sweep_summary
+        from optdesign.reports.sweep_text import sweep_summary
 
         return sweep_summary(self)
 
     def to_frame(self):
         """A pandas DataFrame, one row per point: the parameters, the status, the
         objective and every free variable (columns ``"name [unit]"``), the binding set."""
-        from optdesign.reports.sweep import sweep_frame
+        from optdesign.reports.sweep_text import sweep_frame
 
         return sweep_frame(self)
 
@@ -163,10 +163,10 @@ def run_sweep(
     run
         Where and how the points run (store folder, resume, workers, progress).
     """
-    from optdesign.studies.identity import problem_digest, solver_identity, version
+    from optdesign.runtime.identity import problem_digest, solver_identity, version
+    from optdesign.runtime.processes import process_pool
+    from optdesign.runtime.runner import forks_workers, run_tasks
     from optdesign.studies.nlp_solve import planned_starts
-    from optdesign.studies.processes import process_pool
-    from optdesign.studies.runner import forks_workers, run_tasks
     from optdesign.studies.sweep_solver import sweep_mode
 
     run = run if run is not None else RunOptions()

@@ -306,7 +306,7 @@ def shared_solver(task: Mapping[str, Any]):
     its formulation."""
     if task["mode"] != "shared":
         return None
-    from optdesign.studies.runner import cached
+    from optdesign.runtime.runner import cached
     from optdesign.studies.sweep_solver import SweepSolver
 
     base = task["problem"]

@@ -1,4 +1,5 @@
-"""Error budget (seed 003 eq. 2-6) and its Monte Carlo, mapped through a crank-slider."""
+"""Error budget (seed 003 eq. 2-6), mapped through a crank-slider (its Monte Carlo:
+tests/reproduce/test_monte_carlo.py)."""
 
 import casadi as ca
 import numpy as np
@@ -7,12 +8,11 @@ import pytest
 from optdesign.errors import InputError
 from optdesign.mechanisms import CrankSlider
 from optdesign.models import error_budget as eb
-from optdesign.studies.monte_carlo import run_monte_carlo
 
 MECH = CrankSlider(R=90.0, l=80.0, n=50.0, p=5.0, i_a=2.0)
 
 
-def _sources():
+def budget_sources():
     return [
         eb.lead_error_source(0.003),
         eb.backlash_source(0.005),
@@ -47,14 +47,14 @@ def test_output_mapping_through_the_crank_slider():
     travel = float(MECH.nut_position(phi) - MECH.nut_position(0.0))
     assert eb.contribution(lead, 0.002, MECH, phi) == pytest.approx(0.002 * travel / 5.0 / v)
     # Budget of eq. 6 built from the same gains.
-    b = eb.budget(_sources(), MECH, phi)
-    g = eb.gains(_sources(), MECH, phi)
-    sd = [s.sd for s in _sources()]
+    b = eb.budget(budget_sources(), MECH, phi)
+    g = eb.gains(budget_sources(), MECH, phi)
+    sd = [s.sd for s in budget_sources()]
     assert float(b.rss) == pytest.approx(
         np.sqrt(
             sum(
                 (abs(gi) * si) ** 2
-                for gi, si, s in zip(g, sd, _sources(), strict=True)
+                for gi, si, s in zip(g, sd, budget_sources(), strict=True)
                 if s.kind == "random"
             )
         )
@@ -86,43 +86,8 @@ def test_contribution_casadi_matches_numpy():
     )
 
 
-def test_monte_carlo_reproducible_and_statistically_stable():
-    kw = dict(mechanism=MECH, phi_range=(-0.5, 0.5), chunk=50_000)
-    a = run_monte_carlo(_sources(), 200_000, 7, keep_samples=True, **kw)
-    b = run_monte_carlo(_sources(), 200_000, 7, keep_samples=True, **kw)
-    c = run_monte_carlo(_sources(), 200_000, 8, keep_samples=True, **kw)
-    assert np.array_equal(a.samples, b.samples)
-    assert a.mean == b.mean and a.std == b.std and a.ranking() == b.ranking()
-    assert not np.array_equal(a.samples, c.samples)
-    # Different seeds: means within 5 standard errors, sds within 2 %.
-    assert abs(a.mean - c.mean) < 5 * a.std / np.sqrt(a.n)
-    assert c.std == pytest.approx(a.std, rel=0.02)
-    assert sum(a.mean_square_share.values()) == pytest.approx(1.0)
-
-
-def test_monte_carlo_matches_the_budget_at_one_angle():
-    src = _sources()
-    phi = 0.2
-    res = run_monte_carlo(src, 400_000, 1, MECH, phi=phi)
-    g = eb.gains(src, MECH, phi)
-    # Exact mean and sd of a sum of independent terms.
-    mean = sum(gi * s.mean for gi, s in zip(g, src, strict=True))
-    sd = np.sqrt(sum((gi * s.sd) ** 2 for gi, s in zip(g, src, strict=True)))
-    assert res.mean == pytest.approx(mean, abs=5 * sd / np.sqrt(res.n))
-    assert res.std == pytest.approx(sd, rel=0.01)
-    # The deterministic budget bounds the sampled error (systematic + 3 sigma).
-    b = eb.budget(src, MECH, phi)
-    assert res.abs_max < float(b.systematic) + 5 * float(b.rss)
-    # Fixed backlash ranks although it has no variance.
-    # (a constant column's variance is zero up to rounding: 5e-13 with NumPy 1.26)
-    assert res.mean_square_share["backlash"] > 0.0
-    assert res.variance_share["backlash"] == pytest.approx(0.0, abs=1e-9)
-
-
 def test_source_validation():
     with pytest.raises(InputError, match="distribution"):
         eb.ErrorSource("x", "random", "cauchy", 1.0)
     with pytest.raises(InputError, match="scale"):
         eb.ErrorSource("x", "random", "normal", -1.0)
-    with pytest.raises(InputError, match="n"):
-        run_monte_carlo(_sources(), 1, 0, MECH)

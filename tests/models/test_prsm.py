@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from optdesign.errors import InputError
 from optdesign.models.hertz_point import curvature_sum_difference
 from optdesign.models.prsm import PRSMContact, PRSMGeometry
-from optdesign.studies.prsm_contact import (
+from optdesign.reproduce.prsm_contact_sweeps import (
     area_vs_load,
     omega_vs_position,
     reference_geometry,

@@ -12,8 +12,8 @@ import optdesign as od
 from optdesign.cli import main
 from optdesign.errors import InputError
 from optdesign.reports.display_units import objective_shown
-from optdesign.reports.sweep import _cell, sweep_rows
 from optdesign.reports.sweep_html import NOT_COMPUTED
+from optdesign.reports.sweep_text import _cell, sweep_rows
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 NASTY = '<!--<script>x</script>"><b>%{x}</b>'

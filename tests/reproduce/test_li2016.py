@@ -6,7 +6,7 @@ import pytest
 
 from optdesign.models import error_budget as eb
 from optdesign.reproduce import li2016
-from optdesign.studies.monte_carlo import run_monte_carlo
+from optdesign.reproduce.monte_carlo import run_monte_carlo
 
 
 @pytest.fixture(scope="module")

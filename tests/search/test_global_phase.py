@@ -9,6 +9,7 @@ import time
 import numpy as np
 import pytest
 
+from optdesign.runtime.inherited_map import map_inherited
 from optdesign.search.global_phase import (
     FAILED_LIMIT,
     MAX_POLISHED,
@@ -22,7 +23,6 @@ from optdesign.search.global_phase import (
 from optdesign.search.odds import odds
 from optdesign.search.starts import TiltedStarts
 from optdesign.solvers.result import Result
-from optdesign.studies.inherited_map import map_inherited
 
 #: Centres of the regions of attraction (nearest centre wins) and their optimum values.
 CENTRES = np.array([[0.1, 0.1], [0.9, 0.2], [0.5, 0.8], [0.95, 0.95]])

@@ -16,6 +16,7 @@ from optdesign.cli import main
 from optdesign.errors import InputError
 from optdesign.reports.html import solve_report
 from optdesign.reports.result_json import result_json
+from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.blas import (
     blas_libraries,
     blas_thread_counts,
@@ -31,7 +32,6 @@ from optdesign.solvers.multistart import (
     start_outcome,
 )
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
-from optdesign.studies.inherited_map import map_inherited
 from optdesign.studies.pareto.metrics import non_dominated
 
 PROBLEM = Path(__file__).resolve().parents[2] / "problems" / "cs_min_backlash.toml"

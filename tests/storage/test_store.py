@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
+from optdesign.runtime.runner import run_tasks
 from optdesign.safe_io import UnsafeFileError
 from optdesign.storage import (
     STORE_VERSION,
@@ -28,7 +29,6 @@ from optdesign.storage import (
     open_store,
     read_store,
 )
-from optdesign.studies.runner import run_tasks
 
 ROOT = Path(__file__).resolve().parents[2]
 

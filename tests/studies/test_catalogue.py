@@ -19,6 +19,8 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.discrete import discrete_variables
 from optdesign.problem import load_problem, problem_from_dict
 from optdesign.problem.load import load
+from optdesign.runtime.inherited_map import InheritedWorkers
+from optdesign.runtime.processes import forks_workers
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.studies import catalogue, catalogue_bnb
 from optdesign.studies.catalogue import (
@@ -53,8 +55,6 @@ from optdesign.studies.catalogue_bnb import (
     trusted_value,
     wins,
 )
-from optdesign.studies.inherited_map import InheritedWorkers
-from optdesign.studies.processes import forks_workers
 from optdesign.studies.verify import verify_design
 from studies.test_catalogue_bnb import _infeasible as _failed
 from studies.test_catalogue_bnb import _Problem, _Var  # the stand-in problem of catalogue items

@@ -11,7 +11,7 @@ import pytest
 import optdesign as od
 from optdesign.formulations.robust import draw_samples
 from optdesign.problem.parameters import limit_value, perturbed
-from optdesign.reports.costs import cost_text
+from optdesign.reports.costs_text import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.studies.robust import solve_robust
 

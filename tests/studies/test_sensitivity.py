@@ -9,7 +9,7 @@ import pytest
 import optdesign as od
 from optdesign.errors import ProblemError
 from optdesign.problem.parameters import perturbed, requirement_paths
-from optdesign.reports.costs import cost_text
+from optdesign.reports.costs_text import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.solvers.result import Sensitivity
 from optdesign.studies.sensitivity import finite_difference, nlp_sensitivities

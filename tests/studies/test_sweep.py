@@ -13,8 +13,8 @@ from optdesign.cli import main
 from optdesign.commands.sweep import parse_vary
 from optdesign.problem.parameters import at_values
 from optdesign.problem.request import SolveRequest
+from optdesign.runtime.run_options import RunOptions
 from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.run_options import RunOptions
 from optdesign.studies.sweep import run_sweep
 from optdesign.studies.sweep_grid import grid_order, neighbour, sweep_axes
 from optdesign.studies.sweep_point import grid_neighbours, polish_choice
@@ -543,13 +543,13 @@ def test_check_every_still_checked_by_od_sweep_naming_it(check_every, tmp_path):
 
 
 def test_sweep_csv_neutralises_text_a_spreadsheet_would_run(monkeypatch):
-    """optdesign.reports.sweep.sweep_csv: a text cell starting like a formula (a user's
+    """optdesign.reports.sweep_text.sweep_csv: a text cell starting like a formula (a user's
     text in ``what_fails``) is written with a leading quote, as front.csv writes it; a
     negative number stays a number."""
     import csv
     import io
 
-    import optdesign.reports.sweep as report
+    import optdesign.reports.sweep_text as report
 
     rows = [[1.5, "infeasible", '=HYPERLINK("x")', -2.0], [2.5, "optimal", "", 3.0]]
     monkeypatch.setattr(

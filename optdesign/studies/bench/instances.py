@@ -87,8 +87,8 @@ def coverage() -> Coverage:
         if not cls.bench_families:
             skipped[name] = (
                 "declares no bench_families (bench its problems with "
-                "optdesign bench --problem FILE, or declare bench_families and "
-                "bench_template)"
+                "od.bench(problems=[...]) or optdesign bench --problem FILE, or declare "
+                "bench_families and bench_template)"
             )
             continue
         for family in cls.bench_families:

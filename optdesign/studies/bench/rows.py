@@ -34,7 +34,7 @@ REQUIRED: dict[str, str] = {
     "time_s": "number",
 }
 
-#: Computed from all rows of a benchmark (:func:`~optdesign.studies.bench.metrics.add_gaps`),
+#: Computed from all rows of a benchmark (:func:`~optdesign.studies.bench.scoring.add_gaps`),
 #: never stored.
 DERIVED = ("gap", "best_known", "hypervolume")
 

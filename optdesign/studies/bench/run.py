@@ -13,16 +13,16 @@ from typing import Any
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.runtime.run_options import study_folder
 from optdesign.safe_io import read_file
 from optdesign.storage import atomic_write_text
 from optdesign.store_identity import identity_key
 from optdesign.studies.bench.configs import default_configs, get_config, preload_modules
 from optdesign.studies.bench.instances import Instance, coverage, user_instances
 from optdesign.studies.bench.instances import suite as build_suite
-from optdesign.studies.bench.metrics import ConfigStats, add_gaps, config_stats
 from optdesign.studies.bench.rows import BenchRow
 from optdesign.studies.bench.sandbox import run_task
-from optdesign.studies.run_options import study_folder
+from optdesign.studies.bench.scoring import ConfigStats, add_gaps, config_stats
 
 
 @dataclass
@@ -136,9 +136,9 @@ def run_bench(
     ``overwrite`` starts afresh in a folder that holds a previous run's store (otherwise
     refused unless ``resume``).
     """
+    from optdesign.runtime.runner import Isolation, run_tasks
     from optdesign.studies.bench.report import write_outputs
     from optdesign.studies.bench.sandbox import failed_run, row_check
-    from optdesign.studies.runner import Isolation, run_tasks
 
     names = list(configs) if configs else default_configs()
     for c in names:
@@ -214,7 +214,7 @@ def bench_identity(
     """The identity of a benchmark's store: suite, runs (instances x configurations),
     time limits, optdesign version (instances and configurations are code) and, for the
     caller's own problems, each one's content, formulation and ``[solver]`` table."""
-    from optdesign.studies.identity import problem_digest, solver_identity, version
+    from optdesign.runtime.identity import problem_digest, solver_identity, version
 
     identity: dict[str, Any] = {
         "suite": suite_name,

@@ -20,8 +20,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from optdesign.formulations.discrete import discrete_variables
+from optdesign.runtime.identity import problem_digest
 from optdesign.studies.catalogue_bnb import shared_memo
-from optdesign.studies.identity import problem_digest
 from optdesign.studies.pareto.records import PointRecord
 
 

@@ -1,7 +1,7 @@
 """The task graph of an epsilon-constraint front: anchors, then warm-started chains.
 
 Two objectives: :class:`TwoChains` adds the sweep's tasks as records come in (the
-``expand`` hook of :func:`~optdesign.studies.runner.run_tasks`): one chain ascends from
+``expand`` hook of :func:`~optdesign.runtime.runner.run_tasks`): one chain ascends from
 anchor A, the other descends from anchor B, and they meet wherever they meet. Three
 objectives: :func:`three_objective_tasks` builds the rows of a grid once the anchors are
 in.
@@ -78,8 +78,8 @@ def anchor_message(objective: str, rec: PointRecord, problem: Any = None) -> str
             f"stopped: {rec.message or rec.status}); more starts (starts=) may find one"
         )
     return (
-        f"{head}; at the best point found: {shown}; `optdesign solve` gives the smallest "
-        "relaxation of each"
+        f"{head}; at the best point found: {shown}; od.solve (optdesign solve) gives the "
+        "smallest relaxation of each"
     )
 
 

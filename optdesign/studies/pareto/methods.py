@@ -6,7 +6,7 @@
 - :class:`WeightedSum`: normalised weighted sums (finds only the convex hull).
 - :class:`NSGA2`: pymoo's NSGA-II on the NumPy path of the same problem (the baseline).
 
-Every run of the first two goes through :func:`optdesign.studies.runner.run_tasks`: each
+Every run of the first two goes through :func:`optdesign.runtime.runner.run_tasks`: each
 record is written to a JSONL store as it finishes (resumable), on local processes or a
 Dask cluster. The store's identity (:func:`run_key`) holds the problem's content, its
 formulation, the objectives, the method's settings, the solver with every option and the
@@ -30,6 +30,7 @@ from optdesign.argument_checks import DEFAULT_FRONT_POINTS, ArgumentError
 from optdesign.errors import InputError, ProblemError
 from optdesign.formulations.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.runtime.runner import forks_workers, process_pool
 from optdesign.solvers.multistart import improves
 from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.nlp_solve import formulation_for
@@ -55,7 +56,6 @@ from optdesign.studies.pareto.template import (
     has_catalogue,
     leaves_catalogue,
 )
-from optdesign.studies.runner import forks_workers, process_pool
 from optdesign.tolerances import FEASIBILITY_TOL
 
 

@@ -14,11 +14,11 @@ from typing import Any
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.runtime.identity import run_identity
+from optdesign.runtime.run_options import RunOptions as RunOptions  # the fronts import it here
 from optdesign.safe_io import slug
-from optdesign.studies.identity import run_identity
 from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.records import record_problem
-from optdesign.studies.run_options import RunOptions as RunOptions  # the fronts import it here
 
 
 def check_front_problem(problem: DesignProblem) -> None:
@@ -27,7 +27,7 @@ def check_front_problem(problem: DesignProblem) -> None:
         raise InputError(
             "variables",
             "no free variable: a front trades objectives by moving the design, and this "
-            "problem's design is fixed (optdesign solve checks it)",
+            "problem's design is fixed (od.solve, optdesign solve, checks it)",
         )
 
 
@@ -65,9 +65,12 @@ def run_key(
     problem: DesignProblem, objectives: Sequence[str], back_end: str, /, **settings: Any
 ) -> dict[str, Any]:
     """Identity of a front's run (the components of
-    :func:`optdesign.studies.identity.run_identity`): problem, formulation, objectives,
+    :func:`optdesign.runtime.identity.run_identity`): problem, formulation, objectives,
     the method's ``settings``, the solver ``back_end`` with every option, version."""
-    return run_identity(problem, objectives, back_end=back_end, method=settings)
+    nlp = formulation_for(problem, tuple(sorted(objectives)))
+    return run_identity(
+        problem, objectives, formulation=nlp.fingerprint, back_end=back_end, method=settings
+    )
 
 
 def record_check(problem: DesignProblem, objectives: Sequence[str]):

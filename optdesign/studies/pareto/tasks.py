@@ -1,4 +1,4 @@
-"""The tasks of a front's computation, run by :func:`optdesign.studies.runner.run_tasks`.
+"""The tasks of a front's computation, run by :func:`optdesign.runtime.runner.run_tasks`.
 
 A task is a dict (``id``, ``kind``, ``after``, settings); :func:`front_task` dispatches on
 ``kind`` and returns a :class:`PointRecord` as a dict. Kinds:

@@ -20,6 +20,7 @@ from typing import Any, ClassVar
 
 from optdesign.errors import InputError
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.runtime.runner import run_tasks
 from optdesign.studies.nlp_solve import planned_starts
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
@@ -31,7 +32,6 @@ from optdesign.studies.pareto.run_setup import (
     run_key,
     store_path,
 )
-from optdesign.studies.runner import run_tasks
 
 _COUNTS = {2: "two", 3: "three"}
 
@@ -76,7 +76,7 @@ class FrontRun:
 
     def tasks(self, tasks: Sequence[Mapping[str, Any]], fn: Callable, **kw: Any) -> dict:
         """Run ``tasks`` through ``fn`` with the run's store, key, check, workers and
-        resume (:func:`optdesign.studies.runner.run_tasks`; ``kw`` overrides)."""
+        resume (:func:`optdesign.runtime.runner.run_tasks`; ``kw`` overrides)."""
         settings: dict[str, Any] = {
             "workers": self.run.workers,
             "scheduler": self.run.scheduler,

@@ -12,13 +12,13 @@ import pytest
 
 from optdesign.studies import bench
 from optdesign.studies.bench.instances import instance_dict, make_instance, single_families, suite
-from optdesign.studies.bench.metrics import (
+from optdesign.studies.bench.rows import BenchRow, BenchRowError
+from optdesign.studies.bench.scoring import (
     best_config,
     config_stats,
     paired_time_ratio,
     performance_profile,
 )
-from optdesign.studies.bench.rows import BenchRow, BenchRowError
 
 
 def test_instances_are_reproducible_and_validated():
@@ -286,8 +286,8 @@ def test_a_stored_row_that_is_not_a_row_is_refused_naming_why(change, reason):
 def test_the_committed_store_regenerates_the_readme_block(tmp_path):
     # What `optdesign bench --update-readme` pastes, rebuilt from the committed store's
     # rows through BenchRow, is the block the README holds, character for character.
-    from optdesign.studies.bench.metrics import add_gaps
     from optdesign.studies.bench.report import README_BEGIN, README_END, write_outputs
+    from optdesign.studies.bench.scoring import add_gaps
 
     rows = add_gaps([BenchRow.from_dict(json.loads(line)) for line in _committed_rows()])
     names = [c for c in bench.default_configs(True) if c in {r.config for r in rows}]

@@ -17,8 +17,8 @@ from optdesign.problem.objectives import BUILTIN_OBJECTIVES, ObjectiveInfo
 from optdesign.solvers.result import Result, TerminationCondition
 from optdesign.studies import bench
 from optdesign.studies.bench.configs import Config
-from optdesign.studies.bench.metrics import config_stats
 from optdesign.studies.bench.sandbox import row_problem, run_task
+from optdesign.studies.bench.scoring import config_stats
 from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"

@@ -12,6 +12,7 @@ import pytest
 import optdesign as od
 from optdesign.errors import InputError
 from optdesign.problem import problem_from_dict
+from optdesign.runtime.run_options import RunOptions
 from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.pareto import (
@@ -22,7 +23,6 @@ from optdesign.studies.pareto import (
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon, catalogue_task
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 from optdesign.studies.pareto.template import FrontRun
-from optdesign.studies.run_options import RunOptions
 
 ROOT = Path(__file__).resolve().parents[3]
 

@@ -90,7 +90,7 @@ def test_the_anchor_message_names_what_the_best_point_violates(problem):
     rec = PointRecord.from_dict(_rec("a", 1, 2, status="infeasible", design=design))
     assert anchor_message("A", rec, problem) == (
         "anchor A: no feasible design found (status infeasible); at the best point found: "
-        f"{shown}; `optdesign solve` gives the smallest relaxation of each"
+        f"{shown}; od.solve (optdesign solve) gives the smallest relaxation of each"
     )
 
 

@@ -18,6 +18,7 @@ from optdesign.errors import InputError
 from optdesign.problem import load_problem
 from optdesign.problem.design_problem import relative_violation
 from optdesign.problem.load import load
+from optdesign.runtime.runner import read_store
 from optdesign.solvers import deadline
 from optdesign.studies.pareto import compute_front
 from optdesign.studies.pareto.methods import pymoo_problem
@@ -29,7 +30,6 @@ from optdesign.studies.pareto.metrics import (
     spacing,
     spread,
 )
-from optdesign.studies.runner import read_store
 from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
@@ -522,7 +522,7 @@ def test_a_front_points_costs_equal_resolves_of_its_own_problem(cs):
 def test_a_front_point_whose_costs_cannot_be_known_says_why(cs, cs_front):
     from dataclasses import replace
 
-    from optdesign.reports.costs import front_point_costs
+    from optdesign.reports.costs_text import front_point_costs
 
     point = cs_front.points[len(cs_front.points) // 2]
     shown = front_point_costs(cs, cs_front.objectives, replace(point, multipliers=None))

@@ -44,7 +44,7 @@ def test_a_problem_without_a_free_variable_has_no_front():
     assert caught.value.field == "variables"
     assert str(caught.value) == (
         "variables: no free variable: a front trades objectives by moving the design, and "
-        "this problem's design is fixed (optdesign solve checks it)"
+        "this problem's design is fixed (od.solve, optdesign solve, checks it)"
     )
     # checked before the objectives: a wrong count is not what it is told
     with pytest.raises(InputError, match=r"^variables: no free variable"):

@@ -11,6 +11,7 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
+from optdesign.runtime.run_options import RunOptions
 from optdesign.search.global_phase import default_max_starts
 from optdesign.studies.nlp_solve import planned_starts
 from optdesign.studies.pareto import (
@@ -30,7 +31,6 @@ from optdesign.studies.pareto.template import (
     has_catalogue,
     leaves_catalogue,
 )
-from optdesign.studies.run_options import RunOptions
 
 FORK = "problems/fork_min_backlash.toml"
 CATALOGUE = "problems/cs_min_backlash_catalogue.toml"

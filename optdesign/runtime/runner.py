@@ -14,7 +14,7 @@ benchmark command can reuse it):
   run (Ctrl-C, SIGTERM, SIGHUP through the CLI) writes every record it received before it
   stops its workers. The store and the folder lock live in :mod:`optdesign.storage`;
   the worker processes (which die with this process, whatever kills it) in
-  :mod:`optdesign.studies.processes`;
+  :mod:`optdesign.runtime.processes`;
 - ``expand(task, record, done)`` may add tasks as records come in (a computation that
   decides its next steps from results, e.g. two chains of a sweep meeting wherever they
   meet); on resume it sees the stored records too, so the same tasks are generated;
@@ -48,9 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from optdesign.interrupts import deferred, note_active_store, note_store
-from optdesign.solvers.blas import one_blas_thread
-from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
-from optdesign.studies.processes import (
+from optdesign.runtime.processes import (
     WorkerPool,
     die_with_parent,
     fork_call,
@@ -58,6 +56,8 @@ from optdesign.studies.processes import (
     limit_blas_threads,
     process_pool,
 )
+from optdesign.solvers.blas import one_blas_thread
+from optdesign.storage import StoreWriter, lock_folder, open_store, read_store
 from optdesign.text import printable
 
 __all__ = [

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from optdesign.studies.processes import WorkerPool, forks_workers
+from optdesign.runtime.processes import WorkerPool, forks_workers
 
 #: Callables handed to forked workers by inheritance.
 _INHERITED: dict[int, Callable[[Any], Any]] = {}

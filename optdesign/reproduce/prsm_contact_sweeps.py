@@ -1,4 +1,4 @@
-"""PRSM thread-contact studies ([C-PRSM], Fig. 7-11).
+"""The sweeps behind the PRSM thread-contact reproduction ([C-PRSM], Fig. 7-11).
 
 * omega along the contact position (Fig. 7; the paper: constant);
 * omega and the eccentricity with and without omega against the pitch and the flank

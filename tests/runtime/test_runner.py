@@ -6,8 +6,8 @@ import os
 import pytest
 
 from optdesign.errors import OptDesignError
+from optdesign.runtime.runner import read_store, run_tasks
 from optdesign.storage import STORE_VERSION
-from optdesign.studies.runner import read_store, run_tasks
 
 
 def _chain_fn(task, deps):
@@ -236,7 +236,7 @@ def _my_failure(task, kind, reason, wall_s):
 def test_isolated_tasks_hard_timeout_and_crashes_become_failure_records(tmp_path, workers):
     import time
 
-    from optdesign.studies.runner import Isolation
+    from optdesign.runtime.runner import Isolation
 
     kinds = ["ok", "hang", "segfault", "exit", "raise", "ok"]
     tasks = [{"id": f"t{i}", "do": d, "limit": 0.5} for i, d in enumerate(kinds)]
@@ -275,7 +275,7 @@ def test_isolated_tasks_hard_timeout_and_crashes_become_failure_records(tmp_path
 
 
 def test_fork_call_returns_values_and_kinds():
-    from optdesign.studies.runner import fork_call
+    from optdesign.runtime.runner import fork_call
 
     assert fork_call(lambda: {"a": [1.5]}) == ("ok", {"a": [1.5]})
     assert fork_call(lambda: 1 / 0)[0] == "error"
@@ -286,7 +286,7 @@ def test_fork_call_returns_values_and_kinds():
 
 
 def test_a_scheduler_that_does_not_answer_is_an_input_error_naming_its_address(tmp_path):
-    """optdesign.studies.runner._connect: a well-formed address where no scheduler
+    """optdesign.runtime.runner._connect: a well-formed address where no scheduler
     answers is refused naming the address (it was distributed's traceback)."""
     pytest.importorskip("distributed")
     import dask

@@ -16,8 +16,8 @@ import pytest
 
 import optdesign as od
 from optdesign.cli import main
+from optdesign.runtime.runner import run_tasks
 from optdesign.storage import STORE_VERSION, StoreError, open_store
-from optdesign.studies.runner import run_tasks
 
 ROOT = Path(__file__).resolve().parents[2]
 FORK = (ROOT / "problems" / "fork_min_backlash.toml").read_text()

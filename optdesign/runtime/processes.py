@@ -1,6 +1,6 @@
 """Local worker processes of the task runner: a pipe-per-worker pool, forked task isolation.
 
-Split from :mod:`optdesign.studies.runner` (which re-exports the public names). Every
+Split from :mod:`optdesign.runtime.runner` (which re-exports the public names). Every
 process forked here dies with its parent, whatever signal ends the parent (Linux
 ``PR_SET_PDEATHSIG``), and ignores SIGINT and SIGHUP, which the parent alone handles
 (:func:`optdesign.interrupts.child_signals`).

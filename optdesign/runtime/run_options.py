@@ -1,6 +1,6 @@
 """Where and how a study's tasks run, apart from what they compute: :class:`RunOptions`,
 shared by the Pareto fronts and the sweeps (both run through
-:func:`optdesign.studies.runner.run_tasks`)."""
+:func:`optdesign.runtime.runner.run_tasks`)."""
 
 from __future__ import annotations
 

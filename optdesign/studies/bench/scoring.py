@@ -1,5 +1,5 @@
-"""Benchmark metrics: the gap of each run to the best known value, Dolan-More performance
-profiles, and per-configuration statistics."""
+"""How a benchmark scores its configurations: the gap of each run to the best known value,
+Dolan-More performance profiles, and per-configuration statistics."""
 
 from __future__ import annotations
 

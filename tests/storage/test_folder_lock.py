@@ -1,4 +1,4 @@
-"""The output folder's lock (optdesign/storage/lock.py): who holds it, as read from the lock file."""
+"""The output folder's lock (optdesign/storage/folder_lock.py): who holds it, as read from the lock file."""
 
 from __future__ import annotations
 

@@ -21,7 +21,6 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from optdesign.store_identity import digest
-from optdesign.studies.nlp_solve import formulation_for
 
 #: Parts of a problem file that do not change what is computed (or that the ``solver``
 #: component holds).
@@ -60,15 +59,17 @@ def run_identity(
     problem,
     objectives: Sequence[str],
     *,
+    formulation: str,
     back_end: str,
     method: Mapping[str, Any],
     options: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """The identity components of a run of ``problem`` (see the module docstring)."""
-    nlp = formulation_for(problem, tuple(sorted(objectives)))
+    """The identity components of a run of ``problem`` (see the module docstring);
+    ``formulation`` is the fingerprint of the NLP the run solves (the caller builds it:
+    the engine knows no formulation)."""
     return {
         "problem": problem_digest(problem),
-        "formulation": nlp.fingerprint,
+        "formulation": formulation,
         "objectives": list(objectives),
         "method": dict(method),
         "solver": solver_identity(problem, back_end, options),
