@@ -250,7 +250,7 @@ def part_c(repeats: int) -> dict:
     import numpy as np
 
     from optdesign.problem import load_problem
-    from optdesign.studies.pareto import read_front_csv
+    from optdesign.reports.front_files import read_front_csv
     from optdesign.studies.pareto.metrics import hypervolume, non_dominated, reference_point
 
     problem = load_problem(PROBLEMS / "cs_min_backlash.toml")  # front.csv: ripple in %

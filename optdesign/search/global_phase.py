@@ -14,7 +14,7 @@ rule, :func:`optdesign.search.odds.settled`) and at least ``agree`` starts reach
 value; after :data:`FAILED_LIMIT` starts without a feasible end (no design to compare);
 at the time limit; or when ``max_starts`` have run. The rule reads the starts in their
 order, so the answer is the one a serial run gives whatever the number of workers
-(:func:`optdesign.studies.inherited_map.map_inherited`'s prefix contract).
+(:func:`optdesign.runtime.inherited_map.map_inherited`'s prefix contract).
 
 Local optima are told apart by value alone (:func:`distinct_optima`): two starts whose
 objectives differ by less than the tie tolerance (relative), or by less than what the
