@@ -160,3 +160,69 @@ def design_values(problem, design: dict[str, Any]) -> tuple[dict[str, Any], Any]
     if not number.ndim:
         return {f: float(v) for f, v in out.items()}, float(on)
     return out, on
+
+
+#: Margin on the motor's peak torque before a motor is excluded: the bound below is
+#: proved, the margin keeps a motor a solver could still call feasible within its
+#: tolerance.
+EXCLUSION_MARGIN = 1e-4
+
+
+def torque_floor(problem, row: ServoMotor) -> float | None:
+    """A torque (N*mm) every design of ``problem`` whose motor speed stays within
+    ``row``'s top speed asks of motor ``row``: at some grid angle the motion's torque is at
+    least J0 f' a + M / f' + T_f (the rotor and gear inertia J0 of :func:`~optdesign.
+    problem.motor_drive.motor_side_inertia`, without the screw's and the nut's; the
+    output's demand M of :func:`~optdesign.problem.motor_drive.output_demand` with an
+    efficiency of 1; the ratio's rate dropped), and the speed row caps the ratio f' at the
+    top speed over the fin's top rate: the least of the bound over 0 < f' <= the cap, at
+    the worst angle. None when the motion gives no rate or the demand changes sign."""
+    from optdesign.problem.motor_drive import motion_demand
+
+    spec = problem.spec
+    demand = motion_demand(spec)
+    if demand is None or not demand.rate > 0:
+        return None
+    load = spec.load
+    J_fin, c, k = (
+        (0.0, 0.0, 0.0) if load is None else (load.inertia, load.damping, load.hinge_spring)
+    )
+    a, w = demand.acceleration, demand.rate
+    phi = np.asarray(problem.phi, dtype=float)
+    M = J_fin * a + c * w + np.abs(k * phi) + spec.requirements.hinge_moment
+    if not np.all(M > 0):
+        return None
+    J0 = row.rotor_inertia + spec.motor.gear_inertia
+    cap = row.max_speed / w
+    best = np.minimum(np.sqrt(M / (J0 * a)), cap) if a > 0 else np.full_like(M, cap)
+    return float(np.max(J0 * best * a + M / best)) + spec.motor.friction_torque
+
+
+def impossible_motors(problem) -> dict[float, str]:
+    """The catalogue motors no design of ``problem`` can use, by their number, with why:
+    those whose peak torque lies below :func:`torque_floor`. Empty when the motor is no
+    catalogue variable or the motion gives no rate."""
+    catalogue = catalogue_of(problem)
+    if catalogue is None:
+        return {}
+    lo, hi = problem.by_name["motor"].lower, problem.by_name["motor"].upper
+    out = {}
+    for number, row in enumerate(motors(catalogue), 1):
+        if not lo <= number <= hi:
+            continue
+        need = torque_floor(problem, row)
+        if need is not None and need > row.peak_torque * (1.0 + EXCLUSION_MARGIN):
+            cap = row.max_speed / motion_demand_rate(problem)
+            out[float(number)] = (
+                f"{row.designation}: the motion asks at least {need * 1e-3:.4g} N*m at any "
+                f"design, above its peak torque {row.peak_torque * 1e-3:.4g} N*m (its top "
+                f"speed caps the ratio at {cap:.4g})"
+            )
+    return out
+
+
+def motion_demand_rate(problem) -> float:
+    """The fin's top rate of the problem's motion (rad/s)."""
+    from optdesign.problem.motor_drive import motion_demand
+
+    return motion_demand(problem.spec).rate

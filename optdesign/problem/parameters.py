@@ -127,3 +127,44 @@ def limit_value(problem: DesignProblem, name: str) -> float:
         var, _, side = rest.partition(".")
         return float(getattr(problem.by_name[var], side))
     return dict(requirement_paths(problem))[rest]
+
+
+#: The copies of problems without their impossible catalogue items, by problem state: a
+#: front's points share one, so their searches share their proofs too.
+_NARROWED: OrderedDict[str, tuple[DesignProblem, list[str]]] = OrderedDict()
+
+
+def without_impossible_items(problem: DesignProblem) -> tuple[DesignProblem, list[str]]:
+    """``problem`` without the catalogue items no design can use (proved from the bounds
+    and closed forms before any NLP: the motors that cannot give the motion's torque,
+    :func:`~optdesign.problem.motor_catalogue_variable.impossible_motors`), and why each
+    went. The same problem and ``[]`` when none goes; a variable left with no item keeps
+    none (``values == ()``): the caller reports the problem infeasible with the reasons.
+    """
+    from optdesign.problem.motor_catalogue_variable import impossible_motors
+
+    key = problem.token
+    if key in _NARROWED:
+        _NARROWED.move_to_end(key)
+        return _NARROWED[key]
+    gone = impossible_motors(problem)
+    if not gone:
+        out: tuple[DesignProblem, list[str]] = (problem, [])
+    else:
+        var = problem.by_name["motor"]
+        kept = tuple(v for v in var.values if v not in gone)
+        narrowed = (
+            dataclasses.replace(var, values=kept, lower=kept[0], upper=kept[-1])
+            if kept
+            else dataclasses.replace(var, values=())
+        )
+        new = object.__new__(type(problem))
+        new.__dict__.update(problem.__dict__)
+        new.variables = [narrowed if v.name == "motor" else v for v in problem.variables]
+        new.by_name = {v.name: v for v in new.variables}
+        new._touch()
+        out = (new, [f"motor {k:g} ({reason})" for k, reason in sorted(gone.items())])
+    _NARROWED[key] = out
+    while len(_NARROWED) > MOVED_SIZE:
+        _NARROWED.popitem(last=False)
+    return out

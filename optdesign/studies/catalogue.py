@@ -37,6 +37,7 @@ from optdesign.formulations.discrete import (
 from optdesign.formulations.nlp import Bounds
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
+from optdesign.problem.parameters import without_impossible_items
 from optdesign.problem.request import SolveRequest
 from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
 from optdesign.solvers.details import CatalogueCombination, CatalogueDetails
@@ -409,9 +410,18 @@ def solve_catalogue(
         counts (and the table of every combination when enumerating).
     """
     t0 = time.perf_counter()
-    dvars = discrete_variables(problem)
-    if not dvars:
+    if not discrete_variables(problem):
         raise ProblemError("formulation='catalogue': no variable takes catalogue values")
+    # Items proved impossible from closed forms cost no node: the search runs without them.
+    problem, excluded = without_impossible_items(problem)
+    if any(not v.values for v in discrete_variables(problem)):
+        result = _no_item(
+            solver or default_solver("nlp"),
+            "no catalogue item can meet the requirements: " + "; ".join(excluded),
+        )
+        result.notes.append("excluded before the search: " + "; ".join(excluded))
+        return result
+    dvars = discrete_variables(problem)
     n_comb = n_combinations(problem)
     minlp_solver, minlp_options = None, None
     if method == "minlp" or (method == "auto" and solver_hints(solver).minlp):
@@ -489,6 +499,8 @@ def solve_catalogue(
                 ),
             )
             result.details.catalogue = info
+            if excluded:
+                result.notes.append("excluded before the search: " + "; ".join(excluded))
             return finish(problem, result, objective)
         best.formulation = f"catalogue-{method}"
         best.wall_time_s = wall
@@ -511,6 +523,8 @@ def solve_catalogue(
         best.notes.append(
             f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
         )
+        if excluded:
+            best.notes.append("excluded before the search: " + "; ".join(excluded))
         return finish(problem, best, objective)
 
 

@@ -15,6 +15,7 @@ import os
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import optdesign as od
@@ -193,3 +194,52 @@ def test_catalogue_text_is_refused_without_a_catalogue_file():
     data["motor"]["catalogue_text"] = _csv()
     with pytest.raises(od.OptDesignError, match=r"catalogue_text: only with a catalogue CSV"):
         od.load(data)
+
+
+# --- motors excluded before the search -----------------------------------------------------
+def _catalogue_problem(upper: int | None = None) -> od.DesignProblem:
+    data = _data("Yaskawa Sigma-7")
+    if upper is not None:
+        data["variables"]["motor"] = {"catalogue": "Yaskawa Sigma-7", "upper": upper}
+    return od.load(data)
+
+
+def test_the_torque_floor_lies_below_every_sampled_designs_demand():
+    """Brute force: 1500 designs drawn over the bounds, each with every motor; where the
+    motor's speed stays within its top speed, the torque the motion asks (the model's own
+    motor_peak_torque) is never below the floor the exclusion proves."""
+    from optdesign.problem.motor_catalogue_variable import motors, torque_floor
+
+    problem = _catalogue_problem()
+    rng = np.random.default_rng(7)
+    names = [v.name for v in problem.free]
+    lo, hi = problem.lower(), problem.upper()
+    X = lo + rng.random((1500, len(lo))) * (hi - lo)
+    k = names.index("motor")
+    checked = 0
+    for number, row in enumerate(motors("Yaskawa Sigma-7"), 1):
+        X[:, k] = number
+        ev = problem.evaluate(X)
+        speed_ok = np.all(np.asarray(ev.constraints["motor_speed"].values) <= 1.0, axis=-1)
+        demand = np.asarray(ev.objectives["motor_peak_torque"], dtype=float)
+        ok = speed_ok & np.isfinite(demand)
+        floor = torque_floor(problem, row)
+        assert np.all(demand[ok] >= floor * (1 - 1e-12)), row.designation
+        checked += int(ok.sum())
+    assert checked > 1500  # the speed row holds for many of them
+
+
+def test_motors_that_cannot_give_the_step_are_excluded_before_the_search():
+    from optdesign.problem.motor_catalogue_variable import impossible_motors
+
+    problem = _catalogue_problem()
+    gone = impossible_motors(problem)
+    assert sorted(gone) == [1.0, 2.0, 3.0, 4.0]  # SGM7J-A5A ... -02A; the 04A stays
+    assert "SGM7J-02A: the motion asks at least" in gone[4.0]
+
+
+def test_a_catalogue_of_impossible_motors_is_infeasible_without_a_solve():
+    result = od.solve(_catalogue_problem(upper=4), ranges=False, sensitivities=False)
+    assert result.status == "infeasible" and not result.success
+    assert "no catalogue item can meet the requirements" in result.message
+    assert "SGM7J-A5A" in result.message and result.wall_time_s < 1.0
