@@ -32,7 +32,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.objectives import unavailable_objective
+from optdesign.problem.objectives import piece_rows, unavailable_objective
 
 #: Prefix of the targets that are design variables (``"var:R"``).
 VAR = "var:"
@@ -430,7 +430,8 @@ def build_nlp(
             aux_ub.append(np.inf)
             aux_start.append(ca.mmax(expr) / scale)
             values[name] = t
-            rows.add(t - expr, 0.0, None, scale, f"{name}_envelope", problem.phi_labels, term.unit)
+            for piece, labels in piece_rows(expr, term.pieces, problem.phi_labels):
+                rows.add(t - piece, 0.0, None, scale, f"{name}_envelope", labels, term.unit)
 
     # Constraint blocks of the requirements.
     ref_blocks = {b.name: b for b in ref.constraints}
@@ -439,7 +440,8 @@ def build_nlp(
             continue
         bound = max(abs(block.lower or 0.0), abs(block.upper or 0.0))
         scale = bound if bound > 0 else typical(ref_blocks[block.name].expr)
-        rows.add(block.expr, block.lower, block.upper, scale, block.name, block.labels, block.unit)
+        for piece, labels in piece_rows(block.expr, block.pieces, block.labels):
+            rows.add(piece, block.lower, block.upper, scale, block.name, labels, block.unit)
     limits = problem.objective_limits()
     eps_rows = {}
     for name in names:

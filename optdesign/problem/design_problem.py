@@ -493,8 +493,10 @@ class DesignProblem:
             else:  # a user's function: its failure names it, its file and line
                 expr = quantity_of(info.fn, q, f"objective {info.name!r}", info.kind != "scalar")
             if expr is not None:
+                # the smooth pieces of a kinked objective, for the solver's epigraph only
+                pieces = info.pieces(q) if info.pieces is not None and m.is_symbolic(expr) else ()
                 objectives[info.name] = ObjectiveTerm(
-                    info.name, info.kind, expr, info.unit, info.description
+                    info.name, info.kind, expr, info.unit, info.description, tuple(pieces)
                 )
         backlash = objectives["backlash"].expr if "backlash" in objectives else None
         blocks = requirement_blocks(q, self._constraints, backlash)

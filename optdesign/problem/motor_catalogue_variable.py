@@ -177,7 +177,7 @@ def torque_floor(problem, row: ServoMotor) -> float | None:
     efficiency of 1; the ratio's rate dropped), and the speed row caps the ratio f' at the
     top speed over the fin's top rate: the least of the bound over 0 < f' <= the cap, at
     the worst angle. None when the motion gives no rate or the demand changes sign."""
-    from optdesign.problem.motor_drive import motion_demand
+    from optdesign.problem.motion import motion_demand
 
     spec = problem.spec
     demand = motion_demand(spec)
@@ -223,6 +223,6 @@ def impossible_motors(problem) -> dict[float, str]:
 
 def motion_demand_rate(problem) -> float:
     """The fin's top rate of the problem's motion (rad/s)."""
-    from optdesign.problem.motor_drive import motion_demand
+    from optdesign.problem.motion import motion_demand
 
     return motion_demand(problem.spec).rate

@@ -22,10 +22,9 @@ from optdesign.errors import ProblemError
 from optdesign.models import motor as mo
 from optdesign.problem import drive
 from optdesign.problem import motor_catalogue_variable as mcv
+from optdesign.problem.motion import MotionDemand as MotionDemand
+from optdesign.problem.motion import motion_demand
 from optdesign.problem.objectives import ConstraintBlock
-
-#: The closed-loop step's rise time is the first time it reaches this share of the step.
-RISE_LEVEL = 0.95
 
 
 @dataclass(frozen=True)
@@ -84,15 +83,6 @@ def motor_data(spec) -> MotorData | None:
     )
 
 
-@dataclass(frozen=True)
-class MotionDemand:
-    """The fin's top rate (rad/s) and acceleration (rad/s^2), and where they come from."""
-
-    rate: float
-    acceleration: float
-    source: str
-
-
 def motor_of(q) -> MotorData | None:
     """The motor of design ``q``: :func:`motor_data`, or the catalogue motor its variable
     ``motor`` numbers (:mod:`optdesign.problem.motor_catalogue_variable`)."""
@@ -113,34 +103,6 @@ def motor_of(q) -> MotorData | None:
         values["rotor_inertia_max"],
         on,
     )
-
-
-def motion_demand(spec) -> MotionDemand | None:
-    """What the fin must do (``[motion]``, else ``requirements.deflection_rate`` alone):
-    the top rate is the larger of the given rate and the closed-loop step's peak rate; the
-    top acceleration is the step's (its initial value, step x wn^2) or the given one.
-    None when the problem gives no rate at all."""
-    motion, req = spec.motion, spec.requirements
-    given = motion.rate if motion is not None and motion.rate is not None else None
-    rate = given if given is not None else req.deflection_rate
-    if motion is None:
-        return None if rate is None else MotionDemand(rate, 0.0, "requirements.deflection_rate")
-    if motion.step is not None:
-        zeta, step = motion.damping_ratio, abs(motion.step)
-        wn = None if motion.natural_frequency is None else 2.0 * np.pi * motion.natural_frequency
-        if wn is None:
-            rise = motion.rise_time * 3600.0  # h -> s
-            wn = float(mo.natural_frequency_for_rise_time(zeta, rise, RISE_LEVEL))
-            how = f"95 % at {rise * 1e3:g} ms, wn = {wn:.4g} rad/s"
-        else:
-            how = f"wn = {wn:.4g} rad/s"
-        peak = float(mo.step_peak_rate(wn, zeta, step))
-        acc = float(mo.step_peak_acceleration(wn, zeta, step))
-        source = f"a {np.degrees(step):g} deg step, {how}, damping ratio {zeta:g}"
-        return MotionDemand(max(peak, rate or 0.0), acc, source)
-    if rate is None:
-        return None
-    return MotionDemand(rate, motion.acceleration or 0.0, "[motion]")
 
 
 def _need(value, what: str, field: str):
@@ -219,17 +181,31 @@ def motor_peak_torque(q):
     omega^2) + M_out / (f' eta) + T_f, at the top rate omega and acceleration alpha of the
     fin (:func:`motion_demand`), M_out by :func:`output_demand`; an upper bound of the
     torque along the motion (docs/motor.md)."""
-    spec = q.problem.spec
+    steady, swing = _peak_torque_terms(q)
+    return steady + m.fabs(swing)
+
+
+def motor_peak_torque_pieces(q) -> tuple[Any, Any]:
+    """The two smooth pieces of :func:`motor_peak_torque`, with +f'' and with -f'': their
+    element-wise max is the peak torque (|f''| = max(f'', -f'')). An NLP bounds each: the
+    kink of |f''| where the ratio turns (inside the stroke of every linkage here) stalls
+    Ipopt at its iteration limit from every start."""
+    steady, swing = _peak_torque_terms(q)
+    return steady + swing, steady - swing
+
+
+def _peak_torque_terms(q) -> tuple[Any, Any]:
+    """J_m f' alpha + M_out / (f' eta) + T_f, and J_m f'' omega^2 (its sign kept)."""
     motor = q.motor_data
     demand = _need(
-        motion_demand(spec),
+        motion_demand(q.problem.spec),
         "the fin's rate: [motion] rate or a step, or requirements.deflection_rate",
         "the motor's torque",
     )
     w, a = demand.rate, demand.acceleration
-    inertial = q.motor_side_inertia * (q.ratio * a + m.fabs(q.ratio_rate) * w**2)
+    J = q.motor_side_inertia
     through = mo.torque_at_motor(output_demand(q, w, a), q.ratio, q.drive_efficiency)
-    return inertial + through + motor.friction_torque
+    return J * q.ratio * a + through + motor.friction_torque, J * q.ratio_rate * w**2
 
 
 def motor_rms_torque(q):
@@ -326,6 +302,9 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                     "motor is a motor of the catalogue",
                 )
             )
+        pieces = ()
+        if m.is_symbolic(q.ratio):  # the solver's rows: the smooth pieces (see there)
+            pieces = tuple(p / motor.peak_torque for p in motor_peak_torque_pieces(q))
         out.append(
             ConstraintBlock(
                 "motor_peak_torque",
@@ -335,6 +314,7 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 labels,
                 "",
                 f"torque the motion asks of the motor{name} / its peak torque",
+                pieces=pieces,
             )
         )
         out.append(

@@ -68,6 +68,9 @@ class ObjectiveInfo:
     needs
         ``needs(problem)``: why a problem lacks this objective (``fn`` gives None), in
         the words of its file (``""``: no reason known beyond the objective's own data).
+    pieces
+        ``pieces(q)``: smooth expressions whose element-wise max is ``fn(q)`` (built-ins
+        with a kink: the NLP bounds each piece; :class:`ObjectiveTerm`).
     """
 
     name: str
@@ -80,6 +83,7 @@ class ObjectiveInfo:
     display_scale: float = 1.0
     valid: tuple[float | None, float | None] | None = None
     needs: Callable[[Any], str] | None = None
+    pieces: Callable[[Any], tuple[Any, ...]] | None = None
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -161,13 +165,17 @@ class ConstraintInfo:
 
 @dataclass
 class ObjectiveTerm:
-    """An objective of one design: its declaration's name and kind, and the expression."""
+    """An objective of one design: its declaration's name and kind, and the expression.
+    ``pieces``: smooth expressions whose element-wise max is ``expr`` (on the solver path,
+    for a ``max`` objective with a kink, e.g. |x| = max(x, -x)): the NLP's epigraph bounds
+    each piece, which keeps it smooth (:func:`piece_rows`)."""
 
     name: str
     kind: str
     expr: Any
     unit: str = ""
     description: str = ""
+    pieces: tuple[Any, ...] = ()
 
 
 @dataclass
@@ -188,6 +196,27 @@ class ConstraintBlock:
     description: str = ""
     display: Callable[[Any], Any] | None = None
     display_unit: str = ""
+    #: Smooth expressions whose element-wise max is ``expr`` (solver path; an upper bound
+    #: only, since max(pieces) <= upper holds exactly when every piece does).
+    pieces: tuple[Any, ...] = ()
+
+    def __post_init__(self):
+        if self.pieces and self.lower is not None:
+            raise InputError(f"constraint {self.name}.pieces", "only with an upper bound alone")
+
+
+def piece_rows(
+    expr: Any, pieces: tuple[Any, ...], labels: list[str]
+) -> list[tuple[Any, list[str]]]:
+    """The rows an NLP poses for ``expr``: ``expr`` itself, or each of its smooth
+    ``pieces`` (their element-wise max is ``expr``) with the labels marked by the piece's
+    number (``phi=-30.0deg (2)``), so that a row's name still starts with its block's."""
+    if not pieces:
+        return [(expr, labels)]
+    return [
+        (piece, [f"{lab} ({k})" if lab else f"({k})" for lab in labels])
+        for k, piece in enumerate(pieces, 1)
+    ]
 
 
 def _drive_loss(q):
@@ -227,6 +256,10 @@ def _motor_peak_torque(q):
     if q.motor_data is None or q.motion is None:
         return None
     return q.motor_peak_torque
+
+
+def _motor_peak_torque_pieces(q):
+    return q.motor_peak_torque_pieces
 
 
 def _motor_rms_torque(q):
@@ -412,6 +445,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="N*m",
             display_scale=1e-3,
             valid=NON_NEGATIVE,
+            pieces=_motor_peak_torque_pieces,
         ),
         ObjectiveInfo(
             "motor_rms_torque",

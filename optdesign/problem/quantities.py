@@ -301,6 +301,12 @@ class Quantities:
         return motor_drive.motor_peak_torque(self)
 
     @cached_property
+    def motor_peak_torque_pieces(self):
+        """The peak torque's two smooth pieces (:func:`~optdesign.problem.motor_drive.
+        motor_peak_torque_pieces`)."""
+        return motor_drive.motor_peak_torque_pieces(self)
+
+    @cached_property
     def motor_rms_torque(self):
         """RMS motor torque of the duty cycle (N*mm)."""
         return motor_drive.motor_rms_torque(self)
