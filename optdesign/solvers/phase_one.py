@@ -52,6 +52,12 @@ PHASE_ONE_MAX_ITER = 300
 _CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
+def supports(backend: Any) -> bool:
+    """Whether ``backend`` (an NLP back-end) is CasADi's Ipopt, whose NLP this module's
+    phase-1 problem is built on."""
+    return getattr(backend, "plugin", None) == "ipopt" and hasattr(backend, "options")
+
+
 @dataclass
 class LeastViolation:
     """One phase-1 solve: ``value`` the least ``t`` found (NaN when the solve did not

@@ -26,7 +26,7 @@ from optdesign.problem.request import SolveRequest
 from optdesign.search.global_phase import default_max_starts, global_search, search_globality
 from optdesign.search.starts import TiltedStarts, problem_evaluator
 from optdesign.solvers.multistart import sobol_starts
-from optdesign.solvers.phase_one import LeastViolation, PhaseOneSolver
+from optdesign.solvers.phase_one import LeastViolation, PhaseOneSolver, supports
 from optdesign.solvers.registry import default_solver, make_solver, solver_hints
 from optdesign.solvers.result import (
     Result,
@@ -107,11 +107,11 @@ def phase_one_for(
     """The phase-1 solver (least violation) of a back-end's NLP, built on first use and
     once per process and NLP, with the Ipopt options of the problem file and ``options``
     (a user's ``max_iter = 0`` stops it as it stops the solve); None for a back-end that
-    is not CasADi's Ipopt."""
-    if getattr(backend, "plugin", None) != "ipopt" or not hasattr(backend, "options"):
+    is not CasADi's Ipopt (:func:`~optdesign.solvers.phase_one.supports`)."""
+    if not supports(backend):
         return None
     nlp = backend.nlp
-    opts = {**solver_options(problem, "ipopt"), **(options or {})}
+    opts = {**solver_options(problem, backend.name), **(options or {})}
     key = (nlp.fingerprint, json.dumps(opts, sort_keys=True, default=str))
     return lambda: _remember(_PHASE_ONE, key, lambda: PhaseOneSolver(nlp, opts))
 

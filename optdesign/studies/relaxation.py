@@ -173,14 +173,20 @@ def relaxations(
     return out
 
 
+#: How far beyond the minimised relaxation (relative) the reported limit lies: at the
+#: minimum itself the feasible set is a single design, which a search from random starts
+#: rarely finds; a little beyond, it has room.
+MARGIN = 1e-3
+
+
 def _minimised(
     phase_one: Any, nlp: Any, site: _Prepared, idx: np.ndarray, scale: np.ndarray
 ) -> tuple[tuple[float | None, Any] | None, int]:
     """(the smallest relaxation of rows ``idx`` at ``site`` and its design, or (None,
     None) when Ipopt finds the other rows infeasible from every start; None: no answer,
     bisect), and the solves spent. The least ``t`` of the phase-1 solves from the site's
-    starts, accepted only when its point meets every row with the requirement's widened
-    by it."""
+    starts (:data:`MARGIN` beyond it), accepted only when its point meets every row with
+    the requirement's widened by it."""
     best = None
     refused = 0
     for start in site.starts:
@@ -191,7 +197,7 @@ def _minimised(
     solves = len(site.starts)
     if best is None:
         return ((None, None) if refused == solves else None), solves
-    t = max(0.0, best.value)
+    t = max(0.0, best.value) * (1.0 + MARGIN)
     g = np.asarray(nlp.g_fun(best.z, site.theta), dtype=float).ravel()
     violated, _ = constraint_reports(nlp, g, _relaxed(site.bounds, idx, scale, t))
     if violated:

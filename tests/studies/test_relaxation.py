@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.studies.relaxation import _need, _record, _relaxed, relaxations
+from optdesign.studies.relaxation import MARGIN, _need, _record, _relaxed, relaxations
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 
@@ -49,7 +49,7 @@ def test_the_candidates_are_the_violated_by_amount_then_the_binding(infeasible):
     assert (nt.upper, nt.written, nt.lower_row, nt.upper_row) == (True, 40.0, None, 40.0)
     # the phase-1 minimum; 8 bisection steps gave 41.66 (within their bracket of 85 mm /
     # 2**8 above it), 16 give 41.576 (test_the_phase_one_relaxation_is_the_bisections_limit)
-    assert nt.needed == pytest.approx(41.574, abs=0.01)
+    assert nt.needed == pytest.approx(41.576, abs=0.01)
     assert all(r.at == "" for r in rel)
 
 
@@ -86,7 +86,9 @@ def test_the_phase_one_relaxation_is_the_bisections_limit(infeasible):
         # the last bracket, twice for the local solves' own tolerance on feasibility
         last = 2 * abs(coarse[r.name] - r.written) * 2.0**-16 + 1e-6 * abs(r.written)
         gap = (r.needed - direct[r.name]) * (1 if r.upper else -1)
-        assert -1e-6 * abs(r.written) <= gap <= last, (r.name, gap, last)
+        # the reported limit lies MARGIN beyond the phase-1 minimum
+        beyond = MARGIN * abs(direct[r.name] - r.written) + 1e-6 * abs(r.written)
+        assert -beyond <= gap <= last, (r.name, gap, last)
 
 
 def test_the_need_of_a_design_on_either_side():
