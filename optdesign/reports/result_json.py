@@ -72,20 +72,15 @@ def result_document(result: Result) -> dict[str, Any]:
     doc["violated"] = [lim.to_json() for lim in limits_of(problem, result.violated)]
     diagnosis = result.diagnosis
     if diagnosis is not None:
-        relax = [
-            {
-                "name": lim.name,
-                "description": lim.description,
-                "side": lim.side,
-                "limit": lim.limit.to_json(),
-                "needed": lim.value.to_json(),
-                "at": lim.where[0] if lim.where else "",
-            }
-            for lim in relaxation_limits(problem, diagnosis.relaxations)
-        ]
+        relax = _relaxations_json(problem, diagnosis.relaxations)
         if relax:
             doc["relaxations"] = relax
-        doc["diagnosis"] = {"basis": diagnosis.basis, "note": diagnosis.note, "relaxations": relax}
+        doc["diagnosis"] = {
+            "basis": diagnosis.basis,
+            "note": diagnosis.note,
+            "relaxations": relax,
+            "together": _relaxations_json(problem, diagnosis.together),
+        }
     doc["sensitivities"] = [
         {
             "name": sen.name,
@@ -190,3 +185,18 @@ def _design(problem: Any, result: Result) -> dict[str, Any]:
 def result_json(result: Result) -> str:
     """``result.json`` as text."""
     return json.dumps(result_document(result), indent=2)
+
+
+def _relaxations_json(problem: Any, items: list[Any]) -> list[dict[str, Any]]:
+    """Relaxation records as the JSON document writes them."""
+    return [
+        {
+            "name": lim.name,
+            "description": lim.description,
+            "side": lim.side,
+            "limit": lim.limit.to_json(),
+            "needed": lim.value.to_json(),
+            "at": lim.where[0] if lim.where else "",
+        }
+        for lim in relaxation_limits(problem, items)
+    ]

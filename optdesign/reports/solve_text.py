@@ -172,6 +172,10 @@ def result_summary(result: Result) -> str:
     if relax:
         lines += ["", "smallest change of one requirement that makes the problem feasible:"]
         lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, relax)]
+    together = diagnosis.together if relax else []
+    if together:
+        lines += ["", "no one of them suffices alone; the least change of them together:"]
+        lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, together)]
     if relax and diagnosis.basis:
         lines.append(f"  (computed on {diagnosis.basis})")
     if diagnosis is not None and diagnosis.note:

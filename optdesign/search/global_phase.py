@@ -31,6 +31,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from optdesign.search.infeasible import (
+    LeastViolationFrom,
+    PhaseOne,
+    mark_infeasible,
+    no_feasible_end,
+    phase_one_starts,
+)
 from optdesign.search.odds import odds, settled
 from optdesign.search.starts import CHUNK, TiltedStarts
 from optdesign.solvers.blas import one_blas_thread
@@ -166,6 +173,7 @@ def global_search(
     rel_tol: float = OBJECTIVE_TIE_TOL,
     abs_tol: float = 0.0,
     polish: Callable[[np.ndarray, Result], Result] | None = None,
+    least_violation: LeastViolationFrom | None = None,
 ) -> Result:
     """The best result of local solves from ``own`` then tilted starts, with its record.
 
@@ -195,6 +203,17 @@ def global_search(
         (a converged start) or from the start point (a failed one), when ``solve`` solves
         a cheaper stand-in (the problem on fewer grid angles): the answer is then the best
         of the polished starts (:func:`polish_optima`), never a stand-in's result.
+    least_violation
+        (start point, a failed full solve from it or None) -> the least violation of the
+        rows solved from the start (from the full solve's end when given; a phase-1
+        solve, :class:`~optdesign.solvers.phase_one.PhaseOneSolver`). Given, a start that fails
+        before any start reached a feasible design is followed by it, and while each
+        certifies a positive least violation the next starts solve it alone
+        (:func:`optdesign.search.infeasible.phase_one_starts`): once ``min(agree,
+        max_starts)`` of them agree on it the search stops, its answer marked infeasible
+        (stop ``"least violation"``); a phase-1 solve that meets every row sends the
+        search back to the full solves of the starts it skipped, so a feasible problem's
+        starts are those of a search without it.
 
     Returns
     -------
@@ -216,16 +235,18 @@ def global_search(
     results: list[Result] = []
     points: list[np.ndarray] = []  # each start's point, in start order
     planned = 0
+    watch = least_violation is not None and agree > 0
+    verdict: PhaseOne | None = None
     with one_blas_thread(), deadline(time_limit):
         while len(results) < cap and (not results or not rule(results)):
             n = min(cap, len(results) + (CHUNK if results or not own else len(own)))
             batch = _starts_between(own, starts, len(results), n)
             planned = n
-            points += list(batch)
             before = list(results)
 
-            def stop(tail: list[Result], before=before) -> bool:
-                return rule(before + tail)
+            def stop(tail: list[Result], before=before, watch=watch) -> bool:
+                # a failed start with no feasible design seen yet: its phase 1 decides
+                return rule(before + tail) or (watch and no_feasible_end(before + tail))
 
             if workers > 1 and len(batch) > 1:
                 results = before + parallel_map(solve, list(batch), workers, stop=stop)
@@ -234,13 +255,45 @@ def global_search(
                     results.append(solve(x0))
                     if stop(results[len(before) :]):
                         break
-        why = rule.reason(results) or "all starts run"
+            points = (points + list(batch))[: len(results)]
+            if watch and no_feasible_end(results) and not rule(results):
+                verdict = phase_one_starts(
+                    least_violation,
+                    solve,
+                    lambda a, b: _starts_between(own, starts, a, b),
+                    results,
+                    cap,
+                    min(agree, cap),
+                    FAILED_LIMIT,
+                    workers,
+                    parallel_map,
+                )
+                planned = max(planned, verdict.end)
+                if verdict.stop:
+                    break
+                watch = verdict.feasible is None  # a feasible design seen: never again
+        why = (verdict.stop if verdict else "") or rule.reason(results) or "all starts run"
     polished = None
     if polish is not None:
-        polished = polish_optima(results, lambda k: polish(points[k], results[k]), rule)
-    return _best_with_record(
-        results, rule, why, planned, cap, seed, workers, time_limit, t0, polished
+        # a verdict of infeasibility needs the problem's own point of its best start only
+        limit = 1 if verdict is not None and verdict.proved else MAX_POLISHED
+        polished = polish_optima(results, lambda k: polish(points[k], results[k]), rule, limit)
+    best = _best_with_record(
+        results,
+        rule,
+        why,
+        planned,
+        cap,
+        seed,
+        workers,
+        time_limit,
+        t0,
+        polished,
+        verdict.outcomes if verdict is not None and verdict.stop else (),
     )
+    if verdict is not None and verdict.proved:
+        mark_infeasible(best, verdict)
+    return best
 
 
 #: Most local optima of a stand-in search solved again on the problem itself.
@@ -262,7 +315,10 @@ class Polished:
 
 
 def polish_optima(
-    results: Sequence[Result], polish: Callable[[int], Result], rule: StopRule
+    results: Sequence[Result],
+    polish: Callable[[int], Result],
+    rule: StopRule,
+    max_failed: int = MAX_POLISHED,
 ) -> Polished:
     """The stand-in search's local optima solved again on the problem itself, best first,
     until the next one cannot beat the best polished value: its stand-in value lies above
@@ -271,13 +327,14 @@ def polish_optima(
     problem's near each optimum), plus :data:`POLISH_SLACK`; at most :data:`MAX_POLISHED`.
     Starts at an optimum already polished (within the rule's tie) are skipped. No start
     converged: the least violated starts (at most :data:`MAX_POLISHED`) are solved again
-    and the least violated of those is the answer, so that it belongs to the problem.
-    ``polish(k)`` solves again from start ``k``."""
+    and the least violated of those is the answer, so that it belongs to the problem
+    (``max_failed`` of them: 1 when the search has already proved infeasibility and only
+    the point to report is wanted). ``polish(k)`` solves again from start ``k``."""
     order = sorted(range(len(results)), key=lambda k: results[k].objective)
     ok = [k for k in order if _converged(results[k])]
     if not ok:  # no optimum: the least violated starts, solved again
         least = sorted(range(len(results)), key=lambda k: violation(results[k]))
-        again = [polish(k) for k in least[:MAX_POLISHED]]
+        again = [polish(k) for k in least[:max_failed]]
         return Polished(best_of(again, CHOICE_TOL)[0], len(again))
     best: Result | None = None
     first: Result | None = None
@@ -322,10 +379,13 @@ def _best_with_record(
     time_limit: float | None,
     t0: float,
     polished: Polished | None = None,
+    skipped: Sequence[str] = (),
 ) -> Result:
+    """The best result with the search's record; ``skipped``: the outcomes of the starts
+    that solved only their least violation (after the full solves' starts)."""
     _, n_at_best = best_of(results, rule.rel_tol)
     best = polished.best if polished is not None else best_of(results, CHOICE_TOL)[0]
-    outcomes = [start_outcome(r) for r in results]
+    outcomes = [start_outcome(r) for r in results] + list(skipped)
     timed_out = why == "time limit"
     not_started = max(0, planned - len(results)) if timed_out else 0
     counted = [r.objective for r in results[rule.counted_from :] if _converged(r)]
@@ -338,15 +398,16 @@ def _best_with_record(
             "only the starts that converged"
         )
     best.multistart = MultistartInfo(
-        n_starts=len(results),
+        n_starts=len(outcomes),
         n_converged=sum(r.success for r in results),
         n_at_best=n_at_best,
         tolerance=rule.rel_tol,
-        objectives=[r.objective if r.success else math.nan for r in results],
+        objectives=[r.objective if r.success else math.nan for r in results]
+        + [math.nan] * len(skipped),
         seed=seed,
         workers=workers,
         n_planned=cap,
-        stopped_early=len(results) < cap,
+        stopped_early=len(outcomes) < cap,
         outcomes=outcomes,
         failed=outcome_counts(outcomes + [NOT_STARTED] * not_started),
         optima=rule.optima([r.objective for r in results if _converged(r)]),

@@ -262,11 +262,15 @@ class Diagnosis:
     note
         Why no relaxation is given, or what a reader must know about them (empty if
         nothing).
+    together
+        When no requirement relaxed alone gives a feasible design: the set to relax
+        together and the limit each needs (empty otherwise).
     """
 
     relaxations: list[Relaxation] = field(default_factory=list)
     basis: str = ""
     note: str = ""
+    together: list[Relaxation] = field(default_factory=list)
 
 
 @dataclass

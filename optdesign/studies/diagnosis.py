@@ -45,7 +45,7 @@ from optdesign.solvers.registry import solver_for_kind, solver_hints
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Result
 from optdesign.studies.catalogue import NodeSolver, first_feasible
 from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.relaxation import Site, relaxations
+from optdesign.studies.relaxation import Site, relax_together, relaxations
 
 #: Items of each catalogue variable tried around the continuous best point, and the most
 #: combinations of them solved (nearest first).
@@ -130,7 +130,8 @@ def _nlp(problem: DesignProblem, result: Result, solver: str, relax: bool) -> Di
         return Diagnosis(basis="the NLP", note=_nothing_violated(result))
     if not relax:
         return Diagnosis(basis="the NLP")
-    return Diagnosis(relaxations(problem, result, solver=solver), "the NLP")
+    found = relaxations(problem, result, solver=solver)
+    return Diagnosis(found, "the NLP", together=relax_together(problem, result, found, solver))
 
 
 def _robust(problem: DesignProblem, result: Result, solver: str, relax: bool) -> Diagnosis:
@@ -145,7 +146,9 @@ def _robust(problem: DesignProblem, result: Result, solver: str, relax: bool) ->
     if not relax:
         return Diagnosis(basis=basis, note=why)
     point = _point(problem.objective_names[0], active, violated)
-    return Diagnosis(relaxations(problem, point, solver=solver, x_start=x), basis, why)
+    found = relaxations(problem, point, solver=solver, x_start=x)
+    together = relax_together(problem, point, found, solver, x_start=x)
+    return Diagnosis(found, basis, why, together)
 
 
 def _gp(problem: DesignProblem, result: Result, relax: bool) -> Diagnosis:
@@ -171,7 +174,8 @@ def _gp(problem: DesignProblem, result: Result, relax: bool) -> Diagnosis:
         return Diagnosis(basis=basis, note=_nothing_violated(nlp))
     if not relax:
         return Diagnosis(basis=basis, note=why)
-    return Diagnosis(relaxations(problem, nlp), basis, why)
+    found = relaxations(problem, nlp)
+    return Diagnosis(found, basis, why, relax_together(problem, nlp, found))
 
 
 def _catalogue(

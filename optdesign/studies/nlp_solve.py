@@ -27,6 +27,7 @@ from optdesign.runtime.inherited_map import map_inherited
 from optdesign.search.global_phase import default_max_starts, global_search, search_globality
 from optdesign.search.starts import TiltedStarts, problem_evaluator
 from optdesign.solvers.multistart import sobol_starts
+from optdesign.solvers.phase_one import LeastViolation, PhaseOneSolver, supports
 from optdesign.solvers.registry import default_solver, make_solver, solver_hints
 from optdesign.solvers.result import (
     Result,
@@ -41,6 +42,7 @@ from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 # --- formulation and solver caches ------------------------------------------------------
 _NLPS: OrderedDict[tuple, NLP] = OrderedDict()
 _SOLVERS: OrderedDict[tuple, Any] = OrderedDict()
+_PHASE_ONE: OrderedDict[tuple, Any] = OrderedDict()
 _CACHE_SIZE = 16
 
 #: CasADi's symbolic layer is not thread-safe and its solvers release the GIL: two threads
@@ -97,6 +99,21 @@ def solver_for(
     opts.update(options or {})
     key = (nlp.fingerprint, name, json.dumps(opts, sort_keys=True, default=str))
     return _remember(_SOLVERS, key, lambda: make_solver(nlp, name, opts))
+
+
+def phase_one_for(
+    problem: DesignProblem, backend, options: Mapping[str, Any] | None = None
+) -> Callable[[], PhaseOneSolver] | None:
+    """The phase-1 solver (least violation) of a back-end's NLP, built on first use and
+    once per process and NLP, with the Ipopt options of the problem file and ``options``
+    (a user's ``max_iter = 0`` stops it as it stops the solve); None for a back-end that
+    is not CasADi's Ipopt (:func:`~optdesign.solvers.phase_one.supports`)."""
+    if not supports(backend):
+        return None
+    nlp = backend.nlp
+    opts = {**solver_options(problem, backend.name), **(options or {})}
+    key = (nlp.fingerprint, json.dumps(opts, sort_keys=True, default=str))
+    return lambda: _remember(_PHASE_ONE, key, lambda: PhaseOneSolver(nlp, opts))
 
 
 def solver_options(problem: DesignProblem, name: str | None = None) -> dict[str, Any]:
@@ -215,6 +232,14 @@ def solve_nlp(
             x = np.array([end.design[v.name] for v in problem.free]) if end.success else x0
             return checked_start(problem, backend.solve(backend.nlp.start(x0=x), full), objective)
 
+    phase_one = phase_one_for(problem, search, options)
+    least_violation = None
+    if phase_one is not None:
+
+        def least_violation(x0: np.ndarray, end: Result | None) -> LeastViolation:
+            z0 = search.nlp.z_from_x(x0) if end is None else end.raw["z"]
+            return phase_one().solve(z0, target=target)
+
     result = global_search(
         lambda x: checked_start(stand_in, search.solve(x, target), objective),
         tilted_starts(problem, objective, seed),
@@ -228,6 +253,7 @@ def solve_nlp(
         parallel_map=map_inherited,
         abs_tol=SOLVER_RESOLUTION * float(search.nlp.target_scales[target_index]),
         polish=polish,
+        least_violation=least_violation,
     )
     if polish is not None and result.multistart is not None:
         result.multistart.search_points = len(stand_in.phi)

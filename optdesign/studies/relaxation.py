@@ -4,10 +4,14 @@ relaxation of that requirement alone (the others kept) that makes the problem fe
 
 Each requirement's rows are relaxed by an amount ``t`` in its own unit (through the
 solve's :class:`~optdesign.formulations.nlp.Bounds`, so the formulation and the solver
-are the ones of the solve); ``t`` is bracketed by removing the requirement altogether
-(the violation of the design found then is enough) and bisected on feasibility. A
-requirement whose removal alone leaves the problem infeasible is reported as such: it
-conflicts only together with another one.
+are the ones of the solve). On Ipopt the smallest ``t`` is the minimum of a phase-1
+problem (:class:`~optdesign.solvers.phase_one.PhaseOneSolver`: ``t`` minimised with the
+requirement's rows widened by it and the others held), one solve per start, its point
+checked against the widened rows; elsewhere, or where that solve does not converge,
+``t`` is bracketed by removing the requirement altogether (the violation of the design
+found then is enough) and bisected on feasibility. A requirement whose removal alone
+leaves the problem infeasible is reported as such, and the requirements are then relaxed
+together (:func:`relax_together`): the set to relax and by how much.
 """
 
 from __future__ import annotations
@@ -18,11 +22,12 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.solvers.base import constraint_reports
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Relaxation
-from optdesign.studies.nlp_solve import _objective_set, solver_for
+from optdesign.studies.nlp_solve import _objective_set, phase_one_for, solver_for
 
-__all__ = ["Relaxation", "Site", "relaxations"]
+__all__ = ["Relaxation", "Site", "relax_together", "relaxations"]
 
 
 def relaxations(
@@ -39,6 +44,7 @@ def relaxations(
     x_start: np.ndarray | None = None,
     sites_for: Callable[[str, Callable[[Site], tuple[float | None, Any]]], Iterable[Site]]
     | None = None,
+    direct: bool = True,
 ) -> list[Relaxation]:
     """The smallest relaxation of each requirement ``result`` violates.
 
@@ -72,6 +78,10 @@ def relaxations(
         and the design there ((None, None) if removing the requirement is not enough) -
         e.g. the catalogue items nearest the design of the continuous relaxation's
         smallest one. A relaxation found at a site says where (:attr:`Relaxation.at`).
+    direct
+        Minimise each relaxation by a phase-1 solve where the back-end is Ipopt (False:
+        always bracket and bisect, as other back-ends do; ``iterations=0`` keeps the
+        bracket alone).
     """
     # The conflict is between the violated requirements and the ones binding at the best
     # infeasible point: each is a candidate.
@@ -91,9 +101,8 @@ def relaxations(
     options = {cap: max_iter} if cap is not None else None
     backend = solver_for(problem, solver, options, _objective_set(problem, objective))
     nlp = backend.nlp
-    z_best = result.raw.get("z")
-    if z_best is not None and np.size(z_best) != nlp.z.numel():
-        z_best = None  # another formulation's point (e.g. the robust NLP's)
+    phase_one = phase_one_for(problem, backend) if direct and iterations > 0 else None
+    z_best = _own_z(result, nlp)  # not another formulation's point (the robust NLP's)
     sites = [_Prepared(problem, nlp, Site(box, parameters, x_start, z_best))]
     base_names = [g.split("[", 1)[0] for g in nlp.g_names]
     out = []
@@ -121,6 +130,12 @@ def relaxations(
         def smallest(site: _Prepared, idx=idx, scale=scale, row=row, hi_side=hi_side):
             """(t, the design at it): the smallest relaxation found at ``site``, or
             (None, None) when removing the requirement leaves no feasible design."""
+            nonlocal count
+            if phase_one is not None:
+                found, solves = _minimised(phase_one(), nlp, site, idx, scale)
+                count += solves
+                if found is not None:
+                    return found
             ok = feasible(np.inf, site, site.starts, idx, scale)
             if ok is None:
                 return None, None
@@ -156,6 +171,99 @@ def relaxations(
             record.at = used.site.label
         out.append(record)
     return out
+
+
+#: How far beyond the minimised relaxation (relative) the reported limit lies: at the
+#: minimum itself the feasible set is a single design, which a search from random starts
+#: rarely finds; a little beyond, it has room.
+MARGIN = 1e-3
+
+
+def _minimised(
+    phase_one: Any, nlp: Any, site: _Prepared, idx: np.ndarray, scale: np.ndarray
+) -> tuple[tuple[float | None, Any] | None, int]:
+    """(the smallest relaxation of rows ``idx`` at ``site`` and its design, or (None,
+    None) when Ipopt finds the other rows infeasible from every start; None: no answer,
+    bisect), and the solves spent. The least ``t`` of the phase-1 solves from the site's
+    starts (:data:`MARGIN` beyond it), accepted only when its point meets every row with
+    the requirement's widened by it."""
+    best = None
+    refused = 0
+    for start in site.starts:
+        found = phase_one.solve(start.z0, site.bounds, rows=idx, per_row=1.0 / scale)
+        refused += found.hard_rows_infeasible
+        if found.converged and (best is None or found.value < best.value):
+            best = found
+    solves = len(site.starts)
+    if best is None:
+        return ((None, None) if refused == solves else None), solves
+    t = max(0.0, best.value) * (1.0 + MARGIN)
+    g = np.asarray(nlp.g_fun(best.z, site.theta), dtype=float).ravel()
+    violated, _ = constraint_reports(nlp, g, _relaxed(site.bounds, idx, scale, t))
+    if violated:
+        return None, solves
+    return (t, best.result), solves
+
+
+def relax_together(
+    problem: Any,
+    result: Any,
+    alone: list[Relaxation],
+    solver: str | None = None,
+    *,
+    objective: str | None = None,
+    x_start: np.ndarray | None = None,
+) -> list[Relaxation]:
+    """Where no requirement relaxed alone gives a feasible design (an entry of ``alone``
+    without ``needed``): the requirements of ``alone`` relaxed together, as the phase-1
+    problem with all their rows widened by one scaled amount (each row scaled by its
+    limit, so by about one fraction of each) finds them; of them, those the design found
+    needs changed, each to its worst value there. Empty when one relaxation alone is
+    enough, on a back-end other than Ipopt, or when even that finds no design."""
+    if not alone or any(r.needed is not None for r in alone):
+        return []
+    if objective is None:
+        own = result.objective_name
+        objective = own if own in problem.objectives else problem.objective_names[0]
+    backend = solver_for(problem, solver, None, _objective_set(problem, objective))
+    phase_one = phase_one_for(problem, backend)
+    if phase_one is None:
+        return []
+    nlp = backend.nlp
+    site = _Prepared(problem, nlp, Site(x_start=x_start, z_start=_own_z(result, nlp)))
+    base_names = [g.split("[", 1)[0] for g in nlp.g_names]
+    wanted = {r.name for r in alone}
+    idx = np.array([k for k, b in enumerate(base_names) if b in wanted], dtype=int)
+    found = [phase_one().solve(s.z0, site.bounds, rows=idx) for s in site.starts]
+    found = [f for f in found if f.converged]
+    if not found:
+        return []
+    best = min(found, key=lambda f: f.value)
+    g = np.asarray(nlp.g_fun(best.z, site.theta), dtype=float).ravel()
+    out = []
+    for r in alone:
+        rows = np.array([k for k in idx if base_names[k] == r.name], dtype=int)
+        values = g[rows] * np.asarray(nlp.g_scale, dtype=float)[rows]
+        row = _Row(r.lower_row, r.upper_row, r.name)
+        t = _need(values, row, r.upper)
+        if t > 0.0:
+            out.append(_record(row, r.upper, t, len(found)))
+    return out
+
+
+@dataclass
+class _Row:
+    """The bounds (and name) of a requirement's rows, as a relaxation record reads them."""
+
+    lower: float | None
+    upper: float | None
+    name: str = ""
+
+
+def _own_z(result: Any, nlp: Any) -> np.ndarray | None:
+    """The result's own NLP vector, when it is one of this NLP (else None)."""
+    z = result.raw.get("z")
+    return None if z is None or np.size(z) != nlp.z.numel() else z
 
 
 @dataclass

@@ -114,7 +114,9 @@ def test_infeasible_problem_of_every_formulation_names_its_cause(tmp_path, capsy
     assert violated["nut_travel"]["limit"] == {"value": 5.0, "unit": "mm"}
     assert doc["design"] and all(v["value"] is not None for v in doc["design"].values())
     needed = _needed(doc["diagnosis"]["relaxations"], "nut_travel")
-    assert 0.995 * lo <= needed <= hi, needed
+    # the hand bound is the continuous stroke's; the mean ratio over the 13 grid angles
+    # lets the exact minimum (a phase-1 solve, no bisection above it) lie 0.6 % below it
+    assert 0.99 * lo <= needed <= hi, needed
     assert doc["diagnosis"]["basis"]
     # the default mode: the same, as text, and the files (report.html of the best point)
     out_dir = tmp_path / "out"
@@ -128,7 +130,7 @@ def test_infeasible_problem_of_every_formulation_names_its_cause(tmp_path, capsy
     result = od.solve(path, starts=1, ranges=False)
     assert not result.success and result.design
     relax = {r.name: r for r in result.diagnosis.relaxations}
-    assert relax["nut_travel"].upper and 0.995 * lo <= relax["nut_travel"].needed <= hi
+    assert relax["nut_travel"].upper and 0.99 * lo <= relax["nut_travel"].needed <= hi
     # and od.solve(diagnose=False) skips it
     assert od.solve(path, starts=1, ranges=False, diagnose=False).diagnosis is None
 
