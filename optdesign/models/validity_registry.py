@@ -39,6 +39,8 @@ MODEL_MODULES = (
     "prsm",
     "motor",
     "motor_catalogue",
+    "describing_function",
+    "harmonic_balance",
 )
 
 
