@@ -17,6 +17,9 @@ from optdesign.studies.formulation_registry import choose_formulation
 
 ROOT = Path(__file__).resolve().parents[2]
 FORK = ROOT / "problems" / "fork_min_backlash.toml"
+#: One Ipopt start from its declared start converges here with every release allowed (the
+#: fork's backlash_rss from its declared start ends locally infeasible with NumPy 1.26).
+CRANK = ROOT / "problems" / "cs_min_backlash.toml"
 CS = ROOT / "problems" / "cs_min_backlash.toml"
 CATALOGUE = ROOT / "problems" / "cs_min_backlash_catalogue.toml"
 
@@ -37,12 +40,12 @@ def test_the_built_in_formulations_in_the_order_auto_tries_them():
 
 def test_a_users_formulation_is_one_object_and_one_registration_line(single):
     assert od.formulation_names() == ["catalogue", "robust", "gp", "single", "nlp"]
-    fork = od.load(FORK)
-    result = od.solve(fork, "single", objective="backlash_rss", seed=7, ranges=False)
+    crank = od.load(CRANK)
+    result = od.solve(crank, "single", objective="backlash_rss", seed=7, ranges=False)
     (request,) = single.seen
     assert (request.formulation, request.objective, request.seed) == ("single", "backlash_rss", 7)
     assert result.formulation == "single" and result.status == "optimal"
-    nlp = od.solve(fork, "nlp", objective="backlash_rss", starts=1, ranges=False)
+    nlp = od.solve(crank, "nlp", objective="backlash_rss", starts=1, ranges=False)
     assert result.objective == pytest.approx(nlp.objective, rel=1e-9)
     assert result.objective_name == "backlash_rss"
 
