@@ -42,16 +42,17 @@ def read_catalogue_file(catalogue: str, folder: str | None) -> str:
     file's folder; the working folder for a problem given as a dict), checked by parsing
     it, so that a wrong row is refused when the problem loads (ValueError naming the
     file, the line and the column)."""
-    from optdesign.errors import OptDesignError
-    from optdesign.safe_io import read_file
+    from optdesign.safe_io import UnsafeFileError, read_file
 
     path = Path(catalogue)
     if not path.is_absolute() and folder is not None:
         path = Path(folder) / path
     try:
         raw = read_file(path, what="the motor catalogue", limit=MAX_CATALOGUE_BYTES, follow=True)
-    except (OSError, OptDesignError) as exc:
-        raise ValueError(f"catalogue: cannot read {path} ({exc})") from None
+    except UnsafeFileError as exc:  # its reason alone: the message words an output's
+        raise ValueError(f"catalogue: cannot read {path}: it {exc.reason}") from None
+    except OSError as exc:
+        raise ValueError(f"catalogue: cannot read {path} ({exc.strerror})") from None
     if raw is None:
         raise ValueError(f"catalogue: no file {path}")
     try:

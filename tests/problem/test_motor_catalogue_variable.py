@@ -189,6 +189,17 @@ def test_a_wrong_csv_is_refused_on_the_command_line(tmp_path, json_mode):
     assert not (tmp_path / "out").exists()
 
 
+def test_a_catalogue_that_is_no_regular_file_is_refused_without_reading_it(tmp_path):
+    import os
+
+    os.mkfifo(tmp_path / "motors.csv")  # a reader of a FIFO would wait for ever
+    with pytest.raises(od.OptDesignError) as err:
+        od.load(_problem_file(tmp_path, _data("motors.csv")))
+    message = str(err.value)
+    assert "motor.catalogue: cannot read" in message and "FIFO, not a regular file" in message
+    assert "output folder" not in message
+
+
 def test_catalogue_text_is_refused_without_a_catalogue_file():
     data = _data("Yaskawa Sigma-7")
     data["motor"]["catalogue_text"] = _csv()
