@@ -202,8 +202,11 @@ def impossible_motors(problem) -> dict[float, str]:
     """The catalogue motors no design of ``problem`` can use, by their number, with why:
     those whose peak torque lies below :func:`torque_floor`. Empty when the motor is no
     catalogue variable or the motion gives no rate."""
+    from optdesign.problem.motion import motion_demand
+
     catalogue = catalogue_of(problem)
-    if catalogue is None:
+    demand = motion_demand(problem.spec) if catalogue is not None else None
+    if demand is None:
         return {}
     lo, hi = problem.by_name["motor"].lower, problem.by_name["motor"].upper
     out = {}
@@ -212,17 +215,10 @@ def impossible_motors(problem) -> dict[float, str]:
             continue
         need = torque_floor(problem, row)
         if need is not None and need > row.peak_torque * (1.0 + EXCLUSION_MARGIN):
-            cap = row.max_speed / motion_demand_rate(problem)
+            cap = row.max_speed / demand.rate
             out[float(number)] = (
                 f"{row.designation}: the motion asks at least {need * 1e-3:.4g} N*m at any "
                 f"design, above its peak torque {row.peak_torque * 1e-3:.4g} N*m (its top "
                 f"speed caps the ratio at {cap:.4g})"
             )
     return out
-
-
-def motion_demand_rate(problem) -> float:
-    """The fin's top rate of the problem's motion (rad/s)."""
-    from optdesign.problem.motion import motion_demand
-
-    return motion_demand(problem.spec).rate

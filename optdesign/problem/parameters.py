@@ -79,11 +79,14 @@ def with_bound(problem: DesignProblem, name: str, side: str, value: float) -> De
     """A copy of ``problem`` whose free variable ``name`` has its ``side`` ("lower" or
     "upper") bound at ``value`` (internal units)."""
 
+    return _with_variable(problem, dataclasses.replace(problem.by_name[name], **{side: value}))
+
+
+def _with_variable(problem: DesignProblem, variable: Any) -> DesignProblem:
+    """A copy of ``problem`` whose variable of ``variable``'s name is ``variable``."""
     new = object.__new__(type(problem))
     new.__dict__.update(problem.__dict__)
-    new.variables = [
-        dataclasses.replace(v, **{side: value}) if v.name == name else v for v in problem.variables
-    ]
+    new.variables = [variable if v.name == variable.name else v for v in problem.variables]
     new.by_name = {v.name: v for v in new.variables}
     new._touch()
     return new
@@ -158,12 +161,8 @@ def without_impossible_items(problem: DesignProblem) -> tuple[DesignProblem, lis
             if kept
             else dataclasses.replace(var, values=())
         )
-        new = object.__new__(type(problem))
-        new.__dict__.update(problem.__dict__)
-        new.variables = [narrowed if v.name == "motor" else v for v in problem.variables]
-        new.by_name = {v.name: v for v in new.variables}
-        new._touch()
-        out = (new, [f"motor {k:g} ({reason})" for k, reason in sorted(gone.items())])
+        reasons = [f"motor {k:g} ({reason})" for k, reason in sorted(gone.items())]
+        out = (_with_variable(problem, narrowed), reasons)
     _NARROWED[key] = out
     while len(_NARROWED) > MOVED_SIZE:
         _NARROWED.popitem(last=False)

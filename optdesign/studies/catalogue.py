@@ -28,9 +28,7 @@ import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.discrete import (
-    branch,
     discrete_variables,
-    items_within,
     n_combinations,
     nearest_item,
 )
@@ -51,7 +49,7 @@ from optdesign.solvers.multistart import (
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import Globality, MultistartInfo, Result
 from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes, on_items, split_at_items, trusted_value
+from optdesign.studies.catalogue_bnb import InfeasibleBoxes, trusted_value
 from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
 from optdesign.studies.catalogue_bnb import fixed_box as _fixed
@@ -526,46 +524,6 @@ def solve_catalogue(
         if excluded:
             best.notes.append("excluded before the search: " + "; ".join(excluded))
         return finish(problem, best, objective)
-
-
-def first_feasible(ns: NodeSolver) -> Result | None:
-    """A feasible catalogue design of the node solver's problem, or None: branch and bound
-    from the continuous relaxation, depth first, stopping at the first feasible leaf (a
-    design, not the optimum; e.g. which items allow a requirement to be dropped)."""
-    dvars = discrete_variables(ns.problem)
-    root = ns.solve({})
-    stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []
-    while stack:
-        box, res = stack.pop()
-        worst, items = on_items(dvars, box, res)
-        if worst is None:  # on items: the leaf with them fixed
-            leaf = ns.solve(_fixed(items), ns.x_of(res))
-            if leaf.success:
-                return leaf
-            # The relaxation's item data are the most favourable over the box's items,
-            # not those of the items it sits on: the box's other combinations may still
-            # work (split as the branch and bound does).
-            if all(box[v.name][0] == box[v.name][1] for v in dvars):
-                continue
-            splits = split_at_items(dvars, box, items)
-        else:
-            allowed = items_within(worst.values, *box[worst.name])
-            splits = [(worst, side) for side in branch(res.design[worst.name], allowed)]
-        children = []
-        for var, side in splits:
-            if not side:
-                continue
-            child = dict(box)
-            child[var.name] = (side[0], side[-1])
-            if worst is None and child == _fixed(items):
-                continue  # the leaf just solved
-            r = ns.solve(child, ns.x_of(res))
-            if r.success:
-                children.append((r.objective, child, r))
-        # the better child on top of the stack (explored first)
-        for _, child, r in sorted(children, key=lambda c: -c[0]):
-            stack.append((child, r))
-    return None
 
 
 def relaxation_bound(result: Result) -> float:

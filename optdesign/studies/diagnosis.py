@@ -43,7 +43,8 @@ from optdesign.reports.limits import limits_of
 from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.registry import solver_for_kind, solver_hints
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Relaxation, Result
-from optdesign.studies.catalogue import NodeSolver, first_feasible
+from optdesign.studies.catalogue import NodeSolver
+from optdesign.studies.catalogue_bnb import first_feasible
 from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.relaxation import Site, relax_together, relaxations
 

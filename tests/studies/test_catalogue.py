@@ -28,7 +28,6 @@ from optdesign.studies.catalogue import (
     _no_item,
     catalogue_applies,
     enumerate_catalogue,
-    first_feasible,
     is_on_catalogue,
     minlp_back_end,
     relaxation_bound,
@@ -46,6 +45,7 @@ from optdesign.studies.catalogue_bnb import (
     branch_and_bound_warm,
     cannot_improve,
     combination_key,
+    first_feasible,
     first_incumbent,
     fixed_box,
     item_distances,
@@ -1653,7 +1653,7 @@ def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5
     relaxation works, so no other fast test calls it): a leaf on the catalogue whose
     design the independent check finds feasible; None when no item pair is feasible."""
     problem, enum = enumerated_4x5
-    found = catalogue.first_feasible(catalogue.NodeSolver(problem, starts=2))
+    found = catalogue_bnb.first_feasible(catalogue.NodeSolver(problem, starts=2))
     assert found is not None and found.success
     assert is_on_catalogue(problem, found.design)
     x = np.array([found.design[v.name] for v in problem.free])
@@ -1669,4 +1669,4 @@ def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5
     assert found.objective <= max(feasible.values())
     # pins of 4 mm only: too weak for the hinge moment whatever the lead (every pair fails)
     weak = _catalogue((4, 5, 6, 8), (4,))
-    assert catalogue.first_feasible(catalogue.NodeSolver(weak, starts=2)) is None
+    assert catalogue_bnb.first_feasible(catalogue.NodeSolver(weak, starts=2)) is None

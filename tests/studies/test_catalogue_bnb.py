@@ -175,7 +175,7 @@ class TrapNodes(TiedNodes):
 
 
 def test_first_feasible_searches_the_rest_of_a_box_whose_relaxation_sat_on_items():
-    from optdesign.studies.catalogue import first_feasible
+    from optdesign.studies.catalogue_bnb import first_feasible
 
     ns = TrapNodes()
     found = first_feasible(ns)
