@@ -1,0 +1,166 @@
+"""The drive in its position loop, at one fin angle: the plant and the controller as
+typed records (issue 38; docs/loop.md).
+
+The plant is the two-mass drive of :mod:`optdesign.models.motor`, linearised at one fin
+angle phi0 where the chain's ratio is f' = dtheta/dphi (motor rad per fin rad):
+
+* the motor side, everything that turns with the rotor or moves with the nut
+  (``motor_inertia`` J_m at the motor shaft), seen at the fin as J_1 = J_m f'^2 turning
+  psi = theta / f';
+* the fin side (``fin_inertia`` J_2 about the hinge) turning phi;
+* between them the chain: ``stiffness`` k and ``damping`` c at the fin, in series with
+  the chain's clearance, a gap of total width 2 b at the fin (``backlash`` is the
+  half-width b, the convention of :class:`optdesign.models.describing_function.Backlash`).
+  With the gap the chain's torque at the fin is elastic-backlash (Modelica's
+  ElastoBacklash): zero while |psi - phi| < b, k (|psi - phi| - b) + c (psi' - phi') in
+  contact, never pulling;
+* on the fin, the aerodynamic hinge spring ``hinge_spring`` k_h (dM/dphi: the air puts
+  -k_h phi on the fin; negative for a statically unstable fin) and a damping to ground
+  ``fin_damping``;
+* on the motor, a Coulomb friction ``friction_torque`` and its limits
+  ``peak_torque`` and ``max_speed``.
+
+The controller (:class:`PositionLoop`): the motor's torque command
+
+    T_cmd = kp e + ki int(e) - kd y',   e = r - y
+
+on the fin's angle (``feedback="fin"``) or the motor's seen at the fin, y = psi
+(``feedback="motor"``: a semi-closed loop, the encoder on the motor), then the current
+loop as a first-order lag of time constant ``current_lag`` and the motor's peak torque
+as a saturation. Gains are motor torque per fin angle: kp in N*mm/rad, kd in N*mm*s/rad,
+ki in N*mm/(rad*s).
+
+Units: mm, t, s, N, rad (README "Units"): inertia in t*mm^2, torque in N*mm, stiffness
+in N*mm/rad, damping in N*mm*s/rad, speed in rad/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Literal
+
+from optdesign.errors import InputError
+
+FEEDBACKS = ("fin", "motor")
+
+
+def _finite(owner: str, name: str, value: float) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{owner}.{name}", f"expected a number, got {value!r}") from None
+    if not math.isfinite(value):
+        raise InputError(f"{owner}.{name}", f"must be finite, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class DrivePlant:
+    """The drive at one fin angle (see the module's docstring; internal units).
+
+    Parameters
+    ----------
+    motor_inertia
+        J_m at the motor shaft (t*mm^2), > 0.
+    ratio
+        f' = dtheta/dphi at the angle (motor rad per fin rad), > 0.
+    fin_inertia
+        J_2 about the hinge (t*mm^2), > 0.
+    stiffness
+        The chain's stiffness at the fin with the motor held (N*mm/rad), > 0.
+    damping
+        The chain's damping at the fin, across the chain (N*mm*s/rad), >= 0.
+    hinge_spring
+        dM/dphi of the air load (N*mm/rad), either sign.
+    fin_damping
+        The fin's damping to ground (N*mm*s/rad), >= 0.
+    backlash
+        Half-width b of the chain's clearance at the fin (rad), >= 0.
+    friction_torque
+        Coulomb friction at the motor (N*mm), >= 0.
+    peak_torque
+        The motor's peak torque (N*mm), > 0; ``inf`` for no limit.
+    max_speed
+        The motor's top speed (rad/s), > 0; ``inf`` for no limit.
+    angle
+        The fin angle phi0 this plant is linearised at (rad), for messages and records.
+    """
+
+    motor_inertia: float
+    ratio: float
+    fin_inertia: float
+    stiffness: float
+    damping: float = 0.0
+    hinge_spring: float = 0.0
+    fin_damping: float = 0.0
+    backlash: float = 0.0
+    friction_torque: float = 0.0
+    peak_torque: float = math.inf
+    max_speed: float = math.inf
+    angle: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name in ("peak_torque", "max_speed") and value == math.inf:
+                continue
+            object.__setattr__(self, f.name, _finite("plant", f.name, value))
+        for name in (
+            "motor_inertia",
+            "ratio",
+            "fin_inertia",
+            "stiffness",
+            "peak_torque",
+            "max_speed",
+        ):
+            if not getattr(self, name) > 0:
+                raise InputError(f"plant.{name}", f"must be positive, got {getattr(self, name)!r}")
+        for name in ("damping", "fin_damping", "backlash", "friction_torque"):
+            if getattr(self, name) < 0:
+                raise InputError(
+                    f"plant.{name}", f"cannot be negative, got {getattr(self, name)!r}"
+                )
+
+    @property
+    def motor_inertia_at_fin(self) -> float:
+        """J_1 = J_m f'^2: the motor side seen at the fin (t*mm^2)."""
+        return self.motor_inertia * self.ratio**2
+
+
+@dataclass(frozen=True)
+class PositionLoop:
+    """The position controller and the current loop (see the module's docstring).
+
+    Parameters
+    ----------
+    kp
+        Proportional gain, motor torque per fin angle (N*mm/rad), > 0.
+    kd
+        Derivative gain on the measured rate (N*mm*s/rad), >= 0.
+    ki
+        Integral gain (N*mm/(rad*s)), >= 0.
+    current_lag
+        Time constant of the current loop (s), >= 0 (0: the torque follows at once).
+    feedback
+        ``"fin"`` (the fin's angle is measured) or ``"motor"`` (the motor's, at the fin).
+    """
+
+    kp: float
+    kd: float = 0.0
+    ki: float = 0.0
+    current_lag: float = 0.0
+    feedback: Literal["fin", "motor"] = "fin"
+
+    def __post_init__(self) -> None:
+        for name in ("kp", "kd", "ki", "current_lag"):
+            object.__setattr__(self, name, _finite("loop", name, getattr(self, name)))
+        if not self.kp > 0:
+            raise InputError("loop.kp", f"must be positive, got {self.kp!r}")
+        for name in ("kd", "ki", "current_lag"):
+            if getattr(self, name) < 0:
+                raise InputError(f"loop.{name}", f"cannot be negative, got {getattr(self, name)!r}")
+        if self.feedback not in FEEDBACKS:
+            raise InputError(
+                "loop.feedback", f"expected one of {', '.join(FEEDBACKS)}, got {self.feedback!r}"
+            )
