@@ -141,7 +141,13 @@ def _solve_and_report(args, problem, out: Path | None, figures) -> int:
         # the figure is drawn (in the figure process) while the page is made here
         drawn = figures is not None and bool(result.design)
         if drawn:
-            _submit_figure(figures, result, out / "solution.png")
+            from optdesign.plots.solution import result_figure
+
+            figures.submit(
+                "optdesign.plots.solution:draw_solution",
+                out / "solution.png",
+                lambda: result_figure(result),
+            )
         page, failed_page = None, None
         if not args.no_report and result.design:
             try:
@@ -170,18 +176,3 @@ def _solve_and_report(args, problem, out: Path | None, figures) -> int:
         if wrote:
             print("\nwrote " + ", ".join(printable(w) for w in wrote))
     return 0 if result.success else 1
-
-
-def _submit_figure(figures, result, path: Path) -> None:
-    """Send the figure of ``result`` to ``figures``; evaluating what it shows happens
-    here (its failure is the figure's note, as a failure to draw it is)."""
-    from optdesign.plots.solution import result_figure
-
-    try:
-        record = result_figure(result)
-    except OSError:
-        raise
-    except Exception as exc:
-        figures.failed(path, exc)
-        return
-    figures.submit("optdesign.plots.solution", "draw_solution", record, path)

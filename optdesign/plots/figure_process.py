@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import importlib
 import threading
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -88,12 +89,26 @@ class FigureProcess:
             return
         self._inflight = ""
 
-    def submit(self, module: str, function: str, record: Any, path: str | Path) -> None:
-        """Draw ``module.function(record)`` and write it as PNG at ``path``; the outcome
+    def submit(self, draw: str, path: str | Path, prepare: Callable[[], Any]) -> None:
+        """Write the figure ``draw(prepare())`` as PNG at ``path``; ``draw`` is a
+        ``"module:function"`` path (the worker imports it), ``prepare`` evaluates the
+        record it draws, here. A failure of either is the figure's note; the outcome
         comes from :meth:`outcome`, in the order submitted."""
-        job = (module, function, record, str(path))
         self._waiting += 1
         self._settle()
+        try:
+            record = prepare()
+        except OSError:
+            raise
+        except Exception as exc:  # what the figure shows could not be evaluated
+
+            def fail(error: Exception = exc) -> Any:
+                raise error
+
+            self._outcomes.append(write_figure(fail, path))
+            return
+        module, _, function = draw.partition(":")
+        job = (module, function, record, str(path))
         if self._pool is not None:
             try:
                 self._pool.submit(_draw, job)
@@ -103,17 +118,6 @@ class FigureProcess:
                 self._inflight = str(path)
                 return
         self._outcomes.append(_draw(*job))
-
-    def failed(self, path: str | Path, error: Exception) -> None:
-        """A figure that could not be prepared: its outcome is the note of ``error``, as
-        if drawing it had raised it."""
-
-        def draw() -> Any:
-            raise error
-
-        self._waiting += 1
-        self._settle()
-        self._outcomes.append(write_figure(draw, path))
 
     def outcome(self) -> str | None:
         """The outcome of the oldest figure submitted (None: written; else the note).

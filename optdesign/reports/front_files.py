@@ -129,9 +129,14 @@ def write_front_outputs(
     notes: list[str] = []
     if plot:
         from optdesign.plots.figure_process import FigureProcess
+        from optdesign.plots.front import front_figure
 
         figures = figures if figures is not None else FigureProcess()
-        _submit_front_figure(figures, problem, fronts, out / "front.png")
+        figures.submit(
+            "optdesign.plots.front:draw_front",
+            out / "front.png",
+            lambda: front_figure(problem, fronts),
+        )
     if report and any(f.points for f in fronts):
         from optdesign.errors import OptDesignError
         from optdesign.reports.html import front_report
@@ -151,18 +156,3 @@ def write_front_outputs(
         else:  # the front's files are written; the report and the summary follow
             notes.insert(0, failed)
     return wrote, notes
-
-
-def _submit_front_figure(figures: FigureProcess, problem: Any, fronts: Sequence[Any], path: Path):
-    """Send the figure of ``fronts`` to ``figures``; evaluating what it shows (the picked
-    designs' sketches) happens here, and its failure is the figure's note."""
-    from optdesign.plots.front import front_figure
-
-    try:
-        record = front_figure(problem, fronts)
-    except OSError:
-        raise
-    except Exception as exc:
-        figures.failed(path, exc)
-        return
-    figures.submit("optdesign.plots.front", "draw_front", record, path)

@@ -32,8 +32,8 @@ def test_the_child_writes_the_png_the_process_draws(solved, tmp_path):
         if threading.active_count() != 1:
             pytest.skip("the test process runs threads: no fork (drawn in process)")
         assert figures.forked
-        figures.submit("optdesign.plots.solution", "draw_solution", record, tmp_path / "a.png")
-        figures.submit("optdesign.plots.solution", "draw_solution", record, tmp_path / "b.png")
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "a.png", lambda: record)
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "b.png", lambda: record)
         assert figures.outcome() is None and figures.outcome() is None
     here = (tmp_path / "here.png").read_bytes()
     assert len(here) > 10_000
@@ -43,7 +43,7 @@ def test_the_child_writes_the_png_the_process_draws(solved, tmp_path):
 def test_a_drawing_that_fails_in_the_child_is_a_note(solved, tmp_path):
     with FigureProcess() as figures:
         figures.submit(
-            "optdesign.plots.solution", "draw_solution", "not a record", tmp_path / "x.png"
+            "optdesign.plots.solution:draw_solution", tmp_path / "x.png", lambda: "not a record"
         )
         note = figures.outcome()
     assert note.startswith("x.png not written: AttributeError:")
@@ -54,7 +54,7 @@ def test_a_child_killed_while_drawing_is_a_note(tmp_path):
     with FigureProcess() as figures:
         if not figures.forked:
             pytest.skip("no fork here")
-        figures.submit("time", "sleep", 30.0, tmp_path / "a.png")  # a drawing that hangs
+        figures.submit("time:sleep", tmp_path / "a.png", lambda: 30.0)  # a drawing that hangs
         os.kill(figures.pid, signal.SIGKILL)
         note = figures.outcome()
         assert note == "a.png not written: the figure process ended (exit code -9)"
@@ -80,7 +80,7 @@ def test_after_the_child_is_gone_figures_are_drawn_in_process(solved, tmp_path):
         deadline = time.monotonic() + 10.0
         while not _gone(figures.pid) and time.monotonic() < deadline:
             time.sleep(0.01)
-        figures.submit("optdesign.plots.solution", "draw_solution", record, tmp_path / "b.png")
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "b.png", lambda: record)
         assert not figures.forked and figures.outcome() is None
     assert (tmp_path / "b.png").stat().st_size > 10_000
 
@@ -97,9 +97,13 @@ def test_no_child_is_forked_beside_another_thread(tmp_path):
         other.join()
 
 
+def _no_design():
+    raise ValueError("plot: no design")
+
+
 def test_a_figure_that_cannot_be_prepared_is_its_note(tmp_path):
     with FigureProcess() as figures:
-        figures.failed(tmp_path / "s.png", ValueError("plot: no design"))
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "s.png", _no_design)
         assert figures.outcome() == "s.png not written: ValueError: plot: no design"
     with pytest.raises(RuntimeError, match="no figure was submitted"):
         FigureProcess().outcome()
