@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import optdesign as od
-from optdesign.studies.nlp_solve import solve_nlp
+from optdesign.formulations.nlp.solve import solve_nlp
 
 
 @dataclass

@@ -13,13 +13,13 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError, ProblemError
-from optdesign.formulations import catalogue_minlp
-from optdesign.formulations.catalogue_minlp import build_catalogue_minlp, item_groups
-from optdesign.formulations.nlp import build_nlp
+from optdesign.formulations.catalogue import minlp_program as catalogue_minlp
+from optdesign.formulations.catalogue.bnb import InfeasibleBoxes
+from optdesign.formulations.catalogue.minlp_program import build_catalogue_minlp, item_groups
+from optdesign.formulations.catalogue.search import NodeSolver, solve_catalogue
 from optdesign.problem import problem_from_dict
+from optdesign.programs.nlp import build_nlp
 from optdesign.solvers.registry import solver_hints
-from optdesign.studies.catalogue import NodeSolver, solve_catalogue
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -257,9 +257,9 @@ def test_a_nodes_starts_are_its_seeds_sobol_points_and_a_retry_draws_new_ones(mo
     """A cold node starts from the problem's start, then the Sobol points of the solver's
     seed (the same on every run); when every start fails, the retry tries RETRY_STARTS
     Sobol points of the next seed, not the ones it tried."""
+    from optdesign.formulations.catalogue import search as catalogue
     from optdesign.solvers.multistart import sobol_starts
     from optdesign.solvers.result import Result
-    from optdesign.studies import catalogue
 
     problem = _small()
     solver = NodeSolver(problem, starts=3, seed=5)
@@ -287,7 +287,7 @@ def test_a_nodes_starts_are_its_seeds_sobol_points_and_a_retry_draws_new_ones(mo
 def test_search_coordinates_map_to_the_nearest_catalogue_items_leaving_the_population():
     """A population method's coordinates: a catalogue variable's index rounds to its item
     (clipped to the list), continuous ones pass; the population itself is not changed."""
-    from optdesign.formulations.discrete import CatalogueCoordinates
+    from optdesign.formulations.catalogue.discrete import CatalogueCoordinates
 
     coordinates = CatalogueCoordinates(_small())  # p in (5, 6), d in (5, 6, 8)
     population = np.array([[75, 120, 75, 0.6, 0, 1.4], [80, 100, 70, 1.7, 0.1, 2.2]], float)
@@ -298,7 +298,7 @@ def test_search_coordinates_map_to_the_nearest_catalogue_items_leaving_the_popul
     np.testing.assert_array_equal(population, before)
 
 
-# optdesign/formulations/catalogue_minlp.py as a whole: at every integer point the
+# optdesign/formulations/catalogue/minlp_program.py as a whole: at every integer point the
 # one-hot MINLP is exactly the NLP of the chosen items (objective and rows, on a problem
 # whose pins carry table data and on the fin actuator, whose screw pairs carry ratings),
 # its bounds and flags, the grouping's fallback to one group when the valid combinations

@@ -1,4 +1,4 @@
-"""optdesign/formulations/discrete.py as a whole: which variables are catalogue ones, how
+"""optdesign/formulations/catalogue/discrete.py as a whole: which variables are catalogue ones, how
 many combinations they make, the items in a box (with its tolerance on both sides), the
 nearest item and its relative distance, the branch split, and the search coordinates of
 population methods (index bounds, integrality, rounding and clipping to items)."""
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.formulations.discrete import (
+from optdesign.formulations.catalogue.discrete import (
     ON_ITEM_TOL,
     CatalogueCoordinates,
     branch,

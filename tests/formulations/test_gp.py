@@ -13,8 +13,11 @@ import pytest
 import optdesign as od
 from formulations.test_signomial import _terms, _vars
 from optdesign.errors import ProblemError
-from optdesign.formulations import gp as gpmod
-from optdesign.formulations.gp import (
+from optdesign.formulations.gp.solve import require_gp, solve_gp_problem
+from optdesign.models.fit_formulas import fit_clearance
+from optdesign.problem import load_problem, problem_from_dict
+from optdesign.programs import gp as gpmod
+from optdesign.programs.gp import (
     DGPCheck,
     GPData,
     GPRow,
@@ -31,9 +34,6 @@ from optdesign.formulations.gp import (
     is_gp,
     to_cvxpy,
 )
-from optdesign.models.fit_formulas import fit_clearance
-from optdesign.problem import load_problem, problem_from_dict
-from optdesign.studies.gp import require_gp, solve_gp_problem
 
 ROOT = Path(__file__).resolve().parents[2]
 FORK = ROOT / "problems" / "fork_min_backlash.toml"
@@ -345,7 +345,7 @@ def test_cli_gp_on_a_non_gp_problem_names_the_variable(capsys):
 
 def test_auto_picks_gp_for_the_fork_and_nlp_for_the_crank_slider():
     from optdesign.cli import _load_plugins
-    from optdesign.studies.formulation_registry import choose_formulation
+    from optdesign.formulations.registry import choose_formulation
 
     _load_plugins()
     assert choose_formulation(load_problem(FORK), "auto") == "gp"
@@ -357,7 +357,7 @@ def test_auto_decides_with_the_chosen_objective():
     sum): ``auto`` with ``objective="backlash_rss"`` takes the NLP, where it used to
     pick gp and refuse "not a geometric program"."""
 
-    from optdesign.studies.formulation_registry import choose_formulation
+    from optdesign.formulations.registry import choose_formulation
 
     problem = od.load(FORK)
     assert choose_formulation(problem, "auto") == "gp"
@@ -415,7 +415,7 @@ def test_a_bound_that_puts_a_sum_of_terms_above_a_constant_is_named_with_its_sid
 # The GP builder's observable behaviour, pinned case by case.
 #
 # Issue 21 (mutation deliverable): every value, name and message that
-# :mod:`optdesign.formulations.gp` produces - each branch of a row's classification, the
+# :mod:`optdesign.programs.gp` produces - each branch of a row's classification, the
 # pruning, the diagnosis, the fork's rows, the cvxpy problem - against hand computations or
 # the NumPy model. The signomial tracer is pinned in ``test_signomial.py``.
 
@@ -1024,7 +1024,7 @@ def test_a_gp_objective_with_a_negative_term_is_not_a_gp():
     names the term, and cvxpy agrees; the problem's own objective stays a GP."""
     import copy
 
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     problem = problem_from_dict(copy.deepcopy(CS_FIXED))
     problem.add_objective("lead_margin", lambda q: 12.0 - q.design["p"], unit="mm")
@@ -1041,7 +1041,7 @@ def test_a_ratio_ripple_limit_is_not_a_gp_and_the_diagnosis_says_why():
     posynomials over a sum: the GP diagnosis names it as a constraint that is not DGP."""
     import copy
 
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     data = copy.deepcopy(CS_FIXED)
     data["requirements"]["ripple_max"] = 0.2
@@ -1059,7 +1059,7 @@ def test_an_objective_the_gp_cannot_trace_is_a_failed_check_not_an_unknown_one()
     import copy
 
     from optdesign import math as m
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     problem = problem_from_dict(copy.deepcopy(CS_FIXED))
     problem.add_objective("wavy", lambda q: m.sin(q.design["p"]), unit="")
@@ -1073,7 +1073,7 @@ def test_a_design_independent_ripple_limit_is_checked_by_the_gp_against_its_valu
     named as the infeasible requirement at 0.2."""
     import copy
 
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     ripple = None
     for limit, lead in ((0.3, None), (0.2, None), (0.2, 5.0)):

@@ -1,7 +1,7 @@
 """The NLP formulation's observable behaviour, pinned row by row.
 
 Issue 21 (mutation deliverable): every array, name and message that
-:mod:`optdesign.formulations.nlp` produces - the rows, their bounds, scales, names and
+:mod:`optdesign.programs.nlp` produces - the rows, their bounds, scales, names and
 units, the auxiliary variables and their starts, the targets and their scales, the
 epsilon rows, the bounds of a solve, the starts, the refusals - against the NumPy path
 of the same problem (:meth:`DesignProblem.expressions` / :meth:`DesignProblem.evaluate`)
@@ -19,7 +19,9 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import (
+from optdesign.problem import load_problem, problem_from_dict
+from optdesign.problem.load import load
+from optdesign.programs.nlp import (
     VAR,
     ConstraintRows,
     Target,
@@ -28,8 +30,6 @@ from optdesign.formulations.nlp import (
     numeric_value,
     typical,
 )
-from optdesign.problem import load_problem, problem_from_dict
-from optdesign.problem.load import load
 
 ROOT = Path(__file__).resolve().parents[2]
 CS = ROOT / "problems" / "cs_min_backlash.toml"
@@ -466,7 +466,7 @@ PROBLEMS = ROOT / "problems"
 
 # --- NLP rows: both bounds scaled by the row's divisor -------------------------------------
 def test_nlp_rows_are_scaled_on_both_sides():
-    from optdesign.studies.nlp_solve import formulation_for
+    from optdesign.formulations.nlp.solve import formulation_for
 
     problem = od.load(PROBLEMS / "cs_min_backlash.toml")
     nlp = formulation_for(problem)
@@ -495,7 +495,7 @@ def test_nlp_rows_are_scaled_on_both_sides():
 
 
 def test_an_nlp_of_one_objective_named_by_a_string_holds_that_objective():
-    from optdesign.formulations.nlp import build_nlp
+    from optdesign.programs.nlp import build_nlp
 
     fork = load(ROOT / "problems" / "fork_min_backlash.toml")
     assert list(build_nlp(fork, "size").objective_values) == ["size"]
@@ -504,8 +504,8 @@ def test_an_nlp_of_one_objective_named_by_a_string_holds_that_objective():
 
 def test_an_epsilon_bound_on_a_quantity_the_formulation_lacks_is_refused_naming_them():
     from optdesign.errors import ProblemError
+    from optdesign.formulations.nlp.solve import formulation_for
     from optdesign.problem import load_problem
-    from optdesign.studies.nlp_solve import formulation_for
 
     problem = load_problem(ROOT / "problems" / "cs_min_backlash.toml")
     nlp = formulation_for(problem, ("backlash", "ripple"))

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from optdesign.errors import InputError, ProblemError
-from optdesign.formulations.robust import (
+from optdesign.formulations.nlp.solve import solve_nlp
+from optdesign.formulations.robust.program import (
     STD_EPS,
     Samples,
     build_robust_nlp,
@@ -22,15 +23,14 @@ from optdesign.formulations.robust import (
     sampled_objective,
     tolerances_of,
 )
-from optdesign.problem import load_problem, problem_from_dict
-from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.robust import (
+from optdesign.formulations.robust.solve import (
     compare_nominal_robust,
     empirical_cvar,
     monte_carlo,
     paired_bootstrap,
     solve_robust,
 )
+from optdesign.problem import load_problem, problem_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 FILE = ROOT / "problems" / "cs_min_backlash_robust.toml"
@@ -178,7 +178,7 @@ def test_monte_carlo_with_no_scatter_is_the_nominal_value(problem):
 
 def test_auto_picks_robust_for_a_file_with_tolerances():
     from optdesign.cli import build_parser
-    from optdesign.studies.formulation_registry import choose_formulation
+    from optdesign.formulations.registry import choose_formulation
 
     build_parser()  # registers the formulations and their auto predicates
     from optdesign.problem import load_problem
@@ -267,7 +267,7 @@ def test_the_robust_nlp_is_finite_everywhere_inside_the_bounds(problem):
 # The robust (sample-average) formulation's observable behaviour, pinned row by row.
 #
 # Issue 21 (mutation deliverable): every array, name and message that
-# :mod:`optdesign.formulations.robust` produces - the draws, the perturbed designs, the
+# :mod:`optdesign.formulations.robust.program` produces - the draws, the perturbed designs, the
 # per-sample epigraph rows and variables, the risk measures (CVaR, mean + k std) and
 # their starts, the nominal target, the refusals - against a NumPy recomputation from the
 # same draws (:meth:`DesignProblem.expressions` with the sampled fit fractions) and hand
@@ -459,7 +459,7 @@ def test_the_cvar_nlp_of_the_worst_case_backlash(problem, samples):
     assert n == 6 and nlp.z.shape == (n + 2 * S + 1, 1)
     assert nlp.lbz.tolist() == [0.0] * n + [-np.inf] * (S + 1) + [0.0] * S
     assert nlp.ubz.tolist() == [1.0] * n + [np.inf] * (2 * S + 1)
-    from optdesign.formulations.nlp import build_nlp
+    from optdesign.programs.nlp import build_nlp
 
     base = build_nlp(problem, [])
     nb = len(base.g_names)
@@ -791,7 +791,7 @@ def test_a_requirement_bound_below_one_is_its_own_scale_in_every_sample(samples)
 def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
     """``build_robust_nlp(..., risk=...)`` (od.solve's robust formulation with a risk of
     the caller's): the caller's measure is minimised, the file's only by default."""
-    from optdesign.formulations.robust import build_robust_nlp
+    from optdesign.formulations.robust.program import build_robust_nlp
     from optdesign.problem import load_problem
 
     problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")  # risk = "cvar"
@@ -807,7 +807,7 @@ def test_a_robust_nlp_takes_the_callers_risk_measure_over_the_files():
 def test_a_robust_nlp_of_no_sample_is_refused_naming_the_field():
 
     from optdesign.errors import ProblemError
-    from optdesign.formulations.robust import build_robust_nlp
+    from optdesign.formulations.robust.program import build_robust_nlp
     from optdesign.problem import load_problem
 
     problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")
@@ -819,7 +819,7 @@ def test_a_robust_nlp_of_no_sample_is_refused_naming_the_field():
 def test_a_robust_ripple_names_every_samples_envelope_variables():
     """A spread objective (the ratio ripple) under scatter: two envelope variables per
     sample, each named, as many names as auxiliary variables."""
-    from optdesign.formulations.robust import build_robust_nlp, draw_samples
+    from optdesign.formulations.robust.program import build_robust_nlp, draw_samples
     from optdesign.problem import load_problem
 
     problem = load_problem(ROOT / "problems" / "cs_min_backlash_robust.toml")

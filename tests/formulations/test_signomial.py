@@ -1,7 +1,7 @@
 """The signomial tracer's observable behaviour, pinned case by case.
 
 Issue 21 (mutation deliverable): the terms, texts and refusals of
-:mod:`optdesign.formulations.signomial` - construction, arithmetic, powers, ``abs``, the
+:mod:`optdesign.programs.signomial` - construction, arithmetic, powers, ``abs``, the
 NumPy protocol and grid reductions - against hand computations. The GP builder that
 reads them is pinned in the GP part of ``test_gp.py``.
 """
@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from optdesign.formulations.signomial import NotGP, Signomial
+from optdesign.programs.signomial import NotGP, Signomial
 
 NAMES = ("R", "d")
 REF = np.array([2.0, 3.0])

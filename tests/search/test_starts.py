@@ -13,8 +13,8 @@ import pytest
 
 import optdesign as od
 from optdesign.api import solve
-from optdesign.formulations.nlp import build_nlp
 from optdesign.problem.load import problem_from_dict
+from optdesign.programs.nlp import build_nlp
 from optdesign.search.starts import (
     CHUNK,
     NEAR_FEASIBLE,

@@ -16,24 +16,9 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
-from optdesign.formulations.discrete import discrete_variables
-from optdesign.problem import load_problem, problem_from_dict
-from optdesign.problem.load import load
-from optdesign.runtime.inherited_map import InheritedWorkers
-from optdesign.runtime.processes import forks_workers
-from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.studies import catalogue, catalogue_bnb
-from optdesign.studies.catalogue import (
-    NodeSolver,
-    _no_item,
-    catalogue_applies,
-    enumerate_catalogue,
-    is_on_catalogue,
-    minlp_back_end,
-    relaxation_bound,
-    solve_catalogue,
-)
-from optdesign.studies.catalogue_bnb import (
+from optdesign.formulations.catalogue import bnb as catalogue_bnb
+from optdesign.formulations.catalogue import search as catalogue
+from optdesign.formulations.catalogue.bnb import (
     PRUNE_TOL,
     InfeasibleBoxes,
     PseudoCosts,
@@ -55,7 +40,23 @@ from optdesign.studies.catalogue_bnb import (
     trusted_value,
     wins,
 )
-from optdesign.studies.verify import verify_design
+from optdesign.formulations.catalogue.discrete import discrete_variables
+from optdesign.formulations.catalogue.search import (
+    NodeSolver,
+    _no_item,
+    catalogue_applies,
+    enumerate_catalogue,
+    is_on_catalogue,
+    minlp_back_end,
+    relaxation_bound,
+    solve_catalogue,
+)
+from optdesign.formulations.verify import verify_design
+from optdesign.problem import load_problem, problem_from_dict
+from optdesign.problem.load import load
+from optdesign.runtime.inherited_map import InheritedWorkers
+from optdesign.runtime.processes import forks_workers
+from optdesign.solvers.result import MultistartInfo, Result
 from studies.test_catalogue_bnb import _infeasible as _failed
 from studies.test_catalogue_bnb import _Problem, _Var  # the stand-in problem of catalogue items
 
@@ -142,7 +143,7 @@ def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
 
 def test_catalogue_problem_is_never_solved_as_continuous():
     import optdesign as od
-    from optdesign.studies.formulation_registry import choose_formulation
+    from optdesign.formulations.registry import choose_formulation
 
     problem = load_problem(CATALOGUE)
     assert choose_formulation(problem, "auto") == "catalogue"
@@ -155,8 +156,8 @@ def test_catalogue_problem_is_never_solved_as_continuous():
 def test_node_solver_ipopt_options_file_wins_over_node_defaults():
     # Nodes enter Ipopt's restoration phase early (many boxes are infeasible); a problem
     # file's own [solver] ipopt options still decide, and a caller's override both.
+    from optdesign.formulations.catalogue.search import NodeSolver
     from optdesign.solvers.registry import solver_hints
-    from optdesign.studies.catalogue import NodeSolver
 
     assert solver_hints("ipopt").node_options["expect_infeasible_problem"] == "yes"
     default = NodeSolver(_small_catalogue())
@@ -182,7 +183,7 @@ def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
     """Ipopt's own verdict on every start decides the node: 2 starts, no retries; a
     start stopped by its iteration limit, or a single start, still gets the
     RETRY_STARTS retries."""
-    from optdesign.studies.catalogue import RETRY_STARTS, NodeSolver
+    from optdesign.formulations.catalogue.search import RETRY_STARTS, NodeSolver
 
     box = {"p": (5.0, 5.0), "d": (4.0, 4.0)}
     ns = NodeSolver(_weak_pins(), starts=2)
@@ -212,8 +213,8 @@ def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
 def test_a_start_that_reaches_the_nodes_floor_settles_it():
     """A floor (the parent's trusted value) no start can go below: the start that reaches
     it ends the multistart; one it cannot reach leaves the full multistart."""
-    from optdesign.studies.catalogue import NodeSolver
-    from optdesign.studies.catalogue_bnb import trusted
+    from optdesign.formulations.catalogue.bnb import trusted
+    from optdesign.formulations.catalogue.search import NodeSolver
 
     problem = problem_from_dict(tomllib.loads(CATALOGUE.read_text()))
     box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
@@ -239,8 +240,8 @@ def test_a_box_proved_infeasible_under_a_limit_is_implied_only_under_tighter_one
     """The memo a front's points share: a box the search proved infeasible under an
     epsilon limit is skipped (no NLP) under that limit or a tighter one, and solved again
     under a looser one, where it is feasible."""
-    from optdesign.studies.catalogue import NodeSolver
-    from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+    from optdesign.formulations.catalogue.bnb import InfeasibleBoxes
+    from optdesign.formulations.catalogue.search import NodeSolver
 
     problem = problem_from_dict(tomllib.loads(CATALOGUE.read_text()))
     box = {"p": (6.0, 6.0), "d": (6.0, 6.0)}
@@ -269,7 +270,7 @@ def test_the_memo_proves_a_box_whose_item_combinations_other_proofs_cover():
     """With the items known, a box is infeasible when each of its item combinations lies
     in some proved box whose limits the query holds at least as tight; one combination
     left uncovered, or a proof at looser limits only, and it is not."""
-    from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+    from optdesign.formulations.catalogue.bnb import InfeasibleBoxes
 
     full = {"a": (1.0, 3.0), "b": (1.0, 2.0)}
     memo = InfeasibleBoxes(full, {"a": (1.0, 2.0, 3.0), "b": (1.0, 2.0)})
@@ -294,8 +295,8 @@ def test_a_pruned_box_with_a_trusted_value_is_a_proof_under_a_lower_limit():
     search's own limits; a one-start value or a search with no memo records nothing."""
     from types import SimpleNamespace
 
+    from optdesign.formulations.catalogue.bnb import PRUNE_TOL, InfeasibleBoxes, _bound_proof
     from optdesign.solvers.result import MultistartInfo, Result
-    from optdesign.studies.catalogue_bnb import PRUNE_TOL, InfeasibleBoxes, _bound_proof
 
     def result(n_starts):
         r = Result(
@@ -326,7 +327,7 @@ def test_a_pruned_box_with_a_trusted_value_is_a_proof_under_a_lower_limit():
 def test_the_shared_memos_keep_the_newest_searches_and_evict_the_oldest(monkeypatch):
     """A process keeps the infeasible-box memos of its last eight catalogue searches: a
     ninth search evicts the oldest one (never fails), a known search gets its own back."""
-    from optdesign.studies import catalogue_bnb
+    from optdesign.formulations.catalogue import bnb as catalogue_bnb
 
     monkeypatch.setattr(catalogue_bnb, "_MEMOS", {})
     full = {"p": (5.0, 8.0)}
@@ -340,7 +341,7 @@ def test_the_shared_memos_keep_the_newest_searches_and_evict_the_oldest(monkeypa
 def test_the_catalogue_search_refuses_a_problem_without_catalogue_variables():
     """Through the API and called directly: one message, naming the formulation."""
     import optdesign as od
-    from optdesign.studies.catalogue import solve_catalogue
+    from optdesign.formulations.catalogue.search import solve_catalogue
 
     problem = od.load(Path(__file__).resolve().parents[2] / "problems" / "cs_min_backlash.toml")
     message = "formulation='catalogue': no variable takes catalogue values"
@@ -490,7 +491,7 @@ def _small(pins=("5 mm", "6 mm", "8 mm"), leads=("5 mm", "6 mm"), solver=None):
 def _spied_search(monkeypatch, stats=None):
     """solve_catalogue with its searches replaced by spies finding nothing (only the root
     relaxation is solved): the calls they got."""
-    from optdesign.studies import catalogue
+    from optdesign.formulations.catalogue import search as catalogue
 
     calls: dict = {}
 
@@ -1111,7 +1112,7 @@ def test_a_tied_candidate_with_smaller_items_prunes_the_search_and_is_reported()
 def test_enumeration_starts_from_the_relaxation_and_trusts_its_value(monkeypatch):
     """solve_catalogue enumerates from the relaxation's optimum, with its value as the
     floor (a full multistart's value is trusted)."""
-    from optdesign.studies import catalogue
+    from optdesign.formulations.catalogue import search as catalogue
 
     seen = []
 
@@ -1243,7 +1244,7 @@ def test_a_candidate_without_every_free_variable_is_not_solved():
 def test_a_minlp_back_end_picks_the_items_and_the_default_nlp_solves_the_nodes(monkeypatch):
     """``solver="bonmin"`` under auto (or method minlp) hands bonmin and its options to
     the MINLP search; the nodes (relaxation, chosen items) take the default NLP back-end."""
-    from optdesign.studies import catalogue_minlp
+    from optdesign.formulations.catalogue import minlp as catalogue_minlp
 
     seen = []
 
@@ -1323,8 +1324,8 @@ def test_a_search_on_two_workers_is_the_search_on_one(bnb_problem):
 def test_a_search_reads_the_proofs_it_is_given(bnb_problem):
     """A front's searches share one memo of infeasible boxes: a search given the proofs
     of an earlier one skips the boxes they cover (no NLP), with the same answer."""
-    from optdesign.formulations.discrete import discrete_variables
-    from optdesign.studies.catalogue_bnb import InfeasibleBoxes
+    from optdesign.formulations.catalogue.bnb import InfeasibleBoxes
+    from optdesign.formulations.catalogue.discrete import discrete_variables
 
     dvars = discrete_variables(bnb_problem)
     memo = InfeasibleBoxes(
@@ -1340,7 +1341,7 @@ def test_a_search_reads_the_proofs_it_is_given(bnb_problem):
 
 def test_a_box_without_an_item_is_infeasible_without_a_solve_and_names_its_solver():
     import optdesign as od
-    from optdesign.studies.catalogue import NodeSolver
+    from optdesign.formulations.catalogue.search import NodeSolver
 
     ns = NodeSolver(od.load(ROOT / "problems" / "fin_actuator.toml"))
     # the catalogue's screws are d0 x lead pairs: it has no 14 mm screw of 2 mm lead
@@ -1354,7 +1355,7 @@ def test_a_node_solver_of_another_back_end_does_not_take_the_files_ipopt_options
     (here CasADi's sqpmethod, which has no ``mu_strategy``) is built without them."""
     import copy
 
-    from optdesign.studies.catalogue import NodeSolver
+    from optdesign.formulations.catalogue.search import NodeSolver
 
     data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
     data = copy.deepcopy(data)
@@ -1369,7 +1370,7 @@ def test_a_node_solver_leaves_its_free_rows_unbounded():
     requirement's rows dropped (``free_rows``): both their bounds go."""
     import copy
 
-    from optdesign.studies.catalogue import NodeSolver
+    from optdesign.formulations.catalogue.search import NodeSolver
 
     data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
     data = copy.deepcopy(data)
@@ -1381,7 +1382,7 @@ def test_a_node_solver_leaves_its_free_rows_unbounded():
     freed = NodeSolver(problem, starts=1, free_rows=tuple(rows)).solve(items)
     assert freed.success
     # its design meets every requirement but the dropped one, which it violates
-    from optdesign.studies.verify import verify_design
+    from optdesign.formulations.verify import verify_design
 
     x = np.array([freed.design[v.name] for v in problem.free])
     ok, violated, _ = verify_design(problem, x)
@@ -1392,7 +1393,7 @@ def test_a_node_multistart_stops_once_agree_starts_agree(bnb_problem):
     """As the problem's own multistart (``[solver] agree``, 3 by default): a node's
     starts stop once that many agree on the best value; the answer is the same as with
     every start (``agree=0``), with fewer NLP solves."""
-    from optdesign.studies import catalogue
+    from optdesign.formulations.catalogue import search as catalogue
 
     nodes: list = []
     solve = catalogue.NodeSolver.solve
@@ -1424,7 +1425,7 @@ def test_a_search_that_finds_no_combination_says_whether_the_relaxation_was_feas
 ):
     """No catalogue design from the search: "failed" (more starts may find one) when the
     continuous relaxation has a feasible design, "infeasible" only when it has none."""
-    from optdesign.studies import catalogue
+    from optdesign.formulations.catalogue import search as catalogue
 
     stats = {"nodes": 1, "pruned": 0, "infeasible": 0, "leaves": 0, "seeded": 0}
     monkeypatch.setattr(catalogue, "branch_and_bound", lambda *a, **k: (None, stats))
@@ -1453,8 +1454,8 @@ def test_a_failed_relaxation_is_said_so_beside_the_items_found(monkeypatch):
     import copy
     import math
 
+    from optdesign.formulations.catalogue import search as catalogue
     from optdesign.solvers.result import Result
-    from optdesign.studies import catalogue
 
     data = tomllib.loads((ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text())
     data = copy.deepcopy(data)
@@ -1510,7 +1511,7 @@ def _strongest_nuts() -> dict[tuple[float, float], dict[str, float]]:
 
 # --- branch and bound: what may be pruned --------------------------------------------------
 def test_prune_tolerance_is_relative_one_in_a_million():
-    from optdesign.studies.catalogue import PRUNE_TOL, cannot_improve
+    from optdesign.formulations.catalogue.search import PRUNE_TOL, cannot_improve
 
     assert PRUNE_TOL == pytest.approx(1e-6)
     incumbent = 2.0

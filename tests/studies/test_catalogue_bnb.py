@@ -18,14 +18,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.studies.catalogue import enumerate_catalogue
-from optdesign.studies.catalogue_bnb import (
+from optdesign.formulations.catalogue.bnb import (
     box_cannot_win,
     branch_and_bound_warm,
     combination_key,
     wins,
 )
+from optdesign.formulations.catalogue.search import enumerate_catalogue
+from optdesign.solvers.result import MultistartInfo, Result
 
 A_ITEMS = (1.0, 2.0, 3.0)
 B_ITEMS = (1.0, 2.0, 3.0, 4.0)
@@ -175,7 +175,7 @@ class TrapNodes(TiedNodes):
 
 
 def test_first_feasible_searches_the_rest_of_a_box_whose_relaxation_sat_on_items():
-    from optdesign.studies.catalogue_bnb import first_feasible
+    from optdesign.formulations.catalogue.bnb import first_feasible
 
     ns = TrapNodes()
     found = first_feasible(ns)
@@ -318,7 +318,7 @@ def test_a_value_only_search_keeps_a_strictly_better_candidate_not_a_tie():
 
 
 def test_pseudo_costs_branch_on_what_moved_the_bounds_once_each_variable_has_a_history():
-    from optdesign.studies.catalogue_bnb import PseudoCosts
+    from optdesign.formulations.catalogue.bnb import PseudoCosts
 
     def _result(value, design=None, status="optimal"):
         return Result(status=status, objective=value, design=design or {}, formulation="nlp")
@@ -364,7 +364,7 @@ def test_a_node_kept_on_a_one_start_bound_and_found_infeasible_is_counted():
 
 def test_a_tie_in_distance_from_the_items_branches_on_the_first_declared_variable():
 
-    from optdesign.studies.catalogue_bnb import on_items
+    from optdesign.formulations.catalogue.bnb import on_items
 
     a = SimpleNamespace(name="a", values=(1.0, 2.0))
     b = SimpleNamespace(name="b", values=(10.0, 20.0))

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.formulations.catalogue.search import NodeSolver, _fixed
+from optdesign.formulations.catalogue.sensitivities import fixed_item_difference, neighbour_items
 from optdesign.reports.display_units import objective_shown
 from optdesign.reports.html_page import to_json
 from optdesign.reports.result_json import result_document
-from optdesign.studies.catalogue import NodeSolver, _fixed
-from optdesign.studies.catalogue_sensitivity import fixed_item_difference, neighbour_items
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 FILE = PROBLEMS / "cs_min_backlash_catalogue.toml"

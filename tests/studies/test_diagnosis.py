@@ -528,7 +528,7 @@ def test_a_model_undefined_at_the_midpoint_prints_no_warning():
     RuntimeWarning on stderr (the solve then reports the requirements it violates)."""
     import warnings
 
-    from optdesign.formulations.nlp import build_nlp, typical
+    from optdesign.programs.nlp import build_nlp, typical
 
     data = tomllib.loads(_text(CS, ('hinge_moment = "500 N*m"', 'hinge_moment = "1e12 N*m"')))
     problem = od.load(data)
@@ -566,7 +566,7 @@ def test_a_solution_stays_within_its_bounds():
     design came back 1e4 mm below its lower bound (a negative length); the design read
     from the solution is held within the declared bounds. (The arm: a pin diameter that
     large is refused, outside the pin model's range, docs/validity.md.)"""
-    from optdesign.studies.nlp_solve import formulation_for
+    from optdesign.formulations.nlp.solve import formulation_for
 
     data = tomllib.loads(
         _text(

@@ -12,8 +12,8 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError, ProblemError
-from optdesign.studies import formulation_registry as registry
-from optdesign.studies.formulation_registry import choose_formulation
+from optdesign.formulations import registry
+from optdesign.formulations.registry import choose_formulation
 
 ROOT = Path(__file__).resolve().parents[2]
 FORK = ROOT / "problems" / "fork_min_backlash.toml"

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from optdesign.errors import ProblemError
+from optdesign.formulations.catalogue.search import solve_catalogue
+from optdesign.formulations.reference import attach_reference, reference_design
 from optdesign.problem import load_problem, problem_from_dict
-from optdesign.studies.catalogue import solve_catalogue
-from optdesign.studies.reference import attach_reference, reference_design
 
 ROOT = Path(__file__).resolve().parents[2]
 REDESIGN = ROOT / "problems" / "duan2017_redesign.toml"

@@ -1,4 +1,4 @@
-"""optdesign/studies/relaxation.py as a whole: which requirements are diagnosed and in
+"""optdesign/formulations/nlp/relaxation.py as a whole: which requirements are diagnosed and in
 which order, the relaxation of each checked by solving the problem again with the
 requirement moved to it (feasible there, infeasible a little short of it), the cap on
 requirements and on bisection steps, and the helpers by hand."""
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.studies.relaxation import MARGIN, _need, _record, _relaxed, relaxations
+from optdesign.formulations.nlp.relaxation import MARGIN, _need, _record, _relaxed, relaxations
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 
@@ -155,7 +155,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_relaxation_need_is_the_worst_point_of_the_row():
     from types import SimpleNamespace
 
-    from optdesign.studies.relaxation import _need
+    from optdesign.formulations.nlp.relaxation import _need
 
     g = np.array([3.0, 7.5, 5.0, 1.0])
     upper = SimpleNamespace(upper=4.0, lower=None)
@@ -169,8 +169,8 @@ def test_relaxation_need_is_the_worst_point_of_the_row():
 def test_a_relaxation_site_starts_from_the_design_clipped_into_its_box_only():
     """At a site (catalogue items held in a sub-box) the solves start from the given
     design with the held variables clipped into the box and the others unchanged."""
-    from optdesign.formulations.nlp import build_nlp
-    from optdesign.studies.relaxation import Site, _Prepared
+    from optdesign.formulations.nlp.relaxation import Site, _Prepared
+    from optdesign.programs.nlp import build_nlp
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     nlp = build_nlp(problem)

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.formulations.robust import draw_samples
+from optdesign.formulations.robust.program import draw_samples
+from optdesign.formulations.robust.solve import solve_robust
 from optdesign.problem.parameters import limit_value, perturbed
 from optdesign.reports.costs_text import cost_text
 from optdesign.reports.result_json import result_document
-from optdesign.studies.robust import solve_robust
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 FILE = PROBLEMS / "cs_min_backlash_robust.toml"

@@ -8,11 +8,11 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.formulations.nlp.sensitivities import finite_difference, nlp_sensitivities
 from optdesign.problem.parameters import perturbed, requirement_paths
 from optdesign.reports.costs_text import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.solvers.result import Sensitivity
-from optdesign.studies.sensitivity import finite_difference, nlp_sensitivities
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 
@@ -104,7 +104,7 @@ def test_gp_result_takes_the_exact_nlps_sensitivities(fork):
 
 
 def test_no_multipliers_no_sensitivities(fork):
-    from optdesign.studies.nlp_solve import solve_nlp
+    from optdesign.formulations.nlp.solve import solve_nlp
 
     problem, _ = fork
     result = solve_nlp(problem, starts=1)
@@ -138,7 +138,7 @@ def test_the_gps_own_duals_agree(fork):
     # the NLP's is exact: 0.5 % apart on the pin's pressure, 2e-5 on the travel)
     import numpy as np
 
-    from optdesign.formulations.gp import build_gp, to_cvxpy
+    from optdesign.programs.gp import build_gp, to_cvxpy
 
     problem, result = fork
     prob, _, _, cons = to_cvxpy(build_gp(problem, "backlash"))
@@ -195,7 +195,7 @@ def test_a_negative_bounds_cost_moves_it_the_way_its_line_says(tmp_path):
     """The pivoting screw's trunnion sits behind the horn (a_T < 0): with its upper
     bound at -150 mm the smallest linkage sits on it. The line says 1 % lowers the bound
     to -151.5 mm and narrows the bounds; the re-solve there costs what the line says."""
-    from optdesign.studies.nlp_solve import solve_nlp
+    from optdesign.formulations.nlp.solve import solve_nlp
 
     src = (PROBLEMS / "pivot_min_backlash.toml").read_text()
     old = 'a_T = { lower = "-300 mm", upper = "-40 mm" }'
@@ -227,7 +227,7 @@ def test_a_limit_that_moves_no_model_function_costs_what_a_full_evaluation_says(
     """The sensitivities reuse the design's evaluation for a requirement that only sets a
     limit (a band's ends, a maximum), and evaluate the model again for one the physics
     reads (the hinge moment, the stroke): both give the same derivatives."""
-    from optdesign.studies import sensitivity as S
+    from optdesign.formulations.nlp import sensitivities as S
 
     problem = od.load(PROBLEMS / "cs_min_backlash.toml")
     result = od.solve(problem, ranges=False, sensitivities=False)

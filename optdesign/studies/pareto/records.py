@@ -17,11 +17,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from optdesign.formulations.nlp.solve import finish
+from optdesign.formulations.verify import verify_design
 from optdesign.problem.design_problem import DesignProblem, relative_violation
 from optdesign.solvers.result import Result, clean_json
 from optdesign.solvers.solved_point import SolvedPoint, in_key_order, shared_fields
-from optdesign.studies.nlp_solve import finish
-from optdesign.studies.verify import verify_design
 from optdesign.tolerances import FEASIBILITY_TOL
 
 

@@ -12,14 +12,15 @@ import time
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.gp import GPData, build_gp
+from optdesign.formulations.gp.details import ExactNLP, GPDetails, GPRows
+from optdesign.formulations.nlp.solve import finish, solve_nlp
+from optdesign.formulations.reference import attach_reference, reference_design
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
-from optdesign.solvers.details import ExactNLP, GPDetails, GPRows, GPTiming
+from optdesign.programs.gp import GPData, build_gp
+from optdesign.solvers.details import GPTiming
 from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
 from optdesign.solvers.result import Globality, Result
-from optdesign.studies.nlp_solve import finish, solve_nlp
-from optdesign.studies.reference import attach_reference, reference_design
 
 
 def require_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
@@ -79,7 +80,7 @@ def solve_gp_problem(
         )
         return finish(problem, result, objective)
     result = backend.solve()
-    details = result.details.gp = result.details.gp or GPDetails()
+    details = result.details["gp"] = GPDetails.of(result.details.get("gp"))
     details.timing = details.timing or GPTiming()
     details.timing.trace_s = t_trace
     details.rows = GPRows(len(gp.objective_rows), len(gp.rows), gp.n_rows_before_pruning)
@@ -114,7 +115,7 @@ def solve_gp_problem(
         )
         details.gap_gp_nlp_rel = gap
         if nlp.success and solver_hints(nlp.solver).multipliers:
-            from optdesign.studies.sensitivity import nlp_sensitivities
+            from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
 
             result.sensitivities = nlp_sensitivities(problem, nlp)
             if result.sensitivities:

@@ -1,9 +1,9 @@
 """Robust design study: nominal optimum vs robust (SAA) optimum, judged by an independent
 Monte Carlo.
 
-- :func:`solve_robust`: the robust NLP of :mod:`optdesign.formulations.robust` solved by
+- :func:`solve_robust`: the robust NLP of :mod:`optdesign.formulations.robust.program` solved by
   Ipopt from the nominal optimum and scrambled-Sobol starts; the best point is checked on
-  the NumPy path (nominal requirements, :func:`optdesign.studies.nlp_solve.finish`) and its
+  the NumPy path (nominal requirements, :func:`optdesign.formulations.nlp.solve.finish`) and its
   sample-average statistic recomputed there on the same fixed samples.
 - :func:`monte_carlo`: the objective of a design under freshly drawn scatter (its own seed,
   many samples), vectorised over the population of perturbed designs on the NumPy path of
@@ -24,7 +24,15 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.formulations.robust import (
+from optdesign.formulations.nlp.solve import (
+    continuous_only,
+    finish,
+    solve_nlp,
+    solver_options,
+    start_points,
+)
+from optdesign.formulations.robust.details import NominalOptimum, RobustDetails
+from optdesign.formulations.robust.program import (
     Samples,
     build_robust_nlp,
     draw_samples,
@@ -37,17 +45,9 @@ from optdesign.problem.design_problem import DesignProblem, relative_violation, 
 from optdesign.problem.request import SolveRequest
 from optdesign.reports.tables import format_table
 from optdesign.runtime.inherited_map import map_inherited
-from optdesign.solvers.details import NominalOptimum, RobustDetails
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints
 from optdesign.solvers.result import Globality, Result
-from optdesign.studies.nlp_solve import (
-    continuous_only,
-    finish,
-    solve_nlp,
-    solver_options,
-    start_points,
-)
 from optdesign.tolerances import FEASIBILITY_TOL
 
 #: Default independent Monte Carlo: sample count and seed (different from the SAA seed).
@@ -206,7 +206,7 @@ def solve_robust(
         Registered NLP back-end (None: the registry's default) and its options.
     sensitivities
         Also what each requirement costs at the optimum (``result.sensitivities``, from
-        the multipliers of the sample-average NLP: :mod:`optdesign.studies.robust_sensitivity`).
+        the multipliers of the sample-average NLP: :mod:`optdesign.formulations.robust.sensitivities`).
 
     Returns
     -------
@@ -233,7 +233,7 @@ def solve_robust(
     # Per-sample rows are the formulation's own; report the nominal requirements only.
     result.active = [r for r in result.active if "[s" not in r.name and "cvar" not in r.name]
     result = finish(problem, result, objective)
-    details = result.details.robust = RobustDetails(
+    details = result.details["robust"] = RobustDetails(
         risk_label=label,
         saa_samples=samples.n,
         saa_seed=samples.seed,
@@ -258,7 +258,7 @@ def _attach_sensitivities(
     problem: DesignProblem, result: Result, nlp, samples: Samples, objective: str
 ) -> None:
     """What each requirement costs at the robust optimum (a report: never loses it)."""
-    from optdesign.studies.robust_sensitivity import robust_sensitivities
+    from optdesign.formulations.robust.sensitivities import robust_sensitivities
 
     kind = sampled_objective(problem, problem.design_dict(problem.midpoint()), objective)
     if kind[0].kind not in ("max", "spread"):

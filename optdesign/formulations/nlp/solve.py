@@ -5,7 +5,7 @@ best point on the NumPy path (:func:`finish`) and the ranges of the optimal set.
 Shared by every formulation and study that solves an NLP (the ``nlp`` formulation, whose
 predicate and solve are :func:`nlp_applies` and :func:`solve_nlp_formulation`, the
 catalogue's nodes, the robust and GP formulations' exact NLP, the diagnosis, the fronts);
-the formulation registry (:mod:`optdesign.studies.formulation_registry`) and
+the formulation registry (:mod:`optdesign.formulations.registry`) and
 :func:`~optdesign.studies.solve.solve` sit above it.
 """
 
@@ -20,9 +20,11 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import NLP, VAR, build_nlp
+from optdesign.formulations.reference import attach_reference
+from optdesign.formulations.verify import nan_notes, verify_design
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
+from optdesign.programs.nlp import NLP, VAR, build_nlp
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.search.global_phase import default_max_starts, global_search, search_globality
 from optdesign.search.starts import TiltedStarts, problem_evaluator
@@ -35,8 +37,6 @@ from optdesign.solvers.result import (
     TerminationCondition,
 )
 from optdesign.solvers.solved_point import SOLVED_STATUSES
-from optdesign.studies.reference import attach_reference
-from optdesign.studies.verify import nan_notes, verify_design
 from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 
 # --- formulation and solver caches ------------------------------------------------------

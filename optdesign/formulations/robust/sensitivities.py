@@ -1,7 +1,7 @@
 """What a robust optimum depends on: the sensitivities of the sample-average NLP
-(:mod:`optdesign.formulations.robust`) to every requirement and active bound.
+(:mod:`optdesign.formulations.robust.program`) to every requirement and active bound.
 
-The envelope theorem of :mod:`optdesign.studies.sensitivity` applies to the robust NLP as
+The envelope theorem of :mod:`optdesign.formulations.nlp.sensitivities` applies to the robust NLP as
 to any: ``dv*/dp = sum_i mu_i (dg_i/dp - db_i/dp)`` over its rows, with the multipliers in
 the problem's units (``mu_i = lam_g_i T / s_i``). The rows are of three kinds:
 
@@ -9,7 +9,7 @@ the problem's units (``mu_i = lam_g_i T / s_i``). The rows are of three kinds:
 - per sample ``s`` the epigraph of its objective (``t_s >= theta_s(phi_k)``, or the
   ``lo_s``/``hi_s`` band of a spread) and, with ``constrain_samples``, the requirements
   again: their ``p``-dependence is the sample's model, evaluated on the NumPy path for
-  all samples at once (the same :func:`~optdesign.formulations.robust.sampled_objective`
+  all samples at once (the same :func:`~optdesign.formulations.robust.program.sampled_objective`
   as the solver's); a requirement's multipliers are so summed over its samples;
 - the CVaR excess rows ``u_s >= v_s - VaR``, which hold no parameter.
 
@@ -26,7 +26,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from optdesign.formulations.robust import Samples, perturb, sampled_objective
+from optdesign.formulations.robust.program import Samples, perturb, sampled_objective
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.result import Result, Sensitivity
 
@@ -37,7 +37,7 @@ class _SampleRows:
     """The parameter-dependent part of the robust NLP's rows at a fixed design."""
 
     def __init__(self, nlp, mu: np.ndarray, samples: Samples, objective: str):
-        from optdesign.studies.sensitivity import _RowModel
+        from optdesign.formulations.nlp.sensitivities import _RowModel
 
         self.objective = objective
         self.samples = samples
@@ -92,9 +92,9 @@ def robust_sensitivities(
 ) -> list[Sensitivity]:
     """The sensitivities of a robust optimum (``result`` of the robust NLP ``nlp`` of
     ``objective`` over ``samples``, with the solver's multipliers in ``result.raw``), ranked as
-    :func:`~optdesign.studies.sensitivity.nlp_sensitivities` ranks them; empty without
+    :func:`~optdesign.formulations.nlp.sensitivities.nlp_sensitivities` ranks them; empty without
     multipliers or for a one-value objective."""
-    from optdesign.studies.sensitivity import from_multipliers
+    from optdesign.formulations.nlp.sensitivities import from_multipliers
 
     raw = result.raw
     if not result.success or "lam_g" not in raw or "lam_x" not in raw:

@@ -1,12 +1,12 @@
 """Catalogue optimum by a MINLP back-end on the one-hot encoding.
 
 The problem's NLP with its catalogue variables encoded as one-hot binaries over the
-items (:mod:`optdesign.formulations.catalogue_minlp`) goes to a back-end that declares a
+items (:mod:`optdesign.formulations.catalogue.minlp_program`) goes to a back-end that declares a
 MINLP solve (:attr:`~optdesign.solvers.registry.SolverHints.minlp`; built in: Bonmin
 through CasADi, with its algorithms ``B-BB``: NLP branch and bound, ``B-OA``: outer
 approximation, ``B-Hyb``: the hybrid - the last two exact only for convex problems, and
 the catalogue problems are not). The back-end picks the items; the design reported is
-the node NLP of those items (:class:`optdesign.studies.catalogue.NodeSolver`, started
+the node NLP of those items (:class:`optdesign.formulations.catalogue.search.NodeSolver`, started
 from the back-end's point), so that the result carries the same evidence as the default
 search's.
 """
@@ -18,7 +18,7 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
-from optdesign.solvers.details import MINLPDetails
+from optdesign.formulations.catalogue.details import MINLPDetails
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Result
 
@@ -36,8 +36,8 @@ def solve_minlp(
         point or its items' NLP fails), and what the back-end did: algorithm, return
         status, its objective (the NLP's scaled one), items, seconds.
     """
-    from optdesign.formulations.catalogue_minlp import build_catalogue_minlp
-    from optdesign.studies.catalogue_bnb import fixed_box
+    from optdesign.formulations.catalogue.bnb import fixed_box
+    from optdesign.formulations.catalogue.minlp_program import build_catalogue_minlp
 
     module, _, attr = str(solver_hints(solver).minlp).partition(":")
     solve = getattr(importlib.import_module(module), attr)

@@ -9,7 +9,7 @@ problem (a requirement's limit, a load, the stroke):
 
 with ``b_i`` the bound of row ``i`` that binds (upper when ``mu_i > 0``, lower when
 ``mu_i < 0``: CasADi's sign convention) and ``mu_i`` the multiplier of the row *in the
-problem's own units*. The NLP (:mod:`optdesign.formulations.nlp`) divides the objective
+problem's own units*. The NLP (:mod:`optdesign.programs.nlp`) divides the objective
 by its typical value ``T`` and each row by its scale ``s_i``; Ipopt's ``lam_g`` belongs to
 that scaled problem, so ``mu_i = lam_g_i * T / s_i`` (the scaling changes neither the
 feasible set nor the optimum, so the multipliers of the unscaled problem are these).
@@ -44,6 +44,7 @@ from optdesign.problem.parameters import (
     perturbed,
     requirement_paths,
 )
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.result import Result, Sensitivity
 
 #: Relative step of the central differences of the model (a smooth function evaluated,
@@ -60,7 +61,7 @@ def nlp_sensitivities(problem: DesignProblem, result: Result, nlp=None) -> list[
     multipliers in ``result.raw``), ranked by the size of their log-sensitivity (what
     costs most first); empty when the result carries no multipliers. ``nlp``: the
     formulation that solved it (default: the problem's own)."""
-    from optdesign.studies.nlp_solve import _objective_set, formulation_for
+    from optdesign.formulations.nlp.solve import _objective_set, formulation_for
 
     raw = result.raw
     if not result.success or "lam_g" not in raw or "lam_x" not in raw:
@@ -323,7 +324,7 @@ def finite_difference(
     by ``rel`` (relative) to both sides, each re-solved from the optimum (one start; four,
     the optimum first, where that one fails), central difference; returns (derivative in internal units, the limit's internal
     value). The check of :func:`nlp_sensitivities` (tests, benchmarks)."""
-    from optdesign.studies.nlp_solve import solve_nlp
+    from optdesign.formulations.nlp.solve import solve_nlp
 
     p = limit_value(problem, name)
     h = rel * max(abs(p), 1e-9)
@@ -338,3 +339,41 @@ def finite_difference(
             raise RuntimeError(f"{name} = {q:g}: the re-solve ended {r.status}")
         values.append(r.objective)
     return (values[0] - values[1]) / (2 * h), p
+
+
+def has_multipliers(result: Result, requested: str | None) -> bool:
+    """Whether ``result`` carries multipliers a sensitivity can read. ``result.solver``
+    is the label the run reports (``scipy-slsqp-exact`` for the ``slsqp`` back-end), not
+    always a registered name: the requested back-end answers then."""
+    from optdesign.errors import InputError
+    from optdesign.solvers.registry import solver_hints
+
+    if "lam_g" not in result.raw:
+        return False
+    try:
+        return solver_hints(result.solver).multipliers
+    except InputError:
+        return solver_hints(requested).multipliers
+
+
+def nlp_evidence(problem: DesignProblem, result: Result, request: SolveRequest) -> None:
+    """What an NLP optimum's neighbourhood says, as ``request`` asks: what each
+    requirement costs (from the back-end's multipliers) and the range of each variable
+    over the near-optimal set. Only for a continuous NLP's result (its own rows and
+    multipliers); a failure is a note, never the loss of the optimum."""
+    from optdesign.formulations.nlp.solve import optimal_ranges
+
+    solver, options = request.solver, request.options
+    continuous = result.formulation.startswith("nlp") and not any(v.discrete for v in problem.free)
+    if not (result.success and continuous):
+        return
+    if request.sensitivities and has_multipliers(result, solver):
+        try:
+            result.sensitivities = nlp_sensitivities(problem, result)
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.notes.append(f"sensitivities not computed: {exc}")
+    if request.ranges and result.design and "z" in result.raw:
+        try:
+            result.ranges = optimal_ranges(problem, result, solver=solver, options=options)
+        except Exception as exc:  # a report, not the result: never lose the optimum
+            result.notes.append(f"ranges of the optimal set not computed: {exc}")

@@ -31,8 +31,8 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
-from optdesign.formulations.signomial import NotGP, Signomial
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.programs.signomial import NotGP, Signomial
 
 __all__ = ["DGPCheck", "GPData", "GPRow", "NotGP", "Signomial", "build_gp", "is_gp"]
 

@@ -1,6 +1,6 @@
 """Branch and bound over catalogue items that reuses what it knows.
 
-The search of :mod:`optdesign.studies.catalogue` (best first, over NLP relaxations of
+The search of :mod:`optdesign.formulations.catalogue.search` (best first, over NLP relaxations of
 sub-boxes of the catalogue variables) with three savings:
 
 - **warm nodes**: a child box is solved from its parent's optimum alone; the rest of the
@@ -58,7 +58,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.formulations.discrete import (
+from optdesign.formulations.catalogue.discrete import (
     ON_ITEM_TOL,
     branch,
     discrete_variables,
@@ -83,7 +83,7 @@ def cannot_improve(bound: float, incumbent: float) -> bool:
 
 def trusted(result: Result, starts: int) -> bool:
     """Whether a node's value may serve its children as a floor (see
-    :meth:`~optdesign.studies.catalogue.NodeSolver.solve`): it comes from the node
+    :meth:`~optdesign.formulations.catalogue.search.NodeSolver.solve`): it comes from the node
     solver's full multistart of ``starts``, or it was settled at its own trusted floor."""
     ms = result.multistart
     return ms is not None and (ms.n_starts >= starts or ms.stopped_early)
@@ -513,7 +513,7 @@ def first_feasible(ns: Any) -> Result | None:
     """A feasible catalogue design of the node solver's problem, or None: branch and bound
     from the continuous relaxation, depth first, stopping at the first feasible leaf (a
     design, not the optimum; e.g. which items allow a requirement to be dropped).
-    ``ns``: a :class:`~optdesign.studies.catalogue.NodeSolver`."""
+    ``ns``: a :class:`~optdesign.formulations.catalogue.search.NodeSolver`."""
     dvars = discrete_variables(ns.problem)
     root = ns.solve({})
     stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []

@@ -1,12 +1,9 @@
 """The formulations a solve can take, registered by name, and the choice among them.
 
-A formulation is any object with a ``name``, a ``description`` and two methods
-(:class:`Formulation`):
-
-- ``applies(problem, request)``: ``True`` when it can solve ``problem`` as ``request``
-  asks (its objective included), else the reason it cannot (a string; ``False`` for no
-  reason given);
-- ``solve(problem, request) -> Result``.
+A formulation (:class:`~optdesign.formulations.protocol.Formulation`) says whether it
+applies to a problem and solves it, and brings its own diagnosis, sensitivities and typed
+record; each built-in one is a package of :mod:`optdesign.formulations` (``nlp``, ``gp``,
+``catalogue``, ``robust``) registered below in one line.
 
 ``formulation="auto"`` takes the first registered formulation that applies, in this
 order: catalogue (a variable takes catalogue values: never solved as continuous), robust
@@ -17,67 +14,25 @@ any work, with its reason (``--formulation gp: problem 'x' is not a geometric pr
 ...``).
 
 Adding one is one object and one :func:`register_formulation` line (``od.
-register_formulation``). The built-in ones are :class:`LazyFormulation`\\ s: their
-functions are import paths, loaded on first call, so that listing the formulations (the
-argument checks do) imports no solver library.
+register_formulation``). The built-in ones import their solvers on first call, so that
+listing the formulations (the argument checks do) imports no solver library.
 """
 
 from __future__ import annotations
 
-import importlib
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING
 
 from optdesign.errors import InputError, ProblemError
+from optdesign.formulations.catalogue import CatalogueFormulation
+from optdesign.formulations.gp import GPFormulation
+from optdesign.formulations.nlp import NLPFormulation
+from optdesign.formulations.protocol import Formulation as Formulation
+from optdesign.formulations.protocol import LazyFormulation as LazyFormulation
+from optdesign.formulations.robust import RobustFormulation
 from optdesign.problem.request import SolveRequest
 
 if TYPE_CHECKING:
     from optdesign.problem.design_problem import DesignProblem
-    from optdesign.solvers.result import Result
-
-
-@runtime_checkable
-class Formulation(Protocol):
-    """A way to solve a problem (see the module's docstring).
-
-    ``time_limit`` (optional, default False): the solve stops at ``request.time_limit``;
-    otherwise a result solved under a time limit says in a note that it was not
-    applied."""
-
-    name: str
-    description: str
-
-    def applies(self, problem: DesignProblem, request: SolveRequest) -> bool | str: ...
-
-    def solve(self, problem: DesignProblem, request: SolveRequest) -> Result: ...
-
-
-def _load(ref: str | Callable[..., Any]) -> Callable[..., Any]:
-    if callable(ref):
-        return ref
-    module, _, attr = ref.partition(":")
-    return getattr(importlib.import_module(module), attr)
-
-
-@dataclass(frozen=True)
-class LazyFormulation:
-    """A :class:`Formulation` whose two functions are ``"module:function"`` paths (or
-    callables), imported on first call."""
-
-    name: str
-    solver: str | Callable[[DesignProblem, SolveRequest], Result]
-    predicate: str | Callable[[DesignProblem, SolveRequest], bool | str]
-    description: str = ""
-    time_limit: bool = False
-
-    def applies(self, problem: DesignProblem, request: SolveRequest) -> bool | str:
-        """True, or the reason the formulation cannot solve ``problem`` as asked."""
-        return _load(self.predicate)(problem, request)
-
-    def solve(self, problem: DesignProblem, request: SolveRequest) -> Result:
-        """The formulation's result for ``problem`` as ``request`` asks."""
-        return _load(self.solver)(problem, request)
 
 
 #: name -> formulation, in the order ``auto`` tries them (nlp last).
@@ -153,31 +108,7 @@ def choose_formulation(
     return pick_formulation(problem, request).name
 
 
-for _formulation in (
-    LazyFormulation(
-        "catalogue",
-        "optdesign.studies.catalogue:solve_catalogue_formulation",
-        "optdesign.studies.catalogue:catalogue_applies",
-        "branch and bound (or enumeration) over the catalogue values, NLP at each node",
-    ),
-    LazyFormulation(
-        "robust",
-        "optdesign.studies.robust:solve_robust_formulation",
-        "optdesign.studies.robust:robust_applies",
-        "risk measure (CVaR or mean + k std) of the objective under the tolerances",
-    ),
-    LazyFormulation(
-        "gp",
-        "optdesign.studies.gp:solve_gp_formulation",
-        "optdesign.studies.gp:gp_applies",
-        "geometric program (first-order Hertz) with a dual certificate, exact NLP beside it",
-    ),
-    LazyFormulation(
-        "nlp",
-        "optdesign.studies.nlp_solve:solve_nlp_formulation",
-        "optdesign.studies.nlp_solve:nlp_applies",
-        "NLP (epigraph form) with Sobol multistart",
-        time_limit=True,
-    ),
-):
-    register_formulation(_formulation)
+register_formulation(CatalogueFormulation())
+register_formulation(RobustFormulation())
+register_formulation(GPFormulation())
+register_formulation(NLPFormulation())

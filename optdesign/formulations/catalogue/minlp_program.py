@@ -11,9 +11,9 @@ with
     theta_k = sum_j b_j theta_k(j)  (each item datum k of G: load rating, fit ratio, ...),
 
 so that at any integer point the NLP is exactly the NLP of the chosen items (the node
-NLP of :mod:`optdesign.studies.catalogue` with every catalogue variable fixed). The
+NLP of :mod:`optdesign.formulations.catalogue.search` with every catalogue variable fixed). The
 continuous relaxation (0 <= b_j <= 1) is the MINLP solver's own; the NLP's rows,
-scaling and epsilon rows are the problem's NLP (:func:`optdesign.formulations.nlp.build_nlp`)
+scaling and epsilon rows are the problem's NLP (:func:`optdesign.programs.nlp.build_nlp`)
 with its parameters replaced by the expressions above. No SOS1 constraint is used.
 """
 
@@ -28,9 +28,9 @@ import casadi as ca
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.discrete import discrete_variables
-from optdesign.formulations.nlp import NLP, Target
+from optdesign.formulations.catalogue.discrete import discrete_variables
 from optdesign.problem.drive import box_has_item
+from optdesign.programs.nlp import NLP, Target
 
 #: Above this many item combinations the grouping of the catalogue variables is not
 #: computed from the full table (the one-hot encoding would be too large anyway).

@@ -2,8 +2,8 @@
 chosen items, and the step of each catalogue variable to its neighbouring items.
 
 The catalogue optimum is the NLP solved with every catalogue variable fixed at its item
-(:mod:`optdesign.studies.catalogue`); its multipliers give d(objective)/d(limit) exactly as
-for an NLP optimum (:func:`optdesign.studies.sensitivity.nlp_sensitivities`), with the
+(:mod:`optdesign.formulations.catalogue.search`); its multipliers give d(objective)/d(limit) exactly as
+for an NLP optimum (:func:`optdesign.formulations.nlp.sensitivities.nlp_sensitivities`), with the
 items held (a catalogue variable's fixed value is not a bound the file states). A
 catalogue variable has no derivative: its answer is the step to the next item up and
 down, the other items kept and the continuous part re-solved from the optimum (one warm
@@ -17,10 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.formulations.discrete import discrete_variables
+from optdesign.formulations.catalogue.bnb import InfeasibleBoxes
+from optdesign.formulations.catalogue.discrete import discrete_variables
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.request import SolveRequest
 from optdesign.solvers.result import ItemStep, Result, Sensitivity
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes
 
 
 def neighbour_items(values: tuple[float, ...] | list[float], item: float) -> list[float]:
@@ -48,10 +49,10 @@ def catalogue_sensitivities(
         The NLP back-end and options the optimum was solved with (the re-solves of the
         neighbouring items use the same, warm-started from the optimum).
     """
+    from optdesign.formulations.catalogue.search import NodeSolver, _fixed
+    from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
+    from optdesign.formulations.nlp.solve import finish
     from optdesign.reports.display_units import objective_shown, variable_shown
-    from optdesign.studies.catalogue import NodeSolver, _fixed
-    from optdesign.studies.nlp_solve import finish
-    from optdesign.studies.sensitivity import nlp_sensitivities
 
     if not result.success or not result.design:
         return [], []
@@ -99,8 +100,8 @@ def fixed_item_difference(
     fixed: the limit ``name`` moved by ``rel`` to both sides, each side's continuous
     part re-solved from the optimum; (derivative in internal units, the limit's internal
     value). The check of :func:`catalogue_sensitivities` (tests)."""
+    from optdesign.formulations.catalogue.search import NodeSolver, _fixed
     from optdesign.problem.parameters import limit_value, perturbed
-    from optdesign.studies.catalogue import NodeSolver, _fixed
 
     items = {v.name: float(result.design[v.name]) for v in discrete_variables(problem)}
     p = limit_value(problem, name)
@@ -114,3 +115,27 @@ def fixed_item_difference(
             raise RuntimeError(f"{name} = {q:g}: the re-solve ended {r.status}")
         values.append(r.objective)
     return (values[0] - values[1]) / (2 * h), p
+
+
+def catalogue_evidence(problem: DesignProblem, result: Result, request: SolveRequest) -> None:
+    """What a catalogue optimum's neighbourhood says, when ``request`` asks for the
+    sensitivities: the costs of the continuous part at the chosen items and the
+    neighbouring items (a failure is a note, never the loss of the optimum)."""
+    from optdesign.formulations.nlp.sensitivities import has_multipliers
+    from optdesign.solvers.registry import solver_hints
+
+    solver, options = request.solver, request.options
+    catalogue = result.formulation.startswith("catalogue")
+    if not (request.sensitivities and result.success and catalogue):
+        return
+    if not has_multipliers(result, solver):
+        return
+    try:
+        # a MINLP back-end only picked the items: the default NLP back-end solved them
+        # (optdesign.formulations.catalogue.minlp), and re-solves their neighbours
+        minlp = solver_hints(solver).minlp is not None
+        result.sensitivities, result.item_steps = catalogue_sensitivities(
+            problem, result, None if minlp else solver, None if minlp else options
+        )
+    except Exception as exc:  # a report, not the result: never lose the optimum
+        result.notes.append(f"sensitivities not computed: {exc}")

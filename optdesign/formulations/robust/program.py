@@ -24,7 +24,7 @@ nominal design and the robust optimum is the nominal one.
 
 The same sampling and :func:`sampled_objective` serve the NumPy path (vectorised over a
 population of perturbed designs) for the independent Monte Carlo check
-(:mod:`optdesign.studies.robust`).
+(:mod:`optdesign.formulations.robust.solve`).
 """
 
 from __future__ import annotations
@@ -38,10 +38,10 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
 from optdesign.problem.design_problem import DesignProblem, Expressions
 from optdesign.problem.objectives import ObjectiveTerm, unavailable_objective
 from optdesign.problem.spec import Tolerances
+from optdesign.programs.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
 
 #: Variance guard of the mean + k std measure (in scaled units, objective ~1).
 STD_EPS = 1e-12

@@ -3,7 +3,7 @@ in the conflict (violated, or binding, at the best infeasible point), the smalle
 relaxation of that requirement alone (the others kept) that makes the problem feasible.
 
 Each requirement's rows are relaxed by an amount ``t`` in its own unit (through the
-solve's :class:`~optdesign.formulations.nlp.Bounds`, so the formulation and the solver
+solve's :class:`~optdesign.programs.nlp.Bounds`, so the formulation and the solver
 are the ones of the solve). On Ipopt the smallest ``t`` is the minimum of a phase-1
 problem (:class:`~optdesign.solvers.phase_one.PhaseOneSolver`: ``t`` minimised with the
 requirement's rows widened by it and the others held), one solve per start, its point
@@ -22,10 +22,10 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.formulations.nlp.solve import _objective_set, phase_one_for, solver_for
 from optdesign.solvers.base import constraint_reports
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Relaxation
-from optdesign.studies.nlp_solve import _objective_set, phase_one_for, solver_for
 
 __all__ = ["Relaxation", "Site", "relax_together", "relaxations"]
 

@@ -11,8 +11,8 @@ the bound of a node is the best local optimum found, not a proven global one. A 
 whose relaxation is under-estimated (missed global optimum) can be pruned wrongly;
 enumeration has the same dependence on each fixed-item solve. The test compares the two
 on the shipped catalogue problem. The branch and bound itself (warm nodes, first
-incumbents, implied infeasible boxes) is :mod:`optdesign.studies.catalogue_bnb`; Bonmin
-as the other search, :mod:`optdesign.studies.catalogue_minlp`.
+incumbents, implied infeasible boxes) is :mod:`optdesign.formulations.catalogue.bnb`; Bonmin
+as the other search, :mod:`optdesign.formulations.catalogue.minlp`.
 """
 
 from __future__ import annotations
@@ -27,18 +27,25 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.discrete import (
+from optdesign.formulations.catalogue.bnb import PRUNE_TOL as PRUNE_TOL
+from optdesign.formulations.catalogue.bnb import InfeasibleBoxes, trusted_value
+from optdesign.formulations.catalogue.bnb import branch_and_bound_warm as branch_and_bound
+from optdesign.formulations.catalogue.bnb import cannot_improve as cannot_improve
+from optdesign.formulations.catalogue.bnb import fixed_box as _fixed
+from optdesign.formulations.catalogue.details import CatalogueCombination, CatalogueDetails
+from optdesign.formulations.catalogue.discrete import (
     discrete_variables,
     n_combinations,
     nearest_item,
 )
-from optdesign.formulations.nlp import Bounds
+from optdesign.formulations.nlp.solve import _objective_set, finish, solver_for, solver_options
+from optdesign.formulations.reference import attach_reference, reference_design
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
 from optdesign.problem.parameters import without_impossible_items
 from optdesign.problem.request import SolveRequest
+from optdesign.programs.nlp import Bounds
 from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
-from optdesign.solvers.details import CatalogueCombination, CatalogueDetails
 from optdesign.solvers.multistart import (
     best_of,
     improves,
@@ -48,13 +55,6 @@ from optdesign.solvers.multistart import (
 )
 from optdesign.solvers.registry import default_solver, solver_hints, solver_names
 from optdesign.solvers.result import Globality, MultistartInfo, Result
-from optdesign.studies.catalogue_bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.studies.catalogue_bnb import InfeasibleBoxes, trusted_value
-from optdesign.studies.catalogue_bnb import branch_and_bound_warm as branch_and_bound
-from optdesign.studies.catalogue_bnb import cannot_improve as cannot_improve
-from optdesign.studies.catalogue_bnb import fixed_box as _fixed
-from optdesign.studies.nlp_solve import _objective_set, finish, solver_for, solver_options
-from optdesign.studies.reference import attach_reference, reference_design
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: ``method="auto"`` enumerates when the catalogues make at most this many combinations.
@@ -71,7 +71,7 @@ RETRY_STARTS = 4
 class NodeSolver:
     """Solve the problem's NLP on a sub-box of the catalogue variables.
 
-    One solver (:func:`optdesign.studies.nlp_solve.solver_for`) serves every node: a node
+    One solver (:func:`optdesign.formulations.nlp.solve.solver_for`) serves every node: a node
     only passes its own variable bounds. A node's starts are the hint (or the problem's
     start) and the Sobol points of the solver's ``seed``. A node whose starts all fail is
     tried again from :data:`RETRY_STARTS` Sobol points of ``seed + 1`` (points it has not
@@ -191,7 +191,7 @@ class NodeSolver:
         A multistart also ends once :attr:`agree` of its starts agree on the best value
         (``multistart.stopped_early``, its value then trusted as a full multistart's).
         ``floor``: a lower bound on the node's value that the search trusts (its parent's
-        relaxation value, when :func:`~optdesign.studies.catalogue_bnb.trusted`); the box
+        relaxation value, when :func:`~optdesign.formulations.catalogue.bnb.trusted`); the box
         is a sub-box of the parent's, its item data no more favourable, so no start can
         end below it. A start that reaches it (within the tie tolerance) ends the
         multistart: the node's value is settled (``multistart.stopped_early``), whether
@@ -373,7 +373,7 @@ def solve_catalogue(
         :data:`ENUMERATE_MAX` combinations, branch and bound above; ``"minlp"`` when
         ``solver`` is a MINLP back-end). ``"minlp"``: the MINLP back-end (``solver``, or
         the first registered one) picks the items, with ``options`` its own
-        (:mod:`optdesign.studies.catalogue_minlp`); the default NLP back-end solves the
+        (:mod:`optdesign.formulations.catalogue.minlp`); the default NLP back-end solves the
         relaxation and the items' node NLP.
     solver, options
         The NLP back-end of every node and its options (default: the registry's).
@@ -388,12 +388,12 @@ def solve_catalogue(
         one being the search's first incumbent (e.g. a front's neighbouring optima).
     memo
         Boxes proved infeasible by earlier searches of the same problem and node
-        settings (shared by a front's points; see :mod:`optdesign.studies.catalogue_bnb`).
+        settings (shared by a front's points; see :mod:`optdesign.formulations.catalogue.bnb`).
     ties
         Decide a tie between combinations by their items, so that the design reported
         does not depend on the search's path (default). False when only the optimal
         value is wanted (the first stage of a lexicographic solve): the branch and bound
-        then prunes the ties (:func:`~optdesign.studies.catalogue_bnb.branch_and_bound_warm`).
+        then prunes the ties (:func:`~optdesign.formulations.catalogue.bnb.branch_and_bound_warm`).
     workers
         Local processes for each node's starts (:meth:`NodeSolver.on_workers`): the same
         nodes, values and answer as one worker.
@@ -466,7 +466,7 @@ def solve_catalogue(
                 ns, ns.x_of(root), trusted_value(root, ns.starts)
             )
         elif method == "minlp":
-            from optdesign.studies.catalogue_minlp import solve_minlp
+            from optdesign.formulations.catalogue.minlp import solve_minlp
 
             best, info.minlp = solve_minlp(ns, minlp_solver, minlp_options)
         else:
@@ -496,7 +496,7 @@ def solve_catalogue(
                     else "the continuous relaxation has no feasible design"
                 ),
             )
-            result.details.catalogue = info
+            result.details["catalogue"] = info
             if excluded:
                 result.notes.append("excluded before the search: " + "; ".join(excluded))
             return finish(problem, result, objective)
@@ -508,7 +508,7 @@ def solve_catalogue(
         info.items = {v.name: best.design[v.name] for v in dvars}
         if root.success:
             info.gap_to_relaxation_rel = (best.objective - root.objective) / abs(root.objective)
-        best.details.catalogue = info
+        best.details["catalogue"] = info
         best.bound = root.objective if root.success else None
         items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
         bound = (
