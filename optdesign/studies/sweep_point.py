@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.formulations.nlp.solution import nlp_solution
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.parameters import at_values
 from optdesign.problem.request import SolveRequest
@@ -237,7 +238,7 @@ def _outcome(task, problem: DesignProblem, best, shared, found_by: str) -> dict[
         request.sensitivities
         and best.success
         and solver_hints(best.solver).multipliers
-        and "lam_g" in best.raw
+        and nlp_solution(best) is not None
     ):
         from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
 

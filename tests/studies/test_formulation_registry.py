@@ -50,6 +50,45 @@ def test_a_users_formulation_is_one_object_and_one_registration_line(single):
     assert result.objective_name == "backlash_rss"
 
 
+def test_a_users_formulation_brings_its_own_evidence_and_record(single):
+    """The pipeline asks the formulation for its sensitivities and its diagnosis, and
+    result.json writes its typed record; no line outside it names it."""
+    crank = od.load(CRANK)
+    result = od.solve(crank, "single", objective="backlash_rss", ranges=False)
+    assert single.evidence == [("sensitivities", "optimal")]
+    assert result.sensitivities  # its own: the NLP's would skip a result labelled "single"
+    start = dict(zip([v.name for v in crank.free], crank.start(), strict=True))
+    assert result.details["single"].start == pytest.approx(start)
+    assert result.details.single is result.details["single"]
+    assert result.to_dict()["extra"]["single_start"] == pytest.approx(start)
+    # a result with no feasible design: its own diagnosis
+    solve = single.solve
+
+    def failed(problem, request):
+        out = solve(problem, request)
+        out.status, out.verified = "infeasible", False
+        return out
+
+    single.solve = failed
+    od.solve(crank, "single", objective="backlash_rss", ranges=False)
+    assert single.evidence[-1] == ("diagnose", "infeasible")
+
+
+def test_a_formulation_without_evidence_of_its_own_gets_the_nlps(monkeypatch):
+    """Only name, applies and solve are required: the diagnosis is then the NLP's, and the
+    sensitivities the NLP's (which read only an NLP's own result)."""
+    from formulation_example import SingleStart
+
+    monkeypatch.setattr(registry, "FORMULATIONS", dict(registry.FORMULATIONS))
+    bare = SimpleNamespace(
+        name="bare", description="", applies=SingleStart().applies, solve=SingleStart().solve
+    )
+    od.register_formulation(bare)
+    result = od.solve(CRANK, "bare", objective="backlash_rss", ranges=False)
+    assert result.status == "optimal" and result.formulation == "single"
+    assert result.sensitivities == [] and result.ranges == {}
+
+
 def test_auto_takes_a_users_formulation_after_the_built_ins_and_before_nlp(single):
     # the fork is a GP in backlash: gp comes first; the crank-slider is not
     assert choose_formulation(od.load(FORK), "auto") == "gp"

@@ -121,7 +121,7 @@ def catalogue_evidence(problem: DesignProblem, result: Result, request: SolveReq
     """What a catalogue optimum's neighbourhood says, when ``request`` asks for the
     sensitivities: the costs of the continuous part at the chosen items and the
     neighbouring items (a failure is a note, never the loss of the optimum)."""
-    from optdesign.formulations.nlp.sensitivities import has_multipliers
+    from optdesign.formulations.nlp.solution import has_multipliers
     from optdesign.solvers.registry import solver_hints
 
     solver, options = request.solver, request.options

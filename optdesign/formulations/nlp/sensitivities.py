@@ -341,26 +341,12 @@ def finite_difference(
     return (values[0] - values[1]) / (2 * h), p
 
 
-def has_multipliers(result: Result, requested: str | None) -> bool:
-    """Whether ``result`` carries multipliers a sensitivity can read. ``result.solver``
-    is the label the run reports (``scipy-slsqp-exact`` for the ``slsqp`` back-end), not
-    always a registered name: the requested back-end answers then."""
-    from optdesign.errors import InputError
-    from optdesign.solvers.registry import solver_hints
-
-    if "lam_g" not in result.raw:
-        return False
-    try:
-        return solver_hints(result.solver).multipliers
-    except InputError:
-        return solver_hints(requested).multipliers
-
-
 def nlp_evidence(problem: DesignProblem, result: Result, request: SolveRequest) -> None:
     """What an NLP optimum's neighbourhood says, as ``request`` asks: what each
     requirement costs (from the back-end's multipliers) and the range of each variable
     over the near-optimal set. Only for a continuous NLP's result (its own rows and
     multipliers); a failure is a note, never the loss of the optimum."""
+    from optdesign.formulations.nlp.solution import has_multipliers
     from optdesign.formulations.nlp.solve import optimal_ranges
 
     solver, options = request.solver, request.options

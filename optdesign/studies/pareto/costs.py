@@ -164,6 +164,7 @@ def _resolved(
     its ``z`` by the default NLP back-end, when that back-end returns multipliers and
     ends at the point's ``value`` or at most :data:`NEARBY` below it: (design, lam_g,
     lam_x, how much lower, relative); else None."""
+    from optdesign.formulations.nlp.solution import nlp_solution
     from optdesign.formulations.nlp.solve import solver_for
     from optdesign.solvers.registry import default_solver, solver_hints
 
@@ -174,15 +175,16 @@ def _resolved(
     if backend.nlp.fingerprint != nlp.fingerprint:
         return None
     r = backend.solve(nlp.start(z0=np.asarray(z, dtype=float)), target, nlp.bounds(eps=eps))
-    if not r.success or "lam_g" not in r.raw or not np.isfinite(r.objective):
+    solution = nlp_solution(r)
+    if not r.success or solution is None or not np.isfinite(r.objective):
         return None
     scale = max(abs(value), 1e-300)
     if r.objective > value + SAME_POINT * scale or r.objective < value - NEARBY * scale:
         return None
     return (
         dict(r.design),
-        np.asarray(r.raw["lam_g"], float),
-        np.asarray(r.raw["lam_x"], float),
+        solution.lam_g,
+        solution.lam_x,
         (value - r.objective) / scale,
     )
 
