@@ -1,4 +1,4 @@
-"""A formulation written outside the package, for tests/studies/test_formulation_registry.py: one
+"""A formulation written outside the package, for tests/formulations/test_registry.py: one
 NLP start from the declared start, for a caller who wants the local optimum nearest to
 the design they wrote. A new formulation is this module and one
 ``od.register_formulation`` line; no study changes.

@@ -240,7 +240,7 @@ def test_gp_form_with_fixed_thicknesses_and_its_refusal():
     """Fixed lug thicknesses make Huth's approach a monomial in d (C ~ d^-a): the fixed-
     linkage crank-slider stays a GP and its GP optimum equals the NLP's. With the inner
     lug at L = 1.5 d the factor (t1 + t2)^a is a power of a sum: the diagnosis names it."""
-    from formulations.test_gp import CS_FIXED
+    from programs.test_gp import CS_FIXED
 
     from optdesign.formulations.gp.solve import solve_gp_problem
 

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from formulations.test_signomial import _terms, _vars
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp.solve import require_gp, solve_gp_problem
 from optdesign.models.fit_formulas import fit_clearance
@@ -34,6 +33,7 @@ from optdesign.programs.gp import (
     is_gp,
     to_cvxpy,
 )
+from programs.test_signomial import _terms, _vars
 
 ROOT = Path(__file__).resolve().parents[2]
 FORK = ROOT / "problems" / "fork_min_backlash.toml"

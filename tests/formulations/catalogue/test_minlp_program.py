@@ -21,7 +21,7 @@ from optdesign.problem import problem_from_dict
 from optdesign.programs.nlp import build_nlp
 from optdesign.solvers.registry import solver_hints
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def _small(leads=("5 mm", "6 mm"), pins=("5 mm", "6 mm", "8 mm")):

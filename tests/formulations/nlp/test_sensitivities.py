@@ -14,7 +14,7 @@ from optdesign.reports.costs_text import cost_text
 from optdesign.reports.result_json import result_document
 from optdesign.solvers.result import Sensitivity
 
-PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 
 
 def _check_against_resolves(problem, result, rel=0.01):

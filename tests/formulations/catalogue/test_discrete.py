@@ -20,7 +20,7 @@ from optdesign.formulations.catalogue.discrete import (
     nearest_item,
 )
 
-PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 P_ITEMS = (2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
 D_ITEMS = (4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0)
 

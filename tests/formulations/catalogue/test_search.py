@@ -15,6 +15,11 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from formulations.catalogue.test_bnb import _infeasible as _failed
+from formulations.catalogue.test_bnb import (  # the stand-in problem of catalogue items
+    _Problem,
+    _Var,
+)
 from optdesign.errors import ProblemError
 from optdesign.formulations.catalogue import bnb as catalogue_bnb
 from optdesign.formulations.catalogue import search as catalogue
@@ -57,10 +62,8 @@ from optdesign.problem.load import load
 from optdesign.runtime.inherited_map import InheritedWorkers
 from optdesign.runtime.processes import forks_workers
 from optdesign.solvers.result import MultistartInfo, Result
-from studies.test_catalogue_bnb import _infeasible as _failed
-from studies.test_catalogue_bnb import _Problem, _Var  # the stand-in problem of catalogue items
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 CATALOGUE = ROOT / "problems" / "cs_min_backlash_catalogue.toml"
 #: Relaxation bound of the catalogue problem with its ISO 286-2 table fits: the continuous
 #: problem with the fit's table/formula ratio at its most favourable over the catalogue's
@@ -343,7 +346,7 @@ def test_the_catalogue_search_refuses_a_problem_without_catalogue_variables():
     import optdesign as od
     from optdesign.formulations.catalogue.search import solve_catalogue
 
-    problem = od.load(Path(__file__).resolve().parents[2] / "problems" / "cs_min_backlash.toml")
+    problem = od.load(Path(__file__).resolve().parents[3] / "problems" / "cs_min_backlash.toml")
     message = "formulation='catalogue': no variable takes catalogue values"
     for call in (lambda: od.solve(problem, "catalogue"), lambda: solve_catalogue(problem)):
         with pytest.raises(ProblemError) as refused:
@@ -479,7 +482,7 @@ def _small(pins=("5 mm", "6 mm", "8 mm"), leads=("5 mm", "6 mm"), solver=None):
 
     from optdesign.problem import problem_from_dict
 
-    path = Path(__file__).resolve().parents[2] / "problems" / "cs_min_backlash_catalogue.toml"
+    path = Path(__file__).resolve().parents[3] / "problems" / "cs_min_backlash_catalogue.toml"
     data = tomllib.loads(path.read_text())
     data["variables"]["p"] = {"values": list(leads)}
     data["variables"]["d"] = {"values": list(pins)}

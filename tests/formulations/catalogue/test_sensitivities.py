@@ -16,7 +16,7 @@ from optdesign.reports.display_units import objective_shown
 from optdesign.reports.html_page import to_json
 from optdesign.reports.result_json import result_document
 
-PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 FILE = PROBLEMS / "cs_min_backlash_catalogue.toml"
 
 

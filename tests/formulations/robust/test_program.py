@@ -32,7 +32,7 @@ from optdesign.formulations.robust.solve import (
 )
 from optdesign.problem import load_problem, problem_from_dict
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 FILE = ROOT / "problems" / "cs_min_backlash_robust.toml"
 
 #: Nominal optimum of cs_min_backlash (api notes: 0.0362197 deg; p non-unique).

@@ -15,7 +15,7 @@ from optdesign.problem.parameters import limit_value, perturbed
 from optdesign.reports.costs_text import cost_text
 from optdesign.reports.result_json import result_document
 
-PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 FILE = PROBLEMS / "cs_min_backlash_robust.toml"
 
 

@@ -13,7 +13,7 @@ import pytest
 import optdesign as od
 from optdesign.formulations.nlp.relaxation import MARGIN, _need, _record, _relaxed, relaxations
 
-PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
+PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 
 
 def _data(mean_ratio_min=250):
@@ -148,7 +148,7 @@ def test_a_relaxation_at_catalogue_items_uses_the_items_parameters():
     assert 0.9 * formula < table < 0.99 * formula
 
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 # --- the relaxation's measure of a violation ----------------------------------------------
