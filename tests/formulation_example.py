@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import optdesign as od
-from optdesign.formulations.diagnosis import diagnose
+from optdesign.formulations.diagnosis import Relaxing, diagnose
 from optdesign.formulations.nlp.diagnosis import nlp_diagnosis
 from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
 from optdesign.formulations.nlp.solution import has_multipliers
@@ -69,7 +69,7 @@ class SingleStart:
     def diagnose(self, problem: od.DesignProblem, result: od.Result, request: od.SolveRequest):
         """The NLP's relaxations from the one start's best point."""
         self.evidence.append(("diagnose", result.status))
-        diagnose(problem, result, request.solver, request.options, by=nlp_diagnosis)
+        diagnose(problem, result, Relaxing(request.solver, request.options), by=nlp_diagnosis)
 
     def sensitivities(
         self, problem: od.DesignProblem, result: od.Result, request: od.SolveRequest

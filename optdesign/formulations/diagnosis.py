@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -33,34 +34,45 @@ from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.registry import solver_for_kind
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Result
 
-#: A formulation's own diagnosis: (problem, result, NLP back-end, its options, relax).
-Diagnoser = Callable[[DesignProblem, Result, str, "Mapping[str, Any] | None", bool], Diagnosis]
+
+@dataclass(frozen=True)
+class Relaxing:
+    """How a diagnosis relaxes the requirements.
+
+    Attributes
+    ----------
+    solver, options
+        The NLP back-end of the relaxations and its options (a GP back-end, or None: the
+        registry's default for an NLP).
+    relax
+        False: the best point only, no relaxation (e.g. for an error message).
+    """
+
+    solver: str | None = None
+    options: Mapping[str, Any] | None = None
+    relax: bool = True
+
+
+#: A formulation's own diagnosis of a result with no feasible design (``how.solver``: an
+#: NLP back-end, resolved by :func:`diagnose`).
+Diagnoser = Callable[[DesignProblem, Result, Relaxing], Diagnosis]
 
 
 def diagnose(
-    problem: DesignProblem,
-    result: Result,
-    solver: str | None = None,
-    options: Mapping[str, Any] | None = None,
-    relax: bool = True,
-    *,
-    by: Diagnoser,
+    problem: DesignProblem, result: Result, how: Relaxing | None = None, *, by: Diagnoser
 ) -> Result:
     """Fill ``result.diagnosis`` (and, when the formulation returned no point, the best
-    point found) of a result that is not a success; returns ``result``.
-
-    ``solver``, ``options``: the NLP back-end of the relaxations and its options (a GP
-    back-end, or None: the registry's default for an NLP). ``relax=False``: the best
-    point only, no relaxation (e.g. for an error message). ``by``: the formulation's
-    own diagnosis."""
+    point found) of a result that is not a success, by the formulation's own diagnosis
+    ``by``, relaxing as ``how`` says (None: the default NLP back-end); returns
+    ``result``."""
+    how = how or Relaxing()
     if result.success:
         return result
     outside = [r for r in result.violated if is_validity(r)]
     if outside:
         result.diagnosis = Diagnosis(basis="the best point found", note=validity_note(outside))
         return result
-    nlp_solver = solver_for_kind(solver, "nlp")
-    result.diagnosis = by(problem, result, nlp_solver, options, relax)
+    result.diagnosis = by(problem, result, replace(how, solver=solver_for_kind(how.solver, "nlp")))
     missed = [r for r in result.diagnosis.relaxations if r.needed == r.written]
     if missed:
         # a relaxation of nothing: the diagnosis met every requirement as written

@@ -102,14 +102,11 @@ class FixedDesign:
 
     def diagnose(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
         """The exact relaxations of what the design violates."""
-        from optdesign.formulations.diagnosis import diagnose
+        from optdesign.formulations.diagnosis import Relaxing, diagnose
 
+        how = Relaxing(request.solver, request.options)
         diagnose(
-            problem,
-            result,
-            request.solver,
-            request.options,
-            by=lambda problem, result, *_: fixed_diagnosis(problem, result),
+            problem, result, how, by=lambda problem, result, _: fixed_diagnosis(problem, result)
         )
 
     def sensitivities(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:

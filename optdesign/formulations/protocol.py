@@ -25,7 +25,8 @@ it applies).
 Only ``name``, ``applies`` and ``solve`` are required: a formulation without
 ``diagnose`` or ``sensitivities`` gets the NLP's (:data:`NLP_EVIDENCE`), which read the
 result's own rows and multipliers. :class:`FormulationBase` gives those defaults to a
-subclass.
+subclass, and loads its functions by import path on first call: a built-in formulation's
+package declares one subclass of it, naming its functions.
 """
 
 from __future__ import annotations
@@ -61,31 +62,62 @@ class Formulation(Protocol):
     ) -> None: ...
 
 
+def _load(ref: str | Callable[..., Any]) -> Callable[..., Any]:
+    if callable(ref):
+        return ref
+    module, _, attr = ref.partition(":")
+    return getattr(importlib.import_module(module), attr)
+
+
 class FormulationBase:
-    """Defaults of the optional members: no time limit, no record, no check, and the
-    NLP's diagnosis and sensitivities (a subclass overrides what it does otherwise)."""
+    """A formulation whose functions are ``"module:function"`` paths, imported on first
+    call (listing the formulations imports no solver library), with the defaults of the
+    optional members: no time limit, no record, no check, and the NLP's diagnosis and
+    sensitivities. A built-in formulation's package subclasses it with its own paths.
+
+    Attributes
+    ----------
+    applies_by, solve_by
+        ``(problem, request) -> bool | str`` and ``(problem, request) -> Result``.
+    diagnosis_by
+        Its own diagnosis, a :data:`~optdesign.formulations.diagnosis.Diagnoser`
+        (default: the NLP's relaxations).
+    sensitivities_by
+        ``(problem, result, request) -> None`` (default: the NLP's, which read only an
+        NLP's own result); "" when the solve reports them already.
+    """
 
     name: ClassVar[str]
     description: ClassVar[str] = ""
     details: ClassVar[type | None] = None
     time_limit: ClassVar[bool] = False
+    applies_by: ClassVar[str] = ""
+    solve_by: ClassVar[str] = ""
+    diagnosis_by: ClassVar[str] = "optdesign.formulations.nlp.diagnosis:nlp_diagnosis"
+    sensitivities_by: ClassVar[str] = "optdesign.formulations.nlp.sensitivities:nlp_evidence"
+
+    def applies(self, problem: DesignProblem, request: SolveRequest) -> bool | str:
+        """True, or the reason the formulation cannot solve ``problem`` as asked."""
+        return _load(self.applies_by)(problem, request)
+
+    def solve(self, problem: DesignProblem, request: SolveRequest) -> Result:
+        """The formulation's result for ``problem`` as ``request`` asks."""
+        return _load(self.solve_by)(problem, request)
 
     def check(self, problem: DesignProblem, request: SolveRequest) -> None:
         """Refuse, before any work, a request the formulation cannot honour (nothing)."""
 
     def diagnose(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """The NLP's diagnosis of ``result``'s best point."""
-        from optdesign.formulations.diagnosis import diagnose
-        from optdesign.formulations.nlp.diagnosis import nlp_diagnosis
+        """Fill ``result.diagnosis`` with the formulation's own diagnosis."""
+        from optdesign.formulations.diagnosis import Relaxing, diagnose
 
-        diagnose(problem, result, request.solver, request.options, by=nlp_diagnosis)
+        how = Relaxing(request.solver, request.options)
+        diagnose(problem, result, how, by=_load(self.diagnosis_by))
 
     def sensitivities(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """The NLP's sensitivities and ranges, when ``result`` carries an NLP's
-        multipliers."""
-        from optdesign.formulations.nlp.sensitivities import nlp_evidence
-
-        nlp_evidence(problem, result, request)
+        """Fill what the optimum's neighbourhood says, as ``request`` asks."""
+        if self.sensitivities_by:
+            _load(self.sensitivities_by)(problem, result, request)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(name={self.name!r})"
@@ -112,13 +144,6 @@ def check_with(formulation: Any, problem: DesignProblem, request: SolveRequest) 
     check = getattr(formulation, "check", None)
     if check is not None:
         check(problem, request)
-
-
-def _load(ref: str | Callable[..., Any]) -> Callable[..., Any]:
-    if callable(ref):
-        return ref
-    module, _, attr = ref.partition(":")
-    return getattr(importlib.import_module(module), attr)
 
 
 @dataclass(frozen=True)

@@ -24,21 +24,20 @@ from optdesign.formulations.protocol import FormulationBase
 if TYPE_CHECKING:
     from optdesign.problem.design_problem import DesignProblem
     from optdesign.problem.request import SolveRequest
-    from optdesign.solvers.result import Result
 
 
 class CatalogueFormulation(FormulationBase):
-    """``formulation="catalogue"``: the exact catalogue optimum and its relaxation bound."""
+    """``formulation="catalogue"``: the exact catalogue optimum and its relaxation bound;
+    an infeasible search is diagnosed at the items nearest its best point, an optimum's
+    sensitivities are its continuous part's and its neighbouring items."""
 
     name = "catalogue"
     description = "branch and bound (or enumeration) over the catalogue values, NLP at each node"
     details = CatalogueDetails
-
-    def applies(self, problem: DesignProblem, request: SolveRequest) -> bool | str:
-        """True when some free variable takes catalogue values."""
-        from optdesign.formulations.catalogue.search import catalogue_applies
-
-        return catalogue_applies(problem, request)
+    applies_by = "optdesign.formulations.catalogue.search:catalogue_applies"
+    solve_by = "optdesign.formulations.catalogue.search:solve_catalogue_formulation"
+    diagnosis_by = "optdesign.formulations.catalogue.diagnosis:catalogue_diagnosis"
+    sensitivities_by = "optdesign.formulations.catalogue.sensitivities:catalogue_evidence"
 
     def check(self, problem: DesignProblem, request: SolveRequest) -> None:
         """Refuse tolerances: robust design needs continuous variables."""
@@ -48,22 +47,3 @@ class CatalogueFormulation(FormulationBase):
                 f"tolerances: robust design needs continuous variables, and {disc} take "
                 "catalogue values; remove [tolerances] for the nominal catalogue optimum"
             )
-
-    def solve(self, problem: DesignProblem, request: SolveRequest) -> Result:
-        """The exact catalogue optimum, its relaxation bound and globality."""
-        from optdesign.formulations.catalogue.search import solve_catalogue_formulation
-
-        return solve_catalogue_formulation(problem, request)
-
-    def diagnose(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """The relaxations at the catalogue items nearest the best point."""
-        from optdesign.formulations.catalogue.diagnosis import catalogue_diagnosis
-        from optdesign.formulations.diagnosis import diagnose
-
-        diagnose(problem, result, request.solver, request.options, by=catalogue_diagnosis)
-
-    def sensitivities(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """The continuous part's costs at the chosen items, and the neighbouring items."""
-        from optdesign.formulations.catalogue.sensitivities import catalogue_evidence
-
-        catalogue_evidence(problem, result, request)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -16,7 +15,7 @@ import numpy as np
 from optdesign.formulations.catalogue.bnb import first_feasible
 from optdesign.formulations.catalogue.discrete import discrete_variables, nearest_item
 from optdesign.formulations.catalogue.search import NodeSolver
-from optdesign.formulations.diagnosis import best_point
+from optdesign.formulations.diagnosis import Relaxing, best_point
 from optdesign.formulations.nlp.relaxation import Site, relaxations
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.constraint_rows import constraint_rows
@@ -34,15 +33,10 @@ NODE_MAX_ITER = 150
 MAX_ALTERNATIVES = 3
 
 
-def catalogue_diagnosis(
-    problem: DesignProblem,
-    result: Result,
-    solver: str,
-    options: Mapping[str, Any] | None = None,
-    relax: bool = True,
-) -> Diagnosis:
+def catalogue_diagnosis(problem: DesignProblem, result: Result, how: Relaxing) -> Diagnosis:
     """The relaxations of the NLP at the catalogue items nearest the best point (the
     result's own best point when the search returned none)."""
+    solver, options, relax = how.solver, how.options, how.relax
     dvars = discrete_variables(problem)
     objective = result.objective_name or problem.objective_names[0]
     info = result.details.get("catalogue")

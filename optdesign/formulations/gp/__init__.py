@@ -12,45 +12,20 @@ below the solvers, in :mod:`optdesign.programs.gp`: the GP back-ends take it.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from optdesign.formulations.gp.details import GPDetails
 from optdesign.formulations.protocol import FormulationBase
 
-if TYPE_CHECKING:
-    from optdesign.problem.design_problem import DesignProblem
-    from optdesign.problem.request import SolveRequest
-    from optdesign.solvers.result import Result
-
 
 class GPFormulation(FormulationBase):
-    """``formulation="gp"``: GP with certificate and the exact NLP beside it."""
+    """``formulation="gp"``: GP with certificate and the exact NLP beside it (the solve
+    reports that NLP's sensitivities); an infeasible GP is diagnosed on the exact NLP."""
 
     name = "gp"
     description = (
         "geometric program (first-order Hertz) with a dual certificate, exact NLP beside it"
     )
     details = GPDetails
-
-    def applies(self, problem: DesignProblem, request: SolveRequest) -> bool | str:
-        """True when the problem is a GP in the request's objective, else what breaks
-        DGP form."""
-        from optdesign.formulations.gp.solve import gp_applies
-
-        return gp_applies(problem, request)
-
-    def solve(self, problem: DesignProblem, request: SolveRequest) -> Result:
-        """The GP optimum, its certificate and the exact NLP's comparison."""
-        from optdesign.formulations.gp.solve import solve_gp_formulation
-
-        return solve_gp_formulation(problem, request)
-
-    def diagnose(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """The exact NLP's best point and relaxations (a GP solver gives no point)."""
-        from optdesign.formulations.diagnosis import diagnose
-        from optdesign.formulations.gp.diagnosis import gp_diagnosis
-
-        diagnose(problem, result, request.solver, request.options, by=gp_diagnosis)
-
-    def sensitivities(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """Nothing more: the solve reports the exact NLP's sensitivities already."""
+    applies_by = "optdesign.formulations.gp.solve:gp_applies"
+    solve_by = "optdesign.formulations.gp.solve:solve_gp_formulation"
+    diagnosis_by = "optdesign.formulations.gp.diagnosis:gp_diagnosis"
+    sensitivities_by = ""

@@ -4,25 +4,17 @@ relaxations."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from optdesign.formulations.diagnosis import adopt, nothing_violated
+from optdesign.formulations.diagnosis import Relaxing, adopt, nothing_violated
 from optdesign.formulations.nlp.relaxation import relax_together, relaxations
 from optdesign.formulations.nlp.solve import solve_nlp
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.result import Diagnosis, Result
 
 
-def gp_diagnosis(
-    problem: DesignProblem,
-    result: Result,
-    solver: str | None = None,
-    options: Mapping[str, Any] | None = None,
-    relax: bool = True,
-) -> Diagnosis:
+def gp_diagnosis(problem: DesignProblem, result: Result, how: Relaxing) -> Diagnosis:
     """The exact NLP's best point and relaxations (the GP back-end gives no point; the
     relaxations take the registry's default NLP back-end, whatever ``solver``)."""
+    relax = how.relax
     objective = result.objective_name or problem.objective_names[0]
     nlp = solve_nlp(problem, objective=objective)
     basis = "the exact NLP"

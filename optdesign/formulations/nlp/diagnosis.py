@@ -4,24 +4,17 @@ in the conflict, from the result's best point, on the problem's NLP
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from optdesign.formulations.diagnosis import nothing_violated
+from optdesign.formulations.diagnosis import Relaxing, nothing_violated
 from optdesign.formulations.nlp.relaxation import relax_together, relaxations
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.result import Diagnosis, Result
 
 
-def nlp_diagnosis(
-    problem: DesignProblem,
-    result: Result,
-    solver: str,
-    options: Mapping[str, Any] | None = None,
-    relax: bool = True,
-) -> Diagnosis:
-    """The relaxations of the problem's NLP from ``result``'s best point (``solver``: the
-    NLP back-end of the relaxations; ``relax=False``: the best point's basis only)."""
+def nlp_diagnosis(problem: DesignProblem, result: Result, how: Relaxing) -> Diagnosis:
+    """The relaxations of the problem's NLP from ``result``'s best point (``how.solver``:
+    the NLP back-end of the relaxations; ``how.relax`` False: the best point's basis
+    only)."""
+    solver, relax = how.solver, how.relax
     if not result.design:
         return Diagnosis(note="the solver returned no point to diagnose from")
     if not result.violated:

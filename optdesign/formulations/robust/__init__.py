@@ -11,42 +11,19 @@ optimum.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from optdesign.formulations.protocol import FormulationBase
 from optdesign.formulations.robust.details import RobustDetails
 
-if TYPE_CHECKING:
-    from optdesign.problem.design_problem import DesignProblem
-    from optdesign.problem.request import SolveRequest
-    from optdesign.solvers.result import Result
-
 
 class RobustFormulation(FormulationBase):
-    """``formulation="robust"``: the nominal optimum, then the robust optimum from it."""
+    """``formulation="robust"``: the nominal optimum, then the robust optimum from it (the
+    solve reports its sensitivities: they need its samples' NLP); an infeasible robust
+    problem is diagnosed on the nominal NLP."""
 
     name = "robust"
     description = "risk measure (CVaR or mean + k std) of the objective under the tolerances"
     details = RobustDetails
-
-    def applies(self, problem: DesignProblem, request: SolveRequest) -> bool | str:
-        """True when the problem has tolerances and continuous variables, else why not."""
-        from optdesign.formulations.robust.solve import robust_applies
-
-        return robust_applies(problem, request)
-
-    def solve(self, problem: DesignProblem, request: SolveRequest) -> Result:
-        """The robust optimum, started at the nominal optimum."""
-        from optdesign.formulations.robust.solve import solve_robust_formulation
-
-        return solve_robust_formulation(problem, request)
-
-    def diagnose(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """The nominal NLP's relaxations (the robust problem imposes its requirements)."""
-        from optdesign.formulations.diagnosis import diagnose
-        from optdesign.formulations.robust.diagnosis import robust_diagnosis
-
-        diagnose(problem, result, request.solver, request.options, by=robust_diagnosis)
-
-    def sensitivities(self, problem: DesignProblem, result: Result, request: SolveRequest) -> None:
-        """Nothing more: the solve reports them already (they need its samples' NLP)."""
+    applies_by = "optdesign.formulations.robust.solve:robust_applies"
+    solve_by = "optdesign.formulations.robust.solve:solve_robust_formulation"
+    diagnosis_by = "optdesign.formulations.robust.diagnosis:robust_diagnosis"
+    sensitivities_by = ""

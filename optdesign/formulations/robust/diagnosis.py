@@ -4,26 +4,18 @@ the robust problem's."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
 import numpy as np
 
-from optdesign.formulations.diagnosis import best_point, nothing_violated
+from optdesign.formulations.diagnosis import Relaxing, best_point, nothing_violated
 from optdesign.formulations.nlp.relaxation import relax_together, relaxations
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.result import Diagnosis, Result
 
 
-def robust_diagnosis(
-    problem: DesignProblem,
-    result: Result,
-    solver: str,
-    options: Mapping[str, Any] | None = None,
-    relax: bool = True,
-) -> Diagnosis:
+def robust_diagnosis(problem: DesignProblem, result: Result, how: Relaxing) -> Diagnosis:
     """The nominal NLP's relaxations from the robust result's best point."""
+    solver, relax = how.solver, how.relax
     basis = "the nominal NLP"
     why = "the robust formulation imposes the nominal requirements (its statistic is the objective)"
     if not result.design:

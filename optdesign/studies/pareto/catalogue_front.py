@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 from optdesign.errors import InputError
 from optdesign.formulations.catalogue.diagnosis import catalogue_diagnosis
 from optdesign.formulations.catalogue.search import solve_catalogue
-from optdesign.formulations.diagnosis import diagnose
+from optdesign.formulations.diagnosis import Relaxing, diagnose
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.registry import FRONT_SOLVERS
 from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
@@ -76,7 +76,7 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
         # An anchor with no catalogue design: its best point, for the error to name the
         # requirements it violates (no relaxations: the front stops here).
-        diagnose(problem, result, relax=False, by=catalogue_diagnosis)
+        diagnose(problem, result, Relaxing(relax=False), by=catalogue_diagnosis)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
     info = result.details.get("catalogue")
     rec.n_solves = info.nlp_solves if info is not None else 0
