@@ -1,5 +1,6 @@
 """The formulation protocol (issue 22): ``applies(problem, request)`` and ``solve(problem,
-request)``, registered by name; ``auto`` takes the first that applies with the caller's
+request)``, registered by name, and optionally its own ``diagnose``, ``sensitivities`` and
+typed record (else the NLP's); ``auto`` takes the first that applies with the caller's
 request; a named one that does not apply is refused with its reason; a user's own
 formulation is one module (tests/formulation_example.py) and one registration line."""
 
