@@ -65,7 +65,7 @@ def export_nlp(problem_name: str, folder: Path, starts: int = 8, seed: int = 0) 
     from scipy.stats import qmc
 
     import optdesign as od
-    from optdesign.studies.nlp_solve import formulation_for
+    from optdesign.formulations.nlp.solve import formulation_for
 
     problem = od.load(problem_name)
     nlp = formulation_for(problem)
