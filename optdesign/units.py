@@ -82,7 +82,7 @@ INTERNAL_UNITS: dict[str, str] = {
     "time": "h",
     "angular_speed": "rad/s",
     "rotational_stiffness": "N*mm/rad",
-    # the drive's dynamics (issue 37): with mm and N, a mass is in tonnes (N*s^2/mm) and
+    # the drive's dynamics: with mm and N, a mass is in tonnes (N*s^2/mm) and
     # an inertia in t*mm^2 (N*mm*s^2), so that inertia x angular acceleration is N*mm
     "inertia": "t*mm**2",
     "mass": "t",

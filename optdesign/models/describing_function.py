@@ -1,5 +1,5 @@
 """Sinusoidal-input describing functions of the drive's nonlinearities: backlash and
-saturation (issue 38; docs/loop.md).
+saturation (docs/loop.md).
 
 A nonlinearity driven by x(t) = A sin(w t) puts out a periodic y(t); its describing
 function is the complex gain of the fundamental,

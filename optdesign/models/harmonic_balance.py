@@ -1,5 +1,5 @@
 """Limit cycles of a linear loop closed through a nonlinearity, by harmonic balance
-(issue 38; docs/loop.md).
+(docs/loop.md).
 
 The loop: a nonlinearity N (:mod:`optdesign.models.describing_function`) in series with
 a linear open loop L(s), under negative feedback. A sinusoid of amplitude A and frequency

@@ -1,5 +1,5 @@
 """The drive in its position loop, at one fin angle: the plant and the controller as
-typed records (issue 38; docs/loop.md).
+typed records (docs/loop.md).
 
 The plant is the two-mass drive of :mod:`optdesign.models.motor`, linearised at one fin
 angle phi0 where the chain's ratio is f' = dtheta/dphi (motor rad per fin rad):

@@ -1,6 +1,6 @@
 """The motor in the drive: inertia seen through the linkage, torque along a motion, RMS
 and peak torque over a duty cycle, speed, drive-train frequencies, and what a closed
-loop's step response asks of the motor (issue 37; docs/motor.md).
+loop's step response asks of the motor (docs/motor.md).
 
 Pure functions through :mod:`optdesign.math`: each takes floats, NumPy arrays (the
 deflection grid on the last axis) or CasADi symbols, except
