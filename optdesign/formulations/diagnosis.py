@@ -11,6 +11,12 @@ formulation, which brings its own diagnosis (its ``diagnose``: ``nlp_diagnosis``
 the diagnosis says it in its ``basis``. This module holds what they share: the checks
 before any relaxation and the words of the note.
 
+A condition of the physics (:attr:`~optdesign.problem.objectives.ConstraintBlock.physical`:
+the linkage passes no dead point and assembles) is never relaxed: a design beyond it
+does not work at all. The diagnosis names those the best point violates
+(``Diagnosis.physical``), and the summary says that the stroke or the bounds must
+change.
+
 A result whose best point violates no requirement (a solver that stopped early, a
 catalogue search that missed every feasible item) gets no relaxation but a note saying
 so: the problem may well be feasible. A best point whose models are used outside their
@@ -28,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.requirements import physical_conditions
 from optdesign.problem.validity import is_validity
 from optdesign.reports.limits import limits_of
 from optdesign.solvers.constraint_rows import constraint_rows
@@ -73,6 +80,8 @@ def diagnose(
         result.diagnosis = Diagnosis(basis="the best point found", note=validity_note(outside))
         return result
     result.diagnosis = by(problem, result, replace(how, solver=solver_for_kind(how.solver, "nlp")))
+    violated = {r.name.split("[", 1)[0] for r in result.violated}
+    result.diagnosis.physical = sorted(violated & physical_conditions(problem))
     missed = [r for r in result.diagnosis.relaxations if r.needed == r.written]
     if missed:
         # a relaxation of nothing: the diagnosis met every requirement as written

@@ -199,6 +199,10 @@ class ConstraintBlock:
     #: Smooth expressions whose element-wise max is ``expr`` (solver path; an upper bound
     #: only, since max(pieces) <= upper holds exactly when every piece does).
     pieces: tuple[Any, ...] = ()
+    #: A condition of the physics, not a wish: the linkage passes no dead point and
+    #: assembles. A diagnosis never proposes to relax it (a design beyond it does not
+    #: work at all); the stroke or the bounds must change instead.
+    physical: bool = False
 
     def __post_init__(self):
         if self.pieces and self.lower is not None:

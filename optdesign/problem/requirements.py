@@ -22,7 +22,7 @@ from optdesign.problem.objectives import ConstraintBlock, ConstraintInfo
 from optdesign.user_code import quantity_of
 
 
-def _block(rows: Rows, labels: list[str]) -> ConstraintBlock:
+def _block(rows: Rows, labels: list[str], physical: bool = False) -> ConstraintBlock:
     return ConstraintBlock(
         rows.name,
         rows.expr,
@@ -33,6 +33,7 @@ def _block(rows: Rows, labels: list[str]) -> ConstraintBlock:
         rows.description,
         rows.display,
         rows.display_unit,
+        physical=physical,
     )
 
 
@@ -50,9 +51,11 @@ def requirement_blocks(
     phi = q.phi
     blocks: list[ConstraintBlock] = [
         # The linkage must not pass a dead point inside the stroke: positive ratio.
-        ConstraintBlock("ratio_positive", q.ratio, 1.0, None, labels, "", "ratio i(phi) >= 1")
+        ConstraintBlock(
+            "ratio_positive", q.ratio, 1.0, None, labels, "", "ratio i(phi) >= 1", physical=True
+        )
     ]
-    blocks += [_block(r, labels) for r in q.call_mechanism("assembly_rows", phi)]
+    blocks += [_block(r, labels, True) for r in q.call_mechanism("assembly_rows", phi)]
     for name in type(mech).requirements:
         value = getattr(req, name)
         if value is not None:
@@ -210,3 +213,13 @@ def user_block(c: ConstraintInfo, q) -> ConstraintBlock:
     expr: Any = quantity_of(c.fn, q, f"constraint {c.name!r}", c.over == "stroke")
     labels = q.labels if c.over == "stroke" else [""]
     return ConstraintBlock(c.name, expr, c.lower, c.upper, labels, c.unit, c.description or c.name)
+
+
+def physical_conditions(problem: Any) -> frozenset[str]:
+    """The names of ``problem``'s constraint blocks that are conditions of the physics
+    (:attr:`ConstraintBlock.physical`), read at its start design (NumPy path: only the
+    declarations matter)."""
+    design = problem.design_dict(problem.start()[None, :])
+    with np.errstate(all="ignore"):
+        blocks = problem.expressions(design).constraints
+    return frozenset(b.name for b in blocks if b.physical)

@@ -80,6 +80,7 @@ def result_document(result: Result) -> dict[str, Any]:
             "note": diagnosis.note,
             "relaxations": relax,
             "together": _relaxations_json(problem, diagnosis.together),
+            "physical": list(diagnosis.physical),
         }
     doc["sensitivities"] = [
         {

@@ -178,6 +178,9 @@ def result_summary(result: Result) -> str:
         lines += [f"  {relaxation_text(lim)}" for lim in relaxation_limits(problem, together)]
     if relax and diagnosis.basis:
         lines.append(f"  (computed on {diagnosis.basis})")
+    physical = diagnosis.physical if diagnosis is not None else []
+    if physical and not together and not any(r.needed is not None for r in relax):
+        lines += ["", physical_text(physical)]
     if diagnosis is not None and diagnosis.note:
         lines += ["", f"diagnosis: {diagnosis.note}"]
     if not result.success:
@@ -232,3 +235,15 @@ def _design_table(problem, result: Result) -> str:
             moves = f"optimal for any value in [{a:.6g}, {b:.6g}]"
         rows.append([var.name, var.description, f"{v.value:.6g}", unit, bounds, at, moves])
     return format_table(["variable", "what", "value", "unit", "bounds", "", "optimal set"], rows)
+
+
+def physical_text(names: list[str]) -> str:
+    """Why the summary proposes no relaxation when the best point violates conditions of
+    the physics (``Diagnosis.physical``) and relaxing the requirements found no design
+    that meets them."""
+    shown = ", ".join(printable(n) for n in names)
+    return (
+        f"the linkage itself fails at the best point found ({shown}: it passes a dead point "
+        "inside the stroke or does not assemble); no requirement relaxes that: narrow the "
+        "stroke (requirements.deflection) or widen the bounds of the variables"
+    )

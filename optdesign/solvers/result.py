@@ -265,12 +265,17 @@ class Diagnosis:
     together
         When no requirement relaxed alone gives a feasible design: the set to relax
         together and the limit each needs (empty otherwise).
+    physical
+        The conditions of the physics the best point violates (the linkage passes a
+        dead point inside the stroke, or does not assemble): no relaxation of a
+        requirement is proposed for them; the stroke or the bounds must change.
     """
 
     relaxations: list[Relaxation] = field(default_factory=list)
     basis: str = ""
     note: str = ""
     together: list[Relaxation] = field(default_factory=list)
+    physical: list[str] = field(default_factory=list)
 
 
 @dataclass

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.formulations.nlp.solve import _objective_set, phase_one_for, solver_for
+from optdesign.problem.requirements import physical_conditions
 from optdesign.solvers.base import constraint_reports
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Relaxation
@@ -86,9 +87,11 @@ def relaxations(
     # The conflict is between the violated requirements and the ones binding at the best
     # infeasible point: each is a candidate.
     names: dict[str, Any] = {}
+    physical = physical_conditions(problem)  # never relaxed: beyond them nothing works
     for r in [*sorted(result.violated, key=lambda r: -r.amount), *result.active]:
         base = r.name.split("[", 1)[0]
-        if "_envelope" not in base and base not in names:  # not the objective's rows
+        # not the objective's rows
+        if "_envelope" not in base and base not in names and base not in physical:
             names[base] = r
     if objective is None:
         own = result.objective_name
