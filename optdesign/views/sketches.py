@@ -38,16 +38,9 @@ def stroke_angles(problem: Any) -> tuple[float, float, float]:
 def sketch_frames(
     problem: Any, design: dict[str, float], quantities: Any = None
 ) -> tuple[SketchFrame, ...]:
-    """The :class:`SketchFrame` of ``design`` at each of :func:`stroke_angles`.
-
-    Parameters
-    ----------
-    problem
-        The design problem.
-    design
-        The design: variable name -> value.
-    quantities
-        ``problem.quantities(design)`` when the caller has it already.
+    """The :class:`SketchFrame` of ``design`` (variable name -> value) at each of
+    :func:`stroke_angles`, drawn by the mechanism of its ``quantities`` (computed here
+    unless the caller has them).
 
     Raises
     ------
