@@ -85,7 +85,7 @@ def solution_figure(
     curves = []
     for label, design in designs.items():
         drawn = stroke_curves(problem, dict(design))
-        curves.append(DesignCurves(str(label), drawn.ratio, drawn.backlash if has_pin else None))
+        curves.append(DesignCurves(str(label), drawn.ratio, drawn.backlash))
     band = None
     if req.mean_ratio is not None:
         lo, hi = req.mean_ratio.min, req.mean_ratio.max
