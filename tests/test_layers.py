@@ -3,14 +3,19 @@ an optdesign module in optdesign/ - at module top or inside a function - is an a
 the arrows form no circle and never point up the layers of the architecture:
 
 shared utilities -> models -> mechanisms -> problem -> programs -> solvers -> runtime ->
-search -> formulations -> studies -> api -> cli, commands, plots, reports, reproduce.
+search -> formulations -> views -> studies -> api -> cli, commands, plots, reports,
+reproduce.
 
 The programs (the NLP with its bounds, starts and targets; the GP's data) are what the
 solvers take, so they sit below them. The formulations (one package each: nlp, gp,
 catalogue, robust, with their solve, diagnosis, sensitivities and typed record, and the
 registry that chooses among them) use the solvers, the execution engine and the global
 search, so they sit above them and below the studies (pareto, sweep, bench, the solve
-pipeline) that use them.
+pipeline) that use them. The views (what a page or a figure shows of a design,
+evaluated: its objectives, binding and violated rows, curves over the stroke, sketch
+frames and facts) read the problem and the solvers' rows, so they sit above them; the
+reports and plots format and draw the views' records and evaluate no model themselves
+(:func:`test_reports_and_plots_evaluate_no_model`).
 
 Imports under ``if TYPE_CHECKING:`` are annotations, not arrows, and are left out.
 """
@@ -49,6 +54,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("runtime",),  # the execution engine: tasks, worker processes, stores' identity
     ("search",),  # the global search: starts, stopping rule, odds
     ("formulations",),  # one package per formulation: solve, diagnose, sensitivities
+    ("views",),  # what a page or a figure shows of a design, evaluated
     ("studies",),
     ("api", "validation"),
     ("cli", "__main__", "commands", "plots", "reports", "reproduce"),
@@ -262,6 +268,60 @@ def test_reports_and_plots_import_no_study():
         if t.startswith(above)
     ]
     assert found == [], "reports or plots importing a study:\n" + "\n".join(found)
+
+
+#: the calls that evaluate a model: a problem's ``quantities`` and ``evaluate``, its
+#: constraint rows, a mechanism's ``sketch`` (called directly or through ``call_method``)
+MODEL_CALLS = {"quantities", "evaluate", "constraint_rows", "sketch"}
+
+
+def model_calls(tree: ast.AST) -> list[tuple[int, str]]:
+    """(line, name) of every call in ``tree`` that evaluates a model (:data:`MODEL_CALLS`),
+    ``call_method(obj, "sketch", ...)`` counted as a call of ``sketch``."""
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        func = node.func
+        name = func.id if isinstance(func, ast.Name) else getattr(func, "attr", "")
+        if name == "call_method" and len(node.args) > 1:
+            method = node.args[1]
+            name = method.value if isinstance(method, ast.Constant) else ""
+        if name in MODEL_CALLS:
+            found.append((node.lineno, str(name)))
+    return sorted(found)
+
+
+def test_the_model_call_finder_sees_every_form():
+    source = (
+        "q = problem.quantities(design)\n"
+        "def f(p, x):\n"
+        "    return p.evaluate(x), constraint_rows(p, x)\n"
+        "sk = call_method(mech, 'sketch', 0.0, doing='drawing')\n"
+        "mech.sketch(0.1)\n"
+        "draw_panel(ax, panel)\n"
+    )
+    assert model_calls(ast.parse(source)) == [
+        (1, "quantities"),
+        (3, "constraint_rows"),
+        (3, "evaluate"),
+        (4, "sketch"),
+        (5, "sketch"),
+    ]
+
+
+def test_reports_and_plots_evaluate_no_model():
+    """The reports and plots format and draw records: what a page or a figure shows of a
+    design is evaluated by :mod:`optdesign.views`, and no module of reports/ or plots/
+    calls a problem's ``quantities`` or ``evaluate``, its ``constraint_rows`` or a
+    mechanism's ``sketch``."""
+    found = [
+        f"{path.relative_to(PACKAGE)}:{line} calls {name}"
+        for folder in ("reports", "plots")
+        for path in sorted((PACKAGE / folder).rglob("*.py"))
+        for line, name in model_calls(ast.parse(path.read_text(), str(path)))
+    ]
+    assert found == [], "reports or plots evaluating a model:\n" + "\n".join(found)
 
 
 def test_the_entry_points_are_still_there():

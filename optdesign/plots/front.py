@@ -1,5 +1,5 @@
 """Plot of Pareto fronts: objective space (methods overlaid) and sketches of picked designs
-(the two ends of the front and its knee), drawn from each mechanism's :meth:`sketch`.
+(the two ends of the front and its knee), drawn from their evaluated sketch frames.
 Names (the problem's, the objectives', the methods') are drawn as plain text
 (:func:`optdesign.plots.plain`)."""
 
@@ -12,7 +12,7 @@ import numpy as np
 
 from optdesign.mechanisms.base import Sketch
 from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
-from optdesign.user_code import call_method
+from optdesign.views.sketches import sketch_frames
 
 _STYLE = {
     "epsilon": dict(marker="o", ms=4, lw=1.0),
@@ -68,8 +68,9 @@ class FrontSeries:
 
 @dataclass(frozen=True)
 class FrontFigure:
-    """What the figure of Pareto fronts shows, evaluated (:func:`front_figure`), so that
-    drawing it (:func:`draw_front`) evaluates no model and can run in another process.
+    """What the figure of Pareto fronts shows, from the fronts and the picked designs'
+    evaluated sketches (:mod:`optdesign.views`; :func:`front_figure`), so that drawing it
+    (:func:`draw_front`) evaluates no model and can run in another process.
 
     Attributes
     ----------
@@ -96,15 +97,13 @@ class FrontFigure:
 
 
 def linkage_panel(problem, design: dict, title: str = "") -> SketchPanel:
-    """The sketch of a design at the stroke's ends and middle (mm), from the mechanism's
-    :meth:`~optdesign.mechanisms.Mechanism.sketch`."""
-    mech = problem.quantities(design).mechanism
-    phis = [problem.phi[0], 0.5 * (problem.phi[0] + problem.phi[-1]), problem.phi[-1]]
-    frames = []
-    for phi in phis:
-        sk = call_method(mech, "sketch", float(phi), doing="while drawing its sketch")
-        frames.append((f"phi = {np.degrees(phi):+.0f} deg", sk))
-    return SketchPanel(str(title), tuple(frames))
+    """The sketch of a design at the stroke's ends and middle (mm): its evaluated
+    :func:`~optdesign.views.sketches.sketch_frames`, labelled."""
+    frames = tuple(
+        (f"phi = {np.degrees(frame.phi):+.0f} deg", frame.sketch)
+        for frame in sketch_frames(problem, design)
+    )
+    return SketchPanel(str(title), frames)
 
 
 def draw_panel(ax, panel: SketchPanel) -> None:

@@ -13,7 +13,8 @@ import numpy as np
 from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.reports.limits import binding_angles, bound_limits, limits_of
-from optdesign.solvers.constraint_rows import constraint_rows
+from optdesign.views.curves import stroke_curves
+from optdesign.views.design import design_rows
 
 
 @dataclass(frozen=True)
@@ -28,9 +29,9 @@ class DesignCurves:
 
 @dataclass(frozen=True)
 class SolutionFigure:
-    """What the figure of a solved design shows, evaluated (:func:`solution_figure`), so
-    that drawing it (:func:`draw_solution`) evaluates no model and can run in another
-    process.
+    """What the figure of a solved design shows, from the designs' evaluated curves and
+    rows (:mod:`optdesign.views`; :func:`solution_figure`), so that drawing it
+    (:func:`draw_solution`) evaluates no model and can run in another process.
 
     Attributes
     ----------
@@ -83,11 +84,8 @@ def solution_figure(
     req = problem.spec.requirements
     curves = []
     for label, design in designs.items():
-        with np.errstate(invalid="ignore", divide="ignore"):
-            q = problem.quantities(design)
-            ratio = np.asarray(q.ratio, dtype=float).ravel()
-            backlash = np.asarray(q.backlash.worst_case, dtype=float).ravel() if has_pin else None
-        curves.append(DesignCurves(str(label), ratio, backlash))
+        drawn = stroke_curves(problem, dict(design))
+        curves.append(DesignCurves(str(label), drawn.ratio, drawn.backlash))
     band = None
     if req.mean_ratio is not None:
         lo, hi = req.mean_ratio.min, req.mean_ratio.max
@@ -188,15 +186,15 @@ def result_figure(result) -> SolutionFigure:
     if problem is None or not result.design:
         raise ValueError("plot: the result carries no problem or no design to draw")
     start = problem.design_dict(problem.start())
-    _, violated = constraint_rows(problem, start)
-    n_bad = len(limits_of(problem, violated))
+    n_bad = len(limits_of(problem, list(design_rows(problem, start).violated)))
     initial = "initial design" + (
         f" (violates {n_bad} requirement{'s' if n_bad > 1 else ''})" if n_bad else ""
     )
     best = "optimum" if result.success else "best point found (infeasible)"
-    active, bad = constraint_rows(problem, result.design)
+    rows = design_rows(problem, result.design)
+    active = list(rows.active)
     # an infeasible point's violated requirements come first: they are the news
-    limits = limits_of(problem, bad) + limits_of(problem, active)
+    limits = limits_of(problem, list(rows.violated)) + limits_of(problem, active)
     limits += bound_limits(problem, result.design)
     binding = binding_angles(active)
     return solution_figure(problem, {initial: start, best: result.design}, limits, binding)

@@ -1,6 +1,6 @@
 """What a design achieves, as a user reads it: the mean ratio and its range over the
-stroke, the drive efficiency used, every objective with its unit (and what "size"
-measures for this mechanism)."""
+stroke, the drive efficiency used (evaluated by :mod:`optdesign.views.facts`), every
+objective with its unit (and what "size" measures for this mechanism)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from optdesign import math as m
 from optdesign.reports.display_units import Shown, objective_shown
 from optdesign.text import printable
+from optdesign.views.facts import DesignFacts, MotorFacts
 
 
 @dataclass(frozen=True)
@@ -31,22 +31,15 @@ class Fact:
         return {**self.value.to_json(), "description": self.description}
 
 
-def design_facts(problem: Any, design: dict[str, float]) -> list[Fact]:
-    """Mean ratio, ratio range, drive efficiency of ``design`` (NumPy path)."""
-    if problem is None or not design:
+def shown_facts(problem: Any, facts: DesignFacts | None) -> list[Fact]:
+    """The mean ratio, ratio range, drive efficiency (and motor) of a design's evaluated
+    ``facts`` (:func:`optdesign.views.facts.design_facts`), worded; [] for None."""
+    if problem is None or facts is None:
         return []
-    with np.errstate(all="ignore"):
-        q = problem.quantities(design)
-        ratio = np.asarray(q.ratio, dtype=float).ravel()
-        eta = np.asarray(q.drive_efficiency, dtype=float).ravel()
     out = [
-        Fact(
-            "mean_ratio",
-            Shown(float(m.grid_mean(ratio)), ""),
-            "mean reduction ratio over the stroke",
-        ),
-        Fact("ratio_min", Shown(float(np.min(ratio)), ""), "smallest ratio over the stroke"),
-        Fact("ratio_max", Shown(float(np.max(ratio)), ""), "largest ratio over the stroke"),
+        Fact("mean_ratio", Shown(facts.mean_ratio, ""), "mean reduction ratio over the stroke"),
+        Fact("ratio_min", Shown(facts.ratio_min, ""), "smallest ratio over the stroke"),
+        Fact("ratio_max", Shown(facts.ratio_max, ""), "largest ratio over the stroke"),
     ]
     req = problem.spec.requirements
     screw = problem.spec.screw
@@ -58,37 +51,24 @@ def design_facts(problem: Any, design: dict[str, float]) -> list[Fact]:
         source = "screw x gear, screw from its lead and friction"
     if req.eta_screw == 1.0 and req.eta_gear == 1.0 and problem.spec.screw is None:
         source = "lossless: the file gives no eta_screw, eta_gear or [screw]"
-    out.append(Fact("drive_efficiency", Shown(100.0 * float(np.min(eta)), "%"), source))
-    out += _motor_facts(problem, q)
+    out.append(Fact("drive_efficiency", Shown(100.0 * facts.drive_efficiency, "%"), source))
+    if facts.motor is not None:
+        out.append(_motor_fact(facts.motor))
     return out
 
 
-def _motor_facts(problem: Any, q: Any) -> list[Fact]:
+def _motor_fact(motor: MotorFacts) -> Fact:
     """The motor of the design, named, with its data and how much of each it uses."""
-    from optdesign.problem.motor_catalogue_variable import catalogue_of, motor_by_number
-
-    if problem.spec.motor is None:
-        return []
-    catalogue = catalogue_of(problem)
-    name = problem.spec.motor.designation or ""
-    if catalogue is not None:
-        try:
-            name = motor_by_number(catalogue, float(q.design["motor"])).designation
-        except Exception:  # a number that is no motor's: the membership row says so
-            return []
-    motor = q.motor_data
-    peak = float(motor.peak_torque)
-    with np.errstate(all="ignore"):
-        demand = float(np.max(np.asarray(q.motor_peak_torque, dtype=float))) if q.motion else None
+    name, peak, demand = motor.name, motor.peak_torque, motor.demand
     used = f", {100.0 * demand / peak:.3g} % of it used by the motion" if demand else ""
     text = (
         f"peak torque of the motor{' ' + name if name else ''}{used}; rotor "
-        f"{float(motor.rotor_inertia) * 10:.4g} kg*cm^2, top speed "
-        f"{float(motor.max_speed) * 60 / (2 * np.pi):.5g} 1/min"
+        f"{motor.rotor_inertia * 10:.4g} kg*cm^2, top speed "
+        f"{motor.max_speed * 60 / (2 * np.pi):.5g} 1/min"
     )
-    if motor.mass is not None and float(motor.mass) > 0:
-        text += f", mass {float(motor.mass) * 1e3:.4g} kg"
-    return [Fact("motor", Shown(peak * 1e-3, "N*m"), text)]
+    if motor.mass is not None and motor.mass > 0:
+        text += f", mass {motor.mass * 1e3:.4g} kg"
+    return Fact("motor", Shown(peak * 1e-3, "N*m"), text)
 
 
 def objective_facts(problem: Any, objectives: dict[str, float]) -> list[Fact]:

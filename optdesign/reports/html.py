@@ -2,12 +2,10 @@
 
 The page needs no network: plotly's JavaScript is inlined, and the data of every design
 shown (its values with units, its linkage sketch, its ratio and backlash over the
-stroke, what limits it) is computed here and embedded as JSON; the page only draws it
-(:mod:`optdesign.reports.html_page`). For a front, hovering or clicking a point shows
-that design; for a solve, the optimum is shown against the initial design.
-
-The sketch comes from the mechanism's public :meth:`~optdesign.mechanisms.Mechanism.
-sketch`: no mechanism is named here.
+stroke, what limits it) is evaluated by :mod:`optdesign.views` and embedded here as
+JSON; the page only draws it (:mod:`optdesign.reports.html_page`). For a front,
+hovering or clicking a point shows that design; for a solve, the optimum is shown
+against the initial design.
 
 Any text in the data may come from a user (a problem's name, a label, a constraint's
 name): :func:`~optdesign.reports.html_page.to_json` embeds it so that no string can end or re-open the ``<script>``
@@ -30,21 +28,20 @@ from optdesign.reports.display_units import (
     requirement_echo,
     variable_shown,
 )
-from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.facts import objective_facts, shown_facts
 from optdesign.reports.html_page import render
 from optdesign.reports.limits import binding_angles, bound_limits, limits_of
 from optdesign.reports.solve_text import feasibility_text, objective_value
-from optdesign.solvers.constraint_rows import constraint_rows
-from optdesign.user_code import call_method
+from optdesign.views.curves import StrokeCurves
+from optdesign.views.design import DesignView, design_view
+from optdesign.views.sketches import SketchFrame
 
 
-def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str, Any]:
-    """Everything the page shows of one design (JSON-ready)."""
-    with np.errstate(all="ignore"):
-        ev = problem.evaluate(np.array([design[v.name] for v in problem.free], dtype=float))
-        facts = design_facts(problem, design)
-    active, violated = constraint_rows(problem, design, ev=ev)  # one evaluation for both
-    objectives = ev.objectives
+def design_json(problem: Any, view: DesignView, label: str) -> dict[str, Any]:
+    """Everything the page shows of one design (JSON-ready), from its evaluated ``view``
+    (:func:`optdesign.views.design.design_view`)."""
+    design = view.design
+    active, violated = list(view.rows.active), list(view.rows.violated)
     rows = []
     for var in problem.variables:
         v = variable_shown(problem, var, design[var.name])
@@ -56,33 +53,34 @@ def design_view(problem: Any, design: dict[str, float], label: str) -> dict[str,
     return {
         "label": label,
         "design": rows,
-        "facts": [{"text": f.text(), **f.to_json(), "name": f.name} for f in facts],
+        "facts": [
+            {"text": f.text(), **f.to_json(), "name": f.name}
+            for f in shown_facts(problem, view.facts)
+        ],
         "objectives": [
             {"name": f.name, "text": f.text(), **f.value.to_json()}
-            for f in objective_facts(problem, {k: float(v) for k, v in objectives.items()})
+            for f in objective_facts(problem, dict(view.objectives))
         ],
         "limits": [
             lim.text() for lim in limits_of(problem, active) + bound_limits(problem, design)
         ],
         "violated": [lim.text() for lim in limits_of(problem, violated)],
         "active_angles": binding_angles(active),
-        "sketch": _sketch(problem, design),
-        "curves": _curves(problem, design),
+        "sketch": _sketch(view.frames),
+        "curves": _curves(problem, view.curves),
     }
 
 
-def _sketch(problem: Any, design: dict[str, float]) -> list[dict[str, Any]]:
-    mech = problem.quantities(design).mechanism
-    phis = [problem.phi[0], 0.5 * (problem.phi[0] + problem.phi[-1]), problem.phi[-1]]
+def _sketch(frames: Sequence[SketchFrame]) -> list[dict[str, Any]]:
+    """The sketch's frames as the page draws them ([]: the mechanism draws none)."""
+    if any(frame.sketch is None for frame in frames):
+        return []
     out = []
-    for phi in phis:
-        with np.errstate(all="ignore"):
-            sk = call_method(mech, "sketch", float(phi), doing="while drawing its sketch")
-        if sk is None:
-            return []
+    for frame in frames:
+        sk = frame.sketch
         out.append(
             {
-                "phi": _plotted(math.degrees(float(phi))),
+                "phi": _plotted(math.degrees(frame.phi)),
                 "links": [[[_plotted(x), _plotted(y)] for x, y in link] for link in sk.links],
                 "pivots": [[_plotted(x), _plotted(y)] for x, y in sk.pivots],
                 "slider": None if sk.slider is None else [_plotted(c) for c in sk.slider],
@@ -92,17 +90,11 @@ def _sketch(problem: Any, design: dict[str, float]) -> list[dict[str, Any]]:
     return out
 
 
-def _curves(problem: Any, design: dict[str, float]) -> dict[str, Any]:
-    with np.errstate(all="ignore"):
-        q = problem.quantities(design)
-        ratio = np.asarray(q.ratio, dtype=float).ravel()
-        backlash = (
-            np.asarray(q.backlash.worst_case, dtype=float).ravel() if problem.has("d") else None
-        )
+def _curves(problem: Any, curves: StrokeCurves) -> dict[str, Any]:
     return {
         "phi": [_plotted(v) for v in np.degrees(problem.phi)],
-        "ratio": [_plotted(v) for v in ratio],
-        "backlash": None if backlash is None else [_plotted(v) for v in backlash],
+        "ratio": [_plotted(v) for v in curves.ratio],
+        "backlash": None if curves.backlash is None else [_plotted(v) for v in curves.backlash],
     }
 
 
@@ -142,10 +134,11 @@ def solve_report(result: Any) -> str:
     if problem is None or not result.design:
         raise ValueError("report: the result carries no problem or no design")
     start = problem.design_dict(problem.start())
-    initial = design_view(problem, start, "initial design")
+    initial = design_json(problem, design_view(problem, start), "initial design")
     if initial["violated"]:
         initial["label"] = "initial design (violates the requirements)"
-    best = design_view(problem, result.design, "optimum" if result.success else "best point found")
+    label = "optimum" if result.success else "best point found"
+    best = design_json(problem, design_view(problem, result.design), label)
     best["sensitivities"] = [cost_text(s) for s in result.sensitivities]
     best["item_steps"] = [s.text() for s in result.item_steps]
     name = result.objective_name
@@ -195,7 +188,7 @@ def front_report(problem: Any, fronts: Sequence[Any]) -> str:
         coords: list[list[float]] = [[] for _ in objectives]
         for k, p in enumerate(f.points):
             label = f"{f.method} point {k + 1}"
-            view = design_view(problem, p.design, label)
+            view = design_json(problem, design_view(problem, p.design), label)
             # what each limit costs there, from the point's own solve (or why unknown)
             view.update(front_point_costs(problem, f.objectives, p))
             designs.append(view)

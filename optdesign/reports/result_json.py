@@ -20,7 +20,7 @@ from optdesign.reports.display_units import (
     requirement_values,
     variable_shown,
 )
-from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.facts import objective_facts, shown_facts
 from optdesign.reports.limits import (
     bound_limits,
     limits_of,
@@ -29,6 +29,7 @@ from optdesign.reports.limits import (
 )
 from optdesign.reports.solve_text import objective_value
 from optdesign.solvers.result import Result, clean_json
+from optdesign.views.facts import design_facts
 
 #: Name and version of the document's layout; bumped when a key changes meaning.
 SCHEMA = "optdesign.result/2"
@@ -63,7 +64,9 @@ def result_document(result: Result) -> dict[str, Any]:
         return clean_json(doc)
     doc["requirements"] = {k: json_value(v) for k, v in requirement_values(problem).items()}
     doc["design"] = _design(problem, result)
-    doc["achieved"] = {f.name: f.to_json() for f in design_facts(problem, result.design)}
+    doc["achieved"] = {
+        f.name: f.to_json() for f in shown_facts(problem, design_facts(problem, result.design))
+    }
     doc["objectives"] = {f.name: f.to_json() for f in objective_facts(problem, result.objectives)}
     limits = limits_of(problem, result.active)
     if result.design:

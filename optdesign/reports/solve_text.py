@@ -15,7 +15,7 @@ import math
 
 from optdesign.reports.costs_text import cost_text
 from optdesign.reports.display_units import objective_shown, requirement_echo, variable_shown
-from optdesign.reports.facts import design_facts, objective_facts
+from optdesign.reports.facts import objective_facts, shown_facts
 from optdesign.reports.limits import (
     at_bound,
     bound_limits,
@@ -28,6 +28,7 @@ from optdesign.reports.tables import format_table
 from optdesign.solvers.result import Result
 from optdesign.text import printable
 from optdesign.tolerances import FEASIBILITY_TOL
+from optdesign.views.facts import design_facts
 
 
 def objective_unit(problem, name: str) -> tuple[str, float]:
@@ -141,7 +142,9 @@ def result_summary(result: Result) -> str:
                 "(the optimum is not unique: the variables marked above can move within their "
                 "range, together, without changing the objective by more than 1e-6 relative)"
             )
-    facts = design_facts(problem, result.design) + objective_facts(problem, result.objectives)
+    facts = shown_facts(problem, design_facts(problem, result.design)) + objective_facts(
+        problem, result.objectives
+    )
     if facts:
         lines += ["", "at this design:"]
         lines += [f"  {f.text()}" for f in facts]

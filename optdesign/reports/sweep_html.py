@@ -18,10 +18,11 @@ from typing import Any
 
 from optdesign.reports.costs_text import cost_text
 from optdesign.reports.display_units import objective_shown
-from optdesign.reports.html import _header, design_view
+from optdesign.reports.html import _header, design_json
 from optdesign.reports.html_page import render
 from optdesign.reports.sweep_text import _cell, sweep_rows
 from optdesign.solvers.result import Sensitivity
+from optdesign.views.design import design_view
 
 #: What the page says of a point's sensitivities when the sweep did not compute them
 #: (an empty list would read "none": nothing binds).
@@ -64,7 +65,7 @@ def sweep_report(sweep: Any) -> str:
             for a, v in zip(sweep.axes, p.values, strict=True)
         )
         label = f"point {p.index}: {where}" + ("" if p.success else f" ({p.status}, best found)")
-        view = design_view(at, {**p.design, **at.fixed_values}, label)
+        view = design_json(at, design_view(at, {**p.design, **at.fixed_values}), label)
         view["sensitivities"] = [
             _cost(at, sweep.objective, name, value)
             for name, value in sorted(p.sensitivities.items(), key=lambda kv: -abs(kv[1]))

@@ -1573,15 +1573,12 @@ def test_design_efficiency_sizes_the_motor_torque_with_the_catalogue_value():
     assert ratio == pytest.approx(0.92688 / 0.85, rel=1e-4)
     assert _flat(design.lock_force) == pytest.approx(_flat(friction.lock_force), rel=1e-12)
     # the summary's efficiency fact says where the value comes from
-    from optdesign.reports.facts import design_facts
+    from optdesign.reports.facts import shown_facts
+    from optdesign.views.facts import design_facts
 
     problem = _fin_with(screw={"efficiency_design": "HIWIN"})
-    facts = {
-        f.name: f
-        for f in design_facts(
-            problem, problem.design_dict(np.array([OPT[x.name] for x in problem.free]))
-        )
-    }
+    design = problem.design_dict(np.array([OPT[x.name] for x in problem.free]))
+    facts = {f.name: f for f in shown_facts(problem, design_facts(problem, design))}
     assert "HIWIN's design value 0.85" in facts["drive_efficiency"].description
     assert facts["drive_efficiency"].value.value == pytest.approx(100 * 0.85 * 0.96)
     data = tomllib.loads(FIN.read_text())

@@ -97,3 +97,30 @@ def test_report_refuses_a_result_without_a_design(tmp_path):
     with pytest.raises(InputError, match=r"^result: has no design to report \(status optimal\)"):
         od.report(empty, tmp_path / "r.html")
     assert not (tmp_path / "r.html").exists()
+
+
+def test_the_page_of_a_design_reads_its_view_and_evaluates_no_model(monkeypatch):
+    """What the page shows of a design comes from its evaluated view
+    (:func:`optdesign.views.design.design_view`): formatting it neither evaluates the
+    design nor sketches its mechanism (the limits' wording reads the problem's
+    declarations only)."""
+    import dataclasses
+
+    from optdesign.reports.html import design_json
+    from optdesign.views.design import design_view
+
+    problem = od.load(ROOT / "problems" / "cs_min_ripple.toml")
+    view = design_view(problem, problem.design_dict(problem.start()))
+
+    def evaluates(*args, **kw):
+        raise AssertionError("the page evaluated the model")
+
+    monkeypatch.setattr(problem, "evaluate", evaluates)
+    monkeypatch.setattr(problem.mechanism, "sketch", evaluates)
+    data = design_json(problem, view, "initial design")
+    assert data["label"] == "initial design"
+    assert len(data["sketch"]) == 3
+    assert len(data["curves"]["ratio"]) == len(view.curves.ratio)
+    # a mechanism that draws no sketch at one angle: the page shows none
+    frames = (dataclasses.replace(view.frames[0], sketch=None), *view.frames[1:])
+    assert design_json(problem, dataclasses.replace(view, frames=frames), "x")["sketch"] == []
