@@ -1,0 +1,216 @@
+"""The actuator in its position loop, from the design (issue 38; docs/loop.md): the
+drive's plant at every grid angle and the controller of ``[loop]``, for any mechanism.
+
+Everything here reads the design's quantities (:class:`~optdesign.problem.quantities.
+Quantities`: the ratio f'(phi), the motor-side inertia, the chain's stiffness, the
+clearance chain's worst-case backlash) and the problem's ``[motor]``, ``[load]`` and
+``[loop]`` sections; the equations are :mod:`optdesign.models.loop_plant`'s. Two forms:
+
+* :func:`plant_grid` and :func:`loop_gains`: the plant and the gains as expressions over
+  the grid (CasADi on the solver path, NumPy arrays on the checking path), which the
+  requirement rows (:mod:`optdesign.problem.loop_requirements`) are built from;
+* :func:`drive_plants` and :func:`position_loop`: one :class:`~optdesign.models.
+  loop_plant.DrivePlant` per grid angle and the :class:`~optdesign.models.loop_plant.
+  PositionLoop`, numbers, for the post-solve analyses (poles, limit cycles, simulation).
+
+Internal units: mm, t, s, N, rad (the current loop's lag is read from the file in h).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from optdesign import math as m
+from optdesign.errors import ProblemError
+from optdesign.models.loop_plant import DrivePlant, PositionLoop
+
+#: The chain's damping ratio when ``[loop]`` gives none: 2 % of critical, a steel drive
+#: of bearings, a ball nut and pins (a lightly damped structure, 1-5 %).
+DEFAULT_CHAIN_DAMPING_RATIO = 0.02
+
+#: The hours of a file's time in seconds.
+HOUR = 3600.0
+
+
+@dataclass(frozen=True)
+class PlantGrid:
+    """The drive's plant at every grid angle (the fields of :class:`~optdesign.models.
+    loop_plant.DrivePlant`, each a grid expression or a number; internal units). ``phi``
+    holds the grid angles (rad)."""
+
+    motor_inertia: Any
+    ratio: Any
+    fin_inertia: float
+    stiffness: Any
+    damping: Any
+    hinge_spring: float
+    fin_damping: float
+    backlash: Any
+    friction_torque: float
+    peak_torque: Any
+    max_speed: Any
+    phi: Any
+
+    @property
+    def motor_inertia_at_fin(self) -> Any:
+        """J_1 = J_m f'^2 over the grid (t*mm^2)."""
+        return self.motor_inertia * self.ratio**2
+
+
+@dataclass(frozen=True)
+class LoopGains:
+    """The controller of ``[loop]`` (kp, kd, ki: motor torque per fin angle, internal
+    units; ``current_lag`` in s): numbers for fixed gains, design expressions for gains
+    placed from a bandwidth (:func:`loop_gains`)."""
+
+    kp: Any
+    kd: Any
+    ki: float
+    current_lag: float
+    feedback: str
+
+
+def _need_loop(q):
+    spec = q.problem.spec
+    if spec.loop is None:
+        raise ProblemError("the position loop: needs a [loop] section (its gains or bandwidth)")
+    for section, what in (
+        ("motor", "the motor's inertia and limits"),
+        ("load", "the fin's inertia"),
+        ("screw", "the chain's stiffness: its bearings, nut and shaft"),
+    ):
+        if getattr(spec, section) is None:
+            raise ProblemError(f"[loop]: needs a [{section}] section ({what})")
+    return spec.loop
+
+
+def chain_damping(q, stiffness, J1, J2) -> Any:
+    """The chain's viscous damping at the fin (N*mm*s/rad) over the grid: ``[loop]
+    chain_damping``, or 2 zeta sqrt(k J1 J2 / (J1 + J2)) for its ``chain_damping_ratio``
+    (default :data:`DEFAULT_CHAIN_DAMPING_RATIO`): zeta of critical for the chain's own
+    mode, the two inertias beating against each other on k."""
+    loop = q.problem.spec.loop
+    if loop.chain_damping is not None:
+        return loop.chain_damping + 0.0 * stiffness
+    zeta = loop.chain_damping_ratio
+    zeta = DEFAULT_CHAIN_DAMPING_RATIO if zeta is None else zeta
+    return 2.0 * zeta * m.sqrt(stiffness * J1 * J2 / (J1 + J2))
+
+
+def backlash_half_width(q) -> Any:
+    """b: half the clearance chain's worst-case backlash at the fin (rad) over the grid;
+    the backlash of :class:`~optdesign.mechanisms.joints.Backlash` is the full play
+    between the two contacts, in degrees. 0 for a chain without clearance."""
+    if not q.joints:
+        return 0.0 * q.ratio
+    return q.backlash.worst_case * (np.pi / 180.0) / 2.0
+
+
+def plant_grid(q) -> PlantGrid:
+    """The design's plant at every grid angle (see the module's docstring): J_m from
+    ``motor_side_inertia``, f' the ratio, the fin's inertia, hinge spring and damping of
+    ``[load]``, the chain's stiffness at the fin with the motor held, its damping
+    (:func:`chain_damping`), b (:func:`backlash_half_width`), the motor's friction, peak
+    torque and top speed."""
+    _need_loop(q)
+    load = q.problem.spec.load
+    motor = q.motor_data
+    k = q.output_stiffness
+    Jm = q.motor_side_inertia
+    f = q.ratio
+    J2 = load.inertia
+    return PlantGrid(
+        motor_inertia=Jm,
+        ratio=f,
+        fin_inertia=J2,
+        stiffness=k,
+        damping=chain_damping(q, k, Jm * f**2, J2),
+        hinge_spring=load.hinge_spring,
+        fin_damping=load.damping,
+        backlash=backlash_half_width(q),
+        friction_torque=motor.friction_torque,
+        peak_torque=motor.peak_torque,
+        max_speed=motor.max_speed,
+        phi=q.phi,
+    )
+
+
+def bandwidth_factor(zeta: float) -> float:
+    """w_b / w_n of the second-order loop w_n^2 / (s^2 + 2 zeta w_n s + w_n^2): the
+    frequency where its gain falls to 1/sqrt(2), over its natural frequency: 1 at zeta =
+    1/sqrt(2), 0.6436 at zeta = 1, 1.5538 at zeta = 0."""
+    a = 1.0 - 2.0 * zeta**2
+    return float(np.sqrt(a + np.sqrt(a * a + 1.0)))
+
+
+def _on_grid(mean, like):
+    # A design's mean (one value) against its grid: NumPy keeps the grid on the last axis.
+    if m.is_symbolic(mean, like):
+        return mean
+    return np.asarray(mean)[..., None] if np.ndim(like) > np.ndim(mean) else mean
+
+
+def loop_gains(q) -> LoopGains:
+    """The controller: ``[loop]``'s gains, or kp and kd placed for its ``bandwidth`` and
+    ``damping_ratio`` on the rigid drive at the design's mean ratio: with J = J_m f'^2 +
+    J_fin (J_m and f' their grid means), f' kp = J w_n^2 - k_h and f' kd = 2 zeta w_n J -
+    c_fin, w_n = 2 pi bandwidth / :func:`bandwidth_factor`. One controller for the stroke:
+    at an angle whose ratio is above the mean the loop is faster, below it slower."""
+    loop = _need_loop(q)
+    lag = loop.current_lag * HOUR
+    if loop.bandwidth is None:
+        return LoopGains(loop.kp, loop.kd or 0.0, loop.ki, lag, loop.feedback)
+    load = q.problem.spec.load
+    f = _on_grid(m.grid_mean(q.ratio), q.ratio)
+    Jm = _on_grid(m.grid_mean(q.motor_side_inertia + 0.0 * q.ratio), q.ratio)
+    J = Jm * f**2 + load.inertia
+    wn = 2.0 * np.pi * loop.bandwidth / bandwidth_factor(loop.zeta)
+    kp = (J * wn**2 - load.hinge_spring) / f
+    kd = m.fmax(2.0 * loop.zeta * wn * J - load.damping, 0.0) / f
+    return LoopGains(kp, kd, loop.ki, lag, loop.feedback)
+
+
+def _number(value: Any, k: int, width: int) -> float:
+    """Entry ``k`` of a grid quantity of one design (a number, a grid, or a design's
+    row of a population of one)."""
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 0:
+        return float(a)
+    a = a.reshape(-1)
+    if a.size == 1:
+        return float(a[0])
+    if a.size != width:
+        raise ValueError(f"a grid quantity of {a.size} values for a grid of {width}")
+    return float(a[k])
+
+
+def drive_plants(q) -> list[DrivePlant]:
+    """One :class:`~optdesign.models.loop_plant.DrivePlant` per grid angle of the design
+    whose NumPy quantities are ``q`` (one design, not a population)."""
+    grid = plant_grid(q)
+    width = len(np.asarray(q.phi).reshape(-1))
+    names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
+    return [
+        DrivePlant(
+            **{n: _number(getattr(grid, n), k, width) for n in names},
+            angle=float(np.asarray(q.phi).reshape(-1)[k]),
+        )
+        for k in range(width)
+    ]
+
+
+def position_loop(q) -> PositionLoop:
+    """The :class:`~optdesign.models.loop_plant.PositionLoop` of the design whose NumPy
+    quantities are ``q``; a placed kp that is not positive (a bandwidth below the fin's
+    own frequency on its stabilising hinge spring) refused naming ``loop.bandwidth``."""
+    gains = loop_gains(q)
+    kp = _number(gains.kp, 0, 1)
+    if not kp > 0:
+        raise ProblemError(
+            f"loop.bandwidth: places kp = {kp:.4g} N*mm/rad at this design; the fin's hinge "
+            "spring alone is stiffer than the loop asked for: raise the bandwidth"
+        )
+    return PositionLoop(kp, _number(gains.kd, 0, 1), gains.ki, gains.current_lag, gains.feedback)
