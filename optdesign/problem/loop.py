@@ -173,44 +173,54 @@ def loop_gains(q) -> LoopGains:
     return LoopGains(kp, kd, loop.ki, lag, loop.feedback)
 
 
-def _number(value: Any, k: int, width: int) -> float:
-    """Entry ``k`` of a grid quantity of one design (a number, a grid, or a design's
-    row of a population of one)."""
+def _rows(value: Any, pop: int, width: int) -> np.ndarray:
+    """A grid quantity of a population as a (pop, width) array (a number, a grid, or one
+    row per design)."""
     a = np.asarray(value, dtype=float)
-    if a.ndim == 0:
-        return float(a)
-    a = a.reshape(-1)
-    if a.size == 1:
-        return float(a[0])
-    if a.size != width:
-        raise ValueError(f"a grid quantity of {a.size} values for a grid of {width}")
-    return float(a[k])
+    if a.ndim == 2 and a.shape[0] == pop:
+        return np.broadcast_to(a, (pop, width))
+    return np.broadcast_to(a.reshape(-1) if a.ndim else a, (pop, width))
+
+
+def _population(q) -> int:
+    sizes = [np.shape(v)[0] for v in q.design.values() if np.ndim(v) == 2]
+    return max(sizes, default=1)
+
+
+def drive_plants_of(q) -> list[tuple[list[DrivePlant], PositionLoop]]:
+    """For each design of the NumPy quantities ``q`` (one design, or a population: one
+    row per design), its :class:`~optdesign.models.loop_plant.DrivePlant` at every grid
+    angle and its :class:`~optdesign.models.loop_plant.PositionLoop`."""
+    grid, gains = plant_grid(q), loop_gains(q)
+    phi = np.asarray(q.phi, dtype=float).reshape(-1)
+    pop, width = _population(q), len(phi)
+    names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
+    values = {n: _rows(getattr(grid, n), pop, width) for n in names}
+    kp, kd = _rows(gains.kp, pop, 1)[:, 0], _rows(gains.kd, pop, 1)[:, 0]
+    out = []
+    for i in range(pop):
+        if not kp[i] > 0:
+            raise ProblemError(
+                f"loop.bandwidth: places kp = {kp[i]:.4g} N*mm/rad at this design; the fin's "
+                "hinge spring alone is stiffer than the loop asked for: raise the bandwidth"
+            )
+        loop = PositionLoop(kp[i], kd[i], gains.ki, gains.current_lag, gains.feedback)
+        plants = [
+            DrivePlant(**{n: float(values[n][i, k]) for n in names}, angle=float(phi[k]))
+            for k in range(width)
+        ]
+        out.append((plants, loop))
+    return out
 
 
 def drive_plants(q) -> list[DrivePlant]:
     """One :class:`~optdesign.models.loop_plant.DrivePlant` per grid angle of the design
-    whose NumPy quantities are ``q`` (one design, not a population)."""
-    grid = plant_grid(q)
-    width = len(np.asarray(q.phi).reshape(-1))
-    names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
-    return [
-        DrivePlant(
-            **{n: _number(getattr(grid, n), k, width) for n in names},
-            angle=float(np.asarray(q.phi).reshape(-1)[k]),
-        )
-        for k in range(width)
-    ]
+    whose NumPy quantities are ``q`` (one design)."""
+    return drive_plants_of(q)[0][0]
 
 
 def position_loop(q) -> PositionLoop:
     """The :class:`~optdesign.models.loop_plant.PositionLoop` of the design whose NumPy
     quantities are ``q``; a placed kp that is not positive (a bandwidth below the fin's
     own frequency on its stabilising hinge spring) refused naming ``loop.bandwidth``."""
-    gains = loop_gains(q)
-    kp = _number(gains.kp, 0, 1)
-    if not kp > 0:
-        raise ProblemError(
-            f"loop.bandwidth: places kp = {kp:.4g} N*mm/rad at this design; the fin's hinge "
-            "spring alone is stiffer than the loop asked for: raise the bandwidth"
-        )
-    return PositionLoop(kp, _number(gains.kd, 0, 1), gains.ki, gains.current_lag, gains.feedback)
+    return drive_plants_of(q)[0][1]

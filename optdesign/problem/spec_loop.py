@@ -36,7 +36,10 @@ class Loop(_Model):
     ``feedback``: the angle measured ("fin", or "motor": the encoder on the motor).
     ``chain_damping`` (at the fin, across the chain) or ``chain_damping_ratio`` (of the
     chain's own mode, c = 2 zeta sqrt(k J1 J2 / (J1 + J2)) at each angle): the chain's
-    viscous damping, 2 % of critical when neither is given."""
+    viscous damping, 2 % of critical when neither is given. ``angles``: how many of the
+    stroke's grid angles, evenly spread and both ends included, carry the loop's
+    requirement rows (each costs the solver a frequency response per frequency checked;
+    at most the grid's points)."""
 
     kp: RotationalStiffness | None = None
     kd: RotationalDamping | None = None
@@ -47,6 +50,7 @@ class Loop(_Model):
     feedback: Literal["fin", "motor"] = "fin"
     chain_damping: RotationalDamping | None = None
     chain_damping_ratio: Dimensionless | None = Field(None, ge=0.0, lt=1.0)
+    angles: int = Field(7, ge=2, le=2001)
 
     @model_validator(mode="after")
     def _one_tuning(self):

@@ -1,0 +1,258 @@
+"""The position loop's requirements and objectives (issue 38; docs/loop.md): smooth rows
+at every grid angle, built from the design's plant (:mod:`optdesign.problem.loop`) and
+the loop's frequency response (:func:`optdesign.models.loop_linear.loop_response`).
+
+What each row checks, at each grid angle, on the linear loop (the gap closed, no
+friction, no torque or speed limit):
+
+* ``bandwidth`` (``requirements.bandwidth_min`` = f_b): |T(j w_b)|^2 / |T(j w_b / 10^4)|^2
+  >= 1/2, w_b = 2 pi f_b: the closed loop from the reference to the fin still passes half
+  the power of its static gain (the gain four decades below, within 1e-8 of it) at f_b;
+* ``phase_margin`` (``phase_margin_min`` = PM) and ``modulus_margin``
+  (``modulus_margin_min`` = s): the return difference |1 + L(jw)| kept at or above
+  2 sin(PM / 2), or s, on :data:`POINTS_PER_DECADE` log-spaced frequencies per decade
+  from f_ref / 10 to 100 f_ref, and at the drive's own mode w_r. The row holds a smooth
+  lower bound of the smallest |1 + L| on those frequencies, (sum_k |1 + L_k|^-2p)^(-1/2p)
+  with p = :data:`SOFT_MIN_POWER`: it never exceeds the true minimum, so the check is
+  conservative. Where |L| = 1, |1 + L| = 2 sin(PM' / 2) with PM' the phase margin: the
+  row implies a phase margin of at least PM (and a gain margin of at least
+  1 / (1 - 2 sin(PM / 2))); it asks more than the phase margin alone;
+* ``resonance_margin`` (``resonance_margin_min`` = g): 1 / |L(j w_r)| >= g at the
+  frequency w_r of the drive's own mode (motor free, :func:`~optdesign.problem.
+  motor_drive.two_mass_frequency_squared`): the loop's gain at the resonance stays g
+  times below 1, whatever its phase (gain stabilisation of the mode);
+* ``loop_stable`` (always, with ``[loop]``): the smallest damping ratio -Re p / |p| of the
+  closed loop's poles p, above 1e-9 (:func:`optdesign.models.loop_linear.is_stable`).
+  Checked on the NumPy path only - the independent check of every solver's answer, the
+  margins' rows steer the solver - so a solver's design whose loop is unstable is no
+  verified result.
+
+The backlash limit cycle's amplitude is not a row: it is computed after the solve by
+harmonic balance (:func:`optdesign.problem.loop_analysis.loop_report`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields
+from typing import Any
+
+import numpy as np
+
+from optdesign import math as m
+from optdesign.models import loop_linear as ll
+from optdesign.problem.loop import LoopGains, PlantGrid, drive_plants_of, loop_gains, plant_grid
+from optdesign.problem.objectives import ConstraintBlock
+
+#: The margins' frequencies about the drive's mode: w_r (1 + RESONANCE_STEP j), j = -2..2.
+RESONANCE_STEP = 0.04
+#: The power p of the smooth minimum (sum x^-p)^(-1/p) of |1 + L|^2 over the grid: it is
+#: below the true minimum by at most a factor n^(1/p) (n frequencies equally near it).
+SOFT_MIN_POWER = 16
+#: The static gain is |T| this many times below the bandwidth's frequency.
+STATIC_BELOW = 1e4
+#: The smallest damping ratio of a stable loop's poles (the roots' own precision).
+STABLE_DAMPING = 1e-9
+
+
+def reference_frequency(spec) -> float:
+    """f_ref (Hz), the middle of the margins' grid: the required bandwidth, else the
+    bandwidth the gains are placed for, else 10 Hz."""
+    req, loop = spec.requirements, spec.loop
+    if req.bandwidth_min is not None:
+        return req.bandwidth_min
+    if loop is not None and loop.bandwidth is not None:
+        return loop.bandwidth
+    return 10.0
+
+
+def margin_frequencies(spec) -> np.ndarray:
+    """The margins' fixed frequencies (rad/s): f_ref x 2^(k/2), k = -2 ... 4 (half an
+    octave apart from f_ref / 2 to 4 f_ref, around the loop's crossover;
+    :func:`reference_frequency`)."""
+    f = reference_frequency(spec)
+    return 2.0 * np.pi * f * 2.0 ** (np.arange(-2, 5) / 2.0)
+
+
+def loop_angles(problem) -> np.ndarray:
+    """Indices of the grid angles that carry the loop's rows: ``[loop] angles`` of them
+    (at most the grid's), evenly spread, both ends included."""
+    n = len(problem.phi)
+    count = min(problem.spec.loop.angles, n)
+    return np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
+
+
+def _pick(x: Any, idx: np.ndarray, n: int) -> Any:
+    """The entries ``idx`` of a grid quantity (a number stays a number)."""
+    if m.is_symbolic(x):
+        return x[[int(i) for i in idx]] if x.shape[0] == n else x
+    a = np.asarray(x)
+    return a[..., idx] if a.ndim and a.shape[-1] == n else x
+
+
+def _picked(grid: PlantGrid, idx: np.ndarray, n: int) -> PlantGrid:
+    return PlantGrid(**{f.name: _pick(getattr(grid, f.name), idx, n) for f in fields(PlantGrid)})
+
+
+def _response(grid: PlantGrid, gains: LoopGains, omega) -> ll.LoopResponse:
+    return ll.loop_response(
+        grid.motor_inertia,
+        grid.ratio,
+        grid.fin_inertia,
+        grid.stiffness,
+        grid.damping,
+        grid.hinge_spring,
+        grid.fin_damping,
+        gains.kp,
+        gains.kd,
+        gains.ki,
+        gains.current_lag,
+        omega,
+        gains.feedback,
+    )
+
+
+def resonance_frequency(q, idx: np.ndarray | None = None) -> Any:
+    """w_r (rad/s): the drive's own mode, motor free, over the grid (at ``idx``)."""
+    w2 = q.two_mass_frequency_squared
+    return m.sqrt(w2 if idx is None else _pick(w2, idx, len(q.phi)))
+
+
+def bandwidth_ratio(q, grid: PlantGrid, gains: LoopGains, f_b: float) -> Any:
+    """|T(j w_b)|^2 / |T(j w_b / 10^4)|^2 over the grid (see the module's docstring)."""
+    w = 2.0 * np.pi * f_b
+    at = ll.closed_loop_gain_squared(_response(grid, gains, w))
+    static = ll.closed_loop_gain_squared(_response(grid, gains, w / STATIC_BELOW))
+    return at / static
+
+
+def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:
+    """The smooth lower bound of min |1 + L(jw)| over the margins' frequencies and about
+    w_r (see the module's docstring), at the loop's angles ``idx``."""
+    p = SOFT_MIN_POWER
+    total = 0.0
+    w_r = resonance_frequency(q, idx)
+    around = [w_r * (1.0 + RESONANCE_STEP * j) for j in range(-2, 3)]
+    for w in (*margin_frequencies(q.problem.spec), *around):
+        x = ll.return_difference_squared(_response(grid, gains, w))
+        total = total + (x + 1e-30) ** (-p)
+    return total ** (-0.5 / p)
+
+
+def resonance_gain(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:
+    """|L(j w_r)| at the loop's angles ``idx``: the loop's gain at the drive's own mode."""
+    r = _response(grid, gains, resonance_frequency(q, idx))
+    return m.sqrt(r.open_re**2 + r.open_im**2)
+
+
+def least_pole_damping(q) -> np.ndarray:
+    """The smallest damping ratio -Re p / |p| of the closed loop's poles at each grid
+    angle (NumPy, one row per design of a population)."""
+    out = []
+    for plants, loop in drive_plants_of(q):
+        row = []
+        for plant in plants:
+            poles = ll.closed_loop_poles(plant, loop)
+            row.append(float(np.min(-poles.real / np.maximum(np.abs(poles), 1e-300))))
+        out.append(row)
+    return np.array(out)
+
+
+def _phase_margin(modulus):
+    return np.degrees(2.0 * np.arcsin(np.clip(np.asarray(modulus, dtype=float) / 2.0, -1, 1)))
+
+
+def _inverse(x):
+    return 1.0 / np.asarray(x, dtype=float)
+
+
+def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
+    """The loop's rows (module docstring); none without ``[loop]``."""
+    spec = q.problem.spec
+    req = spec.requirements
+    wanted = [
+        name
+        for name in ("bandwidth_min", "phase_margin_min", "modulus_margin_min", "resonance_margin_min")
+        if getattr(req, name) is not None
+    ]
+    if spec.loop is None:
+        if wanted:
+            from optdesign.errors import ProblemError
+
+            raise ProblemError(f"requirements.{wanted[0]}: needs a [loop] section (its gains)")
+        return []
+    full, gains = plant_grid(q), loop_gains(q)
+    idx = loop_angles(q.problem)
+    grid = _picked(full, idx, len(q.phi))
+    at = [labels[i] for i in idx]
+    out: list[ConstraintBlock] = []
+    if req.bandwidth_min is not None:
+        out.append(
+            ConstraintBlock(
+                "bandwidth",
+                bandwidth_ratio(q, grid, gains, req.bandwidth_min),
+                0.5,
+                None,
+                at,
+                "",
+                f"closed-loop gain at {req.bandwidth_min:g} Hz over its static gain, squared "
+                "(>= 1/2: the -3 dB bandwidth is above it)",
+            )
+        )
+    least = None
+    if req.phase_margin_min is not None or req.modulus_margin_min is not None:
+        least = soft_least_return_difference(q, grid, gains, idx)
+    if req.phase_margin_min is not None:
+        out.append(
+            ConstraintBlock(
+                "phase_margin",
+                least,
+                2.0 * np.sin(req.phase_margin_min / 2.0),
+                None,
+                at,
+                "",
+                "phase margin the return difference min |1 + L(jw)| guarantees, "
+                "2 asin(min |1 + L| / 2) (the row holds min |1 + L|)",
+                display=_phase_margin,
+                display_unit="deg",
+            )
+        )
+    if req.modulus_margin_min is not None:
+        out.append(
+            ConstraintBlock(
+                "modulus_margin",
+                least,
+                req.modulus_margin_min,
+                None,
+                at,
+                "",
+                "smallest return difference |1 + L(jw)| on the margins' frequencies",
+            )
+        )
+    if req.resonance_margin_min is not None:
+        out.append(
+            ConstraintBlock(
+                "resonance_margin",
+                resonance_gain(q, grid, gains, idx),
+                None,
+                1.0 / req.resonance_margin_min,
+                at,
+                "",
+                "1 / loop gain at the drive's own mode (the row holds the gain |L(j w_r)|)",
+                display=_inverse,
+                display_unit="",
+            )
+        )
+    if not m.is_symbolic(q.ratio):
+        out.append(
+            ConstraintBlock(
+                "loop_stable",
+                least_pole_damping(q),
+                STABLE_DAMPING,
+                None,
+                labels,
+                "",
+                "smallest damping ratio of the closed loop's poles (> 0: stable; checked "
+                "on the independent NumPy path, not a row of the NLP)",
+            )
+        )
+    return out
