@@ -43,15 +43,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models.describing_function import DeadZone, dead_zone_df
+from optdesign.models.describing_function import DeadZone
 from optdesign.models.harmonic_balance import (
     HarmonicBalance,
     LimitCycle,
     harmonic_balance,
     polynomial_loop,
 )
-from optdesign.models.loop_linear import frequency_range, scaled_roots
+from optdesign.models.loop_linear import frequency_range
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
 
 
@@ -199,24 +200,54 @@ def limit_cycles(plant: DrivePlant, loop: PositionLoop, points: int = 8000) -> B
     return BacklashCycles(tuple(cycles), reason, b, hb)
 
 
-def deflection_loop_poles(plant: DrivePlant, loop: PositionLoop) -> np.ndarray:
-    """Poles of L_d (rad/s): with the gap open (N = 0), the loop's own modes."""
-    return scaled_roots(deflection_loop(plant, loop)[1])
+def cycle_amplitude_margin(
+    loop_at_crossover,
+    frequency,
+    amplitude_max,
+    backlash,
+    stiffness,
+    damping,
+    fin_inertia,
+    fin_damping,
+    hinge_spring,
+):
+    """A smooth indicator that the phase crossover of L_d at ``frequency`` sustains no
+    cycle whose fin amplitude exceeds ``amplitude_max``: >= 0 when it does not.
 
+    At a phase crossover w (Im L_d(jw) = 0, L_d(jw) = ``loop_at_crossover`` < -1) the
+    cycle's deflection A solves N(A) = N* = -1/L_d, and the fin swings with
+    N* A g, g = |k + j w c| / |D_2(jw)|, increasing in A. So the fin amplitude is at most
+    ``amplitude_max`` exactly when N* <= N(A_max), A_max = ``amplitude_max`` / (N* g) the
+    deflection that would give it: the indicator is N(A_max) - N*, with N the dead zone's
+    describing function (:func:`~optdesign.models.describing_function.dead_zone_df`)
+    written through :mod:`optdesign.math` (0 for A_max <= b).
 
-def no_cycle_above(L_crossover, frequency, amplitude_max, plant: DrivePlant):
-    """The smooth indicator: >= 0 when the phase crossover of L_d at ``frequency``
-    (where L_d = ``L_crossover`` < -1, real) sustains no cycle whose fin amplitude exceeds
-    ``amplitude_max`` (rad).
+    Works on CasADi symbols. Its limits (docs/loop.md): it holds at one phase crossover,
+    which an NLP must track (w a variable bracketed between the crossovers of the
+    design's family, with Im L_d(jw) = 0 a constraint); where L_d(jw) >= -1 there is no
+    cycle at all but the indicator is negative (N* >= 1 > N); and it is a statement of the
+    describing function, as good as its filter hypothesis at that crossover.
 
-    At the crossover the cycle's deflection A solves N(A) = -1/L_d and its fin amplitude
-    is N A |k + jwc| / |D_2(jw)|, increasing in A; the fin amplitude is at most
-    ``amplitude_max`` exactly when N(A_d) >= -1/L_d, A_d the deflection that gives the
-    fin ``amplitude_max`` at this N. Returned: N(A_d) + 1/L_d (NumPy; see docs/loop.md
-    for the NLP form and its limits).
+    Parameters
+    ----------
+    loop_at_crossover
+        L_d(jw), real (< -1 where a cycle exists).
+    frequency
+        The phase crossover w (rad/s).
+    amplitude_max
+        The fin amplitude allowed (rad).
+    backlash, stiffness, damping, fin_inertia, fin_damping, hinge_spring
+        The :class:`~optdesign.models.loop_plant.DrivePlant` quantities (rad, N*mm/rad,
+        N*mm*s/rad, t*mm^2, N*mm*s/rad, N*mm/rad).
     """
-    N = -1.0 / L_crossover
-    d2 = plant.hinge_spring - plant.fin_inertia * frequency**2 + 1j * plant.fin_damping * frequency
-    gain = abs(plant.stiffness + 1j * frequency * plant.damping) / abs(d2)
-    A_d = amplitude_max / (N * gain)
-    return dead_zone_df(A_d, plant.backlash) - N
+    w = frequency
+    n_star = -1.0 / loop_at_crossover
+    d2_re = hinge_spring - fin_inertia * w * w
+    d2_im = fin_damping * w
+    gain = m.sqrt((stiffness**2 + (w * damping) ** 2) / (d2_re**2 + d2_im**2))
+    a_max = amplitude_max / (n_star * gain)
+    # r = b / A_max clipped at 1: N = 0 inside the gap; N is C^1 through r = 1
+    r = m.fmin(backlash / a_max, 1.0)
+    root = m.sqrt(m.fmax(1.0 - r * r, 0.0))
+    n_max = 1.0 - 2.0 / m.pi * (m.arcsin(r) + r * root)
+    return n_max - n_star

@@ -538,3 +538,24 @@ def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSi
         loop=sys.c,
         input_reference=reference,
     )
+
+
+def steady_oscillation(sim: LoopSimulation, start: float) -> tuple[float, float]:
+    """The fin's oscillation after ``start`` (s): (amplitude, frequency).
+
+    The amplitude is half the fin angle's peak-to-peak (rad), the frequency pi times the
+    number of crossings of its mid-range, less one, over the time between the first and
+    the last (rad/s; each crossing interpolated linearly). ``nan`` for the frequency with
+    fewer than three crossings. A measure of a settled limit cycle, for comparing with
+    :func:`optdesign.models.loop_backlash.limit_cycles`.
+    """
+    keep = sim.times >= start
+    if np.count_nonzero(keep) < 3:
+        raise InputError("start", f"leaves fewer than 3 samples (got {start!r} s)")
+    t, y = sim.times[keep], sim.fin_angle[keep]
+    mid = 0.5 * (y.max() + y.min())
+    above = y > mid
+    i = np.flatnonzero(above[:-1] != above[1:])
+    tz = t[i] + (mid - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i])
+    w = math.pi * (tz.size - 1) / (tz[-1] - tz[0]) if tz.size >= 3 else float("nan")
+    return float(0.5 * (y.max() - y.min())), float(w)
