@@ -107,7 +107,10 @@ class SineReference:
     def __call__(self, t: float) -> float:
         return self.offset + self.amplitude * math.sin(self.frequency * t)
 
-    breaks: tuple[float, ...] = ()
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times where the reference jumps: none."""
+        return ()
 
 
 @dataclass(frozen=True)
@@ -141,7 +144,10 @@ class SampledReference:
     def __call__(self, t: float) -> float:
         return float(np.interp(t, self._t, self._a))
 
-    breaks: tuple[float, ...] = ()
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times where the reference jumps: none."""
+        return ()
 
 
 Reference = StepReference | SineReference | SampledReference
