@@ -377,7 +377,7 @@ def simulate(
     samples: int = 2001,
     initial_motor_angle: float = 0.0,
     initial_fin_angle: float = 0.0,
-    rtol: float = 1e-7,
+    rtol: float = 1e-6,
     max_events: int = 20_000,
 ) -> LoopSimulation:
     """The drive's response in its loop from rest (module docstring).
