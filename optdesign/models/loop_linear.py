@@ -320,8 +320,9 @@ def _roots_of(fn, w: np.ndarray) -> list[float]:
 
 
 def bandwidth(plant: DrivePlant, loop: PositionLoop) -> float:
-    """The closed loop's -3 dB bandwidth (rad/s): the first frequency where |T(jw)| falls
-    to |T(0)| / sqrt(2), the static gain's (python-control's ``bandwidth``).
+    """The closed loop's bandwidth (rad/s): the first frequency where |T(jw)| falls to
+    |T(0)| / sqrt(2), half the static gain's power (python-control's ``bandwidth`` with
+    ``dbdrop = -3.0103``; its default -3 dB is 0.1 % higher).
 
     |T(0)| is 1 with integral action and fin feedback, k / (k + k_h) with integral action
     and motor feedback (the hinge load deflects the chain outside the loop); without

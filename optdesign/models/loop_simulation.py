@@ -355,6 +355,10 @@ class _System:
             mode = (contact, side, 1 if motor > 0 else -1)
         if mode[2] == 0:  # a stuck motor whose load changed: it may slip at once
             return self.stick_check(t, x, mode)
+        if abs(mode[2]) == 2:  # a held one may no longer be asked for its hold torque
+            s = 1 if mode[2] > 0 else -1
+            if s * (self.command(t, x) - self.motor_torque(t, x, mode)) <= 0:
+                return (mode[0], mode[1], s), x
         return mode, x
 
 
