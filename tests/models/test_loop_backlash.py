@@ -107,6 +107,42 @@ def test_fin_feedback_gap_sustains_a_stable_cycle_below_the_chain_resonance():
     assert cycles.largest_stable_fin_amplitude == c.fin_amplitude
 
 
+def test_stable_cycle_equals_python_controls_describing_function_response():
+    ct = pytest.importorskip("control")
+    if not hasattr(ct, "describing_function_response"):
+        pytest.skip("python-control < 0.10 has no describing_function_response")
+    import warnings
+
+    class DeadZoneNL(ct.DescribingFunctionNonlinearity):
+        def __init__(self, b):
+            self.b = b
+
+        def __call__(self, x):
+            return _dead_zone(x, self.b)
+
+        def _isstatic(self):
+            return True
+
+        def describing_function(self, A):
+            return df.dead_zone_df(A, self.b)
+
+    num, den = lb.deflection_loop(PLANT, FIN_PD)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        theirs = ct.describing_function_response(
+            ct.tf(list(num), list(den)),
+            DeadZoneNL(B),
+            B * np.geomspace(1.0001, 100.0, 400),
+            omega=np.geomspace(10.0, 1e4, 2000),
+        ).intersections
+    # python-control's minimiser finds the stable cycle; near A = b (the unstable one)
+    # it leaves the amplitude range
+    ((a_pc, w_pc),) = [(a, w) for a, w in theirs if w > 500.0]
+    ours = next(c for c in lb.limit_cycles(PLANT, FIN_PD).cycles if c.stable)
+    assert ours.deflection_amplitude == pytest.approx(a_pc, rel=1e-3)
+    assert ours.frequency == pytest.approx(w_pc, rel=1e-4)
+
+
 def test_cycles_scale_with_the_gap():
     big = lb.limit_cycles(PLANT, FIN_PD)
     small = lb.limit_cycles(DrivePlant(**{**PLANT.__dict__, "backlash": B / 7}), FIN_PD)
