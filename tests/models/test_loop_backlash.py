@@ -26,7 +26,7 @@ from optdesign.models.loop_plant import DrivePlant, PositionLoop
 
 B = math.radians(0.1)
 # fin feedback through a chain with a resonance near 1070 rad/s: the gap sustains a
-# cycle just below it (the loop's gain margin is 1.44 at 1068 rad/s)
+# cycle just below it (the loop's gain margin is 1.45 at 1066 rad/s)
 PLANT = DrivePlant(
     motor_inertia=0.02,
     ratio=60.0,
@@ -99,7 +99,7 @@ def test_fin_feedback_gap_sustains_a_stable_cycle_below_the_chain_resonance():
     stable = [c for c in cycles.cycles if c.stable]
     assert len(stable) == 1
     c = stable[0]
-    # below the linear loop's phase crossover (1068 rad/s): the gap softens the chain
+    # below the linear loop's phase crossover (1066 rad/s): the gap softens the chain
     assert 700.0 < c.frequency < ll.margins(PLANT, FIN_PD).phase_crossover
     assert c.deflection_amplitude > B and c.fin_amplitude > B
     # the balance: N(A) L_d(jw) = -1
