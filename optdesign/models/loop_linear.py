@@ -193,7 +193,8 @@ def frequency_response(
     plant: DrivePlant, loop: PositionLoop, omega
 ) -> tuple[np.ndarray, np.ndarray]:
     """L(jw) and T(jw) as complex NumPy arrays at ``omega`` (rad/s, > 0)."""
-    r = loop_response(**plant_arguments(plant, loop), omega=np.asarray(omega, dtype=float))
+    with np.errstate(divide="ignore", invalid="ignore"):  # an undamped pole on the axis
+        r = loop_response(**plant_arguments(plant, loop), omega=np.asarray(omega, dtype=float))
     L = np.asarray(r.open_re) + 1j * np.asarray(r.open_im)
     T = np.asarray(r.closed_re) + 1j * np.asarray(r.closed_im)
     return L, T
@@ -305,7 +306,12 @@ def _grid(plant: DrivePlant, loop: PositionLoop) -> np.ndarray:
 
 
 def _roots_of(fn, w: np.ndarray) -> list[float]:
-    """Sign changes of fn on the grid w, each refined by brentq."""
+    """Sign changes of fn on the grid w, each refined by brentq.
+
+    A sign change through a pole (an undamped plant's resonance on the axis) is no root:
+    it is dropped when brentq meets a non-finite value or ends on a value that is not
+    small against the bracket's.
+    """
     from scipy.optimize import brentq
 
     v = fn(w)
@@ -313,9 +319,16 @@ def _roots_of(fn, w: np.ndarray) -> list[float]:
     for i in np.flatnonzero(np.isfinite(v[:-1]) & np.isfinite(v[1:]) & (v[:-1] * v[1:] <= 0)):
         if v[i + 1] == 0.0:
             continue
-        out.append(
-            float(w[i]) if v[i] == 0.0 else brentq(fn, w[i], w[i + 1], xtol=1e-14, rtol=1e-13)
-        )
+        if v[i] == 0.0:
+            out.append(float(w[i]))
+            continue
+        try:
+            x = brentq(fn, w[i], w[i + 1], xtol=1e-14, rtol=1e-13)
+        except ValueError:  # a NaN on the way: the bracket holds a pole
+            continue
+        fx = fn(x)
+        if np.isfinite(fx) and abs(fx) <= 1e-6 * max(abs(v[i]), abs(v[i + 1])):
+            out.append(float(x))
     return out
 
 

@@ -207,6 +207,19 @@ def test_hinge_spring_stiffens_the_rigid_loop():
     assert ll.is_stable(stiff_air, PositionLoop(kp=1000.0, kd=10.0))
 
 
+def test_undamped_resonance_is_no_crossing():
+    # c = c_f = 0: L has poles on the axis, where Im L changes sign through infinity (a
+    # heavy motor side, a soft hinge: the poles near 2.8 and 1.3e4 rad/s)
+    params = dict(motor_inertia=0.113, ratio=48.0, fin_inertia=21.1, stiffness=1.52e8)
+    undamped = DrivePlant(**params, hinge_spring=2192.0)
+    barely = DrivePlant(**params, hinge_spring=2192.0, damping=1e-3, fin_damping=1e-4)
+    loop = PositionLoop(kp=307.0, kd=115.7, current_lag=1e-4, feedback="motor")
+    a, b = ll.margins(undamped, loop), ll.margins(barely, loop)
+    assert a.phase_margin == pytest.approx(b.phase_margin, rel=1e-4)
+    assert a.gain_crossover == pytest.approx(b.gain_crossover, rel=1e-6)
+    assert ll.bandwidth(undamped, loop) == pytest.approx(ll.bandwidth(barely, loop), rel=1e-5)
+
+
 def test_loop_response_builds_casadi_expressions_equal_to_numpy():
     loop = LOOPS[3]
     args = ll.plant_arguments(TWO_MASS, loop)
