@@ -27,8 +27,17 @@ friction, no torque or speed limit):
   margins' rows steer the solver - so a solver's design whose loop is unstable is no
   verified result.
 
-The backlash limit cycle's amplitude is not a row: it is computed after the solve by
-harmonic balance (:func:`optdesign.problem.loop_analysis.loop_report`).
+* ``limit_cycle_amplitude`` (``limit_cycle_amplitude_max``): the fin amplitude of the
+  largest stable limit cycle of the chain's clearance at each loop angle, by harmonic
+  balance (:func:`optdesign.models.loop_backlash.limit_cycles`): on the NumPy path only,
+  as ``loop_stable``. The amplitude is a root of the balance, not a smooth function of
+  the design (a cycle appears or vanishes where a phase crossover of L_d crosses -1), so
+  the NLP does not carry it; with the loop's shape fixed it grows with the backlash, which
+  the objective ``backlash`` minimises.
+
+The rows sit at ``[loop] angles`` of the stroke's grid angles (:func:`loop_angles`), not
+at all of them: each row costs the solver one frequency response per frequency checked,
+and the plant changes slowly along the stroke; ``loop_stable`` alone is at every angle.
 """
 
 from __future__ import annotations
@@ -40,6 +49,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.models import loop_linear as ll
+from optdesign.models.loop_backlash import limit_cycles
 from optdesign.problem.loop import LoopGains, PlantGrid, drive_plants_of, loop_gains, plant_grid
 from optdesign.problem.objectives import ConstraintBlock
 
@@ -52,6 +62,16 @@ SOFT_MIN_POWER = 16
 STATIC_BELOW = 1e4
 #: The smallest damping ratio of a stable loop's poles (the roots' own precision).
 STABLE_DAMPING = 1e-9
+
+
+#: The requirements that need ``[loop]``.
+LOOP_REQUIREMENTS = (
+    "bandwidth_min",
+    "phase_margin_min",
+    "modulus_margin_min",
+    "resonance_margin_min",
+    "limit_cycle_amplitude_max",
+)
 
 
 def reference_frequency(spec) -> float:
@@ -157,6 +177,19 @@ def least_pole_damping(q) -> np.ndarray:
     return np.array(out)
 
 
+def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray:
+    """The fin amplitude (deg) of the largest stable limit cycle the chain's clearance
+    sustains at each loop angle ``idx``, by harmonic balance
+    (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
+    one row per design of a population."""
+    return np.array(
+        [
+            [np.degrees(limit_cycles(plants[i], loop).largest_stable_fin_amplitude) for i in idx]
+            for plants, loop in drive_plants_of(q)
+        ]
+    )
+
+
 def _phase_margin(modulus):
     return np.degrees(2.0 * np.arcsin(np.clip(np.asarray(modulus, dtype=float) / 2.0, -1, 1)))
 
@@ -169,11 +202,7 @@ def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
     """The loop's rows (module docstring); none without ``[loop]``."""
     spec = q.problem.spec
     req = spec.requirements
-    wanted = [
-        name
-        for name in ("bandwidth_min", "phase_margin_min", "modulus_margin_min", "resonance_margin_min")
-        if getattr(req, name) is not None
-    ]
+    wanted = [name for name in LOOP_REQUIREMENTS if getattr(req, name) is not None]
     if spec.loop is None:
         if wanted:
             from optdesign.errors import ProblemError
@@ -242,17 +271,31 @@ def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 display_unit="",
             )
         )
-    if not m.is_symbolic(q.ratio):
+    if m.is_symbolic(q.ratio):
+        return out
+    if req.limit_cycle_amplitude_max is not None:
         out.append(
             ConstraintBlock(
-                "loop_stable",
-                least_pole_damping(q),
-                STABLE_DAMPING,
+                "limit_cycle_amplitude",
+                limit_cycle_amplitudes(q, idx),
                 None,
-                labels,
-                "",
-                "smallest damping ratio of the closed loop's poles (> 0: stable; checked "
-                "on the independent NumPy path, not a row of the NLP)",
+                float(np.degrees(req.limit_cycle_amplitude_max)),
+                at,
+                "deg",
+                "fin amplitude of the largest stable backlash limit cycle (harmonic balance; "
+                "checked on the independent NumPy path, not a row of the NLP)",
             )
         )
+    out.append(
+        ConstraintBlock(
+            "loop_stable",
+            least_pole_damping(q),
+            STABLE_DAMPING,
+            None,
+            labels,
+            "",
+            "smallest damping ratio of the closed loop's poles (> 0: stable; checked on "
+            "the independent NumPy path, not a row of the NLP)",
+        )
+    )
     return out
