@@ -187,10 +187,11 @@ def _population(q) -> int:
     return max(sizes, default=1)
 
 
-def drive_plants_of(q) -> list[tuple[list[DrivePlant], PositionLoop]]:
+def drive_plants_of(q, angles=None) -> list[tuple[list[DrivePlant], PositionLoop]]:
     """For each design of the NumPy quantities ``q`` (one design, or a population: one
     row per design), its :class:`~optdesign.models.loop_plant.DrivePlant` at every grid
-    angle and its :class:`~optdesign.models.loop_plant.PositionLoop`."""
+    angle (or at the grid indices ``angles``) and its :class:`~optdesign.models.
+    loop_plant.PositionLoop`."""
     grid, gains = plant_grid(q), loop_gains(q)
     phi = np.asarray(q.phi, dtype=float).reshape(-1)
     pop, width = _population(q), len(phi)
@@ -207,7 +208,7 @@ def drive_plants_of(q) -> list[tuple[list[DrivePlant], PositionLoop]]:
         loop = PositionLoop(kp[i], kd[i], gains.ki, gains.current_lag, gains.feedback)
         plants = [
             DrivePlant(**{n: float(values[n][i, k]) for n in names}, angle=float(phi[k]))
-            for k in range(width)
+            for k in (range(width) if angles is None else angles)
         ]
         out.append((plants, loop))
     return out
@@ -224,3 +225,35 @@ def position_loop(q) -> PositionLoop:
     quantities are ``q``; a placed kp that is not positive (a bandwidth below the fin's
     own frequency on its stabilising hinge spring) refused naming ``loop.bandwidth``."""
     return drive_plants_of(q)[0][1]
+
+
+def check_loop(problem) -> None:
+    """Refuse (:class:`~optdesign.errors.ProblemError` naming ``loop``) a ``[loop]``
+    without the sections it closes around, or whose closed loop is unstable at every one
+    of its angles (``[loop] angles`` of the grid) at the problem's start design: the
+    file's gains (or bandwidth) are wrong for this drive, not one design."""
+    from optdesign.models.loop_linear import closed_loop_poles
+    from optdesign.problem.loop_requirements import loop_angles
+
+    q = problem.quantities(problem.design_dict(problem.start()))
+    _need_loop(q)
+    plants, loop = drive_plants_of(q, loop_angles(problem))[0]
+    rightmost = []
+    for plant in plants:
+        poles = closed_loop_poles(plant, loop)
+        if np.all(poles.real < -1e-9 * np.maximum(np.abs(poles), 1e-300)):
+            return
+        rightmost.append((float(np.max(poles.real)), plant))
+    worst, plant = max(rightmost, key=lambda item: item[0])
+    spec = problem.spec
+    rigid = -spec.load.hinge_spring / plant.ratio  # f' kp + k_h > 0, the rigid loop's
+    raise ProblemError(
+        f"loop: the position loop (kp = {loop.kp * 1e-3:.4g} N*m/rad, kd = "
+        f"{loop.kd * 1e-3:.4g} N*m*s/rad, ki = {loop.ki * 1e-3:.4g} N*m/(rad*s), current "
+        f"lag {loop.current_lag * 1e3:.3g} ms, {loop.feedback} feedback) is unstable at "
+        f"every one of its {len(plants)} angles at the start design: a closed-loop pole at Re s = {worst:.4g} "
+        f"rad/s at {np.degrees(plant.angle):+.1f} deg. Check the gains: the rigid loop "
+        f"alone needs f' kp + k_h > 0 (kp > {max(rigid, 0.0) * 1e-3:.4g} N*m/rad there) "
+        "and kd > 0; with integral action, ki < (f' kd + c_fin) (f' kp + k_h) / (f' J), "
+        "J = J_m f'^2 + J_fin"
+    )
