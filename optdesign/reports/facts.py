@@ -60,7 +60,63 @@ def design_facts(problem: Any, design: dict[str, float]) -> list[Fact]:
         source = "lossless: the file gives no eta_screw, eta_gear or [screw]"
     out.append(Fact("drive_efficiency", Shown(100.0 * float(np.min(eta)), "%"), source))
     out += _motor_facts(problem, q)
+    out += _loop_facts(problem, q)
     return out
+
+
+def _loop_facts(problem: Any, q: Any) -> list[Fact]:
+    """The design's position loop, analysed exactly (optdesign.problem.loop_analysis):
+    the least bandwidth and margins over the loop's angles, the largest limit cycle."""
+    if problem.spec.loop is None:
+        return []
+    from optdesign.problem.loop_analysis import loop_figures
+
+    try:
+        with np.errstate(all="ignore"):
+            f = loop_figures(q)
+    except Exception as exc:  # a report, not the result: say why the figures are missing
+        return [Fact("loop", Shown(float("nan"), ""), f"not analysed: {exc}")]
+    where = f"over the loop's {f.angles} angles"
+    stable = (
+        "stable at every grid angle"
+        if not f.unstable_at
+        else f"UNSTABLE at {len(f.unstable_at)} grid angles from {f.unstable_at[0]:+.1f} deg"
+    )
+    cycle = (
+        f"largest stable backlash limit cycle at the fin (harmonic balance), at "
+        f"{f.limit_cycle.angle:+.0f} deg, {f.limit_cycle_frequency:.4g} Hz"
+        if f.limit_cycle.value > 0
+        else "no stable backlash limit cycle (harmonic balance)"
+    )
+    return [
+        Fact(
+            "loop_bandwidth",
+            Shown(f.bandwidth.value, "Hz"),
+            f"least -3 dB bandwidth {where}, at {f.bandwidth.angle:+.0f} deg; {stable}",
+        ),
+        Fact(
+            "loop_phase_margin",
+            Shown(f.phase_margin.value, "deg"),
+            f"least phase margin {where}, at {f.phase_margin.angle:+.0f} deg",
+        ),
+        Fact(
+            "loop_gain_margin",
+            Shown(f.gain_margin.value, ""),
+            f"least gain margin {where}, at {f.gain_margin.angle:+.0f} deg",
+        ),
+        Fact(
+            "loop_modulus_margin",
+            Shown(f.modulus_margin.value, ""),
+            f"least min |1 + L(jw)| over every w {where}, at {f.modulus_margin.angle:+.0f} deg",
+        ),
+        Fact(
+            "loop_resonance_margin",
+            Shown(f.resonance_margin.value, ""),
+            f"least 1 / |L| at the drive's own mode {where}, at "
+            f"{f.resonance_margin.angle:+.0f} deg",
+        ),
+        Fact("limit_cycle_amplitude", Shown(f.limit_cycle.value, "deg"), cycle),
+    ]
 
 
 def _motor_facts(problem: Any, q: Any) -> list[Fact]:
