@@ -25,6 +25,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import ProblemError
+from optdesign.models import loop_linear as ll
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
 
 #: The chain's damping ratio when ``[loop]`` gives none: 2 % of critical, a steel drive
@@ -173,6 +174,63 @@ def loop_gains(q) -> LoopGains:
     return LoopGains(kp, kd, loop.ki, lag, loop.feedback)
 
 
+def loop_angles(problem) -> np.ndarray:
+    """Indices of the grid angles that carry the loop's rows: ``[loop] angles`` of them
+    (at most the grid's), evenly spread, both ends included."""
+    n = len(problem.phi)
+    count = min(problem.spec.loop.angles, n)
+    return np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
+
+
+def _pick(x: Any, idx: np.ndarray, n: int) -> Any:
+    """The entries ``idx`` of a grid quantity (a number stays a number)."""
+    if m.is_symbolic(x):
+        return x[[int(i) for i in idx]] if x.shape[0] == n else x
+    a = np.asarray(x)
+    return a[..., idx] if a.ndim and a.shape[-1] == n else x
+
+
+def picked(grid: PlantGrid, idx: np.ndarray, n: int) -> PlantGrid:
+    """The plant at the grid indices ``idx`` of its ``n`` angles."""
+    return PlantGrid(**{f.name: _pick(getattr(grid, f.name), idx, n) for f in fields(PlantGrid)})
+
+
+def response(grid: PlantGrid, gains: LoopGains, omega) -> ll.LoopResponse:
+    """L(jw) and T(jw) of the loop at ``omega`` (rad/s) over a plant's grid."""
+    return ll.loop_response(
+        grid.motor_inertia,
+        grid.ratio,
+        grid.fin_inertia,
+        grid.stiffness,
+        grid.damping,
+        grid.hinge_spring,
+        grid.fin_damping,
+        gains.kp,
+        gains.kd,
+        gains.ki,
+        gains.current_lag,
+        omega,
+        gains.feedback,
+    )
+
+
+def resonance_frequency(q, idx: np.ndarray | None = None) -> Any:
+    """w_r (rad/s): the drive's own mode, motor free, over the grid (at ``idx``)."""
+    w2 = q.two_mass_frequency_squared
+    return m.sqrt(w2 if idx is None else _pick(w2, idx, len(q.phi)))
+
+
+def resonance_gain(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:
+    """|L(j w_r)| at the loop's angles ``idx``: the loop's gain at the drive's own mode."""
+    r = response(grid, gains, resonance_frequency(q, idx))
+    return m.sqrt(r.open_re**2 + r.open_im**2)
+
+
+def loop_resonance_gain(q) -> Any:
+    """|L(j w_r)| at every grid angle (the objective ``resonance_gain``)."""
+    return resonance_gain(q, plant_grid(q), loop_gains(q), None)
+
+
 def _rows(value: Any, pop: int, width: int) -> np.ndarray:
     """A grid quantity of a population as a (pop, width) array (a number, a grid, or one
     row per design)."""
@@ -233,7 +291,6 @@ def check_loop(problem) -> None:
     of its angles (``[loop] angles`` of the grid) at the problem's start design: the
     file's gains (or bandwidth) are wrong for this drive, not one design."""
     from optdesign.models.loop_linear import closed_loop_poles
-    from optdesign.problem.loop_requirements import loop_angles
 
     q = problem.quantities(problem.design_dict(problem.start()))
     _need_loop(q)

@@ -47,7 +47,6 @@ angles: each costs a polynomial's roots or a harmonic balance per angle and eval
 
 from __future__ import annotations
 
-from dataclasses import fields
 from typing import Any
 
 import numpy as np
@@ -55,7 +54,18 @@ import numpy as np
 from optdesign import math as m
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
-from optdesign.problem.loop import LoopGains, PlantGrid, drive_plants_of, loop_gains, plant_grid
+from optdesign.problem.loop import (
+    LoopGains,
+    PlantGrid,
+    drive_plants_of,
+    loop_angles,
+    loop_gains,
+    picked,
+    plant_grid,
+    resonance_frequency,
+    resonance_gain,
+    response,
+)
 from optdesign.problem.objectives import ConstraintBlock
 
 #: The margins' frequencies about the drive's mode: w_r (1 + RESONANCE_STEP j), j = -3..3
@@ -105,55 +115,11 @@ def margin_frequencies(spec) -> np.ndarray:
     return 2.0 * np.pi * f * 2.0 ** (np.arange(-2, 5) / 2.0)
 
 
-def loop_angles(problem) -> np.ndarray:
-    """Indices of the grid angles that carry the loop's rows: ``[loop] angles`` of them
-    (at most the grid's), evenly spread, both ends included."""
-    n = len(problem.phi)
-    count = min(problem.spec.loop.angles, n)
-    return np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
-
-
-def _pick(x: Any, idx: np.ndarray, n: int) -> Any:
-    """The entries ``idx`` of a grid quantity (a number stays a number)."""
-    if m.is_symbolic(x):
-        return x[[int(i) for i in idx]] if x.shape[0] == n else x
-    a = np.asarray(x)
-    return a[..., idx] if a.ndim and a.shape[-1] == n else x
-
-
-def _picked(grid: PlantGrid, idx: np.ndarray, n: int) -> PlantGrid:
-    return PlantGrid(**{f.name: _pick(getattr(grid, f.name), idx, n) for f in fields(PlantGrid)})
-
-
-def _response(grid: PlantGrid, gains: LoopGains, omega) -> ll.LoopResponse:
-    return ll.loop_response(
-        grid.motor_inertia,
-        grid.ratio,
-        grid.fin_inertia,
-        grid.stiffness,
-        grid.damping,
-        grid.hinge_spring,
-        grid.fin_damping,
-        gains.kp,
-        gains.kd,
-        gains.ki,
-        gains.current_lag,
-        omega,
-        gains.feedback,
-    )
-
-
-def resonance_frequency(q, idx: np.ndarray | None = None) -> Any:
-    """w_r (rad/s): the drive's own mode, motor free, over the grid (at ``idx``)."""
-    w2 = q.two_mass_frequency_squared
-    return m.sqrt(w2 if idx is None else _pick(w2, idx, len(q.phi)))
-
-
 def bandwidth_ratio(q, grid: PlantGrid, gains: LoopGains, f_b: float) -> Any:
     """|T(j w_b)|^2 / |T(j w_b / 10^4)|^2 over the grid (see the module's docstring)."""
     w = 2.0 * np.pi * f_b
-    at = ll.closed_loop_gain_squared(_response(grid, gains, w))
-    static = ll.closed_loop_gain_squared(_response(grid, gains, w / STATIC_BELOW))
+    at = ll.closed_loop_gain_squared(response(grid, gains, w))
+    static = ll.closed_loop_gain_squared(response(grid, gains, w / STATIC_BELOW))
     return at / static
 
 
@@ -167,7 +133,7 @@ def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> A
     w_r = resonance_frequency(q, idx)
     around = [w_r * (1.0 + RESONANCE_STEP * j) for j in range(-3, 4)]
     z = [
-        -p * m.log(ll.return_difference_squared(_response(grid, gains, w)) + 1e-300)
+        -p * m.log(ll.return_difference_squared(response(grid, gains, w)) + 1e-300)
         for w in (*margin_frequencies(q.problem.spec), *around)
     ]
     top = z[0]
@@ -177,17 +143,6 @@ def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> A
     for zk in z:
         total = total + m.exp(zk - top)
     return m.exp(-(top + m.log(total)) / (2.0 * p))
-
-
-def resonance_gain(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:
-    """|L(j w_r)| at the loop's angles ``idx``: the loop's gain at the drive's own mode."""
-    r = _response(grid, gains, resonance_frequency(q, idx))
-    return m.sqrt(r.open_re**2 + r.open_im**2)
-
-
-def loop_resonance_gain(q) -> Any:
-    """|L(j w_r)| at every grid angle (the objective ``resonance_gain``)."""
-    return resonance_gain(q, plant_grid(q), loop_gains(q), None)
 
 
 def least_pole_damping(q, idx: np.ndarray) -> np.ndarray:
@@ -240,7 +195,7 @@ def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
         return []
     full, gains = plant_grid(q), loop_gains(q)
     idx = loop_angles(q.problem)
-    grid = _picked(full, idx, len(q.phi))
+    grid = picked(full, idx, len(q.phi))
     at = [labels[i] for i in idx]
     out: list[ConstraintBlock] = []
     if req.bandwidth_min is not None:

@@ -274,7 +274,7 @@ def _natural_period(q):
 def _resonance_gain(q):
     if q.problem.spec.loop is None:
         return None
-    from optdesign.problem.loop_requirements import loop_resonance_gain
+    from optdesign.problem.loop import loop_resonance_gain
 
     return loop_resonance_gain(q)
 

@@ -21,7 +21,7 @@ import optdesign as od
 from optdesign.cli import main
 from optdesign.models import loop_linear as ll
 from optdesign.problem.loop import drive_plants_of
-from optdesign.problem.loop_requirements import loop_angles
+from optdesign.problem.loop import loop_angles
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"
