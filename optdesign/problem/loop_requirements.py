@@ -47,6 +47,7 @@ angles: each costs a polynomial's roots or a harmonic balance per angle and eval
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -54,6 +55,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
+from optdesign.models.loop_plant import DrivePlant, PositionLoop
 from optdesign.problem.loop import (
     LoopGains,
     PlantGrid,
@@ -82,6 +84,8 @@ STATIC_BELOW = 1e4
 #: loop's span of about five decades, 400 a decade (8000, the model's default, gives the
 #: same cycles at the shipped problem's seven angles, nine times slower).
 CYCLE_POINTS = 2000
+#: Plants whose poles and cycles are remembered (a few kB each).
+CACHED_PLANTS = 4096
 #: The smallest damping ratio of a stable loop's poles (the roots' own precision).
 STABLE_DAMPING = 1e-9
 
@@ -145,17 +149,25 @@ def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> A
     return m.exp(-(top + m.log(total)) / (2.0 * p))
 
 
+@lru_cache(maxsize=CACHED_PLANTS)
+def _least_damping(plant: DrivePlant, loop: PositionLoop) -> float:
+    # the records are frozen, so a plant met again (the sensitivities evaluate the same
+    # two designs under every moved requirement) is answered from the cache
+    poles = ll.closed_loop_poles(plant, loop)
+    return float(np.min(-poles.real / np.maximum(np.abs(poles), 1e-300)))
+
+
+@lru_cache(maxsize=CACHED_PLANTS)
+def _largest_cycle(plant: DrivePlant, loop: PositionLoop) -> float:
+    return float(np.degrees(limit_cycles(plant, loop, CYCLE_POINTS).largest_stable_fin_amplitude))
+
+
 def least_pole_damping(q, idx: np.ndarray) -> np.ndarray:
     """The smallest damping ratio -Re p / |p| of the closed loop's poles at each loop
     angle ``idx`` (NumPy, one row per design of a population)."""
-    out = []
-    for plants, loop in drive_plants_of(q, idx):
-        row = []
-        for plant in plants:
-            poles = ll.closed_loop_poles(plant, loop)
-            row.append(float(np.min(-poles.real / np.maximum(np.abs(poles), 1e-300))))
-        out.append(row)
-    return np.array(out)
+    return np.array(
+        [[_least_damping(p, loop) for p in plants] for plants, loop in drive_plants_of(q, idx)]
+    )
 
 
 def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray:
@@ -164,13 +176,7 @@ def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray:
     (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
     one row per design of a population."""
     return np.array(
-        [
-            [
-                np.degrees(limit_cycles(plant, loop, CYCLE_POINTS).largest_stable_fin_amplitude)
-                for plant in plants
-            ]
-            for plants, loop in drive_plants_of(q, idx)
-        ]
+        [[_largest_cycle(p, loop) for p in plants] for plants, loop in drive_plants_of(q, idx)]
     )
 
 
