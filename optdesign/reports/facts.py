@@ -88,35 +88,24 @@ def _loop_facts(problem: Any, q: Any) -> list[Fact]:
         if f.limit_cycle.value > 0
         else "no stable backlash limit cycle (harmonic balance)"
     )
-    return [
-        Fact(
-            "loop_bandwidth",
-            Shown(f.bandwidth.value, "Hz"),
-            f"least -3 dB bandwidth {where}, at {f.bandwidth.angle:+.0f} deg; {stable}",
-        ),
-        Fact(
-            "loop_phase_margin",
-            Shown(f.phase_margin.value, "deg"),
-            f"least phase margin {where}, at {f.phase_margin.angle:+.0f} deg",
-        ),
-        Fact(
-            "loop_gain_margin",
-            Shown(f.gain_margin.value, ""),
-            f"least gain margin {where}, at {f.gain_margin.angle:+.0f} deg",
-        ),
-        Fact(
-            "loop_modulus_margin",
-            Shown(f.modulus_margin.value, ""),
-            f"least min |1 + L(jw)| over every w {where}, at {f.modulus_margin.angle:+.0f} deg",
-        ),
-        Fact(
+    rows = (
+        ("loop_bandwidth", f.bandwidth, "Hz", f"least -3 dB bandwidth {where}", f"; {stable}"),
+        ("loop_phase_margin", f.phase_margin, "deg", f"least phase margin {where}", ""),
+        ("loop_gain_margin", f.gain_margin, "", f"least gain margin {where}", ""),
+        ("loop_modulus_margin", f.modulus_margin, "", f"least min |1 + L(jw)| {where}", ""),
+        (
             "loop_resonance_margin",
-            Shown(f.resonance_margin.value, ""),
-            f"least 1 / |L| at the drive's own mode {where}, at "
-            f"{f.resonance_margin.angle:+.0f} deg",
+            f.resonance_margin,
+            "",
+            f"least 1 / |L| at the drive's own mode {where}",
+            "",
         ),
-        Fact("limit_cycle_amplitude", Shown(f.limit_cycle.value, "deg"), cycle),
+    )
+    out = [
+        Fact(name, Shown(fig.value, unit), f"{text}, at {fig.angle:+.0f} deg{tail}")
+        for name, fig, unit, text, tail in rows
     ]
+    return [*out, Fact("limit_cycle_amplitude", Shown(f.limit_cycle.value, "deg"), cycle)]
 
 
 def _motor_facts(problem: Any, q: Any) -> list[Fact]:

@@ -6,9 +6,6 @@ and the loop's refusals (API, command line in both output modes)."""
 
 from __future__ import annotations
 
-import contextlib
-import io
-import json
 import math
 import tomllib
 from pathlib import Path
@@ -16,12 +13,11 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 import pytest
+from cli_refusal import command_line_refusal
 
 import optdesign as od
-from optdesign.cli import main
 from optdesign.models import loop_linear as ll
-from optdesign.problem.loop import drive_plants_of
-from optdesign.problem.loop import loop_angles
+from optdesign.problem.loop import drive_plants_of, loop_angles
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"
@@ -178,18 +174,7 @@ def test_a_loop_unstable_at_all_its_angles_is_refused_through_the_api():
 
 @pytest.mark.parametrize("json_mode", [False, True], ids=["text", "json"])
 def test_a_loop_unstable_at_all_its_angles_is_refused_on_the_command_line(json_mode, tmp_path):
-    from hostile_corpus import dumps
-
-    path = tmp_path / "p.toml"
-    path.write_text(dumps(_loop_data(**UNSTABLE)))
-    argv = ["solve", str(path), "--out", str(tmp_path / "out"), "--no-report"]
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main([*argv, "--json"] if json_mode else argv)
-    assert code == 2 and out.getvalue() == ""
-    message = err.getvalue()
-    if json_mode and message.lstrip().startswith("{"):
-        message = json.loads(message)["error"]
+    message = command_line_refusal(_loop_data(**UNSTABLE), tmp_path, json_mode)
     assert "loop: the position loop" in message and "unstable at every one" in message
 
 
