@@ -208,12 +208,21 @@ class LoopSimulation:
 
 class _System:
     def __init__(self, plant: DrivePlant, loop: PositionLoop, reference):
-        self.p, self.c, self.r = plant, loop, reference
+        self.p, self.c, self.reference = plant, loop, reference
+        # the reference's left limit at a jump ending the current segment: the segment's
+        # last point must not see the jump (its events would fire on it, again and again)
+        self.left_of = math.inf
         self.J1 = plant.motor_inertia_at_fin
         self.fin = loop.feedback == "fin"
         self.w_lim = plant.max_speed / plant.ratio  # psi' at the speed limit
         # without clearance the chain is one linear, two-way spring: no contact events
         self.bilateral = plant.backlash == 0.0
+
+    def r(self, t: float) -> float:
+        """The reference, taken from the left at a jump that ends the segment."""
+        if t >= self.left_of:
+            return self.reference(float(np.nextafter(self.left_of, -math.inf)))
+        return self.reference(t)
 
     def command(self, t, x) -> float:
         """The current loop's output T (N*mm at the motor)."""
@@ -459,6 +468,7 @@ def simulate(
     done = 0  # samples already taken
     while True:
         t_stop = next(b for b in stops if b > t)
+        sys.left_of = t_stop if t_stop < horizon else math.inf
         evs = sys.events(mode, x)
         funcs = []
         for fn, direction, _ in evs:
@@ -476,6 +486,7 @@ def simulate(
         )
         if sol.status < 0:
             raise InputError("plant", f"the integration failed at t = {t:.6g} s: {sol.message}")
+        sys.left_of = math.inf  # from here on, the reference's value at t itself
         t_end = float(sol.t[-1])
         last = t_end >= horizon
         upto = int(np.searchsorted(t_out, t_end, side="right" if last else "left"))
@@ -501,11 +512,17 @@ def simulate(
                     "a chattering contact, or a horizon too long for the limit",
                 )
             mode, x = sys.next_mode(t, x, mode, kind)
-        elif mode[2] == 0:  # a jump of the reference: a stuck motor may slip at once
-            mode, x = sys.stick_check(t, x, mode)
-        elif abs(mode[2]) == 2:  # ... and a held one be released
-            mode, x = sys.next_mode(t, x, mode, "speed released")
-            mode, x = sys.speed_check(t, x, mode)
+        elif mode[2] in (0, 2, -2):  # a jump of the reference: a stuck motor may slip
+            # at once, a held one be released
+            before = mode
+            if mode[2] == 0:
+                mode, x = sys.stick_check(t, x, mode)
+            else:
+                mode, x = sys.next_mode(t, x, mode, "speed released")
+                mode, x = sys.speed_check(t, x, mode)
+            if mode[2] != before[2]:
+                event_times.append(t)
+                event_kinds.append("slips" if before[2] == 0 else "speed released")
     return _record(sys, pieces, event_times, event_kinds, reference)
 
 

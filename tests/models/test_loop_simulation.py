@@ -164,6 +164,18 @@ def test_friction_sticks_the_motor_within_its_band():
     assert np.ptp(sim.motor_angle[late]) == 0.0
 
 
+def test_a_delayed_step_frees_a_stuck_motor_once():
+    # no current lag: the command jumps with the reference at 0.05 s, from inside the
+    # friction band to far beyond it; the motor slips there, once
+    plant = DrivePlant(**TWO_MASS, backlash=4.1e-4, friction_torque=20.0)
+    loop = PositionLoop(kp=2000.0, kd=35.0, ki=3000.0, feedback="fin")
+    sim = ls.simulate(plant, loop, ls.StepReference(-0.07, time=0.05), 0.3, samples=301)
+    assert sim.event_times[0] == 0.05 and sim.event_kinds[0] == "slips"
+    assert sim.event_times.count(0.05) == 1
+    assert np.all(sim.motor_rate[sim.times < 0.05] == 0.0)
+    assert sim.motor_rate[sim.times > 0.05][0] < 0.0
+
+
 def test_saturation_and_speed_limit_bound_the_motor():
     plant = DrivePlant(
         **TWO_MASS, backlash=B, friction_torque=30.0, peak_torque=250.0, max_speed=150.0
