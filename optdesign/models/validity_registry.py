@@ -41,6 +41,7 @@ MODEL_MODULES = (
     "motor_catalogue",
     "describing_function",
     "harmonic_balance",
+    "loop_plant",
 )
 
 
