@@ -35,6 +35,16 @@ with, piece by piece:
 
 Units: mm, t, s, N, rad. Angles in rad at the fin (the motor's as psi = theta / f'),
 torques in N*mm (the motor's at its shaft, the chain's at the fin), times in s.
+
+Validity
+--------
+horizon : 0 < T <= 600 s (call)
+    A fin's manoeuvre lasts seconds; a longer run is a mistake of units or a request for
+    millions of events, refused before it starts.
+reference angle : |r| <= pi rad (call)
+    A fin turns less than half a turn; a non-finite angle is refused.
+output samples : 2 to 10^6 (call)
+    Enough to resolve a cycle near the chain's resonance over a run; more is memory.
 """
 
 from __future__ import annotations
@@ -46,6 +56,7 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.validity import Validity
 
 #: The largest horizon simulated (s): a fin's manoeuvre lasts seconds.
 MAX_HORIZON = 600.0
@@ -55,6 +66,43 @@ MAX_SAMPLES = 1_000_000
 MAX_ANGLE = math.pi
 #: The most events (contacts, sticks, speed limits) handled before the run is refused.
 MAX_EVENTS = 200_000
+HORIZON = Validity(
+    "loop_simulation.horizon",
+    "loop simulation",
+    "simulated time",
+    0.0,
+    MAX_HORIZON,
+    "s",
+    "a fin's manoeuvre lasts seconds; a longer run is a units mistake or millions of events",
+    open_lower=True,
+    checked=("call",),
+)
+REFERENCE_ANGLE = Validity(
+    "loop_simulation.reference_angle",
+    "loop simulation",
+    "reference angle |r| at the fin",
+    0.0,
+    MAX_ANGLE,
+    "rad",
+    "a fin turns less than half a turn",
+    shown_unit="deg",
+    scale=180.0 / math.pi,
+    checked=("call",),
+)
+SAMPLES = Validity(
+    "loop_simulation.samples",
+    "loop simulation",
+    "output samples",
+    2.0,
+    float(MAX_SAMPLES),
+    "",
+    "enough to resolve a cycle near the chain's resonance over a run; more is memory",
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (HORIZON, REFERENCE_ANGLE, SAMPLES)
+
 #: The width of the torque-speed curve's corner, a fraction of the top speed: the
 #: torque in the direction of motion falls to none over the last 1 % of the speed.
 SPEED_BAND = 0.01
