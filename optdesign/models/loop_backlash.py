@@ -43,7 +43,7 @@ loop gain at the cycle : |L_d(j w)| >= 1.3 at the cycle's phase crossover (docum
     of the describing function in the loop's gain becomes a large one in A (10 times at
     |L_d| = 1.1). Against the simulation (docs/loop.md) the fin's amplitude came within
     6 % where |L_d| >= 1.3 and 10.5 % off at 1.12; the frequency within 5 % throughout.
-    Each cycle's |L_d| is ``-1 / balance.describing_function``.
+    Each cycle's |L_d| is 1 / N, N its ``balance.describing_function``.
 filter hypothesis : :mod:`optdesign.models.harmonic_balance`'s (documented)
     Every cycle carries its third-harmonic gain; near the chain's resonance it is about
     0.11, at the edge of that range.
