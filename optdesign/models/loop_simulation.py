@@ -30,8 +30,7 @@ with, piece by piece:
   no mode: the motor settles just below the limit where the load needs torque, and a
   load that drives it on can take it past the limit. Entering and leaving the band are
   recorded as events ("speed limit", "speed released") without stopping the
-  integration. (A held speed, switched by events, chattered between holding and
-  releasing where a load drove the motor harder than the peak torque could brake.)
+  integration (docs/loop.md: why not a held speed).
 
 Units: mm, t, s, N, rad. Angles in rad at the fin (the motor's as psi = theta / f'),
 torques in N*mm (the motor's at its shaft, the chain's at the fin), times in s.
