@@ -32,7 +32,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import optdesign as od
-from optdesign.studies import nlp_solve as solve_study
+from optdesign.formulations.nlp import solve as solve_study
 
 ROOT = Path(__file__).resolve().parents[1]
 FIN = ROOT / "problems" / "fin_actuator.toml"

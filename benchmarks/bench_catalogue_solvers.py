@@ -44,8 +44,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
+from optdesign.formulations.catalogue.search import solve_catalogue
 from optdesign.problem import problem_from_dict
-from optdesign.studies.catalogue import solve_catalogue
 
 ROOT = Path(__file__).resolve().parents[1]
 ISO_2338 = (4, 5, 6, 8, 10, 12, 16)

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from optdesign.formulations.gp import build_gp
+from optdesign.formulations.nlp.solve import solve_nlp, solver_for
 from optdesign.problem import load_problem
+from optdesign.programs.gp import build_gp
 from optdesign.solvers import make_solver
-from optdesign.studies.nlp_solve import solve_nlp, solver_for
 
 ROOT = Path(__file__).resolve().parents[1]
 

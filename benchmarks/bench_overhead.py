@@ -49,7 +49,7 @@ t = [time.perf_counter()]
 import casadi  # noqa: F401
 t.append(time.perf_counter())
 from optdesign.problem import load_problem
-from optdesign.studies.nlp_solve import formulation_for, solver_for, solve_nlp, optimal_ranges, finish
+from optdesign.formulations.nlp.solve import formulation_for, solver_for, solve_nlp, optimal_ranges, finish
 t.append(time.perf_counter())
 problem = load_problem(sys.argv[1])
 t.append(time.perf_counter())
@@ -138,8 +138,8 @@ def kkt_ldl_time(solver, z, p, lam_g, repeats: int = 200) -> float:
 def part_a(repeats: int) -> dict:
     import casadi as ca
 
+    from optdesign.formulations.nlp.solve import solver_for
     from optdesign.problem import load_problem
-    from optdesign.studies.nlp_solve import solver_for
 
     out = {}
     for name in SHIPPED:
@@ -197,8 +197,8 @@ def part_a(repeats: int) -> dict:
 
 
 def part_b(repeats: int) -> dict:
+    from optdesign.formulations.nlp.solve import solve_nlp
     from optdesign.problem import load_problem
-    from optdesign.studies.nlp_solve import solve_nlp
 
     file = str(PROBLEMS / "cs_min_backlash.toml")
     cmd = [sys.executable, "-m", "optdesign", "solve", file, "--json"]

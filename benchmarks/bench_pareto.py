@@ -31,9 +31,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
+from optdesign.formulations.nlp import solve as solve_study
 from optdesign.problem import load_problem
 from optdesign.reports.front_files import read_front_csv
-from optdesign.studies import nlp_solve as solve_study
 from optdesign.studies.pareto import NSGA2, EpsilonConstraint, compute_front
 from optdesign.studies.pareto.metrics import hypervolume, non_dominated, reference_point
 

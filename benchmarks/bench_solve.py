@@ -21,12 +21,12 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from optdesign.formulations.nlp import build_nlp
+from optdesign.formulations.nlp.solve import solve_nlp
 from optdesign.problem import load_problem
+from optdesign.programs.nlp import build_nlp
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
-from optdesign.studies.nlp_solve import solve_nlp
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the independent global search lives with the tests

@@ -25,8 +25,8 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
+from optdesign.formulations.catalogue import search as cat
 from optdesign.solvers.multistart import improves
-from optdesign.studies import catalogue as cat
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import optdesign as od
-from optdesign.studies import catalogue as cat
+from optdesign.formulations.catalogue import search as cat
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))

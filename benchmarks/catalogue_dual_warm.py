@@ -21,10 +21,10 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np
 
 import optdesign as od
-from optdesign.formulations.discrete import discrete_variables
+from optdesign.formulations.catalogue import search as cat
+from optdesign.formulations.catalogue.discrete import discrete_variables
+from optdesign.formulations.nlp.solve import _objective_set, solver_for, solver_options
 from optdesign.solvers.ipopt_options import IPOPT_NODE, IPOPT_WARM
-from optdesign.studies import catalogue as cat
-from optdesign.studies.nlp_solve import _objective_set, solver_for, solver_options
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,6 +1,6 @@
 """Nominal vs robust optimum of a problem with ``[tolerances]``, judged by an independent
 Monte Carlo (another seed, many more samples, the same draws for both designs) with a
-paired bootstrap of the difference (:func:`optdesign.studies.robust.compare_nominal_robust`).
+paired bootstrap of the difference (:func:`optdesign.formulations.robust.solve.compare_nominal_robust`).
 
 Run:  python benchmarks/robust_compare.py problems/cs_min_backlash_robust.toml
       [--mc 20000] [--mc-seed S] [--q 0.95] [--starts N] [--robust-starts N]
@@ -14,8 +14,8 @@ from __future__ import annotations
 import argparse
 import time
 
+from optdesign.formulations.robust.solve import MC_SAMPLES, MC_SEED, compare_nominal_robust
 from optdesign.problem import load_problem
-from optdesign.studies.robust import MC_SAMPLES, MC_SEED, compare_nominal_robust
 
 
 def main(argv: list[str] | None = None) -> int:

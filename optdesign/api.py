@@ -214,6 +214,7 @@ def front_outputs(
     points: int,
     plot: bool = True,
     report: bool = True,
+    figures: Any = None,
 ) -> tuple[list[Path], list[str]]:
     """The files ``optdesign pareto`` writes of the fronts of one problem in folder
     ``out`` (``front.csv``, ``front.json``, ``front.png``, ``report.html``:
@@ -222,7 +223,9 @@ def front_outputs(
 
     Several methods' fronts first get their hypervolumes against one reference point
     (comparable, in ``front.json`` and the summary): a computation of the study, done
-    here so that the report only writes what the fronts hold.
+    here so that the report only writes what the fronts hold. ``figures``: a started
+    :class:`optdesign.plots.figure_process.FigureProcess` that draws front.png while
+    the page is made (None: drawn in process).
     """
     import time
 
@@ -240,6 +243,7 @@ def front_outputs(
         created=time.strftime("%Y-%m-%d %H:%M:%S"),
         plot=plot,
         report=report,
+        figures=figures,
     )
 
 

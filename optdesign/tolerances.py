@@ -9,7 +9,7 @@ same point.
 from __future__ import annotations
 
 #: A design is feasible when no requirement row is violated by more than this, relative
-#: to max(1, |bound|) (the independent check, :func:`optdesign.studies.verify.
+#: to max(1, |bound|) (the independent check, :func:`optdesign.formulations.verify.
 #: verify_design`) or on the solver's scaled rows (:func:`optdesign.solvers.base.
 #: constraint_reports`); a row within it of its bound is active, and so is a free
 #: variable's bound within it (relative to max(1, upper - lower)) of the variable's value

@@ -67,7 +67,7 @@ from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints, solver_names
 
 def formulation(argument: str, value: Any) -> str:
     """``auto`` or a registered formulation."""
-    from optdesign.studies.formulation_registry import formulation_names
+    from optdesign.formulations.registry import formulation_names
 
     return choice(argument, value, ["auto", *formulation_names()], "formulation")
 
@@ -385,7 +385,7 @@ def method_for(problem: Any, method_: Any, argument: str = "method") -> None:
 def front_problem(problem: Any) -> None:
     """A problem a front can be traced on (a free variable), whose file's solver options
     its back-ends accept: refused before any work."""
-    from optdesign.studies.nlp_solve import solver_options
+    from optdesign.formulations.nlp.solve import solver_options
     from optdesign.studies.pareto.run_setup import check_front_problem
 
     check_front_problem(problem)

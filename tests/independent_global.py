@@ -12,7 +12,7 @@ import time
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
-from optdesign.formulations.discrete import CatalogueCoordinates
+from optdesign.formulations.catalogue.discrete import CatalogueCoordinates
 from optdesign.problem.design_problem import DesignProblem
 
 #: Penalty weight on the largest relative constraint violation.

@@ -101,7 +101,7 @@ def test_user_objective_and_constraint_reach_every_formulation():
     assert problem.evaluate(np.array([known.design[v.name] for v in problem.free])).violation < 1e-6
     assert result.objective <= known_peak * (1 + 1e-9)
     # the GP diagnosis names the user's objective (|F| of a non-posynomial ratio)
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     checks = {c.name: c for c in build_gp(problem).checks}
     assert not checks["peak_nut_force"].ok
@@ -283,7 +283,7 @@ def yoke_data(mechanism: str) -> dict:
 
 def test_gp_diagnosis_of_a_user_mechanism_is_never_a_wrong_model():
     from optdesign import math as m
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     class AutoYoke(od.Mechanism):
         name = "auto_yoke"

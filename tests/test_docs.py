@@ -21,7 +21,7 @@ PAGES = [
 #: How docs/README.md spells a test reference in general: not a name to check.
 PLACEHOLDERS = {"tests/FILE.py", "test_function"}
 _TOP = "optdesign|tests|benchmarks|examples|problems|docs|\\.ci"
-_SUB = "models|mechanisms|studies|reports|solvers|formulations|plots|problem|commands|reproduce|runtime"
+_SUB = "models|mechanisms|studies|reports|solvers|formulations|programs|plots|problem|commands|reproduce|runtime"
 PATH = re.compile(rf"(?<![\w./-])(?:(?:{_TOP})/[\w./*-]*|(?:{_SUB})/[\w./*-]+\.py)")
 MODULE = re.compile(r"(?<![\w./-])optdesign(?:\.\w+)+(?![\w/])")
 TEST_REF = re.compile(r"(tests/[\w/]+\.py)|::(test_\w+)")

@@ -557,8 +557,8 @@ def test_an_ipopt_solve_is_interrupted_not_returned_as_a_failed_start(capfd):
     # call, SIGTERM after 0.3 s; Interrupted within a second, CasADi's warning muted.
 
     import optdesign as od
+    from optdesign.formulations.nlp.solve import solver_for
     from optdesign.interrupts import Interrupted, interrupts_as_exceptions
-    from optdesign.studies.nlp_solve import solver_for
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     backend = solver_for(problem, "ipopt", {**SLOW_IPOPT_OPTIONS, "max_iter": 20000})
@@ -579,7 +579,7 @@ def test_ctrl_c_in_a_solve_raises_keyboard_interrupt_without_the_cli():
     # library use: Python's own SIGINT handler, which the solve lends a recording twin
 
     import optdesign as od
-    from optdesign.studies.nlp_solve import solver_for
+    from optdesign.formulations.nlp.solve import solver_for
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
     backend = solver_for(problem, "ipopt", {**SLOW_IPOPT_OPTIONS, "max_iter": 20000})

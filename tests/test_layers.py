@@ -2,8 +2,15 @@
 an optdesign module in optdesign/ - at module top or inside a function - is an arrow, and
 the arrows form no circle and never point up the layers of the architecture:
 
-shared utilities -> models -> mechanisms -> problem -> formulations -> solvers ->
-runtime -> search -> studies -> api -> cli, commands, plots, reports, reproduce.
+shared utilities -> models -> mechanisms -> problem -> programs -> solvers -> runtime ->
+search -> formulations -> studies -> api -> cli, commands, plots, reports, reproduce.
+
+The programs (the NLP with its bounds, starts and targets; the GP's data) are what the
+solvers take, so they sit below them. The formulations (one package each: nlp, gp,
+catalogue, robust, with their solve, diagnosis, sensitivities and typed record, and the
+registry that chooses among them) use the solvers, the execution engine and the global
+search, so they sit above them and below the studies (pareto, sweep, bench, the solve
+pipeline) that use them.
 
 Imports under ``if TYPE_CHECKING:`` are annotations, not arrows, and are left out.
 """
@@ -37,10 +44,11 @@ LAYERS: list[tuple[str, ...]] = [
     ("models", "fits"),  # optdesign.fits: the public entry to the ISO 286 models
     ("mechanisms",),
     ("problem",),
-    ("formulations",),
+    ("programs",),  # the mathematical programs the solvers take: NLP, GP
     ("solvers",),
     ("runtime",),  # the execution engine: tasks, worker processes, stores' identity
     ("search",),  # the global search: starts, stopping rule, odds
+    ("formulations",),  # one package per formulation: solve, diagnose, sensitivities
     ("studies",),
     ("api", "validation"),
     ("cli", "__main__", "commands", "plots", "reports", "reproduce"),

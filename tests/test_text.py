@@ -463,8 +463,8 @@ def test_a_plot_failure_keeps_the_other_outputs(hostile_file, tmp_path, capfd, m
     def broken(*args, **kw):
         raise RuntimeError("drawing failed\nsecond line")
 
-    monkeypatch.setattr(optdesign.plots.solution, "plot_result", broken)
-    monkeypatch.setattr(optdesign.plots.front, "plot_fronts", broken)
+    monkeypatch.setattr(optdesign.plots.solution, "draw_solution", broken)
+    monkeypatch.setattr(optdesign.plots.front, "draw_front", broken)
     out = tmp_path / "solve"
     code = main(["solve", str(hostile_file), "--starts", "1", "--no-ranges", "--out", str(out)])
     stdout, stderr = capfd.readouterr()

@@ -35,8 +35,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests"))
 
 import optdesign as od  # noqa: E402
+from optdesign.formulations.nlp.solve import finish, solver_for, start_points  # noqa: E402
 from optdesign.solvers.multistart import multistart  # noqa: E402
-from optdesign.studies.nlp_solve import finish, solver_for, start_points  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results.jsonl"
 GAP = 1e-6

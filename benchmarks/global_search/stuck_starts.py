@@ -14,7 +14,7 @@ import tomllib
 from pathlib import Path
 
 import optdesign as od
-from optdesign.studies.nlp_solve import _objective_set, solver_for, tilted_starts
+from optdesign.formulations.nlp.solve import _objective_set, solver_for, tilted_starts
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -142,7 +142,7 @@ def _feasible_with_rows(problem: Any, rows: list[tuple[str, float]]) -> bool:
 
     import numpy as np
 
-    from optdesign.studies.nlp_solve import solver_for, tilted_starts
+    from optdesign.formulations.nlp.solve import solver_for, tilted_starts
 
     backend = solver_for(problem)
     nlp = backend.nlp

@@ -71,7 +71,7 @@ def main() -> int:
         tests = sorted(
             [] if args.no_covering else covering.get(function, []),
             key=lambda t: (
-                not t.startswith("tests/formulations/test_gp.py"),
+                not t.startswith("tests/programs/test_gp.py"),
                 duration.get(t, 0.0),
                 t,
             ),

@@ -35,8 +35,8 @@ if [ ${#MODULES[@]} -eq 0 ]; then
     optdesign/formulations/*.py
     optdesign/problem/drive.py
     optdesign/problem/drive_requirements.py
-    optdesign/studies/relaxation.py
-    optdesign/studies/catalogue.py
+    optdesign/formulations/nlp/relaxation.py
+    optdesign/formulations/catalogue/search.py
     optdesign/studies/pareto/*.py
     optdesign/storage/*.py
     optdesign/units.py
@@ -86,7 +86,7 @@ cat >>"$WORK/tests/conftest.py" <<'PY'
 @pytest.fixture(autouse=True)
 def _empty_formulation_caches():
     from optdesign.runtime import runner as _runner
-    from optdesign.studies import nlp_solve as _solve
+    from optdesign.formulations.nlp import solve as _solve
 
     _solve._NLPS.clear()
     _solve._SOLVERS.clear()

@@ -7,6 +7,7 @@ points as they finish; ``--resume`` continues from them) to the output folder.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 from pathlib import Path
@@ -135,7 +136,11 @@ def run_pareto(args) -> int:
                 storage.discard_store(store)
             elif not args.resume:
                 storage.check_new_store(store)
-        return _run_locked(args, problem, objectives, methods, out)
+        from optdesign.plots.figure_process import FigureProcess
+
+        # started before the fronts: matplotlib is imported while they are computed
+        with FigureProcess() if not args.no_plot else contextlib.nullcontext() as figures:
+            return _run_locked(args, problem, objectives, methods, out, figures)
 
 
 def _method_options(args, method: str, seed: int) -> dict:
@@ -149,7 +154,7 @@ def _method_options(args, method: str, seed: int) -> dict:
     return {"starts": args.starts, "seed": seed, "deterministic": args.deterministic}
 
 
-def _run_locked(args, problem, objectives, methods, out: Path) -> int:
+def _run_locked(args, problem, objectives, methods, out: Path, figures) -> int:
     from optdesign.api import front_outputs, pareto
 
     seed = args.seed if args.seed is not None else problem.spec.solver.seed
@@ -185,6 +190,7 @@ def _run_locked(args, problem, objectives, methods, out: Path) -> int:
         args.points,
         plot=not args.no_plot,
         report=not args.no_report,
+        figures=figures,
     )
     from optdesign.reports.front_text import front_summary
     from optdesign.text import printable

@@ -95,14 +95,17 @@ def run_solve(args) -> int:
         check.solve_plan(problem, args.formulation, args.objective)
     write_files = args.out is not None or not args.json
     if not write_files:
-        return _solve_and_report(args, problem, None)
+        return _solve_and_report(args, problem, None, None)
+    from optdesign.plots.figure_process import FigureProcess
+
     # One writer per folder, and a folder we cannot write to is refused before solving.
     with output_folder(args.out, f"solve-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
-        return _solve_and_report(args, problem, out)
+        with FigureProcess() if not args.no_plot else contextlib.nullcontext() as figures:
+            return _solve_and_report(args, problem, out, figures)
 
 
-def _solve_and_report(args, problem, out: Path | None) -> int:
+def _solve_and_report(args, problem, out: Path | None, figures) -> int:
     from optdesign.api import solve
     from optdesign.cli import stdout_to_stderr
     from optdesign.text import printable
@@ -128,33 +131,44 @@ def _solve_and_report(args, problem, out: Path | None) -> int:
     text = result_json(result)
     wrote = []
     if out is not None:
-        from optdesign.plots import write_figure
+        from optdesign.errors import OptDesignError
+        from optdesign.reports.html import solve_report
         from optdesign.storage import atomic_write_text
 
         # result.json first: whatever fails after it, the result is kept.
         atomic_write_text(out / "result.json", text)
         wrote.append(out / "result.json")
-        if not args.no_plot and result.design:
-            failed = write_figure(result.plot, out / "solution.png")
-            if failed is None:
-                wrote.append(out / "solution.png")
-            else:  # said in the summary and in result.json
-                result.notes.append(failed)
-                text = result_json(result)
-                atomic_write_text(out / "result.json", text)
-        if not args.no_report and result.design:
-            from optdesign.errors import OptDesignError
-            from optdesign.reports.html import solve_report
+        # the figure is drawn (in the figure process) while the page is made here
+        drawn = figures is not None and bool(result.design)
+        if drawn:
+            from optdesign.plots.solution import result_figure
 
+            figures.submit(
+                "optdesign.plots.solution:draw_solution",
+                out / "solution.png",
+                lambda: result_figure(result),
+            )
+        page, failed_page = None, None
+        if not args.no_report and result.design:
             try:
                 page = solve_report(result)
             except OptDesignError as exc:  # a user's mechanism that cannot draw itself
-                result.notes.append(f"report.html not written: {exc}")
-                text = result_json(result)
-                atomic_write_text(out / "result.json", text)
-            else:
-                atomic_write_text(out / "report.html", page)
-                wrote.append(out / "report.html")
+                failed_page = f"report.html not written: {exc}"
+        failed = figures.outcome() if drawn else None
+        if drawn and failed is None:
+            wrote.append(out / "solution.png")
+        elif failed is not None:  # said in the summary, in result.json and on the page
+            result.notes.append(failed)
+            if page is not None:
+                page = solve_report(result)
+        if failed_page is not None:
+            result.notes.append(failed_page)
+        if failed is not None or failed_page is not None:
+            text = result_json(result)
+            atomic_write_text(out / "result.json", text)
+        if page is not None:
+            atomic_write_text(out / "report.html", page)
+            wrote.append(out / "report.html")
     if args.json:
         print(text)
     else:

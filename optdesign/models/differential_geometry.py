@@ -32,7 +32,6 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-import scipy.linalg
 
 from optdesign.models.validity import Validity
 
@@ -173,6 +172,8 @@ class Surface:
 def _principal(r, r_u, r_v, n, I1, I2) -> SurfacePoint:
     # Generalised symmetric eigenproblem II x = kappa I x (I positive definite): the
     # eigenvalues are the principal curvatures, the eigenvectors the principal directions.
+    import scipy.linalg  # here: the validity table imports this module, not its solver
+
     w, X = scipy.linalg.eigh(I2, I1)
     order = np.argsort(w)[::-1]
     w, X = w[order], X[:, order]

@@ -49,8 +49,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.special import ellipe, ellipk, ellipkm1
 
 from optdesign.errors import InputError
 from optdesign.models.validity import ELASTIC_MODULUS, POISSON_RATIO, Validity
@@ -151,6 +149,8 @@ def curvature_difference_from_k2(k2: float) -> float:
     ``e^2 < 0.05``, a 40-term series of the numerator that avoids the cancellation of
     the closed form near e = 0.
     """
+    from scipy.special import ellipe, ellipkm1  # SciPy on call: importing models stays light
+
     m = 1.0 - k2
     if m <= 0.0:
         return 0.0
@@ -175,6 +175,8 @@ def eccentricity_from_curvature_difference(F_rho: float) -> float:
     float
         e in [0, 1); e = 0 for a circular contact.
     """
+    from scipy.optimize import brentq
+
     F_rho = float(F_rho)
     if not 0.0 <= F_rho < 1.0:
         raise InputError("F_rho", f"curvature difference must lie in [0, 1), got {F_rho}")
@@ -226,6 +228,8 @@ def hertz_from_curvatures(sum_rho: float, F_rho: float, Q: float, E_star: float)
     -------
     HertzPointContact
     """
+    from scipy.special import ellipe, ellipkm1
+
     if not sum_rho > 0:
         raise InputError("sum_rho", f"curvature sum must be positive, got {sum_rho}")
     if not Q > 0:
@@ -318,6 +322,8 @@ def curvature_difference_closed_form(e: float) -> float:
     Plain closed form without the series; used by the tests as an independent check of
     :func:`curvature_difference_from_k2` away from e = 0.
     """
+    from scipy.special import ellipe, ellipk
+
     m = e * e
     k2 = 1.0 - m
     return float(((1 + k2) * ellipe(m) - 2 * k2 * ellipk(m)) / ((1 - k2) * ellipe(m)))

@@ -37,6 +37,15 @@ rows (|T(j w_bw)|^2 >= 1/2, |1 + L(j w_k)|^2 >= 1/Ms^2 on a grid). The rest is N
 polynomials, poles, bandwidth, margins.
 
 Units: mm, t, s, N, rad (:mod:`optdesign.models.loop_plant`); frequencies in rad/s.
+
+Validity
+--------
+frequency w : w > 0, finite (call)
+    The response is taken on the positive imaginary axis; at w = 0 a loop with integral
+    action has L infinite, and negative frequencies only mirror the positive ones.
+linear loop : the gap closed, no friction, no saturation (documented)
+    The figures hold for motions that keep one flank loaded and the torque below the
+    peak; the gap's own effect is :mod:`optdesign.models.loop_backlash`'s.
 """
 
 from __future__ import annotations
@@ -49,6 +58,23 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError
 from optdesign.models.loop_plant import FEEDBACKS, DrivePlant, PositionLoop
+from optdesign.models.validity import Validity
+
+FREQUENCY = Validity(
+    "loop_linear.frequency",
+    "linear position loop",
+    "frequency w of the response",
+    0.0,
+    None,
+    "rad/s",
+    "the response is taken on the positive imaginary axis; a loop with integral action "
+    "has an infinite gain at w = 0",
+    open_lower=True,
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (FREQUENCY,)
 
 #: Grid points per decade used to bracket crossings before a root refines them.
 _POINTS_PER_DECADE = 400

@@ -32,6 +32,14 @@ ki in N*mm/(rad*s).
 
 Units: mm, t, s, N, rad (README "Units"): inertia in t*mm^2, torque in N*mm, stiffness
 in N*mm/rad, damping in N*mm*s/rad, speed in rad/s.
+
+Validity
+--------
+backlash : 0 <= b <= 5 deg at the fin (checked when a plant is built)
+    The gap is a rotation of the fin at the operating angle's ratio f'(phi0): the ratio
+    is held while the gap is crossed, which needs a gap small against the angle over
+    which f' changes (tens of degrees for the linkages here), and the clearance chain's
+    own model is a small-angle one (:mod:`optdesign.models.clearance`).
 """
 
 from __future__ import annotations
@@ -41,8 +49,26 @@ from dataclasses import dataclass, fields
 from typing import Literal
 
 from optdesign.errors import InputError
+from optdesign.models.validity import Validity
 
 FEEDBACKS = ("fin", "motor")
+
+BACKLASH = Validity(
+    "loop_plant.backlash",
+    "linearised drive plant",
+    "backlash half-width b at the fin",
+    0.0,
+    math.radians(5.0),
+    "rad",
+    "the gap is crossed at the operating angle's ratio, which holds for a gap small "
+    "against the angle over which the ratio changes",
+    shown_unit="deg",
+    scale=180.0 / math.pi,
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (BACKLASH,)
 
 
 def _finite(owner: str, name: str, value: float) -> float:
@@ -121,6 +147,8 @@ class DrivePlant:
                 raise InputError(
                     f"plant.{name}", f"cannot be negative, got {getattr(self, name)!r}"
                 )
+        if not BACKLASH.contains(self.backlash):
+            raise InputError("plant.backlash", BACKLASH.refusal(self.backlash))
 
     @property
     def motor_inertia_at_fin(self) -> float:

@@ -24,14 +24,26 @@ with, piece by piece:
   |f' T - tau| <= f' T_f, and stays stuck (theta' = 0) until that torque reaches the
   friction's; else it reverses. A smooth friction (tanh of the speed) would make the
   motor creep under any torque and make the equations stiff for a small velocity scale;
-* the speed limit: when |theta'| reaches ``max_speed`` while the motor would still
-  accelerate, the drive holds the speed (theta'' = 0, the applied torque the one that
-  holds it, T_fr sign + tau / f'), until the command asks less than that: no torque
-  further in the direction of motion. The held torque is not limited by the peak torque
-  (a load that drives the fin faster than the motor is not modelled).
+* the speed limit as the corner of the motor's torque-speed curve: the torque in the
+  direction of motion falls linearly from the command's at (1 - SPEED_BAND) max_speed to
+  none at ``max_speed`` and above; a braking torque is applied in full. Continuous, so
+  no mode: the motor settles just below the limit where the load needs torque, and a
+  load that drives it on can take it past the limit. Entering and leaving the band are
+  recorded as events ("speed limit", "speed released") without stopping the
+  integration (docs/loop.md: why not a held speed).
 
 Units: mm, t, s, N, rad. Angles in rad at the fin (the motor's as psi = theta / f'),
 torques in N*mm (the motor's at its shaft, the chain's at the fin), times in s.
+
+Validity
+--------
+horizon : 0 < T <= 600 s (call)
+    A fin's manoeuvre lasts seconds; a longer run is a mistake of units or a request for
+    millions of events, refused before it starts.
+reference angle : |r| <= pi rad (call)
+    A fin turns less than half a turn; a non-finite angle is refused.
+output samples : 2 to 10^6 (call)
+    Enough to resolve a cycle near the chain's resonance over a run; more is memory.
 """
 
 from __future__ import annotations
@@ -43,6 +55,7 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.validity import Validity
 
 #: The largest horizon simulated (s): a fin's manoeuvre lasts seconds.
 MAX_HORIZON = 600.0
@@ -52,6 +65,46 @@ MAX_SAMPLES = 1_000_000
 MAX_ANGLE = math.pi
 #: The most events (contacts, sticks, speed limits) handled before the run is refused.
 MAX_EVENTS = 200_000
+HORIZON = Validity(
+    "loop_simulation.horizon",
+    "loop simulation",
+    "simulated time",
+    0.0,
+    MAX_HORIZON,
+    "s",
+    "a fin's manoeuvre lasts seconds; a longer run is a units mistake or millions of events",
+    open_lower=True,
+    checked=("call",),
+)
+REFERENCE_ANGLE = Validity(
+    "loop_simulation.reference_angle",
+    "loop simulation",
+    "reference angle |r| at the fin",
+    0.0,
+    MAX_ANGLE,
+    "rad",
+    "a fin turns less than half a turn",
+    shown_unit="deg",
+    scale=180.0 / math.pi,
+    checked=("call",),
+)
+SAMPLES = Validity(
+    "loop_simulation.samples",
+    "loop simulation",
+    "output samples",
+    2.0,
+    float(MAX_SAMPLES),
+    "",
+    "enough to resolve a cycle near the chain's resonance over a run; more is memory",
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (HORIZON, REFERENCE_ANGLE, SAMPLES)
+
+#: The width of the torque-speed curve's corner, a fraction of the top speed: the
+#: torque in the direction of motion falls to none over the last 1 % of the speed.
+SPEED_BAND = 0.01
 
 
 # --- references ----------------------------------------------------------------------------
@@ -170,8 +223,8 @@ class LoopSimulation:
         The motor's angle and rate seen at the fin, theta / f' (rad) and theta' / f'
         (rad/s).
     motor_torque
-        The torque the motor applies at its shaft (N*mm): the current loop's output, or the
-        torque that holds the speed at the speed limit.
+        The torque the motor applies at its shaft (N*mm): the current loop's output, less
+        in the direction of motion near the top speed.
     chain_torque
         The chain's torque on the fin (N*mm).
     contact
@@ -202,23 +255,35 @@ class LoopSimulation:
 # --- the equations -------------------------------------------------------------------------
 # state x = [psi, phi, psi', phi', T (current loop), z (integral of the error)]
 # mode = (contact, side, motor): contact in {-1, 0, +1}; side in {-1, 0, +1} the flank
-# whose overlap persists while unloaded (contact 0); motor: +-1 turning, 0 stuck,
-# +-2 held at the speed limit
+# whose overlap persists while unloaded (contact 0); motor: +-1 turning, 0 stuck
 
 
 class _System:
     def __init__(self, plant: DrivePlant, loop: PositionLoop, reference):
-        self.p, self.c, self.r = plant, loop, reference
+        self.p, self.c, self.reference = plant, loop, reference
+        # the reference's left limit at a jump ending the current segment: the segment's
+        # last point must not see the jump (its events would fire on it, again and again)
+        self.left_of = math.inf
         self.J1 = plant.motor_inertia_at_fin
         self.fin = loop.feedback == "fin"
         self.w_lim = plant.max_speed / plant.ratio  # psi' at the speed limit
+        self.w_band = self.w_lim * (1.0 - SPEED_BAND)  # ... and where its corner begins
         # without clearance the chain is one linear, two-way spring: no contact events
         self.bilateral = plant.backlash == 0.0
+
+    def r(self, t: float) -> float:
+        """The reference, taken from the left at a jump that ends the segment."""
+        if t >= self.left_of:
+            return self.reference(float(np.nextafter(self.left_of, -math.inf)))
+        return self.reference(t)
 
     def command(self, t, x) -> float:
         """The current loop's output T (N*mm at the motor)."""
         if self.c.current_lag > 0:
-            return x[4]
+            # the lag's state stays within the peak; clipped against the integrator's
+            # overshoot of a saturated input
+            peak = self.p.peak_torque
+            return min(max(x[4], -peak), peak)
         return self.saturated_command(t, x)
 
     def saturated_command(self, t, x) -> float:
@@ -237,12 +302,12 @@ class _System:
         return self.raw_chain(x, mode[0]) if mode[0] else 0.0
 
     def motor_torque(self, t, x, mode) -> float:
-        """The torque the motor applies (N*mm), the hold torque at the speed limit."""
-        if abs(mode[2]) == 2:
-            return (
-                math.copysign(self.p.friction_torque, mode[2]) + self.chain(x, mode) / self.p.ratio
-            )
-        return self.command(t, x)
+        """The torque the motor applies (N*mm): the command, less in the direction of
+        motion over the torque-speed curve's corner (module docstring)."""
+        T = self.command(t, x)
+        if T * x[2] > 0 and abs(x[2]) > self.w_band:
+            return T * max(0.0, (self.w_lim - abs(x[2])) / (self.w_lim - self.w_band))
+        return T
 
     def drive_force(self, t, x, mode) -> float:
         """f' T - tau: the torque on the motor side at the fin, friction apart."""
@@ -254,7 +319,7 @@ class _System:
         dd_phi = (tau - p.hinge_spring * x[1] - p.fin_damping * x[3]) / p.fin_inertia
         motor = mode[2]
         if motor in (1, -1):
-            T = self.command(t, x)
+            T = self.motor_torque(t, x, mode)
             dd_psi = (p.ratio * (T - motor * p.friction_torque) - tau) / self.J1
         else:
             dd_psi = 0.0
@@ -263,7 +328,7 @@ class _System:
         return [x[2], x[3], dd_psi, dd_phi, dT, e]
 
     # -- the events of a mode: (function, direction, kind) ---------------------------------
-    def events(self, mode, x):
+    def events(self, mode):
         p = self.p
         b = p.backlash
         out = []
@@ -282,21 +347,10 @@ class _System:
         if motor in (1, -1):
             if p.friction_torque > 0:
                 out.append((lambda t, x, s=motor: s * x[2], -1, "stops"))
-            if math.isfinite(self.w_lim):
-                out.append((lambda t, x, s=motor: s * x[2] - self.w_lim, 1, "speed limit"))
         elif motor == 0:
             ft = p.ratio * p.friction_torque
             out.append((lambda t, x: self.drive_force(t, x, mode) - ft, 1, "slips"))
             out.append((lambda t, x: -self.drive_force(t, x, mode) - ft, 1, "slips"))
-        else:
-            s = 1 if motor > 0 else -1
-            out.append(
-                (
-                    lambda t, x: s * (self.command(t, x) - self.motor_torque(t, x, mode)),
-                    -1,
-                    "speed released",
-                )
-            )
         return out
 
     # -- the mode after an event, or at the start ----------------------------------------
@@ -311,7 +365,7 @@ class _System:
                 break
         v = x[2]
         if v != 0 or self.p.friction_torque == 0:
-            return self.speed_check(t, x, (*cm, 1 if v >= 0 else -1))
+            return (*cm, 1 if v >= 0 else -1), x
         return self.stick_check(t, x, (*cm, 0))
 
     def stick_check(self, t, x, mode):
@@ -323,16 +377,17 @@ class _System:
             return (mode[0], mode[1], 0), x
         return (mode[0], mode[1], 1 if F > 0 else -1), x
 
-    def speed_check(self, t, x, mode):
-        """At the speed limit: held while the command would accelerate further."""
-        s = mode[2]
-        if math.isfinite(self.w_lim) and s * x[2] >= self.w_lim * (1 - 1e-9):
-            held = (mode[0], mode[1], 2 * s)
-            if s * (self.command(t, x) - self.motor_torque(t, x, held)) > 0:
-                x = x.copy()
-                x[2] = s * self.w_lim
-                return held, x
-        return mode, x
+    def band_events(self):
+        """Entering and leaving the torque-speed curve's corner, either way: recorded,
+        not stopping the integration (the torque is continuous there)."""
+        out = []
+        if math.isfinite(self.w_lim):
+            for s in (1, -1):
+                for direction, kind in ((1, "speed limit"), (-1, "speed released")):
+                    g = lambda t, x, s=s: s * x[2] - self.w_band  # noqa: E731
+                    g.terminal, g.direction = False, direction
+                    out.append((g, kind))
+        return out
 
     def next_mode(self, t, x, mode, kind):
         contact, side, motor = mode
@@ -349,16 +404,8 @@ class _System:
         elif kind == "slips":
             F = self.drive_force(t, x, mode)
             return (contact, side, 1 if F > 0 else -1), x
-        elif kind == "speed limit":
-            return self.speed_check(t, x, mode)
-        elif kind == "speed released":
-            mode = (contact, side, 1 if motor > 0 else -1)
         if mode[2] == 0:  # a stuck motor whose load changed: it may slip at once
             return self.stick_check(t, x, mode)
-        if abs(mode[2]) == 2:  # a held one may no longer be asked for its hold torque
-            s = 1 if mode[2] > 0 else -1
-            if s * (self.command(t, x) - self.motor_torque(t, x, mode)) <= 0:
-                return (mode[0], mode[1], s), x
         return mode, x
 
 
@@ -453,17 +500,20 @@ def simulate(
         x[4] = sys.saturated_command(0.0, x)
     t = 0.0
     mode, x = sys.initial_mode(t, x)
+    band = sys.band_events()
     stops = [b for b in sorted(reference.breaks) if 0.0 < b < horizon] + [horizon]
     event_times: list[float] = []
     event_kinds: list[str] = []
     done = 0  # samples already taken
     while True:
         t_stop = next(b for b in stops if b > t)
-        evs = sys.events(mode, x)
+        sys.left_of = t_stop if t_stop < horizon else math.inf
+        evs = sys.events(mode)
         funcs = []
         for fn, direction, _ in evs:
             fn.terminal, fn.direction = True, direction
             funcs.append(fn)
+        funcs += [g for g, _ in band]
         sol = solve_ivp(
             lambda tt, xx, md=mode: sys.rhs(tt, xx, md),
             (t, t_stop),
@@ -476,7 +526,13 @@ def simulate(
         )
         if sol.status < 0:
             raise InputError("plant", f"the integration failed at t = {t:.6g} s: {sol.message}")
+        sys.left_of = math.inf  # from here on, the reference's value at t itself
         t_end = float(sol.t[-1])
+        for j, (_, kind) in enumerate(band, start=len(evs)):
+            for te in sol.t_events[j]:
+                if te < t_end or sol.status != 1:
+                    event_times.append(float(te))
+                    event_kinds.append(kind)
         last = t_end >= horizon
         upto = int(np.searchsorted(t_out, t_end, side="right" if last else "left"))
         if upto > done:
@@ -503,9 +559,9 @@ def simulate(
             mode, x = sys.next_mode(t, x, mode, kind)
         elif mode[2] == 0:  # a jump of the reference: a stuck motor may slip at once
             mode, x = sys.stick_check(t, x, mode)
-        elif abs(mode[2]) == 2:  # ... and a held one be released
-            mode, x = sys.next_mode(t, x, mode, "speed released")
-            mode, x = sys.speed_check(t, x, mode)
+            if mode[2] != 0:
+                event_times.append(t)
+                event_kinds.append("slips")
     return _record(sys, pieces, event_times, event_kinds, reference)
 
 

@@ -41,6 +41,10 @@ MODEL_MODULES = (
     "motor_catalogue",
     "describing_function",
     "harmonic_balance",
+    "loop_plant",
+    "loop_linear",
+    "loop_backlash",
+    "loop_simulation",
 )
 
 

@@ -6,6 +6,7 @@ and labels are drawn as plain text (:func:`optdesign.plots.plain`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,23 +16,102 @@ from optdesign.reports.limits import binding_angles, bound_limits, limits_of
 from optdesign.solvers.constraint_rows import constraint_rows
 
 
-def plot_designs(
+@dataclass(frozen=True)
+class DesignCurves:
+    """One design's curves over the stroke: its ratio and, with pins, its worst-case
+    backlash (deg)."""
+
+    label: str
+    ratio: np.ndarray
+    backlash: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class SolutionFigure:
+    """What the figure of a solved design shows, evaluated (:func:`solution_figure`), so
+    that drawing it (:func:`draw_solution`) evaluates no model and can run in another
+    process.
+
+    Attributes
+    ----------
+    name
+        The problem's name (the titles').
+    phi_deg
+        The deflection grid (deg).
+    designs
+        The curves of each design drawn, in order (the last one carries the markers).
+    mean_band
+        The required mean ratio's (low, high) drawn as a band, or None.
+    backlash_limit
+        The backlash limit (deg) drawn as a line, or None.
+    binding
+        Requirement name -> the grid indices where it binds, marked on the last design.
+    footer
+        What limits the design, listed under the plot ("" for none).
+    """
+
+    name: str
+    phi_deg: np.ndarray
+    designs: tuple[DesignCurves, ...]
+    mean_band: tuple[float, float] | None = None
+    backlash_limit: float | None = None
+    binding: tuple[tuple[str, tuple[int, ...]], ...] = ()
+    footer: str = ""
+
+    @property
+    def has_backlash(self) -> bool:
+        """Whether the figure has the backlash panel (the problem has pins)."""
+        return any(d.backlash is not None for d in self.designs) or (
+            not self.designs and self.backlash_limit is not None
+        )
+
+
+def solution_figure(
     problem: DesignProblem,
     designs: Mapping[str, Mapping[str, float]],
-    ax=None,
     limits: Sequence | None = None,
     binding: Mapping[str, Sequence[float]] | None = None,
-):
-    """Ratio (and backlash, if the problem has pins) vs deflection for each named design.
+) -> SolutionFigure:
+    """The :class:`SolutionFigure` of the named ``designs`` of ``problem``.
 
     ``limits``: :class:`~optdesign.reports.limits.Limit` records listed under the plot;
     ``binding``: requirement name -> deflection angles (deg) where it binds, marked on the
-    last design's ratio curve. Returns the Figure; with ``ax`` the ratio is drawn on that
-    axes (and the backlash, if any, on a twin axis) instead of a new figure.
+    last design's ratio curve.
     """
-    phi_deg = np.degrees(problem.phi)
+    phi_deg = np.degrees(np.asarray(problem.phi, dtype=float))
     has_pin = problem.has("d")
     req = problem.spec.requirements
+    curves = []
+    for label, design in designs.items():
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q = problem.quantities(design)
+            ratio = np.asarray(q.ratio, dtype=float).ravel()
+            backlash = np.asarray(q.backlash.worst_case, dtype=float).ravel() if has_pin else None
+        curves.append(DesignCurves(str(label), ratio, backlash))
+    band = None
+    if req.mean_ratio is not None:
+        lo, hi = req.mean_ratio.min, req.mean_ratio.max
+        lo_y = lo if lo is not None else 0.0
+        band = (float(lo_y), float(hi if hi is not None else lo_y))
+    limit = None
+    if has_pin and req.backlash_max is not None:
+        limit = float(np.degrees(req.backlash_max))
+    marks = tuple(
+        (str(name), tuple(int(np.argmin(np.abs(phi_deg - a))) for a in angles))
+        for name, angles in (binding or {}).items()
+    )
+    footer = ""
+    if limits:
+        footer = "what limits the design: " + "; ".join(lim.text() for lim in limits[:6])
+    return SolutionFigure(str(problem.name), phi_deg, tuple(curves), band, limit, marks, footer)
+
+
+def draw_solution(figure: SolutionFigure, ax=None):
+    """Draw a :class:`SolutionFigure`: the ratio (and the backlash, with pins) against the
+    deflection for each design. Returns the Figure; with ``ax`` the ratio is drawn on
+    that axes (and the backlash, if any, on a twin axis) instead of a new figure."""
+    has_pin = figure.has_backlash
+    phi_deg = figure.phi_deg
     if ax is None:
         # constrained: the footer (what limits the design) keeps its own room below the
         # axes' labels in a notebook too, where no save_figure lays the figure out
@@ -40,43 +120,28 @@ def plot_designs(
     else:
         fig = ax.figure
         axes = [ax, ax.twinx()] if has_pin else [ax]
-    if req.mean_ratio is not None:
-        lo, hi = req.mean_ratio.min, req.mean_ratio.max
-        lo_y = lo if lo is not None else 0.0
-        hi_y = hi if hi is not None else lo_y
+    if figure.mean_band is not None:
+        lo_y, hi_y = figure.mean_band
         axes[0].axhspan(lo_y, hi_y, color="C2", alpha=0.12, label="required mean ratio")
     ratio = None
-    for k, (label, design) in enumerate(designs.items()):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            q = problem.quantities(design)
-            ratio = np.asarray(q.ratio, dtype=float).ravel()
-            axes[0].plot(phi_deg, ratio, color=f"C{k}", label=plain(label))
-            if req.mean_ratio is not None:
-                axes[0].axhline(
-                    float(np.mean(ratio)),
-                    color=f"C{k}",
-                    ls=":",
-                    lw=0.9,
-                    label=f"mean, {plain(label)}",
-                )
-            if has_pin:
-                axes[1].plot(
-                    phi_deg,
-                    np.asarray(q.backlash.worst_case, dtype=float).ravel(),
-                    "--",
-                    color=f"C{k}",
-                    label=plain(label),
-                )
-    if has_pin and req.backlash_max is not None:
-        axes[1].axhline(
-            float(np.degrees(req.backlash_max)), color="C3", lw=1.2, label="backlash_max"
-        )
-    if binding and ratio is not None:
-        for j, (name, angles) in enumerate(binding.items()):
-            idx = [int(np.argmin(np.abs(phi_deg - a))) for a in angles]
+    for k, curves in enumerate(figure.designs):
+        ratio = curves.ratio
+        axes[0].plot(phi_deg, ratio, color=f"C{k}", label=plain(curves.label))
+        if figure.mean_band is not None:
+            with np.errstate(invalid="ignore"):
+                mean = float(np.mean(ratio))
+            axes[0].axhline(
+                mean, color=f"C{k}", ls=":", lw=0.9, label=f"mean, {plain(curves.label)}"
+            )
+        if has_pin and curves.backlash is not None:
+            axes[1].plot(phi_deg, curves.backlash, "--", color=f"C{k}", label=plain(curves.label))
+    if has_pin and figure.backlash_limit is not None:
+        axes[1].axhline(figure.backlash_limit, color="C3", lw=1.2, label="backlash_max")
+    if ratio is not None:
+        for j, (name, idx) in enumerate(figure.binding):
             axes[0].plot(
-                phi_deg[idx],
-                ratio[idx],
+                phi_deg[list(idx)],
+                ratio[list(idx)],
                 ["x", "+", "D", "v", "^", "s"][j % 6],
                 ms=8,
                 mew=2,
@@ -84,7 +149,7 @@ def plot_designs(
                 label=f"{plain(name)} binds",
             )
     axes[0].set_ylabel("reduction ratio i (motor rad / output rad)")
-    axes[0].set_title(f"{plain(problem.name, MAX_TITLE_NAME)}: ratio over the stroke")
+    axes[0].set_title(f"{plain(figure.name, MAX_TITLE_NAME)}: ratio over the stroke")
     if has_pin:
         axes[1].set_ylabel("worst-case backlash (deg)")
         axes[1].set_title("output backlash over the stroke")
@@ -92,10 +157,21 @@ def plot_designs(
         a.set_xlabel("deflection phi (deg)")
         a.grid(True, alpha=0.3)
         a.legend(fontsize=7)
-    if limits:
-        text = "what limits the design: " + "; ".join(lim.text() for lim in limits[:6])
-        fig.supxlabel(_wrap(plain(text, 6 * 170), 170), fontsize=7, x=0.01, ha="left")
+    if figure.footer:
+        fig.supxlabel(_wrap(plain(figure.footer, 6 * 170), 170), fontsize=7, x=0.01, ha="left")
     return fig
+
+
+def plot_designs(
+    problem: DesignProblem,
+    designs: Mapping[str, Mapping[str, float]],
+    ax=None,
+    limits: Sequence | None = None,
+    binding: Mapping[str, Sequence[float]] | None = None,
+):
+    """Ratio (and backlash, if the problem has pins) vs deflection for each named design
+    (:func:`solution_figure` drawn by :func:`draw_solution`); returns the Figure."""
+    return draw_solution(solution_figure(problem, designs, limits, binding), ax)
 
 
 def _wrap(text: str, width: int) -> str:
@@ -104,9 +180,10 @@ def _wrap(text: str, width: int) -> str:
     return "\n".join(textwrap.wrap(text, width))
 
 
-def plot_result(result, ax=None):
-    """The optimum of ``result`` against the problem's initial design (a Figure); the
-    initial design is labelled as violating the requirements when it does."""
+def result_figure(result) -> SolutionFigure:
+    """The :class:`SolutionFigure` of ``result``: its optimum against the problem's
+    initial design, the initial design labelled as violating the requirements when it
+    does."""
     problem = result.problem_object
     if problem is None or not result.design:
         raise ValueError("plot: the result carries no problem or no design to draw")
@@ -122,4 +199,9 @@ def plot_result(result, ax=None):
     limits = limits_of(problem, bad) + limits_of(problem, active)
     limits += bound_limits(problem, result.design)
     binding = binding_angles(active)
-    return plot_designs(problem, {initial: start, best: result.design}, ax, limits, binding)
+    return solution_figure(problem, {initial: start, best: result.design}, limits, binding)
+
+
+def plot_result(result, ax=None):
+    """The optimum of ``result`` against the problem's initial design (a Figure)."""
+    return draw_solution(result_figure(result), ax)

@@ -2,7 +2,7 @@
 by path (``"requirements.hinge_moment"``, ``"variables.R.upper"``): their values, how the
 user reads them, and copies of the problem with some of them moved.
 
-What a sensitivity moves (:mod:`optdesign.studies.sensitivity`), what a sweep varies
+What a sensitivity moves (:mod:`optdesign.formulations.nlp.sensitivities`), what a sweep varies
 (:mod:`optdesign.studies.sweep`) and what their pages show of a limit
 (:mod:`optdesign.reports.sweep_html`) are these paths; the rules live here, below the
 studies, so that a page reads a point's problem and a limit's value without importing a

@@ -1,7 +1,7 @@
 """What a caller asks of a solve, in one typed record: :class:`SolveRequest`.
 
 :func:`optdesign.solve` checks its arguments (:mod:`optdesign.validation`) and builds the
-request once; the formulation registry (:mod:`optdesign.studies.formulation_registry`)
+request once; the formulation registry (:mod:`optdesign.formulations.registry`)
 picks a formulation with it, and the formulation solves with it - no argument list is
 written twice on the way down. A formulation of a user's own receives the same record
 (``solve(problem, request)``). The record knows no solver and no formulation: a name

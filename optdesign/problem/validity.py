@@ -6,7 +6,7 @@ file is read (:mod:`optdesign.problem.spec`); what depends on the design - the b
 against the small-angle limit, the contact strip against the pin's radius, the pin's
 length against its diameter and the linkage - is evaluated here, on the NumPy path, for
 one design: :func:`design_ranges` lists the quantities and :func:`outside_ranges` the ones
-outside. The independent check of a result (:func:`optdesign.studies.verify.
+outside. The independent check of a result (:func:`optdesign.formulations.verify.
 verify_design`) reports them, so that such a design is never a verified optimum.
 
 Only the models a problem evaluates are checked: the pin's, the contact model the

@@ -29,7 +29,7 @@ from optdesign.reports.display_units import objective_shown
 from optdesign.solvers.result import Sensitivity
 
 #: What the page says when no limit moves the optimum (nothing binds, or only by less
-#: than :data:`optdesign.studies.sensitivity.NEGLIGIBLE`).
+#: than :data:`optdesign.formulations.nlp.sensitivities.NEGLIGIBLE`).
 NOTHING_BINDS = "none: no requirement or bound moves this optimum (by 1e-6 of it or more)"
 
 

@@ -28,6 +28,7 @@ from optdesign.solvers.result import clean_json
 from optdesign.text import csv_cell
 
 if TYPE_CHECKING:
+    from optdesign.plots.figure_process import FigureProcess
     from optdesign.problem.design_problem import DesignProblem
     from optdesign.studies.pareto.front import Front
 
@@ -107,12 +108,14 @@ def write_front_outputs(
     created: str,
     plot: bool = True,
     report: bool = True,
+    figures: FigureProcess | None = None,
 ) -> tuple[list[Path], list[str]]:
     """Everything ``optdesign pareto`` writes beside the stores, in folder ``out``:
     ``front.csv``, ``front.json``, ``front.png`` (``plot``) and ``report.html``
     (``report``, when a front has a point). Returns the files written and the notes of
     the outputs that could not be drawn (a figure or a page that fails is a note, not an
-    error: the other files are kept)."""
+    error: the other files are kept). ``figures``: the process that draws front.png
+    while the page is made (None: drawn here first)."""
     write_front_csv(fronts, problem, out / "front.csv")
     write_front_json(
         fronts,
@@ -125,14 +128,15 @@ def write_front_outputs(
     wrote = [out / "front.csv", out / "front.json"]
     notes: list[str] = []
     if plot:
-        from optdesign.plots import write_figure
-        from optdesign.plots.front import plot_fronts
+        from optdesign.plots.figure_process import FigureProcess
+        from optdesign.plots.front import front_figure
 
-        failed = write_figure(lambda: plot_fronts(problem, fronts), out / "front.png")
-        if failed is None:
-            wrote.append(out / "front.png")
-        else:  # the front's files are written; the report and the summary follow
-            notes.append(failed)
+        figures = figures if figures is not None else FigureProcess()
+        figures.submit(
+            "optdesign.plots.front:draw_front",
+            out / "front.png",
+            lambda: front_figure(problem, fronts),
+        )
     if report and any(f.points for f in fronts):
         from optdesign.errors import OptDesignError
         from optdesign.reports.html import front_report
@@ -145,4 +149,10 @@ def write_front_outputs(
         else:
             atomic_write_text(out / "report.html", page)
             wrote.append(out / "report.html")
+    if plot:
+        failed = figures.outcome()
+        if failed is None:
+            wrote.insert(2, out / "front.png")
+        else:  # the front's files are written; the report and the summary follow
+            notes.insert(0, failed)
     return wrote, notes

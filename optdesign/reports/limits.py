@@ -228,7 +228,7 @@ def objective_where(rows: Iterable[Any]) -> list[str]:
 
 
 def relaxation_limits(problem: Any, items: Sequence[Any]) -> list[Limit]:
-    """:class:`~optdesign.studies.relaxation.Relaxation` records as limits a user reads:
+    """:class:`~optdesign.formulations.nlp.relaxation.Relaxation` records as limits a user reads:
     ``limit`` as written, ``value`` the limit that makes the problem feasible (None:
     relaxing it alone is not enough), ``where`` the catalogue items it needs when they
     are not the diagnosis' basis."""

@@ -120,7 +120,7 @@ class WorkerPool:
                 continue
             try:
                 ok, value = self.conns[i].recv()
-            except EOFError:
+            except (EOFError, ConnectionResetError):  # killed mid-answer: a reset
                 self.procs[i].join(1.0)
                 _signalled_with_us(self.procs[i].exitcode)
                 raise OptDesignError(

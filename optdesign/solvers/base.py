@@ -1,6 +1,6 @@
 """The solver contract: one protocol for every NLP back-end, and what they share.
 
-A back-end is built once for one :class:`~optdesign.formulations.nlp.NLP` and solved many
+A back-end is built once for one :class:`~optdesign.programs.nlp.NLP` and solved many
 times; each call passes its own :class:`Start`, :class:`Target` (what to minimise) and
 :class:`Bounds` (epsilon limits, catalogue sub-boxes), so no back-end ever changes a
 shared NLP. The status mapping and the constraint reports are written once here
@@ -16,7 +16,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from optdesign.formulations.nlp import NLP, Bounds, Start, Target
+from optdesign.programs.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.result import (
     ConstraintReport,
     Result,

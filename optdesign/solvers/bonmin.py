@@ -94,7 +94,7 @@ def check_bonmin_options(options: Mapping[str, Any], field: str = "options") -> 
 
 def solve_minlp(minlp: Any, x0: Any, options: Mapping[str, Any] | None = None):
     """Bonmin on a mixed-integer NLP (``minlp``: x, f, g, its bounds and ``discrete``
-    flags, e.g. :class:`~optdesign.formulations.catalogue_minlp.CatalogueMINLP`) from
+    flags, e.g. :class:`~optdesign.formulations.catalogue.minlp_program.CatalogueMINLP`) from
     ``x0``; a :class:`~optdesign.solvers.base.MINLPSolution` (an evaluation error Bonmin
     cannot recover from is a status ``"error: ..."``, no point)."""
     import casadi as ca

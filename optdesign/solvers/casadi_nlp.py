@@ -27,8 +27,8 @@ import casadi as ca
 import numpy as np
 
 from optdesign.errors import InputError
-from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.interrupts import Interrupted, solver_call
+from optdesign.programs.nlp import NLP, Bounds, Start, Target
 from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas

@@ -4,7 +4,7 @@ their values.
 
 Below the studies so that the pages and plots that show a design's binding and violated
 rows (:mod:`optdesign.reports.html`, :mod:`optdesign.plots.solution`) and the studies that
-check a design (:mod:`optdesign.studies.verify`, :mod:`optdesign.studies.diagnosis`) read
+check a design (:mod:`optdesign.formulations.verify`, :mod:`optdesign.formulations.diagnosis`) read
 one rule.
 """
 

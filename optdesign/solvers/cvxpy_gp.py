@@ -1,6 +1,6 @@
 """cvxpy back-end for geometric programs (DGP, solved in log space by an interior point).
 
-Takes a generic :class:`~optdesign.formulations.gp.GPData` (variables, bounds, posynomial
+Takes a generic :class:`~optdesign.programs.gp.GPData` (variables, bounds, posynomial
 rows) and returns the common :class:`Result`. The certificate is a Lagrange dual bound
 computed from the solver's multipliers, independent of the solver's own stopping test:
 
@@ -26,10 +26,10 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.special import logsumexp
 
-from optdesign.formulations.gp import GPData, GPRow, to_cvxpy
 from optdesign.interrupts import solver_call
+from optdesign.programs.gp import GPData, GPRow, to_cvxpy
 from optdesign.solvers.blas import one_blas_thread
-from optdesign.solvers.details import Details, GPDetails, GPDual, GPTiming
+from optdesign.solvers.details import Details, GPBackEndDetails, GPDual, GPTiming
 from optdesign.solvers.result import (
     Certificate,
     ConstraintReport,
@@ -157,7 +157,7 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
             solution_status=SolutionStatus.INFEASIBLE
             if status == "infeasible"
             else SolutionStatus.NO_SOLUTION,
-            details=Details(gp=GPDetails(timing=timing)),
+            details=Details(gp=GPBackEndDetails(timing=timing)),
             **common,
         )
     t_cert = time.perf_counter()
@@ -214,7 +214,7 @@ def solve_gp(gp: GPData, solver: str = "CLARABEL", options: dict[str, Any] | Non
         max_violation=0.0,
         bound=lower,
         certificate=certificate,
-        details=Details(gp=GPDetails(dual=dual_info, timing=timing)),
+        details=Details(gp=GPBackEndDetails(dual=dual_info, timing=timing)),
         **common,
     )
 

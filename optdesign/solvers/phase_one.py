@@ -1,6 +1,6 @@
 """The least violation of an NLP's rows (a phase-1 problem) on Ipopt.
 
-For an :class:`~optdesign.formulations.nlp.NLP` with rows ``lbg <= g(z) <= ubg`` this
+For an :class:`~optdesign.programs.nlp.NLP` with rows ``lbg <= g(z) <= ubg`` this
 builds, once, the problem
 
     min t  s.t.  g(z) - wu t <= ubg,  g(z) + wl t >= lbg,  lbz <= z <= ubz,  t >= 0
@@ -14,7 +14,7 @@ each call, as are the bounds and the problem's parameters. Two uses:
 - weights ``1 / scale`` on one requirement's rows and 0 elsewhere: ``t`` is the
   relaxation of that requirement, in its own unit, that the others allow - the smallest
   one, found by a single solve where a bisection on feasibility needs a dozen
-  (:mod:`optdesign.studies.relaxation`); weights on several requirements' rows give the
+  (:mod:`optdesign.formulations.nlp.relaxation`); weights on several requirements' rows give the
   smallest relaxation of them together.
 """
 
@@ -28,8 +28,8 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from optdesign.formulations.nlp import NLP, Bounds, Target
 from optdesign.interrupts import solver_call
+from optdesign.programs.nlp import NLP, Bounds, Target
 from optdesign.safe_io import without_option_files
 from optdesign.solvers.base import make_result
 from optdesign.solvers.blas import one_blas_thread

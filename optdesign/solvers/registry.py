@@ -2,8 +2,8 @@
 declares of itself.
 
 ``make_solver(formulation, name, options)`` builds the back-end registered as ``name`` for
-a formulation (an :class:`~optdesign.formulations.nlp.NLP`, or a GP's
-:class:`~optdesign.formulations.gp.GPData`); solve, Pareto, catalogue, robust and bench
+a formulation (an :class:`~optdesign.programs.nlp.NLP`, or a GP's
+:class:`~optdesign.programs.gp.GPData`); solve, Pareto, catalogue, robust and bench
 all go through it. Adding a back-end is one module with a class that follows
 :class:`~optdesign.solvers.base.NLPSolver` and one :func:`register_solver` line, from
 inside the package or from a user's own code.
@@ -70,11 +70,11 @@ class SolverHints:
     preload: tuple[str, ...] = ()
     #: the result carries the constraint and bound multipliers of the NLP it solved
     #: (``raw["lam_g"]``, ``raw["lam_x"]``, in the formulation's scaling), which the
-    #: sensitivities of :mod:`optdesign.studies.sensitivity` read
+    #: sensitivities of :mod:`optdesign.formulations.nlp.sensitivities` read
     multipliers: bool = False
     #: "module:function" solving a catalogue problem as one mixed-integer NLP
     #: (``solve(minlp, x0, options) ->`` :class:`~optdesign.solvers.base.MINLPSolution`;
-    #: ``minlp``: a :class:`~optdesign.formulations.catalogue_minlp.CatalogueMINLP`); a
+    #: ``minlp``: a :class:`~optdesign.formulations.catalogue.minlp_program.CatalogueMINLP`); a
     #: catalogue search given this back-end hands it the whole problem (method
     #: ``"minlp"``) instead of solving its nodes with it. None: an NLP back-end only.
     minlp: str | None = None
@@ -225,7 +225,7 @@ def make_solver(
     """The back-end ``name`` built for ``formulation`` (default: ipopt for an NLP,
     clarabel for a GP). Options that would read or write a file or load code are
     refused (:func:`optdesign.safe_io.refuse_file_options`)."""
-    from optdesign.formulations.nlp import NLP
+    from optdesign.programs.nlp import NLP
     from optdesign.safe_io import refuse_file_options
 
     kind = "nlp" if isinstance(formulation, NLP) else "gp"
@@ -269,7 +269,7 @@ def _sqpmethod(nlp, options):
 
 def _bonmin(nlp, options):
     # a continuous NLP: Bonmin with no integer variable (its Ipopt); catalogue problems
-    # reach Bonmin through the catalogue search (optdesign.studies.catalogue_minlp)
+    # reach Bonmin through the catalogue search (optdesign.formulations.catalogue.minlp)
     from optdesign.solvers.bonmin import bonmin_nlp_solver
 
     return bonmin_nlp_solver(nlp, options)
@@ -321,7 +321,7 @@ def _builtins() -> None:
     slsqp = SolverHints(
         sweep_options={"maxiter": 200}, time_limit_options=("time_limit",), preload=scipy
     )
-    cvxpy = ("cvxpy", "optdesign.solvers.cvxpy_gp", "optdesign.formulations.gp")
+    cvxpy = ("cvxpy", "optdesign.solvers.cvxpy_gp", "optdesign.programs.gp")
     for name, factory, kind, desc, hints in (
         ("ipopt", _ipopt, "nlp", "Ipopt interior point (CasADi), exact Hessian by default", ipopt),
         ("sqpmethod", _sqpmethod, "nlp", "CasADi SQP (sqpmethod) with a QP solver", None),

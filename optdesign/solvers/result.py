@@ -425,8 +425,9 @@ class Result(SolvedPoint):
     notes
         Plain-language remarks for the summary.
     details
-        What a catalogue search, a GP solve, a robust solve or a reference comparison
-        adds (:class:`~optdesign.solvers.details.Details`, typed); ``result.json`` writes
+        What the formulation adds, by its name (``details["catalogue"]``, or
+        ``details.catalogue``: the formulation's own typed record), and a reference
+        comparison (:class:`~optdesign.solvers.details.Details`); ``result.json`` writes
         it as ``"extra"``.
     """
 

@@ -1,5 +1,5 @@
 """SciPy back-ends behind the common :class:`Result`: SLSQP and trust-constr on an
-:class:`~optdesign.formulations.nlp.NLP` (derivatives exact from CasADi or by finite
+:class:`~optdesign.programs.nlp.NLP` (derivatives exact from CasADi or by finite
 differences), and differential evolution on a vectorised NumPy objective.
 
 - :class:`ScipyNLPSolver` turns the NLP into one CasADi Function for f, grad f, g and
@@ -29,8 +29,8 @@ import casadi as ca
 import numpy as np
 import scipy.optimize as so
 
-from optdesign.formulations.nlp import NLP, Bounds, Start, Target
 from optdesign.interrupts import solver_call
+from optdesign.programs.nlp import NLP, Bounds, Start, Target
 from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition

@@ -21,7 +21,7 @@ def is_success(status: str, verified: bool | None = None) -> bool:
     """The one success rule of a solved point (a result, a front's record or point, a
     bench run): a status of :data:`SOLVED_STATUSES` that the independent check on the
     NumPy path did not refuse (``verified`` False). ``verified`` None means not checked
-    (yet): a result before :func:`optdesign.studies.nlp_solve.finish`; a stored front
+    (yet): a result before :func:`optdesign.formulations.nlp.solve.finish`; a stored front
     record that claims success unchecked is refused before it is read
     (:func:`optdesign.studies.pareto.records.record_problem`)."""
     return status in SOLVED_STATUSES and verified is not False

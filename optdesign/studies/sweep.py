@@ -98,7 +98,7 @@ class SweepPoint:
     def success(self) -> bool:
         """The one success rule (:func:`~optdesign.solvers.solved_point.is_success`); a
         stored point's status is already the checked one (a design the independent check
-        refused is ``"infeasible"``, :func:`optdesign.studies.nlp_solve.finish`)."""
+        refused is ``"infeasible"``, :func:`optdesign.formulations.nlp.solve.finish`)."""
         return is_success(self.status)
 
 
@@ -163,10 +163,10 @@ def run_sweep(
     run
         Where and how the points run (store folder, resume, workers, progress).
     """
+    from optdesign.formulations.nlp.solve import planned_starts
     from optdesign.runtime.identity import problem_digest, solver_identity, version
     from optdesign.runtime.processes import process_pool
     from optdesign.runtime.runner import forks_workers, run_tasks
-    from optdesign.studies.nlp_solve import planned_starts
     from optdesign.studies.sweep_solver import sweep_mode
 
     run = run if run is not None else RunOptions()

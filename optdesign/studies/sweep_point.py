@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.formulations.nlp.solution import nlp_solution
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.parameters import at_values
 from optdesign.problem.request import SolveRequest
@@ -100,7 +101,7 @@ def sweep_point(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str, A
         if shared is not None:
             best = shared.search(problem, request.starts, request.seed, request.agree)
         else:
-            from optdesign.studies.nlp_solve import solve_nlp
+            from optdesign.formulations.nlp.solve import solve_nlp
 
             best = solve_nlp(
                 problem,
@@ -237,9 +238,9 @@ def _outcome(task, problem: DesignProblem, best, shared, found_by: str) -> dict[
         request.sensitivities
         and best.success
         and solver_hints(best.solver).multipliers
-        and "lam_g" in best.raw
+        and nlp_solution(best) is not None
     ):
-        from optdesign.studies.sensitivity import nlp_sensitivities
+        from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
 
         nlp = shared.nlp if shared is not None else None
         try:  # a point solved by its formulation has its own (a catalogue's, a robust one's)
@@ -295,7 +296,7 @@ def _warm(task: Mapping[str, Any], problem: DesignProblem, shared, x0: np.ndarra
     """One local solve of the point from ``x0``, checked."""
     if shared is not None:
         return shared.warm(problem, x0)
-    from optdesign.studies.nlp_solve import solve_nlp
+    from optdesign.formulations.nlp.solve import solve_nlp
 
     return solve_nlp(problem, task["request"].objective, starts=1, x0=x0)
 

@@ -16,7 +16,7 @@ solves, not a new formulation (:meth:`SweepSolver.search`, :meth:`SweepSolver.wa
   own NLP (mode ``"rebuild"``).
 
 Every point's result is checked on the point's own problem on the NumPy path
-(:func:`optdesign.studies.nlp_solve.finish`), whichever NLP solved it.
+(:func:`optdesign.formulations.nlp.solve.finish`), whichever NLP solved it.
 """
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from optdesign.formulations.nlp import Bounds
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.programs.nlp import Bounds
 from optdesign.solvers.registry import default_solver
 from optdesign.solvers.result import Result
 
@@ -92,7 +92,7 @@ class SweepSolver:
     its single warm-started solves, each on the point's bounds and parameters."""
 
     def __init__(self, problem: DesignProblem, paths: Sequence[str], objective: str):
-        from optdesign.studies.nlp_solve import _objective_set, solver_for
+        from optdesign.formulations.nlp.solve import _objective_set, solver_for
 
         self.paths = list(paths)
         self.objective = objective
@@ -133,7 +133,7 @@ class SweepSolver:
 
     def warm(self, point: DesignProblem, x0: np.ndarray) -> Result:
         """One solve of the point from ``x0`` (its neighbour's design), checked."""
-        from optdesign.studies.nlp_solve import finish
+        from optdesign.formulations.nlp.solve import finish
 
         bounds = self.bounds(point)
         start = self.nlp.start(x0=x0, parameters=bounds.parameters)
@@ -143,13 +143,18 @@ class SweepSolver:
         self, point: DesignProblem, starts: int | None, seed: int, agree: int | None = None
     ) -> Result:
         """The point's global search on the shared NLP, checked: the search a cold solve
-        of the point runs (:func:`optdesign.studies.nlp_solve.solve_nlp`) - the point's
+        of the point runs (:func:`optdesign.formulations.nlp.solve.solve_nlp`) - the point's
         declared start, if any, then tilted random starts drawn on the point's own
         problem with ``seed`` until the odds say stop (``starts``: the most starts, None:
-        :func:`~optdesign.studies.nlp_solve.planned_starts`; ``agree``: None, the file's)
+        :func:`~optdesign.formulations.nlp.solve.planned_starts`; ``agree``: None, the file's)
         - with the point's bounds and parameters in the shared NLP."""
+        from optdesign.formulations.nlp.solve import (
+            finish,
+            own_starts,
+            planned_starts,
+            tilted_starts,
+        )
         from optdesign.search.global_phase import global_search, search_globality
-        from optdesign.studies.nlp_solve import finish, own_starts, planned_starts, tilted_starts
 
         bounds = self.bounds(point)
         result = global_search(

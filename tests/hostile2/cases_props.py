@@ -176,7 +176,7 @@ def relaxation_works():
 
     def api(ctx: Any) -> Any:
         import optdesign as od
-        from optdesign.studies.relaxation import relaxations
+        from optdesign.formulations.nlp.relaxation import relaxations
 
         problem = od.load(ctx.data())
         result = od.solve(problem, starts=2, ranges=False)

@@ -164,17 +164,54 @@ def test_friction_sticks_the_motor_within_its_band():
     assert np.ptp(sim.motor_angle[late]) == 0.0
 
 
+def test_a_delayed_step_frees_a_stuck_motor_once():
+    # no current lag: the command jumps with the reference at 0.05 s, from inside the
+    # friction band to far beyond it; the motor slips there, once
+    plant = DrivePlant(**TWO_MASS, backlash=4.1e-4, friction_torque=20.0)
+    loop = PositionLoop(kp=2000.0, kd=35.0, ki=3000.0, feedback="fin")
+    sim = ls.simulate(plant, loop, ls.StepReference(-0.07, time=0.05), 0.3, samples=301)
+    assert sim.event_times[0] == 0.05 and sim.event_kinds[0] == "slips"
+    assert sim.event_times.count(0.05) == 1
+    assert np.all(sim.motor_rate[sim.times < 0.05] == 0.0)
+    assert sim.motor_rate[sim.times > 0.05][0] < 0.0
+
+
 def test_saturation_and_speed_limit_bound_the_motor():
     plant = DrivePlant(
         **TWO_MASS, backlash=B, friction_torque=30.0, peak_torque=250.0, max_speed=150.0
     )
     loop = PositionLoop(kp=2000.0, kd=60.0, ki=8000.0, current_lag=2e-4, feedback="motor")
     sim = ls.simulate(plant, loop, ls.StepReference(math.radians(10.0)), 1.0, samples=4001)
-    assert np.max(np.abs(sim.motor_rate)) * plant.ratio == pytest.approx(150.0, rel=1e-9)
-    assert np.max(np.abs(sim.motor_torque[sim.motor_rate * plant.ratio < 149.9])) <= 250.0 + 1e-9
+    # the torque-speed curve's corner: the speed settles in the last 1 % below the limit
+    top = np.max(np.abs(sim.motor_rate)) * plant.ratio
+    assert 150.0 * (1 - ls.SPEED_BAND) < top <= 150.0
+    assert np.max(np.abs(sim.motor_torque)) <= 250.0 + 1e-9
     assert "speed limit" in sim.event_kinds and "speed released" in sim.event_kinds
+    # in the corner the torque is the command's, scaled down linearly to none at the top
+    speed = sim.motor_rate * plant.ratio
+    corner = speed > 150.0 * (1 - ls.SPEED_BAND) + 1e-6
+    assert np.all(sim.motor_torque[corner] <= 250.0 * (150.0 - speed[corner]) / 1.5 + 1e-9)
     # the linear loop would need 10 deg * kp = 349 N*mm at once: the command saturates
     assert np.max(sim.motor_torque) == pytest.approx(250.0)
+
+
+def test_above_the_speed_limit_the_motor_only_brakes():
+    # an undamped chain rings and drives the motor past its limit: there the motor
+    # applies no torque in the direction of motion
+    plant = DrivePlant(
+        motor_inertia=0.0251,
+        ratio=63.47,
+        fin_inertia=3.204,
+        stiffness=1.438e7,
+        hinge_spring=1.324e4,
+        max_speed=150.0,
+    )
+    loop = PositionLoop(kp=1634.7, kd=20.26, ki=3000.0, feedback="motor")
+    sim = ls.simulate(plant, loop, ls.SineReference(math.radians(3.0), 30.0), 0.3, samples=30001)
+    speed = sim.motor_rate * plant.ratio
+    above = np.abs(speed) > 150.0 * (1 + 1e-9)
+    assert np.count_nonzero(above) > 10
+    assert np.all(sim.motor_torque[above] * np.sign(speed[above]) <= 0.0)
 
 
 def test_sampled_reference_reproduces_the_sine():

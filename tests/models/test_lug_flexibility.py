@@ -20,10 +20,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from optdesign.errors import InputError, OptDesignError, ProblemError
-from optdesign.formulations.gp import build_gp
 from optdesign.mechanisms.joints import CONTACT_MODELS, PinJoint
 from optdesign.models.lug_flexibility import HUTH_CONSTANTS, Lug, huth_approach, huth_compliance
 from optdesign.problem import load_problem, problem_from_dict
+from optdesign.programs.gp import build_gp
 from optdesign.units import convert, unit_factor
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -240,9 +240,9 @@ def test_gp_form_with_fixed_thicknesses_and_its_refusal():
     """Fixed lug thicknesses make Huth's approach a monomial in d (C ~ d^-a): the fixed-
     linkage crank-slider stays a GP and its GP optimum equals the NLP's. With the inner
     lug at L = 1.5 d the factor (t1 + t2)^a is a power of a sum: the diagnosis names it."""
-    from formulations.test_gp import CS_FIXED
+    from programs.test_gp import CS_FIXED
 
-    from optdesign.studies.gp import solve_gp_problem
+    from optdesign.formulations.gp.solve import solve_gp_problem
 
     data = copy.deepcopy(CS_FIXED)
     data["requirements"]["pin_contact"] = "huth"

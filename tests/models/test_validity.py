@@ -28,11 +28,11 @@ from validity_problems import variant as variant_of
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.formulations.verify import verify_design
 from optdesign.models import validity_registry
 from optdesign.models.validity import ELASTIC_MODULUS, Validity
 from optdesign.problem.validity import is_validity, outside_ranges
 from optdesign.reports.result_json import result_document
-from optdesign.studies.verify import verify_design
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"

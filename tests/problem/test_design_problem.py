@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from optdesign import math as m
-from optdesign.formulations.nlp import build_nlp
 from optdesign.models import crank_slider as cs
 from optdesign.problem import load_problem
+from optdesign.programs.nlp import build_nlp
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 

@@ -22,10 +22,10 @@ from scipy.optimize import brentq
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.formulations.nlp.solve import solve_nlp
+from optdesign.formulations.verify import verify_design
 from optdesign.problem import drive, load_problem, problem_from_dict
 from optdesign.problem.load import load
-from optdesign.studies.nlp_solve import solve_nlp
-from optdesign.studies.verify import verify_design
 
 ROOT = Path(__file__).resolve().parents[2]
 FIN = ROOT / "problems" / "fin_actuator.toml"

@@ -8,11 +8,11 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.formulations.nlp.solve import solve_nlp
 from optdesign.mechanisms import CrankSlider
 from optdesign.models.lock import PinLock, motor_shaft_lock_load
 from optdesign.models.screw_sizing import buckling_load
 from optdesign.problem import problem_from_dict
-from optdesign.studies.nlp_solve import solve_nlp
 from problem.test_drive import _data  # the drive's crank-slider problem
 
 

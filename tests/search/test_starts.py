@@ -13,8 +13,8 @@ import pytest
 
 import optdesign as od
 from optdesign.api import solve
-from optdesign.formulations.nlp import build_nlp
 from optdesign.problem.load import problem_from_dict
+from optdesign.programs.nlp import build_nlp
 from optdesign.search.starts import (
     CHUNK,
     NEAR_FEASIBLE,
@@ -106,11 +106,11 @@ PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 
 
 #: The multistart optimum of cs_min_backlash without a start (tests/studies/test_solve.py and the
-#: independent global check of tests/studies/test_catalogue.py's RELAXED agree on it).
+#: independent global check of tests/formulations/catalogue/test_search.py's RELAXED agree on it).
 OPTIMUM = 0.0362197
 
 
-#: Branch and bound over ISO 3408 leads and ISO 2338 pins (tests/studies/test_catalogue.py, the
+#: Branch and bound over ISO 3408 leads and ISO 2338 pins (tests/formulations/catalogue/test_search.py, the
 #: ISO 286-2 table clearance at 6 mm).
 CATALOGUE_OPTIMUM = 0.0340646
 

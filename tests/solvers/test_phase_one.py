@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.formulations.nlp.solve import formulation_for
 from optdesign.solvers.phase_one import CERTIFY_ABOVE, PhaseOneSolver
-from optdesign.studies.nlp_solve import formulation_for
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 

@@ -136,7 +136,7 @@ def test_a_new_back_end_is_one_module_and_one_registration_line(lbfgs_back_end):
     assert result.status == "optimal" and result.solver == "ipopt"
     assert result.objective == pytest.approx(0.0194989, rel=1e-4)
     # its declared hints reach the studies: a catalogue node gets its node options
-    from optdesign.studies.catalogue import NodeSolver
+    from optdesign.formulations.catalogue.search import NodeSolver
 
     cat = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
     node = NodeSolver(cat, solver="ipopt-lbfgs-example")

@@ -8,15 +8,10 @@ import math
 
 import pytest
 
-from optdesign.solvers.details import (
-    CatalogueCombination,
-    CatalogueDetails,
-    Details,
-    GPDetails,
-    GPTiming,
-    NominalOptimum,
-    RobustDetails,
-)
+from optdesign.formulations.catalogue.details import CatalogueCombination, CatalogueDetails
+from optdesign.formulations.gp.details import GPDetails
+from optdesign.formulations.robust.details import NominalOptimum, RobustDetails
+from optdesign.solvers.details import Details, GPTiming
 from optdesign.solvers.result import ConstraintReport, Result
 from optdesign.solvers.solved_point import SHARED_FIELDS, SolvedPoint, is_success, shared_fields
 from optdesign.studies.pareto.front import FrontPoint, make_front

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from optdesign.formulations.nlp import build_nlp
 from optdesign.problem import load_problem
+from optdesign.programs.nlp import build_nlp
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 from optdesign.studies.pareto import compute_front

@@ -16,13 +16,13 @@ from independent_physics import _fork_data
 import optdesign as od
 from optdesign.cli import main
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import build_nlp
+from optdesign.formulations.nlp.solve import search_points, search_stand_in, solve_nlp
+from optdesign.formulations.verify import verify_design
 from optdesign.problem import load_problem, problem_from_dict
+from optdesign.programs.nlp import build_nlp
 from optdesign.reports.html import solve_report
 from optdesign.reports.result_json import result_document
 from optdesign.solvers.casadi_nlp import IPOPT_WARM, CasadiNLPSolver
-from optdesign.studies.nlp_solve import search_points, search_stand_in, solve_nlp
-from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 SHIPPED = ["cs_min_ripple", "cs_min_backlash", "fork_min_backlash", "pivot_min_backlash"]
@@ -305,7 +305,7 @@ def test_multistart_on_two_processes_matches_in_process():
 
 
 def test_optimal_ranges_expose_non_unique_optima():
-    from optdesign.studies.nlp_solve import optimal_ranges
+    from optdesign.formulations.nlp.solve import optimal_ranges
 
     fork = load_problem(PROBLEMS / "fork_min_backlash.toml")
     res = solve_nlp(fork, starts=2)

@@ -11,10 +11,10 @@ import pytest
 import optdesign as od
 from optdesign.cli import main
 from optdesign.commands.sweep import parse_vary
+from optdesign.formulations.nlp.solve import solve_nlp
 from optdesign.problem.parameters import at_values
 from optdesign.problem.request import SolveRequest
 from optdesign.runtime.run_options import RunOptions
-from optdesign.studies.nlp_solve import solve_nlp
 from optdesign.studies.sweep import run_sweep
 from optdesign.studies.sweep_grid import grid_order, neighbour, sweep_axes
 from optdesign.studies.sweep_point import grid_neighbours, polish_choice

@@ -23,7 +23,7 @@ def _has_catalogue(problem: DesignProblem) -> bool:
 
 def _catalogue_run(method: str, solver: str | None, options: Mapping[str, Any] | None):
     def run(problem: DesignProblem, objective: str, time_limit: float) -> Result:
-        from optdesign.studies.catalogue import solve_catalogue
+        from optdesign.formulations.catalogue.search import solve_catalogue
 
         return solve_catalogue(
             problem, method=method, objective=objective, solver=solver, options=options

@@ -119,8 +119,8 @@ def nlp_config(
     """A configuration that solves the problem's NLP once from its start."""
 
     def run(problem: DesignProblem, objective: str, time_limit: float) -> Result:
+        from optdesign.formulations.nlp.solve import formulation_for
         from optdesign.solvers.registry import make_solver
-        from optdesign.studies.nlp_solve import formulation_for
 
         nlp = formulation_for(problem, (objective,), form)
         # Each back-end's own wall-time options, as it declares them (sqpmethod has
@@ -198,7 +198,7 @@ def _de_run(problem: DesignProblem, objective: str, time_limit: float) -> Result
 
 def _gp_config(solver: str, description: str, options: Mapping[str, Any] | None = None) -> Config:
     def run(problem: DesignProblem, objective: str, time_limit: float) -> Result:
-        from optdesign.formulations.gp import build_gp
+        from optdesign.programs.gp import build_gp
         from optdesign.solvers.registry import make_solver
 
         gp = build_gp(problem, objective)
@@ -214,7 +214,7 @@ def _gp_config(solver: str, description: str, options: Mapping[str, Any] | None 
 def gp_applies(problem: DesignProblem) -> bool:
     """The problem is a GP once its catalogue variables are fixed (the benchmark enumerates
     catalogues): every diagnosis passes but 'takes catalogue values'."""
-    from optdesign.formulations.gp import build_gp
+    from optdesign.programs.gp import build_gp
 
     return all(
         c.ok or (c.what == "variable" and "catalogue values" in c.reason)

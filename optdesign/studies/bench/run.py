@@ -224,7 +224,7 @@ def bench_identity(
         "optdesign": version(),
     }
     if problems is not None:
-        from optdesign.studies.nlp_solve import formulation_for
+        from optdesign.formulations.nlp.solve import formulation_for
 
         identity["problems"] = [
             {

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import ProblemError
+from optdesign.formulations.verify import verify_design
 from optdesign.problem import DesignProblem, problem_from_dict
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.result import Result
@@ -27,7 +28,6 @@ from optdesign.solvers.solved_point import SOLVED_STATUSES, is_success
 from optdesign.studies.bench.configs import Config, NotApplicable, get_config
 from optdesign.studies.bench.instances import Instance, make_instance
 from optdesign.studies.bench.rows import BenchRow, BenchRowError, is_number
-from optdesign.studies.verify import verify_design
 from optdesign.tolerances import FEASIBILITY_TOL
 
 #: After this many hard timeouts of one configuration on one mechanism in one worker

@@ -2,7 +2,7 @@
 
 A front of continuous NLPs would pass through designs no catalogue sells; here every point
 - the anchors too - is solved by the catalogue search (branch and bound over NLP
-relaxations, :func:`optdesign.studies.catalogue.solve_catalogue`) with the epsilon limit
+relaxations, :func:`optdesign.formulations.catalogue.search.solve_catalogue`) with the epsilon limit
 on the other objective, so every point is a catalogue design with its relaxation bound.
 The points are independent once the anchors are in: they run side by side as tasks of the
 checkpointed runner (resumable, local processes or Dask).
@@ -16,10 +16,11 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from optdesign.errors import InputError
+from optdesign.formulations.catalogue.diagnosis import catalogue_diagnosis
+from optdesign.formulations.catalogue.search import solve_catalogue
+from optdesign.formulations.diagnosis import Relaxing, diagnose
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.registry import FRONT_SOLVERS
-from optdesign.studies.catalogue import solve_catalogue
-from optdesign.studies.diagnosis import diagnose
 from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
 from optdesign.studies.pareto.records import PointRecord, record_from_result
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
@@ -75,9 +76,9 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
         # An anchor with no catalogue design: its best point, for the error to name the
         # requirements it violates (no relaxations: the front stops here).
-        diagnose(problem, result, relax=False)
+        diagnose(problem, result, Relaxing(relax=False), by=catalogue_diagnosis)
     rec = record_from_result(problem, result, task["kind"], task["target"], eps, task["id"])
-    info = result.details.catalogue
+    info = result.details.get("catalogue")
     rec.n_solves = info.nlp_solves if info is not None else 0
     rec.wall_time_s = time.perf_counter() - t0
     return rec.to_dict()

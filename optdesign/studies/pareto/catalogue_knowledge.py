@@ -1,5 +1,5 @@
 """What one point of a catalogue front passes to the next (see
-:mod:`optdesign.studies.catalogue_bnb`).
+:mod:`optdesign.formulations.catalogue.bnb`).
 
 - First incumbents: a point's search starts from the best feasible of its neighbours'
   discrete optima - the previous point (when the points run one after another), then the
@@ -9,7 +9,7 @@
   pruning tolerance (then the candidate tried first is kept).
 - Infeasible boxes: with one local worker the tasks run in order in one process - the
   anchors, then the points from the loosest epsilon limit to the tightest - and they
-  share one :class:`~optdesign.studies.catalogue_bnb.InfeasibleBoxes` memo (a box proved
+  share one :class:`~optdesign.formulations.catalogue.bnb.InfeasibleBoxes` memo (a box proved
   infeasible under looser limits is not solved again).
 """
 
@@ -19,9 +19,9 @@ import itertools
 from collections.abc import Mapping
 from typing import Any
 
-from optdesign.formulations.discrete import discrete_variables
+from optdesign.formulations.catalogue.bnb import shared_memo
+from optdesign.formulations.catalogue.discrete import discrete_variables
 from optdesign.runtime.identity import problem_digest
-from optdesign.studies.catalogue_bnb import shared_memo
 from optdesign.studies.pareto.records import PointRecord
 
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import InfeasibleRequirementsError
-from optdesign.studies.diagnosis import violated_text
+from optdesign.formulations.diagnosis import violated_text
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 

@@ -2,7 +2,7 @@
 
 A point of an epsilon front is the optimum of ``min target s.t. others <= eps`` (the
 record's ``target`` and ``eps``) on the front's one formulation, and its record keeps that
-solve's multipliers. The envelope theorem of :mod:`optdesign.studies.sensitivity` holds
+solve's multipliers. The envelope theorem of :mod:`optdesign.formulations.nlp.sensitivities` holds
 there as at a single optimum: each cost is d(target)/d(limit) with the other objectives
 held at the point's epsilon bounds (the front moves; the point keeps its trade-off). An
 epsilon row enters with the bound it had in that solve, ``min(eps, the requirement's own
@@ -53,7 +53,7 @@ class PointCosts:
     held
         The other objectives held at their epsilon bounds in that solve (internal units).
     sensitivities
-        Ranked as :func:`~optdesign.studies.sensitivity.from_multipliers` ranks them.
+        Ranked as :func:`~optdesign.formulations.nlp.sensitivities.from_multipliers` ranks them.
     why
         Why the costs cannot be known ("" when they are).
     basis
@@ -94,8 +94,8 @@ def _from_multipliers(
     problem: DesignProblem, objectives: Sequence[str], point: Any, raw: Any, costs: PointCosts
 ) -> None:
     """Fill ``costs`` from the point's multipliers ``raw`` (or say why not)."""
-    from optdesign.studies.nlp_solve import formulation_for
-    from optdesign.studies.sensitivity import _RowModel, from_multipliers
+    from optdesign.formulations.nlp.sensitivities import _RowModel, from_multipliers
+    from optdesign.formulations.nlp.solve import formulation_for
 
     target, eps = costs.target, costs.held
     nlp = formulation_for(problem, tuple(sorted(objectives)))
@@ -164,8 +164,9 @@ def _resolved(
     its ``z`` by the default NLP back-end, when that back-end returns multipliers and
     ends at the point's ``value`` or at most :data:`NEARBY` below it: (design, lam_g,
     lam_x, how much lower, relative); else None."""
+    from optdesign.formulations.nlp.solution import nlp_solution
+    from optdesign.formulations.nlp.solve import solver_for
     from optdesign.solvers.registry import default_solver, solver_hints
-    from optdesign.studies.nlp_solve import solver_for
 
     name = default_solver("nlp")
     if not solver_hints(name).multipliers:
@@ -174,15 +175,16 @@ def _resolved(
     if backend.nlp.fingerprint != nlp.fingerprint:
         return None
     r = backend.solve(nlp.start(z0=np.asarray(z, dtype=float)), target, nlp.bounds(eps=eps))
-    if not r.success or "lam_g" not in r.raw or not np.isfinite(r.objective):
+    solution = nlp_solution(r)
+    if not r.success or solution is None or not np.isfinite(r.objective):
         return None
     scale = max(abs(value), 1e-300)
     if r.objective > value + SAME_POINT * scale or r.objective < value - NEARBY * scale:
         return None
     return (
         dict(r.design),
-        np.asarray(r.raw["lam_g"], float),
-        np.asarray(r.raw["lam_x"], float),
+        solution.lam_g,
+        solution.lam_x,
         (value - r.objective) / scale,
     )
 

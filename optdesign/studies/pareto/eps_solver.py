@@ -1,7 +1,7 @@
 """The epsilon-constraint solver of a front: ``min target s.t. others <= eps``.
 
 Every solve of a front - the anchors' multistarts, the tie-breaks, the sweep points, a
-weighted sum - is one formulation (:func:`optdesign.studies.nlp_solve.formulation_for` of the
+weighted sum - is one formulation (:func:`optdesign.formulations.nlp.solve.formulation_for` of the
 front's objectives) with the target and the epsilon limits passed per solve, so each
 back-end is built once per process and any point's solution and multipliers can start
 any other solve.
@@ -24,11 +24,11 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from optdesign.errors import ProblemError
-from optdesign.formulations.nlp import NLP, Start
+from optdesign.formulations.nlp.solve import formulation_for, solver_for
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.programs.nlp import NLP, Start
 from optdesign.solvers.registry import FRONT_SOLVERS, solver_hints
 from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import formulation_for, solver_for
 from optdesign.studies.pareto.records import PointRecord
 
 #: The sweep back-ends a caller may name (``solver=``).

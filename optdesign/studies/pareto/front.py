@@ -156,7 +156,7 @@ class Front:
     def no_point_text(self, problem: Any) -> str:
         """Why the front has no point: the requirements its least violating design
         violates (the command line's line for an infeasible front)."""
-        from optdesign.studies.diagnosis import violated_text
+        from optdesign.formulations.diagnosis import violated_text
 
         head = f"{self.method}: no feasible design"
         designs = [p.design for p in self.rejected if p.design]

@@ -28,12 +28,12 @@ import numpy as np
 
 from optdesign.argument_checks import DEFAULT_FRONT_POINTS, ArgumentError
 from optdesign.errors import InputError, ProblemError
-from optdesign.formulations.discrete import CatalogueCoordinates
+from optdesign.formulations.catalogue.discrete import CatalogueCoordinates
+from optdesign.formulations.nlp.solve import formulation_for
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.runtime.runner import forks_workers, process_pool
 from optdesign.solvers.multistart import improves
 from optdesign.solvers.registry import FRONT_SOLVERS
-from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
 from optdesign.studies.pareto.chains import (
     TwoChains,
@@ -386,7 +386,7 @@ def pymoo_problem(problem: DesignProblem, objectives: Sequence[str]):
     """The problem as a vectorised pymoo ``Problem`` (NumPy path, relative violations).
 
     Catalogue variables are searched as indices of their items
-    (:class:`~optdesign.formulations.discrete.CatalogueCoordinates`): every design
+    (:class:`~optdesign.formulations.catalogue.discrete.CatalogueCoordinates`): every design
     evaluated is a catalogue design."""
     from pymoo.core.problem import Problem
 

@@ -17,11 +17,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from optdesign.formulations.nlp.solution import nlp_solution
+from optdesign.formulations.nlp.solve import finish
+from optdesign.formulations.verify import verify_design
 from optdesign.problem.design_problem import DesignProblem, relative_violation
 from optdesign.solvers.result import Result, clean_json
 from optdesign.solvers.solved_point import SolvedPoint, in_key_order, shared_fields
-from optdesign.studies.nlp_solve import finish
-from optdesign.studies.verify import verify_design
 from optdesign.tolerances import FEASIBILITY_TOL
 
 
@@ -180,13 +181,9 @@ def record_from_result(
         key=lambda s: (s.split("[")[0], s),
     )
     raw = None
-    if result.raw and nlp_fingerprint:
-        raw = RawSolution(
-            np.asarray(result.raw["z"], dtype=float),
-            np.asarray(result.raw["lam_x"], dtype=float),
-            np.asarray(result.raw["lam_g"], dtype=float),
-            nlp_fingerprint,
-        )
+    solution = nlp_solution(result) if nlp_fingerprint else None
+    if solution is not None:
+        raw = RawSolution(solution.z, solution.lam_x, solution.lam_g, nlp_fingerprint)
     return PointRecord(
         **{**shared_fields(result), "status": status},
         id=task_id,

@@ -13,11 +13,11 @@ from pathlib import Path
 from typing import Any
 
 from optdesign.errors import InputError
+from optdesign.formulations.nlp.solve import formulation_for
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.runtime.identity import run_identity
 from optdesign.runtime.run_options import RunOptions as RunOptions  # the fronts import it here
 from optdesign.safe_io import slug
-from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto.records import record_problem
 
 

@@ -23,16 +23,16 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.problem.design_problem import DesignProblem
-from optdesign.search.global_phase import global_search
-from optdesign.solvers.multistart import improves, sobol_starts
-from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import (
+from optdesign.formulations.nlp.solve import (
     THIN_FROM_STARTS,
     own_starts,
     search_stand_in,
     tilted_starts,
 )
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.search.global_phase import global_search
+from optdesign.solvers.multistart import improves, sobol_starts
+from optdesign.solvers.result import Result
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import AnchorStarts, PointRecord, record_from_result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL

@@ -19,9 +19,9 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from optdesign.errors import InputError
+from optdesign.formulations.nlp.solve import planned_starts
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.runtime.runner import run_tasks
-from optdesign.studies.nlp_solve import planned_starts
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
 from optdesign.studies.pareto.records import PointRecord

@@ -65,7 +65,7 @@ def test_performance_profile_hand_made_table():
 
 
 def test_scipy_back_ends_reach_the_fork_optimum():
-    from optdesign.formulations.nlp import build_nlp
+    from optdesign.programs.nlp import build_nlp
     from optdesign.solvers.scipy_nlp import ScipyNLPSolver
 
     p = make_instance("shipped", 2).problem()  # fork_min_backlash, optimum 0.0194989 deg

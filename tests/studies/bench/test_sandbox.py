@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.formulations.verify import verify_design
 from optdesign.problem.objectives import BUILTIN_OBJECTIVES, ObjectiveInfo
 from optdesign.solvers.result import Result, TerminationCondition
 from optdesign.studies import bench
 from optdesign.studies.bench.configs import Config
 from optdesign.studies.bench.sandbox import row_problem, run_task
 from optdesign.studies.bench.scoring import config_stats
-from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 

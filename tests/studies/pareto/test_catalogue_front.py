@@ -11,10 +11,10 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
+from optdesign.formulations.catalogue.search import solve_catalogue
 from optdesign.problem import problem_from_dict
 from optdesign.runtime.run_options import RunOptions
 from optdesign.solvers.registry import FRONT_SOLVERS
-from optdesign.studies.catalogue import solve_catalogue
 from optdesign.studies.pareto import (
     PointRecord,
     catalogue_front,

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
-from optdesign.formulations.discrete import discrete_variables
-from optdesign.studies import catalogue_bnb
+from optdesign.formulations.catalogue import bnb as catalogue_bnb
+from optdesign.formulations.catalogue.discrete import discrete_variables
 from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
 from optdesign.studies.pareto.records import PointRecord
 

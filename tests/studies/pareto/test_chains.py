@@ -81,7 +81,7 @@ def test_the_anchor_message_without_a_problem_or_design_lists_the_records_violat
 
 
 def test_the_anchor_message_names_what_the_best_point_violates(problem):
-    from optdesign.studies.diagnosis import violated_text
+    from optdesign.formulations.diagnosis import violated_text
 
     x = problem.lower().astype(float).copy()
     design = problem.design_dict(x)
@@ -349,7 +349,7 @@ def test_a_failed_tie_break_of_the_far_anchor_names_what_its_point_violates(tmp_
     (the problem reaches the check)."""
     import json
 
-    from optdesign.studies.diagnosis import violated_text
+    from optdesign.formulations.diagnosis import violated_text
     from optdesign.studies.pareto.chains import NoFeasibleAnchor, TwoChains
 
     fork = load(ROOT / "problems" / "fork_min_backlash.toml")

@@ -17,9 +17,9 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import ProblemError
+from optdesign.formulations.nlp.solve import formulation_for
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Result
-from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto import eps_solver
 from optdesign.studies.pareto.eps_solver import EpsSolver
 from optdesign.studies.pareto.records import PointRecord, RawSolution

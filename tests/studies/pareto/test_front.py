@@ -248,7 +248,7 @@ def test_a_front_without_points_names_what_its_least_violating_design_violates()
     from pathlib import Path
 
     import optdesign as od
-    from optdesign.studies.diagnosis import violated_text
+    from optdesign.formulations.diagnosis import violated_text
 
     problem = od.load(Path(__file__).resolve().parents[3] / "problems" / "cs_min_backlash.toml")
     mid = problem.design_dict(problem.midpoint())

@@ -15,6 +15,7 @@ import optdesign.solvers.casadi_nlp
 import optdesign.solvers.multistart
 from optdesign.cli import main
 from optdesign.errors import InputError
+from optdesign.formulations.verify import verify_design
 from optdesign.problem import load_problem
 from optdesign.problem.design_problem import relative_violation
 from optdesign.problem.load import load
@@ -30,7 +31,6 @@ from optdesign.studies.pareto.metrics import (
     spacing,
     spread,
 )
-from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 
@@ -311,8 +311,8 @@ def threaded_blas():
     """Every OpenBLAS of this process at two threads (as a machine with OPENBLAS_NUM_THREADS
     unset or 2 starts them), the counts restored after: the main process then differs
     from the one-thread workers unless the solves set their own count."""
+    from optdesign.formulations.nlp.solve import solver_for
     from optdesign.solvers.blas import blas_libraries
-    from optdesign.studies.nlp_solve import solver_for
 
     solver_for(load_problem(PROBLEMS / "fork_min_backlash.toml"), "ipopt")  # CasADi's BLAS
     before = [(lib, lib.get_threads()) for lib in blas_libraries()]

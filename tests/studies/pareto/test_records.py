@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.formulations.verify import verify_design
 from optdesign.problem import load_problem
 from optdesign.solvers.result import ConstraintReport, Result
 from optdesign.storage import StoreError
@@ -38,7 +39,6 @@ from optdesign.studies.pareto.records import (
     record_problem,
     vector,
 )
-from optdesign.studies.verify import verify_design
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
 #: A feasible design of cs_min_backlash (R, l, n, p, phi0, d), inside every requirement.

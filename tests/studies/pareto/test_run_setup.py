@@ -13,8 +13,8 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
+from optdesign.formulations.nlp.solve import formulation_for
 from optdesign.storage import StoreError
-from optdesign.studies.nlp_solve import formulation_for
 from optdesign.studies.pareto import (
     PointRecord,
 )

@@ -11,9 +11,9 @@ import pytest
 
 import optdesign as od
 from optdesign.errors import InputError
+from optdesign.formulations.nlp.solve import planned_starts
 from optdesign.runtime.run_options import RunOptions
 from optdesign.search.global_phase import default_max_starts
-from optdesign.studies.nlp_solve import planned_starts
 from optdesign.studies.pareto import (
     CatalogueEpsilon,
     EpsilonConstraint,

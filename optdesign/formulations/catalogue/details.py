@@ -1,0 +1,146 @@
+"""The catalogue formulation's typed record (``result.details["catalogue"]``): how the
+exact catalogue optimum was found, and what a MINLP back-end did with the items.
+
+``result.json`` writes it under ``"extra"`` as ``"catalogue"``, with the keys earlier
+releases wrote.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+from optdesign.solvers.details import fields_json
+
+
+@dataclass
+class CatalogueCombination:
+    """One combination of catalogue items solved by the enumeration."""
+
+    items: dict[str, float]
+    status: str
+    objective: float
+
+
+@dataclass
+class MINLPDetails:
+    """What a MINLP back-end did with a catalogue problem (method ``"minlp"``).
+
+    Attributes
+    ----------
+    solver, algorithm, status
+        The back-end (``"bonmin"``), its algorithm and its return status.
+    binaries, groups
+        One-hot binaries of the encoding, and the catalogue variables of each group.
+    seconds
+        Time of the encoding and the MINLP solve.
+    items, objective_scaled
+        The items it chose and its objective (the NLP's scaled one); None when it found
+        no integer-feasible point.
+    """
+
+    solver: str
+    algorithm: str
+    status: str
+    binaries: int
+    groups: list[list[str]]
+    seconds: float
+    items: dict[str, float] | None = None
+    objective_scaled: float | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return fields_json(self, ("items", "objective_scaled"))
+
+
+@dataclass
+class CatalogueDetails:
+    """How the exact catalogue optimum was found (:func:`optdesign.formulations.catalogue.search.
+    solve_catalogue`).
+
+    Attributes
+    ----------
+    method
+        ``"enumerate"``, ``"bnb"`` or ``"minlp"`` (a MINLP back-end picked the items).
+    combinations
+        Number of item combinations.
+    variables
+        The catalogue values of each discrete variable.
+    relaxation_bound, relaxation_status, relaxation_design
+        The continuous relaxation (every catalogue range at once): its optimum (None when
+        it failed), status and design - a lower bound of the catalogue optimum.
+    starts_per_node
+        Multistart of each node's NLP.
+    enumerated
+        Every combination and its solve (enumeration only).
+    nodes, pruned, infeasible, leaves
+        Branch-and-bound counts (branch and bound only).
+    seeded
+        Nodes solved for the first incumbents (a front's neighbouring optima).
+    warm_fallbacks
+        Warm nodes that fell back to the full multistart.
+    implied_infeasible
+        Boxes proved infeasible with no NLP (:class:`~optdesign.formulations.catalogue.bnb.
+        InfeasibleBoxes`).
+    minlp
+        What the MINLP back-end did (method ``"minlp"`` only).
+    nlp_solves
+        NLP solves spent.
+    items
+        The items chosen (None: no feasible combination).
+    gap_to_relaxation_rel
+        (optimum - relaxation bound) / |relaxation bound| (None without a bound).
+    """
+
+    method: str
+    combinations: int
+    variables: dict[str, list[float]]
+    relaxation_bound: float | None
+    relaxation_status: str
+    relaxation_design: dict[str, float | None]
+    starts_per_node: int
+    enumerated: list[CatalogueCombination] | None = None
+    nodes: int | None = None
+    pruned: int | None = None
+    infeasible: int | None = None
+    leaves: int | None = None
+    seeded: int | None = None
+    warm_fallbacks: int | None = None
+    implied_infeasible: int | None = None
+    minlp: MINLPDetails | None = None
+    nlp_solves: int = 0
+    items: dict[str, float] | None = None
+    gap_to_relaxation_rel: float | None = None
+    #: The boxes the search proved infeasible, with the epsilon limits of each proof
+    #: (:class:`~optdesign.formulations.catalogue.bnb.InfeasibleBoxes`): the neighbouring
+    #: items of the optimum read them before solving. In memory only (not in result.json).
+    infeasible_boxes: list[tuple[dict[str, tuple[float, float]], dict[str, float]]] = field(
+        default_factory=list, repr=False
+    )
+
+    def to_json(self) -> dict[str, Any]:
+        out = fields_json(
+            self,
+            (
+                "enumerated",
+                "nodes",
+                "pruned",
+                "infeasible",
+                "leaves",
+                "seeded",
+                "warm_fallbacks",
+                "implied_infeasible",
+                "minlp",
+                "items",
+                "gap_to_relaxation_rel",
+            ),
+        )
+        if self.enumerated is not None:
+            out["enumerated"] = [asdict(row) for row in self.enumerated]
+        if self.minlp is not None:
+            out["minlp"] = self.minlp.to_json()
+        out.pop("infeasible_boxes")
+        return out
+
+    def extra(self) -> dict[str, Any]:
+        """Its keys in ``result.json``'s ``"extra"`` object: one, ``"catalogue"``."""
+        return {"catalogue": self.to_json()}

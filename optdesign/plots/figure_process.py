@@ -1,0 +1,156 @@
+"""A process that draws a command's figures while the command computes.
+
+Importing matplotlib and laying a figure out take about as long as solving a shipped
+problem, and a command needs the figure only at its end. :class:`FigureProcess` starts
+one worker process at the start of the command (:class:`optdesign.runtime.processes.
+WorkerPool`: forked, dies with this process, leaves Ctrl-C to it); the worker imports
+matplotlib while this process solves, then draws each figure it is sent (a record of
+evaluated curves: drawing evaluates no model) and writes the PNG, while this process
+writes its other outputs. On two cores the figure leaves the command's critical path;
+on one it costs what it cost in process.
+
+The worker is started only where it is forked (Linux) from a process running one
+thread (a fork copies no other thread, and a lock another thread held would stay held
+in the worker). Elsewhere, or when the worker cannot start or dies, figures are drawn in
+process, with the same outcome.
+
+Outcome of a figure: None when written, else a note naming the file and the error
+(:func:`optdesign.plots.write_figure`'s contract: a figure is one output among several,
+its failure must not lose the others).
+"""
+
+from __future__ import annotations
+
+import importlib
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from optdesign.errors import OptDesignError
+from optdesign.plots import write_figure
+from optdesign.runtime.processes import WorkerPool, forks_workers
+
+
+def _warm() -> None:
+    """What the worker imports while the command computes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.figure
+    from matplotlib.backends import backend_agg  # noqa: F401
+
+
+def _draw(module: str, function: str, record: Any, path: str) -> str | None:
+    draw = getattr(importlib.import_module(module), function)
+    return write_figure(lambda: draw(record), path)
+
+
+class FigureProcess:
+    """Draws figures in a worker process started before the work that precedes them
+    (see the module's docstring). Use as a context manager: the worker is started on
+    entry and stopped on exit."""
+
+    def __init__(self) -> None:
+        self._pool: WorkerPool | None = None
+        #: the worker's task in flight: "" for the warm-up, else the figure's path
+        self._inflight: str | None = None
+        #: the outcomes of the figures submitted, in order (None: written); the one the
+        #: worker draws is filled in when it answers
+        self._outcomes: list[str | None] = []
+        self._waiting = 0  # figures submitted whose outcome is not yet read
+
+    def __enter__(self) -> FigureProcess:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def forked(self) -> bool:
+        """Whether figures are drawn in a worker process (else in process)."""
+        return self._pool is not None
+
+    @property
+    def pid(self) -> int | None:
+        """The worker's process id (None when figures are drawn in process)."""
+        return None if self._pool is None else self._pool.procs[0].pid
+
+    def start(self) -> None:
+        """Start the worker where it is safe (see the module's docstring)."""
+        if self._pool is not None or not forks_workers() or threading.active_count() != 1:
+            return
+        try:
+            self._pool = WorkerPool(1)
+            self._pool.submit(_warm, ())
+        except (OSError, OptDesignError):  # no process to spare: draw in process
+            self.close()
+            return
+        self._inflight = ""
+
+    def submit(self, draw: str, path: str | Path, prepare: Callable[[], Any]) -> None:
+        """Write the figure ``draw(prepare())`` as PNG at ``path``; ``draw`` is a
+        ``"module:function"`` path (the worker imports it), ``prepare`` evaluates the
+        record it draws, here. A failure of either is the figure's note; the outcome
+        comes from :meth:`outcome`, in the order submitted."""
+        self._waiting += 1
+        self._settle()
+        try:
+            record = prepare()
+        except OSError:
+            raise
+        except Exception as exc:  # what the figure shows could not be evaluated
+
+            def fail(error: Exception = exc) -> Any:
+                raise error
+
+            self._outcomes.append(write_figure(fail, path))
+            return
+        module, _, function = draw.partition(":")
+        job = (module, function, record, str(path))
+        if self._pool is not None:
+            try:
+                self._pool.submit(_draw, job)
+            except Exception:  # a record that does not pickle, a worker gone: in process
+                self.close()
+            else:
+                self._inflight = str(path)
+                return
+        self._outcomes.append(_draw(*job))
+
+    def outcome(self) -> str | None:
+        """The outcome of the oldest figure submitted (None: written; else the note).
+        I/O errors writing it are raised, as :func:`write_figure` raises them."""
+        if not self._waiting:
+            raise RuntimeError("outcome(): no figure was submitted")
+        if not self._outcomes:
+            self._settle()
+        self._waiting -= 1
+        return self._outcomes.pop(0)
+
+    def _settle(self) -> None:
+        """Wait for the worker's task in flight, if any, and keep its outcome."""
+        if self._inflight is None or self._pool is None:
+            return
+        path, self._inflight = self._inflight, None
+        try:
+            ((_, note),) = self._pool.wait()
+        except OSError:
+            raise
+        except OptDesignError:  # the worker died
+            code = self._pool.procs[0].exitcode
+            self.close()
+            note = f"the figure process ended (exit code {code})"
+            if path:
+                self._outcomes.append(f"{Path(path).name} not written: {note}")
+            return
+        if path:
+            self._outcomes.append(note)
+
+    def close(self) -> None:
+        """Stop the worker (it also stops when this process ends)."""
+        if self._pool is not None:
+            self._pool.close()
+        self._pool = None
+        self._inflight = None

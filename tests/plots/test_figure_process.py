@@ -1,0 +1,109 @@
+"""plots.figure_process: a command's figure drawn in a forked child gives the file the
+command drew in process before, and every way the child can fail is a note."""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import pytest
+
+import optdesign as od
+from optdesign.plots import write_figure
+from optdesign.plots.figure_process import FigureProcess
+from optdesign.plots.solution import draw_solution, result_figure
+
+pytestmark = pytest.mark.skipif(
+    not hasattr(os, "fork"), reason="the figure process forks (elsewhere: in process)"
+)
+
+
+@pytest.fixture(scope="module")
+def solved():
+    return od.solve("cs_min_backlash", starts=1, ranges=False)
+
+
+def test_the_child_writes_the_png_the_process_draws(solved, tmp_path):
+    record = result_figure(solved)
+    assert write_figure(lambda: draw_solution(record), tmp_path / "here.png") is None
+    with FigureProcess() as figures:
+        if threading.active_count() != 1:
+            pytest.skip("the test process runs threads: no fork (drawn in process)")
+        assert figures.forked
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "a.png", lambda: record)
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "b.png", lambda: record)
+        assert figures.outcome() is None and figures.outcome() is None
+    here = (tmp_path / "here.png").read_bytes()
+    assert len(here) > 10_000
+    assert (tmp_path / "a.png").read_bytes() == here == (tmp_path / "b.png").read_bytes()
+
+
+def test_a_drawing_that_fails_in_the_child_is_a_note(solved, tmp_path):
+    with FigureProcess() as figures:
+        figures.submit(
+            "optdesign.plots.solution:draw_solution", tmp_path / "x.png", lambda: "not a record"
+        )
+        note = figures.outcome()
+    assert note.startswith("x.png not written: AttributeError:")
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_a_child_killed_while_drawing_is_a_note(tmp_path):
+    with FigureProcess() as figures:
+        if not figures.forked:
+            pytest.skip("no fork here")
+        figures.submit("time:sleep", tmp_path / "a.png", lambda: 30.0)  # a drawing that hangs
+        os.kill(figures.pid, signal.SIGKILL)
+        note = figures.outcome()
+        assert note == "a.png not written: the figure process ended (exit code -9)"
+        assert not figures.forked
+    assert not (tmp_path / "a.png").exists()
+
+
+def _gone(pid: int) -> bool:
+    """Whether process ``pid`` has exited (a zombie: its pipe ends are closed)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except FileNotFoundError:
+        return True
+
+
+def test_after_the_child_is_gone_figures_are_drawn_in_process(solved, tmp_path):
+    record = result_figure(solved)
+    with FigureProcess() as figures:
+        if not figures.forked or not os.path.exists(f"/proc/{figures.pid}/stat"):
+            pytest.skip("no fork here, or no /proc to see the child exit")
+        os.kill(figures.pid, signal.SIGKILL)
+        deadline = time.monotonic() + 10.0
+        while not _gone(figures.pid) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "b.png", lambda: record)
+        assert not figures.forked and figures.outcome() is None
+    assert (tmp_path / "b.png").stat().st_size > 10_000
+
+
+def test_no_child_is_forked_beside_another_thread(tmp_path):
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        with FigureProcess() as figures:
+            assert not figures.forked
+    finally:
+        stop.set()
+        other.join()
+
+
+def _no_design():
+    raise ValueError("plot: no design")
+
+
+def test_a_figure_that_cannot_be_prepared_is_its_note(tmp_path):
+    with FigureProcess() as figures:
+        figures.submit("optdesign.plots.solution:draw_solution", tmp_path / "s.png", _no_design)
+        assert figures.outcome() == "s.png not written: ValueError: plot: no design"
+    with pytest.raises(RuntimeError, match="no figure was submitted"):
+        FigureProcess().outcome()
