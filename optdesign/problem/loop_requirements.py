@@ -1,13 +1,15 @@
-"""The position loop's requirements and objectives (issue 38; docs/loop.md): smooth rows
-at every grid angle, built from the design's plant (:mod:`optdesign.problem.loop`) and
+"""The position loop's requirements (issue 38; docs/loop.md): smooth rows at the loop's
+angles of the grid, built from the design's plant (:mod:`optdesign.problem.loop`) and
 the loop's frequency response (:func:`optdesign.models.loop_linear.loop_response`).
 
-What each row checks, at each grid angle, on the linear loop (the gap closed, no
+What each row checks, at each loop angle, on the linear loop (the gap closed, no
 friction, no torque or speed limit):
 
 * ``bandwidth`` (``requirements.bandwidth_min`` = f_b): |T(j w_b)|^2 / |T(j w_b / 10^4)|^2
   >= 1/2, w_b = 2 pi f_b: the closed loop from the reference to the fin still passes half
-  the power of its static gain (the gain four decades below, within 1e-8 of it) at f_b;
+  the power of its static gain at f_b. The static gain is read four decades below f_b,
+  where T is flat unless the loop has a corner that low (an integral action's zero at
+  ki / kp would be one); at the shipped optimum it is T(0) to 1e-8;
 * ``phase_margin`` (``phase_margin_min`` = PM) and ``modulus_margin``
   (``modulus_margin_min`` = s): the return difference |1 + L(jw)| kept at or above
   2 sin(PM / 2), or s, on 14 frequencies: seven fixed ones half an octave apart from
@@ -16,7 +18,7 @@ friction, no torque or speed limit):
   design. The row holds a smooth lower bound of the smallest |1 + L| on those
   frequencies, (sum_k |1 + L_k|^-2p)^(-1/2p) with p = :data:`SOFT_MIN_POWER`: never
   above that minimum. It is a check on these frequencies, not on every w: a dip of
-  |1 + L| between them is missed (at the shipped optimum the row is within 0.3 % of the
+  |1 + L| between them is missed (at the shipped optimum the row is 0.2-0.25 % above the
   exact modulus margin of :func:`optdesign.models.loop_linear.margins`). Where |L| = 1,
   |1 + L| = 2 sin(PM' / 2), PM' the phase margin: where the gain crossover is on the
   frequencies, the row implies a phase margin of at least PM and a gain margin of at
@@ -26,11 +28,10 @@ friction, no torque or speed limit):
   motor_drive.two_mass_frequency_squared`): the loop's gain at the resonance stays g
   times below 1, whatever its phase (gain stabilisation of the mode);
 * ``loop_stable`` (always, with ``[loop]``): the smallest damping ratio -Re p / |p| of the
-  closed loop's poles p at each loop angle, above 1e-9 (:func:`optdesign.models.loop_linear.is_stable`).
-  Checked on the NumPy path only - the independent check of every solver's answer, the
-  margins' rows steer the solver - so a solver's design whose loop is unstable is no
-  verified result.
-
+  closed loop's poles p at each loop angle, above 1e-9 (as
+  :func:`optdesign.models.loop_linear.is_stable`). Checked on the NumPy path only, the
+  independent check of every solver's answer (the margins' rows steer the solver): a
+  solver's design whose loop is unstable is no verified result;
 * ``limit_cycle_amplitude`` (``limit_cycle_amplitude_max``): the fin amplitude of the
   largest stable limit cycle of the chain's clearance at each loop angle, by harmonic
   balance (:func:`optdesign.models.loop_backlash.limit_cycles`): on the NumPy path only,
@@ -53,6 +54,7 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
+from optdesign.errors import ProblemError
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
@@ -76,7 +78,7 @@ from optdesign.problem.objectives import ConstraintBlock
 RESONANCE_STEP = 0.02
 #: The power p of the smooth minimum (sum x^-p)^(-1/p) of |1 + L|^2 over the frequencies:
 #: it is below the least |1 + L| by at most a factor n^(1/2p), n the frequencies equally
-#: near it (three: 0.9 %; 16 gave 3.5 %, enough to make the shipped optimum infeasible).
+#: near it (three: 0.9 %; p = 16 gave 3.5 %, enough to move a design across a limit).
 SOFT_MIN_POWER = 64
 #: The static gain is |T| this many times below the bandwidth's frequency.
 STATIC_BELOW = 1e4
@@ -195,8 +197,6 @@ def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
     wanted = [name for name in LOOP_REQUIREMENTS if getattr(req, name) is not None]
     if spec.loop is None:
         if wanted:
-            from optdesign.errors import ProblemError
-
             raise ProblemError(f"requirements.{wanted[0]}: needs a [loop] section (its gains)")
         return []
     full, gains = plant_grid(q), loop_gains(q)
@@ -229,8 +229,8 @@ def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 None,
                 at,
                 "",
-                "phase margin the return difference min |1 + L(jw)| guarantees, "
-                "2 asin(min |1 + L| / 2) (the row holds min |1 + L|)",
+                "phase margin in its modulus form, 2 asin(min |1 + L| / 2) over the "
+                "margins' 14 frequencies (the row holds min |1 + L|)",
                 display=_phase_margin,
                 display_unit="deg",
             )
@@ -244,7 +244,7 @@ def loop_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 None,
                 at,
                 "",
-                "smallest return difference |1 + L(jw)| on the margins' frequencies",
+                "smallest return difference |1 + L(jw)| over the margins' 14 frequencies",
             )
         )
     if req.resonance_margin_min is not None:
