@@ -492,6 +492,7 @@ def simulate(
     result: Any,
     reference: str = "step",
     *,
+    design: Mapping[str, float] | None = None,
     amplitude: Any = "1 deg",
     angle: Any = None,
     horizon: Any = "0.5 s",
@@ -506,7 +507,10 @@ def simulate(
     Parameters
     ----------
     result
-        A :class:`Result` of :func:`solve` with a design, of a problem with ``[loop]``.
+        A :class:`Result` of :func:`solve` with a design, of a problem with ``[loop]``;
+        or a :class:`DesignProblem` with ``design``.
+    design
+        With a problem: the design (every free variable, internal units: mm, rad).
     reference
         ``"step"`` (of ``amplitude`` at t = 0) or ``"sine"`` (``amplitude`` at
         ``frequency``).
@@ -532,12 +536,19 @@ def simulate(
     from optdesign.problem.loop_time import simulate_design, simulation_csv
     from optdesign.storage import atomic_write_text
 
-    problem = getattr(result, "problem_object", None)
-    if problem is None or not getattr(result, "design", None):
-        raise InputError("result", "a result of od.solve with a design (and its problem)")
-    sim = simulate_design(
-        problem, result.design, reference, amplitude, angle, horizon, frequency, samples
-    )
+    if isinstance(result, DesignProblem):
+        if design is None:
+            raise InputError("design", "a problem needs the design to simulate")
+        problem, values = result, {**result.fixed_values, **design}
+        missing = [v.name for v in problem.free if v.name not in values]
+        if missing:
+            raise InputError("design", f"gives no value for {', '.join(missing)}")
+    else:
+        problem = getattr(result, "problem_object", None)
+        if problem is None or not getattr(result, "design", None):
+            raise InputError("result", "a result of od.solve with a design (and its problem)")
+        values = result.design
+    sim = simulate_design(problem, values, reference, amplitude, angle, horizon, frequency, samples)
     if csv is not None:
         atomic_write_text(Path(csv), simulation_csv(sim))
     return sim

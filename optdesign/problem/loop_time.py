@@ -17,6 +17,7 @@ import numpy as np
 
 from optdesign.errors import InputError, ProblemError
 from optdesign.models.loop_simulation import (
+    MAX_HORIZON,
     LoopSimulation,
     SineReference,
     StepReference,
@@ -74,9 +75,7 @@ def simulate_design(
     """
     if problem.spec.loop is None:
         raise ProblemError("simulate: needs a [loop] section (the controller)")
-    if reference not in REFERENCES:
-        raise InputError("reference", f"expected one of {', '.join(REFERENCES)}, got {reference!r}")
-    amp = to_internal(amplitude, "angle", "amplitude")
+    args = simulation_arguments(reference, amplitude, horizon, frequency)
     phi = np.asarray(problem.phi, dtype=float)
     where = float(np.mean(phi[[0, -1]])) if angle is None else to_internal(angle, "angle", "angle")
     if not phi[0] - 1e-9 <= where <= phi[-1] + 1e-9:
@@ -85,17 +84,38 @@ def simulate_design(
             f"{math.degrees(where):g} deg lies outside the stroke "
             f"({math.degrees(phi[0]):g} to {math.degrees(phi[-1]):g} deg)",
         )
-    T = to_internal(horizon, "time", "horizon") * 3600.0  # h -> s
     k = _nearest(phi, where)
     with np.errstate(all="ignore"):
         q = problem.quantities(design)
         plants, loop = drive_plants_of(q, [k])[0]
-    if reference == "step":
-        ref: Any = StepReference(amp)
+    response = simulate(plants[0], loop, args.reference, args.horizon, samples)
+    return DesignSimulation(float(phi[k]), k, response)
+
+
+@dataclass(frozen=True)
+class SimulationArguments:
+    """The reference (a model's record, rad and rad/s) and the horizon (s) of a run."""
+
+    reference: Any
+    horizon: float
+
+
+def simulation_arguments(reference: str, amplitude: Any, horizon: Any, frequency: Any):
+    """:class:`SimulationArguments` read from quantities, each refused naming its argument
+    (before any solve: the command line checks them first)."""
+    if reference not in REFERENCES:
+        raise InputError("reference", f"expected one of {', '.join(REFERENCES)}, got {reference!r}")
+    amp = to_internal(amplitude, "angle", "amplitude")
+    if isinstance(horizon, int | float) and not isinstance(horizon, bool):
+        T = float(horizon)  # a number is seconds here (a file's bare time would be hours)
     else:
-        f = to_internal(frequency, "frequency", "frequency")
-        ref = SineReference(amp, 2.0 * math.pi * f)
-    return DesignSimulation(float(phi[k]), k, simulate(plants[0], loop, ref, T, samples))
+        T = to_internal(horizon, "time", "horizon") * 3600.0  # h -> s
+    if not (math.isfinite(T) and 0.0 < T <= MAX_HORIZON):
+        raise InputError("horizon", f"must be in (0, {MAX_HORIZON:g}] s, got {T:g} s")
+    if reference == "step":
+        return SimulationArguments(StepReference(amp), T)
+    f = to_internal(frequency, "frequency", "frequency")
+    return SimulationArguments(SineReference(amp, 2.0 * math.pi * f), T)
 
 
 #: The CSV's columns: header (with its unit), the record's field, the factor to it.

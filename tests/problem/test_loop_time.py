@@ -5,10 +5,12 @@ limit cycle, the CSV's columns and units, and the refusals of bad arguments."""
 from __future__ import annotations
 
 import math
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_refusal import command_line_refusal
 
 import optdesign as od
 from optdesign.models import loop_linear as ll
@@ -83,3 +85,30 @@ def test_a_result_without_a_loop_or_a_design_is_refused():
         od.simulate(plain)
     with pytest.raises(od.OptDesignError, match="result"):
         od.simulate(object())
+
+
+def test_the_command_line_simulates_a_result_json_into_a_csv_and_a_figure(result, tmp_path):
+    """``optdesign simulate RESULT``: the design of a result.json of the shipped problem
+    (its name), a 30 ms step at 0 deg: simulation.csv as od.simulate's, and a figure."""
+    from optdesign.cli import main
+    from optdesign.reports.result_json import result_json
+
+    path = tmp_path / "result.json"
+    path.write_text(result_json(result))
+    out = tmp_path / "sim"
+    argv = ["simulate", str(path), "--horizon", "30 ms", "--samples", "31", "--out", str(out)]
+    assert main(argv) == 0
+    assert (out / "simulation.png").stat().st_size > 10_000
+    data = np.loadtxt(out / "simulation.csv", delimiter=",", skiprows=1)
+    sim = od.simulate(result, horizon="30 ms", samples=31)
+    np.testing.assert_allclose(data[:, 2], np.degrees(sim.response.fin_angle), rtol=1e-8)
+
+
+def test_the_command_line_refuses_a_horizon_of_a_billion_seconds_before_any_solve(tmp_path):
+    message = command_line_refusal(
+        tomllib.loads((ROOT / "problems" / "fin_actuator_loop.toml").read_text()),
+        tmp_path,
+        False,
+        ["simulate", "--horizon", "1e9 s"],
+    )
+    assert "horizon: must be in (0, 600] s" in message
