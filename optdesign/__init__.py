@@ -39,6 +39,7 @@ _EXPORTS: dict[str, str] = {
     "bench_configurations": "optdesign.api:bench_configurations",
     "report": "optdesign.api:report",
     "sweep": "optdesign.api:sweep",
+    "simulate": "optdesign.api:simulate",
     "Sweep": "optdesign.studies.sweep:Sweep",
     "DesignProblem": "optdesign.problem.design_problem:DesignProblem",
     "Quantities": "optdesign.problem.quantities:Quantities",

@@ -30,7 +30,16 @@ from optdesign.problem.load import load
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.result import Result
 
-__all__ = ["bench", "bench_configurations", "load", "pareto", "report", "solve", "sweep"]
+__all__ = [
+    "bench",
+    "bench_configurations",
+    "load",
+    "pareto",
+    "report",
+    "simulate",
+    "solve",
+    "sweep",
+]
 
 
 def solve(
@@ -477,3 +486,69 @@ def sweep(
         _, notes, _ = write_sweep_outputs(swept, Path(out))
         swept.notes.extend(notes)
     return swept
+
+
+def simulate(
+    result: Any,
+    reference: str = "step",
+    *,
+    design: Mapping[str, float] | None = None,
+    amplitude: Any = "1 deg",
+    angle: Any = None,
+    horizon: Any = "0.5 s",
+    frequency: Any = "5 Hz",
+    samples: int = 2001,
+    csv: str | Path | None = None,
+) -> Any:
+    """The time response of a solved design in its position loop (docs/loop.md): the
+    drive at the grid angle nearest ``angle`` with its elastic backlash, friction and the
+    motor's limits (:func:`optdesign.models.loop_simulation.simulate`).
+
+    Parameters
+    ----------
+    result
+        A :class:`Result` of :func:`solve` with a design, of a problem with ``[loop]``;
+        or a :class:`DesignProblem` with ``design``.
+    design
+        With a problem: the design (every free variable, internal units: mm, rad).
+    reference
+        ``"step"`` (of ``amplitude`` at t = 0) or ``"sine"`` (``amplitude`` at
+        ``frequency``).
+    amplitude, angle, horizon, frequency
+        Quantities (``"1 deg"``, ``"0 deg"``, ``"0.5 s"``, ``"5 Hz"``) or numbers in rad,
+        rad, s, Hz; ``angle`` None: the middle of the stroke.
+    samples
+        Output samples (2 to 10^6).
+    csv
+        A file to write the samples to, one column per quantity with its unit.
+
+    Returns
+    -------
+    DesignSimulation
+        The angle simulated and the model's record (internal units: rad, s, N*mm).
+
+    Raises
+    ------
+    InputError
+        Naming the argument and the reason (no design, no ``[loop]``, an angle outside
+        the stroke, a horizon beyond 600 s ...).
+    """
+    from optdesign.problem.loop_time import simulate_design, simulation_csv
+    from optdesign.storage import atomic_write_text
+
+    if isinstance(result, DesignProblem):
+        if design is None:
+            raise InputError("design", "a problem needs the design to simulate")
+        problem, values = result, {**result.fixed_values, **design}
+        missing = [v.name for v in problem.free if v.name not in values]
+        if missing:
+            raise InputError("design", f"gives no value for {', '.join(missing)}")
+    else:
+        problem = getattr(result, "problem_object", None)
+        if problem is None or not getattr(result, "design", None):
+            raise InputError("result", "a result of od.solve with a design (and its problem)")
+        values = result.design
+    sim = simulate_design(problem, values, reference, amplitude, angle, horizon, frequency, samples)
+    if csv is not None:
+        atomic_write_text(Path(csv), simulation_csv(sim))
+    return sim

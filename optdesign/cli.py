@@ -147,6 +147,7 @@ PLUGIN_MODULES: list[str] = [
     "optdesign.commands.pareto",
     "optdesign.commands.sweep",
     "optdesign.commands.bench",
+    "optdesign.commands.simulate",
 ]
 
 

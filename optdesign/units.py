@@ -89,6 +89,8 @@ INTERNAL_UNITS: dict[str, str] = {
     "rotational_damping": "N*mm*s/rad",
     "frequency": "Hz",
     "angular_acceleration": "rad/s**2",
+    # the position loop's integral gain (issue 38): motor torque per fin angle per second
+    "integral_gain": "N*mm/rad/s",
 }
 
 #: The unit suggested to a user for each dimension (error messages, ``bare="refuse"``).
@@ -109,6 +111,7 @@ SUGGESTED_UNITS: dict[str, str] = {
     "rotational_damping": "N*m*s/rad",
     "frequency": "Hz",
     "angular_acceleration": "deg/s^2",
+    "integral_gain": "N*m/(rad*s)",
 }
 
 #: How a dimension is named in messages ("expected a moment").
@@ -129,6 +132,7 @@ _DIMENSION_NAMES: dict[str, str] = {
     "rotational_damping": "a rotational damping, a moment per angular speed",
     "frequency": "a frequency (cycles per time, or an angle per time)",
     "angular_acceleration": "an angular acceleration, an angle per time squared",
+    "integral_gain": "an integral gain, a moment per angle per time",
 }
 
 #: The angle exponents a quantity of each dimension may have (see the module docstring).
@@ -152,6 +156,7 @@ ANGLE_EXPONENTS: dict[str, tuple[int, ...]] = {
     # cycles per time (Hz) or an angle per time (rad/s: one cycle is 2 pi rad)
     "frequency": (0, 1),
     "angular_acceleration": (1,),
+    "integral_gain": (-1,),
 }
 
 #: Largest magnitude accepted in internal units: 1e15 mm is a billion kilometres; beyond
@@ -273,6 +278,7 @@ FAST_UNITS: dict[str, dict[str, float]] = {
     "rotational_damping": {"N*m*s/rad": 1e3, "N*mm*s/rad": 1.0},
     "frequency": {"Hz": 1.0, "kHz": 1e3},
     "angular_acceleration": {"rad/s^2": 1.0, "deg/s^2": _DEG},
+    "integral_gain": {"N*m/(rad*s)": 1e3, "N*mm/(rad*s)": 1.0},
 }
 
 _FAST = re.compile(r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)\s*(\S+)")

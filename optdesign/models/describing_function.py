@@ -35,6 +35,20 @@ Saturation, unit slope, limit ``c`` (y = x for |x| <= c, c sign(x) beyond): with
 
 real, falling from 1 to 4c/(pi A) at large A.
 
+Dead zone, unit slope, half-width ``b`` (y = 0 for |x| <= b, x - b sign(x) beyond): the
+input less a unit saturation at b, so N is one less the saturation's,
+
+    N(A) = 0                                                   A <= b
+    N(A) = 1 - (2/pi) [asin(r) + r sqrt(1 - r^2)],  r = b/A     A > b
+
+real, rising from 0 to 1. It is the elastic backlash of a chain with compliance (the
+chain's spring k acts on the deflection less the gap, k dz(x)): unlike the
+friction-controlled backlash above, the output side has its own inertia and moves in
+the gap, and the chain's torque is a single-valued function of the deflection. Gating a
+damping c x' to the contact (c x' where |x| > b) gives the same fundamental, N(A) c x',
+so the whole contact torque k dz(x) + c x' 1{|x| > b} has the describing function
+N(A) (k + j w c) (docs/loop.md).
+
 Units: the amplitude A is in the unit of the nonlinearity's input, the one ``b`` and
 ``c`` are given in (rad for an angular backlash at the fin: the project's internal
 unit); N is a plain number. Frequencies do not enter (see
@@ -215,6 +229,42 @@ def saturation_amplitude(N, c) -> float:
     return c * x
 
 
+# --- dead zone --------------------------------------------------------------------------
+def dead_zone_df(A, b):
+    """Describing function N(A) of a unit-slope dead zone of half-width ``b`` (real).
+
+    Parameters
+    ----------
+    A : float or array_like
+        Input amplitude (>= 0, in the unit of ``b``).
+    b : float
+        Half-width (> 0): the output is zero while |x| <= b.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        N(A) = 1 - :func:`saturation_df` (A, b), in [0, 1), shaped as ``A``.
+
+    Raises
+    ------
+    InputError
+        ``A`` negative or not finite, ``b`` not positive or not finite.
+    """
+    return 1.0 - saturation_df(A, b)
+
+
+def dead_zone_df_derivative(A, b):
+    """dN/dA of :func:`dead_zone_df`: (4/pi)(r/A) sqrt(1 - r^2), r = b/A; 0 where A <= b."""
+    return -saturation_df_derivative(A, b)
+
+
+def dead_zone_amplitude(N, b) -> float:
+    """The amplitude A > b at which :func:`dead_zone_df` equals ``N`` (0 < N < 1)."""
+    if not (np.isfinite(N) and 0.0 < N < 1.0):
+        raise InputError("N", f"a dead zone's describing function lies in (0, 1), got {N!r}")
+    return saturation_amplitude(1.0 - float(N), b)
+
+
 # --- the nonlinearities as records -------------------------------------------------------
 @dataclass(frozen=True)
 class Backlash:
@@ -282,3 +332,40 @@ class Saturation:
     def amplitude(self, N) -> float:
         """The amplitude where N(A) = ``N``, :func:`saturation_amplitude`."""
         return saturation_amplitude(N, self.limit)
+
+
+@dataclass(frozen=True)
+class DeadZone:
+    """A unit-slope dead zone of half-width ``half_width``: the elastic backlash of a
+    compliant chain, on the chain's deflection.
+
+    Parameters
+    ----------
+    half_width
+        b > 0, in the unit of the loop signal it acts on (rad at the fin).
+    """
+
+    half_width: float
+
+    def __post_init__(self):
+        require_positive("half_width", self.half_width)
+
+    #: N is real: the harmonic balance goes through the phase crossovers.
+    real = True
+
+    @property
+    def threshold(self) -> float:
+        """The amplitude below which N is constant (0: the gap is never closed)."""
+        return float(self.half_width)
+
+    def describing_function(self, A):
+        """N(A), :func:`dead_zone_df`."""
+        return dead_zone_df(A, self.half_width)
+
+    def derivative(self, A):
+        """dN/dA, :func:`dead_zone_df_derivative`."""
+        return dead_zone_df_derivative(A, self.half_width)
+
+    def amplitude(self, N) -> float:
+        """The amplitude where N(A) = ``N``, :func:`dead_zone_amplitude`."""
+        return dead_zone_amplitude(N, self.half_width)

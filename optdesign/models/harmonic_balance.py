@@ -10,10 +10,10 @@ w at the nonlinearity's input comes back unchanged when
 the crossing of the Nyquist curve of L with the curve -1/N(A) (Gelb and Vander Velde
 1968, [GVV68] in docs/references.md). Two routes:
 
-* N real (saturation): -1/N(A) runs along the negative real axis from -1/N(0+) to -inf.
-  The cycles sit at the phase crossovers w180 (Im L(jw180) = 0, Re L < 0), each where
-  N(A) = -1/L(jw180) can be met (|L(jw180)| > 1 for a saturation): one bracketed root in
-  w, then one in A.
+* N real (saturation, dead zone): -1/N(A) runs along the negative real axis, from -1 to
+  -inf (N in (0, 1]). The cycles sit at the phase crossovers w180 (Im L(jw180) = 0,
+  Re L < 0), each where N(A) = -1/L(jw180) can be met (|L(jw180)| > 1): one bracketed
+  root in w, then one in A.
 * N complex (backlash): a 2-D root of 1 + N(A) L(jw) in (A, w). Starts from the
   crossings of the two curves sampled on grids (A/b from 1 + 1e-8 to 1e6, w over the
   loop's range), each refined by ``scipy.optimize.root``; the residual 1 + N L, not
@@ -62,7 +62,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from optdesign.errors import InputError
-from optdesign.models.describing_function import Backlash, Saturation
+from optdesign.models.describing_function import Backlash, DeadZone, Saturation
 from optdesign.models.validity import Validity
 
 FILTER_HYPOTHESIS = Validity(
@@ -274,7 +274,7 @@ def _grid(loop: Loop, points: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 # --- real N: the phase crossovers --------------------------------------------------------
-def _real_route(loop: Loop, nl: Saturation, points: int) -> HarmonicBalance:
+def _real_route(loop: Loop, nl: Saturation | DeadZone, points: int) -> HarmonicBalance:
     from scipy.optimize import brentq
 
     w, L = _grid(loop, points)
@@ -304,7 +304,7 @@ def _real_route(loop: Loop, nl: Saturation, points: int) -> HarmonicBalance:
     for wk in roots:
         Lk = complex(loop(wk)).real
         seen.append(f"L(j{wk:.6g}) = {Lk:.6g}")
-        if Lk < -1.0:  # N = -1/L in (0, 1): a saturation reaches it
+        if Lk < -1.0:  # N = -1/L in (0, 1): a saturation or a dead zone reaches it
             cycles.append(_cycle(loop, nl, nl.amplitude(-1.0 / Lk), wk))
     if not cycles:
         return HarmonicBalance(
@@ -379,7 +379,9 @@ def _complex_route(loop: Loop, nl: Backlash, points: int) -> HarmonicBalance:
     return HarmonicBalance(tuple(_cycle(loop, nl, a, v) for a, v in found), "", loop.omega_range)
 
 
-def harmonic_balance(loop: Loop, nonlinearity: Saturation | Backlash, points: int = 4000):
+def harmonic_balance(
+    loop: Loop, nonlinearity: Saturation | DeadZone | Backlash, points: int = 4000
+):
     """The limit cycles of ``loop`` closed through ``nonlinearity`` (negative feedback).
 
     Parameters
@@ -387,7 +389,8 @@ def harmonic_balance(loop: Loop, nonlinearity: Saturation | Backlash, points: in
     loop
         The linear open loop, :func:`polynomial_loop` or :func:`callable_loop`.
     nonlinearity
-        :class:`~optdesign.models.describing_function.Saturation` (real N: the phase
+        :class:`~optdesign.models.describing_function.Saturation` or
+        :class:`~optdesign.models.describing_function.DeadZone` (real N: the phase
         crossovers) or :class:`~optdesign.models.describing_function.Backlash` (complex
         N: a 2-D root solve).
     points
@@ -403,8 +406,10 @@ def harmonic_balance(loop: Loop, nonlinearity: Saturation | Backlash, points: in
         raise InputError("loop", f"must be a Loop (polynomial_loop, callable_loop), got {loop!r}")
     if not isinstance(points, int | np.integer) or not 100 <= points <= 1_000_000:
         raise InputError("points", f"must be an integer in [100, 1e6], got {points!r}")
-    if isinstance(nonlinearity, Saturation):
+    if isinstance(nonlinearity, Saturation | DeadZone):
         return _real_route(loop, nonlinearity, int(points))
     if isinstance(nonlinearity, Backlash):
         return _complex_route(loop, nonlinearity, int(points))
-    raise InputError("nonlinearity", f"must be a Saturation or a Backlash, got {nonlinearity!r}")
+    raise InputError(
+        "nonlinearity", f"must be a Saturation, a DeadZone or a Backlash, got {nonlinearity!r}"
+    )

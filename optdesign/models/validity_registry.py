@@ -42,6 +42,9 @@ MODEL_MODULES = (
     "describing_function",
     "harmonic_balance",
     "loop_plant",
+    "loop_linear",
+    "loop_backlash",
+    "loop_simulation",
 )
 
 

@@ -24,6 +24,9 @@ DesignProblem` is built or changed (files and dicts alike) and raises a
   clearance, and the backlash model would subtract it);
 - ``pin_contact = "huth"`` without ``[materials.lug]`` (Huth's model needs the lug's
   thicknesses);
+- a ``[loop]`` without the ``[motor]``, ``[load]`` and ``[screw]`` it closes around, or
+  whose closed loop is unstable at every grid angle of the problem's start design
+  (:func:`optdesign.problem.loop.check_loop`);
 - a plain number of the file (a factor, a share of time) with a nonzero magnitude below
   :data:`~optdesign.units.MIN_MAGNITUDE` or above :data:`~optdesign.units.MAX_MAGNITUDE`
   (quantities with units are checked when they are read).
@@ -60,6 +63,10 @@ def check_problem(problem: Any) -> None:
         _screw(problem, spec.screw)
     _fit(problem)
     _lug(problem)
+    if spec.loop is not None:
+        from optdesign.problem.loop import check_loop
+
+        check_loop(problem)
 
 
 def _magnitudes(data: Any, path: str) -> None:

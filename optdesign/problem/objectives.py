@@ -275,6 +275,14 @@ def _natural_period(q):
     return None if spec.load is None or spec.screw is None else q.natural_period
 
 
+def _resonance_gain(q):
+    if q.problem.spec.loop is None:
+        return None
+    from optdesign.problem.loop import loop_resonance_gain
+
+    return loop_resonance_gain(q)
+
+
 def _motor_mass(q):
     motor = q.motor_data
     if motor is None or motor.mass is None or _motor_mass_needs(q.problem):
@@ -472,6 +480,16 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="ms",
             display_scale=1e3,
             valid=NON_NEGATIVE,
+        ),
+        ObjectiveInfo(
+            "resonance_gain",
+            _resonance_gain,
+            "max",
+            "",
+            "largest gain of the position loop at the drive's own mode (1 / resonance margin)",
+            "max over the stroke of |L(j w_r)|, w_r the two-mass mode with the motor free",
+            valid=NON_NEGATIVE,
+            needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
         ),
         ObjectiveInfo(
             "motor_mass",

@@ -17,6 +17,7 @@ from optdesign import math as m
 from optdesign.mechanisms.base import Rows
 from optdesign.models.loads import pin_bearing_pressure, pin_shear_stress
 from optdesign.problem.drive_requirements import drive_blocks
+from optdesign.problem.loop_requirements import loop_blocks
 from optdesign.problem.motor_drive import motor_blocks
 from optdesign.problem.objectives import ConstraintBlock, ConstraintInfo
 from optdesign.user_code import quantity_of
@@ -85,6 +86,7 @@ def requirement_blocks(
         blocks += _screw_blocks(q, labels)
     blocks += drive_blocks(q, labels)
     blocks += motor_blocks(q, labels)
+    blocks += loop_blocks(q, labels)
     if req.lock is not None and req.lock.force_max is not None:
         blocks.append(
             ConstraintBlock(

@@ -41,6 +41,7 @@ from optdesign.problem.spec_drive import (  # noqa: F401 - the names of optdesig
     Screw,
     ScrewSizing,
 )
+from optdesign.problem.spec_loop import Loop
 from optdesign.problem.spec_motor import Load, Motion, Motor
 from optdesign.problem.spec_requirements import (
     Requirements,
@@ -211,6 +212,7 @@ class ProblemSpec(_Model):
     motor: Motor | None = None
     load: Load | None = None
     motion: Motion | None = None
+    loop: Loop | None = None
 
 
 def _requirement_field(info) -> tuple[Any, Any]:

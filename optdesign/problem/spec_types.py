@@ -53,6 +53,7 @@ RotationalDamping = Annotated[float, _quantity("rotational_damping")]
 Frequency = Annotated[float, _quantity("frequency")]
 Speed = Annotated[float, _quantity("speed")]
 AngularAcceleration = Annotated[float, _quantity("angular_acceleration")]
+IntegralGain = Annotated[float, _quantity("integral_gain")]
 
 #: dimension name -> annotated type of a parsed quantity.
 QUANTITY_TYPES: dict[str, Any] = {
@@ -193,6 +194,10 @@ POSITIVE_REQUIREMENTS: dict[str, tuple[str, float]] = {
     "dn_max": ("mm/min", 1.0),
     "inertia_ratio_max": ("", 1.0),
     "natural_frequency_min": ("Hz", 1.0),
+    "bandwidth_min": ("Hz", 1.0),
+    "phase_margin_min": ("deg", 180.0 / math.pi),
+    "resonance_margin_min": ("", 1.0),
+    "limit_cycle_amplitude_max": ("deg", 180.0 / math.pi),
 }
 
 

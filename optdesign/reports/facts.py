@@ -5,13 +5,16 @@ objective with its unit (and what "size" measures for this mechanism)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from optdesign.reports.display_units import Shown, objective_shown
 from optdesign.text import printable
 from optdesign.views.facts import DesignFacts, MotorFacts
+
+if TYPE_CHECKING:
+    from optdesign.problem.loop_analysis import LoopFigures
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,48 @@ def shown_facts(problem: Any, facts: DesignFacts | None) -> list[Fact]:
     out.append(Fact("drive_efficiency", Shown(100.0 * facts.drive_efficiency, "%"), source))
     if facts.motor is not None:
         out.append(_motor_fact(facts.motor))
+    out += _loop_facts(facts.loop)
     return out
+
+
+def _loop_facts(loop: LoopFigures | str | None) -> list[Fact]:
+    """The design's position loop, analysed exactly (optdesign.problem.loop_analysis):
+    the least bandwidth and margins over the loop's angles, the largest limit cycle."""
+    if loop is None:
+        return []
+    if isinstance(loop, str):  # a report, not the result: say why the figures are missing
+        return [Fact("loop", Shown(float("nan"), ""), f"not analysed: {loop}")]
+    f = loop
+    where = f"over the loop's {f.angles} angles"
+    stable = (
+        "stable at every grid angle"
+        if not f.unstable_at
+        else f"UNSTABLE at {len(f.unstable_at)} grid angles from {f.unstable_at[0]:+.1f} deg"
+    )
+    cycle = (
+        f"largest stable backlash limit cycle at the fin (harmonic balance), at "
+        f"{f.limit_cycle.angle:+.0f} deg, {f.limit_cycle_frequency:.4g} Hz"
+        if f.limit_cycle.value > 0
+        else "no stable backlash limit cycle (harmonic balance)"
+    )
+    rows = (
+        ("loop_bandwidth", f.bandwidth, "Hz", f"least -3 dB bandwidth {where}", f"; {stable}"),
+        ("loop_phase_margin", f.phase_margin, "deg", f"least phase margin {where}", ""),
+        ("loop_gain_margin", f.gain_margin, "", f"least gain margin {where}", ""),
+        ("loop_modulus_margin", f.modulus_margin, "", f"least min |1 + L(jw)| {where}", ""),
+        (
+            "loop_resonance_margin",
+            f.resonance_margin,
+            "",
+            f"least 1 / |L| at the drive's own mode {where}",
+            "",
+        ),
+    )
+    out = [
+        Fact(name, Shown(fig.value, unit), f"{text}, at {fig.angle:+.0f} deg{tail}")
+        for name, fig, unit, text, tail in rows
+    ]
+    return [*out, Fact("limit_cycle_amplitude", Shown(f.limit_cycle.value, "deg"), cycle)]
 
 
 def _motor_fact(motor: MotorFacts) -> Fact:

@@ -5,11 +5,14 @@ asks of it. :mod:`optdesign.reports.facts` words them in the user's units."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from optdesign import math as m
+
+if TYPE_CHECKING:
+    from optdesign.problem.loop_analysis import LoopFigures
 
 
 @dataclass(frozen=True)
@@ -55,6 +58,10 @@ class DesignFacts:
     motor
         The design's motor, or None: the problem has none, or the design's motor number
         is no catalogue item's (its membership row says so).
+    loop
+        The design's position loop analysed exactly
+        (:func:`optdesign.problem.loop_analysis.loop_figures`), None without a
+        ``[loop]``, or why it could not be analysed.
     """
 
     mean_ratio: float
@@ -62,6 +69,7 @@ class DesignFacts:
     ratio_max: float
     drive_efficiency: float
     motor: MotorFacts | None = None
+    loop: LoopFigures | str | None = None
 
 
 def design_facts(
@@ -91,7 +99,22 @@ def design_facts(
         float(np.max(ratio)),
         float(np.min(eta)),
         _motor_facts(problem, q),
+        _loop_figures(problem, q),
     )
+
+
+def _loop_figures(problem: Any, q: Any) -> LoopFigures | str | None:
+    """The loop's exact figures at the design, or why they are missing (a page, not the
+    result: a failure is said, not raised)."""
+    if problem.spec.loop is None:
+        return None
+    from optdesign.problem.loop_analysis import loop_figures
+
+    try:
+        with np.errstate(all="ignore"):
+            return loop_figures(q)
+    except Exception as exc:
+        return str(exc)
 
 
 def _motor_facts(problem: Any, q: Any) -> MotorFacts | None:

@@ -8,18 +8,15 @@ field refused with its name and reason (file, command line in both output modes,
 
 from __future__ import annotations
 
-import contextlib
-import io
-import json
 import math
 import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_refusal import command_line_refusal
 
 import optdesign as od
-from optdesign.cli import main
 from optdesign.problem.motor_drive import motion_demand, motor_data
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -229,18 +226,7 @@ def test_a_wrong_field_is_refused_naming_it_through_the_api(section, value, reas
 def test_a_wrong_field_is_refused_naming_it_on_the_command_line(
     section, value, reason, json_mode, tmp_path
 ):
-    from hostile_corpus import dumps
-
-    path = tmp_path / "p.toml"
-    path.write_text(dumps(_refused_data(section, value)))
-    argv = ["solve", str(path), "--out", str(tmp_path / "out"), "--no-report"]
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main([*argv, "--json"] if json_mode else argv)
-    assert code == 2 and out.getvalue() == ""
-    message = err.getvalue()
-    if json_mode:
-        message = json.loads(message)["error"] if message.lstrip().startswith("{") else message
+    message = command_line_refusal(_refused_data(section, value), tmp_path, json_mode)
     assert section in message and reason in message
 
 

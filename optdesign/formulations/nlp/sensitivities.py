@@ -207,7 +207,10 @@ class _RowModel:
             else:
                 base, k = self.where[i]
                 values, lo, hi = ev.blocks[base]
-                g = float(values[k] if values.size > 1 else values[0])
+                # a block posed as its smooth pieces (ConstraintBlock.pieces) has one row
+                # per piece and angle in the NLP, one per angle here: the piece's row
+                # reads the block's value, their max, which the active piece equals
+                g = float(values[k % values.size])
             b = hi if mu > 0 else lo
             total += mu * (g - (b if b is not None and math.isfinite(b) else 0.0))
         return total

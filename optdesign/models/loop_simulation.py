@@ -1,0 +1,627 @@
+"""The drive's time response in its position loop: elastic backlash, friction and the
+motor's limits, by ``scipy.integrate.solve_ivp`` with events (issue 38; docs/loop.md).
+
+The equations are those of :mod:`optdesign.models.loop_plant` in the fin coordinate
+(psi = theta / f', J_1 = J_m f'^2):
+
+    J_1 psi'' = f' (T - T_fr) - tau,     J_2 phi'' = tau - k_h phi - c_f phi'
+
+with, piece by piece:
+
+* the chain's torque tau (elastic backlash, d = psi - phi): 0 while |d| < b;
+  k (d - b) + c d' while the + flank is in contact, k (d + b) + c d' on the - flank; a
+  flank in contact never pulls: when its torque reaches zero the contact opens
+  ("unloaded") though the flanks still overlap, and it closes again when the torque would
+  push. Each change is an event: the integration stops there and restarts in the new
+  contact state, so the jump of the damping torque c d' at the closing is resolved
+  exactly;
+* the controller T_cmd = kp e + ki z - kd y', z' = e = r - y, saturated at
+  +-``peak_torque``, then the current loop T' = (T_cmd,sat - T) / tau_i (T = T_cmd,sat
+  when ``current_lag`` = 0). No anti-windup: the integral keeps integrating while the
+  torque is saturated;
+* Coulomb friction at the motor, event-handled (not smoothed): while the motor turns,
+  T_fr = T_f sign(theta'); when theta' reaches zero the motor sticks if the torque on it,
+  |f' T - tau| <= f' T_f, and stays stuck (theta' = 0) until that torque reaches the
+  friction's; else it reverses. A smooth friction (tanh of the speed) would make the
+  motor creep under any torque and make the equations stiff for a small velocity scale;
+* the speed limit as the corner of the motor's torque-speed curve: the torque in the
+  direction of motion falls linearly from the command's at (1 - SPEED_BAND) max_speed to
+  none at ``max_speed`` and above; a braking torque is applied in full. Continuous, so
+  no mode: the motor settles just below the limit where the load needs torque, and a
+  load that drives it on can take it past the limit. Entering and leaving the band are
+  recorded as events ("speed limit", "speed released") without stopping the
+  integration (docs/loop.md: why not a held speed).
+
+Units: mm, t, s, N, rad. Angles in rad at the fin (the motor's as psi = theta / f'),
+torques in N*mm (the motor's at its shaft, the chain's at the fin), times in s.
+
+Validity
+--------
+horizon : 0 < T <= 600 s (call)
+    A fin's manoeuvre lasts seconds; a longer run is a mistake of units or a request for
+    millions of events, refused before it starts.
+reference angle : |r| <= pi rad (call)
+    A fin turns less than half a turn; a non-finite angle is refused.
+output samples : 2 to 10^6 (call)
+    Enough to resolve a cycle near the chain's resonance over a run; more is memory.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from optdesign.errors import InputError
+from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.validity import Validity
+
+#: The largest horizon simulated (s): a fin's manoeuvre lasts seconds.
+MAX_HORIZON = 600.0
+#: The most output samples returned.
+MAX_SAMPLES = 1_000_000
+#: The largest reference angle (rad): a fin turns less than half a turn.
+MAX_ANGLE = math.pi
+#: The most events (contacts, sticks, speed limits) handled before the run is refused.
+MAX_EVENTS = 200_000
+HORIZON = Validity(
+    "loop_simulation.horizon",
+    "loop simulation",
+    "simulated time",
+    0.0,
+    MAX_HORIZON,
+    "s",
+    "a fin's manoeuvre lasts seconds; a longer run is a units mistake or millions of events",
+    open_lower=True,
+    checked=("call",),
+)
+REFERENCE_ANGLE = Validity(
+    "loop_simulation.reference_angle",
+    "loop simulation",
+    "reference angle |r| at the fin",
+    0.0,
+    MAX_ANGLE,
+    "rad",
+    "a fin turns less than half a turn",
+    shown_unit="deg",
+    scale=180.0 / math.pi,
+    checked=("call",),
+)
+SAMPLES = Validity(
+    "loop_simulation.samples",
+    "loop simulation",
+    "output samples",
+    2.0,
+    float(MAX_SAMPLES),
+    "",
+    "enough to resolve a cycle near the chain's resonance over a run; more is memory",
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (HORIZON, REFERENCE_ANGLE, SAMPLES)
+
+#: The width of the torque-speed curve's corner, a fraction of the top speed: the
+#: torque in the direction of motion falls to none over the last 1 % of the speed.
+SPEED_BAND = 0.01
+
+
+# --- references ----------------------------------------------------------------------------
+def _angle(field: str, value) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"expected a number (rad), got {value!r}") from None
+    if not (math.isfinite(value) and abs(value) <= MAX_ANGLE):
+        raise InputError(field, f"must be finite with |value| <= pi rad, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class StepReference:
+    """A step of ``amplitude`` (rad at the fin) at ``time`` (s, >= 0)."""
+
+    amplitude: float
+    time: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "amplitude", _angle("reference.amplitude", self.amplitude))
+        t = float(self.time)
+        if not (math.isfinite(t) and 0.0 <= t <= MAX_HORIZON):
+            raise InputError("reference.time", f"must be in [0, {MAX_HORIZON:g}] s, got {t!r}")
+        object.__setattr__(self, "time", t)
+
+    def __call__(self, t: float) -> float:
+        return self.amplitude if t >= self.time else 0.0
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times where the reference jumps (the integration restarts there)."""
+        return (self.time,) if self.time > 0 else ()
+
+
+@dataclass(frozen=True)
+class SineReference:
+    """r(t) = offset + amplitude sin(frequency t) (rad at the fin; frequency in rad/s)."""
+
+    amplitude: float
+    frequency: float
+    offset: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "amplitude", _angle("reference.amplitude", self.amplitude))
+        object.__setattr__(self, "offset", _angle("reference.offset", self.offset))
+        w = float(self.frequency)
+        if not (math.isfinite(w) and 0.0 < w <= 1e6):
+            raise InputError("reference.frequency", f"must be in (0, 1e6] rad/s, got {w!r}")
+        object.__setattr__(self, "frequency", w)
+
+    def __call__(self, t: float) -> float:
+        return self.offset + self.amplitude * math.sin(self.frequency * t)
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times where the reference jumps: none."""
+        return ()
+
+
+@dataclass(frozen=True)
+class SampledReference:
+    """A deflection history: piecewise linear through (``times``, ``angles``), held
+    before the first and after the last sample (s, rad at the fin)."""
+
+    times: tuple[float, ...]
+    angles: tuple[float, ...]
+
+    def __post_init__(self):
+        try:
+            t = np.asarray(self.times, dtype=float).ravel()
+            a = np.asarray(self.angles, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise InputError("reference.times", "times and angles must be numbers") from None
+        if t.size < 2 or t.size != a.size or t.size > MAX_SAMPLES:
+            raise InputError(
+                "reference.times",
+                f"needs 2 to {MAX_SAMPLES} times, as many as angles (got {t.size}, {a.size})",
+            )
+        if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+            raise InputError("reference.times", "must be finite and strictly increasing")
+        if not (np.all(np.isfinite(a)) and np.max(np.abs(a)) <= MAX_ANGLE):
+            raise InputError("reference.angles", "must be finite with |angle| <= pi rad")
+        object.__setattr__(self, "times", tuple(t.tolist()))
+        object.__setattr__(self, "angles", tuple(a.tolist()))
+        object.__setattr__(self, "_t", t)
+        object.__setattr__(self, "_a", a)
+
+    def __call__(self, t: float) -> float:
+        return float(np.interp(t, self._t, self._a))
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times where the reference jumps: none."""
+        return ()
+
+
+Reference = StepReference | SineReference | SampledReference
+
+
+# --- the answer ----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LoopSimulation:
+    """The time response of the drive in its loop (units in the attribute names' notes).
+
+    Attributes
+    ----------
+    times
+        Sample times (s).
+    reference
+        r(t), rad at the fin.
+    fin_angle, fin_rate
+        phi (rad), phi' (rad/s).
+    motor_angle, motor_rate
+        The motor's angle and rate seen at the fin, theta / f' (rad) and theta' / f'
+        (rad/s).
+    motor_torque
+        The torque the motor applies at its shaft (N*mm): the current loop's output, less
+        in the direction of motion near the top speed.
+    chain_torque
+        The chain's torque on the fin (N*mm).
+    contact
+        +1 / -1 while the + / - flank transmits torque, 0 in the gap or unloaded.
+    event_times, event_kinds
+        When the contact closed, opened or unloaded, the motor stuck or slipped, or the
+        speed limit began or ended (s; a word each).
+    plant, loop, input_reference
+        What was simulated.
+    """
+
+    times: np.ndarray
+    reference: np.ndarray
+    fin_angle: np.ndarray
+    fin_rate: np.ndarray
+    motor_angle: np.ndarray
+    motor_rate: np.ndarray
+    motor_torque: np.ndarray
+    chain_torque: np.ndarray
+    contact: np.ndarray
+    event_times: tuple[float, ...]
+    event_kinds: tuple[str, ...]
+    plant: DrivePlant
+    loop: PositionLoop
+    input_reference: Reference
+
+
+# --- the equations -------------------------------------------------------------------------
+# state x = [psi, phi, psi', phi', T (current loop), z (integral of the error)]
+# mode = (contact, side, motor): contact in {-1, 0, +1}; side in {-1, 0, +1} the flank
+# whose overlap persists while unloaded (contact 0); motor: +-1 turning, 0 stuck
+
+
+class _System:
+    def __init__(self, plant: DrivePlant, loop: PositionLoop, reference):
+        self.p, self.c, self.reference = plant, loop, reference
+        # the reference's left limit at a jump ending the current segment: the segment's
+        # last point must not see the jump (its events would fire on it, again and again)
+        self.left_of = math.inf
+        self.J1 = plant.motor_inertia_at_fin
+        self.fin = loop.feedback == "fin"
+        self.w_lim = plant.max_speed / plant.ratio  # psi' at the speed limit
+        self.w_band = self.w_lim * (1.0 - SPEED_BAND)  # ... and where its corner begins
+        # without clearance the chain is one linear, two-way spring: no contact events
+        self.bilateral = plant.backlash == 0.0
+
+    def r(self, t: float) -> float:
+        """The reference, taken from the left at a jump that ends the segment."""
+        if t >= self.left_of:
+            return self.reference(float(np.nextafter(self.left_of, -math.inf)))
+        return self.reference(t)
+
+    def command(self, t, x) -> float:
+        """The current loop's output T (N*mm at the motor)."""
+        if self.c.current_lag > 0:
+            # the lag's state stays within the peak; clipped against the integrator's
+            # overshoot of a saturated input
+            peak = self.p.peak_torque
+            return min(max(x[4], -peak), peak)
+        return self.saturated_command(t, x)
+
+    def saturated_command(self, t, x) -> float:
+        c = self.c
+        y, yd = (x[1], x[3]) if self.fin else (x[0], x[2])
+        T = c.kp * (self.r(t) - y) + c.ki * x[5] - c.kd * yd
+        peak = self.p.peak_torque
+        return min(max(T, -peak), peak)
+
+    def raw_chain(self, x, flank: int) -> float:
+        """The flank's contact torque, unclipped: k (d - flank b) + c d'."""
+        p = self.p
+        return p.stiffness * (x[0] - x[1] - flank * p.backlash) + p.damping * (x[2] - x[3])
+
+    def chain(self, x, mode) -> float:
+        return self.raw_chain(x, mode[0]) if mode[0] else 0.0
+
+    def motor_torque(self, t, x, mode) -> float:
+        """The torque the motor applies (N*mm): the command, less in the direction of
+        motion over the torque-speed curve's corner (module docstring)."""
+        T = self.command(t, x)
+        if T * x[2] > 0 and abs(x[2]) > self.w_band:
+            return T * max(0.0, (self.w_lim - abs(x[2])) / (self.w_lim - self.w_band))
+        return T
+
+    def drive_force(self, t, x, mode) -> float:
+        """f' T - tau: the torque on the motor side at the fin, friction apart."""
+        return self.p.ratio * self.command(t, x) - self.chain(x, mode)
+
+    def rhs(self, t, x, mode):
+        p, c = self.p, self.c
+        tau = self.chain(x, mode)
+        dd_phi = (tau - p.hinge_spring * x[1] - p.fin_damping * x[3]) / p.fin_inertia
+        motor = mode[2]
+        if motor in (1, -1):
+            T = self.motor_torque(t, x, mode)
+            dd_psi = (p.ratio * (T - motor * p.friction_torque) - tau) / self.J1
+        else:
+            dd_psi = 0.0
+        dT = (self.saturated_command(t, x) - x[4]) / c.current_lag if c.current_lag > 0 else 0.0
+        e = self.r(t) - (x[1] if self.fin else x[0])
+        return [x[2], x[3], dd_psi, dd_phi, dT, e]
+
+    # -- the events of a mode: (function, direction, kind) ---------------------------------
+    def events(self, mode):
+        p = self.p
+        b = p.backlash
+        out = []
+        contact, side, motor = mode
+        if self.bilateral:
+            pass
+        elif contact:
+            out.append((lambda t, x, f=contact: f * (x[0] - x[1]) - b, -1, "opens"))
+            out.append((lambda t, x, f=contact: f * self.raw_chain(x, f), -1, "unloaded"))
+        elif side:
+            out.append((lambda t, x, f=side: f * self.raw_chain(x, f), 1, "closes"))
+            out.append((lambda t, x, f=side: f * (x[0] - x[1]) - b, -1, "gap"))
+        else:
+            out.append((lambda t, x: (x[0] - x[1]) - b, 1, "closes"))
+            out.append((lambda t, x: -(x[0] - x[1]) - b, 1, "closes"))
+        if motor in (1, -1):
+            if p.friction_torque > 0:
+                out.append((lambda t, x, s=motor: s * x[2], -1, "stops"))
+        elif motor == 0:
+            ft = p.ratio * p.friction_torque
+            out.append((lambda t, x: self.drive_force(t, x, mode) - ft, 1, "slips"))
+            out.append((lambda t, x: -self.drive_force(t, x, mode) - ft, 1, "slips"))
+        return out
+
+    # -- the mode after an event, or at the start ----------------------------------------
+    def initial_mode(self, t, x) -> tuple[tuple[int, int, int], np.ndarray]:
+        """The mode of a state at rest or in motion (the start of the run)."""
+        b = self.p.backlash
+        d = x[0] - x[1]
+        cm = (1, 0) if self.bilateral else (0, 0)
+        for f in (1, -1):
+            if not self.bilateral and f * d >= b:
+                cm = (f, 0) if f * self.raw_chain(x, f) > 0 else (0, f)
+                break
+        v = x[2]
+        if v != 0 or self.p.friction_torque == 0:
+            return (*cm, 1 if v >= 0 else -1), x
+        return self.stick_check(t, x, (*cm, 0))
+
+    def stick_check(self, t, x, mode):
+        """At theta' = 0: stuck while |f' T - tau| <= f' T_f, else turning with it."""
+        F = self.drive_force(t, x, mode)
+        if abs(F) <= self.p.ratio * self.p.friction_torque:
+            x = x.copy()
+            x[2] = 0.0
+            return (mode[0], mode[1], 0), x
+        return (mode[0], mode[1], 1 if F > 0 else -1), x
+
+    def band_events(self):
+        """Entering and leaving the torque-speed curve's corner, either way: recorded,
+        not stopping the integration (the torque is continuous there)."""
+        out = []
+        if math.isfinite(self.w_lim):
+            for s in (1, -1):
+                for direction, kind in ((1, "speed limit"), (-1, "speed released")):
+                    g = lambda t, x, s=s: s * x[2] - self.w_band  # noqa: E731
+                    g.terminal, g.direction = False, direction
+                    out.append((g, kind))
+        return out
+
+    def next_mode(self, t, x, mode, kind):
+        contact, side, motor = mode
+        d = x[0] - x[1]
+        if kind == "closes":
+            flank = side if side else (1 if d > 0 else -1)
+            mode = (flank, 0, motor)
+        elif kind == "opens" or kind == "gap":
+            mode = (0, 0, motor)
+        elif kind == "unloaded":
+            mode = (0, contact, motor)
+        elif kind == "stops":
+            return self.stick_check(t, x, (contact, side, 0))
+        elif kind == "slips":
+            F = self.drive_force(t, x, mode)
+            return (contact, side, 1 if F > 0 else -1), x
+        if mode[2] == 0:  # a stuck motor whose load changed: it may slip at once
+            return self.stick_check(t, x, mode)
+        return mode, x
+
+
+# --- the run ---------------------------------------------------------------------------------
+def _positive(field: str, value, limit: float) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"expected a number, got {value!r}") from None
+    if not (math.isfinite(value) and 0.0 < value <= limit):
+        raise InputError(field, f"must be in (0, {limit:g}], got {value!r}")
+    return value
+
+
+def simulate(
+    plant: DrivePlant,
+    loop: PositionLoop,
+    reference: Reference,
+    horizon: float,
+    samples: int = 2001,
+    initial_motor_angle: float = 0.0,
+    initial_fin_angle: float = 0.0,
+    rtol: float = 1e-6,
+    max_events: int = 20_000,
+) -> LoopSimulation:
+    """The drive's response in its loop from rest (module docstring).
+
+    Parameters
+    ----------
+    plant, loop
+        The drive at one fin angle and its controller.
+    reference
+        :class:`StepReference`, :class:`SineReference` or :class:`SampledReference`.
+    horizon
+        The simulated time (s), in (0, 600].
+    samples
+        Output samples, evenly spaced over [0, horizon], 2 to 10^6.
+    initial_motor_angle, initial_fin_angle
+        psi(0) = theta(0) / f' and phi(0) (rad; at rest).
+    rtol
+        The integrator's relative tolerance, in [1e-12, 1e-3] (absolute tolerances follow
+        from the plant's scales).
+    max_events
+        The most events (contact changes, sticks, speed limits) allowed, 1 to 200000; a
+        run that needs more (a chattering contact) is refused.
+
+    Returns
+    -------
+    LoopSimulation
+        The samples, the event times and what was simulated.
+
+    Raises
+    ------
+    InputError
+        An argument out of its range, naming it and its limit, or more events than
+        ``max_events``.
+    """
+    from scipy.integrate import solve_ivp
+
+    if not isinstance(plant, DrivePlant):
+        raise InputError("plant", f"must be a DrivePlant, got {plant!r}")
+    if not isinstance(loop, PositionLoop):
+        raise InputError("loop", f"must be a PositionLoop, got {loop!r}")
+    if not isinstance(reference, StepReference | SineReference | SampledReference):
+        raise InputError(
+            "reference", f"must be a step, sine or sampled reference, got {reference!r}"
+        )
+    horizon = _positive("horizon", horizon, MAX_HORIZON)
+    if not isinstance(samples, int | np.integer) or not 2 <= samples <= MAX_SAMPLES:
+        raise InputError("samples", f"must be an integer in [2, {MAX_SAMPLES}], got {samples!r}")
+    if not isinstance(max_events, int | np.integer) or not 1 <= max_events <= MAX_EVENTS:
+        raise InputError(
+            "max_events", f"must be an integer in [1, {MAX_EVENTS}], got {max_events!r}"
+        )
+    rtol = float(rtol)
+    if not (math.isfinite(rtol) and 1e-12 <= rtol <= 1e-3):
+        raise InputError("rtol", f"must be in [1e-12, 1e-3], got {rtol!r}")
+    psi0 = _angle("initial_motor_angle", initial_motor_angle)
+    phi0 = _angle("initial_fin_angle", initial_fin_angle)
+
+    sys = _System(plant, loop, reference)
+    # absolute tolerances from the plant's scales: an angle of the gap or the reference
+    angle = max(plant.backlash, _reference_scale(reference), abs(psi0), abs(phi0), 1e-6)
+    rate = angle * math.sqrt(plant.stiffness / plant.fin_inertia)
+    torque = max(loop.kp * angle, 1e-9)
+    atol = rtol * np.array([angle, angle, rate, rate, torque, angle * horizon]) * 1e-2
+
+    t_out = np.linspace(0.0, horizon, int(samples))
+    pieces: list[tuple[np.ndarray, np.ndarray, tuple[int, int, int]]] = []
+    x = np.array([psi0, phi0, 0.0, 0.0, 0.0, 0.0])
+    if loop.current_lag > 0:
+        x[4] = sys.saturated_command(0.0, x)
+    t = 0.0
+    mode, x = sys.initial_mode(t, x)
+    band = sys.band_events()
+    stops = [b for b in sorted(reference.breaks) if 0.0 < b < horizon] + [horizon]
+    event_times: list[float] = []
+    event_kinds: list[str] = []
+    done = 0  # samples already taken
+    while True:
+        t_stop = next(b for b in stops if b > t)
+        sys.left_of = t_stop if t_stop < horizon else math.inf
+        evs = sys.events(mode)
+        funcs = []
+        for fn, direction, _ in evs:
+            fn.terminal, fn.direction = True, direction
+            funcs.append(fn)
+        funcs += [g for g, _ in band]
+        sol = solve_ivp(
+            lambda tt, xx, md=mode: sys.rhs(tt, xx, md),
+            (t, t_stop),
+            x,
+            method="RK45",
+            events=funcs,
+            rtol=rtol,
+            atol=atol,
+            dense_output=True,
+        )
+        if sol.status < 0:
+            raise InputError("plant", f"the integration failed at t = {t:.6g} s: {sol.message}")
+        sys.left_of = math.inf  # from here on, the reference's value at t itself
+        t_end = float(sol.t[-1])
+        for j, (_, kind) in enumerate(band, start=len(evs)):
+            for te in sol.t_events[j]:
+                if te < t_end or sol.status != 1:
+                    event_times.append(float(te))
+                    event_kinds.append(kind)
+        last = t_end >= horizon
+        upto = int(np.searchsorted(t_out, t_end, side="right" if last else "left"))
+        if upto > done:
+            ts = t_out[done:upto]
+            pieces.append((ts, sol.sol(ts), mode))
+            done = upto
+        if last:
+            break
+        t, x = t_end, np.array(sol.y[:, -1])
+        if sol.status == 1:
+            k = min(
+                (j for j in range(len(evs)) if sol.t_events[j].size),
+                key=lambda j: sol.t_events[j][0],
+            )
+            kind = evs[k][2]
+            event_times.append(t)
+            event_kinds.append(kind)
+            if len(event_times) > max_events:
+                raise InputError(
+                    "max_events",
+                    f"more than {max_events} events by t = {t:.6g} s (the last: {kind}): "
+                    "a chattering contact, or a horizon too long for the limit",
+                )
+            mode, x = sys.next_mode(t, x, mode, kind)
+        elif mode[2] == 0:  # a jump of the reference: a stuck motor may slip at once
+            mode, x = sys.stick_check(t, x, mode)
+            if mode[2] != 0:
+                event_times.append(t)
+                event_kinds.append("slips")
+    return _record(sys, pieces, event_times, event_kinds, reference)
+
+
+def _reference_scale(reference) -> float:
+    if isinstance(reference, StepReference):
+        return abs(reference.amplitude)
+    if isinstance(reference, SineReference):
+        return abs(reference.amplitude) + abs(reference.offset)
+    return float(np.max(np.abs(reference._a)))
+
+
+def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSimulation:
+    ts = np.concatenate([p[0] for p in pieces])
+    X = np.concatenate([p[1] for p in pieces], axis=1)
+    torque = np.empty(ts.size)
+    chain = np.empty(ts.size)
+    contact = np.zeros(ts.size, dtype=int)
+    i = 0
+    for tp, Xp, mode in pieces:
+        for j in range(tp.size):
+            x = Xp[:, j]
+            torque[i] = sys.motor_torque(tp[j], x, mode)
+            chain[i] = sys.chain(x, mode)
+            contact[i] = int(np.sign(chain[i])) if sys.bilateral else mode[0]
+            i += 1
+    ref = np.array([reference(tk) for tk in ts])
+    return LoopSimulation(
+        times=ts,
+        reference=ref,
+        fin_angle=X[1],
+        fin_rate=X[3],
+        motor_angle=X[0],
+        motor_rate=X[2],
+        motor_torque=torque,
+        chain_torque=chain,
+        contact=contact,
+        event_times=tuple(event_times),
+        event_kinds=tuple(event_kinds),
+        plant=sys.p,
+        loop=sys.c,
+        input_reference=reference,
+    )
+
+
+def steady_oscillation(sim: LoopSimulation, start: float) -> tuple[float, float]:
+    """The fin's oscillation after ``start`` (s): (amplitude, frequency).
+
+    The amplitude is half the fin angle's peak-to-peak (rad), the frequency pi times the
+    number of crossings of its mid-range, less one, over the time between the first and
+    the last (rad/s; each crossing interpolated linearly). ``nan`` for the frequency with
+    fewer than three crossings. A measure of a settled limit cycle, for comparing with
+    :func:`optdesign.models.loop_backlash.limit_cycles`.
+    """
+    keep = sim.times >= start
+    if np.count_nonzero(keep) < 3:
+        raise InputError("start", f"leaves fewer than 3 samples (got {start!r} s)")
+    t, y = sim.times[keep], sim.fin_angle[keep]
+    mid = 0.5 * (y.max() + y.min())
+    above = y > mid
+    i = np.flatnonzero(above[:-1] != above[1:])
+    tz = t[i] + (mid - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i])
+    w = math.pi * (tz.size - 1) / (tz[-1] - tz[0]) if tz.size >= 3 else float("nan")
+    return float(0.5 * (y.max() - y.min())), float(w)

@@ -1,0 +1,316 @@
+"""The actuator in its position loop, from the design (issue 38; docs/loop.md): the
+drive's plant at every grid angle and the controller of ``[loop]``, for any mechanism.
+
+Everything here reads the design's quantities (:class:`~optdesign.problem.quantities.
+Quantities`: the ratio f'(phi), the motor-side inertia, the chain's stiffness, the
+clearance chain's worst-case backlash) and the problem's ``[motor]``, ``[load]`` and
+``[loop]`` sections; the equations are :mod:`optdesign.models.loop_plant`'s. Two forms:
+
+* :func:`plant_grid` and :func:`loop_gains`: the plant and the gains as expressions over
+  the grid (CasADi on the solver path, NumPy arrays on the checking path), which the
+  requirement rows (:mod:`optdesign.problem.loop_requirements`) are built from;
+* :func:`drive_plants` and :func:`position_loop`: one :class:`~optdesign.models.
+  loop_plant.DrivePlant` per grid angle and the :class:`~optdesign.models.loop_plant.
+  PositionLoop`, numbers, for the post-solve analyses (poles, limit cycles, simulation).
+
+Internal units: mm, t, s, N, rad (the current loop's lag is read from the file in h).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from optdesign import math as m
+from optdesign.errors import ProblemError
+from optdesign.models import loop_linear as ll
+from optdesign.models.loop_plant import DrivePlant, PositionLoop
+
+#: The chain's damping ratio when ``[loop]`` gives none: 2 % of critical, a steel drive
+#: of bearings, a ball nut and pins (a lightly damped structure, 1-5 %).
+DEFAULT_CHAIN_DAMPING_RATIO = 0.02
+
+#: The hours of a file's time in seconds.
+HOUR = 3600.0
+
+
+@dataclass(frozen=True)
+class PlantGrid:
+    """The drive's plant at every grid angle (the fields of :class:`~optdesign.models.
+    loop_plant.DrivePlant`, each a grid expression or a number; internal units). ``phi``
+    holds the grid angles (rad)."""
+
+    motor_inertia: Any
+    ratio: Any
+    fin_inertia: float
+    stiffness: Any
+    damping: Any
+    hinge_spring: float
+    fin_damping: float
+    backlash: Any
+    friction_torque: float
+    peak_torque: Any
+    max_speed: Any
+    phi: Any
+
+    @property
+    def motor_inertia_at_fin(self) -> Any:
+        """J_1 = J_m f'^2 over the grid (t*mm^2)."""
+        return self.motor_inertia * self.ratio**2
+
+
+@dataclass(frozen=True)
+class LoopGains:
+    """The controller of ``[loop]`` (kp, kd, ki: motor torque per fin angle, internal
+    units; ``current_lag`` in s): numbers for fixed gains, design expressions for gains
+    placed from a bandwidth (:func:`loop_gains`)."""
+
+    kp: Any
+    kd: Any
+    ki: float
+    current_lag: float
+    feedback: str
+
+
+def _need_loop(q):
+    spec = q.problem.spec
+    if spec.loop is None:
+        raise ProblemError("the position loop: needs a [loop] section (its gains or bandwidth)")
+    for section, what in (
+        ("motor", "the motor's inertia and limits"),
+        ("load", "the fin's inertia"),
+        ("screw", "the chain's stiffness: its bearings, nut and shaft"),
+    ):
+        if getattr(spec, section) is None:
+            raise ProblemError(f"[loop]: needs a [{section}] section ({what})")
+    return spec.loop
+
+
+def chain_damping(q, stiffness, J1, J2) -> Any:
+    """The chain's viscous damping at the fin (N*mm*s/rad) over the grid: ``[loop]
+    chain_damping``, or 2 zeta sqrt(k J1 J2 / (J1 + J2)) for its ``chain_damping_ratio``
+    (default :data:`DEFAULT_CHAIN_DAMPING_RATIO`): zeta of critical for the chain's own
+    mode, the two inertias beating against each other on k."""
+    loop = q.problem.spec.loop
+    if loop.chain_damping is not None:
+        return loop.chain_damping + 0.0 * stiffness
+    zeta = loop.chain_damping_ratio
+    zeta = DEFAULT_CHAIN_DAMPING_RATIO if zeta is None else zeta
+    return 2.0 * zeta * m.sqrt(stiffness * J1 * J2 / (J1 + J2))
+
+
+def backlash_half_width(q) -> Any:
+    """b: half the clearance chain's worst-case backlash at the fin (rad) over the grid;
+    the backlash of :class:`~optdesign.mechanisms.joints.Backlash` is the full play
+    between the two contacts, in degrees. 0 for a chain without clearance."""
+    if not q.joints:
+        return 0.0 * q.ratio
+    return q.backlash.worst_case * (np.pi / 180.0) / 2.0
+
+
+def plant_grid(q) -> PlantGrid:
+    """The design's plant at every grid angle (see the module's docstring): J_m from
+    ``motor_side_inertia``, f' the ratio, the fin's inertia, hinge spring and damping of
+    ``[load]``, the chain's stiffness at the fin with the motor held, its damping
+    (:func:`chain_damping`), b (:func:`backlash_half_width`), the motor's friction, peak
+    torque and top speed."""
+    _need_loop(q)
+    load = q.problem.spec.load
+    motor = q.motor_data
+    k = q.output_stiffness
+    Jm = q.motor_side_inertia
+    f = q.ratio
+    J2 = load.inertia
+    return PlantGrid(
+        motor_inertia=Jm,
+        ratio=f,
+        fin_inertia=J2,
+        stiffness=k,
+        damping=chain_damping(q, k, Jm * f**2, J2),
+        hinge_spring=load.hinge_spring,
+        fin_damping=load.damping,
+        backlash=backlash_half_width(q),
+        friction_torque=motor.friction_torque,
+        peak_torque=motor.peak_torque,
+        max_speed=motor.max_speed,
+        phi=q.phi,
+    )
+
+
+def bandwidth_factor(zeta: float) -> float:
+    """w_b / w_n of the second-order loop w_n^2 / (s^2 + 2 zeta w_n s + w_n^2): the
+    frequency where its gain falls to 1/sqrt(2), over its natural frequency: 1 at zeta =
+    1/sqrt(2), 0.6436 at zeta = 1, 1.5538 at zeta = 0."""
+    a = 1.0 - 2.0 * zeta**2
+    return float(np.sqrt(a + np.sqrt(a * a + 1.0)))
+
+
+def _on_grid(mean, like):
+    # A design's mean (one value) against its grid: NumPy keeps the grid on the last axis.
+    if m.is_symbolic(mean, like):
+        return mean
+    return np.asarray(mean)[..., None] if np.ndim(like) > np.ndim(mean) else mean
+
+
+def loop_gains(q) -> LoopGains:
+    """The controller: ``[loop]``'s gains, or kp and kd placed for its ``bandwidth`` and
+    ``damping_ratio`` on the rigid drive at the design's mean ratio: with J = J_m f'^2 +
+    J_fin (J_m and f' their grid means), f' kp = J w_n^2 - k_h and f' kd = 2 zeta w_n J -
+    c_fin, w_n = 2 pi bandwidth / :func:`bandwidth_factor`. One controller for the stroke:
+    at an angle whose ratio is above the mean the loop is faster, below it slower."""
+    loop = _need_loop(q)
+    lag = loop.current_lag * HOUR
+    if loop.bandwidth is None:
+        return LoopGains(loop.kp, loop.kd or 0.0, loop.ki, lag, loop.feedback)
+    load = q.problem.spec.load
+    f = _on_grid(m.grid_mean(q.ratio), q.ratio)
+    Jm = _on_grid(m.grid_mean(q.motor_side_inertia + 0.0 * q.ratio), q.ratio)
+    J = Jm * f**2 + load.inertia
+    wn = 2.0 * np.pi * loop.bandwidth / bandwidth_factor(loop.zeta)
+    kp = (J * wn**2 - load.hinge_spring) / f
+    kd = m.fmax(2.0 * loop.zeta * wn * J - load.damping, 0.0) / f
+    return LoopGains(kp, kd, loop.ki, lag, loop.feedback)
+
+
+def loop_angles(problem) -> np.ndarray:
+    """Indices of the grid angles that carry the loop's rows: ``[loop] angles`` of them
+    (at most the grid's), evenly spread, both ends included."""
+    n = len(problem.phi)
+    count = min(problem.spec.loop.angles, n)
+    return np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
+
+
+def _pick(x: Any, idx: np.ndarray, n: int) -> Any:
+    """The entries ``idx`` of a grid quantity (a number stays a number)."""
+    if m.is_symbolic(x):
+        return x[[int(i) for i in idx]] if x.shape[0] == n else x
+    a = np.asarray(x)
+    return a[..., idx] if a.ndim and a.shape[-1] == n else x
+
+
+def picked(grid: PlantGrid, idx: np.ndarray, n: int) -> PlantGrid:
+    """The plant at the grid indices ``idx`` of its ``n`` angles."""
+    return PlantGrid(**{f.name: _pick(getattr(grid, f.name), idx, n) for f in fields(PlantGrid)})
+
+
+def response(grid: PlantGrid, gains: LoopGains, omega) -> ll.LoopResponse:
+    """L(jw) and T(jw) of the loop at ``omega`` (rad/s) over a plant's grid."""
+    return ll.loop_response(
+        grid.motor_inertia,
+        grid.ratio,
+        grid.fin_inertia,
+        grid.stiffness,
+        grid.damping,
+        grid.hinge_spring,
+        grid.fin_damping,
+        gains.kp,
+        gains.kd,
+        gains.ki,
+        gains.current_lag,
+        omega,
+        gains.feedback,
+    )
+
+
+def resonance_frequency(q, idx: np.ndarray | None = None) -> Any:
+    """w_r (rad/s): the drive's own mode, motor free, over the grid (at ``idx``)."""
+    w2 = q.two_mass_frequency_squared
+    return m.sqrt(w2 if idx is None else _pick(w2, idx, len(q.phi)))
+
+
+def resonance_gain(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:
+    """|L(j w_r)| at the loop's angles ``idx``: the loop's gain at the drive's own mode."""
+    r = response(grid, gains, resonance_frequency(q, idx))
+    return m.sqrt(r.open_re**2 + r.open_im**2)
+
+
+def loop_resonance_gain(q) -> Any:
+    """|L(j w_r)| at every grid angle (the objective ``resonance_gain``)."""
+    return resonance_gain(q, plant_grid(q), loop_gains(q), None)
+
+
+def _rows(value: Any, pop: int, width: int) -> np.ndarray:
+    """A grid quantity of a population as a (pop, width) array (a number, a grid, or one
+    row per design)."""
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 2 and a.shape[0] == pop:
+        return np.broadcast_to(a, (pop, width))
+    return np.broadcast_to(a.reshape(-1) if a.ndim else a, (pop, width))
+
+
+def _population(q) -> int:
+    sizes = [np.shape(v)[0] for v in q.design.values() if np.ndim(v) == 2]
+    return max(sizes, default=1)
+
+
+def drive_plants_of(q, angles=None) -> list[tuple[list[DrivePlant], PositionLoop]]:
+    """For each design of the NumPy quantities ``q`` (one design, or a population: one
+    row per design), its :class:`~optdesign.models.loop_plant.DrivePlant` at every grid
+    angle (or at the grid indices ``angles``) and its :class:`~optdesign.models.
+    loop_plant.PositionLoop`."""
+    grid, gains = plant_grid(q), loop_gains(q)
+    phi = np.asarray(q.phi, dtype=float).reshape(-1)
+    pop, width = _population(q), len(phi)
+    names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
+    values = {n: _rows(getattr(grid, n), pop, width) for n in names}
+    kp, kd = _rows(gains.kp, pop, 1)[:, 0], _rows(gains.kd, pop, 1)[:, 0]
+    out = []
+    for i in range(pop):
+        if not kp[i] > 0:
+            raise ProblemError(
+                f"loop.bandwidth: places kp = {kp[i]:.4g} N*mm/rad at this design; the fin's "
+                "hinge spring alone is stiffer than the loop asked for: raise the bandwidth"
+            )
+        loop = PositionLoop(kp[i], kd[i], gains.ki, gains.current_lag, gains.feedback)
+        plants = [
+            DrivePlant(**{n: float(values[n][i, k]) for n in names}, angle=float(phi[k]))
+            for k in (range(width) if angles is None else angles)
+        ]
+        out.append((plants, loop))
+    return out
+
+
+def drive_plants(q) -> list[DrivePlant]:
+    """One :class:`~optdesign.models.loop_plant.DrivePlant` per grid angle of the design
+    whose NumPy quantities are ``q`` (one design)."""
+    return drive_plants_of(q)[0][0]
+
+
+def position_loop(q) -> PositionLoop:
+    """The :class:`~optdesign.models.loop_plant.PositionLoop` of the design whose NumPy
+    quantities are ``q``; a placed kp that is not positive (a bandwidth below the fin's
+    own frequency on its stabilising hinge spring) refused naming ``loop.bandwidth``."""
+    return drive_plants_of(q)[0][1]
+
+
+def check_loop(problem) -> None:
+    """Refuse (:class:`~optdesign.errors.ProblemError` naming ``loop``) a ``[loop]``
+    without the sections it closes around, or whose closed loop is unstable at every one
+    of its angles (``[loop] angles`` of the grid) at the problem's start design: the
+    file's gains (or bandwidth) are wrong for this drive, not one design."""
+    from optdesign.models.loop_linear import closed_loop_poles
+
+    q = problem.quantities(problem.design_dict(problem.start()))
+    _need_loop(q)
+    plants, loop = drive_plants_of(q, loop_angles(problem))[0]
+    rightmost = []
+    for plant in plants:
+        poles = closed_loop_poles(plant, loop)
+        if np.all(poles.real < -1e-9 * np.maximum(np.abs(poles), 1e-300)):
+            return
+        rightmost.append((float(np.max(poles.real)), plant))
+    worst, plant = max(rightmost, key=lambda item: item[0])
+    spec = problem.spec
+    rigid = -spec.load.hinge_spring / plant.ratio  # f' kp + k_h > 0, the rigid loop's
+    raise ProblemError(
+        f"loop: the position loop (kp = {loop.kp * 1e-3:.4g} N*m/rad, kd = "
+        f"{loop.kd * 1e-3:.4g} N*m*s/rad, ki = {loop.ki * 1e-3:.4g} N*m/(rad*s), current "
+        f"lag {loop.current_lag * 1e3:.3g} ms, {loop.feedback} feedback) is unstable at "
+        f"every one of its {len(plants)} angles at the start design: a closed-loop pole at Re s = {worst:.4g} "
+        f"rad/s at {np.degrees(plant.angle):+.1f} deg. Check the gains: the rigid loop "
+        f"alone needs f' kp + k_h > 0 (kp > {max(rigid, 0.0) * 1e-3:.4g} N*m/rad there) "
+        "and kd > 0; with integral action, ki < (f' kd + c_fin) (f' kp + k_h) / (f' J), "
+        "J = J_m f'^2 + J_fin"
+    )
