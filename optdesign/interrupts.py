@@ -315,6 +315,19 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
+#: The name of the watchdog's thread (:func:`start_watchdog`).
+WATCHDOG_THREAD = "optdesign-watchdog"
+
+
+def fork_safe_threads() -> bool:
+    """Whether this process runs no thread but its main one and the watchdog: a fork
+    copies no other thread, so one that held a lock (the import lock, a logging lock)
+    would leave it held in the child forever; the watchdog holds none while it waits,
+    and the child drops its state (:func:`_after_fork_in_child`)."""
+    main = threading.main_thread()
+    return all(t is main or t.name == WATCHDOG_THREAD for t in threading.enumerate())
+
+
 def start_watchdog(finish: Callable[[int], None], grace: float = WATCHDOG_GRACE) -> bool:
     """Make sure a signal ends the command although the main thread cannot hear it.
 
@@ -345,7 +358,7 @@ def start_watchdog(finish: Callable[[int], None], grace: float = WATCHDOG_GRACE)
     _watch_fds = (r, w)
     main = threading.main_thread().ident
     threading.Thread(
-        target=_watch, args=(r, finish, grace, main), name="optdesign-watchdog", daemon=True
+        target=_watch, args=(r, finish, grace, main), name=WATCHDOG_THREAD, daemon=True
     ).start()
     return True
 

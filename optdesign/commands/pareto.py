@@ -138,8 +138,9 @@ def run_pareto(args) -> int:
                 storage.check_new_store(store)
         from optdesign.plots.figure_process import FigureProcess
 
-        # started before the fronts: matplotlib is imported while they are computed
-        with FigureProcess() if not args.no_plot else contextlib.nullcontext() as figures:
+        # forked before the fronts (one thread yet), idle while their workers take the
+        # cores; it draws front.png while this process makes the page
+        with FigureProcess(warm=False) if not args.no_plot else contextlib.nullcontext() as figures:
             return _run_locked(args, problem, objectives, methods, out, figures)
 
 

@@ -9,9 +9,9 @@ evaluated curves: drawing evaluates no model) and writes the PNG, while this pro
 writes its other outputs. On two cores the figure leaves the command's critical path;
 on one it costs what it cost in process.
 
-The worker is started only where it is forked (Linux) from a process running one
-thread (a fork copies no other thread, and a lock another thread held would stay held
-in the worker). Elsewhere, or when the worker cannot start or dies, figures are drawn in
+The worker is started only where it is forked (Linux) from a process running no thread
+but its main one and the command's signal watchdog
+(:func:`optdesign.interrupts.fork_safe_threads`). Elsewhere, or when the worker cannot start or dies, figures are drawn in
 process, with the same outcome.
 
 Outcome of a figure: None when written, else a note naming the file and the error
@@ -22,12 +22,12 @@ its failure must not lose the others).
 from __future__ import annotations
 
 import importlib
-import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from optdesign.errors import OptDesignError
+from optdesign.interrupts import fork_safe_threads
 from optdesign.plots import write_figure
 from optdesign.runtime.processes import WorkerPool, forks_workers
 
@@ -46,12 +46,22 @@ def _draw(module: str, function: str, record: Any, path: str) -> str | None:
     return write_figure(lambda: draw(record), path)
 
 
+def _draw_in_worker(module: str, function: str, record: Any, path: str) -> str | None:
+    """:func:`_draw` in the worker, which selects the file-only back-end first (the
+    process drawing in process keeps its own)."""
+    _warm()
+    return _draw(module, function, record, path)
+
+
 class FigureProcess:
     """Draws figures in a worker process started before the work that precedes them
     (see the module's docstring). Use as a context manager: the worker is started on
     entry and stopped on exit."""
 
-    def __init__(self) -> None:
+    def __init__(self, warm: bool = True) -> None:
+        #: import matplotlib in the worker as soon as it starts (False: with the first
+        #: figure, for a command whose own work keeps every core busy until then)
+        self.warm = warm
         self._pool: WorkerPool | None = None
         #: the worker's task in flight: "" for the warm-up, else the figure's path
         self._inflight: str | None = None
@@ -79,15 +89,17 @@ class FigureProcess:
 
     def start(self) -> None:
         """Start the worker where it is safe (see the module's docstring)."""
-        if self._pool is not None or not forks_workers() or threading.active_count() != 1:
+        if self._pool is not None or not forks_workers() or not fork_safe_threads():
             return
         try:
             self._pool = WorkerPool(1)
-            self._pool.submit(_warm, ())
+            if self.warm:
+                self._pool.submit(_warm, ())
         except (OSError, OptDesignError):  # no process to spare: draw in process
             self.close()
             return
-        self._inflight = ""
+        if self.warm:
+            self._inflight = ""
 
     def submit(self, draw: str, path: str | Path, prepare: Callable[[], Any]) -> None:
         """Write the figure ``draw(prepare())`` as PNG at ``path``; ``draw`` is a
@@ -111,7 +123,7 @@ class FigureProcess:
         job = (module, function, record, str(path))
         if self._pool is not None:
             try:
-                self._pool.submit(_draw, job)
+                self._pool.submit(_draw_in_worker, job)
             except Exception:  # a record that does not pickle, a worker gone: in process
                 self.close()
             else:
