@@ -107,3 +107,47 @@ def test_a_figure_that_cannot_be_prepared_is_its_note(tmp_path):
         assert figures.outcome() == "s.png not written: ValueError: plot: no design"
     with pytest.raises(RuntimeError, match="no figure was submitted"):
         FigureProcess().outcome()
+
+
+def test_the_command_draws_its_figure_in_the_worker_beside_its_watchdog(tmp_path):
+    """``optdesign solve`` as a user runs it (its signal watchdog running): the PNG is
+    written and matplotlib is never imported by the command's own process."""
+    import subprocess
+    import sys
+
+    # the command ends with os._exit: the check runs there, in the command's process only
+    script = (
+        "import os, runpy, sys\n"
+        "me, real_exit = os.getpid(), os._exit\n"
+        "def checked_exit(code):\n"
+        "    if os.getpid() == me:\n"
+        "        print('exit', code, 'matplotlib' in sys.modules, flush=True)\n"
+        "    real_exit(code)\n"
+        "os._exit = checked_exit\n"
+        "sys.argv = ['optdesign', 'solve', 'cs_min_backlash', '--starts', '1', '--no-ranges',"
+        f" '--out', {str(tmp_path / 'out')!r}]\n"
+        "try:\n"
+        "    runpy.run_module('optdesign', run_name='__main__')\n"
+        "except SystemExit as end:\n"
+        "    checked_exit(end.code)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=300
+    )
+    assert done.stdout.strip().splitlines()[-1] == "exit 0 False", done.stderr[-2000:]
+    assert (tmp_path / "out" / "solution.png").stat().st_size > 10_000
+
+
+def test_only_the_watchdog_may_run_beside_a_fork():
+    from optdesign.interrupts import WATCHDOG_THREAD, fork_safe_threads
+
+    assert fork_safe_threads()
+    for name, safe in ((WATCHDOG_THREAD, True), ("a user's thread", False)):
+        stop = threading.Event()
+        other = threading.Thread(target=stop.wait, name=name)
+        other.start()
+        try:
+            assert fork_safe_threads() is safe
+        finally:
+            stop.set()
+            other.join()
