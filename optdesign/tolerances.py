@@ -13,7 +13,7 @@ from __future__ import annotations
 #: verify_design`) or on the solver's scaled rows (:func:`optdesign.solvers.base.
 #: constraint_reports`); a row within it of its bound is active, and so is a free
 #: variable's bound within it (relative to max(1, upper - lower)) of the variable's value
-#: (:func:`optdesign.reports.limits.at_bound`, shared by the summary, the limits table
+#: (:func:`optdesign.display.limits.at_bound`, shared by the summary, the limits table
 #: and a sweep's binding set).
 FEASIBILITY_TOL = 1e-6
 

@@ -89,7 +89,7 @@ INTERNAL_UNITS: dict[str, str] = {
     "rotational_damping": "N*mm*s/rad",
     "frequency": "Hz",
     "angular_acceleration": "rad/s**2",
-    # the position loop's integral gain (issue 38): motor torque per fin angle per second
+    # the position loop's integral gain: motor torque per fin angle per second
     "integral_gain": "N*mm/rad/s",
 }
 

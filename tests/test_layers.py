@@ -45,6 +45,7 @@ LAYERS: list[tuple[str, ...]] = [
         "data",
         "store_identity",
         "storage",
+        "display",  # numbers, tables, limits and figures in the user's units
     ),
     ("models", "fits"),  # optdesign.fits: the public entry to the ISO 286 models
     ("mechanisms",),
@@ -65,10 +66,10 @@ LAYERS: list[tuple[str, ...]] = [
 #: them; they import on call, and nothing they reach imports the record back.
 ENTRY_POINTS = {
     ("optdesign.solvers.result", "optdesign.reports.solve_text"),
-    ("optdesign.solvers.result", "optdesign.reports.frames"),
+    ("optdesign.solvers.result", "optdesign.display.frames"),
     ("optdesign.solvers.result", "optdesign.plots.solution"),
     ("optdesign.studies.pareto.front", "optdesign.reports.front_text"),
-    ("optdesign.studies.pareto.front", "optdesign.reports.frames"),
+    ("optdesign.studies.pareto.front", "optdesign.display.frames"),
     ("optdesign.studies.pareto.front", "optdesign.plots.front"),
     ("optdesign.studies.sweep", "optdesign.reports.sweep_text"),
     ("optdesign.studies.sweep", "optdesign.plots.sweep"),
@@ -141,22 +142,12 @@ def import_graph() -> dict[str, dict[str, int]]:
     return graph
 
 
-#: display primitives: they render numbers, tables, figures and a problem's rows in the
-#: user's units, and import nothing above the shared utilities (this test checks it), so
-#: a study may word a refusal or save a figure with them.
-PRIMITIVES = {
-    "optdesign": "the package root: a version and lazily exported names, no import",
-    "optdesign.reports.tables": "plain-text tables",
-    "optdesign.reports.display_units": "a value in the user's units",
-    "optdesign.reports.limits": "a requirement's row in the user's units",
-    "optdesign.reports.frames": "a table of records in the user's units (pandas)",
-    "optdesign.plots": "a figure saved atomically",
-    "optdesign.plots.profiles": "performance profiles drawn from arrays",
-}
+#: the package root: a version and lazily exported names, no import of its own
+ROOT = "optdesign"
 
 
 def layer(module: str) -> int:
-    if module in PRIMITIVES:
+    if module == ROOT:
         return 0
     parts = module.split(".")
     top = parts[1]

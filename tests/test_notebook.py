@@ -40,7 +40,7 @@ def test_public_figures_are_no_pyplot_figures(solved):
     once more: a figure made through pyplot showed twice. None is made through it now."""
     import matplotlib.pyplot as plt
 
-    from optdesign.plots.profiles import plot_profiles
+    from optdesign.display.profiles import plot_profiles
 
     plt.close("all")
     result, front = solved

@@ -369,7 +369,7 @@ def test_problem_file_loads_without_pint(tmp_path):
 def test_report_unit_table_equals_pint(dimension, unit):
     # A report shows a value in the unit the file wrote it in; the common units convert
     # without pint, and must give pint's number bit for bit (or leave it to pint).
-    from optdesign.reports.display_units import _DIMENSION_UNITS, _shown_factor
+    from optdesign.display.shown import _DIMENSION_UNITS, _shown_factor
 
     factor = _shown_factor(dimension, unit)
     for value in (1.0, 37.5, -0.25, 0.1, 1234.5678, 0.5235987755982988):

@@ -33,10 +33,10 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.display.limits import limits_of
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.requirements import physical_conditions
 from optdesign.problem.validity import is_validity
-from optdesign.reports.limits import limits_of
 from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.registry import solver_for_kind
 from optdesign.solvers.result import ConstraintReport, Diagnosis, Result

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from optdesign.display.tables import format_table
 from optdesign.errors import ProblemError
 from optdesign.formulations.verify import verify_design
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.reports.tables import format_table
 from optdesign.solvers.details import ReferenceComparison
 from optdesign.solvers.result import Result
 from optdesign.text import printable

@@ -1,5 +1,5 @@
 """Limit cycles the chain's clearance sustains in the position loop, by harmonic balance
-(issue 38; docs/loop.md).
+(docs/loop.md).
 
 The model of the clearance. The chain of a :class:`~optdesign.models.loop_plant.DrivePlant`
 is elastic: its torque at the fin is k (|d| - b) + c d' in contact (d = psi - phi the

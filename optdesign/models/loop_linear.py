@@ -1,5 +1,5 @@
 """The linear position loop of a drive: transfer functions, frequency response,
-bandwidth, margins and stability (issue 38; docs/loop.md).
+bandwidth, margins and stability (docs/loop.md).
 
 The plant and controller are :class:`~optdesign.models.loop_plant.DrivePlant` and
 :class:`~optdesign.models.loop_plant.PositionLoop`, here with the gap closed and without

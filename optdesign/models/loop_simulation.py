@@ -1,5 +1,5 @@
 """The drive's time response in its position loop: elastic backlash, friction and the
-motor's limits, by ``scipy.integrate.solve_ivp`` with events (issue 38; docs/loop.md).
+motor's limits, by ``scipy.integrate.solve_ivp`` with events (docs/loop.md).
 
 The equations are those of :mod:`optdesign.models.loop_plant` in the fin coordinate
 (psi = theta / f', J_1 = J_m f'^2):

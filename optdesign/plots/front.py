@@ -249,6 +249,6 @@ def plot_fronts(problem, fronts: Sequence, ax=None, reference: np.ndarray | None
 
 def _value_text(problem, name: str, value: float) -> str:
     """``ripple=0.843 %``: an objective's value with its unit, for titles."""
-    from optdesign.reports.display_units import objective_shown
+    from optdesign.display.shown import objective_shown
 
     return f"{name}=" + objective_shown(problem, name, value).text(4)

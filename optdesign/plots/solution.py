@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from optdesign.display.limits import binding_angles, bound_limits, limits_of
 from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.reports.limits import binding_angles, bound_limits, limits_of
 from optdesign.views.curves import stroke_curves
 from optdesign.views.design import design_rows
 
@@ -75,7 +75,7 @@ def solution_figure(
 ) -> SolutionFigure:
     """The :class:`SolutionFigure` of the named ``designs`` of ``problem``.
 
-    ``limits``: :class:`~optdesign.reports.limits.Limit` records listed under the plot;
+    ``limits``: :class:`~optdesign.display.limits.Limit` records listed under the plot;
     ``binding``: requirement name -> deflection angles (deg) where it binds, marked on the
     last design's ratio curve.
     """

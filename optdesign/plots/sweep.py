@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.display.frames import objective_column, variable_column
 from optdesign.plots import MAX_TITLE_NAME, new_figure, plain
-from optdesign.reports.frames import objective_column, variable_column
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 

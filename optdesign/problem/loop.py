@@ -1,4 +1,4 @@
-"""The actuator in its position loop, from the design (issue 38; docs/loop.md): the
+"""The actuator in its position loop, from the design (docs/loop.md): the
 drive's plant at every grid angle and the controller of ``[loop]``, for any mechanism.
 
 Everything here reads the design's quantities (:class:`~optdesign.problem.quantities.

@@ -1,4 +1,4 @@
-"""The position loop of one design, analysed exactly after a solve (issue 38; docs/loop.md):
+"""The position loop of one design, analysed exactly after a solve (docs/loop.md):
 the figures the summary and result.json show beside the requirement rows, computed by
 :mod:`optdesign.models.loop_linear` and :mod:`optdesign.models.loop_backlash` on the
 design's plants (:mod:`optdesign.problem.loop`), not by the rows' smooth forms.

@@ -1,4 +1,4 @@
-"""The position loop's requirements (issue 38; docs/loop.md): smooth rows at the loop's
+"""The position loop's requirements (docs/loop.md): smooth rows at the loop's
 angles of the grid, built from the design's plant (:mod:`optdesign.problem.loop`) and
 the loop's frequency response (:func:`optdesign.models.loop_linear.loop_response`).
 

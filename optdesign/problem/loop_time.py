@@ -1,4 +1,4 @@
-"""The time response of a design in its position loop (issue 38; docs/loop.md): the
+"""The time response of a design in its position loop (docs/loop.md): the
 plant of one grid angle (:mod:`optdesign.problem.loop`) simulated by
 :func:`optdesign.models.loop_simulation.simulate`, and its samples as a CSV with units.
 

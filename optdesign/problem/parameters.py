@@ -63,9 +63,9 @@ def moved_copy(problem: DesignProblem, path: str, value: float) -> DesignProblem
 def limit_shown(problem: DesignProblem, path: str, p: float) -> Any:
     """The limit ``path`` of a :class:`~optdesign.solvers.result.Sensitivity` of ``problem`` (``"requirements.
     hinge_moment"``, ``"variables.R.upper"``) as the user reads it (a :class:`~optdesign.
-    reports.display_units.Shown`); ``p``: its internal value (a requirement is shown as
+    display.shown.Shown`); ``p``: its internal value (a requirement is shown as
     the problem holds it, in its written unit; ``p`` bare when that is unknown)."""
-    from optdesign.reports.display_units import Shown, requirement_values, variable_shown
+    from optdesign.display.shown import Shown, requirement_values, variable_shown
 
     if path.startswith("variables."):
         return variable_shown(problem, problem.by_name[path.split(".")[1]], p)

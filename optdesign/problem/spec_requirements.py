@@ -79,7 +79,7 @@ class Requirements(_Model):
     stiffness_load: Literal["hinge", "duty-mean"] = "hinge"
     inertia_ratio_max: Dimensionless | None = None
     natural_frequency_min: Frequency | None = None
-    # the position loop (issue 38, optdesign.problem.loop): at every grid angle
+    # the position loop (optdesign.problem.loop): at every grid angle
     bandwidth_min: Frequency | None = None
     phase_margin_min: Angle | None = None
     modulus_margin_min: Dimensionless | None = Field(None, gt=0.0, lt=1.0)

@@ -25,7 +25,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from optdesign.reports.display_units import objective_shown
+from optdesign.display.shown import objective_shown
 from optdesign.solvers.result import Sensitivity
 
 #: What the page says when no limit moves the optimum (nothing binds, or only by less

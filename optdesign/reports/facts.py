@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from optdesign.reports.display_units import Shown, objective_shown
+from optdesign.display.shown import Shown, objective_shown
 from optdesign.text import printable
 from optdesign.views.facts import DesignFacts, MotorFacts
 

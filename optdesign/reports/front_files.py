@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from optdesign.reports.frames import front_table, objective_column
+from optdesign.display.frames import front_table, objective_column
 from optdesign.solvers.result import clean_json
 from optdesign.text import csv_cell
 
@@ -42,7 +42,7 @@ def write_front_csv(
     front: Front | Sequence[Front], problem: DesignProblem, path: Path | str
 ) -> Path:
     """``front.csv``: one row a point (objectives, design variables, status, ...), the
-    rows of :func:`~optdesign.reports.frames.front_table` with the rejected points."""
+    rows of :func:`~optdesign.display.frames.front_table` with the rejected points."""
     from optdesign.storage import atomic_write_text
 
     rows = [r for f in _fronts(front) for r in front_table(f, problem, rejected=True)]

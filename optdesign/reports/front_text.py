@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from optdesign.reports.display_units import variable_shown
-from optdesign.reports.limits import bound_limits, is_internal
+from optdesign.display.limits import bound_limits, is_internal
+from optdesign.display.shown import variable_shown
+from optdesign.display.tables import format_table
 from optdesign.reports.solve_text import objective_unit
-from optdesign.reports.tables import format_table
 from optdesign.text import printable
 
 

@@ -21,16 +21,16 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.reports.costs_text import cost_text, front_point_costs
-from optdesign.reports.display_units import (
+from optdesign.display.limits import binding_angles, bound_limits, limits_of
+from optdesign.display.shown import (
     angle_unit,
     objective_shown,
     requirement_echo,
     variable_shown,
 )
+from optdesign.reports.costs_text import cost_text, front_point_costs
 from optdesign.reports.facts import objective_facts, shown_facts
 from optdesign.reports.html_page import render
-from optdesign.reports.limits import binding_angles, bound_limits, limits_of
 from optdesign.reports.solve_text import feasibility_text, objective_value
 from optdesign.views.curves import StrokeCurves
 from optdesign.views.design import DesignView, design_view

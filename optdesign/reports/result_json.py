@@ -13,7 +13,13 @@ import json
 from dataclasses import asdict
 from typing import Any
 
-from optdesign.reports.display_units import (
+from optdesign.display.limits import (
+    bound_limits,
+    limits_of,
+    objective_where,
+    relaxation_limits,
+)
+from optdesign.display.shown import (
     Shown,
     json_value,
     objective_shown,
@@ -21,12 +27,6 @@ from optdesign.reports.display_units import (
     variable_shown,
 )
 from optdesign.reports.facts import objective_facts, shown_facts
-from optdesign.reports.limits import (
-    bound_limits,
-    limits_of,
-    objective_where,
-    relaxation_limits,
-)
 from optdesign.reports.solve_text import objective_value
 from optdesign.solvers.result import Result, clean_json
 from optdesign.views.facts import design_facts

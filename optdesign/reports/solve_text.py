@@ -3,8 +3,8 @@ design table, what the design achieves, what limits the optimum, and for an infe
 problem the smallest change of each conflicting requirement that makes it feasible.
 
 Every number carries its unit, in the units the problem file wrote where that is
-unambiguous (:mod:`optdesign.reports.display_units`); the formulation's internal rows are never
-shown (:mod:`optdesign.reports.limits`). Names from the user are shown one line each and
+unambiguous (:mod:`optdesign.display.shown`); the formulation's internal rows are never
+shown (:mod:`optdesign.display.limits`). Names from the user are shown one line each and
 the whole text is :func:`~optdesign.text.printable`: no control character of a problem
 file reaches the terminal.
 """
@@ -13,10 +13,7 @@ from __future__ import annotations
 
 import math
 
-from optdesign.reports.costs_text import cost_text
-from optdesign.reports.display_units import objective_shown, requirement_echo, variable_shown
-from optdesign.reports.facts import objective_facts, shown_facts
-from optdesign.reports.limits import (
+from optdesign.display.limits import (
     at_bound,
     bound_limits,
     limits_of,
@@ -24,7 +21,10 @@ from optdesign.reports.limits import (
     relaxation_limits,
     relaxation_text,
 )
-from optdesign.reports.tables import format_table
+from optdesign.display.shown import objective_shown, requirement_echo, variable_shown
+from optdesign.display.tables import format_table
+from optdesign.reports.costs_text import cost_text
+from optdesign.reports.facts import objective_facts, shown_facts
 from optdesign.solvers.result import Result
 from optdesign.text import printable
 from optdesign.tolerances import FEASIBILITY_TOL

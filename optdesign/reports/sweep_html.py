@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from optdesign.display.shown import objective_shown
 from optdesign.reports.costs_text import cost_text
-from optdesign.reports.display_units import objective_shown
 from optdesign.reports.html import _header, design_json
 from optdesign.reports.html_page import render
 from optdesign.reports.sweep_text import _cell, sweep_rows

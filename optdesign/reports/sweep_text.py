@@ -7,7 +7,7 @@ import csv
 import io
 from typing import Any
 
-from optdesign.reports.frames import objective_column, variable_column
+from optdesign.display.frames import objective_column, variable_column
 from optdesign.text import csv_cell, printable
 
 
@@ -99,7 +99,7 @@ def sweep_summary(sweep: Any) -> str:
     headers, rows = sweep_rows(sweep)
     hidden = ("what_fails", "active_change", "jump", "found_by", "global_search")
     keep = [i for i, h in enumerate(headers) if h not in hidden]
-    from optdesign.reports.tables import format_table
+    from optdesign.display.tables import format_table
 
     # an infeasible point's numbers are of the best design found, not an optimum: "-"
     first = 1 + len(sweep.axes)  # the point and the parameters are shown for every point

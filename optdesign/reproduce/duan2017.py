@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 
 from optdesign import math as m
+from optdesign.display.tables import Comparison, comparison_table
 from optdesign.mechanisms import CrankSlider, PinJoint, ShiftingFork
 from optdesign.models.fit_formulas import fit_clearance
 from optdesign.models.hertz_line import contact_half_width, pin_flattening
 from optdesign.plots.curves import plot_curves
-from optdesign.reports.tables import Comparison, comparison_table
 
 #: The paper's actuator (section 1): lead 5 mm, gears 2, arm 90, offset 50, rod 80.
 PAPER_DESIGN = {"p": 5.0, "i_a": 2.0, "R": 90.0, "n": 50.0, "l": 80.0}

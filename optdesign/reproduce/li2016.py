@@ -13,9 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
+from optdesign.display.tables import Comparison, comparison_table, format_table
 from optdesign.models import error_budget as eb
 from optdesign.models import roller_screw as rs
-from optdesign.reports.tables import Comparison, comparison_table, format_table
 from optdesign.reproduce.monte_carlo import plot_ranking, run_monte_carlo
 
 R_S, R_RP, F_K, F_R = 0.04e3, 0.01e3, 0.055, 1e-5 * 1e3

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from optdesign.display.tables import Comparison, comparison_table, format_table
 from optdesign.models.hertz_point import (
     effective_modulus,
     hamrock_brewe,
@@ -32,7 +33,6 @@ from optdesign.models.hertz_point import (
     timoshenko_m_n,
 )
 from optdesign.models.prsm import STEEL_E, STEEL_NU, PRSMContact
-from optdesign.reports.tables import Comparison, comparison_table, format_table
 from optdesign.reproduce.prsm_contact_sweeps import (
     SIDES,
     area_vs_load,

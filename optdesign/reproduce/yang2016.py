@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from optdesign.display.tables import Comparison, comparison_table, format_table
 from optdesign.mechanisms import CrankSlider
 from optdesign.models import lock, screw
-from optdesign.reports.tables import Comparison, comparison_table, format_table
 
 # Seed 002, converted at the boundary: r1 = 0.03 m, r2 = 0.04 m, R = 0.04 m (motor radius).
 R1_MM = 0.03 * 1e3

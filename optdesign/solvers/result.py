@@ -218,7 +218,7 @@ class Certificate:
 class Relaxation:
     """The smallest change of one requirement that makes the problem feasible, in the
     requirement rows' own (internal) quantity; reports show it as the user wrote it
-    (:func:`optdesign.reports.limits.relaxation_limits`).
+    (:func:`optdesign.display.limits.relaxation_limits`).
 
     Attributes
     ----------
@@ -514,7 +514,7 @@ class Result(SolvedPoint):
 
     def to_frame(self):
         """A pandas DataFrame: one row per variable (value, bounds) and objective."""
-        from optdesign.reports.frames import result_frame
+        from optdesign.display.frames import result_frame
 
         return result_frame(self)
 

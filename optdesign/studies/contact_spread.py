@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.display.shown import objective_shown
 from optdesign.errors import OptDesignError
 from optdesign.mechanisms.joints import CONTACT_MODELS
-from optdesign.reports.display_units import objective_shown
 
 
 def contact_model_spread(problem: Any, design: dict[str, float]) -> str | None:

@@ -79,7 +79,7 @@ def check_path_names(path: str) -> None:
 
 def parameter_dimension(problem: DesignProblem, path: str) -> str:
     """The dimension of the parameter at ``path`` (InputError ``vary`` when unknown)."""
-    from optdesign.reports.display_units import _dimension
+    from optdesign.display.shown import _dimension
 
     check_path_names(path)
     head, _, rest = path.partition(".")
@@ -151,7 +151,7 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
     """The axes of ``vary`` (``{path: (start, stop, count)}``), checked: a known parameter
     path, quantities of its dimension (a bare number only for a plain number), a range
     that is not empty, a problem that validates at both ends. InputError naming the field."""
-    from optdesign.reports.display_units import Shown, _value, variable_shown
+    from optdesign.display.shown import Shown, _value, variable_shown
     from optdesign.units import to_internal
 
     if not isinstance(vary, Mapping) or not vary:

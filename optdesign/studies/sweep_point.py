@@ -63,7 +63,7 @@ def grid_neighbours(
 
 def active_names(problem: DesignProblem, result) -> list[str]:
     """The binding set of a result: requirement (block) names and ``VAR.lower/upper``."""
-    from optdesign.reports.limits import at_bound, is_internal
+    from optdesign.display.limits import at_bound, is_internal
 
     names = {r.name.split("[", 1)[0] for r in result.active if not is_internal(r.name)}
     for var in problem.free:
@@ -318,7 +318,7 @@ def shared_solver(task: Mapping[str, Any]):
 
 def _violated(problem: DesignProblem, result) -> list[str]:
     """What fails at the best design found: the violated requirements as read."""
-    from optdesign.reports.limits import limits_of, relaxation_limits, relaxation_text
+    from optdesign.display.limits import limits_of, relaxation_limits, relaxation_text
 
     diagnosis = result.diagnosis
     if not result.violated and diagnosis is not None and diagnosis.relaxations:

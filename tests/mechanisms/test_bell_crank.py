@@ -167,7 +167,7 @@ def test_bell_crank_solves_to_the_hand_backlash_and_traces_a_front(tmp_path):
         DESIGN.update(saved)
     assert result.objective == pytest.approx(worst, rel=1e-6)
     # the transmission angle's row is in rad, shown in degrees (display_unit converts)
-    from optdesign.reports.limits import block_infos
+    from optdesign.display.limits import block_infos
 
     info = block_infos(problem)["transmission_angle"]
     assert info.display(math.radians(50.0)) == pytest.approx(50.0) and info.display_unit == "deg"

@@ -238,7 +238,7 @@ def test_buckling_limits_the_nut_force_to_the_buckling_load(fin):
 
 def test_the_drive_requirements_carry_their_units_for_the_reports(fin):
     """What a report shows beside each drive requirement's value and limit."""
-    from optdesign.reports.limits import block_infos
+    from optdesign.display.limits import block_infos
 
     problem, _ = fin
     units = {name: info.unit for name, info in block_infos(problem).items()}
@@ -1492,7 +1492,7 @@ def test_preloaded_nut_and_the_choices_refused():
     problem = _fin_with(screw={"nut_stiffness_rule": "preload", "nut_preload": 0.05})
     q = _fin_quantities(problem)
     assert _flat(drive.nut_stiffness(q)) == pytest.approx([0.8 * 480e3 * 0.5 ** (1 / 3)])
-    from optdesign.reports.limits import block_infos
+    from optdesign.display.limits import block_infos
 
     text = block_infos(problem)["stiffness"].description
     assert "HIWIN F 3.34 at a preload of 0.05 Ca" in text
@@ -1528,7 +1528,7 @@ def test_mounting_rule_reaches_the_problem_and_its_summary_text():
         assert np.max(ev.constraints["critical_speed"].values) == pytest.approx(
             speed.max() / N1, rel=1e-6
         )
-    from optdesign.reports.limits import block_infos
+    from optdesign.display.limits import block_infos
 
     infos = block_infos(problem)  # what the summary prints beside a binding requirement
     assert "common factor lambda_2 = 15.1" in infos["critical_speed"].description

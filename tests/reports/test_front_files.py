@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.reports.frames import front_table
+from optdesign.display.frames import front_table
 from optdesign.reports.front_files import read_front_csv, write_front_csv, write_front_json
 from optdesign.studies.pareto.front import FrontPoint, make_front
 

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.display.shown import requirement_echo
 from optdesign.problem.load import written_units
-from optdesign.reports.display_units import requirement_echo
 from optdesign.reports.result_json import SCHEMA, result_document
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"

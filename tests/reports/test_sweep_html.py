@@ -10,8 +10,8 @@ import pytest
 
 import optdesign as od
 from optdesign.cli import main
+from optdesign.display.shown import objective_shown
 from optdesign.errors import InputError
-from optdesign.reports.display_units import objective_shown
 from optdesign.reports.sweep_html import NOT_COMPUTED
 from optdesign.reports.sweep_text import _cell, sweep_rows
 

@@ -49,10 +49,10 @@ def catalogue_sensitivities(
         The NLP back-end and options the optimum was solved with (the re-solves of the
         neighbouring items use the same, warm-started from the optimum).
     """
+    from optdesign.display.shown import objective_shown, variable_shown
     from optdesign.formulations.catalogue.search import NodeSolver, _fixed
     from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
     from optdesign.formulations.nlp.solve import finish
-    from optdesign.reports.display_units import objective_shown, variable_shown
 
     if not result.success or not result.design:
         return [], []

@@ -137,7 +137,7 @@ def _record(
     problem: DesignProblem, objective: str, path: str, p: float, dvdp: float, v: float
 ) -> tuple[Sensitivity, float]:
     """The record of ``dv*/dp`` at limit ``p`` (both internal), in the user's units."""
-    from optdesign.reports.display_units import objective_shown
+    from optdesign.display.shown import objective_shown
 
     limit = limit_shown(problem, path, p)
     factor = limit.value / p if p != 0 and limit.value else 1.0

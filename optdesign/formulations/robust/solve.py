@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.display.tables import format_table
 from optdesign.formulations.nlp.solve import (
     continuous_only,
     finish,
@@ -43,7 +44,6 @@ from optdesign.formulations.robust.program import (
 )
 from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
 from optdesign.problem.request import SolveRequest
-from optdesign.reports.tables import format_table
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.multistart import multistart
 from optdesign.solvers.registry import make_solver, solver_hints

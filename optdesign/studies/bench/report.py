@@ -149,7 +149,7 @@ def write_outputs(
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
     fronts = [c for c in configs if get_config(c).kind == "front"]
     if single:
-        from optdesign.plots import save_figure
+        from optdesign.display.figures import save_figure
 
         fig = profiles_figure(rows, configs)
         with atomic_output(out / "bench_profiles.png") as tmp:
@@ -313,7 +313,7 @@ def profiles(
 
 def profiles_figure(rows: Sequence[BenchRow], configs: Sequence[str]):
     """The profiles as a matplotlib Figure."""
-    from optdesign.plots.profiles import plot_profiles
+    from optdesign.display.profiles import plot_profiles
 
     single = [c for c in configs if get_config(c).kind not in ("front", "debug")]
     return plot_profiles(profiles(rows, configs), single, gap_floor=GAP_FLOOR)

@@ -176,7 +176,7 @@ class Front:
 
     def to_frame(self, rejected: bool = False):
         """A pandas DataFrame: one row per point (objectives, free variables, status)."""
-        from optdesign.reports.frames import front_frame
+        from optdesign.display.frames import front_frame
 
         return front_frame(self, rejected)
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import optdesign as od
+from optdesign.display.shown import objective_shown
 from optdesign.formulations.catalogue.search import NodeSolver, _fixed
 from optdesign.formulations.catalogue.sensitivities import fixed_item_difference, neighbour_items
-from optdesign.reports.display_units import objective_shown
 from optdesign.reports.html_page import to_json
 from optdesign.reports.result_json import result_document
 

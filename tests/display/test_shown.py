@@ -1,4 +1,4 @@
-"""optdesign/reports/display_units.py as a whole: the angle unit a report shows (per
+"""optdesign/display/shown.py as a whole: the angle unit a report shows (per
 field, per file, by default), a number's text and JSON, each internal unit as read,
 objectives and their statistics, and the requirements echoed in the units the file
 wrote them in (pint's conversion as the independent check), with bare numbers, percent,
@@ -12,9 +12,7 @@ from types import SimpleNamespace
 import pytest
 
 import optdesign as od
-from optdesign.problem import problem_from_dict
-from optdesign.problem.load import load
-from optdesign.reports.display_units import (
+from optdesign.display.shown import (
     Shown,
     angle_unit,
     json_value,
@@ -24,6 +22,8 @@ from optdesign.reports.display_units import (
     shown,
     variable_shown,
 )
+from optdesign.problem import problem_from_dict
+from optdesign.problem.load import load
 from optdesign.units import registry
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -182,7 +182,7 @@ def test_a_bare_zero_angle_is_echoed_in_the_one_angle_unit_the_file_wrote():
 def test_an_objective_without_a_problem_or_a_declaration_is_shown_bare():
     """An objective value shown with no problem (a record read alone) or under a name the
     problem does not declare: the number as it is, with no unit."""
-    from optdesign.reports.display_units import Shown, objective_shown
+    from optdesign.display.shown import Shown, objective_shown
 
     assert objective_shown(None, "backlash", 0.5) == Shown(0.5, "")
     assert objective_shown(None, "backlash", 0.5).text() == "0.5"
@@ -193,7 +193,7 @@ def test_an_objective_without_a_problem_or_a_declaration_is_shown_bare():
 
 
 def test_an_angle_is_shown_in_the_unit_the_file_wrote_it_in():
-    from optdesign.reports.display_units import shown
+    from optdesign.display.shown import shown
 
     as_rad = shown(0.5, "rad", "rad")
     assert (as_rad.value, as_rad.unit) == (0.5, "rad")

@@ -26,7 +26,7 @@ def plot_profiles(
     """
     import matplotlib
 
-    from optdesign.plots import new_figure, plain
+    from optdesign.display.figures import new_figure, plain
 
     keys = [k for k in ("time", "gap") if k in profiles]
     fig = new_figure((6.0 * len(keys), 5.4), dpi=110)

@@ -2,9 +2,9 @@
 summary shows (pandas is imported only here).
 
 One source of display units: a variable's value is shown as
-:func:`~optdesign.reports.display_units.variable_shown` shows it (the unit the file wrote it in;
+:func:`~optdesign.display.shown.variable_shown` shows it (the unit the file wrote it in;
 an angle in degrees unless the file wrote radians), an objective's as
-:func:`~optdesign.reports.display_units.objective_shown` (its ``display_unit``: ripple in %, a
+:func:`~optdesign.display.shown.objective_shown` (its ``display_unit``: ripple in %, a
 motor torque in N*m). Every such conversion is a factor, so a column's values are the
 internal values times the scale of :func:`display_column`. A front's columns carry the
 unit in their name (``"ripple [%]"``, ``"R [mm]"``; a dimensionless one only its name),
@@ -35,7 +35,7 @@ class Column:
 
     def bound(self, internal: Any) -> Any:
         """A bound as the file wrote it: ``-30`` deg, not ``-29.999999999999996``."""
-        from optdesign.reports.display_units import _tidy
+        from optdesign.display.shown import _tidy
 
         shown = self.value(internal)
         return shown if shown is None or not math.isfinite(shown) else _tidy(shown)
@@ -48,7 +48,7 @@ def header(name: str, unit: str) -> str:
 
 def variable_column(problem: Any, var: Any) -> Column:
     """Design variable ``var`` as the summary shows it."""
-    from optdesign.reports.display_units import variable_shown
+    from optdesign.display.shown import variable_shown
 
     s = variable_shown(problem, var, 1.0)
     return Column(var.name, header(var.name, s.unit), s.unit, float(s.value))
@@ -56,7 +56,7 @@ def variable_column(problem: Any, var: Any) -> Column:
 
 def objective_column(problem: Any, name: str) -> Column:
     """Objective ``name`` as the summary shows it."""
-    from optdesign.reports.display_units import objective_shown
+    from optdesign.display.shown import objective_shown
 
     s = objective_shown(problem, name, 1.0)
     return Column(name, header(name, s.unit), s.unit, float(s.value))

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.reports.display_units import Shown, angle_unit, shown
+from optdesign.display.shown import Shown, angle_unit, shown
 from optdesign.text import printable
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -199,7 +199,7 @@ def bound_limits(
     problem: Any, design: dict[str, float], rel: float = FEASIBILITY_TOL
 ) -> list[Limit]:
     """Free variables of ``design`` at a bound (:func:`at_bound`)."""
-    from optdesign.reports.display_units import variable_shown
+    from optdesign.display.shown import variable_shown
 
     out = []
     for var in problem.free:
