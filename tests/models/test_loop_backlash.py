@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 import casadi as ca
+import loop_drives
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -27,16 +28,7 @@ from optdesign.models.loop_plant import DrivePlant, PositionLoop
 B = math.radians(0.1)
 # fin feedback through a chain with a resonance near 1070 rad/s: the gap sustains a
 # cycle just below it (the loop's gain margin is 1.45 at 1066 rad/s)
-PLANT = DrivePlant(
-    motor_inertia=0.02,
-    ratio=60.0,
-    fin_inertia=10.0,
-    stiffness=1e7,
-    damping=400.0,
-    hinge_spring=2e4,
-    fin_damping=20.0,
-    backlash=B,
-)
+PLANT = DrivePlant(**loop_drives.TWO_MASS, backlash=B)
 FIN_PD = PositionLoop(kp=1500.0, kd=45.0, current_lag=1e-4, feedback="fin")
 MOTOR_PID = PositionLoop(kp=2000.0, kd=60.0, ki=8000.0, current_lag=2e-4, feedback="motor")
 

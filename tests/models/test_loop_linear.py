@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import casadi as ca
+import loop_drives
 import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
@@ -23,17 +24,8 @@ from optdesign.models.loop_plant import DrivePlant, PositionLoop
 ct = pytest.importorskip("control")
 pytestmark = pytest.mark.filterwarnings("ignore:Unused output")
 
-# a two-mass drive: 0.02 t*mm^2 at the motor (2e-5 kg*m^2), ratio 60, a fin of 10 t*mm^2
-# (0.01 kg*m^2), 1e7 N*mm/rad at the fin: anti-resonance 1000 rad/s
-TWO_MASS = DrivePlant(
-    motor_inertia=0.02,
-    ratio=60.0,
-    fin_inertia=10.0,
-    stiffness=1e7,
-    damping=400.0,
-    hinge_spring=2e4,
-    fin_damping=20.0,
-)
+# the shared two-mass drive (tests/loop_drives.py): anti-resonance 1000 rad/s
+TWO_MASS = DrivePlant(**loop_drives.TWO_MASS)
 # a rigid one: the same inertias on a chain 10^5 times stiffer (damped: its mode at
 # 3.4e5 rad/s has zeta = 0.017)
 RIGID = DrivePlant(motor_inertia=0.02, ratio=60.0, fin_inertia=10.0, stiffness=1e12, damping=1e5)

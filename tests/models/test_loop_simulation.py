@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import loop_drives
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -25,15 +26,7 @@ from optdesign.models.loop_plant import DrivePlant, PositionLoop
 from optdesign.models.motor import step_response
 
 B = math.radians(0.1)
-TWO_MASS = dict(
-    motor_inertia=0.02,
-    ratio=60.0,
-    fin_inertia=10.0,
-    stiffness=1e7,
-    damping=400.0,
-    hinge_spring=2e4,
-    fin_damping=20.0,
-)
+TWO_MASS = loop_drives.TWO_MASS
 
 
 # --- (a) the rigid loop -------------------------------------------------------------------
