@@ -141,8 +141,10 @@ def test_the_command_draws_its_figure_in_the_worker_beside_its_watchdog(tmp_path
 def test_only_the_watchdog_may_run_beside_a_fork():
     from optdesign.interrupts import WATCHDOG_THREAD, fork_safe_threads
 
-    assert fork_safe_threads()
-    for name, safe in ((WATCHDOG_THREAD, True), ("a user's thread", False)):
+    # the verdict of this process as it runs (pytest-xdist's workers run threads of
+    # their own); the watchdog never changes it, any other thread makes it False
+    before = fork_safe_threads()
+    for name, safe in ((WATCHDOG_THREAD, before), ("a user's thread", False)):
         stop = threading.Event()
         other = threading.Thread(target=stop.wait, name=name)
         other.start()
@@ -151,3 +153,4 @@ def test_only_the_watchdog_may_run_beside_a_fork():
         finally:
             stop.set()
             other.join()
+    assert fork_safe_threads() is before
