@@ -40,8 +40,6 @@ Validity
 horizon : 0 < T <= 600 s (call)
     A fin's manoeuvre lasts seconds; a longer run is a mistake of units or a request for
     millions of events, refused before it starts.
-reference angle : |r| <= pi rad (call)
-    A fin turns less than half a turn; a non-finite angle is refused.
 output samples : 2 to 10^6 (call)
     Enough to resolve a cycle near the chain's resonance over a run; more is memory.
 """
@@ -55,14 +53,17 @@ import numpy as np
 
 from optdesign.errors import InputError
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_references import (
+    MAX_HORIZON,
+    MAX_SAMPLES,
+    Reference,
+    SampledReference,
+    SineReference,
+    StepReference,
+    angle_value,
+)
 from optdesign.models.validity import Validity
 
-#: The largest horizon simulated (s): a fin's manoeuvre lasts seconds.
-MAX_HORIZON = 600.0
-#: The most output samples returned.
-MAX_SAMPLES = 1_000_000
-#: The largest reference angle (rad): a fin turns less than half a turn.
-MAX_ANGLE = math.pi
 #: The most events (contacts, sticks, speed limits) handled before the run is refused.
 MAX_EVENTS = 200_000
 HORIZON = Validity(
@@ -74,18 +75,6 @@ HORIZON = Validity(
     "s",
     "a fin's manoeuvre lasts seconds; a longer run is a units mistake or millions of events",
     open_lower=True,
-    checked=("call",),
-)
-REFERENCE_ANGLE = Validity(
-    "loop_simulation.reference_angle",
-    "loop simulation",
-    "reference angle |r| at the fin",
-    0.0,
-    MAX_ANGLE,
-    "rad",
-    "a fin turns less than half a turn",
-    shown_unit="deg",
-    scale=180.0 / math.pi,
     checked=("call",),
 )
 SAMPLES = Validity(
@@ -100,110 +89,11 @@ SAMPLES = Validity(
 )
 
 #: The ranges of validity of this model.
-VALIDITY: tuple[Validity, ...] = (HORIZON, REFERENCE_ANGLE, SAMPLES)
+VALIDITY: tuple[Validity, ...] = (HORIZON, SAMPLES)
 
 #: The width of the torque-speed curve's corner, a fraction of the top speed: the
 #: torque in the direction of motion falls to none over the last 1 % of the speed.
 SPEED_BAND = 0.01
-
-
-# --- references ----------------------------------------------------------------------------
-def _angle(field: str, value) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"expected a number (rad), got {value!r}") from None
-    if not (math.isfinite(value) and abs(value) <= MAX_ANGLE):
-        raise InputError(field, f"must be finite with |value| <= pi rad, got {value!r}")
-    return value
-
-
-@dataclass(frozen=True)
-class StepReference:
-    """A step of ``amplitude`` (rad at the fin) at ``time`` (s, >= 0)."""
-
-    amplitude: float
-    time: float = 0.0
-
-    def __post_init__(self):
-        object.__setattr__(self, "amplitude", _angle("reference.amplitude", self.amplitude))
-        t = float(self.time)
-        if not (math.isfinite(t) and 0.0 <= t <= MAX_HORIZON):
-            raise InputError("reference.time", f"must be in [0, {MAX_HORIZON:g}] s, got {t!r}")
-        object.__setattr__(self, "time", t)
-
-    def __call__(self, t: float) -> float:
-        return self.amplitude if t >= self.time else 0.0
-
-    @property
-    def breaks(self) -> tuple[float, ...]:
-        """Times where the reference jumps (the integration restarts there)."""
-        return (self.time,) if self.time > 0 else ()
-
-
-@dataclass(frozen=True)
-class SineReference:
-    """r(t) = offset + amplitude sin(frequency t) (rad at the fin; frequency in rad/s)."""
-
-    amplitude: float
-    frequency: float
-    offset: float = 0.0
-
-    def __post_init__(self):
-        object.__setattr__(self, "amplitude", _angle("reference.amplitude", self.amplitude))
-        object.__setattr__(self, "offset", _angle("reference.offset", self.offset))
-        w = float(self.frequency)
-        if not (math.isfinite(w) and 0.0 < w <= 1e6):
-            raise InputError("reference.frequency", f"must be in (0, 1e6] rad/s, got {w!r}")
-        object.__setattr__(self, "frequency", w)
-
-    def __call__(self, t: float) -> float:
-        return self.offset + self.amplitude * math.sin(self.frequency * t)
-
-    @property
-    def breaks(self) -> tuple[float, ...]:
-        """Times where the reference jumps: none."""
-        return ()
-
-
-@dataclass(frozen=True)
-class SampledReference:
-    """A deflection history: piecewise linear through (``times``, ``angles``), held
-    before the first and after the last sample (s, rad at the fin)."""
-
-    times: tuple[float, ...]
-    angles: tuple[float, ...]
-
-    def __post_init__(self):
-        try:
-            t = np.asarray(self.times, dtype=float).ravel()
-            a = np.asarray(self.angles, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise InputError("reference.times", "times and angles must be numbers") from None
-        if t.size < 2 or t.size != a.size or t.size > MAX_SAMPLES:
-            raise InputError(
-                "reference.times",
-                f"needs 2 to {MAX_SAMPLES} times, as many as angles (got {t.size}, {a.size})",
-            )
-        if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-            raise InputError("reference.times", "must be finite and strictly increasing")
-        if not (np.all(np.isfinite(a)) and np.max(np.abs(a)) <= MAX_ANGLE):
-            raise InputError("reference.angles", "must be finite with |angle| <= pi rad")
-        object.__setattr__(self, "times", tuple(t.tolist()))
-        object.__setattr__(self, "angles", tuple(a.tolist()))
-        object.__setattr__(self, "_t", t)
-        object.__setattr__(self, "_a", a)
-
-    def __call__(self, t: float) -> float:
-        return float(np.interp(t, self._t, self._a))
-
-    @property
-    def breaks(self) -> tuple[float, ...]:
-        """Times where the reference jumps: none."""
-        return ()
-
-
-Reference = StepReference | SineReference | SampledReference
 
 
 # --- the answer ----------------------------------------------------------------------------
@@ -483,8 +373,8 @@ def simulate(
     rtol = float(rtol)
     if not (math.isfinite(rtol) and 1e-12 <= rtol <= 1e-3):
         raise InputError("rtol", f"must be in [1e-12, 1e-3], got {rtol!r}")
-    psi0 = _angle("initial_motor_angle", initial_motor_angle)
-    phi0 = _angle("initial_fin_angle", initial_fin_angle)
+    psi0 = angle_value("initial_motor_angle", initial_motor_angle)
+    phi0 = angle_value("initial_fin_angle", initial_fin_angle)
 
     sys = _System(plant, loop, reference)
     # absolute tolerances from the plant's scales: an angle of the gap or the reference

@@ -44,6 +44,7 @@ MODEL_MODULES = (
     "loop_plant",
     "loop_linear",
     "loop_backlash",
+    "loop_references",
     "loop_simulation",
 )
 
