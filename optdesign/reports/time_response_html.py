@@ -43,7 +43,7 @@ def time_response_json(view: TimeResponseView | str) -> dict[str, Any]:
     why (``error``)."""
     # the view's module is imported here: every page imports this one, and only a solve's
     # report of a problem with [loop] needs it (it brings the loop's models)
-    from optdesign.views.time_response import HORIZON_PER_BANDWIDTH, HORIZON_RANGE
+    from optdesign.views.time_response import HORIZON_PER_BANDWIDTH, HORIZON_RANGE, SETTLED
 
     if isinstance(view, str):
         return {"error": view}
@@ -62,11 +62,18 @@ def time_response_json(view: TimeResponseView | str) -> dict[str, Any]:
         f"mid-stroke), from rest at the gap's centre, with the chain's gap and damping, "
         f"friction and the motor's limits; {view.horizon:.3g} s simulated ({basis}).",
         f"Over the last third (from {view.tail_start:.3g} s) the fin holds "
-        f"{view.settled * deg:.5g} deg on average and moves +-{view.oscillation * deg:.3g} deg"
+        f"{view.settled * deg:.5g} deg on average and "
         + (
-            f" at {view.oscillation_frequency / (2 * math.pi):.4g} Hz."
-            if math.isfinite(view.oscillation_frequency)
-            else " (no oscillation: fewer than three crossings of its mid-range)."
+            f"comes to rest: it moves +-{view.oscillation * deg:.3g} deg, less than "
+            f"{100 * SETTLED:g} % of the gap's half-width b = {view.gap * deg:.3g} deg."
+            if view.settles
+            else f"moves +-{view.oscillation * deg:.3g} deg ({view.oscillation / view.gap:.3g} "
+            f"times the gap's half-width b = {view.gap * deg:.3g} deg)"
+            + (
+                f" at {view.oscillation_frequency / (2 * math.pi):.4g} Hz."
+                if math.isfinite(view.oscillation_frequency)
+                else " (fewer than three crossings of its mid-range: no frequency)."
+            )
         ),
     ]
     table = None

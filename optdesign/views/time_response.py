@@ -40,6 +40,9 @@ TAIL = 1.0 / 3.0
 SAMPLES = 2001
 #: Periods of the cycle the close-up shows, at the run's end.
 PERIODS_SHOWN = 5
+#: A fin that moves less than this share of the gap's half-width over the tail has
+#: settled: what is left is the integration's own ripple (1e-5 b in a loop that stops).
+SETTLED = 0.01
 
 
 @dataclass(frozen=True)
@@ -119,6 +122,17 @@ class TimeResponseView:
     cycle: PredictedCycle | None
     no_cycle: str
     close_up: float
+
+    @property
+    def gap(self) -> float:
+        """The chain's gap at the angle, its half-width b at the fin (rad)."""
+        return float(self.simulation.response.plant.backlash)
+
+    @property
+    def settles(self) -> bool:
+        """Whether the fin comes to rest: it moves less than :data:`SETTLED` b over the
+        tail."""
+        return self.oscillation < SETTLED * self.gap
 
     @property
     def amplitude_error(self) -> float:

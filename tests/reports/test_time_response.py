@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -110,3 +111,27 @@ def test_a_design_that_cannot_be_simulated_gets_the_reason_not_a_lost_page(
     assert "Time response" in html and "max_events: more than 20000" in html
     assert "step-response" not in html
     assert time_response_view(od.load(PROBLEMS / "fin_actuator_motor.toml"), OPTIMUM) is None
+
+
+def test_without_a_predicted_cycle_the_section_says_why_and_what_the_fin_does():
+    """The optimum with the encoder on the motor and a stable fin (+500 N*m/rad): L_d never
+    crosses -180 deg, so no cycle is predicted, and the simulated fin comes to rest."""
+    data = tomllib.loads((PROBLEMS / "fin_actuator_loop.toml").read_text())
+    data["loop"]["feedback"] = "motor"
+    data["load"]["hinge_spring"] = "500 N*m/rad"
+    problem = od.load(data)
+    view = time_response_view(problem, OPTIMUM)
+    r = view.simulation.response
+    cycles = limit_cycles(r.plant, r.loop)
+    assert cycles.cycles == () and "never crosses -180 deg" in cycles.reason
+    shown = time_response_json(view)
+    assert shown["table"] is None and shown["cycle"] is None
+    assert (
+        f"predicts no stable limit cycle of the clearance at this angle: {cycles.reason}"
+        in (shown["lines"][2])
+    )
+    # what the simulation shows, from a direct run of the same length
+    direct = od.simulate(problem, design=OPTIMUM, horizon=view.horizon).response
+    tail = np.degrees(direct.fin_angle[direct.times >= 2.0 * view.horizon / 3.0])
+    assert 0.5 * (tail.max() - tail.min()) < 0.01 * math.degrees(r.plant.backlash)
+    assert f"holds {tail.mean():.5g} deg on average and comes to rest" in shown["lines"][1]
