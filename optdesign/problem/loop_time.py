@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import InputError, ProblemError
+from optdesign.models.loop_plant import DrivePlant, PositionLoop
 from optdesign.models.loop_simulation import (
     MAX_HORIZON,
     LoopSimulation,
@@ -76,6 +77,26 @@ def simulate_design(
     if problem.spec.loop is None:
         raise ProblemError("simulate: needs a [loop] section (the controller)")
     args = simulation_arguments(reference, amplitude, horizon, frequency)
+    at = design_plant(problem, design, angle)
+    response = simulate(at.plant, at.loop, args.reference, args.horizon, samples)
+    return DesignSimulation(at.angle, at.index, response)
+
+
+@dataclass(frozen=True)
+class DesignPlant:
+    """The drive of a design at one grid angle (rad; its index in the grid) and its
+    position loop (:mod:`optdesign.models.loop_plant` records)."""
+
+    angle: float
+    index: int
+    plant: DrivePlant
+    loop: PositionLoop
+
+
+def design_plant(problem: Any, design: dict[str, float], angle: Any = None) -> DesignPlant:
+    """The :class:`DesignPlant` of ``design`` at the grid angle nearest ``angle`` (a
+    quantity, or a number in rad; default: the middle of the stroke), which must lie on
+    the stroke."""
     phi = np.asarray(problem.phi, dtype=float)
     where = float(np.mean(phi[[0, -1]])) if angle is None else to_internal(angle, "angle", "angle")
     if not phi[0] - 1e-9 <= where <= phi[-1] + 1e-9:
@@ -88,8 +109,7 @@ def simulate_design(
     with np.errstate(all="ignore"):
         q = problem.quantities(design)
         plants, loop = drive_plants_of(q, [k])[0]
-    response = simulate(plants[0], loop, args.reference, args.horizon, samples)
-    return DesignSimulation(float(phi[k]), k, response)
+    return DesignPlant(float(phi[k]), k, plants[0], loop)
 
 
 @dataclass(frozen=True)

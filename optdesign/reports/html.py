@@ -32,9 +32,11 @@ from optdesign.reports.costs_text import cost_text, front_point_costs
 from optdesign.reports.facts import objective_facts, shown_facts
 from optdesign.reports.html_page import render
 from optdesign.reports.solve_text import feasibility_text, objective_value
+from optdesign.reports.time_response_html import time_response_json
 from optdesign.views.curves import StrokeCurves
 from optdesign.views.design import DesignView, design_view
 from optdesign.views.sketches import SketchFrame
+from optdesign.views.time_response import time_response_view
 
 
 def design_json(problem: Any, view: DesignView, label: str) -> dict[str, Any]:
@@ -141,6 +143,7 @@ def solve_report(result: Any) -> str:
     best = design_json(problem, design_view(problem, result.design), label)
     best["sensitivities"] = [cost_text(s) for s in result.sensitivities]
     best["item_steps"] = [s.text() for s in result.item_steps]
+    time_response = time_response_view(problem, result.design)
     name = result.objective_name
     data = {
         **_header(problem),
@@ -153,6 +156,8 @@ def solve_report(result: Any) -> str:
         "selected": 1,
         "front": None,
     }
+    if time_response is not None:  # a [loop]: the optimum's step response and cycle
+        data["time_response"] = time_response_json(time_response)
     return render(data, title=f"optdesign: {problem.name}")
 
 

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.reports.plotly_js import loader_script
+from optdesign.reports.time_response_html import TIME_RESPONSE_SCRIPT, time_response_section
 from optdesign.solvers.result import clean_json
 from optdesign.text import printable
 
@@ -247,8 +248,8 @@ moments in N*m, ripple in %.</p>
 <div id="sketch" class="plot"></div>
 <div id="curves" class="plot"></div>
 </div>
-<script type="application/json" id="report-data">{to_json(data)}</script>
-<script>{_SCRIPT}</script>
+{time_response_section(data.get("time_response"))}<script type="application/json" id="report-data">{to_json(data)}</script>
+<script>{_SCRIPT}{TIME_RESPONSE_SCRIPT if "time_response" in data else ""}</script>
 </body></html>
 """
 

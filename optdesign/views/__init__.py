@@ -9,6 +9,9 @@ motor) - is evaluated here, once, into typed frozen records:
 - :mod:`optdesign.views.curves`: :class:`~optdesign.views.curves.StrokeCurves`;
 - :mod:`optdesign.views.sketches`: :class:`~optdesign.views.sketches.SketchFrame`;
 - :mod:`optdesign.views.facts`: :class:`~optdesign.views.facts.DesignFacts`;
+- :mod:`optdesign.views.time_response`: :class:`~optdesign.views.time_response.
+  TimeResponseView`, a design's step response in its position loop (a solve's page of a
+  problem with ``[loop]``);
 - :mod:`optdesign.views.design`: :class:`~optdesign.views.design.DesignRows` and
   :class:`~optdesign.views.design.DesignView`, all of the above for one design.
 

@@ -400,3 +400,27 @@ def test_sweep_page_hover_a_point_or_a_row_shows_its_design(browser, sweep_dir):
         cell = browser.find_element(By.CSS_SELECTOR, '#design td[data-var="R"]')
         assert float(cell.text) == pytest.approx(points[k]["R [mm]"], rel=1e-5)
     _nothing_injected(browser)
+
+
+def test_solve_report_of_a_loop_draws_its_step_response_and_cycle(browser, tmp_path):
+    """The section "Time response" of fin_actuator_loop's optimum: both plots drawn,
+    with their traces, and no console error."""
+    from loop_optimum import loop_report
+
+    path = tmp_path / "report.html"
+    path.write_text(loop_report())
+    _open(browser, path)
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    WebDriverWait(browser, 30).until(
+        lambda d: d.execute_script("return document.body.dataset.timeResponse") == "1"
+    )
+    assert _console_errors(browser) == []
+    traces = browser.execute_script(
+        "return ['step-response', 'limit-cycle'].map("
+        "(id) => document.getElementById(id).data.map((t) => t.name))"
+    )
+    assert traces == [
+        ["reference", "fin", "motor torque"],
+        ["fin, simulated", "describing function (predicted)"],
+    ]
