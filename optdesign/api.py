@@ -395,6 +395,7 @@ def sweep(
     problem: DesignProblem | str | Path | Mapping[str, Any],
     vary: Mapping[str, Any],
     *,
+    linked: Mapping[str, str] | None = None,
     objective: str | None = None,
     check_every: int = 10,
     starts: int | None = None,
@@ -412,11 +413,17 @@ def sweep(
 
     ``vary``: ``{path: (start, stop, count)}`` for one or two parameters, e.g.
     ``{"requirements.hinge_moment": ("200 N*m", "1000 N*m", 20)}``; a path is
-    ``requirements.NAME`` (``requirements.mean_ratio.min`` inside a band),
-    ``variables.NAME.lower`` / ``.upper`` (a free variable's bound) or ``variables.NAME``
+    ``requirements.NAME`` (``requirements.mean_ratio.min`` inside a band), a number of
+    the motion, the load or the loop (``motion.rise_time``, ``load.inertia``,
+    ``loop.bandwidth``), ``variables.NAME.lower`` / ``.upper`` (a free variable's bound)
+    or ``variables.NAME``
     (a fixed variable); start and stop are quantities of the parameter's dimension
     (a bare number only for a plain number), count 2..1000, at most 2 500 points in all
-    (the product of the counts). Every point gets the global search a cold solve of it
+    (the product of the counts). ``linked``: ``{path: swept path}``, parameters that
+    move with a swept one, set to its value at every point (paths as above, of the same
+    dimension), e.g. ``{"loop.bandwidth":
+    "requirements.bandwidth_min"}``: the loop's gains placed for the bandwidth that is
+    required. Every point gets the global search a cold solve of it
     runs (``starts``, ``seed``: that search's, default the file's; the same seed at every
     point), then polish rounds warm-start each point from
     its neighbours' designs until no point improves (:mod:`optdesign.studies.sweep`).
@@ -479,7 +486,7 @@ def sweep(
         overwrite=overwrite,
         progress=progress,
     )
-    swept = run_sweep(problem, vary, request, check_every=check_every, run=run)
+    swept = run_sweep(problem, vary, request, linked=linked, check_every=check_every, run=run)
     if out is not None and files:
         from optdesign.reports.sweep_files import write_sweep_outputs
 

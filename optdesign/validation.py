@@ -392,15 +392,24 @@ def front_problem(problem: Any) -> None:
     solver_options(problem)
 
 
-def sweep_parameters(problem: Any, vary: Mapping[str, Any], field: str = "vary") -> None:
-    """The parameters of a sweep (``{path: (start, stop, count)}``) of ``problem``:
-    refused, naming ``field`` and the path, before any work."""
+def sweep_parameters(
+    problem: Any,
+    vary: Mapping[str, Any],
+    field: str = "vary",
+    linked: Mapping[str, str] | None = None,
+    linked_field: str = "linked",
+) -> None:
+    """The parameters of a sweep (``{path: (start, stop, count)}``) of ``problem`` and the
+    ones linked to them (``{path: swept path}``): refused, naming ``field`` (or
+    ``linked_field``) and the path, before any work."""
     from optdesign.studies.sweep_grid import sweep_axes
 
     try:
-        sweep_axes(problem, vary)
+        sweep_axes(problem, vary, linked)
     except InputError as exc:
-        raise InputError(exc.field.replace("vary", field, 1), exc.reason) from None
+        head, dot, rest = exc.field.partition(".")
+        name = {"vary": field, "linked": linked_field}.get(head)
+        raise InputError(name + dot + rest if name else exc.field, exc.reason) from None
 
 
 def front_store(problem: Any, method: str) -> str | None:

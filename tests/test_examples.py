@@ -12,7 +12,10 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 EXAMPLE = EXAMPLES / "custom_mechanism.py"
 
 
-@pytest.mark.parametrize("name", ["custom_mechanism.py", "bell_crank.py", "fin_actuator_sweep.py"])
+@pytest.mark.parametrize(
+    "name",
+    ["custom_mechanism.py", "bell_crank.py", "fin_actuator_sweep.py", "fin_actuator_loop_front.py"],
+)
 def test_examples_use_only_public_names(name):
     tree = ast.parse((EXAMPLES / name).read_text())
     for node in ast.walk(tree):
@@ -66,3 +69,18 @@ def test_the_fin_actuator_sweep_example_states_a_valid_sweep():
         "requirements.deflection_rate": "angular_speed",
     }
     assert [spec[2] for spec in module["VARY"].values()] == [7, 3]
+
+
+def test_the_loop_front_example_moves_the_placed_bandwidth_with_the_required_one():
+    """examples/fin_actuator_loop_front.py (minutes to run: its table and figure are in
+    docs/loop.md) sweeps the required bandwidth with the loop's placed bandwidth linked,
+    and analyses each point on the problem with both moved."""
+    import optdesign as od
+    from optdesign.studies.sweep_grid import sweep_axes
+
+    module = runpy.run_path(str(EXAMPLES / "fin_actuator_loop_front.py"), run_name="example")
+    problem = od.load(module["PROBLEM"])
+    (axis,) = sweep_axes(problem, module["VARY"], module["LINKED"])
+    assert axis.linked == ("loop.bandwidth",) and axis.values[0] == 6.0 and len(axis.values) == 11
+    at = module["point_problem"](problem, 9.5)
+    assert at.spec.loop.bandwidth == at.spec.requirements.bandwidth_min == 9.5  # Hz

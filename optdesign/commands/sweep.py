@@ -1,5 +1,6 @@
-"""``optdesign sweep FILE --vary PATH=START..STOP UNIT:COUNT [--vary ...]``: how the
-optimum moves when one or two parameters change (:func:`optdesign.sweep`).
+"""``optdesign sweep FILE --vary PATH=START..STOP UNIT:COUNT [--vary ...] [--with
+PATH=SWEPT ...]``: how the optimum moves when one or two parameters change
+(:func:`optdesign.sweep`); ``--with`` moves another parameter with a swept one.
 
 Writes ``sweep.csv`` (units in the headers), ``sweep.json``, the design chart
 ``sweep.png`` and the JSONL store ``sweep.jsonl`` (the points as they finish;
@@ -56,6 +57,23 @@ def parse_vary(text: str) -> tuple[str, tuple[str, str, int]]:
     return path.strip(), (start, stop, int(m["count"]))
 
 
+def parse_with(text: str) -> tuple[str, str]:
+    """``"loop.bandwidth=requirements.bandwidth_min"`` -> (the path that follows, the
+    swept path it follows)."""
+    path, sep, follows = (part.strip() for part in text.partition("="))
+    if not sep or not path or not follows:
+        raise InputError(
+            "--with",
+            f"{text!r}: write PATH=SWEPT_PATH, e.g. loop.bandwidth=requirements.bandwidth_min",
+        )
+    for name in (path, follows):
+        try:
+            check.vary_path(name)
+        except InputError as exc:
+            raise InputError("--with", exc.reason) from None
+    return path, follows
+
+
 @command("sweep")
 def _sweep(sub):
     p = sub.add_parser("sweep", help="the optimum against one or two parameters")
@@ -66,7 +84,16 @@ def _sweep(sub):
         required=True,
         help="PATH=START..STOP UNIT:COUNT, e.g. requirements.hinge_moment=200..1000N*m:20 "
         "(once or twice; PATH: requirements.NAME, motion.NAME, load.NAME, "
-        "variables.NAME.lower|upper, variables.NAME)",
+        "loop.NAME, variables.NAME.lower|upper, variables.NAME)",
+    )
+    p.add_argument(
+        "--with",
+        dest="linked",
+        action="append",
+        default=[],
+        metavar="PATH=SWEPT",
+        help="move PATH with the swept parameter SWEPT (the same value at every point), "
+        "e.g. loop.bandwidth=requirements.bandwidth_min; repeatable",
     )
     p.add_argument("--objective", default=None, help="objective (default: the file's first)")
     p.add_argument(
@@ -125,11 +152,15 @@ def run_sweep_command(args) -> int:
     vary = dict(parse_vary(t) for t in args.vary)
     if len(vary) < len(args.vary):
         raise InputError("--vary", "the same parameter twice")
+    linked = dict(parse_with(t) for t in args.linked)
+    if len(linked) < len(args.linked):
+        raise InputError("--with", "the same parameter twice")
     problem = load_problem(args.file)
     with as_options():
         check.objective_of(problem, args.objective)
         check.run_folder(args.out, args.resume, args.overwrite)
-        check.sweep_parameters(problem, vary, "--vary")  # before the output folder is made
+        # before the output folder is made
+        check.sweep_parameters(problem, vary, "--vary", linked or None, "--with")
     with output_folder(args.out, f"sweep-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
         quiet = stdout_to_stderr() if args.json else contextlib.nullcontext()
@@ -137,6 +168,7 @@ def run_sweep_command(args) -> int:
             sweep = od.sweep(
                 problem,
                 vary,
+                linked=linked or None,
                 objective=args.objective,
                 check_every=args.check_every,
                 starts=args.starts,

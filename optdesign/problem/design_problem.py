@@ -74,8 +74,9 @@ class Evaluation:
 
 
 #: The sections of a problem whose numbers :meth:`DesignProblem.with_setting` moves (and a
-#: sweep varies): the requirements, the motion the fin must make and the load it drives.
-SETTING_SECTIONS = ("requirements", "motion", "load")
+#: sweep varies): the requirements, the motion the fin must make, the load it drives and
+#: the position loop around the drive (its placed bandwidth, its lag, ...).
+SETTING_SECTIONS = ("requirements", "motion", "load", "loop")
 
 
 class DesignProblem:
@@ -379,10 +380,10 @@ class DesignProblem:
 
     def with_setting(self, path: str, value: Any) -> DesignProblem:
         """A copy whose value at ``path`` - a requirement (``"requirements.hinge_moment"``)
-        or a number of the motion or the load (``"motion.rise_time"``,
-        ``"load.inertia"``; :data:`SETTING_SECTIONS`) - is ``value`` in internal units,
-        validated like a file; as :meth:`with_requirement` otherwise. ProblemError when
-        the problem has no such section."""
+        or a number of the motion, the load or the loop (``"motion.rise_time"``,
+        ``"load.inertia"``, ``"loop.bandwidth"``; :data:`SETTING_SECTIONS`) - is ``value``
+        in internal units, validated like a file; as :meth:`with_requirement` otherwise.
+        ProblemError when the problem has no such section."""
         section, _, rest = path.partition(".")
         if section not in SETTING_SECTIONS or not rest:
             raise ProblemError(

@@ -113,6 +113,13 @@ def at_values(problem: DesignProblem, values: Mapping[str, float]) -> DesignProb
     return problem
 
 
+def linked_values(values: Mapping[str, float], linked: Mapping[str, str]) -> dict[str, float]:
+    """``values`` (path -> internal value) and each path of ``linked`` (path -> the path
+    of ``values`` it follows) at the value of the path it follows: the parameters of a
+    sweep's point whose swept parameter moves others with it."""
+    return {**values, **{path: values[follows] for path, follows in linked.items()}}
+
+
 def perturbed(problem: DesignProblem, name: str, value: float) -> DesignProblem:
     """``problem`` with the limit ``name`` of a :class:`~optdesign.solvers.result.Sensitivity` at ``value``
     (internal units)."""

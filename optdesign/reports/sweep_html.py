@@ -49,17 +49,18 @@ def _cost(problem: Any, objective: str, name: str, log: float) -> str:
 
 def sweep_report(sweep: Any) -> str:
     """The page of ``sweep``: the design chart, the table, the design of each point."""
-    from optdesign.problem.parameters import at_values
+    from optdesign.problem.parameters import at_values, linked_values
 
     problem = sweep.problem
     paths = [a.path for a in sweep.axes]
+    linked = {path: a.path for a in sweep.axes for path in a.linked}
     first = sweep.axes[0]
     designs: list[dict[str, Any]] = []
     of_point: dict[int, int] = {}
     for p in sweep.points:
         if not p.design:
             continue
-        at = at_values(problem, dict(zip(paths, p.values, strict=True)))
+        at = at_values(problem, linked_values(dict(zip(paths, p.values, strict=True)), linked))
         where = ", ".join(
             f"{a.label} = {_shown_value(a, v):.6g}"
             for a, v in zip(sweep.axes, p.values, strict=True)

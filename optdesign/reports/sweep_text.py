@@ -81,7 +81,8 @@ def sweep_summary(sweep: Any) -> str:
     n = len(sweep.points)
     solved = [p for p in sweep.points if p.success]
     what = ", ".join(
-        f"{a.label} {a.shown[0]:.6g}..{a.shown[-1]:.6g} ({len(a.values)} points)"
+        f"{a.label} {a.shown[0]:.6g}..{a.shown[-1]:.6g} ({len(a.values)} points"
+        + (f"; {', '.join(a.linked)} with it)" if a.linked else ")")
         for a in sweep.axes
     )
     how = (
@@ -152,7 +153,15 @@ def sweep_document(sweep) -> dict:
             "problem": sweep.problem.name,
             "objective": sweep.objective,
             "continuation": sweep.continuation,
-            "axes": [{"path": a.path, "unit": a.unit, "values": list(a.shown)} for a in sweep.axes],
+            "axes": [
+                {
+                    "path": a.path,
+                    "unit": a.unit,
+                    "values": list(a.shown),
+                    **({"linked": list(a.linked)} if a.linked else {}),
+                }
+                for a in sweep.axes
+            ],
             "units": {c[0]: c[1] for c in sweep_columns(sweep) if c[1]},
             "points": [dict(zip(headers, r, strict=True)) for r in rows],
             "sensitivities": [p.sensitivities for p in sweep.points]

@@ -57,7 +57,7 @@ from optdesign.problem.request import SolveRequest
 from optdesign.runtime.run_options import RunOptions
 from optdesign.solvers.registry import default_solver
 from optdesign.solvers.solved_point import is_success
-from optdesign.studies.sweep_grid import Axis, grid_order, neighbour, sweep_axes
+from optdesign.studies.sweep_grid import Axis, grid_order, neighbour, point_settings, sweep_axes
 from optdesign.studies.sweep_point import (
     GLOBAL_SEARCH,
     continuable,
@@ -144,6 +144,7 @@ def run_sweep(
     vary: Any,
     request: SolveRequest,
     *,
+    linked: Mapping[str, str] | None = None,
     check_every: int | None = None,
     run: RunOptions | None = None,
 ) -> Sweep:
@@ -153,6 +154,9 @@ def run_sweep(
     ----------
     problem, vary
         The problem and ``{path: (start, stop, count)}`` (checked here: :func:`sweep_axes`).
+    linked
+        ``{path: swept path}``: parameters set, at every point, to the value of the swept
+        parameter they follow (:func:`~optdesign.studies.sweep_grid.point_settings`).
     request
         How each point is solved: its objective, the global search (``starts``: the most
         starts, ``seed``: its draws, the same at every point; None: the problem file's),
@@ -171,11 +175,14 @@ def run_sweep(
 
     run = run if run is not None else RunOptions()
     t0 = time.perf_counter()
-    axes = sweep_axes(problem, vary)
+    axes = sweep_axes(problem, vary, linked)
     objective = request.objective
     cont = continuable(problem)
-    paths = [a.path for a in axes]
-    mode = sweep_mode(problem, paths, [(a.values[0], a.values[-1]) for a in axes])
+    # every parameter a point sets, a linked one with the range of the one it follows
+    first = point_settings(axes, [a.values[0] for a in axes])
+    last = point_settings(axes, [a.values[-1] for a in axes])
+    paths = list(first)
+    mode = sweep_mode(problem, paths, [(first[p], last[p]) for p in paths])
     mode = mode if cont else "formulation"
     # the file's, stated in the identity; a point its formulation solves gets the
     # caller's starts as they are (None: the formulation's own default, as od.solve)
@@ -188,6 +195,7 @@ def run_sweep(
     common = {
         "problem": problem,
         "paths": paths,
+        "axes": axes,
         "request": request,
         "continuation": cont,
         "mode": mode,
@@ -204,6 +212,12 @@ def run_sweep(
         "objectives": [objective],
         "method": {
             "sweep": {a.path: list(a.values) for a in axes},
+            # only when some are, so that the stores of sweeps without them still resume
+            **(
+                {"linked": {p: a.path for a in axes for p in a.linked}}
+                if len(paths) > len(axes)
+                else {}
+            ),
             "continuation": "global+polish" if cont else False,
             "mode": mode,
             "sensitivities": bool(request.sensitivities),

@@ -1,21 +1,22 @@
 """A sweep's grid: the swept parameters (:class:`Axis`), checked against the problem -
 each path names a requirement or a variable's bound, each range has the parameter's
-dimension, the grid stays within its caps - and the order in which its points are
-visited. :mod:`optdesign.studies.sweep` solves the points."""
+dimension, the grid stays within its caps - the parameters linked to them (which move
+with a swept one, :func:`point_settings`) and the order in which its points are visited.
+:mod:`optdesign.studies.sweep` solves the points."""
 
 from __future__ import annotations
 
 import difflib
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from optdesign.errors import InputError, OptDesignError
 from optdesign.problem.design_problem import SETTING_SECTIONS, DesignProblem
-from optdesign.problem.parameters import at_values
+from optdesign.problem.parameters import at_values, linked_values
 
 #: Most parameters of one sweep, and most points along one parameter.
 MAX_AXES = 2
@@ -41,12 +42,17 @@ class Axis:
         The values, internal units.
     unit, shown
         The unit the values are shown in and the values in it.
+    linked
+        The paths that move with this one: at every point each is set to the same value
+        (``("loop.bandwidth",)`` on ``requirements.bandwidth_min``: the loop's gains are
+        placed for the bandwidth the requirement asks).
     """
 
     path: str
     values: tuple[float, ...]
     unit: str
     shown: tuple[float, ...]
+    linked: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
@@ -55,7 +61,9 @@ class Axis:
 
 
 #: What a sweep may vary, as its refusals say it.
-WHAT_TO_VARY = "requirements.NAME, motion.NAME, load.NAME or variables.NAME[.lower|.upper]"
+WHAT_TO_VARY = (
+    "requirements.NAME, motion.NAME, load.NAME, loop.NAME or variables.NAME[.lower|.upper]"
+)
 
 
 def check_path_names(path: str) -> None:
@@ -147,10 +155,14 @@ def _known(problem: DesignProblem) -> str:
     return "known: " + ", ".join(v.name for v in problem.variables)
 
 
-def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
+def sweep_axes(
+    problem: DesignProblem, vary: Any, linked: Mapping[str, str] | None = None
+) -> list[Axis]:
     """The axes of ``vary`` (``{path: (start, stop, count)}``), checked: a known parameter
     path, quantities of its dimension (a bare number only for a plain number), a range
-    that is not empty, a problem that validates at both ends. InputError naming the field."""
+    that is not empty, a problem that validates at both ends. ``linked``: ``{path: swept
+    path}``, parameters that take the value of a swept one at every point (checked by
+    :func:`linked_paths`; the ends are checked with them). InputError naming the field."""
     from optdesign.display.shown import Shown, _value, variable_shown
     from optdesign.units import to_internal
 
@@ -163,6 +175,7 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
     if len(vary) > MAX_AXES:
         raise InputError("vary", f"{len(vary)} parameters; at most {MAX_AXES}")
     axes = []
+    ranges: dict[str, tuple[Any, Any, str]] = {}  # path -> start, stop as given, dimension
     for path, spec in vary.items():
         if not isinstance(path, str):
             raise InputError("vary", f"a parameter path is text, got {path!r}")
@@ -180,13 +193,7 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
         if lo == hi:
             raise InputError(where, f"an empty range: start and stop are both {start}")
         values = tuple(float(v) for v in np.linspace(lo, hi, int(count)))
-        for end in (lo, hi):
-            try:
-                at_values(problem, {path: end})
-            except InputError:
-                raise
-            except OptDesignError as exc:
-                raise InputError(where, f"{start}..{stop}: {exc}") from None
+        ranges[path] = (start, stop, dim)
         head, _, rest = path.partition(".")
         if head == "variables":
             var = problem.by_name[rest.partition(".")[0]]
@@ -199,6 +206,22 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
         axes.append(Axis(path, values, shown[0].unit, tuple(float(s.value) for s in shown)))
     if len({a.path for a in axes}) < len(axes):
         raise InputError("vary", "the same parameter twice")
+    links = linked_paths(problem, {p: dim for p, (_, _, dim) in ranges.items()}, linked)
+    axes = [
+        replace(a, linked=tuple(p for p, swept in links.items() if swept == a.path)) for a in axes
+    ]
+    for a in axes:
+        start, stop, _ = ranges[a.path]
+        for end in (a.values[0], a.values[-1]):
+            try:
+                at_values(problem, point_settings([a], (end,)))
+            except InputError as exc:
+                if exc.field.startswith("vary.") and exc.field[5:] in a.linked:
+                    raise InputError("linked." + exc.field[5:], exc.reason) from None
+                raise
+            except OptDesignError as exc:
+                with_ = f" (with {', '.join(a.linked)})" if a.linked else ""
+                raise InputError(f"vary.{a.path}", f"{start}..{stop}{with_}: {exc}") from None
     total = math.prod(len(a.values) for a in axes)
     if total > MAX_GRID:
         counts = " x ".join(str(len(a.values)) for a in axes)
@@ -208,6 +231,57 @@ def sweep_axes(problem: DesignProblem, vary: Any) -> list[Axis]:
             "is a global search): give fewer points",
         )
     return axes
+
+
+def linked_paths(
+    problem: DesignProblem, swept: Mapping[str, str], linked: Mapping[str, str] | None
+) -> dict[str, str]:
+    """``linked`` (``{path: swept path}``) checked against the swept paths and their
+    dimensions (``swept``: path -> dimension): each path a parameter a sweep could vary,
+    not swept itself, following a swept path of its own dimension (it takes that path's
+    value, in internal units). InputError ``linked`` or ``linked.PATH`` naming the
+    reason."""
+    if linked is None:
+        return {}
+    if not isinstance(linked, Mapping):
+        raise InputError(
+            "linked",
+            "give {path: swept path}, e.g. "
+            '{"loop.bandwidth": "requirements.bandwidth_min"}, got ' + repr(linked),
+        )
+    out: dict[str, str] = {}
+    for path, follows in linked.items():
+        if not isinstance(path, str) or not isinstance(follows, str):
+            raise InputError("linked", f"paths are text, got {path!r}: {follows!r}")
+        where = f"linked.{path}"
+        try:
+            dim = parameter_dimension(problem, path)
+        except InputError as exc:
+            raise InputError(where, exc.reason) from None
+        if path in swept:
+            raise InputError(
+                where, "is swept itself: a parameter has its own range or follows a swept one"
+            )
+        if follows not in swept:
+            raise InputError(
+                where, f"follows {follows!r}, which is not swept (swept: {', '.join(swept)})"
+            )
+        if dim != swept[follows]:
+            raise InputError(
+                where,
+                f"a {dim.replace('_', ' ')} cannot follow {follows} "
+                f"(a {swept[follows].replace('_', ' ')}): it takes that parameter's value",
+            )
+        out[path] = follows
+    return out
+
+
+def point_settings(axes: Sequence[Axis], values: Sequence[float]) -> dict[str, float]:
+    """The parameters of the point at ``values`` (one per axis, internal units): each
+    swept path at its value, each path linked to it at the same value - what
+    :func:`~optdesign.problem.parameters.at_values` makes the point's problem of."""
+    swept = {axis.path: value for axis, value in zip(axes, values, strict=True)}
+    return linked_values(swept, {path: a.path for a in axes for path in a.linked})
 
 
 def grid_order(axes: Sequence[Axis]) -> list[tuple[int, ...]]:

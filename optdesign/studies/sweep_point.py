@@ -28,6 +28,7 @@ from optdesign.studies.sweep_grid import (  # noqa: F401 - the grid's names, as 
     grid_order,
     neighbour,
     parameter_dimension,
+    point_settings,
     sweep_axes,
 )
 
@@ -264,17 +265,13 @@ _POINTS_LOCK = threading.Lock()
 def _point_problem(task: Mapping[str, Any]) -> DesignProblem:
     """The point's problem (the base problem at the point's values), the same object
     for every task of the point in this process while it is among the last used."""
-    key = (
-        threading.get_ident(),
-        task["problem"].token,
-        tuple(task["paths"]),
-        tuple(task["values"]),
-    )
+    settings = point_settings(task["axes"], task["values"])
+    key = (threading.get_ident(), task["problem"].token, tuple(settings.items()))
     with _POINTS_LOCK:
         if key in _POINTS:
             _POINTS.move_to_end(key)
             return _POINTS[key]
-    point = at_values(task["problem"], dict(zip(task["paths"], task["values"], strict=True)))
+    point = at_values(task["problem"], settings)
     with _POINTS_LOCK:
         _POINTS[key] = point
         while len(_POINTS) > _POINTS_SIZE:

@@ -256,7 +256,7 @@ def test_a_path_with_an_empty_name_is_refused_naming_vary_and_where(tmp_path, ca
         od.sweep(FORK, {HINGE + ".": ("200 N*m", "300 N*m", 3)})
     assert str(err.value).startswith(
         "vary: 'requirements.hinge_moment.': an empty name after its last dot; give "
-        "requirements.NAME, motion.NAME, load.NAME or variables.NAME[.lower|.upper]"
+        "requirements.NAME, motion.NAME, load.NAME, loop.NAME or variables.NAME[.lower|.upper]"
     )
     problem = od.load(FORK)
     with pytest.raises(od.InputError) as err:
