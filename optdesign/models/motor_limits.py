@@ -73,7 +73,7 @@ THERMAL_TIME_CONSTANT = Validity(
     "s",
     "a lag needs a positive time constant",
     open_lower=True,
-    checked=("call",),
+    checked=("file", "call"),
 )
 
 #: The ranges of validity of this model.
