@@ -32,6 +32,7 @@ from pathlib import Path
 
 from optdesign.errors import InputError
 from optdesign.models.motor import KG, KG_CM2, N_M, RPM
+from optdesign.models.motor_limits import envelope_intercept, envelope_slope
 from optdesign.models.validity import Validity
 
 CATALOGUE_ITEMS = Validity(
@@ -60,8 +61,9 @@ CATALOGUE_SOURCE = (
 _RESOURCE = "data/servo_motors.csv"
 
 #: Columns a motor CSV must have (``rotor_inertia_brake_1e-4kgm2``, ``mass_kg``,
-#: ``rated_output_W``, ``power_rate_kW_per_s``, ``angular_accel_rad_per_s2``, ``series``,
-#: ``section``, ``page`` and ``note`` are optional and may be empty).
+#: ``rated_output_W``, ``power_rate_kW_per_s``, ``angular_accel_rad_per_s2``,
+#: ``corner_speed_rpm``, ``top_speed_torque_Nm``, ``series``, ``section``, ``page`` and
+#: ``note`` are optional and may be empty).
 REQUIRED_COLUMNS = (
     "designation",
     "rated_torque_Nm",
@@ -76,6 +78,8 @@ _OPTIONAL_NUMBERS = (
     "rated_output_W",
     "power_rate_kW_per_s",
     "angular_accel_rad_per_s2",
+    "corner_speed_rpm",
+    "top_speed_torque_Nm",
 )
 
 
@@ -111,6 +115,11 @@ class ServoMotor:
         The CSV and its line the row was read from.
     note
         Remark on the printed values, if any.
+    corner_speed, top_speed_torque
+        The intermittent zone's corner (rad/s), above which the peak torque falls
+        linearly to ``top_speed_torque`` (N*mm) at the top speed
+        (:mod:`optdesign.models.motor_limits`); None where not given (no fall). Without
+        a top-speed torque the fall ends at the rated torque.
     """
 
     designation: str
@@ -130,6 +139,24 @@ class ServoMotor:
     file: str
     line: int
     note: str = ""
+    corner_speed: float | None = None
+    top_speed_torque: float | None = None
+
+    @property
+    def envelope_slope(self) -> float:
+        """How fast the intermittent torque falls above the corner (N*mm per rad/s); 0
+        without a corner."""
+        if self.corner_speed is None:
+            return 0.0
+        top = self.rated_torque if self.top_speed_torque is None else self.top_speed_torque
+        return envelope_slope(self.peak_torque, self.corner_speed, self.max_speed, top)
+
+    @property
+    def envelope_intercept(self) -> float:
+        """The falling line's torque at standstill, T_peak + s n_c (N*mm); the peak
+        torque without a corner."""
+        corner = 0.0 if self.corner_speed is None else self.corner_speed
+        return envelope_intercept(self.peak_torque, corner, self.envelope_slope)
 
     @property
     def source(self) -> str:
@@ -184,6 +211,13 @@ def _motor(row: _Row) -> ServoMotor:
     rated = row.required("rated_torque_Nm")
     if rated <= 0:
         raise row.error("rated_torque_Nm", f"{rated:g}: a rated torque must be positive")
+    corner = row.number("corner_speed_rpm")
+    if corner is not None and row.number("peak_torque_Nm") is None:
+        raise row.error(
+            "peak_torque_Nm",
+            f"missing; the corner speed {corner:g} min^-1 is where the peak torque starts to "
+            "fall, so the motor needs it",
+        )
     peak = row.required("peak_torque_Nm")
     if peak < rated:
         raise row.error("peak_torque_Nm", f"{peak:g} N*m is below the rated torque {rated:g} N*m")
@@ -206,6 +240,7 @@ def _motor(row: _Row) -> ServoMotor:
             f"{brake:g} is below the motor's own {inertia:g}: a brake adds inertia",
         )
     mass = row.positive("mass_kg", "a mass must be positive", False)
+    top = _envelope(row, corner, peak, n_max)
     output = row.positive("rated_output_W", "a rated output must be positive", False)
     return ServoMotor(
         designation=row.name,
@@ -225,7 +260,38 @@ def _motor(row: _Row) -> ServoMotor:
         file=row.file,
         line=row.line,
         note=row.text("note"),
+        corner_speed=None if corner is None else RPM * corner,
+        top_speed_torque=None if top is None else N_M * top,
     )
+
+
+def _envelope(row: _Row, corner: float | None, peak: float, n_max: float) -> float | None:
+    """The row's top-speed torque (N*m, None when not given), after checking the corner
+    and the torque against the peak torque and the top speed."""
+    top = row.number("top_speed_torque_Nm")
+    if corner is None:
+        if top is not None:
+            raise row.error(
+                "top_speed_torque_Nm",
+                f"{top:g} N*m without a corner speed (corner_speed_rpm): give the speed above "
+                "which the peak torque falls",
+            )
+        return None
+    if corner <= 0:
+        raise row.error("corner_speed_rpm", f"{corner:g}: a corner speed must be positive")
+    if corner >= n_max:
+        raise row.error(
+            "corner_speed_rpm",
+            f"{corner:g} min^-1 is not below the maximum speed {n_max:g} min^-1 (a motor whose "
+            "peak torque holds up to its top speed has no corner: leave the cell empty)",
+        )
+    if top is not None and not 0 <= top <= peak:
+        raise row.error(
+            "top_speed_torque_Nm",
+            f"{top:g} N*m is outside [0, the peak torque {peak:g} N*m]: the intermittent "
+            "torque falls from the peak above the corner",
+        )
+    return top
 
 
 def parse_motors(text: str, file: str = "<text>") -> tuple[ServoMotor, ...]:

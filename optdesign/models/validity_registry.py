@@ -38,6 +38,7 @@ MODEL_MODULES = (
     "differential_geometry",
     "prsm",
     "motor",
+    "motor_limits",
     "motor_catalogue",
     "describing_function",
     "harmonic_balance",

@@ -8,7 +8,8 @@ problem's *parameters* on the solver path: a leaf's motor's own values, and at a
 relaxation node the most favourable values of the motors in the node's box - the least
 rotor inertia where it costs torque or lowers the drive's mode, the largest where it
 divides the load's inertia (the inertia ratio), the largest peak torque, rated torque and
-top speed, the least mass - so that the relaxation stays a valid bound. On the NumPy path
+top speed, the least mass, the highest and least steep falling line of the speed-torque
+envelope - so that the relaxation stays a valid bound. On the NumPy path
 they are looked up from the design's number (a number that is no motor's gives NaN and
 fails ``motor_catalogue_membership``).
 """
@@ -37,6 +38,10 @@ MOTOR_FIELDS: dict[str, tuple[int, str]] = {
     "rated_torque": (+1, "rated_torque"),
     "max_speed": (+1, "max_speed"),
     "mass": (-1, "mass"),
+    # the falling piece of the speed-torque envelope, T + s n <= a: the largest a and the
+    # least s over a node's motors give a line above each of theirs at every speed
+    "envelope_intercept": (+1, "envelope_intercept"),
+    "envelope_slope": (-1, "envelope_slope"),
 }
 
 #: Prefix of the motor's parameters (``param:motor_peak_torque``...).
@@ -105,6 +110,12 @@ def catalogue_of(problem) -> MotorCatalogue | None:
     if var is None or not var.discrete:
         return None
     return spec_catalogue(problem.spec.motor)
+
+
+def has_corners(catalogue: MotorCatalogue | None) -> bool:
+    """True when a motor of the catalogue has a speed-torque corner (then the problem
+    poses the envelope's falling piece; a motor without one has a flat envelope)."""
+    return catalogue is not None and any(r.corner_speed is not None for r in motors(catalogue))
 
 
 def masses_missing(catalogue: MotorCatalogue) -> list[str]:

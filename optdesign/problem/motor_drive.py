@@ -20,6 +20,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import motor as mo
+from optdesign.models import motor_limits as ml
 from optdesign.problem import drive
 from optdesign.problem import motor_catalogue_variable as mcv
 from optdesign.problem.motion import MotionDemand as MotionDemand
@@ -33,7 +34,11 @@ class MotorData:
     motor the problem names, the catalogue's parameters (solver path) or looked-up values
     (NumPy path) for a motor the search chooses. ``rotor_inertia`` is the one that costs
     torque, ``rotor_inertia_max`` the one that divides the load's inertia: equal for one
-    motor, the least and the largest of a relaxation node's motors otherwise."""
+    motor, the least and the largest of a relaxation node's motors otherwise.
+    ``envelope_intercept`` and ``envelope_slope`` are the falling piece of its
+    speed-torque envelope, T + s n <= T_peak + s n_c (None when no motor of the problem
+    has a corner; :mod:`optdesign.models.motor_limits`); ``thermal_time_constant`` the
+    winding's (s), or None."""
 
     designation: str
     rotor_inertia: Any
@@ -45,6 +50,9 @@ class MotorData:
     friction_torque: float
     rotor_inertia_max: Any = None
     on_catalogue: Any = None
+    envelope_intercept: Any = None
+    envelope_slope: Any = None
+    thermal_time_constant: float | None = None
 
     @property
     def inertia_for_ratio(self) -> Any:
@@ -61,6 +69,7 @@ def motor_data(spec) -> MotorData | None:
         from optdesign.models.motor_catalogue import by_designation
 
         row = by_designation(motor.designation)
+        corner = row.corner_speed is not None
         return MotorData(
             row.designation,
             row.rotor_inertia,
@@ -70,16 +79,29 @@ def motor_data(spec) -> MotorData | None:
             row.mass,
             motor.gear_inertia,
             motor.friction_torque,
+            envelope_intercept=row.envelope_intercept if corner else None,
+            envelope_slope=row.envelope_slope if corner else None,
         )
+    max_speed = motor.max_speed * 2.0 * np.pi / 60.0  # 1/min -> rad/s
+    intercept = slope = None
+    if motor.corner_speed is not None:
+        top = motor.rated_torque if motor.top_speed_torque is None else motor.top_speed_torque
+        corner = motor.corner_speed * mo.RPM
+        slope = ml.envelope_slope(motor.peak_torque, corner, max_speed, top)
+        intercept = ml.envelope_intercept(motor.peak_torque, corner, slope)
+    tau = motor.thermal_time_constant
     return MotorData(
         "",
         motor.rotor_inertia,
         motor.peak_torque,
         motor.rated_torque,
-        motor.max_speed * 2.0 * np.pi / 60.0,  # 1/min -> rad/s
+        max_speed,
         motor.mass,
         motor.gear_inertia,
         motor.friction_torque,
+        envelope_intercept=intercept,
+        envelope_slope=slope,
+        thermal_time_constant=None if tau is None else tau * 3600.0,  # h -> s
     )
 
 
@@ -91,6 +113,7 @@ def motor_of(q) -> MotorData | None:
     if fixed is not None or spec.motor is None:
         return fixed
     values, on = mcv.design_values(q.problem, q.design)
+    corner = mcv.has_corners(mcv.catalogue_of(q.problem))
     return MotorData(
         "",
         values["rotor_inertia"],
@@ -102,6 +125,8 @@ def motor_of(q) -> MotorData | None:
         spec.motor.friction_torque,
         values["rotor_inertia_max"],
         on,
+        envelope_intercept=values["envelope_intercept"] if corner else None,
+        envelope_slope=values["envelope_slope"] if corner else None,
     )
 
 
@@ -208,21 +233,46 @@ def _peak_torque_terms(q) -> tuple[Any, Any]:
     return J * q.ratio * a + through + motor.friction_torque, J * q.ratio_rate * w**2
 
 
-def motor_rms_torque(q):
-    """The RMS torque of the duty cycle (N*mm): each step's hinge moment held at its
-    deflection through the ratio there and the forward efficiency, plus the drive's
-    friction, weighted by the step's share of the time (THK's equation (54))."""
+def duty_torques(q) -> list[Any]:
+    """The motor's torque in each step of the duty cycle (N*mm): the step's hinge moment
+    held at its deflection, through the ratio there and the forward efficiency, plus the
+    drive's friction."""
     spec = q.problem.spec
     steps = _need(spec.requirements.duty_cycle, "requirements.duty_cycle", "the RMS torque")
     motor = q.motor_data
     friction = 0.0 if motor is None else motor.friction_torque
     phis = np.array([s.deflection for s in steps])
     ratio = q.call_mechanism("ratio", phis)
-    torques = [
+    return [
         mo.torque_at_motor(s.hinge_moment, drive.at_angle(ratio, k), q.drive_efficiency) + friction
         for k, s in enumerate(steps)
     ]
-    return mo.rms_torque(torques, [s.time for s in steps])
+
+
+def motor_rms_torque(q):
+    """The RMS torque of the duty cycle (N*mm): :func:`duty_torques` weighted by each
+    step's share of the time (THK's equation (54))."""
+    steps = q.problem.spec.requirements.duty_cycle
+    return mo.rms_torque(duty_torques(q), [s.time for s in steps])
+
+
+def motor_thermal_torques(q) -> list[Any]:
+    """sqrt(x_k) at the end of each duty step (N*mm): the torque whose steady heating
+    equals the winding's then, in the periodic steady state of the first-order thermal
+    model of time constant tau over the cycle of ``requirements.duty_period``
+    (:func:`optdesign.models.motor_limits.thermal_torque_squares`)."""
+    req = q.problem.spec.requirements
+    tau = q.motor_data.thermal_time_constant
+    period = _need(
+        req.duty_period,
+        "requirements.duty_period (the duty cycle's length, its steps' times being shares "
+        "of it), to compare with the winding's time constant",
+        "motor.thermal_time_constant",
+    )
+    total = sum(s.time for s in req.duty_cycle)
+    seconds = [s.time / total * period * 3600.0 for s in req.duty_cycle]  # h -> s
+    squares = ml.thermal_torque_squares(duty_torques(q), seconds, tau)
+    return [m.sqrt(x) for x in squares]
 
 
 def chain_stiffness(q):
@@ -328,18 +378,10 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 f"speed of the motor{name} at the fin's top rate / its top speed",
             )
         )
+        if motor.envelope_slope is not None:
+            out.append(_envelope_block(q, motor, labels, name))
         if motor.rated_torque is not None and req.duty_cycle:
-            out.append(
-                ConstraintBlock(
-                    "motor_rms_torque",
-                    q.motor_rms_torque / motor.rated_torque,
-                    None,
-                    1.0,
-                    [""],
-                    "",
-                    f"RMS torque of the duty cycle / the motor{name}'s rated torque",
-                )
-            )
+            out.append(_duty_block(q, motor, name))
     if req.inertia_ratio_max is not None:
         _need(motor, "a [motor] section (the rotor's inertia)", "requirements.inertia_ratio_max")
         out.append(
@@ -383,6 +425,63 @@ def motor_blocks(q, labels: list[str]) -> list[ConstraintBlock]:
                 )
             )
     return out
+
+
+def _envelope_block(q, motor: MotorData, labels: list[str], name: str) -> ConstraintBlock:
+    """The falling piece of the speed-torque envelope at every grid angle: (T + s n) /
+    (T_peak + s n_c) <= 1 at the motor's speed n and the torque T the motion asks there,
+    linear in (n, T); with the peak-torque row (T <= T_peak) it is exact for the
+    envelope min(T_peak, T_peak - s (n - n_c)). Every phase of the motion asks at most T
+    at at most n, and the envelope falls with speed, so the one point covers them all."""
+    s, a = motor.envelope_slope, motor.envelope_intercept
+    speed = q.motor_speed
+    pieces = ()
+    if m.is_symbolic(q.ratio):  # the solver's rows: the smooth pieces of the peak torque
+        pieces = tuple((p + s * speed) / a for p in motor_peak_torque_pieces(q))
+    return ConstraintBlock(
+        "motor_speed_torque",
+        (q.motor_peak_torque + s * speed) / a,
+        None,
+        1.0,
+        labels,
+        "",
+        f"torque the motion asks of the motor{name} at its speed, against its speed-torque "
+        "envelope above the corner, (T + s n) / (T_peak + s n_c)",
+        pieces=pieces,
+    )
+
+
+def _duty_block(q, motor: MotorData, name: str) -> ConstraintBlock:
+    """The duty cycle's heating against the rated torque: the plain RMS torque, or with
+    the winding's thermal time constant the first-order thermal model's torque at the end
+    of every step (it is never below the RMS torque, so it replaces that row)."""
+    if motor.thermal_time_constant is None:
+        return ConstraintBlock(
+            "motor_rms_torque",
+            q.motor_rms_torque / motor.rated_torque,
+            None,
+            1.0,
+            [""],
+            "",
+            f"RMS torque of the duty cycle / the motor{name}'s rated torque",
+        )
+    rows = [x / motor.rated_torque for x in motor_thermal_torques(q)]
+    if m.is_symbolic(*rows):
+        import casadi as ca
+
+        expr = ca.vertcat(*rows)
+    else:
+        expr = np.stack(np.broadcast_arrays(*rows), axis=-1)
+    return ConstraintBlock(
+        "motor_thermal_torque",
+        expr,
+        None,
+        1.0,
+        [f"after step {k}" for k in range(1, len(rows) + 1)],
+        "",
+        f"thermal torque of the duty cycle (first-order winding, tau = "
+        f"{motor.thermal_time_constant:g} s) / the motor{name}'s rated torque",
+    )
 
 
 def natural_period(q) -> Any:

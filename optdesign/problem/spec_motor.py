@@ -82,6 +82,17 @@ MOTOR_DATA = {
 }
 
 
+#: The motor's optional data (a motor of the catalogue or a catalogue variable carries its
+#: own: they are refused beside a designation or a catalogue).
+OPTIONAL_DATA = (
+    "rated_torque",
+    "mass",
+    "corner_speed",
+    "top_speed_torque",
+    "thermal_time_constant",
+)
+
+
 class Motor(_Model):
     """The drive's motor (``max_speed`` in 1/min, turns per minute, as ISO's n): one motor
     of the shipped catalogue (``designation``), one given by its data, or a catalogue
@@ -93,7 +104,13 @@ class Motor(_Model):
     text is read once, when the problem loads, into ``catalogue_text`` (so a problem
     carries its motors to every worker, and a changed file is a changed problem).
     ``gear_inertia`` is what else turns with the motor (gear, coupling), at the motor
-    shaft; ``friction_torque`` the drive's own friction at the motor shaft."""
+    shaft; ``friction_torque`` the drive's own friction at the motor shaft.
+
+    Optional data of a motor given by its data: ``corner_speed`` (1/min), above which the
+    intermittent torque falls linearly from the peak torque to ``top_speed_torque`` at
+    the top speed (to the rated torque without it), and ``thermal_time_constant``, the
+    winding's: with it the duty cycle's heating is the first-order thermal model's, not
+    its plain RMS (:mod:`optdesign.models.motor_limits`)."""
 
     designation: str | None = None
     catalogue: str | None = None
@@ -103,6 +120,9 @@ class Motor(_Model):
     rated_torque: Moment | None = None
     max_speed: Speed | None = None
     mass: Mass | None = None
+    corner_speed: Speed | None = None
+    top_speed_torque: Moment | None = None
+    thermal_time_constant: Time | None = None
     gear_inertia: Inertia = 0.0
     friction_torque: Moment = 0.0
 
@@ -128,7 +148,7 @@ class Motor(_Model):
 
     @model_validator(mode="after")
     def _data(self):
-        given = [k for k in (*MOTOR_DATA, "rated_torque", "mass") if getattr(self, k) is not None]
+        given = [k for k in (*MOTOR_DATA, *OPTIONAL_DATA) if getattr(self, k) is not None]
         if self.catalogue is not None:
             from optdesign.problem.motor_catalogue_variable import MOTOR_CATALOGUES
 
@@ -167,6 +187,12 @@ class Motor(_Model):
             value = getattr(self, name)
             if value is not None and not value > 0:
                 raise ValueError(f"{name}: must be positive, got {value:g} (internal units)")
+        if self.thermal_time_constant is not None and not self.thermal_time_constant > 0:
+            raise ValueError(
+                f"thermal_time_constant: must be positive, got "
+                f"{self.thermal_time_constant * 3600.0:g} s"
+            )
+        self._check_envelope()
         for name in ("gear_inertia", "friction_torque"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name}: cannot be negative, got {getattr(self, name):g}")
@@ -176,6 +202,38 @@ class Motor(_Model):
                 f"peak torque {_shown('motor_torque_max', self.peak_torque)}"
             )
         return self
+
+    def _check_envelope(self) -> None:
+        # The envelope falls from the peak torque at the corner to the top-speed torque
+        # at the top speed: a corner outside (0, top speed) or a torque that rises is a
+        # typing error, not a motor.
+        if self.corner_speed is None:
+            if self.top_speed_torque is not None:
+                raise ValueError(
+                    "top_speed_torque: needs corner_speed (the speed above which the peak "
+                    "torque falls to it)"
+                )
+            return
+        if not self.corner_speed > 0:
+            raise ValueError(f"corner_speed: must be positive, got {self.corner_speed:g} 1/min")
+        if self.corner_speed >= self.max_speed:
+            raise ValueError(
+                f"corner_speed: {self.corner_speed:g} 1/min is not below the top speed "
+                f"max_speed = {self.max_speed:g} 1/min (a motor whose peak torque holds up to "
+                "its top speed has no corner: leave corner_speed out)"
+            )
+        top = self.top_speed_torque
+        if top is None and self.rated_torque is None:
+            raise ValueError(
+                "corner_speed: needs top_speed_torque or rated_torque (the torque the "
+                "intermittent zone falls to at the top speed)"
+            )
+        if top is not None and not 0 <= top <= self.peak_torque:
+            raise ValueError(
+                f"top_speed_torque: {_shown('motor_torque_max', top)} is outside [0, the peak "
+                f"torque {_shown('motor_torque_max', self.peak_torque)}]: the intermittent "
+                "torque falls from the peak above the corner"
+            )
 
 
 class Load(_Model):

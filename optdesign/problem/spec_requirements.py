@@ -74,6 +74,9 @@ class Requirements(_Model):
     static_safety_min: Dimensionless | None = Field(None, ge=1.0)
     life_min: Time | None = None
     duty_cycle: list[DutyStep] | None = Field(None, max_length=1000)
+    # the duty cycle's length (its steps' times are shares of it): the motor's thermal
+    # model compares it with the winding's time constant
+    duty_period: Time | None = None
     f_w: Dimensionless = Field(1.0, ge=1.0, le=3.0)
     stiffness_min: RotationalStiffness | None = None
     stiffness_load: Literal["hinge", "duty-mean"] = "hinge"
@@ -112,6 +115,11 @@ class Requirements(_Model):
     def _drive_rules(self):
         if self.life_min is not None and not self.duty_cycle:
             raise ValueError("life_min needs a duty_cycle (deflection, hinge_moment, time)")
+        if self.duty_period is not None and not self.duty_cycle:
+            raise ValueError(
+                "duty_period: the length of a duty cycle; give the duty_cycle (deflection, "
+                "hinge_moment, time) too"
+            )
         if self.stiffness_load == "duty-mean" and not self.duty_cycle:
             raise ValueError('stiffness_load: "duty-mean" needs a duty_cycle')
         if (self.life_min is not None or self.critical_speed or self.dn_max is not None) and (

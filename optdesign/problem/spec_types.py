@@ -190,6 +190,7 @@ POSITIVE_REQUIREMENTS: dict[str, tuple[str, float]] = {
     "pin_contact_pressure_max": ("MPa", 1.0),
     "deflection_rate": ("deg/s", 180.0 / math.pi),
     "life_min": ("h", 1.0),
+    "duty_period": ("s", 3600.0),
     "stiffness_min": ("N*m/rad", 1e-3),
     "dn_max": ("mm/min", 1.0),
     "inertia_ratio_max": ("", 1.0),
