@@ -28,7 +28,7 @@ import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.catalogue.bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.formulations.catalogue.bnb import InfeasibleBoxes, trusted_value
+from optdesign.formulations.catalogue.bnb import InfeasibleBoxes, trusted, trusted_value
 from optdesign.formulations.catalogue.bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.formulations.catalogue.bnb import cannot_improve as cannot_improve
 from optdesign.formulations.catalogue.bnb import fixed_box as _fixed
@@ -137,6 +137,9 @@ class NodeSolver:
         #: boxes proved infeasible (shared by the searches of one front), read before a
         #: node is solved and written when one is proved; None: no memo
         self.memo = None
+        #: a node of a front's search starts from the optimum an earlier search found
+        #: at the same items (:meth:`NodeBounds.start`) rather than from its parent's
+        self.neighbour_starts = True
         #: where this search's own proofs are recorded besides (never read by it: a
         #: single search keeps its nodes; the optimum's neighbouring items read them)
         self.proofs = None
@@ -197,9 +200,21 @@ class NodeSolver:
         multistart: the node's value is settled (``multistart.stopped_early``), whether
         the search would prune it or not.
         """
-        if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
+        nodes = None if self.memo is None else self.memo.nodes
+        if self.memo is not None and (
+            self.memo.known_infeasible(bounds, self.eps)
+            or (nodes is not None and nodes.infeasible(bounds, self.eps))
+        ):
             self.n_implied += 1
             return _no_item(self.backend.name, "infeasible: a wider box was at looser limits")
+        if nodes is not None:
+            # what an earlier search of the front learnt of this box: the least value
+            # under looser limits (a floor here), its optimum at these items (a start)
+            earlier = nodes.lower_bound(bounds, self.eps, self.objective)
+            if earlier is not None:
+                floor = earlier if floor is None else max(floor, earlier)
+            if self.neighbour_starts:
+                x_hint = _first_not_none(nodes.start(bounds, self.objective), x_hint)
         lo, hi = self.problem.lower().copy(), self.problem.upper().copy()
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
@@ -284,6 +299,11 @@ class NodeSolver:
             n_planned=n_planned,
             stopped_early=settled,
         )
+        if nodes is not None:
+            value = best.objective if best.success and trusted(best, self.starts) else None
+            nodes.add(
+                bounds, self.eps, self.objective, value, self.x_of(best) if best.success else None
+            )
         return best
 
     def verdicts_decide(self, results: Sequence[Result]) -> bool:
@@ -305,6 +325,10 @@ class NodeSolver:
         if not result.design:
             return None
         return np.array([result.design[n] for n in self.names])
+
+
+def _first_not_none(*values):
+    return next((v for v in values if v is not None), None)
 
 
 def _no_item(solver: str, message: str) -> Result:
