@@ -12,12 +12,15 @@
 
 - (c) ``--only ratio``: the catalogue front of (b) against a 50-point continuous front
   of the same problem, alternated ``--repeats`` times in one process (each from an empty
-  solver cache): the NLP solves per point of each and the ratio of their wall times. The
+  solver cache): the NLP solves per point of each and the ratio of their wall times (and
+  of their CPU times, one thread: less moved by the other jobs of a shared machine). The
   continuous problem is fin_actuator.toml with d0, p and d continuous over the same
   ranges; the catalogue's item data go with them (the nut stiffness is the fixed 270
   N/um of tests/hostile2/data/drive_continuous.toml, and the requirements that need a
   catalogue screw's load ratings - static safety, life and its duty cycle - are left
-  out). The 50-point front of the shipped continuous cs_min_backlash runs beside them.
+  out). The 50-point front of the shipped continuous cs_min_backlash (ripple against
+  backlash, as in global_search/cost.py) runs beside them. The fronts alone are timed
+  (``files=False``: no figure or report, which cost the same for either).
 
 Every figure is written as one JSON line to ``--out`` as soon as it is measured, so a
 killed run keeps what it measured. Seconds are wall-clock on a shared machine: read them
@@ -195,7 +198,7 @@ def timed_front(path: Path, tag: str, case: str, problem, objectives, points: in
         rec = rec if isinstance(rec, dict) else rec.to_dict()
         solves[rec["id"]] = rec.get("n_solves") or 0
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     fr = od.pareto(
         problem,
         objectives,
@@ -203,14 +206,18 @@ def timed_front(path: Path, tag: str, case: str, problem, objectives, points: in
         workers=1,
         out=Path(tempfile.mkdtemp(prefix="bench-ratio-")),
         on_record=on_record,
+        files=False,  # the fronts alone: no figure or report (the same cost for both)
     )
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     points_solves = [n for k, n in solves.items() if not k.startswith("anchor")]
     row = {
         "tag": tag,
         "case": case,
         "points": points,
         "wall_s": round(wall, 3),
+        # this process's CPU time (one worker, one thread): less moved by the other
+        # jobs on a shared machine than the wall time
+        "cpu_s": round(cpu, 3),
         "nlp_solves": fr.n_solves,
         "anchor_solves": fr.n_solves - sum(points_solves),
         "point_solves": sum(points_solves),
@@ -241,6 +248,8 @@ def ratio(path: Path, tag: str, points: int, repeats: int) -> None:
                 "repeat": i,
                 "catalogue_over_continuous": round(cat["wall_s"] / con["wall_s"], 3),
                 "catalogue_over_cs_min_backlash": round(cat["wall_s"] / ref["wall_s"], 3),
+                "cpu_catalogue_over_continuous": round(cat["cpu_s"] / con["cpu_s"], 3),
+                "cpu_catalogue_over_cs_min_backlash": round(cat["cpu_s"] / ref["cpu_s"], 3),
                 "solves_per_point": {
                     "catalogue": cat["solves_per_point"],
                     "continuous": con["solves_per_point"],
