@@ -16,7 +16,10 @@ sub-boxes of the catalogue variables) with three savings:
   only when the search finds no leaf as good;
 - **infeasible boxes implied** (:class:`InfeasibleBoxes`): a box proved infeasible under
   some epsilon limits proves every sub-box infeasible under limits at least as tight,
-  with no NLP; the points of one catalogue front share these proofs.
+  with no NLP; the points of one catalogue front share these proofs, and the values and
+  optima of their nodes (:mod:`~optdesign.formulations.catalogue.node_bounds`): a node
+  whose bound from a search under looser limits cannot beat the incumbent is pruned with
+  no NLP (:func:`earlier_bound`).
 
 What is proved and what is heuristic. Proved: the reported bound is the root
 relaxation's optimum (multistart, as before) and lies below the discrete optimum; every

@@ -137,9 +137,6 @@ class NodeSolver:
         #: boxes proved infeasible (shared by the searches of one front), read before a
         #: node is solved and written when one is proved; None: no memo
         self.memo = None
-        #: a node of a front's search starts from the optimum an earlier search found
-        #: at the same items (:meth:`NodeBounds.start`) rather than from its parent's
-        self.neighbour_starts = True
         #: where this search's own proofs are recorded besides (never read by it: a
         #: single search keeps its nodes; the optimum's neighbouring items read them)
         self.proofs = None
@@ -213,8 +210,8 @@ class NodeSolver:
             earlier = nodes.lower_bound(bounds, self.eps, self.objective)
             if earlier is not None:
                 floor = earlier if floor is None else max(floor, earlier)
-            if self.neighbour_starts:
-                x_hint = _first_not_none(nodes.start(bounds, self.objective), x_hint)
+            earlier_x = nodes.start(bounds, self.objective)
+            x_hint = earlier_x if earlier_x is not None else x_hint
         lo, hi = self.problem.lower().copy(), self.problem.upper().copy()
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
@@ -325,10 +322,6 @@ class NodeSolver:
         if not result.design:
             return None
         return np.array([result.design[n] for n in self.names])
-
-
-def _first_not_none(*values):
-    return next((v for v in values if v is not None), None)
 
 
 def _no_item(solver: str, message: str) -> Result:
