@@ -5,7 +5,7 @@ motor torque, docs/drive.md) and ``problems/cs_min_backlash_catalogue.toml`` (ba
 against motor torque), 1 worker, each from an empty solver cache: every record's
 objectives, items and NLP solves, one JSON file per ``--tag``. ``--compare A B`` then
 prints the largest relative difference of the two fronts' objectives, whether the items
-are the same at every point, and the NLP solves of each (of an anchor's first stage,
+and the binding rows are the same at every point, and the NLP solves of each (of an anchor's first stage,
 which only gives its tie-break the least value of its objective, that value alone).
 
     # the code before, exported, and this tree:
@@ -54,6 +54,7 @@ def run(tag: str, out: Path, points: int) -> None:
                 "objectives": {k: rec["objectives"].get(k) for k in objectives},
                 "items": {k: rec["design"][k] for k in ITEMS if k in (rec.get("design") or {})},
                 "n_solves": rec.get("n_solves"),
+                "active": rec.get("active"),
             }
 
         t0 = time.perf_counter()
@@ -75,7 +76,7 @@ def compare(out: Path, a: str, b: str) -> None:
     fb = json.loads((out / f"catalogue_front_{b}.json").read_text())
     for case in CASES:
         ra, rb = fa[case]["records"], fb[case]["records"]
-        worst, same_items = 0.0, True
+        worst, same_items, same_active = 0.0, True, True
         for key in sorted(ra):
             # an anchor's first stage wants only its objective's least value (its
             # tie-break, the anchor, picks the design): its other values and items may
@@ -86,9 +87,11 @@ def compare(out: Path, a: str, b: str) -> None:
                 va, vb = ra[key]["objectives"][k], rb[key]["objectives"][k]
                 worst = max(worst, abs(va - vb) / max(abs(va), 1e-300))
             same_items &= first_stage or ra[key]["items"] == rb[key]["items"]
+            same_active &= first_stage or ra[key].get("active") == rb[key].get("active")
         solves = [sum(r["n_solves"] or 0 for r in f.values()) for f in (ra, rb)]
         print(
             f"{case}: largest relative difference {worst:.3g}, same items: {same_items}, "
+            f"same binding rows: {same_active}, "
             f"NLP solves {a} {solves[0]}, {b} {solves[1]}"
         )
         for key in sorted(ra):

@@ -22,7 +22,13 @@ box ``b`` inside ``B`` under limits ``e``:
   point's backlash limit, learnt while the backlash anchor was searched;
 - *a start* (:meth:`NodeBounds.start`): the optimum of the same box, for the same
   objective, under whatever limits: only the first start of the node's NLP, whose
-  verdicts rest on the same starts as before (a start proves nothing).
+  verdicts rest on the same starts as before (a start proves nothing);
+- *the node's result itself* (:meth:`NodeBounds.reuse`): an optimum of the same box and
+  objective under looser limits that meets the tighter limits (its limited objectives,
+  as the solve checked them, below each limit by more than the tie tolerance, so the
+  limit is not active) is an optimum under them too - the feasible set shrank around
+  it. The node is not solved again; its result (starts, values, what binds) is the
+  earlier one.
 
 Every value here comes from the local multistart of a non-convex NLP: a "lower bound" is
 what the searches already treat as one (the pruning of each search rests on the same
@@ -31,8 +37,10 @@ values), carried to the searches under tighter limits.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -57,6 +65,8 @@ class NodeEntry:
         Its optimal value when the search trusts it as a bound, else None.
     x
         Its optimum (the design vector), or None when it has no feasible point.
+    result
+        The node's :class:`~optdesign.solvers.result.Result` when it is feasible.
     """
 
     box: dict[str, tuple[float, float]]
@@ -64,6 +74,7 @@ class NodeEntry:
     objective: str
     value: float | None
     x: np.ndarray | None
+    result: Any = None
 
 
 def looser_or_equal(stored: Mapping[str, float], eps: Mapping[str, float]) -> bool:
@@ -109,14 +120,17 @@ class NodeBounds:
         objective: str,
         value: float | None,
         x: np.ndarray | None,
+        result: Any = None,
     ) -> None:
-        """Record a node: ``value`` only when the search trusts it as the node's least."""
+        """Record a node: ``value`` only when the search trusts it as the node's least;
+        ``result`` (a feasible one) for :meth:`reuse`."""
         entry = NodeEntry(
             {**self.full, **box},
             dict(eps),
             objective,
             None if value is None or not np.isfinite(value) else float(value),
             None if x is None else np.array(x, dtype=float),
+            result,
         )
         self._entries.append(entry)
         self._by_box.setdefault(self._key(box), []).append(entry)
@@ -147,6 +161,21 @@ class NodeBounds:
                 if looser_or_equal(e.eps, eps) and inside(whole, e.box):
                     return True
         return False
+
+    def reuse(self, box: Box, eps: Mapping[str, float], objective: str) -> Any:
+        """A copy of the latest result of exactly ``box`` for ``objective``, solved under
+        limits ``eps`` holds at least as tight, whose design meets every limit of ``eps``
+        with room (the tie tolerance, relative); None when there is none."""
+        for e in reversed(self._by_box.get(self._key(box), [])):
+            if e.result is None or e.objective != objective or not looser_or_equal(e.eps, eps):
+                continue
+            values = e.result.objectives
+            if all(
+                k in values and values[k] < v - OBJECTIVE_TIE_TOL * max(abs(v), 1e-12)
+                for k, v in eps.items()
+            ):
+                return copy.deepcopy(e.result)
+        return None
 
     def start(self, box: Box, objective: str) -> np.ndarray | None:
         """The latest optimum of exactly ``box`` for ``objective`` (a first start)."""

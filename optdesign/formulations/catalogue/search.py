@@ -134,6 +134,8 @@ class NodeSolver:
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
         self.n_implied = 0
+        #: nodes whose optimum under a front's looser limits meets this search's limits
+        self.n_reused = 0
         #: boxes proved infeasible (shared by the searches of one front), read before a
         #: node is solved and written when one is proved; None: no memo
         self.memo = None
@@ -205,8 +207,13 @@ class NodeSolver:
             self.n_implied += 1
             return _no_item(self.backend.name, "infeasible: a wider box was at looser limits")
         if nodes is not None:
-            # what an earlier search of the front learnt of this box: the least value
-            # under looser limits (a floor here), its optimum at these items (a start)
+            # what an earlier search of the front learnt of this box: its optimum under
+            # looser limits when it meets these (the node's optimum here too), else the
+            # least value under looser limits (a floor here) and its optimum (a start)
+            reused = nodes.reuse(bounds, self.eps, self.objective)
+            if reused is not None:
+                self.n_reused += 1
+                return reused
             earlier = nodes.lower_bound(bounds, self.eps, self.objective)
             if earlier is not None:
                 floor = earlier if floor is None else max(floor, earlier)
@@ -297,10 +304,12 @@ class NodeSolver:
             stopped_early=settled,
         )
         if nodes is not None:
-            value = best.objective if best.success and trusted(best, self.starts) else None
-            nodes.add(
-                bounds, self.eps, self.objective, value, self.x_of(best) if best.success else None
-            )
+            # a value (and the result, for a later search to reuse) only when the search
+            # trusts it as the node's least: a full multistart, or settled at its floor
+            ok = best.success and trusted(best, self.starts)
+            x = self.x_of(best) if best.success else None
+            value, kept = (best.objective, best) if ok else (None, None)
+            nodes.add(bounds, self.eps, self.objective, value, x, kept)
         return best
 
     def verdicts_decide(self, results: Sequence[Result]) -> bool:

@@ -73,3 +73,32 @@ def test_limits_are_looser_or_equal_when_every_stored_one_is_held_as_tight():
     assert looser_or_equal({"a": 2.0}, {"a": 2.0, "b": 1.0})
     assert not looser_or_equal({"a": 2.0}, {"a": 2.5})
     assert not looser_or_equal({"a": 2.0}, {"b": 1.0})
+
+
+def test_an_optimum_under_looser_limits_is_reused_only_where_it_meets_the_tighter_ones():
+    """The feasible set shrank around it: an optimum that meets the tighter limits with
+    room is their optimum too (a copy of its result); one at a limit, one found under
+    tighter limits, or one of another box or objective is not."""
+    from optdesign.solvers.result import Result
+
+    def result(backlash):
+        return Result(
+            status="optimal",
+            objective=2190.0,
+            design={"p": 5.0, "d": 6.0},
+            objectives={"torque": 2190.0, "backlash": backlash},
+            solver="fake",
+            formulation="nlp",
+        )
+
+    nodes = NodeBounds(FULL)
+    leaf = {"p": (5.0, 5.0), "d": (6.0, 6.0)}
+    kept = result(0.0379)
+    nodes.add(leaf, {"backlash": 0.0403}, "torque", 2190.0, np.zeros(2), kept)
+    again = nodes.reuse(leaf, {"backlash": 0.0389}, "torque")
+    assert again is not kept and again.objective == 2190.0 and again.design == kept.design
+    assert nodes.reuse(leaf, {"backlash": 0.0379}, "torque") is None  # at the limit
+    assert nodes.reuse(leaf, {"backlash": 0.041}, "torque") is None  # looser: may move
+    assert nodes.reuse({"p": (5.0, 5.0)}, {"backlash": 0.0389}, "torque") is None
+    assert nodes.reuse(leaf, {"backlash": 0.0389}, "backlash") is None
+    assert nodes.reuse(leaf, {"backlash": 0.0389, "mass": 1.0}, "torque") is None  # unknown
