@@ -96,6 +96,11 @@ def _tol(v: float) -> float:
     return 1e-12 * max(1.0, abs(v))
 
 
+#: Nodes a memo keeps: past it the oldest half is dropped (knowledge lost, never wrong),
+#: so that a process running the same front again and again does not scan ever more.
+MAX_ENTRIES = 4096
+
+
 class NodeBounds:
     """The nodes solved by a front's searches: lower bounds, infeasibility and starts
     for the nodes of the searches after them (see the module's text for which way each
@@ -134,6 +139,11 @@ class NodeBounds:
         )
         self._entries.append(entry)
         self._by_box.setdefault(self._key(box), []).append(entry)
+        if len(self._entries) > MAX_ENTRIES:
+            self._entries = self._entries[len(self._entries) // 2 :]
+            self._by_box = {}
+            for e in self._entries:
+                self._by_box.setdefault(self._key(e.box), []).append(e)
 
     def lower_bound(self, box: Box, eps: Mapping[str, float], objective: str) -> float | None:
         """The greatest trusted value of ``objective`` over a box holding ``box``, solved

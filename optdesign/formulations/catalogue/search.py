@@ -134,8 +134,7 @@ class NodeSolver:
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
         self.n_implied = 0
-        #: nodes whose optimum under a front's looser limits meets this search's limits
-        self.n_reused = 0
+        self.n_reused = 0  # nodes whose optimum under looser limits meets these limits
         #: boxes proved infeasible (shared by the searches of one front), read before a
         #: node is solved and written when one is proved; None: no memo
         self.memo = None
@@ -207,9 +206,8 @@ class NodeSolver:
             self.n_implied += 1
             return _no_item(self.backend.name, "infeasible: a wider box was at looser limits")
         if nodes is not None:
-            # what an earlier search of the front learnt of this box: its optimum under
-            # looser limits when it meets these (the node's optimum here too), else the
-            # least value under looser limits (a floor here) and its optimum (a start)
+            # an earlier search's optimum of this box under looser limits that meets these
+            # (the optimum here too), else its least value (a floor) and optimum (a start)
             reused = nodes.reuse(bounds, self.eps, self.objective)
             if reused is not None:
                 self.n_reused += 1
@@ -304,11 +302,10 @@ class NodeSolver:
             stopped_early=settled,
         )
         if nodes is not None:
-            # a value (and the result, for a later search to reuse) only when the search
-            # trusts it as the node's least: a full multistart, or settled at its floor
+            # its value and result only when trusted (a full multistart, or at its floor)
             ok = best.success and trusted(best, self.starts)
-            x = self.x_of(best) if best.success else None
             value, kept = (best.objective, best) if ok else (None, None)
+            x = self.x_of(best) if best.success else None
             nodes.add(bounds, self.eps, self.objective, value, x, kept)
         return best
 

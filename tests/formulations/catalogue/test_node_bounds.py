@@ -102,3 +102,16 @@ def test_an_optimum_under_looser_limits_is_reused_only_where_it_meets_the_tighte
     assert nodes.reuse({"p": (5.0, 5.0)}, {"backlash": 0.0389}, "torque") is None
     assert nodes.reuse(leaf, {"backlash": 0.0389}, "backlash") is None
     assert nodes.reuse(leaf, {"backlash": 0.0389, "mass": 1.0}, "torque") is None  # unknown
+
+
+def test_a_full_memo_drops_its_oldest_half(monkeypatch):
+    from optdesign.formulations.catalogue import node_bounds
+
+    monkeypatch.setattr(node_bounds, "MAX_ENTRIES", 4)
+    nodes = NodeBounds(FULL)
+    for k in range(5):
+        nodes.add({"p": (float(k), float(k))}, {}, "torque", 100.0 + k, np.full(2, k))
+    assert len(nodes) == 3  # 5 > 4: the oldest 2 dropped
+    assert nodes.start({"p": (1.0, 1.0)}, "torque") is None
+    assert nodes.start({"p": (4.0, 4.0)}, "torque") == pytest.approx([4.0, 4.0])
+    assert nodes.lower_bound({"p": (2.0, 2.0)}, {}, "torque") == 102.0
