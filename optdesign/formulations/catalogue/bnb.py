@@ -16,7 +16,10 @@ sub-boxes of the catalogue variables) with three savings:
   only when the search finds no leaf as good;
 - **infeasible boxes implied** (:class:`InfeasibleBoxes`): a box proved infeasible under
   some epsilon limits proves every sub-box infeasible under limits at least as tight,
-  with no NLP; the points of one catalogue front share these proofs.
+  with no NLP; the points of one catalogue front share these proofs, and the values and
+  optima of their nodes (:mod:`~optdesign.formulations.catalogue.node_bounds`): a node
+  whose bound from a search under looser limits cannot beat the incumbent is pruned with
+  no NLP (:func:`earlier_bound`).
 
 What is proved and what is heuristic. Proved: the reported bound is the root
 relaxation's optimum (multistart, as before) and lies below the discrete optimum; every
@@ -65,6 +68,8 @@ from optdesign.formulations.catalogue.discrete import (
     items_within,
     nearest_item,
 )
+from optdesign.formulations.catalogue.node_bounds import NodeBounds
+from optdesign.formulations.catalogue.node_bounds import inside as _inside
 from optdesign.solvers.multistart import improves
 from optdesign.solvers.result import Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
@@ -150,6 +155,9 @@ class InfeasibleBoxes:
         #: when every item combination in it lies in some proved box (a union of proofs)
         self.items = {k: tuple(sorted(v)) for k, v in items.items()} if items else None
         self._proofs: list[tuple[dict[str, tuple[float, float]], dict[str, float]]] = []
+        #: the nodes the searches solved (their bounds and optima), when the memo is a
+        #: front's (:func:`shared_memo`); None for a single search's proofs
+        self.nodes: NodeBounds | None = None
 
     def __len__(self) -> int:
         return len(self._proofs)
@@ -200,18 +208,6 @@ class InfeasibleBoxes:
 MAX_COVER_COMBINATIONS = 4096
 
 
-def _inside(box: Box, wide: Box) -> bool:
-    return all(
-        wide[k][0] - _tol(wide[k][0]) <= lo and hi <= wide[k][1] + _tol(wide[k][1])
-        for k, (lo, hi) in box.items()
-        if k in wide
-    )
-
-
-def _tol(v: float) -> float:
-    return 1e-12 * max(1.0, abs(v))
-
-
 #: Memos of this process, one per (problem, node-solver settings): the points of a
 #: catalogue front solved one after another share their proofs.
 _MEMOS: dict[tuple, InfeasibleBoxes] = {}
@@ -225,7 +221,9 @@ def shared_memo(
     if key not in _MEMOS:
         while len(_MEMOS) >= _MEMO_MAX:
             _MEMOS.pop(next(iter(_MEMOS)))
-        _MEMOS[key] = InfeasibleBoxes(full, items)
+        memo = InfeasibleBoxes(full, items)
+        memo.nodes = NodeBounds(full)
+        _MEMOS[key] = memo
     return _MEMOS[key]
 
 
@@ -350,8 +348,9 @@ def branch_and_bound_warm(
     while heap:
         bound, _, box, res, warm_from, floor = heapq.heappop(heap)
         if prunes(bound, box):
-            if warm_from is not None:
+            if warm_from is not None and not _earlier_prunes(ns, prunes, box):
                 # a bound from the warm start alone: pruned only on the full multistart
+                # (or on a bound an earlier search of the front trusted)
                 res = ns.solve(box, warm_from, floor=floor)
                 stats["nodes"] += 1
                 if not res.success:
@@ -376,12 +375,19 @@ def branch_and_bound_warm(
             one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
             if one_combination:
                 leaf = res  # already solved with every catalogue variable fixed
+            elif _earlier_prunes(ns, prunes, fixed_box(items)):
+                leaf = None  # it cannot win: an earlier search's bound under looser limits
+                stats["pruned"] += 1
             else:
                 leaf = leaf_solve(fixed_box(items), x, below)
                 stats["nodes"] += 1
             stats["leaves"] += 1
             key = combination_key(items, names)
-            if leaf.success and wins(leaf.objective, key, _value(incumbent), inc_key):
+            if (
+                leaf is not None
+                and leaf.success
+                and wins(leaf.objective, key, _value(incumbent), inc_key)
+            ):
                 incumbent, inc_key = leaf, key
             if one_combination or prunes(bound, box):
                 continue
@@ -401,6 +407,12 @@ def branch_and_bound_warm(
             if worst is None and child == fixed_box(items):
                 continue  # the leaf just solved
             fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
+            earlier = earlier_bound(ns, child)
+            if earlier is not None and prunes(earlier, child):
+                # no NLP: an earlier search of the front bounded it under looser limits
+                stats["pruned"] += 1
+                gains.append(pseudo.rise(bound, earlier))
+                continue
             # a box of one combination is a leaf: its value is reported, full multistart
             if fixed:
                 r = leaf_solve(child, x, below)
@@ -454,7 +466,12 @@ class PseudoCosts:
         """The relative rise of a child's value over its parent's ``parent``."""
         if not child.success:
             return self.INFEASIBLE_GAIN
-        return max(child.objective - parent, 0.0) / max(abs(parent), 1e-300)
+        return self.rise(parent, child.objective)
+
+    @staticmethod
+    def rise(parent: float, value: float) -> float:
+        """The relative rise of ``value`` over ``parent`` (none when below it)."""
+        return max(value - parent, 0.0) / max(abs(parent), 1e-300)
 
     def record(self, name: str, gains: Sequence[float]) -> None:
         """One branching on ``name`` whose children rose by ``gains`` (one or two)."""
@@ -471,6 +488,20 @@ class PseudoCosts:
             return worst
         # the first of equal pseudo-costs, in the declared order (max keeps the first)
         return max(off, key=lambda v: sum(self.scores[v.name]) / len(self.scores[v.name]))
+
+
+def earlier_bound(ns, box: Box) -> float | None:
+    """The least value of the search's objective over ``box`` that an earlier search of
+    the same front trusted under limits the search holds at least as tight
+    (:meth:`~optdesign.formulations.catalogue.node_bounds.NodeBounds.lower_bound`); None
+    outside a front, or when no earlier node holds the box."""
+    nodes = getattr(getattr(ns, "memo", None), "nodes", None)
+    return None if nodes is None else nodes.lower_bound(box, ns.eps, ns.objective)
+
+
+def _earlier_prunes(ns, prunes, box: Box) -> bool:
+    earlier = earlier_bound(ns, box)
+    return earlier is not None and prunes(earlier, box)
 
 
 def _bound_proof(ns, box: Box, res: Result) -> None:

@@ -28,7 +28,7 @@ import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.catalogue.bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.formulations.catalogue.bnb import InfeasibleBoxes, trusted_value
+from optdesign.formulations.catalogue.bnb import InfeasibleBoxes, trusted, trusted_value
 from optdesign.formulations.catalogue.bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.formulations.catalogue.bnb import cannot_improve as cannot_improve
 from optdesign.formulations.catalogue.bnb import fixed_box as _fixed
@@ -134,6 +134,7 @@ class NodeSolver:
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
         self.n_implied = 0
+        self.n_reused = 0  # nodes whose optimum under looser limits meets these limits
         #: boxes proved infeasible (shared by the searches of one front), read before a
         #: node is solved and written when one is proved; None: no memo
         self.memo = None
@@ -197,9 +198,25 @@ class NodeSolver:
         multistart: the node's value is settled (``multistart.stopped_early``), whether
         the search would prune it or not.
         """
-        if self.memo is not None and self.memo.known_infeasible(bounds, self.eps):
+        nodes = None if self.memo is None else self.memo.nodes
+        if self.memo is not None and (
+            self.memo.known_infeasible(bounds, self.eps)
+            or (nodes is not None and nodes.infeasible(bounds, self.eps))
+        ):
             self.n_implied += 1
             return _no_item(self.backend.name, "infeasible: a wider box was at looser limits")
+        if nodes is not None:
+            # an earlier search's optimum of this box under looser limits that meets these
+            # (the optimum here too), else its least value (a floor) and optimum (a start)
+            reused = nodes.reuse(bounds, self.eps, self.objective)
+            if reused is not None:
+                self.n_reused += 1
+                return reused
+            earlier = nodes.lower_bound(bounds, self.eps, self.objective)
+            if earlier is not None:
+                floor = earlier if floor is None else max(floor, earlier)
+            earlier_x = nodes.start(bounds, self.objective)
+            x_hint = earlier_x if earlier_x is not None else x_hint
         lo, hi = self.problem.lower().copy(), self.problem.upper().copy()
         for name, (a, b) in bounds.items():
             k = self.names.index(name)
@@ -284,6 +301,12 @@ class NodeSolver:
             n_planned=n_planned,
             stopped_early=settled,
         )
+        if nodes is not None:
+            # its value and result only when trusted (a full multistart, or at its floor)
+            ok = best.success and trusted(best, self.starts)
+            value, kept = (best.objective, best) if ok else (None, None)
+            x = self.x_of(best) if best.success else None
+            nodes.add(bounds, self.eps, self.objective, value, x, kept)
         return best
 
     def verdicts_decide(self, results: Sequence[Result]) -> bool:

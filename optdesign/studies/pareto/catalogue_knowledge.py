@@ -11,6 +11,10 @@
   anchors, then the points from the loosest epsilon limit to the tightest - and they
   share one :class:`~optdesign.formulations.catalogue.bnb.InfeasibleBoxes` memo (a box proved
   infeasible under looser limits is not solved again).
+- Node bounds and starts: the same memo keeps every node's trusted value and optimum
+  (:class:`~optdesign.formulations.catalogue.node_bounds.NodeBounds`); a value bounds the
+  nodes of the searches under tighter limits from below (their floor, or a prune with no
+  NLP), and an optimum is the first start of the same items' node in a later search.
 """
 
 from __future__ import annotations
