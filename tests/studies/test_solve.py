@@ -515,6 +515,11 @@ def test_a_stroke_the_geometry_rules_out_is_refused_before_any_solve(monkeypatch
     assert "    - rod_inclination_max of at least 70 deg" in text
     doc = result_document(result)
     assert doc["diagnosis"]["impossible"][0]["requirements"][0] == "deflection"
+    # a front of it is refused the same way, before any work (exit 1 from the command)
+    from optdesign.errors import InfeasibleRequirementsError
+
+    with pytest.raises(InfeasibleRequirementsError, match="rod_inclination_max of at least 70"):
+        od.pareto(problem, ["ripple", "backlash"], points=5, out=tmp_path / "front")
     # the remedy: +-80 deg is not refused (whether it is feasible is the search's answer)
     from optdesign.problem.necessary import impossibilities
 
