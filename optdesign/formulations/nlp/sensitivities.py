@@ -196,12 +196,7 @@ def _evaluate_many(problem: DesignProblem, X: np.ndarray) -> list[_Evaluated]:
             e = e[:, None]
         rows = population_rows(e, pop)
         for (blocks, scalars), row in zip(per, rows, strict=True):
-            row = np.ravel(row)
-            blocks[f"{name}_lower_envelope"] = (row, 0.0, None)
-            blocks[f"{name}_upper_envelope"] = (-row, 0.0, None)
-            blocks[f"{name}_envelope"] = (-row, 0.0, None)
-            if term.kind == "scalar":
-                scalars[name] = float(row[0])
+            _objective_rows(blocks, scalars, name, term.kind, np.ravel(row))
     for block in ex.constraints:
         rows = population_rows(np.asarray(block.expr, dtype=float), pop)
         for (blocks, _), row in zip(per, rows, strict=True):
@@ -348,16 +343,21 @@ class _Limits:
     objectives: dict[str, float]
 
 
+def _objective_rows(blocks: dict, scalars: dict, name: str, kind: str, e: np.ndarray) -> None:
+    """An objective's epigraph rows (the NLP's envelope rows read its values) and, for a
+    scalar one, its value."""
+    blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
+    blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
+    blocks[f"{name}_envelope"] = (-e, 0.0, None)
+    if kind == "scalar":
+        scalars[name] = float(e[0])
+
+
 def _blocks(ex) -> tuple[dict[str, tuple[np.ndarray, Any, Any]], dict[str, float]]:
     blocks: dict[str, tuple[np.ndarray, Any, Any]] = {}
     scalars: dict[str, float] = {}
     for name, term in ex.objectives.items():
-        e = np.ravel(np.asarray(term.expr, dtype=float))
-        blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
-        blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
-        blocks[f"{name}_envelope"] = (-e, 0.0, None)
-        if term.kind == "scalar":
-            scalars[name] = float(e[0])
+        _objective_rows(blocks, scalars, name, term.kind, np.ravel(np.asarray(term.expr, float)))
     for block in ex.constraints:
         blocks[block.name] = (
             np.ravel(np.asarray(block.expr, dtype=float)),
