@@ -99,6 +99,7 @@ def verdict(name: str) -> dict[str, Any]:
         "alone": [_relaxation(r) for r in alone],
         "together": [_relaxation(r) for r in together],
         "note": diagnosis.note if diagnosis is not None else "",
+        "impossible": [] if diagnosis is None else [p.to_json() for p in diagnosis.impossible],
     }
 
 
@@ -175,6 +176,11 @@ def table(old_path: Path, new_path: Path) -> str:
         if n.get("together"):
             named.append(
                 "together: " + ", ".join(f"{r['name']} -> {_g(r['needed'])}" for r in n["together"])
+            )
+        for proof in n.get("impossible", []):
+            named.append(
+                f"proved before any solve: {', '.join(proof['requirements'])} "
+                f"(lifted by: {'; '.join(proof['remedies'])})"
             )
         if not named and n.get("note"):
             named = [n["note"].split(":", 1)[0]]

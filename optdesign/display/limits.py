@@ -11,6 +11,7 @@ and in the units a user reads; active variable bounds are limits too.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -103,9 +104,29 @@ class BlockInfo:
     display_unit: str
 
 
+#: :func:`block_infos` of the last problems asked, by their state's token (a front's page
+#: shows every point's limits; the declarations are the same for all of them).
+_BLOCK_INFOS: OrderedDict[str, dict[str, BlockInfo]] = OrderedDict()
+_BLOCK_INFOS_SIZE = 8
+
+
 def block_infos(problem: Any) -> dict[str, BlockInfo]:
     """Name -> :class:`BlockInfo` of every constraint block of ``problem`` (NumPy path,
-    at its start design: only the declarations are read)."""
+    at its start design: only the declarations are read). Remembered per problem state:
+    the caller must not change the mapping it gets."""
+    token = getattr(problem, "token", None)
+    if token is not None and token in _BLOCK_INFOS:
+        _BLOCK_INFOS.move_to_end(token)
+        return _BLOCK_INFOS[token]
+    infos = _block_infos(problem)
+    if token is not None:
+        _BLOCK_INFOS[token] = infos
+        while len(_BLOCK_INFOS) > _BLOCK_INFOS_SIZE:
+            _BLOCK_INFOS.popitem(last=False)
+    return infos
+
+
+def _block_infos(problem: Any) -> dict[str, BlockInfo]:
     design = problem.design_dict(problem.start()[None, :])
     with np.errstate(all="ignore"):
         ex = problem.expressions(design)

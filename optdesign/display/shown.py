@@ -152,9 +152,24 @@ def json_value(value: Any) -> Any:
 _DIMENSION_UNITS = {k: v for k, v in INTERNAL_UNITS.items() if k != "dimensionless"}
 
 
+#: Each spec field's dimension, by the field's id (the field kept beside it, so an id
+#: is never reused): a front's page shows every point's costs, each reading the whole
+#: table of requirements.
+_FIELD_DIMENSIONS: dict[int, tuple[Any, str | None]] = {}
+
+
 def _dimension(field: Any) -> str | None:
     """The dimension of a spec field (its quantity validator's), looking inside
     ``Length | None`` and the like."""
+    known = _FIELD_DIMENSIONS.get(id(field))
+    if known is not None and known[0] is field:
+        return known[1]
+    dim = _field_dimension(field)
+    _FIELD_DIMENSIONS[id(field)] = (field, dim)
+    return dim
+
+
+def _field_dimension(field: Any) -> str | None:
     import typing
 
     metas = list(field.metadata)

@@ -32,6 +32,7 @@ from optdesign import math as m
 from optdesign.errors import AssemblyError, InputError
 from optdesign.mechanisms.joints import Backlash, Joint, PinJoint, backlash_of
 from optdesign.models._checks import require_finite, require_positive
+from optdesign.models.impossibility import Impossibility
 from optdesign.models.loads import force_from_rate, motor_torque
 from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity
 from optdesign.models.validity import Validity
@@ -378,6 +379,37 @@ class Mechanism:
     # --- requirements ----------------------------------------------------------------------
     def assembly_rows(self, phi) -> list[Rows]:
         """Rows that keep the linkage assembled over the stroke (none by default)."""
+        return []
+
+    @classmethod
+    def impossible(
+        cls,
+        stroke: tuple[float, float],
+        requirements: Mapping[str, Any],
+        bounds: Mapping[str, tuple[float, float]],
+    ) -> list[Impossibility]:
+        """Closed-form proofs that no design of this mechanism within ``bounds`` can turn
+        through the stroke under its requirements: necessary conditions of the geometry,
+        checked before any solve, so that a problem no design can meet gets its verdict
+        in milliseconds and the names of the requirements to change.
+
+        Parameters
+        ----------
+        stroke
+            The deflection range (min, max) in rad.
+        requirements
+            The mechanism's own requirements the problem sets (:attr:`requirements`),
+            name -> parsed value (internal units; a band has ``.min`` and ``.max``).
+        bounds
+            Every variable of :meth:`variable_table` -> (lower, upper), internal units
+            (a fixed variable as (value, value)).
+
+        Returns
+        -------
+        list of Impossibility
+            Empty when no condition is known to fail (the default): a necessary
+            condition only, never a claim that the problem is feasible.
+        """
         return []
 
     def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:

@@ -11,6 +11,8 @@ from optdesign.mechanisms.base import Mechanism, RequirementInfo, Rows, Sketch, 
 from optdesign.mechanisms.joints import Joint, PinJoint
 from optdesign.mechanisms.registry import register_mechanism
 from optdesign.models import crank_slider as cs
+from optdesign.models.impossibility import ANGLE_TOL, Impossibility
+from optdesign.models.impossibility import degrees_text as _deg
 from optdesign.models.loads import force_from_rate
 
 #: sqrt guard of the assembly condition on the solver path (mm^2): keeps iterates that
@@ -147,6 +149,54 @@ class CrankSlider(Mechanism):
         return self.rod_force(phi, M_h)
 
     # --- requirements ----------------------------------------------------------------------
+    @classmethod
+    def impossible(cls, stroke, requirements, bounds) -> list[Impossibility]:
+        """The transmission angle's sweep. Wherever the ratio is positive (the nut
+        velocity R cos(a + beta) / cos(beta) > 0, beta the rod's inclination), cos(mu) =
+        sin(a + beta) gives mu = 90 deg - (phi0 + phi) - beta exactly. Over the stroke mu
+        so changes by the stroke less the change of beta: at least the stroke less twice
+        the rod's inclination limit (90 deg without one), whatever R, l and n. Two proofs
+        follow: that sweep exceeds the transmission band, or the neutral angle phi0 that
+        puts mu inside the band at both ends of the stroke lies outside its bounds."""
+        lo, hi = stroke
+        band = requirements.get("transmission_angle")
+        mu_lo = band.min if band is not None and band.min is not None else 0.0
+        mu_hi = band.max if band is not None and band.max is not None else np.pi
+        tilt = requirements.get("rod_inclination_max")
+        beta = np.pi / 2 if tilt is None else float(tilt)
+        named = ("deflection",) + ("transmission_angle",) * (band is not None)
+        named += ("rod_inclination_max",) * (tilt is not None)
+        width, sweep = mu_hi - mu_lo, (hi - lo) - 2 * beta
+        if sweep > width + ANGLE_TOL:
+            remedies = [f"a stroke of at most {_deg(width + 2 * beta)} deg"]
+            if sweep < np.pi:
+                remedies.append(f"a transmission band at least {_deg(sweep)} deg wide")
+            if (hi - lo - width) / 2 < np.pi / 2:
+                remedies.append(
+                    f"rod_inclination_max of at least {_deg((hi - lo - width) / 2)} deg"
+                )
+            reason = (
+                "the transmission angle of a crank-slider is 90 deg - (phi0 + phi) - (the "
+                "rod's inclination) wherever its ratio is positive, so over the stroke of "
+                f"{_deg(hi - lo)} deg it sweeps at least {_deg(hi - lo)} - 2 x {_deg(beta)} = "
+                f"{_deg(sweep)} deg, more than the {_deg(width)} deg between {_deg(mu_lo)} and "
+                f"{_deg(mu_hi)} deg that it may take"
+            )
+            return [Impossibility(named, reason, tuple(remedies))]
+        # mu(lo) <= mu_hi and mu(hi) >= mu_lo, with |beta| <= its limit, bound phi0
+        window = (np.pi / 2 - lo - beta - mu_hi, np.pi / 2 - hi + beta - mu_lo)
+        p_lo, p_hi = bounds["phi0"]
+        if p_hi < window[0] - ANGLE_TOL or p_lo > window[1] + ANGLE_TOL:
+            reason = (
+                "the transmission angle 90 deg - (phi0 + phi) - (the rod's inclination) "
+                f"stays between {_deg(mu_lo)} and {_deg(mu_hi)} deg at both ends of the stroke "
+                f"only with phi0 between {_deg(window[0])} and {_deg(window[1])} deg, and its "
+                f"bounds are {_deg(p_lo)} to {_deg(p_hi)} deg"
+            )
+            remedy = f"bounds of phi0 that reach {_deg(window[0])} to {_deg(window[1])} deg"
+            return [Impossibility(("variables.phi0", *named), reason, (remedy,))]
+        return []
+
     def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
         R, l, n, phi0 = self.R, self.l, self.n, self.phi0
         if name == "assembly_margin_min":

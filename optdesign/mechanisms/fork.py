@@ -11,6 +11,8 @@ from optdesign.mechanisms.base import Mechanism, Sketch, VariableInfo
 from optdesign.mechanisms.joints import Joint, PinJoint
 from optdesign.mechanisms.registry import register_mechanism
 from optdesign.models import fork
+from optdesign.models.impossibility import ANGLE_TOL, Impossibility
+from optdesign.models.impossibility import degrees_text as _deg
 from optdesign.models.loads import fork_pin_normal_force
 
 
@@ -89,6 +91,31 @@ class ShiftingFork(Mechanism):
         a = self.phi0 + phi
         pin = (self.nut_position(phi), self.R + 0.0 * phi)
         return (self.R * m.tan(a), self.R + 0.0 * phi), pin
+
+    @classmethod
+    def impossible(cls, stroke, requirements, bounds) -> list[Impossibility]:
+        """The arm's pole. The nut sits at R tan(a), a = phi0 + phi, which holds only for
+        |a| < 90 deg: no stroke of 180 deg or more can be turned, and phi0 must keep both
+        ends of the stroke inside (-90, 90) deg."""
+        lo, hi = stroke
+        if hi - lo >= np.pi - ANGLE_TOL:
+            reason = (
+                "the nut of a shifting fork sits at R tan(phi0 + phi), which has its poles "
+                f"at -90 and 90 deg: a stroke of {_deg(hi - lo)} deg cannot lie between them"
+            )
+            return [Impossibility(("deflection",), reason, ("a stroke of less than 180 deg",))]
+        window = (-np.pi / 2 - lo, np.pi / 2 - hi)
+        p_lo, p_hi = bounds["phi0"]
+        if p_hi <= window[0] + ANGLE_TOL or p_lo >= window[1] - ANGLE_TOL:
+            reason = (
+                "the arm phi0 + phi stays between the poles of R tan(phi0 + phi) at -90 and "
+                f"90 deg over the stroke only with phi0 between {_deg(window[0])} and "
+                f"{_deg(window[1])} deg (exclusive), and its bounds are {_deg(p_lo)} to "
+                f"{_deg(p_hi)} deg"
+            )
+            remedy = f"bounds of phi0 that reach inside {_deg(window[0])} to {_deg(window[1])} deg"
+            return [Impossibility(("variables.phi0", "deflection"), reason, (remedy,))]
+        return []
 
     def sketch(self, phi: float) -> Sketch:
         with np.errstate(invalid="ignore"):

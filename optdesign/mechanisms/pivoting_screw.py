@@ -27,6 +27,8 @@ from optdesign import math as m
 from optdesign.mechanisms.base import Mechanism, RequirementInfo, Rows, Sketch, VariableInfo
 from optdesign.mechanisms.joints import Joint, PinJoint
 from optdesign.mechanisms.registry import register_mechanism
+from optdesign.models.impossibility import ANGLE_TOL, Impossibility
+from optdesign.models.impossibility import degrees_text as _deg
 
 
 @register_mechanism
@@ -98,6 +100,32 @@ class PivotingScrew(Mechanism):
         bx, by = self._horn(phi)
         dot = (-bx) * (self.a_T - bx) + (-by) * (self.b_T - by)
         return dot / (self.R * self.nut_position(phi))
+
+    @classmethod
+    def impossible(cls, stroke, requirements, bounds) -> list[Impossibility]:
+        """The triangle's angle at the output axis. The horn pin B, the axis O and the
+        trunnion T make a triangle whose angle at O changes by the stroke (the horn turns
+        about O) and whose angle at B is the transmission angle. The ratio is positive
+        only while that angle at O stays inside (0, 180) deg (at 0 or 180 deg O, B and T
+        align: a dead point), and the three angles sum to 180 deg, so with the
+        transmission angle at least gamma_min it stays below 180 deg - gamma_min: no
+        stroke of that width or more can be turned."""
+        lo, hi = stroke
+        band = requirements.get("transmission_angle")
+        gamma = band.min if band is not None and band.min is not None else 0.0
+        if hi - lo >= np.pi - gamma - ANGLE_TOL:
+            named = ("deflection",) + ("transmission_angle",) * (gamma > 0.0)
+            reason = (
+                "the angle at the output axis of the triangle (axis, horn pin, trunnion) "
+                f"changes by the stroke, {_deg(hi - lo)} deg, and stays between 0 and 180 deg "
+                f"less the least transmission angle ({_deg(gamma)} deg): at most "
+                f"{_deg(np.pi - gamma)} deg"
+            )
+            remedies = [f"a stroke of less than {_deg(np.pi - gamma)} deg"]
+            if gamma > 0.0 and hi - lo < np.pi - ANGLE_TOL:
+                remedies.append(f"a least transmission angle below {_deg(np.pi - (hi - lo))} deg")
+            return [Impossibility(named, reason, tuple(remedies))]
+        return []
 
     def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
         if name == "transmission_angle":

@@ -156,13 +156,16 @@ def loop_response(
     Raises
     ------
     InputError
-        ``feedback`` unknown, or a numeric ``omega`` not finite and positive.
+        ``feedback`` unknown, or a numeric ``omega`` infinite or not positive (NaN, a
+        design that does not assemble, gives NaN).
     """
     if feedback not in FEEDBACKS:
         raise InputError("feedback", f"expected one of {', '.join(FEEDBACKS)}, got {feedback!r}")
     if not m.is_symbolic(omega):
+        # NaN passes through: a design of a population that does not assemble has no
+        # frequency, and its rows are NaN (the NumPy path's answer), not an error
         w_arr = np.asarray(omega, dtype=float)
-        if not np.all(np.isfinite(w_arr)) or np.any(w_arr <= 0):
+        if np.any(np.isinf(w_arr)) or np.any(w_arr <= 0):
             raise InputError("omega", f"must be finite and positive (rad/s), got {omega!r}")
     w = omega
     J1 = motor_inertia * ratio**2

@@ -146,10 +146,22 @@ def fit_values(problem) -> str:
 
 
 def parameter_defaults(problem) -> dict[str, float]:
-    """The problem's parameters and their defaults: a fit ratio of 1 (the smooth
-    formula's clearance) or the fit's favourable table clearance; the screw's values are
-    placeholders (1), which every catalogue solve replaces by its items' values
-    (:func:`parameter_values`)."""
+    """The problem's parameters and their defaults. With no catalogue variable free (a
+    screw, a pin or a motor the file gives as one item), no catalogue search replaces
+    them: the defaults are then those items' own data (:func:`parameter_values`), as the
+    NumPy check reads them. Otherwise a fit ratio of 1 (the smooth formula's clearance)
+    or the fit's favourable table clearance, and placeholders (1) for the screw's and the
+    motor's data, which every catalogue solve replaces by its node's values."""
+    out = _placeholders(problem)
+    if not any(v.discrete for v in problem.free):
+        out.update(parameter_values(problem, {}))
+    return out
+
+
+def _placeholders(problem) -> dict[str, float]:
+    """Every parameter of the problem: a fit ratio of 1 (the smooth formula's clearance)
+    or the fit's favourable table clearance, and placeholders (1) for the screw's and the
+    motor's data."""
     out: dict[str, float] = {}
     if "d" in problem.by_name and fit_values(problem) == "table":
         d = problem.by_name["d"]
@@ -175,7 +187,7 @@ def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, 
     """Parameter values of a solve whose discrete variables lie in ``box`` (name ->
     (lo, hi); fixed variables as (v, v)): exact for a single item, favourable over the
     items of a wider box (a valid relaxation). Empty when the box holds no catalogue item."""
-    defaults = parameter_defaults(problem)
+    defaults = _placeholders(problem)
     values: dict[str, float] = {}
     if "fit_ratio_max" in defaults:
         values.update(_fit_ratios(problem, box))

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from optdesign import math as m
-from optdesign.errors import ProblemError
+from optdesign.errors import InputError, ProblemError
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
 
@@ -245,29 +245,43 @@ def _population(q) -> int:
     return max(sizes, default=1)
 
 
-def drive_plants_of(q, angles=None) -> list[tuple[list[DrivePlant], PositionLoop]]:
+def drive_plants_of(
+    q, angles=None, strict: bool = True
+) -> list[tuple[list[DrivePlant], PositionLoop] | None]:
     """For each design of the NumPy quantities ``q`` (one design, or a population: one
     row per design), its :class:`~optdesign.models.loop_plant.DrivePlant` at every grid
     angle (or at the grid indices ``angles``) and its :class:`~optdesign.models.
-    loop_plant.PositionLoop`."""
+    loop_plant.PositionLoop`.
+
+    ``strict`` False: a design whose drive is no plant (a ratio that is not positive: a
+    dead point inside the stroke; a linkage that does not assemble: NaN; a loop gain
+    placed at or below zero) gives None instead of the error, as the NumPy path answers
+    NaN for a design that does not work (a population's rows)."""
     grid, gains = plant_grid(q), loop_gains(q)
     phi = np.asarray(q.phi, dtype=float).reshape(-1)
     pop, width = _population(q), len(phi)
     names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
     values = {n: _rows(getattr(grid, n), pop, width) for n in names}
     kp, kd = _rows(gains.kp, pop, 1)[:, 0], _rows(gains.kd, pop, 1)[:, 0]
-    out = []
+    out: list[tuple[list[DrivePlant], PositionLoop] | None] = []
     for i in range(pop):
-        if not kp[i] > 0:
-            raise ProblemError(
-                f"loop.bandwidth: places kp = {kp[i]:.4g} N*mm/rad at this design; the fin's "
-                "hinge spring alone is stiffer than the loop asked for: raise the bandwidth"
-            )
-        loop = PositionLoop(kp[i], kd[i], gains.ki, gains.current_lag, gains.feedback)
-        plants = [
-            DrivePlant(**{n: float(values[n][i, k]) for n in names}, angle=float(phi[k]))
-            for k in (range(width) if angles is None else angles)
-        ]
+        try:
+            if not kp[i] > 0:
+                raise ProblemError(
+                    f"loop.bandwidth: places kp = {kp[i]:.4g} N*mm/rad at this design; the "
+                    "fin's hinge spring alone is stiffer than the loop asked for: raise the "
+                    "bandwidth"
+                )
+            loop = PositionLoop(kp[i], kd[i], gains.ki, gains.current_lag, gains.feedback)
+            plants = [
+                DrivePlant(**{n: float(values[n][i, k]) for n in names}, angle=float(phi[k]))
+                for k in (range(width) if angles is None else angles)
+            ]
+        except (InputError, ProblemError):
+            if strict:
+                raise
+            out.append(None)
+            continue
         out.append((plants, loop))
     return out
 

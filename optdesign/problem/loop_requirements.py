@@ -166,20 +166,25 @@ def _largest_cycle(plant: DrivePlant, loop: PositionLoop) -> float:
 
 def least_pole_damping(q, idx: np.ndarray) -> np.ndarray:
     """The smallest damping ratio -Re p / |p| of the closed loop's poles at each loop
-    angle ``idx`` (NumPy, one row per design of a population)."""
-    return np.array(
-        [[_least_damping(p, loop) for p in plants] for plants, loop in drive_plants_of(q, idx)]
-    )
+    angle ``idx`` (NumPy, one row per design of a population; NaN for a design whose
+    drive is no plant, :func:`~optdesign.problem.loop.drive_plants_of`)."""
+    return _per_plant(q, idx, _least_damping)
 
 
 def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray:
     """The fin amplitude (deg) of the largest stable limit cycle the chain's clearance
     sustains at each loop angle ``idx``, by harmonic balance
     (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
-    one row per design of a population."""
-    return np.array(
-        [[_largest_cycle(p, loop) for p in plants] for plants, loop in drive_plants_of(q, idx)]
-    )
+    one row per design of a population (NaN for a design whose drive is no plant)."""
+    return _per_plant(q, idx, _largest_cycle)
+
+
+def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray:
+    rows = [
+        [np.nan] * len(idx) if drive is None else [fn(p, drive[1]) for p in drive[0]]
+        for drive in drive_plants_of(q, idx, strict=False)
+    ]
+    return np.array(rows, dtype=float)
 
 
 def _phase_margin(modulus):

@@ -148,7 +148,9 @@ def trace(problem: DesignProblem):
 def _rows_of(expr, shape_n: int) -> tuple[list[dict], list[float]]:
     """Per grid row: {exponent tuple: coefficient} of the variable terms, constant part."""
     if not isinstance(expr, Signomial):
-        vals = np.broadcast_to(np.asarray(expr, dtype=float), (shape_n,))
+        # a number of the NumPy path (a row no free variable enters, e.g. the loop's
+        # post-solve checks) may come as one design's row, (1, n)
+        vals = np.broadcast_to(np.asarray(expr, dtype=float).reshape(-1), (shape_n,))
         return [{} for _ in range(shape_n)], list(vals)
     terms = {
         a: np.broadcast_to(np.asarray(c, dtype=float), (shape_n,)) for a, c in expr.terms.items()

@@ -39,10 +39,14 @@ def cost_text(s: Sensitivity) -> str:
     return s.text()
 
 
-def front_point_costs(problem: Any, objectives: Sequence[str], point: Any) -> dict[str, Any]:
+def front_point_costs(
+    problem: Any, objectives: Sequence[str], point: Any, costs: Any = None
+) -> dict[str, Any]:
     """What the page shows of a front point's costs: ``sensitivities`` (lines, most
-    costly first) and ``costs_note`` (what they are of, or why they cannot be known)."""
-    costs = point.costs(problem, objectives)  # the study's, through the record
+    costly first) and ``costs_note`` (what they are of, or why they cannot be known).
+    ``costs``: the point's, when the caller has them (``Front.point_costs``)."""
+    if costs is None:
+        costs = point.costs(problem, objectives)  # the study's, through the record
     if costs.why:
         return {"sensitivities": [], "costs_note": f"not known for this point: {costs.why}"}
     held = [

@@ -191,11 +191,12 @@ def front_report(problem: Any, fronts: Sequence[Any]) -> str:
     for f in fronts:
         idx = []
         coords: list[list[float]] = [[] for _ in objectives]
+        # what each limit costs at each point, from the point's own solve (or why unknown)
+        costs = f.point_costs(problem)
         for k, p in enumerate(f.points):
             label = f"{f.method} point {k + 1}"
             view = design_json(problem, design_view(problem, p.design), label)
-            # what each limit costs there, from the point's own solve (or why unknown)
-            view.update(front_point_costs(problem, f.objectives, p))
+            view.update(front_point_costs(problem, f.objectives, p, costs[k]))
             designs.append(view)
             idx.append(len(designs) - 1)
             for j, o in enumerate(objectives):

@@ -84,6 +84,7 @@ def result_document(result: Result) -> dict[str, Any]:
             "relaxations": relax,
             "together": _relaxations_json(problem, diagnosis.together),
             "physical": list(diagnosis.physical),
+            "impossible": [proof.to_json() for proof in diagnosis.impossible],
         }
     doc["sensitivities"] = [
         {

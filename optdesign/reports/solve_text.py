@@ -171,6 +171,14 @@ def result_summary(result: Result) -> str:
         lines += ["", "violated constraints:"]
         lines += [f"  {printable(r.describe())}" for r in result.violated[:25]]
     diagnosis = result.diagnosis
+    proofs = diagnosis.impossible if diagnosis is not None else []
+    if proofs:
+        lines += ["", f"no design within the bounds can meet these together ({diagnosis.basis}):"]
+        for proof in proofs:
+            lines.append(f"  {printable(', '.join(proof.requirements))}: {printable(proof.reason)}")
+            if proof.remedies:
+                lines.append("  any one of these changes lifts this proof:")
+                lines += [f"    - {printable(r)}" for r in proof.remedies]
     relax = diagnosis.relaxations if diagnosis is not None and problem is not None else []
     if relax:
         lines += ["", "smallest change of one requirement that makes the problem feasible:"]
@@ -191,6 +199,8 @@ def result_summary(result: Result) -> str:
             end = "the fixed design does not meet the requirements above"
         elif result.verified:  # feasible, checked: only the optimality is missing
             end = f"a feasible design, but no optimum: the solver stopped ({result.status})"
+        elif proofs:
+            end = "no feasible design exists within the bounds (proved, no solve was run)"
         else:
             end = "no feasible design found"
             if result.status != "infeasible":  # not proven: the solver stopped
@@ -198,7 +208,9 @@ def result_summary(result: Result) -> str:
             elif result.violated:
                 end += ": the requirements above conflict within the bounds"
         lines += ["", end]
-        if not relax and result.violated:
+        if proofs:
+            lines.append("next: change one of the requirements or bounds named above")
+        elif not relax and result.violated:
             lines.append(
                 "next: relax one of the violated requirements, or widen a bound at its limit"
             )

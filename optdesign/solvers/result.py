@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass, field
 from enum import Enum, StrEnum
 from typing import Any, ClassVar
 
+from optdesign.models.impossibility import Impossibility
 from optdesign.solvers.details import Details
 from optdesign.solvers.solved_point import SolvedPoint, in_key_order
 
@@ -269,6 +270,10 @@ class Diagnosis:
         The conditions of the physics the best point violates (the linkage passes a
         dead point inside the stroke, or does not assemble): no relaxation of a
         requirement is proposed for them; the stroke or the bounds must change.
+    impossible
+        Closed-form proofs, found before any solve, that no design within the bounds
+        meets the requirements they name (the mechanism's necessary conditions,
+        :class:`~optdesign.models.impossibility.Impossibility`); empty otherwise.
     """
 
     relaxations: list[Relaxation] = field(default_factory=list)
@@ -276,6 +281,7 @@ class Diagnosis:
     note: str = ""
     together: list[Relaxation] = field(default_factory=list)
     physical: list[str] = field(default_factory=list)
+    impossible: list[Impossibility] = field(default_factory=list)
 
 
 @dataclass

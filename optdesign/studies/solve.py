@@ -14,6 +14,7 @@ sensitivities and the ranges of an optimum.
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -28,12 +29,20 @@ from optdesign.formulations.protocol import (
 )
 from optdesign.formulations.registry import pick_formulation
 from optdesign.formulations.verify import validity_report
+from optdesign.models.impossibility import Impossibility
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.necessary import impossibilities
 from optdesign.problem.request import SolveRequest
 from optdesign.problem.validity import is_validity, outside_ranges
 from optdesign.safe_io import refuse_file_options
 from optdesign.solvers.deadline import deadline, passed
-from optdesign.solvers.result import Diagnosis, Result
+from optdesign.solvers.result import (
+    Diagnosis,
+    Globality,
+    Result,
+    SolutionStatus,
+    TerminationCondition,
+)
 
 __all__ = ["check_fixed_design", "name_outside_ranges", "plan_solve", "solve"]
 
@@ -66,6 +75,12 @@ def solve(problem: DesignProblem, request: SolveRequest) -> Result:
     # Before any work and whatever the formulation: no option may read or write a file.
     refuse_file_options(request.options, "options")
     formulation = plan_solve(problem, request)
+    t0 = time.perf_counter()
+    proofs = impossibilities(problem) if problem.free else []
+    if proofs:  # the mechanism's own geometry rules out every design: no search
+        result = impossible_result(problem, formulation.name, proofs, request.objective)
+        result.wall_time_s = time.perf_counter() - t0
+        return result
     time_limit = request.time_limit
     with deadline(time_limit):
         result = _solve_within(problem, formulation, request)
@@ -79,6 +94,43 @@ def solve(problem: DesignProblem, request: SolveRequest) -> Result:
     # the diagnosis may give a failed result its best point (a GP's, the exact NLP's)
     name_outside_ranges(problem, result)
     return result
+
+
+def impossible_result(
+    problem: DesignProblem,
+    formulation: str,
+    proofs: list[Impossibility],
+    objective: str | None = None,
+) -> Result:
+    """The verdict of a problem whose mechanism proves, before any solve, that no design
+    within the bounds meets the requirements the ``proofs`` name: infeasible, with no
+    design, the proofs in its diagnosis (``objective``: the one asked, None: the
+    problem's first)."""
+    label = problem.mechanism.label()
+    return Result(
+        status="infeasible",
+        objective=float("nan"),
+        solver="none",
+        formulation=formulation,
+        termination=TerminationCondition.INFEASIBLE,
+        solution_status=SolutionStatus.NO_SOLUTION,
+        message=f"no {label} within the bounds can meet {_names(proofs)} together (proved "
+        "by a closed form of its geometry: no solve was run)",
+        objective_name=objective or problem.objective_names[0],
+        problem=problem.name,
+        mechanism=problem.mechanism_name,
+        problem_object=problem,
+        diagnosis=Diagnosis(
+            basis=f"a closed form of the {label}'s geometry, before any solve",
+            impossible=list(proofs),
+        ),
+        globality=Globality(basis="proved infeasible by a closed form: nothing to search"),
+    )
+
+
+def _names(proofs: list[Impossibility]) -> str:
+    names = list(dict.fromkeys(n for p in proofs for n in p.requirements))
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
 
 
 def name_outside_ranges(problem: DesignProblem, result: Result) -> None:

@@ -1066,11 +1066,21 @@ def test_fit_values_is_the_files_choice_else_table_for_a_catalogue_pin():
 
 
 def test_parameter_defaults_of_fin_actuator_and_without_a_table_fit():
+    """With catalogue variables free, every catalogue solve passes its node's values: the
+    defaults are placeholders. With every catalogue variable fixed, no search replaces
+    them: they are the fixed items' own data."""
     names = ["screw_d1", "screw_Ca", "screw_C0a", "screw_K_nut", "screw_K_load"]
     assert _fin().parameters() == {"fit_ratio_max": 1.0, "fit_ratio_min": 1.0} | dict.fromkeys(
         names, 1.0
     )
     assert _fin(fit_values="smooth").parameters() == dict.fromkeys(names, 1.0)
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+    for name, value in (("d0", "25 mm"), ("p", "5 mm"), ("d", "6 mm")):
+        data["variables"][name] = value
+    data["requirements"]["fit_values"] = "table"
+    fixed = od.load(data)
+    assert fixed.parameters() == fixed.parameter_values({"d0": (25.0, 25.0), "p": (5.0, 5.0)})
+    assert fixed.parameters()["screw_C0a"] > 1e4
 
 
 def test_a_fit_without_smooth_formula_takes_the_smallest_table_clearance():
@@ -1635,3 +1645,23 @@ def test_an_off_catalogue_screw_takes_the_nearest_items_data():
     assert (row.d0, row.p, on) == (20.0, 5.0, False)
     row, on = _nearest(items, 25.0, 10.0)
     assert (row.d0, row.p, on) == (25.0, 10.0, True)
+
+
+def test_a_catalogue_optimums_items_fixed_give_its_optimum_by_a_plain_nlp():
+    """fin_actuator's catalogue optimum, its screw (d0, p) and pins fixed in the file (the
+    table fit its catalogue pins use): a solve with no catalogue search must see those
+    items' data, not placeholders, and ends at the same optimum. Before, the NLP read a
+    static load rating of 1 N and called the problem infeasible (least violation 6e3)."""
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator.toml").read_text())
+    found = od.solve(od.load(copy.deepcopy(data)), ranges=False, sensitivities=False)
+    assert found.status == "optimal"
+    for name in ("d0", "p", "d"):
+        data["variables"][name] = f"{found.design[name]} mm"
+    data["requirements"]["fit_values"] = "table"
+    problem = od.load(data)
+    assert not any(v.discrete for v in problem.free)
+    defaults = drive.parameter_defaults(problem)
+    assert defaults["screw_C0a"] > 1e4  # the item's rating (N), not the placeholder 1
+    again = od.solve(problem, ranges=False, sensitivities=False)
+    assert again.status == "optimal" and again.formulation.startswith("nlp")
+    assert again.objective == pytest.approx(found.objective, rel=1e-7)

@@ -183,3 +183,31 @@ def test_loop_requirements_without_a_loop_say_what_they_need():
     del data["loop"]
     with pytest.raises(od.OptDesignError, match=r"bandwidth_min: needs a \[loop\] section"):
         od.solve(od.load(data), starts=1, ranges=False)
+
+
+def test_a_population_with_designs_that_pass_a_dead_point_gets_nan_loop_rows(problem):
+    """The NumPy path answers NaN for a design whose drive is no plant (a ratio that is
+    not positive inside the stroke, a linkage that does not assemble), never an error:
+    the global search evaluates such populations (a continuous fin_actuator_loop, items
+    fixed, failed with "plant.ratio: must be positive")."""
+    good = _x(problem, LOOP_OPTIMUM)
+    # a short arm and rod at the offset's top: the linkage folds inside the stroke
+    bad = _x(problem, dict(LOOP_OPTIMUM, R=30.0, l=40.0, n=150.0))
+    ev = problem.evaluate(np.array([good, bad]))
+    for name in ("loop_stable", "limit_cycle_amplitude"):
+        values = ev.constraints[name].values
+        assert np.all(np.isfinite(values[0])) and np.all(np.isnan(values[1])), name
+    alone = problem.evaluate(good).constraints["loop_stable"].values
+    np.testing.assert_array_equal(np.ravel(alone), ev.constraints["loop_stable"].values[0])
+
+
+def test_a_loop_problem_with_every_variable_fixed_is_checked():
+    """Every variable fixed at fin_actuator_loop's optimum (the table fit its catalogue
+    pins use): the fixed design is checked, its backlash the catalogue optimum's."""
+    data = tomllib.loads((PROBLEMS / "fin_actuator_loop.toml").read_text())
+    for name, value in LOOP_OPTIMUM.items():
+        data["variables"][name] = f"{value} {'rad' if name == 'phi0' else 'mm'}"
+    data["requirements"]["fit_values"] = "table"
+    result = od.solve(od.load(data))
+    assert result.formulation == "fixed" and result.status == "optimal"
+    assert result.objective == pytest.approx(0.0430783894, rel=1e-6)

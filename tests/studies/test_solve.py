@@ -483,3 +483,45 @@ def test_fork_optimum_backlash_from_the_iso_formula_and_hertz_by_hand():
     res = solve_nlp(load_problem(PROBLEMS / "fork_min_backlash.toml"), starts=2, seed=1)
     assert res.design["d"] == pytest.approx(d, rel=1e-6)
     assert res.objective == pytest.approx(expected, rel=1e-6)
+
+
+def _widened_stroke(degrees: float) -> od.DesignProblem:
+    import tomllib
+
+    data = tomllib.loads((PROBLEMS / "cs_min_backlash.toml").read_text())
+    data["requirements"]["deflection"].update(min=f"-{degrees} deg", max=f"{degrees} deg")
+    return od.load(data)
+
+
+def test_a_stroke_the_geometry_rules_out_is_refused_before_any_solve(monkeypatch, tmp_path):
+    """cs_min_backlash over +-120 deg: no crank-slider turns through 240 deg with its
+    transmission angle in [40, 140] deg and its rod within 30 deg. The verdict names the
+    three and what lifts the proof, with no NLP built; the summary and result.json say
+    so; a remedy applied lifts it."""
+    from optdesign.formulations.nlp import solve as nlp_solve
+
+    def no_solver(*args, **kwargs):
+        raise AssertionError("an NLP was built for a problem proved impossible")
+
+    monkeypatch.setattr(nlp_solve, "solver_for", no_solver)
+    problem = _widened_stroke(120)
+    result = od.solve(problem)
+    assert result.status == "infeasible" and not result.design and result.multistart is None
+    (proof,) = result.diagnosis.impossible
+    assert proof.requirements == ("deflection", "transmission_angle", "rod_inclination_max")
+    assert proof.remedies[0] == "a stroke of at most 160 deg"
+    text = result.summary()
+    assert "no feasible design exists within the bounds (proved, no solve was run)" in text
+    assert "    - rod_inclination_max of at least 70 deg" in text
+    doc = result_document(result)
+    assert doc["diagnosis"]["impossible"][0]["requirements"][0] == "deflection"
+    # a front of it is refused the same way, before any work (exit 1 from the command)
+    from optdesign.errors import InfeasibleRequirementsError
+
+    with pytest.raises(InfeasibleRequirementsError, match="rod_inclination_max of at least 70"):
+        od.pareto(problem, ["ripple", "backlash"], points=5, out=tmp_path / "front")
+    # the remedy: +-80 deg is not refused (whether it is feasible is the search's answer)
+    from optdesign.problem.necessary import impossibilities
+
+    assert impossibilities(_widened_stroke(80)) == []
+    assert impossibilities(_widened_stroke(80.01))

@@ -29,13 +29,13 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.design_problem import DesignProblem, population_rows
 from optdesign.problem.parameters import (
     MOVED_SIZE,
     limit_shown,
@@ -88,21 +88,54 @@ def from_multipliers(
     scaling; ``objective``: the name the records carry; ``row_model(mu)``: the rows'
     value (``.value(problem, x)``) weighted by the unscaled multipliers ``mu``. Ranked by
     the size of the log-sensitivity (what costs most first); empty without multipliers."""
-    raw = result.raw
-    lam_g = np.asarray(raw["lam_g"], dtype=float)
-    lam_x = np.asarray(raw["lam_x"], dtype=float)
-    if len(lam_g) != len(nlp.g_names) or len(lam_x) != len(nlp.lbz):
-        return []
+    return from_multipliers_many(problem, [result], nlp, target, objective, [row_model])[0]
+
+
+def from_multipliers_many(
+    problem: DesignProblem,
+    results: Sequence[Result],
+    nlp: Any,
+    target: str,
+    objective: str,
+    row_models: Sequence[Any],
+) -> list[list[Sensitivity]]:
+    """:func:`from_multipliers` of several optima of one ``nlp`` (a front's points), each
+    with its row model. The rows of every optimum are evaluated together, one NumPy
+    population per moved requirement, where each optimum's own evaluation would cost as
+    much as all of them; the records are those of one optimum at a time."""
     T = nlp.target_scales[nlp.targets.index(target)]
-    mu = lam_g * T / nlp.g_scale
-    x = np.array([result.design[v.name] for v in problem.free])
-    v = float(result.objective)
-    rows = row_model(mu)
-    # a row model that can reuse the design's evaluation (the NLP's rows) moves a limit that
-    # changes no model function without evaluating the model again
-    evaluated = rows.evaluate(problem, x) if isinstance(rows, _RowModel) else None
-    base = rows.total(evaluated) if evaluated is not None else rows.value(problem, x)
-    out: list[tuple[Sensitivity, float]] = []  # with the effect of +1 % (or +1 unit at 0)
+    out: list[list[Sensitivity]] = [[] for _ in results]
+    ready: list[tuple[int, np.ndarray, float, Any, np.ndarray]] = []
+    for j, (result, row_model) in enumerate(zip(results, row_models, strict=True)):
+        raw = result.raw
+        lam_g = np.asarray(raw["lam_g"], dtype=float)
+        lam_x = np.asarray(raw["lam_x"], dtype=float)
+        if len(lam_g) != len(nlp.g_names) or len(lam_x) != len(nlp.lbz):
+            continue
+        x = np.array([result.design[v.name] for v in problem.free])
+        rows = row_model(lam_g * T / nlp.g_scale)
+        ready.append((j, x, float(result.objective), rows, lam_x))
+    if not ready:
+        return out
+    X = np.array([x for _, x, _, _, _ in ready])
+    models = [rows for _, _, _, rows, _ in ready]
+    # a row model that can reuse the design's evaluation (the NLP's rows) moves a limit
+    # that changes no model function without evaluating the model again
+    reuse = all(isinstance(rows, _RowModel) for rows in models)
+
+    def values(q: DesignProblem) -> list[float]:
+        if reuse:
+            return [r.total(ev) for r, ev in zip(models, _evaluate_many(q, X), strict=True)]
+        return [r.value(q, x) for r, x in zip(models, X, strict=True)]
+
+    evaluated = _evaluate_many(problem, X) if reuse else None
+    base = (
+        values(problem)
+        if evaluated is None
+        else [r.total(ev) for r, ev in zip(models, evaluated, strict=True)]
+    )
+    found: list[list[tuple[Sensitivity, float]]] = [[] for _ in ready]
+    shown: dict[str, Any] = {}  # each limit as read, once for every optimum
     for path, p in requirement_paths(problem):
         h = STEP * max(abs(p), 1e-9)
         try:
@@ -110,36 +143,107 @@ def from_multipliers(
         except Exception:  # a step the schema refuses (a band's min at its max): skip it
             continue
         limits = None if evaluated is None else moved_limits(problem, path, p + h, p - h)
-        if limits is not None:
-            up, down = (rows.total(evaluated.with_limits(lim)) for lim in limits)
+        if limits is not None and evaluated is not None:
+            pairs = list(zip(models, evaluated, strict=True))
+            ups = [r.total(ev.with_limits(limits[0])) for r, ev in pairs]
+            downs = [r.total(ev.with_limits(limits[1])) for r, ev in pairs]
         else:
-            up, down = (rows.value(q, x) for q in moved)
-        if not (math.isfinite(up) and math.isfinite(down) and math.isfinite(base)):
-            continue
-        out.append(_record(problem, objective, f"requirements.{path}", p, (up - down) / (2 * h), v))
-    for k, var in enumerate(problem.free):
-        lam = float(lam_x[k])
-        if lam == 0.0 or var.discrete:  # a catalogue variable is held at its item, not a bound
-            continue
-        side = "upper" if lam > 0 else "lower"
-        bound = var.upper if lam > 0 else var.lower
-        d = -lam * T / nlp.x_span[k]
-        out.append(_record(problem, objective, f"variables.{var.name}.{side}", bound, d, v))
-    kept = [s for s, effect in out if abs(effect) > NEGLIGIBLE * max(abs(v), 1e-300)]
-    # ranked by the size of the effect to 6 digits, then by name: two limits that cost the
-    # same (the two ends of a symmetric stroke) keep one order whatever the last digits of
-    # the solve that gave their multipliers
-    kept.sort(key=lambda s: (-float(f"{abs(s.log_sensitivity or 0.0):.6g}"), s.name))
-    return kept
+            ups, downs = values(moved[0]), values(moved[1])
+        name = f"requirements.{path}"
+        for i, (up, down) in enumerate(zip(ups, downs, strict=True)):
+            if not (math.isfinite(up) and math.isfinite(down) and math.isfinite(base[i])):
+                continue
+            if name not in shown:
+                shown[name] = limit_shown(problem, name, p)
+            slope = (up - down) / (2 * h)
+            found[i].append(_record(problem, objective, name, p, slope, ready[i][2], shown[name]))
+    for i, (j, _, v, _, lam_x) in enumerate(ready):
+        for k, var in enumerate(problem.free):
+            lam = float(lam_x[k])
+            if lam == 0.0 or var.discrete:  # a catalogue variable is held at its item
+                continue
+            side = "upper" if lam > 0 else "lower"
+            bound = var.upper if lam > 0 else var.lower
+            d = -lam * T / nlp.x_span[k]
+            found[i].append(
+                _record(problem, objective, f"variables.{var.name}.{side}", bound, d, v)
+            )
+        kept = [s for s, effect in found[i] if abs(effect) > NEGLIGIBLE * max(abs(v), 1e-300)]
+        # ranked by the size of the effect to 6 digits, then by name: two limits that cost
+        # the same (the two ends of a symmetric stroke) keep one order whatever the last
+        # digits of the solve that gave their multipliers
+        kept.sort(key=lambda s: (-float(f"{abs(s.log_sensitivity or 0.0):.6g}"), s.name))
+        out[j] = kept
+    return out
+
+
+def _evaluate_many(problem: DesignProblem, X: np.ndarray) -> list[_Evaluated]:
+    """The rows of ``problem`` at each design of ``X`` (one per row), from one NumPy
+    evaluation of the population. The first design's rows are checked against its own
+    evaluation: a block whose shape could be read two ways (a grid row as long as the
+    population) sends every design to its own evaluation instead."""
+    own = _evaluate_one(problem, X[0])
+    if len(X) == 1:
+        return [own]
+    pop = len(X)
+    with np.errstate(all="ignore"):
+        ex = problem.expressions(problem.design_dict(X))
+    limits = problem.objective_limits()
+    per: list[tuple[dict, dict]] = [({}, {}) for _ in range(pop)]
+    for name, term in ex.objectives.items():
+        e = np.asarray(term.expr, dtype=float)
+        if term.kind == "scalar" and e.shape == (pop,):
+            e = e[:, None]
+        rows = population_rows(e, pop)
+        for (blocks, scalars), row in zip(per, rows, strict=True):
+            _objective_rows(blocks, scalars, name, term.kind, np.ravel(row))
+    for block in ex.constraints:
+        rows = population_rows(np.asarray(block.expr, dtype=float), pop)
+        for (blocks, _), row in zip(per, rows, strict=True):
+            blocks[block.name] = (np.ravel(row), block.lower, block.upper)
+    out = [_Evaluated(blocks, scalars, limits) for blocks, scalars in per]
+    if not _same_evaluation(own, out[0]):
+        return [own, *(_evaluate_one(problem, x) for x in X[1:])]
+    return out
+
+
+def _evaluate_one(problem: DesignProblem, x: np.ndarray) -> _Evaluated:
+    """The model's blocks and scalar objectives at design ``x``, with their limits."""
+    with np.errstate(all="ignore"):
+        ex = problem.expressions(problem.design_dict(x))
+        blocks, scalars = _blocks(ex)
+    return _Evaluated(blocks, scalars, problem.objective_limits())
+
+
+def _same_evaluation(a: _Evaluated, b: _Evaluated) -> bool:
+    if a.blocks.keys() != b.blocks.keys() or a.scalars.keys() != b.scalars.keys():
+        return False
+    same = all(
+        a.blocks[k][0].shape == b.blocks[k][0].shape
+        and np.allclose(a.blocks[k][0], b.blocks[k][0], rtol=1e-12, atol=0.0, equal_nan=True)
+        for k in a.blocks
+    )
+    return same and all(
+        np.isclose(a.scalars[k], b.scalars[k], rtol=1e-12, atol=0.0, equal_nan=True)
+        for k in a.scalars
+    )
 
 
 def _record(
-    problem: DesignProblem, objective: str, path: str, p: float, dvdp: float, v: float
+    problem: DesignProblem,
+    objective: str,
+    path: str,
+    p: float,
+    dvdp: float,
+    v: float,
+    limit: Any = None,
 ) -> tuple[Sensitivity, float]:
-    """The record of ``dv*/dp`` at limit ``p`` (both internal), in the user's units."""
+    """The record of ``dv*/dp`` at limit ``p`` (both internal), in the user's units
+    (``limit``: the limit as read, :func:`limit_shown`, when the caller has it)."""
     from optdesign.display.shown import objective_shown
 
-    limit = limit_shown(problem, path, p)
+    if limit is None:
+        limit = limit_shown(problem, path, p)
     factor = limit.value / p if p != 0 and limit.value else 1.0
     obj = objective_shown(problem, objective, v)
     obj_factor = obj.value / v if v != 0 else objective_shown(problem, objective, 1.0).value
@@ -185,10 +289,7 @@ class _RowModel:
 
     def evaluate(self, problem: DesignProblem, x: np.ndarray) -> _Evaluated:
         """The model's blocks and scalar objectives at design ``x``, with their limits."""
-        with np.errstate(all="ignore"):
-            ex = problem.expressions(problem.design_dict(x))
-            blocks, scalars = _blocks(ex)
-        return _Evaluated(blocks, scalars, problem.objective_limits())
+        return _evaluate_one(problem, x)
 
     def total(self, ev: _Evaluated) -> float:
         """``v(p) + sum mu_i (g_i - b_i)`` from an evaluation."""
@@ -242,16 +343,21 @@ class _Limits:
     objectives: dict[str, float]
 
 
+def _objective_rows(blocks: dict, scalars: dict, name: str, kind: str, e: np.ndarray) -> None:
+    """An objective's epigraph rows (the NLP's envelope rows read its values) and, for a
+    scalar one, its value."""
+    blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
+    blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
+    blocks[f"{name}_envelope"] = (-e, 0.0, None)
+    if kind == "scalar":
+        scalars[name] = float(e[0])
+
+
 def _blocks(ex) -> tuple[dict[str, tuple[np.ndarray, Any, Any]], dict[str, float]]:
     blocks: dict[str, tuple[np.ndarray, Any, Any]] = {}
     scalars: dict[str, float] = {}
     for name, term in ex.objectives.items():
-        e = np.ravel(np.asarray(term.expr, dtype=float))
-        blocks[f"{name}_lower_envelope"] = (e, 0.0, None)
-        blocks[f"{name}_upper_envelope"] = (-e, 0.0, None)
-        blocks[f"{name}_envelope"] = (-e, 0.0, None)
-        if term.kind == "scalar":
-            scalars[name] = float(e[0])
+        _objective_rows(blocks, scalars, name, term.kind, np.ravel(np.asarray(term.expr, float)))
     for block in ex.constraints:
         blocks[block.name] = (
             np.ravel(np.asarray(block.expr, dtype=float)),

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from types import SimpleNamespace
 from typing import Any
 
@@ -71,37 +72,75 @@ class PointCosts:
 def point_costs(problem: DesignProblem, objectives: Sequence[str], point: Any) -> PointCosts:
     """The costs at ``point`` (a :class:`~optdesign.studies.pareto.front.FrontPoint` of a
     front of ``objectives`` on ``problem``), or why they cannot be known."""
-    costs = PointCosts(target=point.target, held=dict(point.eps))
-    raw = getattr(point, "multipliers", None)
-    if point.kind == "nsga2":
-        costs.why = "NSGA-II evolves its designs without a gradient solver: no multipliers"
-    elif point.kind == "weighted_sum":
-        costs.why = "its multipliers price the weighted sum of the objectives, not one of them"
-    elif raw is None:
-        costs.why = "the point's record keeps no multipliers of its solve"
-    if costs.why:
-        return costs
-    try:
-        _from_multipliers(problem, objectives, point, raw, costs)
-    except Exception as exc:  # a report: never lose the page for a point's costs
-        text = " ".join(str(exc).split())[:200]
-        costs.sensitivities = []
-        costs.why = f"they could not be computed ({type(exc).__name__}: {text})"
-    return costs
+    return front_costs(problem, objectives, [point])[0]
 
 
-def _from_multipliers(
+def front_costs(
+    problem: DesignProblem, objectives: Sequence[str], points: Sequence[Any]
+) -> list[PointCosts]:
+    """:func:`point_costs` of each of ``points``, their models evaluated together (one
+    NumPy population per moved requirement and target,
+    :func:`~optdesign.formulations.nlp.sensitivities.from_multipliers_many`)."""
+    from optdesign.formulations.nlp.sensitivities import from_multipliers_many
+    from optdesign.formulations.nlp.solve import formulation_for
+
+    out: list[PointCosts] = []
+    pending: dict[str, list[tuple[PointCosts, Any, Any]]] = {}
+    for point in points:
+        costs = PointCosts(target=point.target, held=dict(point.eps))
+        out.append(costs)
+        raw = getattr(point, "multipliers", None)
+        if point.kind == "nsga2":
+            costs.why = "NSGA-II evolves its designs without a gradient solver: no multipliers"
+        elif point.kind == "weighted_sum":
+            costs.why = "its multipliers price the weighted sum of the objectives, not one of them"
+        elif raw is None:
+            costs.why = "the point's record keeps no multipliers of its solve"
+        if costs.why:
+            continue
+        try:
+            prepared = _prepared(problem, objectives, point, raw, costs)
+        except Exception as exc:  # a report: never lose the page for a point's costs
+            _failed(costs, exc)
+            continue
+        if prepared is not None:
+            pending.setdefault(costs.target, []).append((costs, *prepared))
+    if pending:
+        nlp = formulation_for(problem, tuple(sorted(objectives)))
+    for target, items in pending.items():
+        solved = [s for _, s, _ in items]
+        models = [m for _, _, m in items]
+        try:
+            found = from_multipliers_many(problem, solved, nlp, target, target, models)
+        except Exception as exc:  # a report: never lose the page for the points' costs
+            for costs, _, _ in items:
+                _failed(costs, exc)
+            continue
+        for (costs, _, _), sensitivities in zip(items, found, strict=True):
+            costs.sensitivities = sensitivities
+    return out
+
+
+def _failed(costs: PointCosts, exc: Exception) -> None:
+    text = " ".join(str(exc).split())[:200]
+    costs.sensitivities = []
+    costs.why = f"they could not be computed ({type(exc).__name__}: {text})"
+
+
+def _prepared(
     problem: DesignProblem, objectives: Sequence[str], point: Any, raw: Any, costs: PointCosts
-) -> None:
-    """Fill ``costs`` from the point's multipliers ``raw`` (or say why not)."""
-    from optdesign.formulations.nlp.sensitivities import _RowModel, from_multipliers
+) -> tuple[Any, Any] | None:
+    """The point's solve as the envelope theorem reads it (design, multipliers, value) and
+    its row model, from the point's multipliers ``raw``; None when they cannot serve
+    (``costs.why`` says why)."""
+    from optdesign.formulations.nlp.sensitivities import _RowModel
     from optdesign.formulations.nlp.solve import formulation_for
 
     target, eps = costs.target, costs.held
     nlp = formulation_for(problem, tuple(sorted(objectives)))
     if raw.nlp != nlp.fingerprint or len(raw.lam_g) != len(nlp.g_names):
         costs.why = "its multipliers belong to another formulation than the front's"
-        return
+        return None
     lam_x = np.asarray(raw.lam_x, dtype=float)
     lam_g = np.asarray(raw.lam_g, dtype=float)
     derived, residual = bound_multipliers(
@@ -116,7 +155,7 @@ def _from_multipliers(
                 f"(residual {residual:.2g} of the scaled gradient), nor did a solve again "
                 "from its design end at its value or just below"
             )
-            return
+            return None
         design, lam_g, lam_x, lower = again
         costs.basis = (
             "its problem solved again from its design (the front's solve left multipliers "
@@ -131,14 +170,7 @@ def _from_multipliers(
         design=design,
         objective=point.objectives[target],
     )
-    costs.sensitivities = from_multipliers(
-        problem,
-        solved,  # type: ignore[arg-type]  # the fields from_multipliers reads
-        nlp,
-        target,
-        target,
-        lambda mu: _RowModel(nlp, target, mu, eps=eps),
-    )
+    return solved, partial(_RowModel, nlp, target, eps=eps)
 
 
 #: A point's value and its solve again from its design agree within this (relative):

@@ -174,6 +174,13 @@ class Front:
 
         return front_summary([self])
 
+    def point_costs(self, problem: Any) -> list[PointCosts]:
+        """:meth:`FrontPoint.costs` of every point, in their order, the points' models
+        evaluated together (what a page of the whole front shows)."""
+        from optdesign.studies.pareto.costs import front_costs
+
+        return front_costs(problem, self.objectives, self.points)
+
     def to_frame(self, rejected: bool = False):
         """A pandas DataFrame: one row per point (objectives, free variables, status)."""
         from optdesign.display.frames import front_frame

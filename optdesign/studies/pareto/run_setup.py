@@ -12,9 +12,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from optdesign.errors import InputError
+from optdesign.errors import InfeasibleRequirementsError, InputError
 from optdesign.formulations.nlp.solve import formulation_for
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.necessary import impossibilities
 from optdesign.runtime.identity import run_identity
 from optdesign.runtime.run_options import RunOptions as RunOptions  # the fronts import it here
 from optdesign.safe_io import slug
@@ -22,12 +23,19 @@ from optdesign.studies.pareto.records import record_problem
 
 
 def check_front_problem(problem: DesignProblem) -> None:
-    """Refuse, before any work, a problem no front can be traced on."""
+    """Refuse, before any work, a problem no front can be traced on: no free variable,
+    or a mechanism's proof that no design within the bounds meets the requirements."""
     if not problem.free:
         raise InputError(
             "variables",
             "no free variable: a front trades objectives by moving the design, and this "
             "problem's design is fixed (od.solve, optdesign solve, checks it)",
+        )
+    proofs = impossibilities(problem)
+    if proofs:
+        raise InfeasibleRequirementsError(
+            "no design within the bounds can meet the requirements, so there is no front "
+            f"(proved before any solve): {'; '.join(p.text() for p in proofs)}"
         )
 
 

@@ -519,6 +519,31 @@ def test_a_front_points_costs_equal_resolves_of_its_own_problem(cs):
     assert {"variables.p.lower", "requirements.mean_ratio.min"} <= checked
 
 
+def test_a_fronts_costs_evaluated_together_equal_each_points_own(cs, cs_front, monkeypatch):
+    """``Front.point_costs`` evaluates the points' models as one population per moved
+    requirement: the same records, to the last digits, as each point's own evaluation,
+    and far fewer model evaluations (one per moved requirement, not one per point)."""
+    from optdesign.problem.design_problem import DesignProblem
+    from optdesign.studies.pareto.costs import point_costs
+
+    point_costs(cs, cs_front.objectives, cs_front.points[0])  # the per-problem caches filled
+    calls = []
+    build = DesignProblem._build
+    monkeypatch.setattr(
+        DesignProblem, "_build", lambda self, *a, **k: calls.append(1) or build(self, *a, **k)
+    )
+    together = cs_front.point_costs(cs)
+    n_together = len(calls)
+    alone = [point_costs(cs, cs_front.objectives, point) for point in cs_front.points]
+    assert len(cs_front.points) >= 8 and n_together * 4 < len(calls) - n_together
+    for a, b in zip(together, alone, strict=True):
+        assert a.why == b.why == "" and a.basis == b.basis
+        assert [s.name for s in a.sensitivities] == [s.name for s in b.sensitivities]
+        for s, t in zip(a.sensitivities, b.sensitivities, strict=True):
+            assert s.d_objective_d_limit == pytest.approx(t.d_objective_d_limit, rel=1e-9)
+            assert (s.limit, s.unit) == (t.limit, t.unit)
+
+
 def test_a_front_point_whose_costs_cannot_be_known_says_why(cs, cs_front):
     from dataclasses import replace
 
