@@ -16,7 +16,7 @@
   of their CPU times, one thread: less moved by the other jobs of a shared machine). The
   continuous problem is fin_actuator.toml with d0, p and d continuous over the same
   ranges; the catalogue's item data go with them (the nut stiffness is the fixed 270
-  N/um of tests/hostile2/data/drive_continuous.toml, and the requirements that need a
+  N/um of tests/hostile_classes/data/drive_continuous.toml, and the requirements that need a
   catalogue screw's load ratings - static safety, life and its duty cycle - are left
   out). The 50-point front of the shipped continuous cs_min_backlash (ripple against
   backlash, as in global_search/cost.py) runs beside them. The fronts alone are timed

@@ -1,6 +1,6 @@
 """The command line under hostile input (optdesign/cli.py): generated mutations of every
 shipped problem file, hand-written files and bad command lines (tests/hostile_corpus.py), and
-the second corpus organised by class (tests/hostile2) - every case ends cleanly: the exit code,
+the second corpus organised by class (tests/hostile_classes) - every case ends cleanly: the exit code,
 one line naming the field, no traceback; the whole corpus runs under the ``slow`` mark."""
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from hostile2.controls import cases as control_cases
-from hostile2.fuzz import run_fuzz
-from hostile2.model import CLASSES
-from hostile2.run import all_cases as corpus2_cases
-from hostile2.run import run_case as run_corpus2_case
-from hostile2.server import Server
+from hostile_classes.controls import cases as control_cases
+from hostile_classes.fuzz import run_fuzz
+from hostile_classes.model import CLASSES
+from hostile_classes.run import all_cases as corpus2_cases
+from hostile_classes.run import run_case as run_corpus2_case
+from hostile_classes.server import Server
 from hostile_corpus import PROBLEMS, all_cases, handwritten_cases, run_case
 
 HERE = Path(__file__).resolve().parent
@@ -147,7 +147,7 @@ def test_an_unforeseen_error_is_one_line(monkeypatch, capsys):
         run_guarded(boom)
 
 
-# The second corpus (tests/hostile2): a representative subset of its cases in the fast suite, the
+# The second corpus (tests/hostile_classes): a representative subset of its cases in the fast suite, the
 # whole corpus under the ``slow`` mark; every case runs in a corpus server (a child process: a
 # crash or a hang costs it, not pytest).
 
@@ -174,7 +174,7 @@ def _param(case):
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    s = Server(tmp_path_factory.mktemp("hostile2-server"))
+    s = Server(tmp_path_factory.mktemp("hostile-classes-server"))
     yield s
     s.stop()
 
@@ -255,7 +255,7 @@ def test_every_hostile_case_ends_as_its_class_requires(tmp_path):
     determinism, which depend on timing, aside)."""
     out = tmp_path / "corpus2.json"
     proc = subprocess.run(
-        [sys.executable, str(HERE / "hostile_corpus2.py"), str(out), "--quiet"],
+        [sys.executable, str(HERE / "hostile_classes_corpus.py"), str(out), "--quiet"],
         capture_output=True,
         text=True,
         timeout=7200,

@@ -114,7 +114,7 @@ cp "$ROOT/pyproject.toml" "$WORK/"
       test_every_hostile_case_ends_as_its_class_requires; do
     printf '    --deselect\n    tests/test_cli.py::%s\n' "$t"
   done
-  printf '    --ignore\n    tests/hostile2\n'
+  printf '    --ignore\n    tests/hostile_classes\n'
   printf "also_copy =\n"
   for f in problems examples docs benchmarks README.md setup.py .ci; do printf '    %s\n' "$f"; done
   echo "use_git_change_detection = false"

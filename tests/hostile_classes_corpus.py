@@ -1,6 +1,6 @@
-"""The second hostile corpus (issue 21): ``python tests/hostile_corpus2.py OUT.json``.
+"""The second hostile corpus (issue 21): ``python tests/hostile_classes_corpus.py OUT.json``.
 
-Runs every case of ``tests/hostile2`` - organised by the issue's eleven classes - through
+Runs every case of ``tests/hostile_classes`` - organised by the issue's eleven classes - through
 the command line in the default output mode and with ``--json``, and through the Python
 API where it applies, plus the hypothesis fuzz of problem dicts; writes every run's
 verdict to OUT.json and prints the counts per class. Options: ``--classes 2,5`` (only
@@ -16,7 +16,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE.parent), str(HERE)]
 
-from hostile2.run import main  # noqa: E402
+from hostile_classes.run import main  # noqa: E402
 
 if __name__ == "__main__":
     sys.exit(main())

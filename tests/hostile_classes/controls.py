@@ -9,8 +9,8 @@ import sys
 import time
 from typing import Any
 
-from hostile2.common import SOLVE, api_solve, base
-from hostile2.model import SUCCESS, Case, refuse
+from hostile_classes.common import SOLVE, api_solve, base
+from hostile_classes.model import SUCCESS, Case, refuse
 
 RIPPLE = base("cs_min_ripple")
 

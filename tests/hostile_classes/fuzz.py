@@ -21,7 +21,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from hostile2.common import base
+from hostile_classes.common import base
 
 SHIPPED = (
     "cs_min_ripple",
@@ -174,7 +174,7 @@ def _alarm(signum, frame):
 def judge_draw(data: dict[str, Any], names: set[str]) -> tuple[str, str]:
     """(verdict, message) of one draw: od.load, then od.solve (one start) if it loads."""
     import optdesign as od
-    from hostile2.verify import failure_text, result_problems
+    from hostile_classes.verify import failure_text, result_problems
     from optdesign.errors import OptDesignError
 
     old = signal.signal(signal.SIGALRM, _alarm)
@@ -241,8 +241,8 @@ def run_in_child(examples: int, home: str) -> list[dict[str, Any]]:
 def run_fuzz(server: Any, root: Path, examples: int) -> list[Any]:
     """The fuzz through the corpus server (a crash or a hang costs the batch, not the
     runner); its working directory checked like a case's."""
-    from hostile2 import workspace
-    from hostile2.model import Outcome
+    from hostile_classes import workspace
+    from hostile_classes.model import Outcome
 
     if root.exists():
         import shutil

@@ -7,8 +7,8 @@ import math
 import re
 from typing import Any
 
-from hostile2 import workspace
-from hostile2.common import (
+from hostile_classes import workspace
+from hostile_classes.common import (
     SOLVE,
     SOLVE_OUT,
     add,
@@ -19,7 +19,7 @@ from hostile2.common import (
     toml_str,
     value_check,
 )
-from hostile2.model import SUCCESS, Case, either, refuse
+from hostile_classes.model import SUCCESS, Case, either, refuse
 
 RIPPLE = base("cs_min_ripple")
 BACKLASH = base("cs_min_backlash")

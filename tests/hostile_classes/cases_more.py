@@ -19,9 +19,9 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from hostile2.common import base, sub
-from hostile2.model import SUCCESS, Case, either, refuse
-from hostile2.server import child_env
+from hostile_classes.common import base, sub
+from hostile_classes.model import SUCCESS, Case, either, refuse
+from hostile_classes.server import child_env
 
 #: The front every resume case starts from: cs_min_ripple with its solver settings written.
 PARETO_TEXT = base("cs_min_ripple") + "\n[solver]\nstarts = 2\nipopt = { tol = 1e-8 }\n"
@@ -45,7 +45,7 @@ def _base_run(kind: str) -> Path:
     """The finished run ``kind`` ("pareto" or "bench"), made once per process."""
     if kind in _BASES:
         return _BASES[kind]
-    top = Path(tempfile.mkdtemp(prefix="hostile2-base-"))
+    top = Path(tempfile.mkdtemp(prefix="hostile-classes-base-"))
     atexit.register(shutil.rmtree, top, True)
     out = top / "out"
     if kind == "pareto":

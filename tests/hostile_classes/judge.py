@@ -8,8 +8,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from hostile2 import verify, workspace
-from hostile2.model import Case, Outcome, worst
+from hostile_classes import verify, workspace
+from hostile_classes.model import Case, Outcome, worst
 
 Problems = list[tuple[str, str]]
 

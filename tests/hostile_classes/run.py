@@ -1,6 +1,6 @@
 """The corpus as a whole: every case in every form, judged, counted per class.
 
-``python tests/hostile_corpus2.py OUT.json`` runs it (see that script for the options);
+``python tests/hostile_classes_corpus.py OUT.json`` runs it (see that script for the options);
 :func:`run` is what the tests call.
 """
 
@@ -19,16 +19,23 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from hostile2 import workspace
-from hostile2.judge import judge_api, judge_cli
-from hostile2.model import CLASSES, Case, Outcome, counts
-from hostile2.server import ROOT, Server
+from hostile_classes import workspace
+from hostile_classes.judge import judge_api, judge_cli
+from hostile_classes.model import CLASSES, Case, Outcome, counts
+from hostile_classes.server import ROOT, Server
 
 
 @functools.cache
 def all_cases() -> tuple[Case, ...]:
     """Every case of the corpus (names unique)."""
-    from hostile2 import cases_api, cases_files, cases_more, cases_props, cases_units, special
+    from hostile_classes import (
+        cases_api,
+        cases_files,
+        cases_more,
+        cases_props,
+        cases_units,
+        special,
+    )
 
     cases = [
         *special.determinism_cases(),
@@ -51,7 +58,7 @@ def all_cases() -> tuple[Case, ...]:
 
 def case_index() -> dict[str, Case]:
     """Every case the server may be asked to run: the corpus and the control cases."""
-    from hostile2 import controls
+    from hostile_classes import controls
 
     return {c.name: c for c in [*all_cases(), *controls.cases()]}
 
@@ -157,7 +164,7 @@ def run(
                     flush=True,
                 )
         if fuzz_examples:
-            from hostile2.fuzz import run_fuzz
+            from hostile_classes.fuzz import run_fuzz
 
             outcomes += run_fuzz(server, workdir / "fuzz", fuzz_examples)
     finally:
@@ -252,7 +259,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.monotonic()
     tmp = None
     if args.workdir is None:
-        tmp = tempfile.mkdtemp(prefix="hostile2-")
+        tmp = tempfile.mkdtemp(prefix="hostile-classes-")
         workdir = Path(tmp)
     else:
         workdir = args.workdir
@@ -263,11 +270,11 @@ def main(argv: list[str] | None = None) -> int:
             shutil.rmtree(tmp, ignore_errors=True)
     summary = counts(outcomes)
     doc = {
-        "corpus": "tests/hostile_corpus2.py (issue 21)",
+        "corpus": "tests/hostile_classes_corpus.py (issue 21)",
         "commit": _commit(),
         "date": time.strftime("%Y-%m-%d %H:%M:%S"),
         "seconds": round(time.monotonic() - t0, 1),
-        "command": "python tests/hostile_corpus2.py "
+        "command": "python tests/hostile_classes_corpus.py "
         + " ".join(sys.argv[1:] if argv is None else argv),
         "classes": CLASSES,
         "counts": summary,

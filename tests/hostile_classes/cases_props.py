@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from hostile2.common import base, solving, sub
-from hostile2.model import SUCCESS, Case
+from hostile_classes.common import base, solving, sub
+from hostile_classes.model import SUCCESS, Case
 
 RIPPLE = base("cs_min_ripple")
 BACKLASH = base("cs_min_backlash")

@@ -32,10 +32,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from hostile2 import workspace
-from hostile2.common import base, sub
-from hostile2.model import SUCCESS, Case, Expect, worst
-from hostile2.server import child_env
+from hostile_classes import workspace
+from hostile_classes.common import base, sub
+from hostile_classes.model import SUCCESS, Case, Expect, worst
+from hostile_classes.server import child_env
 
 #: Seconds from the signal to the end of the process.
 DEADLINE = 1.0

@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from hostile2.common import PROBLEMS, ROOT, base, solving
-from hostile2.model import SUCCESS, Case, either, refuse
+from hostile_classes.common import PROBLEMS, ROOT, base, solving
+from hostile_classes.model import SUCCESS, Case, either, refuse
 
 RIPPLE = base("cs_min_ripple")
 BACKLASH = base("cs_min_backlash")

@@ -7,7 +7,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from hostile2.common import (
+from hostile_classes.common import (
     SOLVE,
     SOLVE_OUT,
     add,
@@ -18,7 +18,7 @@ from hostile2.common import (
     sub,
     toml_str,
 )
-from hostile2.model import SUCCESS, Case, either, infeasible, refuse
+from hostile_classes.model import SUCCESS, Case, either, infeasible, refuse
 
 RIPPLE = base("cs_min_ripple")
 BACKLASH = base("cs_min_backlash")

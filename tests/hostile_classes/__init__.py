@@ -13,7 +13,7 @@ does not contain, organised by the issue's eleven classes, and the runner that j
 - :mod:`.cases_files`, :mod:`.cases_api`, :mod:`.cases_more`: the cases;
 - :mod:`.special`: signals (class 3) and determinism (class 1), run as real processes;
 - :mod:`.fuzz`: the hypothesis fuzz of problem dicts through ``od.load`` / ``od.solve``;
-- :mod:`.run`: the corpus as a whole (``python tests/hostile_corpus2.py OUT.json``).
+- :mod:`.run`: the corpus as a whole (``python tests/hostile_classes_corpus.py OUT.json``).
 
 A case's expectation follows the issue, not today's behaviour: many cases fail on the
 code the corpus was written against (their counts are the issue's "before").

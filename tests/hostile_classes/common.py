@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from hostile2.model import Case, Expect
+from hostile_classes.model import Case, Expect
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"
@@ -21,7 +21,7 @@ SOLVE_OUT = [*SOLVE, "--out", "@OUT@"]
 
 
 def base(name: str) -> str:
-    """A shipped problem file (or one of tests/hostile2/data) as text."""
+    """A shipped problem file (or one of tests/hostile_classes/data) as text."""
     path = PROBLEMS / f"{name}.toml"
     if not path.exists():
         path = DATA / f"{name}.toml"

@@ -26,7 +26,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from hostile2 import workspace
+from hostile_classes import workspace
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
@@ -112,7 +112,7 @@ def _run_cli(argv: list[str]) -> Any:
 
 
 def _run_api(case: Any, root: Path) -> dict[str, Any]:
-    from hostile2.verify import failure_text, value_problems
+    from hostile_classes.verify import failure_text, value_problems
     from optdesign.errors import OptDesignError
 
     ctx = Ctx(root, case.text)
@@ -216,7 +216,7 @@ def execute(case: Any, req: dict[str, Any]) -> dict[str, Any]:
 
 
 def execute_fuzz(req: dict[str, Any]) -> dict[str, Any]:
-    from hostile2.fuzz import run_in_child
+    from hostile_classes.fuzz import run_in_child
 
     t0 = time.perf_counter()
     try:
@@ -239,7 +239,7 @@ def serve() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
     import optdesign.cli
     import optdesign.studies.solve
-    from hostile2.run import case_index
+    from hostile_classes.run import case_index
 
     optdesign.cli.build_parser()
     cases = case_index()
@@ -267,7 +267,7 @@ class Server:
         self.workdir.mkdir(parents=True, exist_ok=True)
         log = open(self.workdir / "server.log", "ab")
         self.proc = subprocess.Popen(
-            [sys.executable, "-c", "from hostile2.server import serve; serve()"],
+            [sys.executable, "-c", "from hostile_classes.server import serve; serve()"],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=log,
