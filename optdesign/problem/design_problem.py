@@ -497,7 +497,13 @@ class DesignProblem:
                 # the smooth pieces of a kinked objective, for the solver's epigraph only
                 pieces = info.pieces(q) if info.pieces is not None and m.is_symbolic(expr) else ()
                 objectives[info.name] = ObjectiveTerm(
-                    info.name, info.kind, expr, info.unit, info.description, tuple(pieces)
+                    info.name,
+                    info.kind,
+                    expr,
+                    info.unit,
+                    info.description,
+                    tuple(pieces),
+                    _bound_rows_of(info, q, expr),
                 )
         backlash = objectives["backlash"].expr if "backlash" in objectives else None
         blocks = requirement_blocks(q, self._constraints, backlash)
@@ -536,6 +542,15 @@ class DesignProblem:
             }
             worst = float(worst[0])
         return Evaluation(objectives, constraints, worst)
+
+
+def _bound_rows_of(info, q, expr):
+    """The implicit epigraph rows ``t -> (rows, labels)`` of an objective that declares
+    them, on the solver path only (the NumPy path has the exact value)."""
+    if info.bound_rows is None or not m.is_symbolic(expr):
+        return None
+    bound_rows = info.bound_rows
+    return lambda t: bound_rows(q, t)
 
 
 def _display_scale(unit: str, display_unit: str | None, scale: float | None) -> float:
