@@ -99,7 +99,7 @@ def test_the_solvers_start_is_the_rigid_drives_bandwidth(problem):
     np.testing.assert_allclose(exact / starts, 0.890, atol=5e-4)
 
 
-def _small_problem(angles: int = 2):
+def _small_problem(angles: int = 2, **sections):
     """fin_actuator_loop with its items and R, l, phi0 fixed at :data:`FAST`, the offset n
     free, the loop's rows at ``angles`` angles, and only the requirements a bandwidth
     needs: the stroke and its loads, the transmission angle, the motor and the loop's
@@ -115,7 +115,7 @@ def _small_problem(angles: int = 2):
     data["requirements"]["bandwidth_min"] = "8 Hz"
     data["loop"]["angles"] = angles
     data["objective"] = {"minimize": "bandwidth_period"}
-    return od.load(data)
+    return od.load({**data, **sections})
 
 
 @pytest.fixture(scope="module")
@@ -196,3 +196,16 @@ def test_a_period_bounds_the_objective_exactly_when_its_rows_hold(small, n, R):
     below, _ = bandwidth_period_rows(q, period * (1 - 1e-5))
     assert np.min(above) > 0
     assert np.min(below) < 0
+
+
+def test_the_gp_and_the_robust_design_say_why_they_cannot_pose_the_bandwidth():
+    """A root of the model is no posynomial, and the robust NLP has no per-sample implicit
+    epigraph: both refuse before any work, naming the objective."""
+    from optdesign.errors import ProblemError
+
+    robust = _small_problem(tolerances={"n": "0.05 mm"})
+    with pytest.raises(ProblemError, match="bandwidth_period is a root of the model") as gp:
+        od.solve(robust, "gp")
+    assert "not a posynomial" in str(gp.value)
+    with pytest.raises(ProblemError, match="robust design takes objectives that are"):
+        od.solve(robust, "robust")
