@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 import optdesign as od
+from optdesign.errors import InfeasibleRequirementsError
 from optdesign.problem.loop_analysis import loop_figures
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -49,18 +50,23 @@ def main() -> None:
     parser.add_argument("--points", type=int, default=4)
     args = parser.parse_args()
     print("placement Hz | point | backlash deg | d0/p/d mm | least bandwidth Hz (exact)"
-          " | resonance margin | sweep's backlash, pins | wall s")  # fmt: skip
+          " | resonance margin | sweep's backlash, pins | NLP solves | wall s")  # fmt: skip
     for f in (float(v) for v in args.placements.split(",")):
         problem = problem_at(f)
         start = time.perf_counter()
-        front = od.pareto(
-            problem, "backlash,bandwidth_period", points=args.points, workers=1, progress=False
-        )
-        wall = time.perf_counter() - start
         sweep = SWEEP.get(f)
         shown = "-" if sweep is None else f"{sweep[0]:.7f}, {sweep[1]} mm"
+        try:
+            front = od.pareto(
+                problem, "backlash,bandwidth_period", points=args.points, workers=1, progress=False
+            )
+        except InfeasibleRequirementsError as exc:  # no design at this placement
+            wall = time.perf_counter() - start
+            print(f"{f:g} | none: {' '.join(str(exc).split())[:400]} | {shown} | | {wall:.0f}")
+            continue
+        wall = time.perf_counter() - start
         if not front.points:
-            print(f"{f:g} | none | | | | | {shown} | {wall:.0f}")
+            print(f"{f:g} | none | | | | | {shown} | {front.n_solves} | {wall:.0f}")
             continue
         for k, point in enumerate(sorted(front.points, key=lambda p: p.objectives["backlash"])):
             x = np.array([point.design[v.name] for v in problem.free])
@@ -70,7 +76,7 @@ def main() -> None:
                 f"{f:g} | {k} | {point.objectives['backlash']:.7f} | {items} | "
                 f"{1.0 / point.objectives['bandwidth_period']:.5f} "
                 f"({figures.bandwidth.value:.5f}) | {figures.resonance_margin.value:.3f} | "
-                f"{shown if k == 0 else ''} | {wall if k == 0 else 0:.0f}"
+                + (f"{shown} | {front.n_solves} | {wall:.0f}" if k == 0 else "| |")
             )
 
 
