@@ -28,6 +28,7 @@ from optdesign.problem.objectives import (
     ConstraintInfo,
     ObjectiveInfo,
     ObjectiveTerm,
+    bound_rows_of,
 )
 from optdesign.problem.quantities import Quantities
 from optdesign.problem.requirements import requirement_blocks
@@ -496,14 +497,9 @@ class DesignProblem:
             if expr is not None:
                 # the smooth pieces of a kinked objective, for the solver's epigraph only
                 pieces = info.pieces(q) if info.pieces is not None and m.is_symbolic(expr) else ()
+                bound = bound_rows_of(info, q, expr)
                 objectives[info.name] = ObjectiveTerm(
-                    info.name,
-                    info.kind,
-                    expr,
-                    info.unit,
-                    info.description,
-                    tuple(pieces),
-                    _bound_rows_of(info, q, expr),
+                    info.name, info.kind, expr, info.unit, info.description, tuple(pieces), bound
                 )
         backlash = objectives["backlash"].expr if "backlash" in objectives else None
         blocks = requirement_blocks(q, self._constraints, backlash)
@@ -542,15 +538,6 @@ class DesignProblem:
             }
             worst = float(worst[0])
         return Evaluation(objectives, constraints, worst)
-
-
-def _bound_rows_of(info, q, expr):
-    """The implicit epigraph rows ``t -> (rows, labels)`` of an objective that declares
-    them, on the solver path only (the NumPy path has the exact value)."""
-    if info.bound_rows is None or not m.is_symbolic(expr):
-        return None
-    bound_rows = info.bound_rows
-    return lambda t: bound_rows(q, t)
 
 
 def _display_scale(unit: str, display_unit: str | None, scale: float | None) -> float:

@@ -8,7 +8,7 @@ max_k 1 / f_k <= t, exactly when every loop angle still passes half the power at
 
     |T_k(j 2 pi / t)|^2 / |T_k(j 2 pi / (t 10^4))|^2 - 1/2 >= 0   for every k
 
-which is the requirement row ``bandwidth`` (:func:`~optdesign.problem.loop_requirements.
+which is the requirement row ``bandwidth`` (:func:`~optdesign.problem.loop.
 bandwidth_ratio`) at f = 1 / t. The NLP minimises t subject to these rows
 (:attr:`~optdesign.problem.objectives.ObjectiveInfo.bound_rows`). The NumPy path computes
 the exact value, the least root of |T_k| (:func:`optdesign.models.loop_linear.bandwidth`),
@@ -29,13 +29,14 @@ from optdesign import math as m
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
 from optdesign.problem.loop import (
+    CACHED_PLANTS,
+    bandwidth_ratio,
     drive_plants_of,
     loop_angles,
     loop_gains,
     picked,
     plant_grid,
 )
-from optdesign.problem.loop_requirements import CACHED_PLANTS, bandwidth_ratio
 
 #: |T|^2 over its static value at the bandwidth: half the power.
 HALF_POWER = 0.5

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
 
 #: Objective kinds: how a grid quantity becomes one number.
@@ -225,6 +226,16 @@ class ConstraintBlock:
     def __post_init__(self):
         if self.pieces and self.lower is not None:
             raise InputError(f"constraint {self.name}.pieces", "only with an upper bound alone")
+
+
+def bound_rows_of(info: ObjectiveInfo, q: Any, expr: Any) -> Callable[[Any], Any] | None:
+    """The implicit epigraph rows ``t -> (rows, labels)`` of an objective that declares
+    them (:attr:`ObjectiveInfo.bound_rows`), on the solver path only: the NumPy path has
+    the exact value."""
+    if info.bound_rows is None or not m.is_symbolic(expr):
+        return None
+    bound_rows = info.bound_rows
+    return lambda t: bound_rows(q, t)
 
 
 def piece_rows(
