@@ -5,7 +5,9 @@ bounds, so the bounds stay true bounds) followed by auxiliary epigraph variables
 
 - ``"spread"`` objectives (ratio ripple) become lo <= i(phi_k) <= hi with the smooth
   value (hi - lo)/(hi + lo); ``"max"`` objectives (worst-case backlash, peak torque)
-  become theta(phi_k) <= t with value t;
+  become theta(phi_k) <= t with value t; an objective that is a root of the model (the
+  loop's ``bandwidth_period``) bounds its t by implicit rows instead, smooth rows that
+  hold exactly when t bounds it (``ObjectiveInfo.bound_rows``);
 - every constraint block is divided by a typical magnitude so that one tolerance fits
   all; the scales come from the middle of the bounds, never from a declared start;
 - the objective is a *parameter*: ``f = sum_k p_k v_k`` over the targets (every objective
