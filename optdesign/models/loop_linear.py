@@ -258,6 +258,13 @@ def _trim(p: np.ndarray) -> np.ndarray:
     return p[nz[0] :] if nz.size else np.zeros(1)
 
 
+def _mul(a, b) -> np.ndarray:
+    # numpy.polymul's product without its poly1d round trip, which trims leading zeros
+    # at three times the cost of the product: a loop analysis builds these polynomials
+    # thousands of times (a population's bandwidths), and the zeros are trimmed once, below
+    return np.convolve(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+
+
 def loop_polynomials(plant: DrivePlant, loop: PositionLoop) -> LoopPolynomials:
     """L(s) and T(s) of the linear loop as polynomial coefficients (module docstring).
 
@@ -268,7 +275,7 @@ def loop_polynomials(plant: DrivePlant, loop: PositionLoop) -> LoopPolynomials:
     d1 = np.array([J1, c, k])
     d2 = np.array([J2, c + plant.fin_damping, k + plant.hinge_spring])
     coupling = np.array([c, k])
-    delta = np.polysub(np.polymul(d1, d2), np.polymul(coupling, coupling))
+    delta = np.polysub(_mul(d1, d2), _mul(coupling, coupling))
     n_phi = fr * coupling
     n_y = n_phi if loop.feedback == "fin" else fr * d2
     lag = np.array([loop.current_lag, 1.0])
@@ -276,12 +283,10 @@ def loop_polynomials(plant: DrivePlant, loop: PositionLoop) -> LoopPolynomials:
         ctrl, ref, s = np.array([loop.kd, loop.kp, loop.ki]), np.array([loop.kp, loop.ki]), [1, 0]
     else:
         ctrl, ref, s = np.array([loop.kd, loop.kp]), np.array([loop.kp]), [1]
-    den_open = np.polymul(np.polymul(s, lag), delta)
-    num_open = np.polymul(ctrl, n_y)
+    den_open = _mul(_mul(s, lag), delta)
+    num_open = _mul(ctrl, n_y)
     char = np.polyadd(den_open, num_open)
-    return LoopPolynomials(
-        _trim(num_open), _trim(den_open), _trim(np.polymul(ref, n_phi)), _trim(char)
-    )
+    return LoopPolynomials(_trim(num_open), _trim(den_open), _trim(_mul(ref, n_phi)), _trim(char))
 
 
 def scaled_roots(coefficients) -> np.ndarray:

@@ -28,6 +28,7 @@ from optdesign.problem.objectives import (
     ConstraintInfo,
     ObjectiveInfo,
     ObjectiveTerm,
+    bound_rows_of,
 )
 from optdesign.problem.quantities import Quantities
 from optdesign.problem.requirements import requirement_blocks
@@ -496,8 +497,9 @@ class DesignProblem:
             if expr is not None:
                 # the smooth pieces of a kinked objective, for the solver's epigraph only
                 pieces = info.pieces(q) if info.pieces is not None and m.is_symbolic(expr) else ()
+                bound = bound_rows_of(info, q, expr)
                 objectives[info.name] = ObjectiveTerm(
-                    info.name, info.kind, expr, info.unit, info.description, tuple(pieces)
+                    info.name, info.kind, expr, info.unit, info.description, tuple(pieces), bound
                 )
         backlash = objectives["backlash"].expr if "backlash" in objectives else None
         blocks = requirement_blocks(q, self._constraints, backlash)

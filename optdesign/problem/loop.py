@@ -35,6 +35,12 @@ DEFAULT_CHAIN_DAMPING_RATIO = 0.02
 #: The hours of a file's time in seconds.
 HOUR = 3600.0
 
+#: The static gain is |T| this many times below the bandwidth's frequency.
+STATIC_BELOW = 1e4
+
+#: Plants whose poles, cycles and bandwidths are remembered (a few kB each).
+CACHED_PLANTS = 4096
+
 
 @dataclass(frozen=True)
 class PlantGrid:
@@ -212,6 +218,16 @@ def response(grid: PlantGrid, gains: LoopGains, omega) -> ll.LoopResponse:
         omega,
         gains.feedback,
     )
+
+
+def bandwidth_ratio(q, grid: PlantGrid, gains: LoopGains, f_b: float) -> Any:
+    """|T(j w_b)|^2 / |T(j w_b / 10^4)|^2 over the grid: the requirement row ``bandwidth``
+    (:mod:`~optdesign.problem.loop_requirements`) and the objective ``bandwidth_period``'s
+    implicit rows (:mod:`~optdesign.problem.loop_bandwidth`)."""
+    w = 2.0 * np.pi * f_b
+    at = ll.closed_loop_gain_squared(response(grid, gains, w))
+    static = ll.closed_loop_gain_squared(response(grid, gains, w / STATIC_BELOW))
+    return at / static
 
 
 def resonance_frequency(q, idx: np.ndarray | None = None) -> Any:

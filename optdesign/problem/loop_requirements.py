@@ -59,8 +59,10 @@ from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
 from optdesign.problem.loop import (
+    CACHED_PLANTS,
     LoopGains,
     PlantGrid,
+    bandwidth_ratio,
     drive_plants_of,
     loop_angles,
     loop_gains,
@@ -80,14 +82,10 @@ RESONANCE_STEP = 0.02
 #: it is below the least |1 + L| by at most a factor n^(1/2p), n the frequencies equally
 #: near it (three: 0.9 %; p = 16 gave 3.5 %, enough to move a design across a limit).
 SOFT_MIN_POWER = 64
-#: The static gain is |T| this many times below the bandwidth's frequency.
-STATIC_BELOW = 1e4
 #: Frequencies the harmonic balance samples to bracket L_d's phase crossovers: over the
 #: loop's span of about five decades, 400 a decade (8000, the model's default, gives the
 #: same cycles at the shipped problem's seven angles, nine times slower).
 CYCLE_POINTS = 2000
-#: Plants whose poles and cycles are remembered (a few kB each).
-CACHED_PLANTS = 4096
 #: The smallest damping ratio of a stable loop's poles (the roots' own precision).
 STABLE_DAMPING = 1e-9
 
@@ -119,14 +117,6 @@ def margin_frequencies(spec) -> np.ndarray:
     :func:`reference_frequency`)."""
     f = reference_frequency(spec)
     return 2.0 * np.pi * f * 2.0 ** (np.arange(-2, 5) / 2.0)
-
-
-def bandwidth_ratio(q, grid: PlantGrid, gains: LoopGains, f_b: float) -> Any:
-    """|T(j w_b)|^2 / |T(j w_b / 10^4)|^2 over the grid (see the module's docstring)."""
-    w = 2.0 * np.pi * f_b
-    at = ll.closed_loop_gain_squared(response(grid, gains, w))
-    static = ll.closed_loop_gain_squared(response(grid, gains, w / STATIC_BELOW))
-    return at / static
 
 
 def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:

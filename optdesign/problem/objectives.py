@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
 
 #: Objective kinds: how a grid quantity becomes one number.
@@ -71,6 +72,14 @@ class ObjectiveInfo:
     pieces
         ``pieces(q)``: smooth expressions whose element-wise max is ``fn(q)`` (built-ins
         with a kink: the NLP bounds each piece; :class:`ObjectiveTerm`).
+    bound_rows
+        ``bound_rows(q, t) -> (rows, labels)``: smooth rows, each ``>= 0``, that hold
+        together exactly when ``t`` bounds the objective from above (``max`` kind only).
+        For an objective that is no explicit function of the design but a root (the
+        closed loop's bandwidth): the NLP's epigraph variable ``t`` is bounded by these
+        implicit rows instead of ``t - piece >= 0``, of which they are the general form.
+        On the solver path ``fn(q)`` then gives only a start for ``t`` (an estimate, not
+        the value); on the NumPy path it gives the exact value, as for every objective.
     """
 
     name: str
@@ -84,10 +93,16 @@ class ObjectiveInfo:
     valid: tuple[float | None, float | None] | None = None
     needs: Callable[[Any], str] | None = None
     pieces: Callable[[Any], tuple[Any, ...]] | None = None
+    bound_rows: Callable[[Any, Any], tuple[Any, list[str]]] | None = None
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise InputError(f"objective {self.name}.kind", f"{self.kind!r} not in {KINDS}")
+        if self.bound_rows is not None and (self.kind != "max" or self.pieces is not None):
+            raise InputError(
+                f"objective {self.name}.bound_rows",
+                "only for a 'max' objective without pieces (the rows replace them)",
+            )
         if not callable(self.fn):
             raise InputError(f"objective {self.name}.fn", "must be a function of the quantities")
         if self.valid is not None and not _is_range(self.valid):
@@ -168,7 +183,10 @@ class ObjectiveTerm:
     """An objective of one design: its declaration's name and kind, and the expression.
     ``pieces``: smooth expressions whose element-wise max is ``expr`` (on the solver path,
     for a ``max`` objective with a kink, e.g. |x| = max(x, -x)): the NLP's epigraph bounds
-    each piece, which keeps it smooth (:func:`piece_rows`)."""
+    each piece, which keeps it smooth (:func:`piece_rows`). ``bound_rows``: on the solver
+    path, ``t -> (rows, labels)``, rows ``>= 0`` that hold exactly when ``t`` bounds the
+    objective (:attr:`ObjectiveInfo.bound_rows`); ``expr`` is then a start for ``t``, not
+    the objective."""
 
     name: str
     kind: str
@@ -176,6 +194,7 @@ class ObjectiveTerm:
     unit: str = ""
     description: str = ""
     pieces: tuple[Any, ...] = ()
+    bound_rows: Callable[[Any], tuple[Any, list[str]]] | None = None
 
 
 @dataclass
@@ -207,6 +226,16 @@ class ConstraintBlock:
     def __post_init__(self):
         if self.pieces and self.lower is not None:
             raise InputError(f"constraint {self.name}.pieces", "only with an upper bound alone")
+
+
+def bound_rows_of(info: ObjectiveInfo, q: Any, expr: Any) -> Callable[[Any], Any] | None:
+    """The implicit epigraph rows ``t -> (rows, labels)`` of an objective that declares
+    them (:attr:`ObjectiveInfo.bound_rows`), on the solver path only: the NumPy path has
+    the exact value."""
+    if info.bound_rows is None or not m.is_symbolic(expr):
+        return None
+    bound_rows = info.bound_rows
+    return lambda t: bound_rows(q, t)
 
 
 def piece_rows(
@@ -281,6 +310,18 @@ def _resonance_gain(q):
     from optdesign.problem.loop import loop_resonance_gain
 
     return loop_resonance_gain(q)
+
+
+def _bandwidth_period(q):
+    from optdesign.problem.loop_bandwidth import bandwidth_period
+
+    return bandwidth_period(q)
+
+
+def _bandwidth_period_rows(q, t):
+    from optdesign.problem.loop_bandwidth import bandwidth_period_rows
+
+    return bandwidth_period_rows(q, t)
 
 
 def _motor_mass(q):
@@ -490,6 +531,21 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "max over the stroke of |L(j w_r)|, w_r the two-mass mode with the motor free",
             valid=NON_NEGATIVE,
             needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
+        ),
+        ObjectiveInfo(
+            "bandwidth_period",
+            _bandwidth_period,
+            "max",
+            "s",
+            "1 / the least closed-loop bandwidth over the stroke (minimising it raises the "
+            "bandwidth)",
+            "max over the loop's angles of 1 / f_k, f_k the first frequency where "
+            "|T(j 2 pi f)|^2 falls to half its static value",
+            display_unit="ms",
+            display_scale=1e3,
+            valid=NON_NEGATIVE,
+            needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
+            bound_rows=_bandwidth_period_rows,
         ),
         ObjectiveInfo(
             "motor_mass",

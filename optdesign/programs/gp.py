@@ -340,6 +340,20 @@ def build_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
                 )
             )
     gp = GPData(names, problem.lower(), problem.upper(), objective, "", [], [], checks, [])
+    info = problem.objectives.get(objective)
+    if info is not None and info.bound_rows is not None:
+        # a root of the model (the closed loop's bandwidth): no expression of the design,
+        # let alone a posynomial; only an NLP can pose its implicit epigraph rows
+        checks.append(
+            DGPCheck(
+                "objective",
+                objective,
+                False,
+                f"{objective} is a root of the model (bounded by implicit rows), not a "
+                "posynomial of the design; use formulation='nlp' or 'catalogue'",
+            )
+        )
+        return gp
     ex, error = trace(problem)
     if ex is None:
         checks.append(DGPCheck("problem", problem.name, False, f"model not traceable ({error})"))

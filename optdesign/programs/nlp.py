@@ -5,7 +5,9 @@ bounds, so the bounds stay true bounds) followed by auxiliary epigraph variables
 
 - ``"spread"`` objectives (ratio ripple) become lo <= i(phi_k) <= hi with the smooth
   value (hi - lo)/(hi + lo); ``"max"`` objectives (worst-case backlash, peak torque)
-  become theta(phi_k) <= t with value t;
+  become theta(phi_k) <= t with value t; an objective that is a root of the model (the
+  loop's ``bandwidth_period``) bounds its t by implicit rows instead, smooth rows that
+  hold exactly when t bounds it (``ObjectiveInfo.bound_rows``);
 - every constraint block is divided by a typical magnitude so that one tolerance fits
   all; the scales come from the middle of the bounds, never from a declared start;
 - the objective is a *parameter*: ``f = sum_k p_k v_k`` over the targets (every objective
@@ -305,6 +307,11 @@ def typical(value) -> float:
     return float(v) if np.isfinite(v) and v > 0 else 1.0
 
 
+#: The lower bound of an implicit epigraph's variable (:attr:`ObjectiveTerm.bound_rows`),
+#: as a fraction of its scale: its rows may divide by it (a period is a frequency's
+#: inverse), so it stays positive.
+BOUND_ROWS_FLOOR = 1e-3
+
 #: Designs tried for the scales when the middle of the bounds does not assemble.
 SCALE_SAMPLE = 64
 
@@ -404,7 +411,20 @@ def build_nlp(
         expr = term.expr
         scale = typical(ref.objectives[name].expr)
         scales[name] = typical(numeric_value(ref.objectives[name]))
-        if term.kind == "scalar":
+        if term.bound_rows is not None:
+            # an implicit epigraph (a root of the model, no expression of the design):
+            # t bounds the objective exactly when its rows hold; the naive form has no
+            # max to hand the solver, so it poses the same rows
+            t = ca.SX.sym(f"{name}_max")
+            aux.append((t, scales[name]))
+            aux_names.append(f"{name}_max")
+            aux_lb.append(BOUND_ROWS_FLOOR * scales[name])
+            aux_ub.append(np.inf)
+            aux_start.append(ca.mmax(expr) / scales[name])
+            values[name] = t
+            bound, labels = term.bound_rows(t)
+            rows.add(bound, 0.0, None, 1.0, f"{name}_envelope", labels, "")
+        elif term.kind == "scalar":
             values[name] = expr
         elif form == "naive":
             values[name] = m.grid_spread(ca.SX(expr)) if term.kind == "spread" else ca.mmax(expr)

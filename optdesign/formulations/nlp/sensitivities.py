@@ -114,6 +114,8 @@ def from_multipliers_many(
             continue
         x = np.array([result.design[v.name] for v in problem.free])
         rows = row_model(lam_g * T / nlp.g_scale)
+        if isinstance(rows, _RowModel):
+            _implicit_rows(problem, nlp, x, rows)
         ready.append((j, x, float(result.objective), rows, lam_x))
     if not ready:
         return out
@@ -341,6 +343,47 @@ class _Limits:
 
     blocks: dict[str, tuple[Any, Any]]
     objectives: dict[str, float]
+
+
+#: Relative step of the difference that gives an implicit epigraph row's slope in t.
+IMPLICIT_STEP = 1e-6
+
+
+def _implicit_rows(problem: DesignProblem, nlp: Any, x: np.ndarray, rows: _RowModel) -> None:
+    """Read the active rows of an implicit epigraph (``ObjectiveInfo.bound_rows``: rows
+    g_k(t) >= 0 that hold iff t bounds the objective's value e_k at angle k) as a ``max``
+    objective's rows t - e_k >= 0. The NumPy model has e_k, not g_k; at the optimum
+    g_k(e_k) = 0, so at fixed t dg_k/dp = -(dg_k/dt) de_k/dp: the row's multiplier times
+    dg_k/dt (a central difference at t = e_k) acting on -e_k (the objective's envelope
+    block, matched by the row's angle) gives the envelope theorem's term exactly."""
+    implicit = [
+        name
+        for name in nlp.targets
+        if name in problem.objectives and problem.objectives[name].bound_rows is not None
+    ]
+    ex = q = None
+    for name in implicit:
+        head = f"{name}_envelope["
+        active = [i for i in rows.rows if nlp.g_names[i].startswith(head)]
+        if not active:
+            continue
+        if ex is None:
+            with np.errstate(all="ignore"):
+                ex = problem.expressions(problem.design_dict(x))
+            q = ex.quantities
+            rows.mu = rows.mu.copy()
+        values = np.ravel(np.asarray(ex.objectives[name].expr, dtype=float))
+        bound_rows = problem.objectives[name].bound_rows
+        for i in active:
+            label = nlp.g_names[i][len(head) : -1]
+            k = problem.phi_labels.index(label)
+            t, h = values[k], IMPLICIT_STEP * values[k]
+            up, labels = bound_rows(q, t + h)
+            down, _ = bound_rows(q, t - h)
+            j = labels.index(label)
+            slope = (np.ravel(up)[j] - np.ravel(down)[j]) / (2.0 * h)
+            rows.mu[i] *= slope
+            rows.where[i] = (f"{name}_envelope", k)
 
 
 def _objective_rows(blocks: dict, scalars: dict, name: str, kind: str, e: np.ndarray) -> None:

@@ -203,6 +203,12 @@ def build_robust_nlp(
         raise ProblemError(f"tolerances.risk: {risk!r} is not 'cvar' or 'mean_std'")
     if not 0.0 <= alpha < 1.0:
         raise ProblemError(f"tolerances.alpha: {alpha} must lie in [0, 1)")
+    info = problem.objectives.get(objective)
+    if info is not None and info.bound_rows is not None:
+        raise ProblemError(
+            f"robust design: objective {objective!r} is a root of the model, bounded by "
+            "implicit rows; the robust NLP takes objectives that are expressions of the design"
+        )
     samples = samples if samples is not None else draw_samples(problem, tol.samples, tol.seed, tol)
     S = samples.n
     if S < 1:

@@ -281,6 +281,17 @@ def robust_applies(problem: DesignProblem, request: SolveRequest | None = None) 
             'robust design needs a [tolerances] section (e.g. R = "0.05 mm", '
             'phi0 = "0.1 deg", fit = "uniform")'
         )
+    names = problem.objective_names
+    objective = request.objective if request is not None else None
+    info = problem.objectives.get(objective or (names[0] if names else ""))
+    if info is not None and info.bound_rows is not None:
+        # each sample would need its own implicit epigraph and the sensitivities their
+        # slopes in it: not built; the nominal NLP and the catalogue search pose it
+        return (
+            f"robust design takes objectives that are expressions of the design; "
+            f"{info.name} is a root of the model, bounded by implicit rows (use "
+            "formulation='nlp')"
+        )
     return continuous_only(problem, "robust design needs continuous variables")
 
 
