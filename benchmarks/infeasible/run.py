@@ -64,6 +64,8 @@ CORPUS: dict[str, tuple[str, dict[str, Any]]] = {
     "robust travel 5 mm": ("cs_min_backlash_robust", {"nut_travel_max": "5 mm"}),
     "duan travel 20 mm": ("duan2017_redesign", {"nut_travel_max": "20 mm"}),
     "duan ripple 0.001": ("duan2017_redesign", {"ripple_max": 0.001}),
+    "catalogue hinge 50 kN*m": ("fin_actuator", {"hinge_moment": "50000 N*m"}),
+    "fork band 10-30": ("fork_min_backlash", {"mean_ratio": {"min": 10, "max": 30}}),
 }
 
 

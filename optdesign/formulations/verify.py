@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from optdesign.problem.design_problem import DesignProblem, relative_violation
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.evaluation import relative_violation
 from optdesign.problem.validity import OutsideRange, outside_ranges
 from optdesign.solvers.constraint_rows import violation_amount
 from optdesign.solvers.result import ConstraintReport

@@ -32,7 +32,7 @@ from optdesign import math as m
 from optdesign.errors import AssemblyError, InputError
 from optdesign.mechanisms.joints import Backlash, Joint, PinJoint, backlash_of
 from optdesign.models._checks import require_finite, require_positive
-from optdesign.models.impossibility import Impossibility
+from optdesign.models.impossibility import Impossibility, NutVelocityBounds
 from optdesign.models.loads import force_from_rate, motor_torque
 from optdesign.models.ratio import ratio_finite_step, ratio_from_nut_velocity
 from optdesign.models.validity import Validity
@@ -411,6 +411,26 @@ class Mechanism:
             condition only, never a claim that the problem is feasible.
         """
         return []
+
+    @classmethod
+    def nut_velocity_bounds(
+        cls,
+        stroke: tuple[float, float],
+        requirements: Mapping[str, Any],
+        bounds: Mapping[str, tuple[float, float]],
+    ) -> NutVelocityBounds | None:
+        """Closed-form bounds of the nut velocity dx/dphi over the stroke for every design
+        within ``bounds`` that meets ``requirements`` (arguments as for
+        :meth:`impossible`). From them the problem proves, before any solve, that a ratio
+        band lies beyond every ratio 2 pi i_a v / p the bounds allow, or that the nut
+        force M / v exceeds what every catalogue screw carries.
+
+        Returns
+        -------
+        NutVelocityBounds or None
+            None (the default): nothing known, no such proof.
+        """
+        return None
 
     def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
         """Rows of the mechanism-specific requirement ``name`` with its parsed ``value``."""

@@ -11,7 +11,7 @@ from optdesign.mechanisms.base import Mechanism, RequirementInfo, Rows, Sketch, 
 from optdesign.mechanisms.joints import Joint, PinJoint
 from optdesign.mechanisms.registry import register_mechanism
 from optdesign.models import crank_slider as cs
-from optdesign.models.impossibility import ANGLE_TOL, Impossibility
+from optdesign.models.impossibility import ANGLE_TOL, Impossibility, NutVelocityBounds
 from optdesign.models.impossibility import degrees_text as _deg
 from optdesign.models.loads import force_from_rate
 
@@ -196,6 +196,36 @@ class CrankSlider(Mechanism):
             remedy = f"bounds of phi0 that reach {_deg(window[0])} to {_deg(window[1])} deg"
             return [Impossibility(("variables.phi0", *named), reason, (remedy,))]
         return []
+
+    @classmethod
+    def nut_velocity_bounds(cls, stroke, requirements, bounds) -> NutVelocityBounds | None:
+        """The nut velocity is R cos(a + beta) / cos(beta) (beta the rod's inclination), so
+        |dx/dphi| <= R / cos(beta) at every angle: at most the arm's upper bound over the
+        cosine of the inclination limit, or of the assembly margin's (cos^2 beta = the
+        margin (l^2 - u^2)/l^2). No lower bound: it tends to 0 at a dead point."""
+        R_hi = bounds["R"][1]
+        tilt = requirements.get("rod_inclination_max")
+        margin = requirements.get("assembly_margin_min")
+        cosines = {}
+        if tilt is not None and float(tilt) < np.pi / 2:
+            cosines["rod_inclination_max"] = float(np.cos(float(tilt)))
+        if margin is not None and float(margin) > 0.0:
+            cosines["assembly_margin_min"] = float(np.sqrt(float(margin)))
+        if not cosines:
+            return None
+        name, cos_beta = max(cosines.items(), key=lambda kv: kv[1])
+        upper = R_hi / cos_beta
+        what = (
+            f"cos(beta) >= cos({_deg(float(tilt))} deg)"
+            if name == "rod_inclination_max"
+            else f"cos(beta) >= sqrt({float(margin):g}), the assembly margin's floor"
+        )
+        reason = (
+            "a crank-slider's nut velocity R cos(phi0 + phi + beta) / cos(beta) is at most "
+            f"R / cos(beta) = {R_hi:.4g} / {cos_beta:.4g} = {upper:.4g} mm/rad (R <= "
+            f"{R_hi:.4g} mm, {what})"
+        )
+        return NutVelocityBounds(0.0, upper, reason, ("variables.R", name))
 
     def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
         R, l, n, phi0 = self.R, self.l, self.n, self.phi0

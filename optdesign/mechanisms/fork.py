@@ -11,7 +11,7 @@ from optdesign.mechanisms.base import Mechanism, Sketch, VariableInfo
 from optdesign.mechanisms.joints import Joint, PinJoint
 from optdesign.mechanisms.registry import register_mechanism
 from optdesign.models import fork
-from optdesign.models.impossibility import ANGLE_TOL, Impossibility
+from optdesign.models.impossibility import ANGLE_TOL, Impossibility, NutVelocityBounds
 from optdesign.models.impossibility import degrees_text as _deg
 from optdesign.models.loads import fork_pin_normal_force
 
@@ -116,6 +116,21 @@ class ShiftingFork(Mechanism):
             remedy = f"bounds of phi0 that reach inside {_deg(window[0])} to {_deg(window[1])} deg"
             return [Impossibility(("variables.phi0", "deflection"), reason, (remedy,))]
         return []
+
+    @classmethod
+    def nut_velocity_bounds(cls, stroke, requirements, bounds) -> NutVelocityBounds | None:
+        """dx/dphi = R / cos^2(a), a = phi0 + phi: at least the arm's lower bound (at a =
+        0) and at most its upper bound over cos^2 of the widest arm angle phi0's bounds
+        and the stroke allow (none when that reaches a pole)."""
+        (R_lo, R_hi), (p_lo, p_hi) = bounds["R"], bounds["phi0"]
+        widest = max(abs(p_lo + stroke[0]), abs(p_hi + stroke[1]))
+        upper = R_hi / np.cos(widest) ** 2 if widest < np.pi / 2 - ANGLE_TOL else np.inf
+        reason = (
+            f"a shifting fork's nut velocity R / cos^2(phi0 + phi) lies between R's lower "
+            f"bound, {R_lo:.4g} mm/rad, and R's upper bound over cos^2 of the widest arm "
+            f"angle, {R_hi:.4g} / cos^2({_deg(widest)} deg) = {upper:.4g} mm/rad"
+        )
+        return NutVelocityBounds(R_lo, upper, reason, ("variables.R", "variables.phi0"))
 
     def sketch(self, phi: float) -> Sketch:
         with np.errstate(invalid="ignore"):

@@ -27,7 +27,7 @@ from optdesign import math as m
 from optdesign.mechanisms.base import Mechanism, RequirementInfo, Rows, Sketch, VariableInfo
 from optdesign.mechanisms.joints import Joint, PinJoint
 from optdesign.mechanisms.registry import register_mechanism
-from optdesign.models.impossibility import ANGLE_TOL, Impossibility
+from optdesign.models.impossibility import ANGLE_TOL, Impossibility, NutVelocityBounds
 from optdesign.models.impossibility import degrees_text as _deg
 
 
@@ -126,6 +126,17 @@ class PivotingScrew(Mechanism):
                 remedies.append(f"a least transmission angle below {_deg(np.pi - (hi - lo))} deg")
             return [Impossibility(named, reason, tuple(remedies))]
         return []
+
+    @classmethod
+    def nut_velocity_bounds(cls, stroke, requirements, bounds) -> NutVelocityBounds | None:
+        """dL/dphi is the actuator's lever arm about the output axis, R sin(transmission
+        angle): at most the horn radius's upper bound."""
+        R_hi = bounds["R"][1]
+        reason = (
+            "a pivoting screw's dL/dphi is its lever arm about the output axis, R sin(the "
+            f"transmission angle), at most R's upper bound, {R_hi:.4g} mm/rad"
+        )
+        return NutVelocityBounds(0.0, R_hi, reason, ("variables.R",))
 
     def requirement_rows(self, name: str, value: Any, phi) -> list[Rows]:
         if name == "transmission_angle":

@@ -59,3 +59,29 @@ class Impossibility:
 def degrees_text(angle: float) -> str:
     """An angle in rad as the proofs write it: degrees to 4 significant digits."""
     return f"{math.degrees(angle):.4g}"
+
+
+@dataclass(frozen=True)
+class NutVelocityBounds:
+    """Bounds of the nut velocity dx/dphi (mm/rad) that hold at every angle of the stroke
+    for every design within the variables' bounds that meets the mechanism's own
+    requirements: what a mechanism knows in closed form
+    (:meth:`optdesign.mechanisms.base.Mechanism.nut_velocity_bounds`), from which the
+    problem's proofs on the ratio and the loads follow (the ratio is 2 pi i_a v / p, the
+    nut force M / v).
+
+    Attributes
+    ----------
+    lower, upper
+        ``lower <= dx/dphi <= upper`` (mm/rad); 0 and ``inf`` where nothing is known.
+    reason
+        Why, with its numbers (the proofs quote it).
+    requirements
+        The problem file's fields the bounds rest on (``"variables.R"``,
+        ``"rod_inclination_max"``).
+    """
+
+    lower: float
+    upper: float
+    reason: str
+    requirements: tuple[str, ...] = ()

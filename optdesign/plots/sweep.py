@@ -52,7 +52,7 @@ def plot_sweep(sweep: Any):
             pad = 0.05 * max(abs(mid), 1e-9)
             ax.set_ylim(mid - pad, mid + pad)
         if k + ncol >= n:  # nothing drawn below it: its x axis is labelled
-            ax.set_xlabel(plain(axis.label))
+            ax.set_xlabel(_axis_label(axis))
             ax.xaxis.set_tick_params(labelbottom=True)
     for ax in axs[n:]:
         ax.set_visible(False)
@@ -63,6 +63,13 @@ def plot_sweep(sweep: Any):
         fontsize=9,
     )
     return fig
+
+
+def _axis_label(axis: Any) -> str:
+    """The swept parameter, and the parameters that move with it (set to its value at
+    every point), so a chart of a linked sweep says what else changed along it."""
+    linked = f" (with {', '.join(axis.linked)})" if axis.linked else ""
+    return plain(axis.label + linked)
 
 
 def _contours(sweep: Any):
@@ -92,8 +99,8 @@ def _contours(sweep: Any):
     for k, p in enumerate(sweep.points):
         if p.active_change:
             ax.plot(a0.shown[k % n0], a1.shown[k // n0], "o", mfc="none", color="C3", ms=7)
-    ax.set_xlabel(plain(a0.label))
-    ax.set_ylabel(plain(a1.label))
+    ax.set_xlabel(_axis_label(a0))
+    ax.set_ylabel(_axis_label(a1))
     name = plain(problem.name, MAX_TITLE_NAME)
     ax.set_title(f"{name}: {plain(col.header)} (circles: binding set changes)", fontsize=9)
     return fig

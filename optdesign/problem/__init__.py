@@ -6,7 +6,8 @@ mechanism it names (:mod:`optdesign.problem.spec`) and turned into a
 design's quantities, on the CasADi path or the NumPy path alike.
 """
 
-from optdesign.problem.design_problem import DesignProblem, Evaluation, Expressions
+from optdesign.problem.design_problem import DesignProblem, Expressions
+from optdesign.problem.evaluation import Evaluation
 from optdesign.problem.load import load, load_problem, problem_from_dict
 from optdesign.problem.objectives import (
     BUILTIN_OBJECTIVES,

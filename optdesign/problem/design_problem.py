@@ -22,6 +22,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
 from optdesign.problem import declarations, drive
+from optdesign.problem.evaluation import Evaluation, evaluation_of
 from optdesign.problem.objectives import (
     BUILTIN_OBJECTIVES,
     ConstraintBlock,
@@ -49,29 +50,6 @@ class Expressions:
     @property
     def mechanism(self):
         return self.quantities.mechanism
-
-
-@dataclass
-class BlockValues:
-    """Values of one constraint block on the NumPy path (rows of a population)."""
-
-    values: np.ndarray
-    lower: float | None
-    upper: float | None
-
-
-@dataclass
-class Evaluation:
-    """Objectives and constraints of designs on the NumPy path.
-
-    ``objectives``: name -> value (array over the population, or a float for one
-    design); ``constraints``: block name -> :class:`BlockValues`; ``violation``: the
-    largest relative violation per design.
-    """
-
-    objectives: dict[str, Any]
-    constraints: dict[str, BlockValues]
-    violation: Any
 
 
 #: The sections of a problem whose numbers :meth:`DesignProblem.with_setting` moves (and a
@@ -514,30 +492,9 @@ class DesignProblem:
         x = np.asarray(x, dtype=float)
         single = x.ndim == 1
         X = x[None, :] if single else x
-        pop = X.shape[0]
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             ex = self.expressions(self.design_dict(X))
-            objectives = {
-                name: term_values(term, pop, len(self.phi)) for name, term in ex.objectives.items()
-            }
-            constraints: dict[str, BlockValues] = {}
-            worst = np.zeros(pop)
-            for block in ex.constraints:
-                e = population_rows(np.asarray(block.expr, dtype=float), pop)
-                viol = relative_violation(e, block.lower, block.upper)
-                worst = np.maximum(worst, np.nan_to_num(viol.max(axis=-1), nan=np.inf))
-                constraints[block.name] = BlockValues(e, block.lower, block.upper)
-            for name, limit in self.objective_limits().items():
-                val = objectives[name][:, None]
-                worst = np.maximum(worst, relative_violation(val, None, limit)[:, 0])
-                constraints[f"{name}_max"] = BlockValues(val, None, limit)
-        if single:
-            objectives = {k: float(v[0]) for k, v in objectives.items()}
-            constraints = {
-                k: BlockValues(v.values[0], v.lower, v.upper) for k, v in constraints.items()
-            }
-            worst = float(worst[0])
-        return Evaluation(objectives, constraints, worst)
+        return evaluation_of(ex, X.shape[0], len(self.phi), self.objective_limits(), single)
 
 
 def _display_scale(unit: str, display_unit: str | None, scale: float | None) -> float:
@@ -562,42 +519,3 @@ def _display_scale(unit: str, display_unit: str | None, scale: float | None) -> 
             f"(the factor is {factor:.10g}; leave display_scale out to use it)",
         )
     return float(scale)
-
-
-def term_values(term: ObjectiveTerm, pop: int, n_phi: int) -> np.ndarray:
-    """Value of an objective term for each of ``pop`` designs on the NumPy path."""
-    e = np.asarray(term.expr, dtype=float)
-    if term.kind == "scalar" and e.shape == (pop,):
-        # one value per design already reduced over the grid (od.math.grid_max of a
-        # population): a column, not a row to spread over the angles
-        e = e[:, None]
-    e = np.broadcast_to(e, (pop, n_phi))
-    if term.kind == "spread":
-        return m.grid_spread(e)
-    if term.kind == "max":
-        return e.max(axis=-1)
-    return e[:, 0]
-
-
-def population_rows(e: np.ndarray, pop: int) -> np.ndarray:
-    """A constraint block's values as one row per design of a population of ``pop``: a
-    block that does not depend on the design (a grid row, one row, or one number) is
-    the same row for every design."""
-    if e.ndim == 0:
-        return np.full((pop, 1), float(e))
-    if e.ndim == 2 and e.shape[0] == 1 and pop > 1:
-        return np.broadcast_to(e, (pop, e.shape[1]))
-    if e.size % pop == 0:
-        return e.reshape(pop, -1)
-    return np.broadcast_to(e.reshape(1, -1), (pop, e.size))
-
-
-def relative_violation(values, lower, upper):
-    """Violation of lower <= values <= upper, relative to max(1, |bound|)."""
-    values = np.asarray(values, dtype=float)
-    viol = np.zeros_like(values)
-    if lower is not None:
-        viol = np.maximum(viol, (lower - values) / max(1.0, abs(lower)))
-    if upper is not None:
-        viol = np.maximum(viol, (values - upper) / max(1.0, abs(upper)))
-    return np.where(np.isnan(values), np.inf, viol)

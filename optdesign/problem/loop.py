@@ -256,7 +256,8 @@ def _rows(value: Any, pop: int, width: int) -> np.ndarray:
     return np.broadcast_to(a.reshape(-1) if a.ndim else a, (pop, width))
 
 
-def _population(q) -> int:
+def population_size(q) -> int:
+    """How many designs the NumPy quantities ``q`` hold (1: one design)."""
     sizes = [np.shape(v)[0] for v in q.design.values() if np.ndim(v) == 2]
     return max(sizes, default=1)
 
@@ -275,7 +276,7 @@ def drive_plants_of(
     NaN for a design that does not work (a population's rows)."""
     grid, gains = plant_grid(q), loop_gains(q)
     phi = np.asarray(q.phi, dtype=float).reshape(-1)
-    pop, width = _population(q), len(phi)
+    pop, width = population_size(q), len(phi)
     names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
     values = {n: _rows(getattr(grid, n), pop, width) for n in names}
     kp, kd = _rows(gains.kp, pop, 1)[:, 0], _rows(gains.kd, pop, 1)[:, 0]

@@ -58,6 +58,7 @@ from optdesign.errors import ProblemError
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.problem.evaluation import ScreenedRows
 from optdesign.problem.loop import (
     CACHED_PLANTS,
     LoopGains,
@@ -68,6 +69,7 @@ from optdesign.problem.loop import (
     loop_gains,
     picked,
     plant_grid,
+    population_size,
     resonance_frequency,
     resonance_gain,
     response,
@@ -154,14 +156,14 @@ def _largest_cycle(plant: DrivePlant, loop: PositionLoop) -> float:
     return float(np.degrees(limit_cycles(plant, loop, CYCLE_POINTS).largest_stable_fin_amplitude))
 
 
-def least_pole_damping(q, idx: np.ndarray) -> np.ndarray:
+def least_pole_damping(q, idx: np.ndarray) -> np.ndarray | ScreenedRows:
     """The smallest damping ratio -Re p / |p| of the closed loop's poles at each loop
     angle ``idx`` (NumPy, one row per design of a population; NaN for a design whose
     drive is no plant, :func:`~optdesign.problem.loop.drive_plants_of`)."""
     return _per_plant(q, idx, _least_damping)
 
 
-def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray:
+def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray | ScreenedRows:
     """The fin amplitude (deg) of the largest stable limit cycle the chain's clearance
     sustains at each loop angle ``idx``, by harmonic balance
     (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
@@ -169,12 +171,28 @@ def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray:
     return _per_plant(q, idx, _largest_cycle)
 
 
-def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray:
-    rows = [
-        [np.nan] * len(idx) if drive is None else [fn(p, drive[1]) for p in drive[0]]
-        for drive in drive_plants_of(q, idx, strict=False)
-    ]
-    return np.array(rows, dtype=float)
+def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray | ScreenedRows:
+    # a population's rows are screened: computed for the designs that pass every other
+    # row only (optdesign.problem.evaluation), which spares a global search's start
+    # sample a harmonic balance per design and angle
+    drives: list = []
+
+    def rows_of(designs: np.ndarray) -> np.ndarray:
+        if not drives:
+            drives.extend(drive_plants_of(q, idx, strict=False))
+        return np.array(
+            [
+                [np.nan] * len(idx)
+                if drives[i] is None
+                else [fn(p, drives[i][1]) for p in drives[i][0]]
+                for i in designs
+            ],
+            dtype=float,
+        ).reshape(len(designs), len(idx))
+
+    pop = population_size(q)
+    rows = ScreenedRows(rows_of, pop, len(idx))
+    return np.asarray(rows) if pop == 1 else rows
 
 
 def _phase_margin(modulus):

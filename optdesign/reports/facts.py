@@ -105,6 +105,11 @@ def _motor_fact(motor: MotorFacts) -> Fact:
     """The motor of the design, named, with its data and how much of each it uses."""
     name, peak, demand = motor.name, motor.peak_torque, motor.demand
     used = f", {100.0 * demand / peak:.3g} % of it used by the motion" if demand else ""
+    if motor.envelope_use is not None:
+        used += (
+            f", {100.0 * motor.envelope_use:.3g} % of the torque its speed-torque envelope "
+            "gives at the motion's speed"
+        )
     text = (
         f"peak torque of the motor{' ' + name if name else ''}{used}; rotor "
         f"{motor.rotor_inertia * 10:.4g} kg*cm^2, top speed "

@@ -199,8 +199,9 @@ def mark_infeasible(best: Result, verdict: PhaseOne) -> None:
         f"least violation {least:.3g} (phase 1, {n} starts)"
     )
     best.notes.append(
-        f"no feasible design: the violation of the requirements (the largest, each row "
-        f"scaled by its limit) minimised from {n} starts stays positive at each, at least "
-        f"{least:.3g} ({at_least} of them reached it); a positive minimum says no feasible "
-        "design lies near its start"
+        f"no feasible design found from {n} starts (a local verdict, not a proof): the "
+        f"violation of the requirements (the largest, each row scaled by its limit) "
+        f"minimised from each stays positive, at least {least:.3g} ({at_least} of them "
+        "reached it); a positive local minimum says no feasible design lies near its start, "
+        "not that none exists within the bounds"
     )

@@ -15,7 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.problem.design_problem import DesignProblem, relative_violation
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.evaluation import relative_violation
 from optdesign.solvers.result import ConstraintReport
 
 

@@ -33,6 +33,9 @@ class MotorFacts:
         Its mass (t), or None when its data give none.
     demand
         The largest torque the motion asks of it (N*mm), or None without a motion.
+    envelope_use
+        With a speed-torque corner, the largest share over the stroke of the torque the
+        envelope gives at the motor's speed that the motion asks (1: it binds), or None.
     """
 
     name: str
@@ -41,6 +44,7 @@ class MotorFacts:
     max_speed: float
     mass: float | None
     demand: float | None
+    envelope_use: float | None = None
 
 
 @dataclass(frozen=True)
@@ -133,6 +137,15 @@ def _motor_facts(problem: Any, q: Any) -> MotorFacts | None:
     motor = q.motor_data
     with np.errstate(all="ignore"):
         demand = float(np.max(np.asarray(q.motor_peak_torque, dtype=float))) if q.motion else None
+        envelope = None
+        if demand is not None and motor.envelope_slope is not None:
+            # the torque the envelope gives at each angle's speed: the peak up to the
+            # corner, falling linearly above it
+            speed = np.asarray(q.motor_speed, dtype=float)
+            available = np.minimum(
+                motor.peak_torque, motor.envelope_intercept - motor.envelope_slope * speed
+            )
+            envelope = float(np.max(np.asarray(q.motor_peak_torque, dtype=float) / available))
     return MotorFacts(
         name,
         float(motor.peak_torque),
@@ -140,4 +153,5 @@ def _motor_facts(problem: Any, q: Any) -> MotorFacts | None:
         float(motor.max_speed),
         None if motor.mass is None else float(motor.mass),
         demand,
+        envelope,
     )

@@ -218,3 +218,32 @@ def test_a_duty_period_without_a_duty_cycle_is_refused():
     data["requirements"]["duty_period"] = "20 s"
     with pytest.raises(od.OptDesignError, match="duty_period: the length of a duty cycle"):
         od.load(data)
+
+
+def test_the_summarys_motor_fact_reads_the_envelope_at_the_top_speed():
+    """The motor fact of a design with a corner gives the largest share, over the stroke,
+    of the torque the envelope gives at the motor's speed that the motion asks: the
+    envelope read from the datasheet's points by interpolation, a separate computation
+    from the model's intercept and slope."""
+    from optdesign.reports.facts import _motor_fact
+    from optdesign.views.facts import design_facts
+
+    problem = od.load(_data())
+    design = {**problem.fixed_values, **problem.design_dict(problem.start())}
+    facts = design_facts(problem, design)
+    q = problem.quantities(design)
+    T = np.asarray(q.motor_peak_torque, dtype=float).ravel() / 1e3  # at each grid angle
+    n = np.asarray(q.motor_speed, dtype=float).ravel() / RPM
+    # the envelope: 6.69 N*m up to the corner, then straight to (6000 1/min, 5.5 N*m)
+    line = np.interp(n, [0.0, 5000.0, 6000.0], [6.69, 6.69, 5.5])
+    use = float(np.max(T / line))
+    assert facts.motor.envelope_use == pytest.approx(use, rel=1e-9)
+    assert use >= float(np.max(T)) / 6.69  # never below the peak torque's share
+    text = _motor_fact(facts.motor).text()
+    assert f"{100 * use:.3g} % of the torque its speed-torque envelope gives" in text
+    # without a corner the fact says nothing of an envelope
+    plain = od.load(
+        _data({k: v for k, v in MOTOR.items() if "corner" not in k and "top_" not in k})
+    )
+    bare = design_facts(plain, {**plain.fixed_values, **plain.design_dict(plain.start())})
+    assert bare.motor.envelope_use is None and "envelope" not in _motor_fact(bare.motor).text()

@@ -152,6 +152,9 @@ def test_a_linked_bound_moves_with_the_swept_one_and_the_store_knows_it(tmp_path
         assert point.design["R"] == pytest.approx(point.values[0] / (2 * np.tan(np.pi / 6)))
         assert "nut_travel" in point.active and "R.upper" not in point.active
     assert "R.upper [mm] 80..100 (2 points; requirements.nut_travel_max with it)" in sweep.summary()
+    figure = sweep.plot()  # the chart's x axis says what moved with R's upper bound
+    labels = {ax.get_xlabel() for ax in figure.axes if ax.get_visible()}
+    assert "R.upper [mm] (with requirements.nut_travel_max)" in labels
     doc = json.loads((out / "sweep.json").read_text())
     assert doc["axes"][0]["linked"] == [TRAVEL]
     lines = (out / "sweep.jsonl").read_text().splitlines()

@@ -35,7 +35,8 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.problem.design_problem import DesignProblem, population_rows
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.evaluation import population_rows
 from optdesign.problem.parameters import (
     MOVED_SIZE,
     limit_shown,

@@ -42,7 +42,8 @@ from optdesign.formulations.robust.program import (
     sampled_objective,
     tolerances_of,
 )
-from optdesign.problem.design_problem import DesignProblem, relative_violation, term_values
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.evaluation import relative_violation, term_values
 from optdesign.problem.request import SolveRequest
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.multistart import multistart

@@ -418,7 +418,10 @@ def pymoo_problem(problem: DesignProblem, objectives: Sequence[str]):
                     g = np.maximum(g, (block.lower - v) / max(1.0, abs(block.lower)))
                 if block.upper is not None:
                     g = np.maximum(g, (v - block.upper) / max(1.0, abs(block.upper)))
-                G.append(np.nan_to_num(g.max(axis=1), nan=1e6))
+                g = np.nan_to_num(g.max(axis=1), nan=1e6)
+                if block.unchecked is not None:  # not computed: another row already fails
+                    g = np.where(block.unchecked, 0.0, g)
+                G.append(g)
             out["G"] = np.column_stack(G)
 
     return _Vectorised()

@@ -20,7 +20,8 @@ import numpy as np
 from optdesign.formulations.nlp.solution import nlp_solution
 from optdesign.formulations.nlp.solve import finish
 from optdesign.formulations.verify import verify_design
-from optdesign.problem.design_problem import DesignProblem, relative_violation
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.evaluation import relative_violation
 from optdesign.solvers.result import Result, clean_json
 from optdesign.solvers.solved_point import SolvedPoint, in_key_order, shared_fields
 from optdesign.tolerances import FEASIBILITY_TOL

@@ -17,7 +17,7 @@ from optdesign.cli import main
 from optdesign.errors import InputError
 from optdesign.formulations.verify import verify_design
 from optdesign.problem import load_problem
-from optdesign.problem.design_problem import relative_violation
+from optdesign.problem.evaluation import relative_violation
 from optdesign.problem.load import load
 from optdesign.runtime.runner import read_store
 from optdesign.solvers import deadline
