@@ -2,12 +2,14 @@
 each design's largest relative violation, from one design's (or a population's)
 :class:`~optdesign.problem.design_problem.Expressions`.
 
-Some rows are checks of the NumPy path alone, costly per design and never rows of an NLP
-(the loop's pole damping and limit cycles: a root finding and a harmonic balance per
-design and angle). Their block holds :class:`ScreenedRows`: in a population they are
-computed only for the designs that pass every other row, since a design that fails one
-is infeasible whatever they say. A single design, and any reader that takes the block as
-an array, gets every row.
+Some values are costly per design: the checks of the NumPy path alone, never rows of an
+NLP (the loop's pole damping and limit cycles: a root finding and a harmonic balance per
+design and angle), and an objective that is a root (the loop's bandwidth). They are held
+as :class:`RowsOnDemand`. In a population a constraint block's are computed only for the
+designs that pass every other row, since a design that fails one is infeasible whatever
+they say; an objective's only when it is read (:class:`PopulationObjectives`: a global
+search's start sample reads the one objective it ranks by). A single design, and any
+reader that takes such a value as an array, gets every row.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ class BlockValues:
     """Values of one constraint block on the NumPy path (rows of a population).
 
     ``unchecked``: the designs whose rows were not computed (NaN in ``values``) because
-    another row already fails (:class:`ScreenedRows`); None when every row was."""
+    another row already fails (:class:`RowsOnDemand`); None when every row was."""
 
     values: np.ndarray
     lower: float | None
@@ -44,13 +46,13 @@ class Evaluation:
     largest relative violation per design.
     """
 
-    objectives: dict[str, Any]
+    objectives: Mapping[str, Any]
     constraints: dict[str, BlockValues]
     violation: Any
 
 
 @dataclass
-class ScreenedRows:
+class RowsOnDemand:
     """The rows of a check computed design by design, for the designs asked only.
 
     ``rows_of(designs)`` gives one row per design index in ``designs`` (shape
@@ -61,6 +63,10 @@ class ScreenedRows:
     designs: int
     width: int
     _all: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self.designs, self.width)
 
     def __array__(self, dtype=None, copy=None) -> np.ndarray:
         if self._all is None:
@@ -76,6 +82,28 @@ class ScreenedRows:
                 len(designs), self.width
             )
         return out
+
+
+class PopulationObjectives(Mapping[str, np.ndarray]):
+    """A population's objective values, each computed when it is first read: name ->
+    one value per design (:func:`term_values` of the objective's term)."""
+
+    def __init__(self, terms: Mapping[str, Any], pop: int, n_phi: int):
+        self._terms, self._pop, self._n_phi = dict(terms), pop, n_phi
+        self._values: dict[str, np.ndarray] = {}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._values:
+            term = self._terms[name]  # KeyError for a name the problem lacks
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                self._values[name] = term_values(term, self._pop, self._n_phi)
+        return self._values[name]
+
+    def __iter__(self):
+        return iter(self._terms)
+
+    def __len__(self) -> int:
+        return len(self._terms)
 
 
 def term_values(term: Any, pop: int, n_phi: int) -> np.ndarray:
@@ -123,7 +151,7 @@ def evaluation_of(
     """The :class:`Evaluation` of the expressions ``ex`` of ``pop`` designs (module
     docstring: the screened blocks last, for the designs that pass the others)."""
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        objectives = {name: term_values(t, pop, n_phi) for name, t in ex.objectives.items()}
+        objectives = PopulationObjectives(ex.objectives, pop, n_phi)
         values: dict[str, BlockValues] = {}
         worst = np.zeros(pop)
 
@@ -136,7 +164,7 @@ def evaluation_of(
             values[name] = BlockValues(e, lower, upper, unchecked)
 
         for block in ex.constraints:
-            if not isinstance(block.expr, ScreenedRows):
+            if not isinstance(block.expr, RowsOnDemand):
                 e = population_rows(np.asarray(block.expr, dtype=float), pop)
                 add(block.name, e, block.lower, block.upper)
         for name, limit in objective_limits.items():
@@ -145,7 +173,7 @@ def evaluation_of(
         unchecked = np.ones(pop, dtype=bool)
         unchecked[passing] = False
         for block in ex.constraints:
-            if isinstance(block.expr, ScreenedRows):
+            if isinstance(block.expr, RowsOnDemand):
                 e = block.expr.of(passing)
                 add(block.name, e, block.lower, block.upper, unchecked if unchecked.any() else None)
         # the blocks in the problem's order, then the objectives' limits

@@ -28,6 +28,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
     bandwidth_ratio,
@@ -36,6 +37,7 @@ from optdesign.problem.loop import (
     loop_gains,
     picked,
     plant_grid,
+    population_size,
 )
 
 #: |T|^2 over its static value at the bandwidth: half the power.
@@ -54,19 +56,28 @@ def _bandwidth(plant: DrivePlant, loop: PositionLoop) -> float:
     return ll.bandwidth(plant, loop)
 
 
-def _exact_periods(q) -> np.ndarray:
+def _exact_periods(q) -> np.ndarray | RowsOnDemand:
     """1 / f_k (s) at the loop's angles, 0 at the other grid angles (they bound nothing),
-    one row per design; NaN for a design whose drive is no plant."""
+    one row per design; NaN for a design whose drive is no plant. A population's rows are
+    computed when read (a root finding per design and angle)."""
     idx = loop_angles(q.problem)
-    drives = drive_plants_of(q, idx, strict=False)
-    out = np.zeros((len(drives), len(np.ravel(q.phi))))
-    for i, drive in enumerate(drives):
-        if drive is None:
-            out[i] = np.nan
-            continue
-        plants, loop = drive
-        out[i, idx] = [2.0 * math.pi / _bandwidth(p, loop) for p in plants]
-    return out
+    width = len(np.ravel(q.phi))
+    drives: list = []
+
+    def rows_of(designs: np.ndarray) -> np.ndarray:
+        if not drives:
+            drives.extend(drive_plants_of(q, idx, strict=False))
+        out = np.zeros((len(designs), width))
+        for row, i in enumerate(designs):
+            if drives[i] is None:
+                out[row] = np.nan
+                continue
+            plants, loop = drives[i]
+            out[row, idx] = [2.0 * math.pi / _bandwidth(p, loop) for p in plants]
+        return out
+
+    rows = RowsOnDemand(rows_of, population_size(q), width)
+    return np.asarray(rows) if rows.designs == 1 else rows
 
 
 def _rigid_periods(q) -> Any:

@@ -58,7 +58,7 @@ from optdesign.errors import ProblemError
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
-from optdesign.problem.evaluation import ScreenedRows
+from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
     LoopGains,
@@ -156,14 +156,14 @@ def _largest_cycle(plant: DrivePlant, loop: PositionLoop) -> float:
     return float(np.degrees(limit_cycles(plant, loop, CYCLE_POINTS).largest_stable_fin_amplitude))
 
 
-def least_pole_damping(q, idx: np.ndarray) -> np.ndarray | ScreenedRows:
+def least_pole_damping(q, idx: np.ndarray) -> np.ndarray | RowsOnDemand:
     """The smallest damping ratio -Re p / |p| of the closed loop's poles at each loop
     angle ``idx`` (NumPy, one row per design of a population; NaN for a design whose
     drive is no plant, :func:`~optdesign.problem.loop.drive_plants_of`)."""
     return _per_plant(q, idx, _least_damping)
 
 
-def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray | ScreenedRows:
+def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray | RowsOnDemand:
     """The fin amplitude (deg) of the largest stable limit cycle the chain's clearance
     sustains at each loop angle ``idx``, by harmonic balance
     (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
@@ -171,7 +171,7 @@ def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray | ScreenedRows:
     return _per_plant(q, idx, _largest_cycle)
 
 
-def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray | ScreenedRows:
+def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray | RowsOnDemand:
     # a population's rows are screened: computed for the designs that pass every other
     # row only (optdesign.problem.evaluation), which spares a global search's start
     # sample a harmonic balance per design and angle
@@ -191,7 +191,7 @@ def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray | ScreenedRows:
         ).reshape(len(designs), len(idx))
 
     pop = population_size(q)
-    rows = ScreenedRows(rows_of, pop, len(idx))
+    rows = RowsOnDemand(rows_of, pop, len(idx))
     return np.asarray(rows) if pop == 1 else rows
 
 

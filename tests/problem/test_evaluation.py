@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.problem.evaluation import ScreenedRows
+from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.tolerances import FEASIBILITY_TOL
 
 PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
@@ -88,7 +88,7 @@ def test_screened_rows_read_as_an_array_are_every_designs(problem, population):
     ex = problem.expressions(problem.design_dict(population))
     blocks = {b.name: b for b in ex.constraints}
     for name in SCREENED:
-        assert isinstance(blocks[name].expr, ScreenedRows)
+        assert isinstance(blocks[name].expr, RowsOnDemand)
         rows = np.asarray(blocks[name].expr)
         for j, x in enumerate(population):
             own = np.ravel(problem.evaluate(x).constraints[name].values)
@@ -116,3 +116,30 @@ def test_a_front_search_population_marks_unchecked_rows_as_no_violation(problem,
         assert column[0] < 0 and np.all(column[1:] == 0.0), name
     assert G[0].max() <= FEASIBILITY_TOL
     assert G[2].max() == pytest.approx(0.01193, rel=1e-3)  # the resonance margin's
+
+
+def test_a_populations_costly_objective_is_computed_when_read(problem, population, monkeypatch):
+    """The loop's bandwidth (a root finding per design and angle) is not computed for a
+    population until its objective is read, and then equals each design's alone; reading
+    another objective (the start sample ranks by one) computes none of it."""
+    from optdesign.problem import loop_bandwidth
+
+    calls = []
+    exact = loop_bandwidth._bandwidth.__wrapped__
+
+    def counted(plant, loop):
+        calls.append(plant.angle)
+        return exact(plant, loop)
+
+    monkeypatch.setattr(loop_bandwidth, "_bandwidth", counted)
+    ev = problem.evaluate(population)
+    backlash = ev.objectives["backlash"]
+    assert calls == [] and backlash.shape == (len(population),)
+    periods = ev.objectives["bandwidth_period"]
+    assert len(calls) == 4 * 7  # the four designs that are plants, at the seven angles
+    for j, x in enumerate(population):
+        alone = problem.evaluate(x).objectives["bandwidth_period"]
+        if j == 3:  # folds inside the stroke: no plant
+            assert np.isnan(periods[j])
+        else:
+            assert periods[j] == alone
