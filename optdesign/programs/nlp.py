@@ -189,6 +189,29 @@ class NLP:
         """(z, theta) -> the constraint rows."""
         return ca.Function("g", [self.z, self.theta], [self.g])
 
+    def objective_reads(self, target: Target) -> tuple[set[int], set[int]]:
+        """Which design variables and parameters the value of ``target`` depends on,
+        structurally (CasADi's ``depends_on``): positions in :attr:`design_names` and in
+        :attr:`param_names`. An epigraph's auxiliary variable stands for the expression
+        it bounds (its tightest value, :attr:`aux_init`), so a minimax objective reads
+        what its envelope reads. A term multiplied by zero still counts: the answer may
+        say "depends" where the value does not, never the other way."""
+        zd, za = self.z[: self.n_design], self.z[self.n_design :]
+        theta = self.theta
+        exprs = []
+        for name, _ in target.coefficients:
+            if name.startswith(VAR):
+                exprs.append(zd[self.design_names.index(name[len(VAR) :])])
+                continue
+            expr = ca.SX(self.objective_values[name])
+            if self.aux_init is not None and za.numel():
+                expr = ca.substitute(expr, za, self.aux_init(zd, theta))
+            exprs.append(expr)
+        total = ca.vertcat(*exprs) if exprs else ca.SX(0)
+        design = {k for k in range(self.n_design) if ca.depends_on(total, zd[k])}
+        params = {k for k in range(theta.numel()) if ca.depends_on(total, theta[k])}
+        return design, params
+
     def objective_of(self, target: Target, values: np.ndarray) -> float:
         """``sum c_k v_k`` from the vector of target values."""
         return float(sum(c * values[self.targets.index(k)] for k, c in target.coefficients))
