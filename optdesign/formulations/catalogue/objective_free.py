@@ -54,7 +54,7 @@ def objective_free_variables(ns) -> frozenset[str]:
     not enter its objective (empty when the back-end's NLP cannot say). A parameter no
     variable claims counts as read from every catalogue variable."""
     dvars = [v.name for v in discrete_variables(ns.problem)]
-    try:
+    try:  # a node solver whose NLP cannot say (a test's double): none
         design, params = ns.nlp.objective_reads(ns.target)
     except (AttributeError, NotImplementedError, RuntimeError):
         return frozenset()
@@ -74,12 +74,13 @@ def split_last_variables(ns) -> frozenset[str]:
     value: it is split as before.)"""
     import casadi as ca
 
+    free = objective_free_variables(ns)
+    if not free:
+        return frozenset()
     nlp = ns.nlp
     g = ca.SX(nlp.g)
     return frozenset(
-        name
-        for name in objective_free_variables(ns)
-        if not ca.depends_on(g, nlp.z[nlp.design_names.index(name)])
+        name for name in free if not ca.depends_on(g, nlp.z[nlp.design_names.index(name)])
     )
 
 
