@@ -46,6 +46,10 @@ depend on the warm bounds, the first incumbent or the number of workers. (Enumer
 visits the combinations in that order and keeps the first of a tie: the same rule.)
 The variable split at a node is the one farthest from an item until every candidate has
 been split before; then the one whose splits raised the bound most (:class:`PseudoCosts`).
+A variable whose item data only the rows read (a motor under a backlash objective) is
+split last, at the first item the node's design meets, its sides bounded by the node's
+value until popped (:mod:`~optdesign.formulations.catalogue.objective_free`: where a box
+is split and when a side is solved change, not what may be pruned).
 A search that only needs the optimal value (``ties=False``: the first stage of a front's
 lexicographic anchor, whose tie-break picks the design) prunes a tie whatever its items.
 """
@@ -85,8 +89,8 @@ from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 Box = Mapping[str, tuple[float, float]]
 
-#: Split the catalogue variables the objective does not read last, at the first item a
-#: node's design meets (:mod:`~optdesign.formulations.catalogue.objective_free`).
+#: Split last the catalogue variables whose item data only the rows read (neither the
+#: objective nor any row reads their value), at the first item a node's design meets (:mod:`~optdesign.formulations.catalogue.objective_free`).
 SPLIT_LAST = True
 
 #: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
@@ -337,9 +341,10 @@ def branch_and_bound_warm(
                 return True
         return False
 
-    def visit(child: Box, x, below: float | None, bound: float) -> float | None:
+    def visit(child: Box, x, below: float | None, bound: float) -> float:
         """Solve a child box and queue it unless it is infeasible or pruned; the rise
-        of its value over ``bound`` (None when an earlier search's bound pruned it)."""
+        of its value (or of an earlier search's bound on it) over ``bound``, for the
+        pseudo-costs."""
         fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
         earlier = earlier_bound(ns, child)
         if earlier is not None and prunes(earlier, child):
