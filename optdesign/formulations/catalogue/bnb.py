@@ -70,6 +70,7 @@ from optdesign.formulations.catalogue.branching import first_feasible as first_f
 from optdesign.formulations.catalogue.branching import fixed_box as fixed_box
 from optdesign.formulations.catalogue.branching import item_distances as item_distances
 from optdesign.formulations.catalogue.branching import on_items as on_items
+from optdesign.formulations.catalogue.branching import side_boxes
 from optdesign.formulations.catalogue.branching import split_at_items as split_at_items
 from optdesign.formulations.catalogue.discrete import (
     branch,
@@ -81,6 +82,7 @@ from optdesign.formulations.catalogue.node_bounds import NodeBounds
 from optdesign.formulations.catalogue.node_bounds import inside as _inside
 from optdesign.formulations.catalogue.objective_free import (
     first_items_met,
+    split_first,
     split_last_variables,
 )
 from optdesign.solvers.multistart import improves
@@ -409,10 +411,11 @@ def branch_and_bound_warm(
             if reading is not None:
                 worst, pool = reading, first
         worst = pseudo.choose(pool, box, res, worst)
+        met: list[str] = []
         if last and (worst is None or worst.name in last):
             # the first item of each such variable that the node's design meets, the
             # others on theirs: that combination's value is the node's
-            worst = first_items_met(ns, dvars, last, box, res, items, worst)
+            worst, met = first_items_met(ns, dvars, last, box, res, items, worst)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
             one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
@@ -437,23 +440,24 @@ def branch_and_bound_warm(
             # The node's relaxation sits on items, but its item data (fit ratios, screw
             # ratings) are the most favourable over the box's items, not those of the
             # items it sits on: the box's other combinations may still beat this leaf.
-            sides = split_at_items(order, box, items)
+            lead = split_first(dvars, met, box, items, names)
+            sides = split_at_items([lead] if lead else order, box, items)
         else:
             allowed = items_within(worst.values, *box[worst.name])
             sides = [(worst, side) for side in branch(res.design[worst.name], allowed)]
         gains: list[float] = []
-        for var, side in sides:
-            if not side:
-                continue
-            child = dict(box)
-            child[var.name] = (side[0], side[-1])
-            if worst is None and child == fixed_box(items):
-                continue  # the leaf just solved
-            if worst is None and var.name in last and own is not None:
-                # beside the leaf at the first item met: bounded by this node's value
-                # (a tie that loses on its items above that item) until popped
-                heapq.heappush(heap, (own, next(counter), child, None, x, below))
-                continue
+        for var, child in side_boxes(box, sides, fixed_box(items) if worst is None else None):
+            if worst is None and var.name in last:
+                # beside the leaf at the first item met: this node's value bounds it, as
+                # it bounds the whole box once its leaf is solved (above); a side that
+                # cannot win on it goes with no NLP, now or, when the value is trusted,
+                # once the side is popped
+                if prunes(bound, child):
+                    stats["pruned"] += 1
+                    continue
+                if own is not None:
+                    heapq.heappush(heap, (own, next(counter), child, None, x, below))
+                    continue
             gains.append(visit(child, x, below, bound))
         if worst is not None and gains:
             pseudo.record(worst.name, gains)

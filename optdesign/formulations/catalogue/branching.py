@@ -129,13 +129,7 @@ def first_feasible(ns: Any) -> Result | None:
             allowed = items_within(worst.values, *box[worst.name])
             splits = [(worst, side) for side in branch(res.design[worst.name], allowed)]
         children = []
-        for var, side in splits:
-            if not side:
-                continue
-            child = dict(box)
-            child[var.name] = (side[0], side[-1])
-            if worst is None and child == fixed_box(items):
-                continue  # the leaf just solved
+        for _, child in side_boxes(box, splits, fixed_box(items) if worst is None else None):
             r = ns.solve(child, ns.x_of(res))
             if r.success:
                 children.append((r.objective, child, r))
@@ -143,3 +137,16 @@ def first_feasible(ns: Any) -> Result | None:
         for _, child, r in sorted(children, key=lambda c: -c[0]):
             stack.append((child, r))
     return None
+
+
+def side_boxes(box: Box, sides, leaf: Box | None = None):
+    """The child boxes of ``box`` split into ``sides`` ((variable, its items) pairs; an
+    empty side makes none), without the box of the ``leaf`` just solved: (variable,
+    child box) pairs."""
+    for var, side in sides:
+        if not side:
+            continue
+        child = dict(box)
+        child[var.name] = (side[0], side[-1])
+        if child != leaf:
+            yield var, child

@@ -35,6 +35,7 @@ variable whose data enter only the requirements is treated the same way.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -133,10 +134,12 @@ def first_item_met(
     return None
 
 
-def first_items_met(ns, dvars, last: frozenset[str], box, res, items: dict[str, float], worst):
+def first_items_met(
+    ns, dvars, last: frozenset[str], box, res, items: dict[str, float], worst
+) -> tuple[Any, list[str]]:
     """The variable to split at the node ``res`` over ``box`` (None: the node is a leaf of
     the combination ``items``, updated here), given the variables split last (``last``,
-    :func:`split_last_variables`).
+    :func:`split_last_variables`), and those of them whose item the design meets.
 
     When ``worst`` is one of them and every other catalogue variable sits on an item, the
     node is a leaf: ``worst`` takes the first of its items that the design meets (else its
@@ -147,14 +150,37 @@ def first_items_met(ns, dvars, last: frozenset[str], box, res, items: dict[str, 
 
     x = ns.x_of(res)
     if x is None:
-        return worst
+        return worst, []
     if worst is not None:
         others = [v for v in dvars if v is not worst]
         if worst.name not in last or on_items(others, box, res)[0] is not None:
-            return worst
+            return worst, []
+    met = []
     for v in dvars:
         if v.name in last and box[v.name][0] != box[v.name][1]:
             item = first_item_met(ns, box, x, res.objective, v.name, items)
             if item is not None:
                 items[v.name] = item
+                met.append(v.name)
+    return None, met
+
+
+def split_first(dvars, met: list[str], box, items: Mapping[str, float], names) -> Any:
+    """The variable of ``met`` (those whose item the leaf's design meets) to split a
+    leaf's box on before the others, or None.
+
+    Split at its item ``j``, the box's sides are it below ``j``, at ``j`` and above
+    ``j``. When the side at ``j`` holds no combination before the leaf's in the order of
+    the items (``names``: the variables that decide a tie, in their declared order; the
+    side above comes later still), the leaf's value prunes both on a tie and only the
+    side below is left to solve: the first such variable is returned. Otherwise (the
+    box's other variables reach below the leaf's items) the others are split first, down
+    to the leaf's items, so that the sides of this variable hold one combination of the
+    others each - never a copy of their tree."""
+    leaf = tuple(float(items[k]) for k in names)
+    for v in dvars:
+        if v.name in met:
+            at = tuple(float(items[k]) if k == v.name else float(box[k][0]) for k in names)
+            if at >= leaf:
+                return v
     return None

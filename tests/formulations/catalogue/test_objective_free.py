@@ -8,12 +8,12 @@ must not apply."""
 from __future__ import annotations
 
 import copy
-import math
 import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from problem.test_motor_catalogue_variable import _csv  # the shipped rows as a CSV
 
 import optdesign as od
 from optdesign.formulations.catalogue.objective_free import (
@@ -22,48 +22,35 @@ from optdesign.formulations.catalogue.objective_free import (
     split_last_variables,
 )
 from optdesign.formulations.catalogue.search import NodeSolver, solve_catalogue
-from optdesign.models.motor_catalogue import load_motors
 from optdesign.problem.parameters import without_impossible_items
 
 ROOT = Path(__file__).resolve().parents[3]
 
-COLUMNS = (
-    "designation,rated_torque_Nm,peak_torque_Nm,rated_speed_rpm,max_speed_rpm,"
-    "rotor_inertia_1e-4kgm2,mass_kg"
-)
 #: The shipped SGM7J-02A ... -08A rows with masses made up for the test, the 04A the
 #: heaviest: under motor_mass the lightest motor that can give the step is not the first.
 MASSES_KG = {"SGM7J-02A": 1.1, "SGM7J-04A": 2.9, "SGM7J-06A": 1.9, "SGM7J-08A": 2.6}
 
 
-def _csv() -> str:
-    rows = {r.designation: r for r in load_motors()}
-    lines = [COLUMNS]
-    for name, mass in MASSES_KG.items():
-        r = rows[name]
-        lines.append(
-            f"{name},{r.rated_torque / 1e3:g},{r.peak_torque / 1e3:g},"
-            f"{r.rated_speed * 30 / math.pi:.6g},{r.max_speed * 30 / math.pi:.6g},"
-            f"{r.rotor_inertia * 10:g},{mass}"
-        )
-    return "\n".join(lines) + "\n"
-
-
-def _small(tmp_path: Path, objective: str, rise_time: str = "72 ms") -> od.DesignProblem:
+def _small(
+    tmp_path: Path, objective: str, rise_time: str = "72 ms", motor_first: bool = False
+) -> od.DesignProblem:
     """cs_min_backlash with its pins from the ISO 2338 catalogue (8, 10, 12 mm), a motor
     from a four-motor CSV (the 02A excluded in closed form), the fin's load and a step:
-    9 combinations."""
+    9 combinations. ``motor_first``: the file declares the motor before the pins, so a
+    tie goes to the smaller motor first."""
     from hostile_corpus import dumps
 
     data = tomllib.loads((ROOT / "problems" / "cs_min_backlash.toml").read_text())
     data["variables"]["d"] = {"catalogue": "ISO 2338", "lower": "8 mm", "upper": "12 mm"}
+    if motor_first:
+        data["variables"] = {"motor": {"catalogue": "motors.csv"}, **data["variables"]}
     data["motor"] = {"catalogue": "motors.csv"}
     data["load"] = {"inertia": "0.5 kg*m^2", "hinge_spring": "-500 N*m/rad",
                     "damping": "5 N*m*s/rad", "nut_mass": "0.6 kg"}  # fmt: skip
     data["motion"] = {"step": "3 deg", "rise_time": rise_time, "damping_ratio": 0.7,
                       "rate": "120 deg/s"}  # fmt: skip
     data["objective"] = {"minimize": objective}
-    (tmp_path / "motors.csv").write_text(_csv())
+    (tmp_path / "motors.csv").write_text(_csv(MASSES_KG))
     path = tmp_path / f"{objective}.toml"
     path.write_text(dumps(data))
     return od.load(path)
@@ -107,28 +94,32 @@ def test_the_first_motor_the_named_optimum_meets_is_its_own_motor():
 
 
 @pytest.mark.parametrize(
-    ("objective", "rise_time", "items"),
+    ("objective", "rise_time", "motor_first", "items"),
     [
         # every motor that can give the step ties on the backlash: the first one (04A)
-        ("backlash", "72 ms", {"d": 10.0, "motor": 2.0}),
+        ("backlash", "72 ms", False, {"d": 10.0, "motor": 2.0}),
         # a faster step: the 04A still can, at a larger backlash (0.0370046 deg against
         # the 06A's and 08A's 0.0369799): the first motor is not the answer
-        ("backlash", "68 ms", {"d": 10.0, "motor": 3.0}),
+        ("backlash", "68 ms", False, {"d": 10.0, "motor": 3.0}),
+        ("backlash", "68 ms", True, {"motor": 3.0, "d": 10.0}),
         # the objective reads the motor (its mass): the lightest that can, the 06A
-        ("motor_mass", "72 ms", {"d": 8.0, "motor": 3.0}),
+        ("motor_mass", "72 ms", False, {"d": 8.0, "motor": 3.0}),
     ],
 )
-def test_branch_and_bound_finds_the_enumerations_combination(tmp_path, objective, rise_time, items):
+def test_branch_and_bound_finds_the_enumerations_combination(
+    tmp_path, objective, rise_time, motor_first, items
+):
     """The search's value and items equal the enumeration's over the combinations,
-    whether the objective ignores the motor (split last) or reads its mass (not)."""
-    problem = _small(tmp_path, objective, rise_time)
+    whether the objective ignores the motor (split last) or reads its mass (not), with
+    the motor declared after the pins or before them (the order that decides a tie)."""
+    problem = _small(tmp_path, objective, rise_time, motor_first)
     ns = NodeSolver(problem, starts=1)
     assert ("motor" in split_last_variables(ns)) == (objective == "backlash")
     enum = solve_catalogue(problem, method="enumerate")
     bnb = solve_catalogue(problem, method="bnb")
     assert enum.status == bnb.status == "optimal"
     assert enum.details.catalogue.items == items
-    assert bnb.details.catalogue.items == items
+    assert list(bnb.details.catalogue.items.items()) == list(items.items())
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-7)
 
 
