@@ -47,9 +47,10 @@ visits the combinations in that order and keeps the first of a tie: the same rul
 The variable split at a node is the one farthest from an item until every candidate has
 been split before; then the one whose splits raised the bound most (:class:`PseudoCosts`).
 A variable whose item data only the rows read (a motor under a backlash objective) is
-split last, at the first item the node's design meets, its sides bounded by the node's
-value until popped (:mod:`~optdesign.formulations.catalogue.objective_free`: where a box
-is split and when a side is solved change, not what may be pruned).
+split last, at the first item the node's design meets; the sides that lose a tie with
+that leaf go on the node's value
+(:mod:`~optdesign.formulations.catalogue.objective_free`: where a box is split and when a
+side is solved change, not what may be pruned).
 A search that only needs the optimal value (``ties=False``: the first stage of a front's
 lexicographic anchor, whose tie-break picks the design) prunes a tie whatever its items.
 """

@@ -1,35 +1,39 @@
-"""Catalogue variables whose items the objective never reads, and the item a node's
+"""Catalogue variables whose items only the requirements read, and the item a node's
 design already meets.
 
 A catalogue variable is *objective-free* when neither its value nor any parameter read
 from its item (:func:`~optdesign.problem.drive.parameter_owners`) enters the searched
-objective (:meth:`~optdesign.programs.nlp.NLP.objective_reads`, structurally): its items
-differ only in which designs they allow. The branch and bound
-(:mod:`optdesign.formulations.catalogue.bnb`) then treats it in two ways:
+objective (:meth:`~optdesign.programs.nlp.NLP.objective_reads`, structurally). When no
+row reads its value either - only its item data enter the rows (a motor's number under
+a backlash objective) - its items differ only in which designs they allow, and its
+relaxed value lies wherever the start left it. The branch and bound
+(:mod:`optdesign.formulations.catalogue.bnb`) then treats it in two ways
+(:func:`split_last_variables`):
 
 - it is split last, once the other catalogue variables sit on items: splitting it first
   copies the other variables' tree under each of its halves, whose relaxations differ in
   none of their values (only its rows read its data);
 - at a node whose other variables sit on items ``c``, the node's design is checked
-  against each of its items in turn (every row and the objective evaluated at the
-  design, no NLP: :func:`first_item_met`). The first item ``j`` the design meets gives a
-  combination ``(c, j)`` whose value equals the node's bound: the design is feasible for
-  it and no design of the box does better. The node is split at ``j``: below ``j``,
-  ``j`` itself (a leaf), above ``j``; the two sides are bounded by the node's own value
-  until they are popped, and each is solved only if that bound cannot prune it then.
+  against each of its items in turn, smallest first (every row and the objective
+  evaluated at the design, no NLP: :func:`first_item_met`). The first item ``j`` the
+  design meets gives the combination ``(c, j)`` solved as the node's leaf: the design is
+  feasible for it, so its value is the node's. The box is then split at ``j`` (below,
+  at, above), on this variable first when its sides at and above ``j`` hold no
+  combination before ``(c, j)`` in the order of the items (:func:`split_first`): they
+  lose a tie with the leaf and go on the node's value, leaving only the side below
+  (usually proved infeasible) to solve; else on the others first, down to ``c``.
 
 Why the answer stays the enumeration's: these rules choose *where* a box is split and
-*when* a child is solved, never what is discarded. Every split partitions the box's item
-combinations; a child is pruned only by the search's own rule
+*when* a side is solved, never what may be discarded. Every split partitions the box's
+item combinations; a side is pruned only by the search's own rule
 (:func:`~optdesign.formulations.catalogue.bnb.box_cannot_win`: its bound worse than the
-incumbent beyond the tie tolerance, or a tie and no combination of the box before the
-incumbent's in the order of the items), on a bound that is the trusted value of the
-node it came from - a sub-box's data are no more favourable, so its value is no lower.
-Ties are still decided by value, then by the items in their declared order: the side
-above ``j`` holds only combinations ``(c, j')`` with ``j' > j``, which lose to ``(c, j)``
-on a tie, and the side below ``j`` is solved (usually proved infeasible) before ``(c,
-j)`` can be reported. Nothing here reads the variable's name: a user's catalogue
-variable whose data enter only the requirements is treated the same way.
+incumbent beyond the tie tolerance, or a tie and no combination of the side before the
+incumbent's in the order of the items), on the value of the node it came from - the same
+value on which the search already prunes that node's whole box once its leaf is solved
+(a sub-box's data are no more favourable, so its value is no lower). Ties are still
+decided by value, then by the items in their declared order, wherever the variable is
+declared. Nothing here reads the variable's name: a user's catalogue variable whose
+data enter only the requirements is treated the same way.
 """
 
 from __future__ import annotations

@@ -127,7 +127,7 @@ def test_the_catalogue_motor_is_the_enumerations_motor_for_less_than_twice_the_n
     """fin_actuator_motor with the motor from the 14-motor catalogue: motor 6 (SGM7J-06A)
     at the named motor's backlash (motors 1-4 excluded in closed form, 5 infeasible, 6-14
     tie: benchmarks/motor/cost.py enumerates them), in fewer than twice the NLP solves of
-    the named motor's search (68 before the motor was split last)."""
+    the named motor's search (68 before the motor was split last, 27 since)."""
     named = tomllib.loads((ROOT / "problems" / "fin_actuator_motor.toml").read_text())
     one = od.solve(od.load(named), ranges=False, sensitivities=False)
     chosen = od.solve(_catalogue_motor(), ranges=False, sensitivities=False)
