@@ -135,3 +135,17 @@ def test_the_catalogue_motor_is_the_enumerations_motor_for_less_than_twice_the_n
     assert chosen.objective == pytest.approx(0.0377566355, rel=1e-9)
     assert chosen.objective == pytest.approx(one.objective, rel=1e-9)
     assert chosen.details.catalogue.nlp_solves < 2 * one.details.catalogue.nlp_solves
+
+
+def test_an_implicit_epigraph_reads_the_motor_through_its_rows():
+    """fin_actuator_loop's bandwidth_period is a root of the loop, bounded by implicit
+    rows rather than an expression: the motor's rotor inertia enters those rows, so the
+    motor is read by the objective and split as the others are; under the backlash the
+    same problem's motor is split last."""
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator_loop.toml").read_text())
+    data["motor"] = {k: v for k, v in data["motor"].items() if k != "designation"}
+    data["motor"]["catalogue"] = "Yaskawa Sigma-7"
+    problem, _ = without_impossible_items(od.load(data))
+    bandwidth = NodeSolver(problem, objective="bandwidth_period", starts=1)
+    assert objective_free_variables(bandwidth) == frozenset()
+    assert split_last_variables(NodeSolver(problem, starts=1)) == {"motor"}
