@@ -2,8 +2,9 @@
 ``fin_actuator_motor`` (the same actuator with a named motor, its load and a step
 response) and against the same problem with the motor chosen from the catalogue
 (``[motor] catalogue = "Yaskawa Sigma-7"``, one more catalogue variable), in one process,
-the least of ``--rounds`` rounds each (the solver caches built by a first solve), and the
-catalogue choice against an enumeration over the motors named one by one.
+the least of ``--rounds`` rounds each (the solver caches built by a first solve), with
+each search's NLP solves (``details.catalogue.nlp_solves``: the same on any machine),
+and the catalogue choice against an enumeration over the motors named one by one.
 
     python benchmarks/motor/cost.py --rounds 3
 """
@@ -55,9 +56,9 @@ def main() -> None:
         t, r = rows[label]
         print(f"{label}: {t:.2f} s, {r.status}, backlash {r.objective:.9g}, {r.design}")
     base = rows["fin_actuator"][0]
-    print("\n| solve | time (s) | ratio to fin_actuator |\n|---|---|---|")
-    for label, (t, _) in rows.items():
-        print(f"| {label} | {t:.2f} | {t / base:.2f} |")
+    print("\n| solve | time (s) | ratio to fin_actuator | NLP solves |\n|---|---|---|---|")
+    for label, (t, r) in rows.items():
+        print(f"| {label} | {t:.2f} | {t / base:.2f} | {r.details.catalogue.nlp_solves} |")
     values = []
     for row in motors(CATALOGUE):
         data = copy.deepcopy(named)

@@ -197,6 +197,21 @@ def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, 
     return values
 
 
+def parameter_owners(problem) -> dict[str, tuple[str, ...]]:
+    """The variables whose catalogue item each parameter of :func:`parameter_values`
+    reads (parameter name -> variable names): the fit's ratios the pin's ``d``, the
+    screw's data its ``(d0, p)`` pair, the motor's data its number. A search asks which
+    items' data enter a quantity through this map, not through the parameters' names."""
+    out: dict[str, tuple[str, ...]] = {}
+    for name in _placeholders(problem):
+        if name.startswith("fit_ratio_"):
+            out[name] = ("d",)
+        elif name.startswith("screw_"):
+            out[name] = ("d0", "p")
+    out.update(motor_catalogue_variable.parameter_owners(problem))
+    return out
+
+
 def _range(problem, name: str, box) -> tuple[float, float]:
     v = problem.by_name[name]
     if name in box:

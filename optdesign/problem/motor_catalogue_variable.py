@@ -130,6 +130,11 @@ def parameter_defaults(problem) -> dict[str, float]:
     return {PREFIX + field: 1.0 for field in MOTOR_FIELDS}
 
 
+def parameter_owners(problem) -> dict[str, tuple[str, ...]]:
+    """The motor's parameters, each read from the item of the variable ``motor``."""
+    return {name: ("motor",) for name in parameter_defaults(problem)}
+
+
 def parameter_values(problem, box: dict[str, tuple[float, float]]) -> dict[str, float]:
     """The motor's parameters over the motors whose number lies in ``box["motor"]`` (the
     variable's bounds when the box leaves it out): exact for one motor, favourable over

@@ -189,6 +189,32 @@ class NLP:
         """(z, theta) -> the constraint rows."""
         return ca.Function("g", [self.z, self.theta], [self.g])
 
+    def objective_reads(self, target: Target) -> tuple[set[int], set[int]]:
+        """Which design variables and parameters the value of ``target`` depends on,
+        structurally (CasADi's sparsity of its derivatives): positions in
+        :attr:`design_names` and in :attr:`param_names`. An epigraph's auxiliary variable
+        reads what the rows that hold it read (a minimax objective's envelope, an
+        implicit epigraph's rows). A term multiplied by zero still counts: the answer
+        may say "depends" where the value does not, never the other way."""
+        zd, za = self.z[: self.n_design], self.z[self.n_design :]
+        theta = self.theta
+        exprs, aux = [], set()
+        for name, _ in target.coefficients:
+            if name.startswith(VAR):
+                exprs.append(zd[self.design_names.index(name[len(VAR) :])])
+                continue
+            expr = ca.SX(self.objective_values[name])
+            aux |= set(_columns(expr, za))
+            exprs.append(expr)
+        if aux:
+            g = ca.SX(self.g)
+            rows, cols = ca.jacobian_sparsity(g, za).get_triplet()
+            exprs += [
+                g[r] for r in sorted({r for r, c in zip(rows, cols, strict=True) if c in aux})
+            ]
+        total = ca.vertcat(*exprs) if exprs else ca.SX(0)
+        return set(_columns(total, zd)), set(_columns(total, theta))
+
     def objective_of(self, target: Target, values: np.ndarray) -> float:
         """``sum c_k v_k`` from the vector of target values."""
         return float(sum(c * values[self.targets.index(k)] for k, c in target.coefficients))
@@ -259,6 +285,14 @@ class NLP:
             h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
         h.update("\0".join([*self.g_names, *self.targets, *self.aux_names]).encode())
         return h.hexdigest()[:16]
+
+
+def _columns(expr, symbols) -> list[int]:
+    """The positions of ``symbols`` (a vector of CasADi symbols) that ``expr`` depends on."""
+    if not symbols.numel():
+        return []
+    _, cols = ca.jacobian_sparsity(ca.SX(expr), symbols).get_triplet()
+    return sorted(set(cols))
 
 
 def _vec(v) -> np.ndarray | None:

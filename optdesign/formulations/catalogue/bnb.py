@@ -46,6 +46,11 @@ depend on the warm bounds, the first incumbent or the number of workers. (Enumer
 visits the combinations in that order and keeps the first of a tie: the same rule.)
 The variable split at a node is the one farthest from an item until every candidate has
 been split before; then the one whose splits raised the bound most (:class:`PseudoCosts`).
+A variable whose item data only the rows read (a motor under a backlash objective) is
+split last, at the first item the node's design meets; the sides that lose a tie with
+that leaf go on the node's value
+(:mod:`~optdesign.formulations.catalogue.objective_free`: where a box is split and when a
+side is solved change, not what may be pruned).
 A search that only needs the optimal value (``ties=False``: the first stage of a front's
 lexicographic anchor, whose tie-break picks the design) prunes a tie whatever its items.
 """
@@ -61,8 +66,14 @@ from typing import Any
 
 import numpy as np
 
+from optdesign.formulations.catalogue.branching import PseudoCosts as PseudoCosts
+from optdesign.formulations.catalogue.branching import first_feasible as first_feasible
+from optdesign.formulations.catalogue.branching import fixed_box as fixed_box
+from optdesign.formulations.catalogue.branching import item_distances as item_distances
+from optdesign.formulations.catalogue.branching import on_items as on_items
+from optdesign.formulations.catalogue.branching import side_boxes
+from optdesign.formulations.catalogue.branching import split_at_items as split_at_items
 from optdesign.formulations.catalogue.discrete import (
-    ON_ITEM_TOL,
     branch,
     discrete_variables,
     items_within,
@@ -70,11 +81,20 @@ from optdesign.formulations.catalogue.discrete import (
 )
 from optdesign.formulations.catalogue.node_bounds import NodeBounds
 from optdesign.formulations.catalogue.node_bounds import inside as _inside
+from optdesign.formulations.catalogue.objective_free import (
+    first_items_met,
+    split_first,
+    split_last_variables,
+)
 from optdesign.solvers.multistart import improves
 from optdesign.solvers.result import Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 Box = Mapping[str, tuple[float, float]]
+
+#: Split last the catalogue variables whose item data only the rows read (neither the
+#: objective nor any row reads their value), at the first item a node's design meets (:mod:`~optdesign.formulations.catalogue.objective_free`).
+SPLIT_LAST = True
 
 #: Relative tolerance of pruning (a node within it of the incumbent cannot improve it).
 PRUNE_TOL = OBJECTIVE_TIE_TOL
@@ -132,11 +152,6 @@ def box_cannot_win(
         return False  # it may beat the best by more than the tolerance
     worse = bound > best + PRUNE_TOL * abs(best)
     return worse or box_key(box, names) >= best_key
-
-
-def fixed_box(values: Mapping[str, float]) -> dict[str, tuple[float, float]]:
-    """The box of one item combination (each variable fixed to its item)."""
-    return {k: (v, v) for k, v in values.items()}
 
 
 class InfeasibleBoxes:
@@ -227,27 +242,6 @@ def shared_memo(
     return _MEMOS[key]
 
 
-def item_distances(dvars, box: Box, res: Result) -> list[tuple[Any, float, float]]:
-    """(variable, nearest item within the box, relative distance to it) of each catalogue
-    variable at the node ``res`` over ``box``, in the declared order."""
-    out = []
-    for v in dvars:
-        item, dist = nearest_item(res.design[v.name], tuple(items_within(v.values, *box[v.name])))
-        out.append((v, item, dist))
-    return out
-
-
-def on_items(dvars, box: Box, res: Result) -> tuple[Any, dict[str, float]]:
-    """The catalogue variable to branch on - the one farthest (relatively) from an item
-    in its range, None when every one sits on an item - and the nearest items."""
-    worst, worst_d, items = None, ON_ITEM_TOL, {}
-    for v, item, dist in item_distances(dvars, box, res):
-        items[v.name] = item
-        if dist > worst_d:
-            worst, worst_d = v, dist
-    return worst, items
-
-
 def first_incumbent(
     ns, candidates: Sequence[Mapping[str, float]], stats: dict, ties: bool = True
 ) -> tuple[Result | None, dict | None]:
@@ -323,6 +317,11 @@ def branch_and_bound_warm(
 
     solved: dict[tuple[float, ...], Result] = {}  # each combination's full multistart
     pseudo = PseudoCosts()
+    # the catalogue variables that only the rows' data read, not the objective: split
+    # last, at the first item a node's design meets (objective_free)
+    last = split_last_variables(ns) if SPLIT_LAST else frozenset()
+    first = [v for v in dvars if v.name not in last]
+    order = first + [v for v in dvars if v.name in last]
 
     def leaf_solve(box: Box, x, floor: float | None) -> Result:
         # A combination solved before (from another node's optimum) is solved again only
@@ -345,8 +344,45 @@ def branch_and_bound_warm(
                 return True
         return False
 
+    def visit(child: Box, x, below: float | None, bound: float) -> float:
+        """Solve a child box and queue it unless it is infeasible or pruned; the rise
+        of its value (or of an earlier search's bound on it) over ``bound``, for the
+        pseudo-costs."""
+        fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
+        earlier = earlier_bound(ns, child)
+        if earlier is not None and prunes(earlier, child):
+            # no NLP: an earlier search of the front bounded it under looser limits
+            stats["pruned"] += 1
+            return pseudo.rise(bound, earlier)
+        # a box of one combination is a leaf: its value is reported, full multistart
+        if fixed:
+            r = leaf_solve(child, x, below)
+        else:
+            test = partial(_prunes_box, prunes, child)
+            r = ns.solve(child, x, warm=True, prunes=test, floor=below)
+        stats["nodes"] += 1
+        gain = pseudo.gain(bound, r)
+        if not r.success:
+            stats["infeasible"] += 1
+        elif prunes(r.objective, child):
+            stats["pruned"] += 1
+            _bound_proof(ns, child, r)
+        else:
+            warm_only = not fixed and r.multistart is not None and not trusted(r, ns.starts)
+            entry = (r.objective, next(counter), child, r, x if warm_only else None, below)
+            heapq.heappush(heap, entry)
+        return gain
+
     while heap:
         bound, _, box, res, warm_from, floor = heapq.heappop(heap)
+        if res is None:
+            # a side of a split at the first item met, bounded by its node's trusted
+            # value until now: solved only when that bound no longer prunes it
+            if prunes(bound, box):
+                stats["pruned"] += 1
+            else:
+                visit(box, warm_from, floor, bound)
+            continue
         if prunes(bound, box):
             if warm_from is not None and not _earlier_prunes(ns, prunes, box):
                 # a bound from the warm start alone: pruned only on the full multistart
@@ -369,7 +405,18 @@ def branch_and_bound_warm(
         own = trusted_value(res, ns.starts)
         below = own if own is not None else floor
         worst, items = on_items(dvars, box, res)
-        worst = pseudo.choose(dvars, box, res, worst)
+        pool = first
+        if worst is not None and worst.name in last:
+            # such a variable is split once the others sit on items
+            reading, _ = on_items(first, box, res)
+            if reading is not None:
+                worst, pool = reading, first
+        worst = pseudo.choose(pool, box, res, worst)
+        met: list[str] = []
+        if last and (worst is None or worst.name in last):
+            # the first item of each such variable that the node's design meets, the
+            # others on theirs: that combination's value is the node's
+            worst, met = first_items_met(ns, dvars, last, box, res, items, worst)
         sides: list[tuple[Any, list[float]]] = []
         if worst is None:  # every catalogue variable sits on an item: a leaf
             one_combination = all(box[v.name][0] == box[v.name][1] for v in dvars)
@@ -394,43 +441,25 @@ def branch_and_bound_warm(
             # The node's relaxation sits on items, but its item data (fit ratios, screw
             # ratings) are the most favourable over the box's items, not those of the
             # items it sits on: the box's other combinations may still beat this leaf.
-            sides = split_at_items(dvars, box, items)
+            lead = split_first(dvars, met, box, items, names)
+            sides = split_at_items([lead] if lead else order, box, items)
         else:
             allowed = items_within(worst.values, *box[worst.name])
             sides = [(worst, side) for side in branch(res.design[worst.name], allowed)]
         gains: list[float] = []
-        for var, side in sides:
-            if not side:
-                continue
-            child = dict(box)
-            child[var.name] = (side[0], side[-1])
-            if worst is None and child == fixed_box(items):
-                continue  # the leaf just solved
-            fixed = all(child[v.name][0] == child[v.name][1] for v in dvars)
-            earlier = earlier_bound(ns, child)
-            if earlier is not None and prunes(earlier, child):
-                # no NLP: an earlier search of the front bounded it under looser limits
-                stats["pruned"] += 1
-                gains.append(pseudo.rise(bound, earlier))
-                continue
-            # a box of one combination is a leaf: its value is reported, full multistart
-            if fixed:
-                r = leaf_solve(child, x, below)
-            else:
-                test = partial(_prunes_box, prunes, child)
-                r = ns.solve(child, x, warm=True, prunes=test, floor=below)
-            stats["nodes"] += 1
-            gains.append(pseudo.gain(bound, r))
-            if not r.success:
-                stats["infeasible"] += 1
-                continue
-            if prunes(r.objective, child):
-                stats["pruned"] += 1
-                _bound_proof(ns, child, r)
-                continue
-            warm_only = not fixed and r.multistart is not None and not trusted(r, ns.starts)
-            entry = (r.objective, next(counter), child, r, x if warm_only else None, below)
-            heapq.heappush(heap, entry)
+        for var, child in side_boxes(box, sides, fixed_box(items) if worst is None else None):
+            if worst is None and var.name in last:
+                # beside the leaf at the first item met: this node's value bounds it, as
+                # it bounds the whole box once its leaf is solved (above); a side that
+                # cannot win on it goes with no NLP, now or, when the value is trusted,
+                # once the side is popped
+                if prunes(bound, child):
+                    stats["pruned"] += 1
+                    continue
+                if own is not None:
+                    heapq.heappush(heap, (own, next(counter), child, None, x, below))
+                    continue
+            gains.append(visit(child, x, below, bound))
         if worst is not None and gains:
             pseudo.record(worst.name, gains)
     if seed is not None and wins(seed.objective, seed_key, _value(incumbent), inc_key):
@@ -441,53 +470,6 @@ def branch_and_bound_warm(
         stats["nodes"] += 1
         incumbent = full if full.success and full.objective <= seed.objective else seed
     return incumbent, stats
-
-
-class PseudoCosts:
-    """Pseudo-costs of the search's branching: what splitting each catalogue variable has
-    cost so far.
-
-    A branching's cost is the product of its two children's relative rises over the
-    parent's value (SCIP's product rule; an infeasible child counts as
-    :attr:`INFEASIBLE_GAIN`, a side with no items as the other side); a variable's
-    pseudo-cost is the mean over its branchings. Once every variable off its items has a
-    history, the one with the highest pseudo-cost is split; before that, the farthest
-    from an item (:func:`on_items`). The history is the search's own, in its order, so
-    the choice never depends on timing or the number of workers.
-    """
-
-    #: The relative rise counted for an infeasible child (as if its value doubled).
-    INFEASIBLE_GAIN = 1.0
-
-    def __init__(self) -> None:
-        self.scores: dict[str, list[float]] = {}
-
-    def gain(self, parent: float, child: Result) -> float:
-        """The relative rise of a child's value over its parent's ``parent``."""
-        if not child.success:
-            return self.INFEASIBLE_GAIN
-        return self.rise(parent, child.objective)
-
-    @staticmethod
-    def rise(parent: float, value: float) -> float:
-        """The relative rise of ``value`` over ``parent`` (none when below it)."""
-        return max(value - parent, 0.0) / max(abs(parent), 1e-300)
-
-    def record(self, name: str, gains: Sequence[float]) -> None:
-        """One branching on ``name`` whose children rose by ``gains`` (one or two)."""
-        g = [max(x, 1e-6) for x in gains]
-        self.scores.setdefault(name, []).append(g[0] * (g[1] if len(g) > 1 else g[0]))
-
-    def choose(self, dvars, box: Box, res: Result, worst):
-        """The variable to split at the node ``res`` over ``box``: ``worst`` (the search's
-        own choice, None at a leaf) unless every variable off its items has a history."""
-        if worst is None:
-            return None
-        off = [v for v, _, dist in item_distances(dvars, box, res) if dist > ON_ITEM_TOL]
-        if len(off) < 2 or not all(v.name in self.scores for v in off):
-            return worst
-        # the first of equal pseudo-costs, in the declared order (max keeps the first)
-        return max(off, key=lambda v: sum(self.scores[v.name]) / len(self.scores[v.name]))
 
 
 def earlier_bound(ns, box: Box) -> float | None:
@@ -521,61 +503,9 @@ def _bound_proof(ns, box: Box, res: Result) -> None:
     memo.add_infeasible(box, eps)
 
 
-def split_at_items(dvars, box: Box, items: Mapping[str, float]) -> list[tuple[Any, list[float]]]:
-    """The sides of a box whose relaxation sits on ``items`` though it holds other
-    combinations: its first wide variable's items below, at and above the item (a side
-    may be empty). The box must hold more than one combination."""
-    var = next(v for v in dvars if box[v.name][0] != box[v.name][1])
-    allowed = items_within(var.values, *box[var.name])
-    at = items[var.name]
-    below, above = [a for a in allowed if a < at], [a for a in allowed if a > at]
-    return [(var, below), (var, [at]), (var, above)]
-
-
 def _value(result: Result | None) -> float | None:
     return None if result is None else result.objective
 
 
 def _prunes_box(prunes, box: Box, value: float) -> bool:
     return prunes(value, box)
-
-
-def first_feasible(ns: Any) -> Result | None:
-    """A feasible catalogue design of the node solver's problem, or None: branch and bound
-    from the continuous relaxation, depth first, stopping at the first feasible leaf (a
-    design, not the optimum; e.g. which items allow a requirement to be dropped).
-    ``ns``: a :class:`~optdesign.formulations.catalogue.search.NodeSolver`."""
-    dvars = discrete_variables(ns.problem)
-    root = ns.solve({})
-    stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []
-    while stack:
-        box, res = stack.pop()
-        worst, items = on_items(dvars, box, res)
-        if worst is None:  # on items: the leaf with them fixed
-            leaf = ns.solve(fixed_box(items), ns.x_of(res))
-            if leaf.success:
-                return leaf
-            # The relaxation's item data are the most favourable over the box's items,
-            # not those of the items it sits on: the box's other combinations may still
-            # work (split as the branch and bound does).
-            if all(box[v.name][0] == box[v.name][1] for v in dvars):
-                continue
-            splits = split_at_items(dvars, box, items)
-        else:
-            allowed = items_within(worst.values, *box[worst.name])
-            splits = [(worst, side) for side in branch(res.design[worst.name], allowed)]
-        children = []
-        for var, side in splits:
-            if not side:
-                continue
-            child = dict(box)
-            child[var.name] = (side[0], side[-1])
-            if worst is None and child == fixed_box(items):
-                continue  # the leaf just solved
-            r = ns.solve(child, ns.x_of(res))
-            if r.success:
-                children.append((r.objective, child, r))
-        # the better child on top of the stack (explored first)
-        for _, child, r in sorted(children, key=lambda c: -c[0]):
-            stack.append((child, r))
-    return None
