@@ -154,3 +154,69 @@ def test_only_the_watchdog_may_run_beside_a_fork():
             stop.set()
             other.join()
     assert fork_safe_threads() is before
+
+
+def test_a_warm_up_asked_for_later_draws_the_png_the_process_draws(solved, tmp_path):
+    record = result_figure(solved)
+    assert write_figure(lambda: draw_solution(record), tmp_path / "here.png") is None
+    draw = "optdesign.plots.solution:draw_solution"
+    with FigureProcess(warm=False, draws=(draw,)) as figures:
+        if not figures.forked:
+            pytest.skip("no fork here")
+        figures.warm_up()
+        figures.warm_up()  # once: the second finds it sent
+        figures.submit(draw, tmp_path / "a.png", lambda: record)
+        assert figures.outcome() is None
+    assert (tmp_path / "a.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+
+
+def test_the_pareto_command_warms_its_figure_worker_when_a_front_worker_idles(tmp_path):
+    """``optdesign pareto`` as a user runs it, on two cores with two workers: the figure
+    worker is warmed before front.png is submitted (when a chain first waits for the
+    other's anchor, not beside two busy workers), the command's own process never
+    imports matplotlib, and front.png is byte for byte what this process draws of the
+    same record."""
+    import pickle
+    import subprocess
+    import sys
+
+    from optdesign.plots.front import draw_front
+
+    record_file = tmp_path / "record.pickle"
+    script = (
+        "import os, pickle, runpy, sys\n"
+        "os.cpu_count = lambda: 2  # two workers hold every core: warmed when one idles\n"
+        "import optdesign.plots.figure_process as fp\n"
+        "events = []\n"
+        "warm, submit = fp.FigureProcess.warm_up, fp.FigureProcess.submit\n"
+        "def warm_up(self):\n"
+        "    events.append('warm-up' if self._pool is not None else 'no worker')\n"
+        "    warm(self)\n"
+        "def keep(self, draw, path, prepare):\n"
+        "    record = prepare()\n"
+        f"    pickle.dump(record, open({str(record_file)!r}, 'wb'))\n"
+        "    events.append('figure')\n"
+        "    submit(self, draw, path, lambda: record)\n"
+        "fp.FigureProcess.warm_up, fp.FigureProcess.submit = warm_up, keep\n"
+        "me, real_exit = os.getpid(), os._exit\n"
+        "def checked_exit(code):\n"
+        "    if os.getpid() == me:\n"
+        "        print('exit', code, 'matplotlib' in sys.modules, events, flush=True)\n"
+        "    real_exit(code)\n"
+        "os._exit = checked_exit\n"
+        "sys.argv = ['optdesign', 'pareto', 'cs_min_backlash', '--objectives',"
+        " 'ripple,backlash', '--points', '6', '--workers', '2', '--no-progress',"
+        f" '--out', {str(tmp_path / 'out')!r}]\n"
+        "try:\n"
+        "    runpy.run_module('optdesign', run_name='__main__')\n"
+        "except SystemExit as end:\n"
+        "    checked_exit(end.code)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=300
+    )
+    last = done.stdout.strip().splitlines()[-1]
+    assert last == "exit 0 False ['warm-up', 'figure']", done.stderr[-2000:]
+    record = pickle.loads(record_file.read_bytes())
+    assert write_figure(lambda: draw_front(record), tmp_path / "here.png") is None
+    assert (tmp_path / "out" / "front.png").read_bytes() == (tmp_path / "here.png").read_bytes()
