@@ -29,7 +29,7 @@ first two of another tree; then the command's phases from ``--phase-runs`` runs 
 forked workers), the NLP solves of the front, and every command's front compared with
 the first default run's (objectives and designs, relative 1e-9).
 
-    python benchmarks/command_cost.py --pareto [--rounds 5] [--phase-runs 3] [--baseline TREE]
+    python benchmarks/command_cost.py --pareto [--rounds 5] [--phase-runs 3] [--baseline TREE] [--bytecode]
 """
 
 from __future__ import annotations
@@ -117,6 +117,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--label", default="")
     parser.add_argument("--pareto", action="store_true", help="the pareto command")
     parser.add_argument("--phase-runs", type=int, default=3, help="--pareto: phase runs")
+    parser.add_argument(
+        "--bytecode",
+        action="store_true",
+        help="--pareto: keep compiled bytecode (as an installed package does), after a warm-up",
+    )
     args = parser.parse_args(argv)
     if args.pareto:
         from pareto_cost import pareto_cost

@@ -43,6 +43,15 @@ def _difference(a: list[dict], b: list[dict]) -> float:
     return worst
 
 
+def _busiest(events: list[dict], name: str, until: float) -> float:
+    """The largest sum over one process of the ``name`` spans that end by ``until``."""
+    per: dict[int, float] = {}
+    for e in events:
+        if e["name"] == name and e["b"] <= until:
+            per[e["pid"]] = per.get(e["pid"], 0.0) + e["b"] - e["a"]
+    return max(per.values(), default=0.0)
+
+
 def summarise(events: list[dict], wall: float) -> dict[str, float]:
     """The phases of one run (seconds) from its events (see pareto_phases.py)."""
 
@@ -71,8 +80,15 @@ def summarise(events: list[dict], wall: float) -> dict[str, float]:
         "  anchor multistarts (each)": statistics.mean(spans("task anchor-multistart")),
         "  anchor tie-breaks (each)": statistics.mean(spans("task anchor ")),
         "  solver builds in the workers (sum)": sum(spans("solver build")),
+        "  NLP solves in the anchors, busiest worker (builds included)": _busiest(
+            events, "NLP solve", anchors_end
+        ),
         "chain points": eps_end - anchors_end,
         "  per point (mean of a worker's task)": statistics.mean(spans("task eps") or [0.0]),
+        "  NLP solve per point (mean)": statistics.mean(
+            [e["b"] - e["a"] for e in events if e["name"] == "NLP solve" and e["a"] >= anchors_end]
+            or [0.0]
+        ),
         "polish": tasks_end - eps_end,
         "front's end (records, metrics, workers stopped)": front["b"] - tasks_end,
         "front.csv + front.json": sum(spans("front.csv")) + sum(spans("front.json")),
@@ -111,6 +127,11 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
     file = ROOT / "problems" / f"{problem}.toml"
     work = Path(tempfile.mkdtemp(prefix="pareto_cost_"))
     base_env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    if args.bytecode:
+        # compiled once and reused, as an installed package's modules are (the agents'
+        # environment sets PYTHONDONTWRITEBYTECODE: every run compiles from source)
+        base_env.pop("PYTHONDONTWRITEBYTECODE", None)
+        base_env["PYTHONPYCACHEPREFIX"] = str(work / "pyc")
     ours = {**base_env, "PYTHONPATH": str(ROOT)}
     command = [sys.executable, "-m", "optdesign", "pareto", str(file), "--objectives"]
     command += [OBJECTIVES, "--points", POINTS, "--no-progress"]
@@ -125,6 +146,11 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
         theirs = {**base_env, "PYTHONPATH": str(args.baseline.resolve())}
         variants["baseline tree: default"] = (command, theirs)
         variants["baseline tree: --no-plot --no-report"] = ([*command, *alone], theirs)
+    if args.bytecode:  # one short run of each, to compile
+        for k, (cmd, env) in enumerate(variants.values()):
+            short = NSGA2_SCRIPT.replace("500", "1")
+            first = [sys.executable, "-c", short, str(file)] if cmd is None else cmd
+            wall([*first, *(["--out", str(work / f"warm{k}")] if cmd else [])], env, work)
     times: dict[str, list[float]] = {name: [] for name in variants}
     fronts: dict[str, tuple[list[dict], int]] = {}
     for r in range(args.rounds):
@@ -143,6 +169,7 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
         "label": args.label,
         "problem": problem,
         "rounds": args.rounds,
+        "bytecode": bool(args.bytecode),
         "load_before": os.getloadavg()[0],
         "median_s": {k: statistics.median(v) for k, v in times.items()},
         "over_nsga2": {k: statistics.median(v) / peer for k, v in times.items()},

@@ -112,6 +112,18 @@ probe(api, "front_outputs", "the front's files")
 probe(methods, "formulation_for", "formulation (parent, before the fork)")
 probe(methods, "front_task", _task_name, sent=True)
 eps_solver.solver_for = _solver_for(eps_solver.solver_for)
+_solve = eps_solver.EpsSolver.solve
+
+
+def _timed_solve(self, *args, **kwargs):
+    # the solve alone: the back-end's work on the NLP (builds are timed above)
+    t0 = time.time()
+    out = _solve(self, *args, **kwargs)
+    log("NLP solve", t0, time.time())
+    return out
+
+
+eps_solver.EpsSolver.solve = _timed_solve
 probe(figure_process, "_warm", "figure worker: warm-up (imports)", sent=True)
 probe(figure_process, "_draw_in_worker", "front.png: drawn in the figure worker", sent=True)
 probe(figure_process, "_draw", "front.png: drawn")
