@@ -161,8 +161,15 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
             out = work / f"out{r}-{k}"
             times[name].append(wall([*cmd, "--out", str(out)], env, work))
             fronts.setdefault(name, _front(out))
-    phases = [phase_run(file, ours, work, k, []) for k in range(args.phase_runs)]
-    phases_alone = [phase_run(file, ours, work, 100 + k, alone) for k in range(args.phase_runs)]
+    # interleaved as the rounds are: ours, ours alone, the baseline's (the same probes)
+    runs: dict[str, list[dict[str, float]]] = {"phases_default_s": [], "phases_alone_s": []}
+    if args.baseline is not None:
+        runs["phases_baseline_default_s"] = []
+    for k in range(args.phase_runs):
+        runs["phases_default_s"].append(phase_run(file, ours, work, k, []))
+        runs["phases_alone_s"].append(phase_run(file, ours, work, 100 + k, alone))
+        if args.baseline is not None:
+            runs["phases_baseline_default_s"].append(phase_run(file, theirs, work, 200 + k, []))
     peer = statistics.median(times["NSGA-II script (pymoo 100 x 500)"])
     reference, _ = fronts["optdesign pareto (default)"]
     row = {
@@ -175,9 +182,9 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
         "over_nsga2": {k: statistics.median(v) / peer for k, v in times.items()},
         "front_difference": {k: _difference(reference, f[0]) for k, f in fronts.items()},
         "nlp_solves": {k: f[1] for k, f in fronts.items()},
-        "phases_default_s": {k: statistics.median(p[k] for p in phases) for k in phases[0]},
-        "phases_alone_s": {
-            k: statistics.median(p[k] for p in phases_alone) for k in phases_alone[0]
+        **{
+            key: {k: statistics.median(p.get(k, 0.0) for p in ps) for k in ps[0]}
+            for key, ps in runs.items()
         },
         "when": time.strftime("%Y-%m-%d %H:%M"),
     }
@@ -192,7 +199,8 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
         print(
             f"{k:45s} {row['median_s'][k]:10.3f} {row['over_nsga2'][k]:9.2f} {solves!s:>6s} {shown:>10s}"
         )
-    for title, key in (("default", "phases_default_s"), ("front alone", "phases_alone_s")):
+    for key in runs:
+        title = key.removeprefix("phases_").removesuffix("_s").replace("_", " ")
         print(f"\nphases, {title} (medians of {args.phase_runs} runs, s):")
         for k, v in row[key].items():
             print(f"  {k:70s} {v:7.3f}")
