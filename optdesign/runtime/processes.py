@@ -51,6 +51,12 @@ def _worker_idle() -> None:
         _ON_IDLE.pop(0)()
 
 
+if hasattr(os, "register_at_fork"):
+    # A forked worker's own pools are not the run's: its copy of a callback would act on
+    # the parent's objects (send on the parent's pipes) from the wrong process.
+    os.register_at_fork(after_in_child=_ON_IDLE.clear)
+
+
 @contextmanager
 def process_pool(workers: int) -> Iterator[WorkerPool | None]:
     """A pool of ``workers`` local processes (None for ``workers <= 1``).

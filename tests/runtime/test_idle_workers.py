@@ -47,3 +47,22 @@ def test_no_callback_after_its_block():
     finally:
         pool.close()
     assert calls == []
+
+
+def _callbacks_here() -> int:
+    from optdesign.runtime import processes
+
+    return len(processes._ON_IDLE)
+
+
+def test_a_forked_worker_inherits_no_callback():
+    # a worker's own pools are not the run's: the callback acts on this process's objects
+    with when_a_worker_idles(lambda: None):
+        assert _callbacks_here() == 1
+        pool = WorkerPool(1)
+        try:
+            pool.submit(_callbacks_here, ())
+            ((_, inherited),) = pool.wait()
+        finally:
+            pool.close()
+    assert inherited == 0
