@@ -177,7 +177,7 @@ def pareto_cost(args, results: Path, wall: Callable[..., float]) -> int:
         "problem": problem,
         "rounds": args.rounds,
         "bytecode": bool(args.bytecode),
-        "load_before": os.getloadavg()[0],
+        "load_at_end": os.getloadavg()[0],
         "median_s": {k: statistics.median(v) for k, v in times.items()},
         "over_nsga2": {k: statistics.median(v) / peer for k, v in times.items()},
         "front_difference": {k: _difference(reference, f[0]) for k, f in fronts.items()},
