@@ -18,6 +18,18 @@ machine; the medians and their ratios to the peer are printed and appended to
 ``benchmarks/results/command_cost.jsonl`` (one line a run).
 
     python benchmarks/command_cost.py [--problem cs_min_ripple] [--rounds 7] [--baseline TREE]
+
+With ``--pareto``, the same for ``optdesign pareto FILE --objectives ripple,backlash
+--points 50`` (default problem cs_min_backlash) against the NSGA-II script of part (c) of
+``benchmarks/bench_overhead.py`` (pymoo, population 100, 500 generations, NumPy path):
+the default command (front.csv, front.json, front.png, report.html), the front alone
+(``--no-plot --no-report``), the front alone on one worker, and with ``--baseline`` the
+first two of another tree; then the command's phases from ``--phase-runs`` runs of
+``benchmarks/pareto_phases.py`` (a timestamp at each phase, in the parent and in the
+forked workers), the NLP solves of the front, and every command's front compared with
+the first default run's (objectives and designs, relative 1e-9).
+
+    python benchmarks/command_cost.py --pareto [--rounds 5] [--phase-runs 3] [--baseline TREE] [--bytecode]
 """
 
 from __future__ import annotations
@@ -99,11 +111,23 @@ def _wall(cmd: list[str], env: dict[str, str], cwd: Path) -> float:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--problem", default="cs_min_ripple")
+    parser.add_argument("--problem", default=None, help="default cs_min_ripple (solve)")
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--baseline", type=Path, help="another tree's default command")
     parser.add_argument("--label", default="")
+    parser.add_argument("--pareto", action="store_true", help="the pareto command")
+    parser.add_argument("--phase-runs", type=int, default=3, help="--pareto: phase runs")
+    parser.add_argument(
+        "--bytecode",
+        action="store_true",
+        help="--pareto: keep compiled bytecode (as an installed package does), after a warm-up",
+    )
     args = parser.parse_args(argv)
+    if args.pareto:
+        from pareto_cost import pareto_cost
+
+        return pareto_cost(args, RESULTS, _wall)
+    args.problem = args.problem or "cs_min_ripple"
     work = Path(tempfile.mkdtemp(prefix="command_cost_"))
     export_nlp(args.problem, work)
     file = ROOT / "problems" / f"{args.problem}.toml"

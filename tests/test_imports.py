@@ -24,10 +24,10 @@ print(json.dumps({"code": code, "heavy": heavy}))
 """
 
 
-def loaded(*args: str, cwd: Path = ROOT) -> dict:
+def loaded(*args: str, cwd: Path = ROOT, modules: tuple[str, ...] = HEAVY) -> dict:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
-    code = RUN.replace("json.loads(HEAVY)", repr(list(HEAVY)))
+    code = RUN.replace("json.loads(HEAVY)", repr(list(modules)))
     proc = subprocess.run(
         [sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, cwd=cwd
     )
@@ -75,5 +75,28 @@ def test_solve_json_shows_written_units_without_pint():
         "--starts",
         "1",
         "--no-ranges",
+    )
+    assert out["code"] == 0 and out["heavy"] == []
+
+
+def test_a_continuous_front_imports_no_catalogue_search(tmp_path):
+    # the catalogue front's search (branch and bound, diagnosis) is for problems with
+    # catalogue variables only
+    catalogue = ("optdesign.formulations.catalogue.bnb", "optdesign.formulations.catalogue.search")
+    out = loaded(
+        "pareto",
+        str(ROOT / "problems" / "cs_min_backlash.toml"),
+        "--objectives",
+        "ripple,backlash",
+        "--points",
+        "4",
+        "--workers",
+        "1",
+        "--no-plot",
+        "--no-report",
+        "--no-progress",
+        "--out",
+        str(tmp_path / "out"),
+        modules=catalogue,
     )
     assert out["code"] == 0 and out["heavy"] == []

@@ -7,7 +7,6 @@ points as they finish; ``--resume`` continues from them) to the output folder.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import os
 import sys
 from pathlib import Path
@@ -136,11 +135,19 @@ def run_pareto(args) -> int:
                 storage.discard_store(store)
             elif not args.resume:
                 storage.check_new_store(store)
+        if args.no_plot:
+            return _run_locked(args, problem, objectives, methods, out, None)
         from optdesign.plots.figure_process import FigureProcess
+        from optdesign.reports.front_files import FRONT_FIGURE
+        from optdesign.runtime.processes import when_a_worker_idles
 
-        # forked before the fronts (one thread yet), idle while their workers take the
-        # cores; it draws front.png while this process makes the page
-        with FigureProcess(warm=False) if not args.no_plot else contextlib.nullcontext() as figures:
+        # Forked before the fronts (one thread yet); it draws front.png while this
+        # process makes the page. It imports matplotlib at once where the fronts leave a
+        # core free, else when one of their workers first idles (a chain waiting for the
+        # other's anchor): importing it beside two busy workers only slows them.
+        free_core = args.scheduler is not None or args.workers < (os.cpu_count() or 1)
+        figures = FigureProcess(warm=free_core, draws=(FRONT_FIGURE,))
+        with figures, when_a_worker_idles(figures.warm_up):
             return _run_locked(args, problem, objectives, methods, out, figures)
 
 

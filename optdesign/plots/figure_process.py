@@ -22,7 +22,7 @@ its failure must not lose the others).
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -32,13 +32,17 @@ from optdesign.plots import write_figure
 from optdesign.runtime.processes import WorkerPool, forks_workers
 
 
-def _warm() -> None:
-    """What the worker imports while the command computes."""
+def _warm(modules: Sequence[str] = ()) -> None:
+    """What the worker imports while the command computes: matplotlib, and ``modules``
+    (those of the figures it will draw)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.figure
     from matplotlib.backends import backend_agg  # noqa: F401
+
+    for module in modules:
+        importlib.import_module(module)
 
 
 def _draw(module: str, function: str, record: Any, path: str) -> str | None:
@@ -58,10 +62,14 @@ class FigureProcess:
     (see the module's docstring). Use as a context manager: the worker is started on
     entry and stopped on exit."""
 
-    def __init__(self, warm: bool = True) -> None:
-        #: import matplotlib in the worker as soon as it starts (False: with the first
-        #: figure, for a command whose own work keeps every core busy until then)
+    def __init__(self, warm: bool = True, draws: Sequence[str] = ()) -> None:
+        #: import matplotlib in the worker as soon as it starts (False: when
+        #: :meth:`warm_up` is called, or with the first figure, for a command whose own
+        #: work keeps every core busy until then)
         self.warm = warm
+        #: the ``"module:function"`` paths of the figures to come, imported by the warm-up
+        self.modules = tuple(dict.fromkeys(d.partition(":")[0] for d in draws))
+        self._warmed = False  # the warm-up was sent to the worker
         self._pool: WorkerPool | None = None
         #: the worker's task in flight: "" for the warm-up, else the figure's path
         self._inflight: str | None = None
@@ -93,13 +101,26 @@ class FigureProcess:
             return
         try:
             self._pool = WorkerPool(1)
-            if self.warm:
-                self._pool.submit(_warm, ())
         except (OSError, OptDesignError):  # no process to spare: draw in process
             self.close()
             return
         if self.warm:
-            self._inflight = ""
+            self.warm_up()
+
+    def warm_up(self) -> None:
+        """Let the worker import matplotlib and the figures' modules now (once; nothing
+        when figures are drawn in process or the worker is busy). A command whose
+        workers take every core calls it when one of them idles
+        (:func:`optdesign.runtime.processes.when_a_worker_idles`)."""
+        if self._pool is None or self._warmed or self._inflight is not None:
+            return
+        self._warmed = True
+        try:
+            self._pool.submit(_warm, (self.modules,))
+        except (OSError, OptDesignError):  # the worker is gone: figures in process
+            self.close()
+            return
+        self._inflight = ""
 
     def submit(self, draw: str, path: str | Path, prepare: Callable[[], Any]) -> None:
         """Write the figure ``draw(prepare())`` as PNG at ``path``; ``draw`` is a

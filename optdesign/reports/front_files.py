@@ -32,6 +32,10 @@ if TYPE_CHECKING:
     from optdesign.problem.design_problem import DesignProblem
     from optdesign.studies.pareto.front import Front
 
+#: What draws front.png, in a figure worker (:class:`optdesign.plots.figure_process.
+#: FigureProcess`) that imports it ahead.
+FRONT_FIGURE = "optdesign.plots.front:draw_front"
+
 
 def _fronts(front: Front | Sequence[Front]) -> list[Front]:
     """One front or several as a list (a :class:`Front` is a record, not a sequence)."""
@@ -133,7 +137,7 @@ def write_front_outputs(
 
         figures = figures if figures is not None else FigureProcess()
         figures.submit(
-            "optdesign.plots.front:draw_front",
+            FRONT_FIGURE,
             out / "front.png",
             lambda: front_figure(problem, fronts),
         )

@@ -25,6 +25,37 @@ from optdesign.errors import OptDesignError
 from optdesign.interrupts import child_signals, deferred, signals_blocked
 from optdesign.solvers.blas import limit_blas_threads
 
+#: Callbacks waiting for a core that a run's local workers leave idle
+#: (:func:`when_a_worker_idles`).
+_ON_IDLE: list[Callable[[], None]] = []
+
+
+@contextmanager
+def when_a_worker_idles(callback: Callable[[], None]) -> Iterator[None]:
+    """Call ``callback()`` once, the first time a :class:`WorkerPool` is waited on while
+    one of its workers has nothing to do (the run has no task ready for it: a chain
+    waiting for the other chain's anchor, the last points of a sweep), and not after the
+    block. A command that keeps other work for later (drawing its figures) starts it
+    then, on a core its own workers leave idle, instead of competing with them for one.
+    The callback runs in the waiting thread and must be quick (start work elsewhere)."""
+    _ON_IDLE.append(callback)
+    try:
+        yield
+    finally:
+        with contextlib.suppress(ValueError):  # called already
+            _ON_IDLE.remove(callback)
+
+
+def _worker_idle() -> None:
+    while _ON_IDLE:
+        _ON_IDLE.pop(0)()
+
+
+if hasattr(os, "register_at_fork"):
+    # A forked worker's own pools are not the run's: its copy of a callback would act on
+    # the parent's objects (send on the parent's pipes) from the wrong process.
+    os.register_at_fork(after_in_child=_ON_IDLE.clear)
+
 
 @contextmanager
 def process_pool(workers: int) -> Iterator[WorkerPool | None]:
@@ -113,6 +144,8 @@ class WorkerPool:
         """Block until at least one busy worker answers; ``(worker index, result)`` each."""
         from multiprocessing.connection import wait as wait_any
 
+        if _ON_IDLE and len(self.busy) < self.size:
+            _worker_idle()
         ready = wait_any([self.conns[i] for i in self.busy])
         out = []
         for i in sorted(self.busy):

@@ -109,23 +109,26 @@ def test_a_figure_that_cannot_be_prepared_is_its_note(tmp_path):
         FigureProcess().outcome()
 
 
-def test_the_command_draws_its_figure_in_the_worker_beside_its_watchdog(tmp_path):
-    """``optdesign solve`` as a user runs it (its signal watchdog running): the PNG is
-    written and matplotlib is never imported by the command's own process."""
+def _as_a_user(tmp_path, argv: list[str], prelude: str = "", shown: str = "") -> str:
+    """The last line ``optdesign ARGV`` prints, run as a user runs it (its signal
+    watchdog running), followed by ``exit CODE MATPLOTLIB_IMPORTED[ SHOWN]`` printed by
+    the command's own process as it ends (with os._exit: the check runs there, in the
+    command's process only). ``prelude``: code run first; ``shown``: an expression
+    printed after it."""
     import subprocess
     import sys
 
-    # the command ends with os._exit: the check runs there, in the command's process only
+    printed = "'exit', code, 'matplotlib' in sys.modules" + (f", {shown}" if shown else "")
     script = (
         "import os, runpy, sys\n"
+        f"{prelude}"
         "me, real_exit = os.getpid(), os._exit\n"
         "def checked_exit(code):\n"
         "    if os.getpid() == me:\n"
-        "        print('exit', code, 'matplotlib' in sys.modules, flush=True)\n"
+        f"        print({printed}, flush=True)\n"
         "    real_exit(code)\n"
         "os._exit = checked_exit\n"
-        "sys.argv = ['optdesign', 'solve', 'cs_min_backlash', '--starts', '1', '--no-ranges',"
-        f" '--out', {str(tmp_path / 'out')!r}]\n"
+        f"sys.argv = {['optdesign', *argv]!r}\n"
         "try:\n"
         "    runpy.run_module('optdesign', run_name='__main__')\n"
         "except SystemExit as end:\n"
@@ -134,7 +137,16 @@ def test_the_command_draws_its_figure_in_the_worker_beside_its_watchdog(tmp_path
     done = subprocess.run(
         [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=300
     )
-    assert done.stdout.strip().splitlines()[-1] == "exit 0 False", done.stderr[-2000:]
+    lines = done.stdout.strip().splitlines()
+    assert lines, done.stderr[-2000:]
+    return lines[-1]
+
+
+def test_the_command_draws_its_figure_in_the_worker_beside_its_watchdog(tmp_path):
+    """``optdesign solve`` as a user runs it: the PNG is written and matplotlib is never
+    imported by the command's own process."""
+    argv = ["solve", "cs_min_backlash", "--starts", "1", "--no-ranges"]
+    assert _as_a_user(tmp_path, [*argv, "--out", str(tmp_path / "out")]) == "exit 0 False"
     assert (tmp_path / "out" / "solution.png").stat().st_size > 10_000
 
 
@@ -154,3 +166,53 @@ def test_only_the_watchdog_may_run_beside_a_fork():
             stop.set()
             other.join()
     assert fork_safe_threads() is before
+
+
+def test_a_warm_up_asked_for_later_draws_the_png_the_process_draws(solved, tmp_path):
+    record = result_figure(solved)
+    assert write_figure(lambda: draw_solution(record), tmp_path / "here.png") is None
+    draw = "optdesign.plots.solution:draw_solution"
+    with FigureProcess(warm=False, draws=(draw,)) as figures:
+        if not figures.forked:
+            pytest.skip("no fork here")
+        figures.warm_up()
+        figures.warm_up()  # once: the second finds it sent
+        figures.submit(draw, tmp_path / "a.png", lambda: record)
+        assert figures.outcome() is None
+    assert (tmp_path / "a.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+
+
+def test_the_pareto_command_warms_its_figure_worker_when_a_front_worker_idles(tmp_path):
+    """``optdesign pareto`` as a user runs it, on two cores with two workers: the figure
+    worker is warmed before front.png is submitted (when a chain first waits for the
+    other's anchor, not beside two busy workers), the command's own process never
+    imports matplotlib, and front.png is byte for byte what this process draws of the
+    same record."""
+    import pickle
+
+    from optdesign.plots.front import draw_front
+
+    record_file = tmp_path / "record.pickle"
+    prelude = (
+        "import pickle\n"
+        "os.cpu_count = lambda: 2  # two workers hold every core: warmed when one idles\n"
+        "import optdesign.plots.figure_process as fp\n"
+        "events = []\n"
+        "warm, submit = fp.FigureProcess.warm_up, fp.FigureProcess.submit\n"
+        "def warm_up(self):\n"
+        "    events.append('warm-up' if self._pool is not None else 'no worker')\n"
+        "    warm(self)\n"
+        "def keep(self, draw, path, prepare):\n"
+        "    record = prepare()\n"
+        f"    pickle.dump(record, open({str(record_file)!r}, 'wb'))\n"
+        "    events.append('figure')\n"
+        "    submit(self, draw, path, lambda: record)\n"
+        "fp.FigureProcess.warm_up, fp.FigureProcess.submit = warm_up, keep\n"
+    )
+    argv = ["pareto", "cs_min_backlash", "--objectives", "ripple,backlash", "--points", "6"]
+    argv += ["--workers", "2", "--no-progress", "--out", str(tmp_path / "out")]
+    last = _as_a_user(tmp_path, argv, prelude, shown="events")
+    assert last == "exit 0 False ['warm-up', 'figure']"
+    record = pickle.loads(record_file.read_bytes())
+    assert write_figure(lambda: draw_front(record), tmp_path / "here.png") is None
+    assert (tmp_path / "out" / "front.png").read_bytes() == (tmp_path / "here.png").read_bytes()

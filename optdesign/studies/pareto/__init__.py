@@ -17,7 +17,6 @@ from optdesign.studies.pareto.front import Front, FrontPoint, common_hypervolume
 from optdesign.studies.pareto.methods import (
     METHODS,
     NSGA2,
-    CatalogueEpsilon,
     EpsilonConstraint,
     FrontMethod,
     RunOptions,
@@ -26,6 +25,16 @@ from optdesign.studies.pareto.methods import (
     make_method,
 )
 from optdesign.studies.pareto.records import PointRecord
+
+
+def __getattr__(name: str):
+    # imported when named: see optdesign.studies.pareto.methods
+    if name == "CatalogueEpsilon":
+        from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
+
+        return CatalogueEpsilon
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "METHODS",

@@ -34,7 +34,6 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.runtime.runner import forks_workers, process_pool
 from optdesign.solvers.multistart import improves
 from optdesign.solvers.registry import FRONT_SOLVERS
-from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
 from optdesign.studies.pareto.chains import (
     TwoChains,
     anchor_tasks,
@@ -468,6 +467,8 @@ def make_method(
         if method not in ("epsilon", "uniform", "nsga2"):
             raise InputError("method", leaves_catalogue(method))
         if method != "nsga2":
+            from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
+
             keep = {k: settings[k] for k in ("starts", "seed") if k in settings}
             return CatalogueEpsilon(points=settings.get("points", points), **keep)
     if method == "nsga2":
@@ -524,11 +525,20 @@ def compute_front(
         return method.run(problem, objectives, run)
 
 
+def __getattr__(name: str) -> Any:
+    # The catalogue front imports the catalogue search (~50 ms): only a problem with
+    # catalogue variables needs it, so it is imported when named.
+    if name == "CatalogueEpsilon":
+        from optdesign.studies.pareto.catalogue_front import CatalogueEpsilon
+
+        return CatalogueEpsilon
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = [
     "ANCHOR_SLACK",
     "METHODS",
     "NSGA2",
-    "CatalogueEpsilon",
     "EpsilonConstraint",
     "FrontMethod",
     "RunOptions",
