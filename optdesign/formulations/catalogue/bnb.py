@@ -108,7 +108,7 @@ def cannot_improve(bound: float, incumbent: float) -> bool:
 
 def trusted(result: Result, starts: int) -> bool:
     """Whether a node's value may serve its children as a floor (see
-    :meth:`~optdesign.formulations.catalogue.search.NodeSolver.solve`): it comes from the node
+    :meth:`~optdesign.formulations.catalogue.node_solver.NodeSolver.solve`): it comes from the node
     solver's full multistart of ``starts``, or it was settled at its own trusted floor."""
     ms = result.multistart
     return ms is not None and (ms.n_starts >= starts or ms.stopped_early)

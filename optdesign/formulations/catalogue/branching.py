@@ -108,7 +108,7 @@ def first_feasible(ns: Any) -> Result | None:
     """A feasible catalogue design of the node solver's problem, or None: branch and bound
     from the continuous relaxation, depth first, stopping at the first feasible leaf (a
     design, not the optimum; e.g. which items allow a requirement to be dropped).
-    ``ns``: a :class:`~optdesign.formulations.catalogue.search.NodeSolver`."""
+    ``ns``: a :class:`~optdesign.formulations.catalogue.node_solver.NodeSolver`."""
     dvars = discrete_variables(ns.problem)
     root = ns.solve({})
     stack = [({v.name: (v.lower, v.upper) for v in dvars}, root)] if root.success else []

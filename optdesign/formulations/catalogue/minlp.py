@@ -6,7 +6,7 @@ MINLP solve (:attr:`~optdesign.solvers.registry.SolverHints.minlp`; built in: Bo
 through CasADi, with its algorithms ``B-BB``: NLP branch and bound, ``B-OA``: outer
 approximation, ``B-Hyb``: the hybrid - the last two exact only for convex problems, and
 the catalogue problems are not). The back-end picks the items; the design reported is
-the node NLP of those items (:class:`optdesign.formulations.catalogue.search.NodeSolver`, started
+the node NLP of those items (:class:`optdesign.formulations.catalogue.node_solver.NodeSolver`, started
 from the back-end's point), so that the result carries the same evidence as the default
 search's.
 """

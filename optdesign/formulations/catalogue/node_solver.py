@@ -1,0 +1,312 @@
+"""A node of the catalogue search: the problem's NLP (built once) with the catalogue
+variables restricted to a box, solved by a small seeded multistart whose starts may run
+on forked workers (:class:`NodeSolver`). The search over the boxes is
+:mod:`optdesign.formulations.catalogue.search` and :mod:`optdesign.formulations.catalogue.bnb`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+
+from optdesign.formulations.catalogue.bnb import trusted
+from optdesign.formulations.catalogue.discrete import (
+    discrete_variables,
+)
+from optdesign.formulations.nlp.solve import _objective_set, solver_for, solver_options
+from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.drive import box_has_item
+from optdesign.programs.nlp import Bounds
+from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
+from optdesign.solvers.multistart import (
+    best_of,
+    improves,
+    outcome_counts,
+    sobol_starts,
+    start_outcome,
+)
+from optdesign.solvers.registry import default_solver, solver_hints
+from optdesign.solvers.result import MultistartInfo, Result
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
+
+#: Starts per node when neither the caller nor the problem file sets them.
+NODE_STARTS = 4
+
+#: Sobol starts a node tries before it is called infeasible, when its own starts fail.
+RETRY_STARTS = 4
+
+
+class NodeSolver:
+    """Solve the problem's NLP on a sub-box of the catalogue variables.
+
+    One solver (:func:`optdesign.formulations.nlp.solve.solver_for`) serves every node: a node
+    only passes its own variable bounds. A node's starts are the hint (or the problem's
+    start) and the Sobol points of the solver's ``seed``. A node whose starts all fail is
+    tried again from :data:`RETRY_STARTS` Sobol points of ``seed + 1`` (points it has not
+    tried) before it counts as infeasible, so a poor
+    first start (e.g. a declared one) that stops at an iteration limit or an error never
+    makes a feasible problem look infeasible. Two starts that both end with the back-end's
+    own verdict of local infeasibility (:meth:`verdicts_decide`) end the multistart: the
+    node is infeasible on those two starts (over the catalogue instance family, no later
+    start or retry ever found a feasible point after two such verdicts:
+    benchmarks/README.md, "Catalogue searches"). As the problem's own
+    multistart, a node's multistart stops once :attr:`agree` starts agree on the best
+    value (the file's ``[solver] agree``, 3 by default, through :func:`solve_catalogue`;
+    over the same cases no later start beat a value that 3 starts agreed on:
+    ``benchmarks/catalogue_agreement.py``).
+    """
+
+    def __init__(
+        self,
+        problem: DesignProblem,
+        objective: str | None = None,
+        starts: int = 3,
+        seed: int = 0,
+        solver: str | None = None,
+        options: Mapping[str, Any] | None = None,
+        eps: Mapping[str, float] | None = None,
+        free_rows: tuple[int, ...] = (),
+        workers: int = 1,
+        agree: int = 0,
+    ):
+        self.problem = problem
+        #: A node's multistart stops once this many of its starts agree on the best value
+        #: (0: every start), as the problem's own multistart does (``[solver] agree``).
+        self.agree = max(0, int(agree))
+        #: Local processes for a node's starts, inside :meth:`on_workers` (see there).
+        self.workers = max(1, int(workers))
+        self._workers: InheritedWorkers | None = None
+        #: Constraint rows left unbounded at every node (a requirement dropped, to find
+        #: which catalogue items the others allow: the diagnosis of an infeasible problem).
+        self.free_rows = np.asarray(free_rows, dtype=int)
+        self.objective = objective or problem.objective_names[0]
+        self.eps = dict(eps or {})
+        names = _objective_set(problem, self.objective)
+        names = tuple(dict.fromkeys([*names, *sorted(self.eps)]))
+        solver = self.solver = solver or default_solver("nlp")
+        node = solver_hints(solver).node_options
+        if node is not None:
+            # The back-end's node options (infeasible boxes are common; a node still
+            # counts as infeasible only once all its starts say so, and RETRY_STARTS
+            # more unless verdicts_decide), then the problem file's own options, then
+            # the caller's.
+            options = {**node, **solver_options(problem, solver), **(options or {})}
+        self.backend = solver_for(problem, solver, options, names)
+        self.verdicts = solver_hints(solver).infeasible_verdicts
+        self.nlp = self.backend.nlp
+        self.target = self.nlp.target(self.objective)
+        self.starts = max(1, starts)
+        self.seed = seed
+        self.names = [v.name for v in problem.free]
+        self.n_solves = 0
+        #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
+        self.n_cold = 0
+        self.n_implied = 0
+        self.n_reused = 0  # nodes whose optimum under looser limits meets these limits
+        #: boxes proved infeasible (shared by the searches of one front), read before a
+        #: node is solved and written when one is proved; None: no memo
+        self.memo = None
+        #: where this search's own proofs are recorded besides (never read by it: a
+        #: single search keeps its nodes; the optimum's neighbouring items read them)
+        self.proofs = None
+
+    @contextmanager
+    def on_workers(self) -> Iterator[None]:
+        """Inside it, a node's starts run on :attr:`workers` local processes forked once
+        (they inherit the built solver). Each node keeps its serial answer: its starts
+        in their order up to the one that settles it or the verdicts that end it
+        (:class:`~optdesign.runtime.inherited_map.InheritedWorkers`), so any number of
+        workers solves the same nodes to the same values and records."""
+        if self.workers <= 1:
+            yield
+            return
+        with InheritedWorkers(self._solve_start, self.workers) as workers:
+            self._workers = workers
+            try:
+                yield
+            finally:
+                self._workers = None
+
+    def _solve_start(self, item: tuple[Bounds, np.ndarray]) -> Result:
+        box, x0 = item
+        return self.backend.solve(
+            self.nlp.start(x0=x0, parameters=box.parameters), self.target, box
+        )
+
+    def _starts(self, box: Bounds, points, stop: Callable[[list[Result]], bool]) -> list[Result]:
+        items = [(box, np.asarray(p, dtype=float)) for p in points]
+        if self._workers is None:
+            return map_serial(self._solve_start, items, stop)
+        return self._workers.map(items, stop)
+
+    def solve(
+        self,
+        bounds: Mapping[str, tuple[float, float]],
+        x_hint=None,
+        warm: bool = False,
+        prunes: Callable[[float], bool] | None = None,
+        fallback: bool = True,
+        floor: float | None = None,
+    ) -> Result:
+        """Best of the multistart on the box where ``bounds`` replace the catalogue
+        variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
+
+        ``warm``: the hint alone decides when its solve succeeds with a value that
+        ``prunes`` (the search's pruning test) would not prune; a failed hint, or a value
+        that would prune the node, runs the rest of the multistart (and its retries) as
+        a cold node does, so infeasibility and pruning rest on the same starts as before.
+        ``fallback=False``: the warm start's result whatever it is (a first incumbent's
+        value, which only needs to be feasible).
+        A multistart also ends once :attr:`agree` of its starts agree on the best value
+        (``multistart.stopped_early``, its value then trusted as a full multistart's).
+        ``floor``: a lower bound on the node's value that the search trusts (its parent's
+        relaxation value, when :func:`~optdesign.formulations.catalogue.bnb.trusted`); the box
+        is a sub-box of the parent's, its item data no more favourable, so no start can
+        end below it. A start that reaches it (within the tie tolerance) ends the
+        multistart: the node's value is settled (``multistart.stopped_early``), whether
+        the search would prune it or not.
+        """
+        nodes = None if self.memo is None else self.memo.nodes
+        if self.memo is not None and (
+            self.memo.known_infeasible(bounds, self.eps)
+            or (nodes is not None and nodes.infeasible(bounds, self.eps))
+        ):
+            self.n_implied += 1
+            return no_item(self.backend.name, "infeasible: a wider box was at looser limits")
+        if nodes is not None:
+            # an earlier search's optimum of this box under looser limits that meets these
+            # (the optimum here too), else its least value (a floor) and optimum (a start)
+            reused = nodes.reuse(bounds, self.eps, self.objective)
+            if reused is not None:
+                self.n_reused += 1
+                return reused
+            earlier = nodes.lower_bound(bounds, self.eps, self.objective)
+            if earlier is not None:
+                floor = earlier if floor is None else max(floor, earlier)
+            earlier_x = nodes.start(bounds, self.objective)
+            x_hint = earlier_x if earlier_x is not None else x_hint
+        lo, hi = self.problem.lower().copy(), self.problem.upper().copy()
+        for name, (a, b) in bounds.items():
+            k = self.names.index(name)
+            lo[k], hi[k] = a, b
+        node = {
+            v.name: bounds.get(v.name, (v.lower, v.upper)) for v in discrete_variables(self.problem)
+        }
+        if not box_has_item(self.problem, node):
+            # e.g. a (d0, p) box that holds no screw of the catalogue: nothing to solve
+            return no_item(self.backend.name, "no catalogue item in this box")
+        params = self.problem.parameter_values(node)
+        box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
+        if self.free_rows.size:
+            from dataclasses import replace
+
+            lbg, ubg = np.array(box.lbg, dtype=float), np.array(box.ubg, dtype=float)
+            lbg[self.free_rows], ubg[self.free_rows] = -np.inf, np.inf
+            box = replace(box, lbg=lbg, ubg=ubg)
+        first = self.problem.start() if x_hint is None else np.asarray(x_hint, dtype=float)
+        pts = [np.clip(first, lo, hi)]
+        if self.starts > 1:
+            pts += list(sobol_starts(lo, hi, self.starts - 1, self.seed))
+        n_planned = len(pts)
+
+        def at_floor(r: Result) -> bool:
+            return floor is not None and r.success and not improves(floor, r.objective)
+
+        def agreed(rs: list[Result]) -> bool:
+            return bool(self.agree) and len(rs) > 1 and best_of(rs)[1] >= self.agree
+
+        results: list[Result] = []
+        if warm and x_hint is not None:
+            results.append(self._solve_start((box, pts.pop(0))))
+            first_ok = results[0]
+            if first_ok.success and (
+                prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
+            ):
+                pts = []  # the warm start decides this node
+            elif not fallback:
+                self.n_solves += 1
+                return first_ok
+            else:
+                self.n_cold += 1
+
+        def run(points) -> bool:
+            """Solve from ``points`` in order, stopping at a start that settles the node
+            (True: it reached the floor, or ``agree`` starts agree on the best value) or
+            once the starts so far decide it infeasible (verdicts_decide)."""
+            before = list(results)
+
+            def stop(new: list[Result]) -> bool:
+                done = before + new
+                return at_floor(new[-1]) or agreed(done) or self.verdicts_decide(done)
+
+            new = self._starts(box, points, stop)
+            results.extend(new)
+            return bool(new) and (at_floor(new[-1]) or agreed(results))
+
+        settled = bool(results) and at_floor(results[0])
+        if not settled:
+            settled = run(pts)
+        if not any(r.success for r in results):
+            if not self.verdicts_decide(results):
+                run(sobol_starts(lo, hi, RETRY_STARTS, self.seed + 1))
+            if not any(r.success for r in results):
+                if self.memo is not None:
+                    self.memo.add_infeasible(bounds, self.eps)
+                if self.proofs is not None and self.proofs is not self.memo:
+                    self.proofs.add_infeasible(bounds, self.eps)
+        self.n_solves += len(results)
+        best, n_at_best = best_of(results)
+        outcomes = [start_outcome(r) for r in results]
+        best.multistart = MultistartInfo(
+            len(results),
+            sum(r.success for r in results),
+            n_at_best,
+            OBJECTIVE_TIE_TOL,
+            [r.objective for r in results],
+            self.seed,
+            outcomes=outcomes,
+            failed=outcome_counts(outcomes),
+            n_planned=n_planned,
+            stopped_early=settled,
+        )
+        if nodes is not None:
+            # its value and result only when trusted (a full multistart, or at its floor)
+            ok = best.success and trusted(best, self.starts)
+            value, kept = (best.objective, best) if ok else (None, None)
+            x = self.x_of(best) if best.success else None
+            nodes.add(bounds, self.eps, self.objective, value, x, kept)
+        return best
+
+    def verdicts_decide(self, results: Sequence[Result]) -> bool:
+        """Whether the starts so far call a node infeasible, without its other starts
+        and the retries: at least two starts, every one ended with the back-end's own
+        verdict of local infeasibility
+        (:attr:`~optdesign.solvers.registry.SolverHints.infeasible_verdicts`). A start
+        stopped by its iteration limit or an error, or a solved point that fails the
+        check, leaves the node to its other starts and the retries; a node solver of one
+        start (the neighbouring items of an optimum, the diagnosis) decides on its start
+        and the first retry."""
+        return (
+            len(results) >= 2
+            and bool(self.verdicts)
+            and all(r.message in self.verdicts for r in results)
+        )
+
+    def x_of(self, result: Result) -> np.ndarray | None:
+        if not result.design:
+            return None
+        return np.array([result.design[n] for n in self.names])
+
+
+def no_item(solver: str, message: str) -> Result:
+    """An infeasible node with nothing solved: ``message`` says why."""
+    return Result(
+        status="infeasible",
+        objective=float("nan"),
+        solver=solver,
+        formulation="catalogue",
+        message=message,
+    )
