@@ -80,6 +80,11 @@ class ObjectiveInfo:
         implicit rows instead of ``t - piece >= 0``, of which they are the general form.
         On the solver path ``fn(q)`` then gives only a start for ``t`` (an estimate, not
         the value); on the NumPy path it gives the exact value, as for every objective.
+    numeric_only
+        Why the objective has no smooth form (``""``: it has one). Such an objective is
+        computed on the NumPy path only (``fn`` gives None on the solver path), for the
+        population methods; every formulation that needs a smooth form refuses it before
+        any work with this reason (:func:`smooth_form_refusal`).
     """
 
     name: str
@@ -94,6 +99,7 @@ class ObjectiveInfo:
     needs: Callable[[Any], str] | None = None
     pieces: Callable[[Any], tuple[Any, ...]] | None = None
     bound_rows: Callable[[Any, Any], tuple[Any, list[str]]] | None = None
+    numeric_only: str = ""
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -324,6 +330,44 @@ def _bandwidth_period_rows(q, t):
     return bandwidth_period_rows(q, t)
 
 
+#: Why ``limit_cycle_amplitude`` has no smooth form, and what to use instead: the text of
+#: every refusal (docs/loop.md gives the argument in full).
+LIMIT_CYCLE_NOT_SMOOTH = (
+    "the amplitude of the largest limit cycle is a root of the harmonic balance, with no "
+    "smooth form (a cycle appears or vanishes where a phase crossover of L_d passes -1), "
+    "so it is computed on the NumPy path only: trace a front with method='nsga2', or bound "
+    "it with the requirement limit_cycle_amplitude_max (the independent check enforces it) "
+    "and minimise backlash"
+)
+
+
+def _sensitivity_peak(q):
+    from optdesign.problem.loop_objectives import sensitivity_peak
+
+    return sensitivity_peak(q)
+
+
+def _limit_cycle_amplitude(q):
+    from optdesign.problem.loop_objectives import limit_cycle_amplitude
+
+    return limit_cycle_amplitude(q)
+
+
+def _needs_loop(problem: Any) -> str:
+    return "" if problem.spec.loop is not None else "needs a [loop] section"
+
+
+def smooth_form_refusal(problem: Any, objectives: Any, who: str) -> str:
+    """Why ``who`` (a formulation needing a smooth form: the NLP, the catalogue search,
+    the GP, the robust design, an epsilon front) cannot pose one of ``objectives`` (a
+    name or names), naming it, or ``""``."""
+    for name in [objectives] if isinstance(objectives, str) else list(objectives or ()):
+        info = problem.objectives.get(name)
+        if info is not None and info.numeric_only:
+            return f"{who} needs a smooth form of objective {name!r}: {info.numeric_only}"
+    return ""
+
+
 def _motor_mass(q):
     motor = q.motor_data
     if motor is None or motor.mass is None or _motor_mass_needs(q.problem):
@@ -530,7 +574,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "largest gain of the position loop at the drive's own mode (1 / resonance margin)",
             "max over the stroke of |L(j w_r)|, w_r the two-mass mode with the motor free",
             valid=NON_NEGATIVE,
-            needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
+            needs=_needs_loop,
         ),
         ObjectiveInfo(
             "bandwidth_period",
@@ -544,8 +588,31 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="ms",
             display_scale=1e3,
             valid=NON_NEGATIVE,
-            needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
+            needs=_needs_loop,
             bound_rows=_bandwidth_period_rows,
+        ),
+        ObjectiveInfo(
+            "sensitivity_peak",
+            _sensitivity_peak,
+            "max",
+            "",
+            "peak of the sensitivity function Ms = 1 / min |1 + L| (an upper bound of it over "
+            "the margins' 14 frequencies)",
+            "max over the loop's angles of 1 / the soft minimum of |1 + L(jw)| that the "
+            "phase and modulus margin rows hold",
+            valid=NON_NEGATIVE,
+            needs=_needs_loop,
+        ),
+        ObjectiveInfo(
+            "limit_cycle_amplitude",
+            _limit_cycle_amplitude,
+            "max",
+            "deg",
+            "fin amplitude of the largest stable backlash limit cycle (NumPy path only)",
+            "max over the loop's angles of the harmonic balance's largest stable cycle",
+            valid=NON_NEGATIVE,
+            needs=_needs_loop,
+            numeric_only=LIMIT_CYCLE_NOT_SMOOTH,
         ),
         ObjectiveInfo(
             "motor_mass",

@@ -21,6 +21,7 @@ from typing import Any, ClassVar
 from optdesign.errors import InputError
 from optdesign.formulations.nlp.solve import planned_starts
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.objectives import smooth_form_refusal
 from optdesign.runtime.runner import run_tasks
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
@@ -119,6 +120,9 @@ class FrontMethod:
     what: ClassVar[str] = "a front"
     #: Most starts of an anchor by default (None: the problem file's).
     max_default_starts: ClassVar[int | None] = None
+    #: Whether it solves NLPs, which need each objective's smooth form (False: it reads
+    #: the NumPy path's values only, as NSGA-II does).
+    smooth: ClassVar[bool] = True
 
     # --- what a method says --------------------------------------------------------------
     def check_settings(self) -> None:
@@ -142,6 +146,11 @@ class FrontMethod:
     def refuse(self, problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
         """The checked objectives; refuse a problem or settings the method cannot take."""
         objectives = check_objectives(problem, objectives)
+        refusal = self.smooth and smooth_form_refusal(
+            problem, objectives, f"{type(self).__name__} {self.name!r}"
+        )
+        if refusal:
+            raise InputError("objectives", refusal)
         if len(objectives) not in self.n_objectives:
             counts = " or ".join(_COUNTS[n] for n in self.n_objectives)
             raise InputError("objectives", f"{self.what} takes {counts} objectives")
