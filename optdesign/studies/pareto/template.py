@@ -102,6 +102,16 @@ class Traced:
     notes: list[str] = field(default_factory=list)
 
 
+def smooth_refusal(method: Any, problem: DesignProblem, objectives: Sequence[str]) -> str:
+    """Why front ``method`` (an object) cannot trace ``objectives``: one of them has no
+    smooth form and the method solves NLPs (``""``: it can; NSGA-II reads the NumPy
+    path's values)."""
+    if not getattr(method, "smooth", True):
+        return ""
+    who = f"the front method {getattr(method, 'name', type(method).__name__)!r} (it solves NLPs)"
+    return smooth_form_refusal(problem, objectives, who)
+
+
 class FrontMethod:
     """Base of the front methods (see the module docstring); subclasses are dataclasses
     with a ``name`` field (the method's and its store's name)."""
@@ -146,9 +156,7 @@ class FrontMethod:
     def refuse(self, problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
         """The checked objectives; refuse a problem or settings the method cannot take."""
         objectives = check_objectives(problem, objectives)
-        refusal = self.smooth and smooth_form_refusal(
-            problem, objectives, f"{type(self).__name__} {self.name!r}"
-        )
+        refusal = smooth_refusal(self, problem, objectives)
         if refusal:
             raise InputError("objectives", refusal)
         if len(objectives) not in self.n_objectives:
