@@ -29,7 +29,7 @@ from optdesign.formulations.nlp import NLPFormulation
 from optdesign.formulations.protocol import Formulation as Formulation
 from optdesign.formulations.protocol import LazyFormulation as LazyFormulation
 from optdesign.formulations.robust import RobustFormulation
-from optdesign.problem.objectives import smooth_form_refusal
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 
 if TYPE_CHECKING:

@@ -16,7 +16,7 @@
   the balance with no smooth form (a cycle appears or vanishes where a phase crossover of
   L_d passes -1), so it exists on the NumPy path only, for the population methods; every
   formulation that needs a smooth form refuses it
-  (:func:`~optdesign.problem.objectives.smooth_form_refusal`, with the reason
+  (:func:`~optdesign.problem.objective_refusals.smooth_form_refusal`, with the reason
   :data:`~optdesign.problem.objectives.LIMIT_CYCLE_NOT_SMOOTH`).
 
 Both are 0 at the grid angles that carry no loop row: they bound nothing there, and the

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from optdesign import math as m
-from optdesign.errors import InputError, ProblemError
+from optdesign.errors import InputError
+from optdesign.problem.objective_refusals import motor_mass_needs
 
 #: Objective kinds: how a grid quantity becomes one number.
 #: ``spread``: (max - min)/(max + min) over the grid (the ratio ripple);
@@ -84,7 +85,11 @@ class ObjectiveInfo:
         Why the objective has no smooth form (``""``: it has one). Such an objective is
         computed on the NumPy path only (``fn`` gives None on the solver path), for the
         population methods; every formulation that needs a smooth form refuses it before
-        any work with this reason (:func:`smooth_form_refusal`).
+        any work with this reason
+        (:func:`~optdesign.problem.objective_refusals.smooth_form_refusal`).
+    not_posynomial
+        Why a GP cannot pose the objective whatever the problem (``""``: it may, as the
+        GP's own check of the traced model decides).
     """
 
     name: str
@@ -100,6 +105,7 @@ class ObjectiveInfo:
     pieces: Callable[[Any], tuple[Any, ...]] | None = None
     bound_rows: Callable[[Any, Any], tuple[Any, list[str]]] | None = None
     numeric_only: str = ""
+    not_posynomial: str = ""
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -357,64 +363,11 @@ def _needs_loop(problem: Any) -> str:
     return "" if problem.spec.loop is not None else "needs a [loop] section"
 
 
-def smooth_form_refusal(problem: Any, objectives: Any, who: str) -> str:
-    """Why ``who`` (a formulation needing a smooth form: the NLP, the catalogue search,
-    the GP, the robust design, an epsilon front) cannot pose one of ``objectives`` (a
-    name or names), naming it, or ``""``."""
-    for name in [objectives] if isinstance(objectives, str) else list(objectives or ()):
-        info = problem.objectives.get(name)
-        if info is not None and info.numeric_only:
-            return f"{who} needs a smooth form of objective {name!r}: {info.numeric_only}"
-    return ""
-
-
 def _motor_mass(q):
     motor = q.motor_data
-    if motor is None or motor.mass is None or _motor_mass_needs(q.problem):
+    if motor is None or motor.mass is None or motor_mass_needs(q.problem):
         return None
     return motor.mass
-
-
-def _motor_mass_needs(problem: Any) -> str:
-    """What a problem must give for the objective motor_mass (``""``: it gives it)."""
-    from optdesign.problem import motor_catalogue_variable as mcv
-
-    motor = problem.spec.motor
-    if motor is None:
-        return "needs a [motor] section with the motor's mass"
-    catalogue = mcv.spec_catalogue(motor)
-    if catalogue is not None:
-        missing = mcv.masses_missing(catalogue)
-        if missing:
-            more = f" and {len(missing) - 3} more" if len(missing) > 3 else ""
-            return (
-                f"the motor catalogue {catalogue.name!r} prints no mass for "
-                f"{', '.join(missing[:3])}{more}: give a catalogue CSV whose mass_kg column "
-                "is filled (catalogue = FILE)"
-            )
-        return ""
-    if motor.designation is not None:
-        from optdesign.models.motor_catalogue import by_designation
-
-        if by_designation(motor.designation).mass is None:
-            return (
-                f"the shipped catalogue prints no mass for {motor.designation}: give the "
-                "motor's data with its mass, or a catalogue CSV with mass_kg"
-            )
-        return ""
-    return "" if motor.mass is not None else "give [motor] mass"
-
-
-def unavailable_objective(problem: Any, name: str, available: Any) -> ProblemError:
-    """The error for objective ``name`` that the problem's expressions lack: its own
-    reason where the objective declares one, and the objectives the problem has."""
-    info = problem.objectives.get(name)
-    reason = info.needs(problem) if info is not None and info.needs is not None else ""
-    why = f": {reason}" if reason else ""
-    return ProblemError(
-        f"objective {name!r} is not available for this problem{why} "
-        f"(available: {', '.join(available)})"
-    )
 
 
 def _backlash(q):
@@ -602,6 +555,9 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "phase and modulus margin rows hold",
             valid=NON_NEGATIVE,
             needs=_needs_loop,
+            not_posynomial="a power sum (sum_k |1 + L_k|^-2p)^(1/2p) of reciprocals of "
+            "signomials (|1 + L|^2 is a difference of posynomials), not a posynomial of the "
+            "design; use formulation='nlp' or 'catalogue'",
         ),
         ObjectiveInfo(
             "limit_cycle_amplitude",
@@ -624,7 +580,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="kg",
             display_scale=1e3,
             valid=NON_NEGATIVE,
-            needs=_motor_mass_needs,
+            needs=motor_mass_needs,
         ),
         ObjectiveInfo(
             "lock_force",

@@ -34,7 +34,8 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.objectives import piece_rows, smooth_form_refusal, unavailable_objective
+from optdesign.problem.objective_refusals import smooth_form_refusal, unavailable_objective
+from optdesign.problem.objectives import piece_rows
 
 #: Prefix of the targets that are design variables (``"var:R"``).
 VAR = "var:"

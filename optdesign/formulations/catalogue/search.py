@@ -42,7 +42,7 @@ from optdesign.formulations.catalogue.node_solver import no_item as _no_item
 from optdesign.formulations.nlp.solve import finish, requested_objective
 from optdesign.formulations.reference import attach_reference, reference_design
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.objectives import smooth_form_refusal
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.parameters import without_impossible_items
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.multistart import (

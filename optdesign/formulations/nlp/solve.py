@@ -23,7 +23,7 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.reference import attach_reference
 from optdesign.formulations.verify import nan_notes, verify_design
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.objectives import smooth_form_refusal
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 from optdesign.programs.nlp import NLP, VAR, build_nlp
 from optdesign.runtime.inherited_map import map_inherited

@@ -39,7 +39,8 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem, Expressions
-from optdesign.problem.objectives import ObjectiveTerm, smooth_form_refusal, unavailable_objective
+from optdesign.problem.objective_refusals import smooth_form_refusal, unavailable_objective
+from optdesign.problem.objectives import ObjectiveTerm
 from optdesign.problem.spec import Tolerances
 from optdesign.programs.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
 

@@ -44,7 +44,7 @@ from optdesign.formulations.robust.program import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.evaluation import relative_violation, term_values
-from optdesign.problem.objectives import smooth_form_refusal
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.multistart import multistart

@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 from optdesign.errors import InputError
 from optdesign.formulations.nlp.solve import planned_starts
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.objectives import smooth_form_refusal
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.runtime.runner import run_tasks
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
