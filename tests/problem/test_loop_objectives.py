@@ -16,6 +16,7 @@ import pytest
 from cli_refusal import command_line_refusal
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
+from loop_problems import assert_no_scan_point_beats, small_loop_problem
 
 import optdesign as od
 from optdesign.models import loop_linear as ll
@@ -30,8 +31,6 @@ PROBLEMS = Path(__file__).resolve().parents[2] / "problems"
 #: fin_actuator_loop's optimum (16 mm pins, docs/loop.md).
 LOOP_OPTIMUM = {"R": 105.5714658, "l": 59.7942416, "n": 102.0869895, "phi0": 0.2292040,
                 "d0": 25.0, "p": 5.0, "d": 16.0}  # fmt: skip
-#: A fast linkage of the shipped problem with its items (test_loop_bandwidth.py's FAST).
-FAST = {"R": 101.591698, "l": 146.677980, "phi0": 0.4952934, "d0": 25.0, "p": 5.0, "d": 16.0}
 NOT_SMOOTH = "needs a smooth form of objective 'limit_cycle_amplitude'"
 
 
@@ -45,21 +44,7 @@ def problem():
 
 
 def _small_problem(**sections) -> od.DesignProblem:
-    """fin_actuator_loop with its items and R, l, phi0 fixed at :data:`FAST`, the offset
-    n free, the loop's rows at two angles, and the requirements of the stroke, its loads,
-    the transmission angle and an 8 Hz bandwidth; minimising sensitivity_peak."""
-    data = _data()
-    variables = data["variables"]
-    for name in ("R", "l", "d0", "p", "d"):
-        variables[name] = f"{FAST[name]} mm"
-    variables["phi0"] = f"{FAST['phi0']} rad"
-    keep = ("deflection", "hinge_moment", "deflection_rate", "transmission_angle", "fit")
-    keep += ("fit_clearance", "pin_shear_planes")
-    data["requirements"] = {k: v for k, v in data["requirements"].items() if k in keep}
-    data["requirements"]["bandwidth_min"] = "8 Hz"
-    data["loop"]["angles"] = 2
-    data["objective"] = {"minimize": "sensitivity_peak"}
-    return od.load({**data, **sections})
+    return small_loop_problem("sensitivity_peak", **sections)
 
 
 @pytest.fixture(scope="module")
@@ -162,14 +147,7 @@ def test_the_nlp_minimising_the_sensitivity_peak_beats_a_scan_of_its_free_variab
     200-point scan of n that meets every requirement has a smaller value."""
     result = od.solve(small, starts=1, ranges=False, diagnose=False, sensitivities=False)
     assert result.status == "optimal" and result.verified
-    n = small.free[0]
-    scan = np.linspace(n.lower, n.upper, 200)[:, None]
-    ev = small.evaluate(scan)
-    peaks = np.where(ev.violation <= 1e-6, ev.objectives["sensitivity_peak"], np.inf)
-    best = int(np.argmin(peaks))
-    assert np.isfinite(peaks[best])
-    assert result.objective <= peaks[best] * (1 + 1e-9)
-    assert abs(scan[best, 0] - result.design["n"]) < (n.upper - n.lower) / 199
+    assert_no_scan_point_beats(small, result, "sensitivity_peak")
     assert result.objective == pytest.approx(1.40608, abs=1e-5)
 
 
