@@ -58,7 +58,8 @@ def smooth_form_refusal(problem: Any, objectives: Any, who: str) -> str:
     """Why ``who`` (a formulation needing a smooth form: the NLP, the catalogue search,
     the GP, the robust design, an epsilon front) cannot pose one of ``objectives`` (a
     name or names), naming it, or ``""``."""
-    for name in [objectives] if isinstance(objectives, str) else list(objectives or ()):
+    names = [objectives] if isinstance(objectives, str) else list(objectives or ())
+    for name in filter(None, names):
         info = problem.objectives.get(name)
         if info is not None and info.numeric_only:
             return f"{who} needs a smooth form of objective {name!r}: {info.numeric_only}"

@@ -417,10 +417,12 @@ def nlp_applies(problem: DesignProblem, request: SolveRequest | None = None) -> 
 
 
 def requested_objective(problem: DesignProblem, request: SolveRequest | None) -> str:
-    """The objective a request minimises (the problem's first without a request)."""
+    """The objective a request minimises (the problem's first without a request; ``""``
+    for a problem that declares none, e.g. a stand-in of a test)."""
     if request is not None and request.objective:
         return request.objective
-    return problem.objective_names[0] if problem.objective_names else ""
+    names = getattr(problem, "objective_names", None)
+    return names[0] if names else ""
 
 
 def solve_nlp_formulation(problem: DesignProblem, request: SolveRequest) -> Result:
