@@ -19,6 +19,9 @@
   (:func:`~optdesign.problem.objective_refusals.smooth_form_refusal`, with the reason
   :data:`~optdesign.problem.objectives.LIMIT_CYCLE_NOT_SMOOTH`).
 
+A single design's evaluation reads every objective, so it computes the cycles (shared with
+the requirement's row through the per-plant cache when the problem has one).
+
 Both are 0 at the grid angles that carry no loop row: they bound nothing there, and the
 ``max`` over the grid is the max over the loop's angles.
 """
