@@ -205,7 +205,7 @@ def pareto(
     )
     problem = load(problem)
     validation.front_objectives(problem, objectives)
-    validation.method_for(problem, method)
+    validation.method_for(problem, method, objectives=objectives)
     validation.front_time_limit(problem, [method], options.get("time_limit"))
     files = options.pop("files", True)
     front = compute_front(problem, objectives, points, method, **options)

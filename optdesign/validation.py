@@ -372,14 +372,24 @@ def report_arguments(subject: Any, path_: Any) -> tuple[Any, list[Any], Any]:
     return problem, items, target
 
 
-def method_for(problem: Any, method_: Any, argument: str = "method") -> None:
-    """A front method that keeps the problem's designs valid: a weighted sum of
-    continuous NLPs would leave a catalogue."""
+def method_for(
+    problem: Any, method_: Any, argument: str = "method", objectives: Sequence[str] = ()
+) -> None:
+    """A front method that keeps the problem's designs valid (a weighted sum of
+    continuous NLPs would leave a catalogue) and can pose ``objectives`` (a method that
+    solves NLPs needs each one's smooth form)."""
     if method_ == "weighted_sum" or type(method_).__name__ == "WeightedSum":
         from optdesign.studies.pareto.template import has_catalogue, leaves_catalogue
 
         if has_catalogue(problem):
             raise ArgumentError(argument, leaves_catalogue("weighted_sum"))
+    if objectives:
+        from optdesign.studies.pareto.methods import make_method
+        from optdesign.studies.pareto.template import smooth_refusal
+
+        refusal = smooth_refusal(make_method(problem, method_), problem, objectives)
+        if refusal:
+            raise ArgumentError("objectives", refusal)
 
 
 def front_problem(problem: Any) -> None:

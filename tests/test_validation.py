@@ -140,7 +140,7 @@ CASES = [
         "backlsh",
         "unknown objective 'backlsh' (did you mean 'backlash'? known: ripple, backlash, "
         "backlash_rss, size, nut_travel, motor_torque, drive_loss, screw_mass, motor_inertia, "
-        "hinge_compliance, motor_peak_torque, motor_rms_torque, natural_period, resonance_gain, bandwidth_period, motor_mass, lock_force)",
+        "hinge_compliance, motor_peak_torque, motor_rms_torque, natural_period, resonance_gain, bandwidth_period, sensitivity_peak, limit_cycle_amplitude, motor_mass, lock_force)",
     ),
     # --- pareto --------------------------------------------------------------------
     pareto("points", 1, "1", "1 is outside 2..10000"),
@@ -164,7 +164,7 @@ CASES = [
         "ripple,sise",
         "unknown objective 'sise' (did you mean 'size'? known: ripple, backlash, backlash_rss, "
         "size, nut_travel, motor_torque, drive_loss, screw_mass, motor_inertia, "
-        "hinge_compliance, motor_peak_torque, motor_rms_torque, natural_period, resonance_gain, bandwidth_period, motor_mass, lock_force)",
+        "hinge_compliance, motor_peak_torque, motor_rms_torque, natural_period, resonance_gain, bandwidth_period, sensitivity_peak, limit_cycle_amplitude, motor_mass, lock_force)",
     ),
     pareto(
         "method",

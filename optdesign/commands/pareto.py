@@ -119,7 +119,7 @@ def run_pareto(args) -> int:
         methods = list(METHOD_NAMES) if args.method == "all" else check.names("method", args.method)
         for m in methods:
             check.method("method", m)
-            check.method_for(problem, m)  # refused before the output folder is made
+            check.method_for(problem, m, objectives=objectives)  # before the folder is made
         check.front_time_limit(problem, methods, args.time_limit)
         check.run_folder(args.out, args.resume, args.overwrite)
     # One run per folder for the whole command (the runner re-enters the lock per store),

@@ -29,6 +29,7 @@ from optdesign.formulations.nlp import NLPFormulation
 from optdesign.formulations.protocol import Formulation as Formulation
 from optdesign.formulations.protocol import LazyFormulation as LazyFormulation
 from optdesign.formulations.robust import RobustFormulation
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 
 if TYPE_CHECKING:
@@ -96,6 +97,9 @@ def pick_formulation(problem: DesignProblem, request: SolveRequest) -> Formulati
         if reason is None:
             return formulation
         reasons.append(f"{name}: {reason}")
+    refusal = smooth_form_refusal(problem, request.objective, "every formulation")
+    if refusal:  # one reason for all, rather than the same one four times
+        raise ProblemError(f"formulation='auto': {refusal}")
     raise ProblemError("formulation='auto': no formulation applies (" + "; ".join(reasons) + ")")
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
 from optdesign.problem.loop import drive_plants_of, loop_angles
-from optdesign.problem.loop_requirements import CYCLE_POINTS
+from optdesign.problem.loop_margins import CYCLE_POINTS
 
 
 @dataclass(frozen=True)

@@ -13,10 +13,10 @@ friction, no torque or speed limit):
 * ``phase_margin`` (``phase_margin_min`` = PM) and ``modulus_margin``
   (``modulus_margin_min`` = s): the return difference |1 + L(jw)| kept at or above
   2 sin(PM / 2), or s, on 14 frequencies: seven fixed ones half an octave apart from
-  f_ref / 2 to 4 f_ref around the crossover (:func:`margin_frequencies`), and seven
+  f_ref / 2 to 4 f_ref around the crossover (:func:`~optdesign.problem.loop_margins.margin_frequencies`), and seven
   about the drive's own mode, w_r (1 + 0.02 j), j = -3 ... 3, which move with the
   design. The row holds a smooth lower bound of the smallest |1 + L| on those
-  frequencies, (sum_k |1 + L_k|^-2p)^(-1/2p) with p = :data:`SOFT_MIN_POWER`: never
+  frequencies, (sum_k |1 + L_k|^-2p)^(-1/2p) with p = :data:`~optdesign.problem.loop_margins.SOFT_MIN_POWER`: never
   above that minimum. It is a check on these frequencies, not on every w: a dip of
   |1 + L| between them is missed (at the shipped optimum the row is 0.2-0.25 % above the
   exact modulus margin of :func:`optdesign.models.loop_linear.margins`). Where |L| = 1,
@@ -49,45 +49,30 @@ angles: each costs a polynomial's roots or a harmonic balance per angle and eval
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import loop_linear as ll
-from optdesign.models.loop_backlash import limit_cycles
 from optdesign.models.loop_plant import DrivePlant, PositionLoop
 from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
-    LoopGains,
-    PlantGrid,
     bandwidth_ratio,
-    drive_plants_of,
     loop_angles,
     loop_gains,
     picked,
     plant_grid,
-    population_size,
-    resonance_frequency,
     resonance_gain,
-    response,
+)
+from optdesign.problem.loop_margins import (
+    limit_cycle_amplitudes,
+    per_plant_rows,
+    soft_least_return_difference,
 )
 from optdesign.problem.objectives import ConstraintBlock
 
-#: The margins' frequencies about the drive's mode: w_r (1 + RESONANCE_STEP j), j = -3..3
-#: (the mode's dip of |1 + L| is a few % of w_r wide at 5 % damping; 4 % steps missed
-#: the shipped optimum's minimum by 2 %, these by 0.3 %).
-RESONANCE_STEP = 0.02
-#: The power p of the smooth minimum (sum x^-p)^(-1/p) of |1 + L|^2 over the frequencies:
-#: it is below the least |1 + L| by at most a factor n^(1/2p), n the frequencies equally
-#: near it (three: 0.9 %; p = 16 gave 3.5 %, enough to move a design across a limit).
-SOFT_MIN_POWER = 64
-#: Frequencies the harmonic balance samples to bracket L_d's phase crossovers: over the
-#: loop's span of about five decades, 400 a decade (8000, the model's default, gives the
-#: same cycles at the shipped problem's seven angles, nine times slower).
-CYCLE_POINTS = 2000
 #: The smallest damping ratio of a stable loop's poles (the roots' own precision).
 STABLE_DAMPING = 1e-9
 
@@ -102,47 +87,6 @@ LOOP_REQUIREMENTS = (
 )
 
 
-def reference_frequency(spec) -> float:
-    """f_ref (Hz), the middle of the margins' grid: the required bandwidth, else the
-    bandwidth the gains are placed for, else 10 Hz."""
-    req, loop = spec.requirements, spec.loop
-    if req.bandwidth_min is not None:
-        return req.bandwidth_min
-    if loop is not None and loop.bandwidth is not None:
-        return loop.bandwidth
-    return 10.0
-
-
-def margin_frequencies(spec) -> np.ndarray:
-    """The margins' fixed frequencies (rad/s): f_ref x 2^(k/2), k = -2 ... 4 (half an
-    octave apart from f_ref / 2 to 4 f_ref, around the loop's crossover;
-    :func:`reference_frequency`)."""
-    f = reference_frequency(spec)
-    return 2.0 * np.pi * f * 2.0 ** (np.arange(-2, 5) / 2.0)
-
-
-def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> Any:
-    """The smooth lower bound of min |1 + L(jw)| over the margins' frequencies and about
-    w_r (see the module's docstring), at the loop's angles ``idx``: (sum_k x_k^-p)^(-1/2p)
-    of x_k = |1 + L_k|^2, summed as a log-sum-exp shifted by its largest term (the shift
-    cancels in the value and its derivatives; unshifted, x^-p overflows where |1 + L| is
-    small)."""
-    p = SOFT_MIN_POWER
-    w_r = resonance_frequency(q, idx)
-    around = [w_r * (1.0 + RESONANCE_STEP * j) for j in range(-3, 4)]
-    z = [
-        -p * m.log(ll.return_difference_squared(response(grid, gains, w)) + 1e-300)
-        for w in (*margin_frequencies(q.problem.spec), *around)
-    ]
-    top = z[0]
-    for zk in z[1:]:
-        top = m.fmax(top, zk)
-    total = 0.0
-    for zk in z:
-        total = total + m.exp(zk - top)
-    return m.exp(-(top + m.log(total)) / (2.0 * p))
-
-
 @lru_cache(maxsize=CACHED_PLANTS)
 def _least_damping(plant: DrivePlant, loop: PositionLoop) -> float:
     # the records are frozen, so a plant met again (the sensitivities evaluate the same
@@ -151,48 +95,11 @@ def _least_damping(plant: DrivePlant, loop: PositionLoop) -> float:
     return float(np.min(-poles.real / np.maximum(np.abs(poles), 1e-300)))
 
 
-@lru_cache(maxsize=CACHED_PLANTS)
-def _largest_cycle(plant: DrivePlant, loop: PositionLoop) -> float:
-    return float(np.degrees(limit_cycles(plant, loop, CYCLE_POINTS).largest_stable_fin_amplitude))
-
-
 def least_pole_damping(q, idx: np.ndarray) -> np.ndarray | RowsOnDemand:
     """The smallest damping ratio -Re p / |p| of the closed loop's poles at each loop
     angle ``idx`` (NumPy, one row per design of a population; NaN for a design whose
     drive is no plant, :func:`~optdesign.problem.loop.drive_plants_of`)."""
-    return _per_plant(q, idx, _least_damping)
-
-
-def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray | RowsOnDemand:
-    """The fin amplitude (deg) of the largest stable limit cycle the chain's clearance
-    sustains at each loop angle ``idx``, by harmonic balance
-    (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
-    one row per design of a population (NaN for a design whose drive is no plant)."""
-    return _per_plant(q, idx, _largest_cycle)
-
-
-def _per_plant(q, idx: np.ndarray, fn) -> np.ndarray | RowsOnDemand:
-    # a population's rows are screened: computed for the designs that pass every other
-    # row only (optdesign.problem.evaluation), which spares a global search's start
-    # sample a harmonic balance per design and angle
-    drives: list = []
-
-    def rows_of(designs: np.ndarray) -> np.ndarray:
-        if not drives:
-            drives.extend(drive_plants_of(q, idx, strict=False))
-        return np.array(
-            [
-                [np.nan] * len(idx)
-                if drives[i] is None
-                else [fn(p, drives[i][1]) for p in drives[i][0]]
-                for i in designs
-            ],
-            dtype=float,
-        ).reshape(len(designs), len(idx))
-
-    pop = population_size(q)
-    rows = RowsOnDemand(rows_of, pop, len(idx))
-    return np.asarray(rows) if pop == 1 else rows
+    return per_plant_rows(q, idx, _least_damping)
 
 
 def _phase_margin(modulus):

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from optdesign import math as m
-from optdesign.errors import InputError, ProblemError
+from optdesign.errors import InputError
+from optdesign.problem.objective_refusals import motor_mass_needs
 
 #: Objective kinds: how a grid quantity becomes one number.
 #: ``spread``: (max - min)/(max + min) over the grid (the ratio ripple);
@@ -80,6 +81,15 @@ class ObjectiveInfo:
         implicit rows instead of ``t - piece >= 0``, of which they are the general form.
         On the solver path ``fn(q)`` then gives only a start for ``t`` (an estimate, not
         the value); on the NumPy path it gives the exact value, as for every objective.
+    numeric_only
+        Why the objective has no smooth form (``""``: it has one). Such an objective is
+        computed on the NumPy path only (``fn`` gives None on the solver path), for the
+        population methods; every formulation that needs a smooth form refuses it before
+        any work with this reason
+        (:func:`~optdesign.problem.objective_refusals.smooth_form_refusal`).
+    not_posynomial
+        Why a GP cannot pose the objective whatever the problem (``""``: it may, as the
+        GP's own check of the traced model decides).
     """
 
     name: str
@@ -94,6 +104,8 @@ class ObjectiveInfo:
     needs: Callable[[Any], str] | None = None
     pieces: Callable[[Any], tuple[Any, ...]] | None = None
     bound_rows: Callable[[Any, Any], tuple[Any, list[str]]] | None = None
+    numeric_only: str = ""
+    not_posynomial: str = ""
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -324,53 +336,38 @@ def _bandwidth_period_rows(q, t):
     return bandwidth_period_rows(q, t)
 
 
+#: Why ``limit_cycle_amplitude`` has no smooth form, and what to use instead: the text of
+#: every refusal (docs/loop.md gives the argument in full).
+LIMIT_CYCLE_NOT_SMOOTH = (
+    "the amplitude of the largest limit cycle is a root of the harmonic balance, with no "
+    "smooth form (a cycle appears or vanishes where a phase crossover of L_d passes -1), "
+    "so it is computed on the NumPy path only: trace a front with method='nsga2', or bound "
+    "it with the requirement limit_cycle_amplitude_max (the independent check enforces it) "
+    "and minimise backlash"
+)
+
+
+def _sensitivity_peak(q):
+    from optdesign.problem.loop_objectives import sensitivity_peak
+
+    return sensitivity_peak(q)
+
+
+def _limit_cycle_amplitude(q):
+    from optdesign.problem.loop_objectives import limit_cycle_amplitude
+
+    return limit_cycle_amplitude(q)
+
+
+def _needs_loop(problem: Any) -> str:
+    return "" if problem.spec.loop is not None else "needs a [loop] section"
+
+
 def _motor_mass(q):
     motor = q.motor_data
-    if motor is None or motor.mass is None or _motor_mass_needs(q.problem):
+    if motor is None or motor.mass is None or motor_mass_needs(q.problem):
         return None
     return motor.mass
-
-
-def _motor_mass_needs(problem: Any) -> str:
-    """What a problem must give for the objective motor_mass (``""``: it gives it)."""
-    from optdesign.problem import motor_catalogue_variable as mcv
-
-    motor = problem.spec.motor
-    if motor is None:
-        return "needs a [motor] section with the motor's mass"
-    catalogue = mcv.spec_catalogue(motor)
-    if catalogue is not None:
-        missing = mcv.masses_missing(catalogue)
-        if missing:
-            more = f" and {len(missing) - 3} more" if len(missing) > 3 else ""
-            return (
-                f"the motor catalogue {catalogue.name!r} prints no mass for "
-                f"{', '.join(missing[:3])}{more}: give a catalogue CSV whose mass_kg column "
-                "is filled (catalogue = FILE)"
-            )
-        return ""
-    if motor.designation is not None:
-        from optdesign.models.motor_catalogue import by_designation
-
-        if by_designation(motor.designation).mass is None:
-            return (
-                f"the shipped catalogue prints no mass for {motor.designation}: give the "
-                "motor's data with its mass, or a catalogue CSV with mass_kg"
-            )
-        return ""
-    return "" if motor.mass is not None else "give [motor] mass"
-
-
-def unavailable_objective(problem: Any, name: str, available: Any) -> ProblemError:
-    """The error for objective ``name`` that the problem's expressions lack: its own
-    reason where the objective declares one, and the objectives the problem has."""
-    info = problem.objectives.get(name)
-    reason = info.needs(problem) if info is not None and info.needs is not None else ""
-    why = f": {reason}" if reason else ""
-    return ProblemError(
-        f"objective {name!r} is not available for this problem{why} "
-        f"(available: {', '.join(available)})"
-    )
 
 
 def _backlash(q):
@@ -530,7 +527,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             "largest gain of the position loop at the drive's own mode (1 / resonance margin)",
             "max over the stroke of |L(j w_r)|, w_r the two-mass mode with the motor free",
             valid=NON_NEGATIVE,
-            needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
+            needs=_needs_loop,
         ),
         ObjectiveInfo(
             "bandwidth_period",
@@ -544,8 +541,34 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="ms",
             display_scale=1e3,
             valid=NON_NEGATIVE,
-            needs=lambda problem: "" if problem.spec.loop is not None else "needs a [loop] section",
+            needs=_needs_loop,
             bound_rows=_bandwidth_period_rows,
+        ),
+        ObjectiveInfo(
+            "sensitivity_peak",
+            _sensitivity_peak,
+            "max",
+            "",
+            "peak of the sensitivity function Ms = 1 / min |1 + L| (an upper bound of it over "
+            "the margins' 14 frequencies)",
+            "max over the loop's angles of 1 / the soft minimum of |1 + L(jw)| that the "
+            "phase and modulus margin rows hold",
+            valid=NON_NEGATIVE,
+            needs=_needs_loop,
+            not_posynomial="a power sum (sum_k |1 + L_k|^-2p)^(1/2p) of reciprocals of "
+            "signomials (|1 + L|^2 is a difference of posynomials), not a posynomial of the "
+            "design; use formulation='nlp' or 'catalogue'",
+        ),
+        ObjectiveInfo(
+            "limit_cycle_amplitude",
+            _limit_cycle_amplitude,
+            "max",
+            "deg",
+            "fin amplitude of the largest stable backlash limit cycle (NumPy path only)",
+            "max over the loop's angles of the harmonic balance's largest stable cycle",
+            valid=NON_NEGATIVE,
+            needs=_needs_loop,
+            numeric_only=LIMIT_CYCLE_NOT_SMOOTH,
         ),
         ObjectiveInfo(
             "motor_mass",
@@ -557,7 +580,7 @@ BUILTIN_OBJECTIVES: dict[str, ObjectiveInfo] = {
             display_unit="kg",
             display_scale=1e3,
             valid=NON_NEGATIVE,
-            needs=_motor_mass_needs,
+            needs=motor_mass_needs,
         ),
         ObjectiveInfo(
             "lock_force",

@@ -32,6 +32,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.programs.signomial import NotGP, Signomial
 
 __all__ = ["DGPCheck", "GPData", "GPRow", "NotGP", "Signomial", "build_gp", "is_gp"]
@@ -341,6 +342,12 @@ def build_gp(problem: DesignProblem, objective: str | None = None) -> GPData:
             )
     gp = GPData(names, problem.lower(), problem.upper(), objective, "", [], [], checks, [])
     info = problem.objectives.get(objective)
+    refusal = smooth_form_refusal(problem, objective, "a GP")
+    if not refusal and info is not None and info.not_posynomial:
+        refusal = f"{objective} is {info.not_posynomial}"
+    if refusal:
+        checks.append(DGPCheck("objective", objective, False, refusal))
+        return gp
     if info is not None and info.bound_rows is not None:
         # a root of the model (the closed loop's bandwidth): no expression of the design,
         # let alone a posynomial; only an NLP can pose its implicit epigraph rows

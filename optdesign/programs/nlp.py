@@ -34,7 +34,8 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem
-from optdesign.problem.objectives import piece_rows, unavailable_objective
+from optdesign.problem.objective_refusals import smooth_form_refusal, unavailable_objective
+from optdesign.problem.objectives import piece_rows
 
 #: Prefix of the targets that are design variables (``"var:R"``).
 VAR = "var:"
@@ -413,6 +414,9 @@ def build_nlp(
     for name in [*objectives, *problem.objective_limits()]:
         if name not in names:
             names.append(name)
+    refusal = smooth_form_refusal(problem, names, "an NLP")
+    if refusal:
+        raise ProblemError(refusal)
 
     free = problem.free
     n = len(free)

@@ -39,9 +39,10 @@ from optdesign.formulations.catalogue.node_solver import NODE_STARTS as NODE_STA
 from optdesign.formulations.catalogue.node_solver import RETRY_STARTS as RETRY_STARTS
 from optdesign.formulations.catalogue.node_solver import NodeSolver as NodeSolver
 from optdesign.formulations.catalogue.node_solver import no_item as _no_item
-from optdesign.formulations.nlp.solve import finish
+from optdesign.formulations.nlp.solve import finish, requested_objective
 from optdesign.formulations.reference import attach_reference, reference_design
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.parameters import without_impossible_items
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.multistart import (
@@ -270,8 +271,13 @@ def relaxation_bound(result: Result) -> float:
 
 def catalogue_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
     """The ``catalogue`` formulation's predicate: some free variable takes catalogue
-    values (the objective does not matter)."""
-    return bool(discrete_variables(problem)) or "no variable takes catalogue values"
+    values and the objective has a smooth form (its nodes are NLPs)."""
+    if not discrete_variables(problem):
+        return "no variable takes catalogue values"
+    objective = requested_objective(problem, request)
+    return (
+        smooth_form_refusal(problem, objective, "the catalogue search (its nodes are NLPs)") or True
+    )
 
 
 def solve_catalogue_formulation(problem: DesignProblem, request: SolveRequest) -> Result:

@@ -23,6 +23,7 @@ from optdesign.errors import ProblemError
 from optdesign.formulations.reference import attach_reference
 from optdesign.formulations.verify import nan_notes, verify_design
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 from optdesign.programs.nlp import NLP, VAR, build_nlp
 from optdesign.runtime.inherited_map import map_inherited
@@ -409,9 +410,19 @@ def continuous_only(problem: DesignProblem, advice: str) -> bool | str:
 
 
 def nlp_applies(problem: DesignProblem, request: SolveRequest | None = None) -> bool | str:
-    """The ``nlp`` formulation's predicate: True unless a variable takes catalogue
-    values (then the reason)."""
-    return continuous_only(problem, "use formulation='catalogue' or formulation='auto'")
+    """The ``nlp`` formulation's predicate: True unless the objective has no smooth form
+    or a variable takes catalogue values (then the reason)."""
+    refusal = smooth_form_refusal(problem, requested_objective(problem, request), "the NLP")
+    return refusal or continuous_only(problem, "use formulation='catalogue' or formulation='auto'")
+
+
+def requested_objective(problem: DesignProblem, request: SolveRequest | None) -> str:
+    """The objective a request minimises (the problem's first without a request; ``""``
+    for a problem that declares none, e.g. a stand-in of a test)."""
+    if request is not None and request.objective:
+        return request.objective
+    names = getattr(problem, "objective_names", None)
+    return names[0] if names else ""
 
 
 def solve_nlp_formulation(problem: DesignProblem, request: SolveRequest) -> Result:

@@ -39,7 +39,8 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.problem.design_problem import DesignProblem, Expressions
-from optdesign.problem.objectives import ObjectiveTerm, unavailable_objective
+from optdesign.problem.objective_refusals import smooth_form_refusal, unavailable_objective
+from optdesign.problem.objectives import ObjectiveTerm
 from optdesign.problem.spec import Tolerances
 from optdesign.programs.nlp import NLP, ConstraintRows, build_nlp, numeric_value, typical
 
@@ -204,6 +205,9 @@ def build_robust_nlp(
     if not 0.0 <= alpha < 1.0:
         raise ProblemError(f"tolerances.alpha: {alpha} must lie in [0, 1)")
     info = problem.objectives.get(objective)
+    refusal = smooth_form_refusal(problem, objective, "robust design (an NLP per sample)")
+    if refusal:
+        raise ProblemError(refusal)
     if info is not None and info.bound_rows is not None:
         raise ProblemError(
             f"robust design: objective {objective!r} is a root of the model, bounded by "

@@ -44,6 +44,7 @@ from optdesign.formulations.robust.program import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.evaluation import relative_violation, term_values
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.multistart import multistart
@@ -285,6 +286,8 @@ def robust_applies(problem: DesignProblem, request: SolveRequest | None = None) 
     names = problem.objective_names
     objective = request.objective if request is not None else None
     info = problem.objectives.get(objective or (names[0] if names else ""))
+    if info is not None and info.numeric_only:
+        return smooth_form_refusal(problem, info.name, "robust design (an NLP per sample)")
     if info is not None and info.bound_rows is not None:
         # each sample would need its own implicit epigraph and the sensitivities their
         # slopes in it: not built; the nominal NLP and the catalogue search pose it

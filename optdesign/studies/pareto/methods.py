@@ -336,6 +336,7 @@ class NSGA2(FrontMethod):
 
     designs: ClassVar[str] = "any"  # searched as indices of the catalogue items
     stored: ClassVar[bool] = False
+    smooth: ClassVar[bool] = False  # the NumPy path's values, computed when read
 
     def settings(self, starts: int, seed: int, objectives: Sequence[str]) -> dict[str, Any]:
         return {"pop_size": self.pop_size, "generations": self.generations, "seed": self.seed}

@@ -21,6 +21,7 @@ from typing import Any, ClassVar
 from optdesign.errors import InputError
 from optdesign.formulations.nlp.solve import planned_starts
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.runtime.runner import run_tasks
 from optdesign.studies.pareto.chains import check_anchor
 from optdesign.studies.pareto.front import Front, FrontPoint, anchors_of, make_front
@@ -101,6 +102,16 @@ class Traced:
     notes: list[str] = field(default_factory=list)
 
 
+def smooth_refusal(method: Any, problem: DesignProblem, objectives: Sequence[str]) -> str:
+    """Why front ``method`` (an object) cannot trace ``objectives``: one of them has no
+    smooth form and the method solves NLPs (``""``: it can; NSGA-II reads the NumPy
+    path's values)."""
+    if not getattr(method, "smooth", True):
+        return ""
+    who = f"the front method {getattr(method, 'name', type(method).__name__)!r} (it solves NLPs)"
+    return smooth_form_refusal(problem, objectives, who)
+
+
 class FrontMethod:
     """Base of the front methods (see the module docstring); subclasses are dataclasses
     with a ``name`` field (the method's and its store's name)."""
@@ -119,6 +130,9 @@ class FrontMethod:
     what: ClassVar[str] = "a front"
     #: Most starts of an anchor by default (None: the problem file's).
     max_default_starts: ClassVar[int | None] = None
+    #: Whether it solves NLPs, which need each objective's smooth form (False: it reads
+    #: the NumPy path's values only, as NSGA-II does).
+    smooth: ClassVar[bool] = True
 
     # --- what a method says --------------------------------------------------------------
     def check_settings(self) -> None:
@@ -142,6 +156,9 @@ class FrontMethod:
     def refuse(self, problem: DesignProblem, objectives: Sequence[str]) -> list[str]:
         """The checked objectives; refuse a problem or settings the method cannot take."""
         objectives = check_objectives(problem, objectives)
+        refusal = smooth_refusal(self, problem, objectives)
+        if refusal:
+            raise InputError("objectives", refusal)
         if len(objectives) not in self.n_objectives:
             counts = " or ".join(_COUNTS[n] for n in self.n_objectives)
             raise InputError("objectives", f"{self.what} takes {counts} objectives")
