@@ -202,8 +202,8 @@ def torque_floor(problem, row: ServoMotor, ratio_min: float | None = None) -> fl
     top speed over the fin's top rate: the least of the bound over 0 < f' <= the cap, at
     the worst angle. ``ratio_min`` (the least mean ratio a design may have): the ratio at
     the angle where it is largest is at least that mean, so the torque there is at least
-    the least of the bound over ``ratio_min <= f' <= the cap`` at the most favourable
-    angle; the floor is the larger of the two (infinite when the cap lies below
+    the least of the bound over ``ratio_min <= f' <= the cap`` with the least output
+    demand over the stroke; the floor is the larger of the two (infinite when the cap lies below
     ``ratio_min``). None when the motion gives no rate or the demand changes sign."""
     from optdesign.problem.motion import motion_demand
 
@@ -228,8 +228,13 @@ def torque_floor(problem, row: ServoMotor, ratio_min: float | None = None) -> fl
     if ratio_min is not None and ratio_min > 0:
         if ratio_min > cap:
             return math.inf
-        top = np.clip(best, ratio_min, cap)
-        floor = max(floor, float(np.min(J0 * top * a + M / top)))
+        # the angle of the largest ratio is unknown: the least output demand over the
+        # stroke (the spring's share 0 where the stroke passes through 0, whatever the
+        # grid), which only lowers the bound
+        spring = 0.0 if phi.min() <= 0.0 <= phi.max() else float(np.min(np.abs(k * phi)))
+        M_least = float(np.min(M - np.abs(k * phi))) + spring
+        top = min(max(math.sqrt(M_least / (J0 * a)), ratio_min), cap) if a > 0 else cap
+        floor = max(floor, J0 * top * a + M_least / top)
     return floor + spec.motor.friction_torque
 
 
