@@ -215,25 +215,33 @@ def _catalogue_problem(upper: int | None = None) -> od.DesignProblem:
     return od.load(data)
 
 
-def test_the_torque_floor_lies_below_every_sampled_designs_demand():
-    """Brute force: 1500 designs drawn over the bounds, each with every motor; where the
-    motor's speed stays within its top speed, the torque the motion asks (the model's own
-    motor_peak_torque) is never below the floor the exclusion proves."""
-    from optdesign.problem.motor_catalogue_variable import motors, torque_floor
+def _sampled(problem: od.DesignProblem, n: int, seed: int):
+    """Designs drawn over the bounds, each with every motor: (motor row, the model's own
+    motor_peak_torque, where the speed row holds, the mean ratio) for each motor."""
+    from optdesign.problem.motor_catalogue_variable import motors
 
-    problem = _catalogue_problem()
-    rng = np.random.default_rng(7)
-    names = [v.name for v in problem.free]
+    rng = np.random.default_rng(seed)
     lo, hi = problem.lower(), problem.upper()
-    X = lo + rng.random((1500, len(lo))) * (hi - lo)
-    k = names.index("motor")
-    checked = 0
+    X = lo + rng.random((n, len(lo))) * (hi - lo)
+    k = [v.name for v in problem.free].index("motor")
     for number, row in enumerate(motors("Yaskawa Sigma-7"), 1):
         X[:, k] = number
         ev = problem.evaluate(X)
         speed_ok = np.all(np.asarray(ev.constraints["motor_speed"].values) <= 1.0, axis=-1)
+        mean = np.asarray(ev.constraints["mean_ratio"].values, dtype=float).reshape(n)
         demand = np.asarray(ev.objectives["motor_peak_torque"], dtype=float)
-        ok = speed_ok & np.isfinite(demand)
+        yield row, demand, speed_ok & np.isfinite(demand), mean
+
+
+def test_the_torque_floor_lies_below_every_sampled_designs_demand():
+    """Brute force: 1500 designs drawn over the bounds, each with every motor; where the
+    motor's speed stays within its top speed, the torque the motion asks (the model's own
+    motor_peak_torque) is never below the floor the exclusion proves."""
+    from optdesign.problem.motor_catalogue_variable import torque_floor
+
+    problem = _catalogue_problem()
+    checked = 0
+    for row, demand, ok, _ in _sampled(problem, 1500, 7):
         floor = torque_floor(problem, row)
         assert np.all(demand[ok] >= floor * (1 - 1e-12)), row.designation
         checked += int(ok.sum())
@@ -267,22 +275,12 @@ def test_the_mean_ratio_floor_lies_below_every_sampled_designs_demand():
     motor, the torque the motion asks (the model's own motor_peak_torque) is never below
     the floor proved for designs whose mean ratio reaches their own mean ratio, where the
     motor's speed stays within its top speed."""
-    from optdesign.problem.motor_catalogue_variable import motors, torque_floor
+    from optdesign.problem.motor_catalogue_variable import torque_floor
 
     problem = _fast_step_problem("40 ms")
-    rng = np.random.default_rng(11)
-    names = [v.name for v in problem.free]
-    lo, hi = problem.lower(), problem.upper()
-    X = lo + rng.random((150, len(lo))) * (hi - lo)
-    k = names.index("motor")
     checked = 0
-    for number, row in enumerate(motors("Yaskawa Sigma-7"), 1):
-        X[:, k] = number
-        ev = problem.evaluate(X)
-        speed_ok = np.all(np.asarray(ev.constraints["motor_speed"].values) <= 1.0, axis=-1)
-        mean = np.asarray(ev.constraints["mean_ratio"].values, dtype=float).reshape(len(X))
-        demand = np.asarray(ev.objectives["motor_peak_torque"], dtype=float)
-        for j in np.flatnonzero(speed_ok & np.isfinite(demand) & (mean > 0)):
+    for row, demand, ok, mean in _sampled(problem, 150, 11):
+        for j in np.flatnonzero(ok & (mean > 0)):
             floor = torque_floor(problem, row, ratio_min=float(mean[j]))
             assert demand[j] >= floor * (1 - 1e-12), (row.designation, mean[j])
             checked += 1
