@@ -139,9 +139,10 @@ def limit_value(problem: DesignProblem, name: str) -> float:
     return dict(requirement_paths(problem))[rest]
 
 
-#: The copies of problems without their impossible catalogue items, by problem state: a
-#: front's points share one, so their searches share their proofs too.
-_NARROWED: OrderedDict[str, tuple[DesignProblem, list[str]]] = OrderedDict()
+#: The copies of problems without their impossible catalogue items, by problem state and
+#: the requirements a search drops: a front's points share one, so their searches share
+#: their proofs too.
+_NARROWED: OrderedDict[tuple[str, frozenset[str]], tuple[DesignProblem, list[str]]] = OrderedDict()
 
 
 def without_impossible_items(
