@@ -16,6 +16,8 @@ fails ``motor_catalogue_membership``).
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -183,16 +185,26 @@ def design_values(problem, design: dict[str, Any]) -> tuple[dict[str, Any], Any]
 #: tolerance.
 EXCLUSION_MARGIN = 1e-4
 
+#: The requirements (row names) :func:`impossible_motors` rests on: the torque the
+#: motion asks within the motor's peak torque, and the motor's speed within its top
+#: speed (the cap on the ratio). With either dropped (a diagnosis's search without it),
+#: the exclusion proves nothing; with ``mean_ratio`` dropped, it uses the motion alone.
+EXCLUSION_ROWS = frozenset({"motor_peak_torque", "motor_speed"})
 
-def torque_floor(problem, row: ServoMotor) -> float | None:
+
+def torque_floor(problem, row: ServoMotor, ratio_min: float | None = None) -> float | None:
     """A torque (N*mm) every design of ``problem`` whose motor speed stays within
-    ``row``'s top speed asks of motor ``row``: at some grid angle the motion's torque is at
-    least J0 f' a + M / f' + T_f (the rotor and gear inertia J0 of :func:`~optdesign.
+    ``row``'s top speed asks of motor ``row``: at every grid angle the motion's torque is
+    at least J0 f' a + M / f' + T_f (the rotor and gear inertia J0 of :func:`~optdesign.
     problem.motor_drive.motor_side_inertia`, without the screw's and the nut's; the
     output's demand M of :func:`~optdesign.problem.motor_drive.output_demand` with an
     efficiency of 1; the ratio's rate dropped), and the speed row caps the ratio f' at the
     top speed over the fin's top rate: the least of the bound over 0 < f' <= the cap, at
-    the worst angle. None when the motion gives no rate or the demand changes sign."""
+    the worst angle. ``ratio_min`` (the least mean ratio a design may have): the ratio at
+    the angle where it is largest is at least that mean, so the torque there is at least
+    the least of the bound over ``ratio_min <= f' <= the cap`` with the least output
+    demand over the stroke; the floor is the larger of the two (infinite when the cap lies below
+    ``ratio_min``). None when the motion gives no rate or the demand changes sign."""
     from optdesign.problem.motion import motion_demand
 
     spec = problem.spec
@@ -210,31 +222,64 @@ def torque_floor(problem, row: ServoMotor) -> float | None:
         return None
     J0 = row.rotor_inertia + spec.motor.gear_inertia
     cap = row.max_speed / w
+    # J0 a f' + M / f' is convex in f' > 0, least at sqrt(M / (J0 a)): clipped to the range
     best = np.minimum(np.sqrt(M / (J0 * a)), cap) if a > 0 else np.full_like(M, cap)
-    return float(np.max(J0 * best * a + M / best)) + spec.motor.friction_torque
+    floor = float(np.max(J0 * best * a + M / best))
+    if ratio_min is not None and ratio_min > 0:
+        if ratio_min > cap:
+            return math.inf
+        # the angle of the largest ratio is unknown: the least output demand over the
+        # stroke (the spring's share 0 where the stroke passes through 0, whatever the
+        # grid), which only lowers the bound
+        spring = 0.0 if phi.min() <= 0.0 <= phi.max() else float(np.min(np.abs(k * phi)))
+        M_least = float(np.min(M - np.abs(k * phi))) + spring
+        top = min(max(math.sqrt(M_least / (J0 * a)), ratio_min), cap) if a > 0 else cap
+        floor = max(floor, J0 * top * a + M_least / top)
+    return floor + spec.motor.friction_torque
 
 
-def impossible_motors(problem) -> dict[float, str]:
+def impossible_motors(problem, dropped: Iterable[str] = ()) -> dict[float, str]:
     """The catalogue motors no design of ``problem`` can use, by their number, with why:
-    those whose peak torque lies below :func:`torque_floor`. Empty when the motor is no
-    catalogue variable or the motion gives no rate."""
+    those whose peak torque lies below :func:`torque_floor` (with the least mean ratio
+    when ``mean_ratio`` has a minimum). Empty when the motor is no catalogue variable,
+    the motion gives no rate, or ``dropped`` (requirements a search leaves unbounded)
+    holds one of :data:`EXCLUSION_ROWS`; ``mean_ratio`` dropped: the floor without it."""
     from optdesign.problem.motion import motion_demand
 
+    dropped = set(dropped)
     catalogue = catalogue_of(problem)
     demand = motion_demand(problem.spec) if catalogue is not None else None
-    if demand is None:
+    if demand is None or EXCLUSION_ROWS & dropped:
         return {}
+    band = problem.spec.requirements.mean_ratio
+    ratio_min = None if band is None or "mean_ratio" in dropped else band.min
     lo, hi = problem.by_name["motor"].lower, problem.by_name["motor"].upper
     out = {}
     for number, row in enumerate(motors(catalogue), 1):
         if not lo <= number <= hi:
             continue
-        need = torque_floor(problem, row)
-        if need is not None and need > row.peak_torque * (1.0 + EXCLUSION_MARGIN):
-            cap = row.max_speed / demand.rate
+        need = torque_floor(problem, row, ratio_min)
+        if need is None or need <= row.peak_torque * (1.0 + EXCLUSION_MARGIN):
+            continue
+        cap = row.max_speed / demand.rate
+        alone = torque_floor(problem, row)
+        if alone is not None and alone > row.peak_torque * (1.0 + EXCLUSION_MARGIN):
+            # the motion alone proves it: the message names no mean ratio
             out[float(number)] = (
-                f"{row.designation}: the motion asks at least {need * 1e-3:.4g} N*m at any "
+                f"{row.designation}: the motion asks at least {alone * 1e-3:.4g} N*m at any "
                 f"design, above its peak torque {row.peak_torque * 1e-3:.4g} N*m (its top "
                 f"speed caps the ratio at {cap:.4g})"
+            )
+        elif math.isinf(need):
+            out[float(number)] = (
+                f"{row.designation}: its top speed caps the ratio at {cap:.4g}, below "
+                f"mean_ratio.min {ratio_min:.4g}"
+            )
+        else:
+            out[float(number)] = (
+                f"{row.designation}: the motion asks at least {need * 1e-3:.4g} N*m of any "
+                f"design whose mean ratio reaches mean_ratio.min {ratio_min:.4g} (the "
+                f"largest ratio at least that, at most its top speed's cap {cap:.4g}), "
+                f"above its peak torque {row.peak_torque * 1e-3:.4g} N*m"
             )
     return out

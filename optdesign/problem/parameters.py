@@ -14,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections import OrderedDict
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 from optdesign.errors import InputError
@@ -139,25 +139,33 @@ def limit_value(problem: DesignProblem, name: str) -> float:
     return dict(requirement_paths(problem))[rest]
 
 
-#: The copies of problems without their impossible catalogue items, by problem state: a
-#: front's points share one, so their searches share their proofs too.
-_NARROWED: OrderedDict[str, tuple[DesignProblem, list[str]]] = OrderedDict()
+#: The copies of problems without their impossible catalogue items, by problem state and
+#: the requirements a search drops: a front's points share one, so their searches share
+#: their proofs too.
+_NARROWED: OrderedDict[tuple[str, frozenset[str]], tuple[DesignProblem, list[str]]] = OrderedDict()
 
 
-def without_impossible_items(problem: DesignProblem) -> tuple[DesignProblem, list[str]]:
+def without_impossible_items(
+    problem: DesignProblem, dropped: Iterable[str] = ()
+) -> tuple[DesignProblem, list[str]]:
     """``problem`` without the catalogue items no design can use (proved from the bounds
     and closed forms before any NLP: the motors that cannot give the motion's torque,
     :func:`~optdesign.problem.motor_catalogue_variable.impossible_motors`), and why each
     went. The same problem and ``[]`` when none goes; a variable left with no item keeps
     none (``values == ()``): the caller reports the problem infeasible with the reasons.
+    ``dropped``: requirements (row names) the caller's search leaves unbounded (a
+    diagnosis's search without one); a proof that rests on one of them excludes nothing.
     """
-    from optdesign.problem.motor_catalogue_variable import impossible_motors
+    from optdesign.problem.motor_catalogue_variable import EXCLUSION_ROWS, impossible_motors
 
-    key = problem.token
+    dropped = frozenset(dropped)
+    if EXCLUSION_ROWS & dropped:
+        return problem, []
+    key = (problem.token, dropped)
     if key in _NARROWED:
         _NARROWED.move_to_end(key)
         return _NARROWED[key]
-    gone = impossible_motors(problem)
+    gone = impossible_motors(problem, dropped)
     if not gone:
         out: tuple[DesignProblem, list[str]] = (problem, [])
     else:

@@ -215,25 +215,33 @@ def _catalogue_problem(upper: int | None = None) -> od.DesignProblem:
     return od.load(data)
 
 
-def test_the_torque_floor_lies_below_every_sampled_designs_demand():
-    """Brute force: 1500 designs drawn over the bounds, each with every motor; where the
-    motor's speed stays within its top speed, the torque the motion asks (the model's own
-    motor_peak_torque) is never below the floor the exclusion proves."""
-    from optdesign.problem.motor_catalogue_variable import motors, torque_floor
+def _sampled(problem: od.DesignProblem, n: int, seed: int):
+    """Designs drawn over the bounds, each with every motor: (motor row, the model's own
+    motor_peak_torque, where the speed row holds, the mean ratio) for each motor."""
+    from optdesign.problem.motor_catalogue_variable import motors
 
-    problem = _catalogue_problem()
-    rng = np.random.default_rng(7)
-    names = [v.name for v in problem.free]
+    rng = np.random.default_rng(seed)
     lo, hi = problem.lower(), problem.upper()
-    X = lo + rng.random((1500, len(lo))) * (hi - lo)
-    k = names.index("motor")
-    checked = 0
+    X = lo + rng.random((n, len(lo))) * (hi - lo)
+    k = [v.name for v in problem.free].index("motor")
     for number, row in enumerate(motors("Yaskawa Sigma-7"), 1):
         X[:, k] = number
         ev = problem.evaluate(X)
         speed_ok = np.all(np.asarray(ev.constraints["motor_speed"].values) <= 1.0, axis=-1)
+        mean = np.asarray(ev.constraints["mean_ratio"].values, dtype=float).reshape(n)
         demand = np.asarray(ev.objectives["motor_peak_torque"], dtype=float)
-        ok = speed_ok & np.isfinite(demand)
+        yield row, demand, speed_ok & np.isfinite(demand), mean
+
+
+def test_the_torque_floor_lies_below_every_sampled_designs_demand():
+    """Brute force: 1500 designs drawn over the bounds, each with every motor; where the
+    motor's speed stays within its top speed, the torque the motion asks (the model's own
+    motor_peak_torque) is never below the floor the exclusion proves."""
+    from optdesign.problem.motor_catalogue_variable import torque_floor
+
+    problem = _catalogue_problem()
+    checked = 0
+    for row, demand, ok, _ in _sampled(problem, 1500, 7):
         floor = torque_floor(problem, row)
         assert np.all(demand[ok] >= floor * (1 - 1e-12)), row.designation
         checked += int(ok.sum())
@@ -254,3 +262,76 @@ def test_a_catalogue_of_impossible_motors_is_infeasible_without_a_solve():
     assert result.status == "infeasible" and not result.success
     assert "no catalogue item can meet the requirements" in result.message
     assert "SGM7J-A5A" in result.message and result.wall_time_s < 1.0
+
+
+def _fast_step_problem(rise_time: str) -> od.DesignProblem:
+    data = _data("Yaskawa Sigma-7")
+    data["motion"]["rise_time"] = rise_time
+    return od.load(data)
+
+
+def test_the_mean_ratio_floor_lies_below_every_sampled_designs_demand():
+    """Brute force at a 40 ms step: for designs drawn over the bounds, each with every
+    motor, the torque the motion asks (the model's own motor_peak_torque) is never below
+    the floor proved for designs whose mean ratio reaches their own mean ratio, where the
+    motor's speed stays within its top speed."""
+    from optdesign.problem.motor_catalogue_variable import torque_floor
+
+    problem = _fast_step_problem("40 ms")
+    checked = 0
+    for row, demand, ok, mean in _sampled(problem, 150, 11):
+        for j in np.flatnonzero(ok & (mean > 0)):
+            floor = torque_floor(problem, row, ratio_min=float(mean[j]))
+            assert demand[j] >= floor * (1 - 1e-12), (row.designation, mean[j])
+            checked += 1
+    assert checked > 150
+
+
+def test_the_least_mean_ratio_excludes_the_large_rotors_at_a_fast_step():
+    """At 40 ms the motion alone excludes motors 1-7; with the ratio at least the mean
+    ratio's minimum (200) at its largest, the large rotors of 11-14 cannot give the step
+    either. A search without the mean ratio excludes what the motion alone proves, one
+    without the peak torque or the speed row nothing."""
+    from optdesign.problem.motor_catalogue_variable import impossible_motors
+    from optdesign.problem.parameters import without_impossible_items
+
+    problem = _fast_step_problem("40 ms")
+    gone = impossible_motors(problem)
+    assert sorted(gone) == [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 11.0, 12.0, 13.0, 14.0]
+    assert "SGM7J-08A: the motion asks at least 12.62 N*m at any design" in gone[7.0]
+    assert "SGM7A-30A: the motion asks at least 41.77 N*m" in gone[11.0]
+    assert "mean_ratio.min 200" in gone[11.0] and "peak torque 29.4 N*m" in gone[11.0]
+    assert sorted(impossible_motors(problem, dropped=("mean_ratio",))) == [
+        1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0,
+    ]  # fmt: skip
+    for row in ("motor_peak_torque", "motor_speed"):
+        assert impossible_motors(problem, dropped=(row,)) == {}
+        assert without_impossible_items(problem, dropped=(row,)) == (problem, [])
+    narrowed, why = without_impossible_items(problem, dropped=("lock_force",))
+    assert narrowed.by_name["motor"].values == (8.0, 9.0, 10.0) and len(why) == 11
+
+
+@pytest.mark.parametrize(
+    ("rise_time", "chosen"), [("100 ms", 6.0), ("72 ms", 6.0), ("60 ms", 8.0), ("50 ms", 9.0)]
+)
+def test_the_motors_a_slower_step_chooses_are_never_excluded(rise_time, chosen):
+    """fin_actuator_motor with the catalogue motor solves to motors 6, 6, 8 and 9 at these
+    rise times (docs/motor.md): the closed forms never exclude them, nor any larger motor
+    whose rotor the step can still afford."""
+    from optdesign.problem.motor_catalogue_variable import impossible_motors
+
+    data = tomllib.loads((ROOT / "problems" / "fin_actuator_motor.toml").read_text())
+    data["motor"] = {k: v for k, v in data["motor"].items() if k != "designation"}
+    data["motor"]["catalogue"] = "Yaskawa Sigma-7"
+    data["motion"]["rise_time"] = rise_time
+    gone = impossible_motors(od.load(data))
+    assert chosen not in gone and max(gone) < chosen
+
+
+def test_a_step_no_catalogue_motor_can_give_with_the_mean_ratio_is_infeasible_without_a_solve():
+    """At 35 ms the motion alone leaves motors 9, 10 and 12-14; with the mean ratio none is
+    left: infeasible before any NLP, the reasons naming mean_ratio.min."""
+    result = od.solve(_fast_step_problem("35 ms"), ranges=False, sensitivities=False)
+    assert result.status == "infeasible" and not result.success
+    assert "no catalogue item can meet the requirements" in result.message
+    assert "mean_ratio.min 200" in result.message and result.wall_time_s < 1.0

@@ -18,6 +18,7 @@ from optdesign.formulations.catalogue.search import NodeSolver
 from optdesign.formulations.diagnosis import Relaxing, best_point
 from optdesign.formulations.nlp.relaxation import Site, relaxations
 from optdesign.problem.design_problem import DesignProblem
+from optdesign.problem.parameters import without_impossible_items
 from optdesign.solvers.constraint_rows import constraint_rows
 from optdesign.solvers.registry import solver_hints
 from optdesign.solvers.result import Diagnosis, Result
@@ -121,9 +122,17 @@ def catalogue_diagnosis(problem: DesignProblem, result: Result, how: Relaxing) -
         xr = np.array([relaxed.design[v.name] for v in problem.free])
         for other in item_combinations(problem, dvars, xr)[: MAX_ALTERNATIVES + 1]:
             yield site(other, xr)
-        # none of them: the catalogue search without the requirement (reached only then)
-        rows = tuple(k for k, g in enumerate(ns.nlp.g_names) if g.split("[", 1)[0] == name)
-        free = NodeSolver(problem, objective, 1, ns.seed, solver, options, free_rows=rows)
+        # none of them: the catalogue search without the requirement (reached only then),
+        # over the items the closed forms leave when their proof holds without it (the
+        # motors too small for the motion: a search that misses everything visits every
+        # box, theirs too), its starts capped as the combinations' are (a capped start
+        # leaves its node to the retries)
+        searched, _ = without_impossible_items(problem, dropped=(name,))
+        if any(not v.values for v in discrete_variables(searched)):
+            return  # no item the requirement's removal could use
+        free = NodeSolver(searched, objective, 1, ns.seed, solver, capped)
+        rows = [k for k, g in enumerate(free.nlp.g_names) if g.split("[", 1)[0] == name]
+        free.free_rows = np.asarray(rows, dtype=int)
         found = first_feasible(free)
         if found is not None and found.design:
             items = {v.name: nearest_item(found.design[v.name], v.values)[0] for v in dvars}
