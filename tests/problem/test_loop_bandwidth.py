@@ -152,7 +152,9 @@ def test_the_sensitivity_through_the_implicit_rows_equals_a_difference_of_optima
 @settings(
     max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
-@given(n=st.floats(0.0, 150.0), R=st.floats(90.0, 110.0))
+# offsets below 40 mm fold the linkage or destabilise the loop at some R: a strategy
+# that lands on working designs (the oldest hypothesis allowed refused a 15 % yield)
+@given(n=st.floats(40.0, 150.0), R=st.floats(90.0, 110.0))
 def test_a_period_bounds_the_objective_exactly_when_its_rows_hold(small, n, R):
     """At a design whose loop is stable, the rows hold at t 1e-5 above the exact period
     (the bandwidth is above 1 / t at every angle) and one fails 1e-5 below it."""
