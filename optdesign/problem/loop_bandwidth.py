@@ -32,13 +32,13 @@ from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
     bandwidth_ratio,
-    drive_plants_of,
     loop_angles,
     loop_gains,
     picked,
     plant_grid,
     population_size,
 )
+from optdesign.problem.loop_margins import on_grid, per_plant_rows
 
 #: |T|^2 over its static value at the bandwidth: half the power.
 HALF_POWER = 0.5
@@ -56,27 +56,18 @@ def _bandwidth(plant: DrivePlant, loop: PositionLoop) -> float:
     return ll.bandwidth(plant, loop)
 
 
+def _period(plant: DrivePlant, loop: PositionLoop) -> float:
+    """1 / f (s) of the loop at one plant."""
+    return 2.0 * math.pi / _bandwidth(plant, loop)
+
+
 def _exact_periods(q) -> np.ndarray | RowsOnDemand:
     """1 / f_k (s) at the loop's angles, 0 at the other grid angles (they bound nothing),
-    one row per design; NaN for a design whose drive is no plant. A population's rows are
+    one row per design; NaN at the loop's angles for a design whose drive is no plant. A population's rows are
     computed when read (a root finding per design and angle)."""
     idx = loop_angles(q.problem)
     width = len(np.ravel(q.phi))
-    drives: list = []
-
-    def rows_of(designs: np.ndarray) -> np.ndarray:
-        if not drives:
-            drives.extend(drive_plants_of(q, idx, strict=False))
-        out = np.zeros((len(designs), width))
-        for row, i in enumerate(designs):
-            if drives[i] is None:
-                out[row] = np.nan
-                continue
-            plants, loop = drives[i]
-            out[row, idx] = [2.0 * math.pi / _bandwidth(p, loop) for p in plants]
-        return out
-
-    rows = RowsOnDemand(rows_of, population_size(q), width)
+    rows = on_grid(lambda: per_plant_rows(q, idx, _period), population_size(q), idx, width)
     return np.asarray(rows) if rows.designs == 1 else rows
 
 

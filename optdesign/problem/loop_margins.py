@@ -7,6 +7,7 @@ objective ``limit_cycle_amplitude``), with the per-design rows of the NumPy path
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
 
@@ -93,6 +94,29 @@ def limit_cycle_amplitudes(q, idx: np.ndarray) -> np.ndarray | RowsOnDemand:
     (:func:`optdesign.models.loop_backlash.limit_cycles`; 0 where there is none), NumPy,
     one row per design of a population (NaN for a design whose drive is no plant)."""
     return per_plant_rows(q, idx, _largest_cycle)
+
+
+def on_grid(
+    make_rows: Callable[[], np.ndarray | RowsOnDemand], designs: int, idx: np.ndarray, width: int
+) -> RowsOnDemand:
+    """Rows at the loop's angles ``idx`` placed on the grid's ``width`` angles, 0 at the
+    others (they bound nothing), computed when read: ``make_rows()`` (one design's array,
+    or a population's :class:`RowsOnDemand`) is called on the first read only."""
+    held: list = []
+
+    def rows_of(chosen: np.ndarray) -> np.ndarray:
+        if not held:
+            held.append(make_rows())
+        rows = held[0]
+        if isinstance(rows, RowsOnDemand):
+            at = rows.rows_of(chosen)
+        else:
+            at = np.asarray(rows, dtype=float).reshape(1, -1)
+        out = np.zeros((len(chosen), width))
+        out[:, idx] = at
+        return out
+
+    return RowsOnDemand(rows_of, designs, width)
 
 
 def per_plant_rows(q, idx: np.ndarray, fn) -> np.ndarray | RowsOnDemand:

@@ -37,6 +37,7 @@ from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import loop_angles, loop_gains, picked, plant_grid, population_size
 from optdesign.problem.loop_margins import (
     limit_cycle_amplitudes,
+    on_grid,
     soft_least_return_difference,
 )
 
@@ -76,19 +77,5 @@ def limit_cycle_amplitude(q) -> RowsOnDemand | None:
     if q.problem.spec.loop is None or m.is_symbolic(q.ratio):
         return None
     idx = loop_angles(q.problem)
-    n = _grid_width(q)
-    held: list = []  # the requirement's rows, built on first read (a single design's are eager)
-
-    def rows_of(designs: np.ndarray) -> np.ndarray:
-        if not held:
-            held.append(limit_cycle_amplitudes(q, idx))
-        cycles = held[0]
-        if isinstance(cycles, RowsOnDemand):
-            at = cycles.rows_of(designs)
-        else:
-            at = np.asarray(cycles, dtype=float).reshape(1, -1)
-        out = np.zeros((len(designs), n))
-        out[:, idx] = at
-        return out
-
-    return RowsOnDemand(rows_of, population_size(q), n)
+    # the requirement's rows, built on first read (a single design's are eager)
+    return on_grid(lambda: limit_cycle_amplitudes(q, idx), population_size(q), idx, _grid_width(q))
