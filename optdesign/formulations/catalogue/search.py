@@ -101,6 +101,7 @@ def solve_catalogue(
     ties: bool = True,
     workers: int = 1,
     agree: int | None = None,
+    thinned_nodes: bool = True,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -138,6 +139,15 @@ def solve_catalogue(
     agree
         A node's multistart stops once this many starts agree on the best value (default:
         the problem file's ``[solver] agree``; 0: every start).
+    thinned_nodes
+        Solve a branch-and-bound node that holds several item combinations on the
+        problem's thinned grid (:meth:`NodeSolver.relaxed_backend`): a relaxation, cheaper
+        by about half, whose value still bounds the node's; each leaf on the whole grid.
+        Only with ``ties``: a search that prunes a node whose bound ties with the
+        incumbent (``ties`` False) prunes none on a thinned bound, which lies below the
+        tie wherever the objective peaks between the thinned angles (a front's first
+        stage of the motor-torque anchor: 16 -> 164 NLP solves on
+        cs_min_backlash_catalogue).
 
     Returns
     -------
@@ -177,7 +187,16 @@ def solve_catalogue(
     seed = seed if seed is not None else problem.spec.solver.seed
     agree = agree if agree is not None else problem.spec.solver.agree
     ns = NodeSolver(
-        problem, objective, n_starts, seed, solver, options, eps, workers=workers, agree=agree
+        problem,
+        objective,
+        n_starts,
+        seed,
+        solver,
+        options,
+        eps,
+        workers=workers,
+        agree=agree,
+        thinned=thinned_nodes and ties,
     )
     with ns.on_workers():
         ns.memo = memo
@@ -189,7 +208,7 @@ def solve_catalogue(
             if memo is not None
             else InfeasibleBoxes({v.name: (v.lower, v.upper) for v in dvars})
         )
-        root = ns.solve({})
+        root = ns.solve({}, relaxed=method not in ("enumerate", "minlp"))
         info = CatalogueDetails(
             method=method,
             combinations=n_comb,

@@ -419,7 +419,9 @@ class QuadNodes:
     def value(self, point: dict) -> float:
         return sum((point[n] - self.centre[n]) ** 2 for n in self.names)
 
-    def solve(self, bounds, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, bounds, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         self.calls.append((dict(bounds), warm, floor))
         self.hints.append(None if x_hint is None else np.asarray(x_hint).tolist())
         box = {v.name: bounds.get(v.name, (v.lower, v.upper)) for v in self.problem.free}
