@@ -91,7 +91,8 @@ from optdesign.solvers.result import Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: The key of a node result's ``details`` set when the node was solved on the thinned
-#: grid (a relaxation of the node: its value bounds the box's, its design may miss a row).
+#: grid (a relaxation of the node: its value bounds the box's, its design may miss a row):
+#: the thinned grid's number of angles.
 RELAXED = "relaxed_grid"
 
 Box = Mapping[str, tuple[float, float]]

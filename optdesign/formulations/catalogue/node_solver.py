@@ -111,6 +111,8 @@ class NodeSolver:
         self.seed = seed
         self.names = [v.name for v in problem.free]
         self.n_solves = 0
+        self.n_thinned = 0  # of those, on the thinned grid
+        self.relaxed_angles = 0  # the thinned grid's angles, once built
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
         self.n_implied = 0
@@ -153,6 +155,7 @@ class NodeSolver:
                 self._relaxed = False
             else:
                 self._relaxed = solver_for(stand_in, *self._relaxed_args)
+                self.relaxed_angles = len(stand_in.phi)
         return self._relaxed or None
 
     def _solve_start(self, item: tuple[Bounds, np.ndarray, bool]) -> Result:
@@ -292,6 +295,8 @@ class NodeSolver:
                 if self.proofs is not None and self.proofs is not self.memo:
                     self.proofs.add_infeasible(bounds, self.eps)
         self.n_solves += len(results)
+        if backend is not self.backend:
+            self.n_thinned += len(results)
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
         best.multistart = MultistartInfo(
@@ -307,7 +312,7 @@ class NodeSolver:
             stopped_early=settled,
         )
         if backend is not self.backend:
-            best.details[RELAXED] = len(backend.nlp.g_names)
+            best.details[RELAXED] = self.relaxed_angles
         if nodes is not None:
             # its value and result only when trusted (a full multistart, or at its floor)
             ok = best.success and trusted(best, self.starts)
