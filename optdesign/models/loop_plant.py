@@ -174,6 +174,24 @@ class DrivePlant:
         return self.motor_inertia * self.ratio**2
 
 
+def _check_controller(record, positive: tuple[str, ...], nonnegative: tuple[str, ...]) -> None:
+    """Store a controller record's gains as floats; refuse (naming ``loop.<field>``) one
+    that is not finite, not positive (``positive``) or negative (``nonnegative``), and an
+    unknown ``feedback``."""
+    for name in (*positive, *nonnegative):
+        object.__setattr__(record, name, _finite("loop", name, getattr(record, name)))
+    for name in positive:
+        if not getattr(record, name) > 0:
+            raise InputError(f"loop.{name}", f"must be positive, got {getattr(record, name)!r}")
+    for name in nonnegative:
+        if getattr(record, name) < 0:
+            raise InputError(f"loop.{name}", f"cannot be negative, got {getattr(record, name)!r}")
+    if record.feedback not in FEEDBACKS:
+        raise InputError(
+            "loop.feedback", f"expected one of {', '.join(FEEDBACKS)}, got {record.feedback!r}"
+        )
+
+
 @dataclass(frozen=True)
 class PositionLoop:
     """The position controller and the current loop (see the module's docstring).
@@ -199,17 +217,7 @@ class PositionLoop:
     feedback: Literal["fin", "motor"] = "fin"
 
     def __post_init__(self) -> None:
-        for name in ("kp", "kd", "ki", "current_lag"):
-            object.__setattr__(self, name, _finite("loop", name, getattr(self, name)))
-        if not self.kp > 0:
-            raise InputError("loop.kp", f"must be positive, got {self.kp!r}")
-        for name in ("kd", "ki", "current_lag"):
-            if getattr(self, name) < 0:
-                raise InputError(f"loop.{name}", f"cannot be negative, got {getattr(self, name)!r}")
-        if self.feedback not in FEEDBACKS:
-            raise InputError(
-                "loop.feedback", f"expected one of {', '.join(FEEDBACKS)}, got {self.feedback!r}"
-            )
+        _check_controller(self, ("kp",), ("kd", "ki", "current_lag"))
 
     @property
     def speed_ki(self) -> float:
@@ -248,18 +256,9 @@ class CascadeLoop:
     feedback: Literal["fin", "motor"] = "fin"
 
     def __post_init__(self) -> None:
-        for name in ("position_gain", "speed_gain", "speed_integral_time", "current_lag"):
-            object.__setattr__(self, name, _finite("loop", name, getattr(self, name)))
-        for name in ("position_gain", "speed_gain"):
-            if not getattr(self, name) > 0:
-                raise InputError(f"loop.{name}", f"must be positive, got {getattr(self, name)!r}")
-        for name in ("speed_integral_time", "current_lag"):
-            if getattr(self, name) < 0:
-                raise InputError(f"loop.{name}", f"cannot be negative, got {getattr(self, name)!r}")
-        if self.feedback not in FEEDBACKS:
-            raise InputError(
-                "loop.feedback", f"expected one of {', '.join(FEEDBACKS)}, got {self.feedback!r}"
-            )
+        _check_controller(
+            self, ("position_gain", "speed_gain"), ("speed_integral_time", "current_lag")
+        )
 
     # the rational form C_e = kp + ki / s on the error, C_v = kd + speed_ki / s on psi'
     @property
