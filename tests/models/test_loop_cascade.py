@@ -18,6 +18,8 @@ import casadi as ca
 import loop_drives
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from optdesign.errors import InputError
 from optdesign.models import loop_backlash as lb
@@ -119,6 +121,30 @@ def test_cascade_response_on_casadi_symbols_equals_the_numbers():
     got = [float(v) for v in fn(TWO_MASS.motor_inertia)]
     L, T = ll.frequency_response(TWO_MASS, c, np.array([300.0]))
     assert got == pytest.approx([L[0].real, L[0].imag, T[0].real, T[0].imag], rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    kpos=st.floats(2.0, 200.0),
+    kv=st.floats(5.0, 500.0),
+    ti=st.sampled_from([0.0, 0.005, 0.05, 0.5]),
+    lag=st.sampled_from([0.0, 1e-4, 1e-3]),
+    feedback=st.sampled_from(["fin", "motor"]),
+)
+def test_the_dead_zones_loop_closed_at_unit_gain_is_the_cascades_linear_loop(
+    kpos, kv, ti, lag, feedback
+):
+    # 1 + L_d = 0 with the gap closed (N = 1) is the characteristic equation of the
+    # linear loop: the same roots, from two ways of writing the controller's two angles
+    loop = CascadeLoop(kpos, kv, ti, lag, feedback)
+    num, den = lb.deflection_loop(TWO_MASS, loop)
+    lur_e = np.polyadd(num, den)
+    char = ll.loop_polynomials(TWO_MASS, loop).closed_denominator
+    assert len(lur_e) == len(char)
+    ours = list(ll.scaled_roots(lur_e))
+    for root in ll.scaled_roots(char):  # each root matched to its nearest, then removed
+        k = int(np.argmin([abs(o - root) for o in ours]))
+        assert abs(ours.pop(k) - root) < 1e-6 * abs(root)
 
 
 # --- (b) a P speed loop is the PD loop on the motor -------------------------------------------

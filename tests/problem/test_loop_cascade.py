@@ -241,3 +241,18 @@ def test_a_wrong_cascade_field_is_refused_naming_it_on_the_command_line(
 ):
     message = command_line_refusal(_refused_data(value), tmp_path, json_mode)
     assert "loop" in message and reason in message
+
+
+def test_an_unstable_cascade_is_refused_showing_its_own_gains():
+    data = _with_loop(
+        structure="cascade",
+        position_gain="5000 1/s",
+        speed_gain="0.01 N*m*s/rad",
+        speed_integral_time="1 ms",
+    )
+    with pytest.raises(od.OptDesignError) as err:
+        od.load(data)
+    message = str(err.value)
+    assert "is unstable at every one of its 7 angles" in message
+    assert "cascade: position_gain = 5000 1/s, speed_gain = 0.01 N*m*s/rad" in message
+    assert "speed_integral_time = 1 ms; kp = Kv Kpos = 50 N*m/rad" in message
