@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
@@ -286,6 +286,28 @@ class NLP:
             h.update(np.ascontiguousarray(arr, dtype=float).tobytes())
         h.update("\0".join([*self.g_names, *self.targets, *self.aux_names]).encode())
         return h.hexdigest()[:16]
+
+
+def with_rows(nlp: NLP, keep: Sequence[int]) -> NLP:
+    """The NLP with only the constraint rows ``keep`` (indices, in order): the same
+    variables, objective and parameters with fewer rows, hence a relaxation (its optimum
+    is never above the NLP's). Every objective's epsilon row must be kept."""
+    rows = sorted({int(k) for k in keep})
+    at = {row: k for k, row in enumerate(rows)}
+    missing = [name for name, row in nlp.eps_rows.items() if row not in at]
+    if missing:
+        raise ValueError(f"with_rows: the epsilon rows of {', '.join(missing)} must be kept")
+    idx = np.asarray(rows, dtype=int)
+    return replace(
+        nlp,
+        g=ca.vertcat(*[nlp.g[k] for k in rows]) if rows else ca.SX(0, 1),
+        lbg=nlp.lbg[idx],
+        ubg=nlp.ubg[idx],
+        g_names=[nlp.g_names[k] for k in rows],
+        g_units=[nlp.g_units[k] for k in rows],
+        g_scale=nlp.g_scale[idx],
+        eps_rows={name: at[row] for name, row in nlp.eps_rows.items()},
+    )
 
 
 def _columns(expr, symbols) -> list[int]:

@@ -70,7 +70,7 @@ class CatalogueDetails:
         it failed), status and design - a lower bound of the catalogue optimum.
     relaxation_angles
         The grid angles the relaxation was solved on: fewer than the problem's when the
-        branch and bound solved it on the thinned grid (a relaxation of the relaxation,
+        branch and bound solved it on every other angle (a relaxation of the relaxation,
         so still a lower bound, a little weaker); None: the problem's own grid.
     starts_per_node
         Multistart of each node's NLP.
@@ -90,7 +90,8 @@ class CatalogueDetails:
     nlp_solves
         NLP solves spent.
     thinned_solves
-        Of those, the solves on the thinned grid (nodes of several item combinations).
+        Of those, the solves on every other grid angle (nodes of several item
+        combinations).
     items
         The items chosen (None: no feasible combination).
     gap_to_relaxation_rel

@@ -16,15 +16,10 @@ from optdesign.formulations.catalogue.bnb import RELAXED, trusted
 from optdesign.formulations.catalogue.discrete import (
     discrete_variables,
 )
-from optdesign.formulations.nlp.solve import (
-    _objective_set,
-    search_stand_in,
-    solver_for,
-    solver_options,
-)
+from optdesign.formulations.nlp.solve import _objective_set, solver_for, solver_options
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
-from optdesign.programs.nlp import Bounds
+from optdesign.programs.nlp import NLP, Bounds, with_rows
 from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
 from optdesign.solvers.multistart import (
     best_of,
@@ -33,7 +28,7 @@ from optdesign.solvers.multistart import (
     sobol_starts,
     start_outcome,
 )
-from optdesign.solvers.registry import default_solver, solver_hints
+from optdesign.solvers.registry import default_solver, make_solver, solver_hints
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
@@ -143,19 +138,25 @@ class NodeSolver:
                 self._workers = None
 
     def relaxed_backend(self):
-        """The solver of the problem on its search's thinned grid
-        (:func:`~optdesign.formulations.nlp.solve.search_stand_in`), for a node that holds
-        more than one item combination: its rows are a subset of the problem's, so its
-        optimum is a relaxation of the node's, never above it - a valid bound for the
-        search, at about half the cost of a start. None when the grid is not thinned, or
-        when rows are left free by index (the diagnosis), which index the problem's rows."""
+        """The solver of the node NLP with the rows of every other grid angle only
+        (:func:`thinned_angles`: 31 of 61), for a node that holds more than one item
+        combination. Only rows are
+        left out - the objective, the variables and every row not tied to one angle
+        (a mean ratio, the nut travel, the life, the epsilon rows) are the node's own -
+        so its optimum is a relaxation of the node's, never above it: a valid bound for
+        the search, at a lower cost per start (Ipopt's time per iteration follows the
+        rows). (The stand-in problem of the NLP's global search, a problem on fewer
+        angles, is not one: its grid's mean ratio is another number.) None when
+        the grid is not thinned, or when rows are left free by index (the diagnosis)."""
         if self._relaxed is None:
-            stand_in = search_stand_in(self.problem)
-            if stand_in is self.problem or self.free_rows.size:
+            keep = thinned_rows(self.problem, self.nlp)
+            if keep is None or self.free_rows.size:
                 self._relaxed = False
             else:
-                self._relaxed = solver_for(stand_in, *self._relaxed_args)
-                self.relaxed_angles = len(stand_in.phi)
+                solver, options, _ = self._relaxed_args
+                opts = {**solver_options(self.problem, solver), **(options or {})}
+                self._relaxed = make_solver(with_rows(self.nlp, keep), solver, opts)
+                self.relaxed_angles = len(thinned_angles(len(self.problem.phi)))
         return self._relaxed or None
 
     def _solve_start(self, item: tuple[Bounds, np.ndarray, bool]) -> Result:
@@ -342,6 +343,49 @@ class NodeSolver:
         if not result.design:
             return None
         return np.array([result.design[n] for n in self.names])
+
+
+#: A node of several item combinations keeps every this-many-th grid angle's rows ...
+NODE_ANGLE_STEP = 2
+
+#: ... when the grid has at least this many angles (fewer: the node's own rows).
+NODE_THIN_FROM = 21
+
+
+def thinned_angles(points: int) -> list[int]:
+    """The grid angles (indices) whose rows a node of several item combinations keeps
+    (its thinned grid): every :data:`NODE_ANGLE_STEP`-th and both ends; every angle below
+    :data:`NODE_THIN_FROM`. Every other angle: with a sparser subset (13 of 61) the
+    nodes of the motor's problems met rows between the kept angles that their leaves
+    then missed, and the search solved more nodes than it saved (benchmarks/README.md,
+    "Catalogue nodes on every other grid angle")."""
+    if points < NODE_THIN_FROM:
+        return list(range(points))
+    return sorted({*range(0, points, NODE_ANGLE_STEP), points - 1})
+
+
+def thinned_rows(problem: DesignProblem, nlp: NLP) -> list[int] | None:
+    """The rows of ``nlp`` a node of several item combinations keeps: every row not
+    labelled with a grid angle, and those of :func:`thinned_angles` (the NLP's rows are
+    named ``NAME[phi=+12.0deg]``); None when every angle is kept."""
+    angles = thinned_angles(len(problem.phi))
+    if len(angles) == len(problem.phi):
+        return None
+    labels = set(problem.phi_labels)
+    kept = {problem.phi_labels[k] for k in angles}
+    return [
+        k
+        for k, name in enumerate(nlp.g_names)
+        if not (lab := _angle_label(name)) or lab not in labels or lab in kept
+    ]
+
+
+def _angle_label(name: str) -> str:
+    """The grid angle's label in a row's name (``phi=+12.0deg``, also of a row's piece
+    ``phi=+12.0deg (2)``), or ""."""
+    inside = name[name.find("[") + 1 : name.rfind("]")] if "[" in name else ""
+    words = inside.replace(",", " ").split()
+    return next((word for word in words if word.startswith("phi=")), "")
 
 
 def no_item(solver: str, message: str) -> Result:

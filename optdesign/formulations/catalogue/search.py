@@ -140,14 +140,13 @@ def solve_catalogue(
         A node's multistart stops once this many starts agree on the best value (default:
         the problem file's ``[solver] agree``; 0: every start).
     thinned_nodes
-        Solve a branch-and-bound node that holds several item combinations on the
-        problem's thinned grid (:meth:`NodeSolver.relaxed_backend`): a relaxation, cheaper
-        by about half, whose value still bounds the node's; each leaf on the whole grid.
-        Only with ``ties``: a search that prunes a node whose bound ties with the
-        incumbent (``ties`` False) prunes none on a thinned bound, which lies below the
-        tie wherever the objective peaks between the thinned angles (a front's first
-        stage of the motor-torque anchor: 16 -> 164 NLP solves on
-        cs_min_backlash_catalogue).
+        Solve a branch-and-bound node that holds several item combinations with the rows
+        of every other grid angle only (:meth:`NodeSolver.relaxed_backend`): a relaxation
+        of the node, cheaper per start, whose value still bounds the node's; each leaf on
+        the whole grid. Only with ``ties``: a search that prunes a node whose bound ties
+        with the incumbent (``ties`` False, an anchor's first stage) prunes none on a
+        thinned bound, which lies below the tie wherever the objective peaks between the
+        kept angles.
 
     Returns
     -------
@@ -283,7 +282,7 @@ def solve_catalogue(
         how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
         best.notes.append(
             f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
-            + (f" ({info.thinned_solves} on the thinned grid)" if info.thinned_solves else "")
+            + (f" ({info.thinned_solves} on every other grid angle)" if info.thinned_solves else "")
         )
         if excluded:
             best.notes.append("excluded before the search: " + "; ".join(excluded))

@@ -139,13 +139,14 @@ def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
     bnb = solve_catalogue(problem, method="bnb", starts=3)
     enum = solve_catalogue(problem, method="enumerate", starts=2)
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-6)
-    # the enumeration's relaxation is on the whole grid; the branch and bound's on the
-    # thinned grid (13 of 61 angles), a relaxation of it: lower, and still a bound
+    # the enumeration's relaxation is on the whole grid; the branch and bound's on every
+    # other angle (31 of 61), a relaxation of it: no higher, and still a bound
     assert relaxation_bound(enum) == pytest.approx(RELAXED, rel=1e-5)
     assert enum.details.catalogue.relaxation_angles is None
-    assert bnb.details.catalogue.relaxation_angles == 13
-    assert relaxation_bound(bnb) == pytest.approx(0.0339507, rel=1e-5)
-    assert relaxation_bound(bnb) < relaxation_bound(enum) < bnb.objective
+    assert bnb.details.catalogue.relaxation_angles == 31
+    assert relaxation_bound(bnb) == pytest.approx(RELAXED, rel=1e-5)
+    assert relaxation_bound(bnb) <= relaxation_bound(enum) * (1 + 1e-9)
+    assert relaxation_bound(enum) < bnb.objective
     assert bnb.details.catalogue.items == {"p": 6, "d": 6}
 
 
@@ -1618,15 +1619,15 @@ def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x
     monkeypatch.setattr(catalogue.NodeSolver, "solve", counted)
     bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
     info = bnb.details.catalogue
-    # the relaxation, 8 boxes of 20 item pairs, and the box whose warm bound (one start)
+    # the relaxation, 7 boxes of 20 item pairs, and the box whose warm bound (one start)
     # would prune it, solved again with the full multistart before it is pruned; every
-    # box of several pairs on the thinned grid, the one leaf on the whole grid
-    assert info.nodes == len(solves) == 10
+    # box of several pairs on every other grid angle, the one leaf on the whole grid
+    assert info.nodes == len(solves) == 9
     assert info.infeasible == solves.count(False) == 2
-    # the one leaf (p = 6, d = 6) prunes the two boxes left open when it was found
-    assert (info.leaves, info.pruned) == (1, 2)
+    # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
+    assert (info.leaves, info.pruned) == (1, 1)
     assert 0 < info.thinned_solves < info.nlp_solves
-    assert info.relaxation_angles == 13 < len(problem.phi)
+    assert info.relaxation_angles == 31 < len(problem.phi) == 61
     assert len(enum.details.catalogue.enumerated) == 20
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
     assert bnb.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
