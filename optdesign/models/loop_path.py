@@ -51,8 +51,6 @@ from optdesign.models.loop_plant import BACKLASH, DrivePlant
 from optdesign.models.loop_references import (
     MAX_HORIZON,
     SampledReference,
-    SineReference,
-    StepReference,
 )
 from optdesign.models.loop_simulation import SPEED_BAND, _System
 
@@ -355,16 +353,7 @@ def refuse_outside(path, reference, psi0: float, phi0: float) -> None:
     """Refuse a start or a reference outside the path's grid (interpolated, not
     extrapolated), naming it."""
     lo, hi = path.range
-    if isinstance(reference, StepReference):
-        before = reference.amplitude if reference.time == 0 else 0.0
-        span = (min(reference.amplitude, before), max(reference.amplitude, before))
-    elif isinstance(reference, SineReference):
-        span = (
-            reference.offset - abs(reference.amplitude),
-            reference.offset + abs(reference.amplitude),
-        )
-    else:
-        span = (float(np.min(reference._a)), float(np.max(reference._a)))
+    span = reference.span
     for name, (a, b) in (
         ("initial_motor_angle", (psi0, psi0)),
         ("initial_fin_angle", (phi0, phi0)),
@@ -516,26 +505,11 @@ class PathSystem(_System):
             mode = (0, 0, mode[2])
         return mode, x
 
-    def initial_mode(self, t, x):
-        b = self.path.at(x[0])[5]
-        d = x[0] - x[1]
-        cm = (1, 0) if self.bilateral else (0, 0)
-        for f in (1, -1):
-            if not self.bilateral and f * d >= b:
-                cm = (f, 0) if f * self.raw_chain(x, f) > 0 else (0, f)
-                break
-        v = x[2]
-        if v != 0 or self.path.friction_torque == 0:
-            return (*cm, 1 if v >= 0 else -1), x
-        return self.stick_check(t, x, (*cm, 0))
+    def gap_at(self, x) -> float:
+        return self.path.at(x[0])[5]
 
-    def stick_check(self, t, x, mode):
-        F = self.drive_force(t, x, mode)
-        if abs(F) <= self.path.at(x[0])[0] * self.path.friction_torque:
-            x = x.copy()
-            x[2] = 0.0
-            return (mode[0], mode[1], 0), x
-        return (mode[0], mode[1], 1 if F > 0 else -1), x
+    def ratio_at(self, x) -> float:
+        return self.path.at(x[0])[0]
 
     def band_events(self):
         out = []

@@ -32,9 +32,8 @@ with, piece by piece:
   recorded as events ("speed limit", "speed released") without stopping the
   integration (docs/loop.md: why not a held speed).
 
-A :class:`~optdesign.models.loop_path.DrivePath` in place of the fixed plant gives the
-same equations with the ratio, the chain's stiffness, damping and gap following the
-angle, and an external moment on the fin (:mod:`optdesign.models.loop_path`).
+A :class:`~optdesign.models.loop_path.DrivePath` for the plant: the same equations with
+the ratio, stiffness, damping and gap following the angle, and a load on the fin.
 
 Units: mm, t, s, N, rad. Angles in rad at the fin (the motor's as psi = theta / f'),
 torques in N*mm (the motor's at its shaft, the chain's at the fin), times in s.
@@ -131,8 +130,7 @@ class LoopSimulation:
         When the contact closed, opened or unloaded, the motor stuck or slipped, or the
         speed limit began or ended (s; a word each).
     plant, loop, input_reference
-        What was simulated (the plant a :class:`~optdesign.models.loop_plant.DrivePlant`
-        or a :class:`~optdesign.models.loop_path.DrivePath`).
+        What was simulated (the plant a ``DrivePlant`` or a ``DrivePath``).
     """
 
     times: np.ndarray
@@ -159,8 +157,7 @@ class LoopSimulation:
 
 
 class _System:
-    #: Times where the plant's own inputs jump (an external load): none for a fixed plant.
-    breaks: tuple[float, ...] = ()
+    breaks: tuple[float, ...] = ()  # times where a load on the fin jumps: none here
 
     def __init__(self, plant: DrivePlant, loop: PositionLoop, reference):
         self.p, self.c, self.reference = plant, loop, reference
@@ -318,9 +315,15 @@ class _System:
         return out
 
     # -- the mode after an event, or at the start ----------------------------------------
+    def gap_at(self, x) -> float:  # b and f' where the drive is (a path's vary)
+        return self.p.backlash
+
+    def ratio_at(self, x) -> float:
+        return self.p.ratio
+
     def initial_mode(self, t, x) -> tuple[tuple[int, int, int], np.ndarray]:
         """The mode of a state at rest or in motion (the start of the run)."""
-        b = self.p.backlash
+        b = self.gap_at(x)
         d = x[0] - x[1]
         cm = (1, 0) if self.bilateral else (0, 0)
         for f in (1, -1):
@@ -335,7 +338,7 @@ class _System:
     def stick_check(self, t, x, mode):
         """At theta' = 0: stuck while |f' T - tau| <= f' T_f, else turning with it."""
         F = self.drive_force(t, x, mode)
-        if abs(F) <= self.p.ratio * self.p.friction_torque:
+        if abs(F) <= self.ratio_at(x) * self.p.friction_torque:
             x = x.copy()
             x[2] = 0.0
             return (mode[0], mode[1], 0), x
@@ -401,9 +404,8 @@ def simulate(
     Parameters
     ----------
     plant, loop
-        The drive at one fin angle (:class:`~optdesign.models.loop_plant.DrivePlant`) or
-        along the stroke (:class:`~optdesign.models.loop_path.DrivePath`: its angles are
-        the fin's own, the reference within its grid), and the controller.
+        The drive at one fin angle, or along the stroke (a ``DrivePath``: its angles the
+        fin's own, the reference within its grid), and the controller.
     reference
         :class:`StepReference`, :class:`SineReference` or :class:`SampledReference`.
     horizon
@@ -419,9 +421,8 @@ def simulate(
         The most events (contact changes, sticks, speed limits) allowed, 1 to 200000; a
         run that needs more (a chattering contact) is refused.
     load
-        A :class:`~optdesign.models.loop_path.LoadHistory`, the external moment on the
-        fin, with a ``DrivePath`` only (the fixed plant is linearised about its angle,
-        without a mean load); None: no load.
+        A ``LoadHistory``, a moment on the fin: with a ``DrivePath`` only (the fixed
+        plant is linearised about its angle without a mean load); None: none.
 
     Returns
     -------
@@ -467,7 +468,7 @@ def simulate(
         sys = plant.equations(loop, reference, psi0, phi0, load)
         gap, stiffness = plant.backlash_scale, plant.stiffness_scale
     # absolute tolerances from the plant's scales: an angle of the gap or the reference
-    angle = max(gap, _reference_scale(reference), abs(psi0), abs(phi0), 1e-6)
+    angle = max(gap, *map(abs, reference.span), abs(psi0), abs(phi0), 1e-6)
     rate = angle * math.sqrt(stiffness / plant.fin_inertia)
     torque = max(loop.kp * angle, 1e-9)
     atol = rtol * np.array([angle, angle, rate, rate, torque, angle * horizon]) * 1e-2
@@ -546,14 +547,6 @@ def simulate(
                 event_times.append(t)
                 event_kinds.append("slips")
     return _record(sys, pieces, event_times, event_kinds, reference)
-
-
-def _reference_scale(reference) -> float:
-    if isinstance(reference, StepReference):
-        return abs(reference.amplitude)
-    if isinstance(reference, SineReference):
-        return abs(reference.amplitude) + abs(reference.offset)
-    return float(np.max(np.abs(reference._a)))
 
 
 def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSimulation:

@@ -29,7 +29,7 @@ def plot_loop_response(sim):
     else:
         title = f"response in the loop at {math.degrees(sim.angle):+.1f} deg of the stroke"
     top.set_title(title)
-    top.legend(loc="lower right")
+    top.legend(loc="best" if sim.duty is not None else "lower right")
     # the motor's torque is the chain's over the ratio (hundreds): an axis of its own
     bottom.plot(t, np.asarray(r.chain_torque) * 1e-3, "C1", lw=0.8)
     bottom.set_ylabel("chain torque at the fin [N*m]", color="C1")
