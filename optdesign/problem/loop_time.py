@@ -103,6 +103,8 @@ def simulate_design(
         raise ProblemError("simulate: needs a [loop] section (the controller)")
     args = simulation_arguments(reference, amplitude, horizon, frequency, plant, periods, period)
     if args.duty:
+        if angle is not None:
+            raise InputError("angle", "a duty run follows its steps' deflections: give none")
         duty = duty_simulation_history(problem, args)
         at = design_plant(problem, design, duty.reference.angles[0])
         path = design_path(problem, design)

@@ -112,6 +112,7 @@ def test_the_command_line_simulates_the_duty_cycle_into_a_csv_with_the_hinge_mom
         ({"period": "5 s", "plant": "angle"}, "plant", "sweeps the stroke"),
         ({"period": "5 s", "horizon": "1 s"}, "horizon", "periods"),
         ({"period": "-5 s"}, "period", "must be in (0, 600] s"),
+        ({"period": "5 s", "angle": "10 deg"}, "angle", "steps' deflections"),
     ],
 )
 def test_bad_duty_arguments_are_refused_naming_them(result, kwargs, field, reason):
