@@ -33,9 +33,11 @@ Units: mm, t, s, N, rad (those of :mod:`optdesign.models.loop_plant`).
 
 Validity
 --------
-angles : within the grid (call)
-    The plant is interpolated, not extrapolated: a reference outside the grid is refused;
-    a motion that overshoots the grid's end holds the end's values (f'' = k' = b' = 0).
+grid angles : 2 or more, strictly increasing (call)
+    A spline and its derivative need two angles at least. Between the first and the last
+    the plant is interpolated, not extrapolated: a reference or a start outside them is
+    refused; a motion that overshoots the grid's end holds the end's values (f'' = k' =
+    b' = 0).
 """
 
 from __future__ import annotations
@@ -54,6 +56,22 @@ from optdesign.models.loop_references import (
     SampledReference,
 )
 from optdesign.models.loop_simulation import SPEED_BAND, _System
+from optdesign.models.validity import Validity
+
+GRID_ANGLES = Validity(
+    "loop_path.grid_angles",
+    "drive plant along the stroke",
+    "grid angles",
+    2.0,
+    None,
+    "",
+    "a spline and its derivative need two angles; between the first and the last the "
+    "plant is interpolated, outside them a reference or a start is refused",
+    checked=("call",),
+)
+
+#: The ranges of validity of this model.
+VALIDITY: tuple[Validity, ...] = (GRID_ANGLES,)
 
 #: The plant's quantities that may vary along the stroke (interpolated) ...
 VARYING = ("ratio", "stiffness", "damping", "backlash")
@@ -122,7 +140,7 @@ class DrivePath:
         from scipy.interpolate import CubicSpline, PchipInterpolator
 
         phi = _array("path.angles", self.angles)
-        if phi.size < 2 or np.any(np.diff(phi) <= 0):
+        if not GRID_ANGLES.contains(phi.size) or np.any(np.diff(phi) <= 0):
             raise InputError("path.angles", "needs at least 2 strictly increasing angles")
         arrays = {name: _array(f"path.{name}", getattr(self, name), phi.size) for name in VARYING}
         for name in ("ratio", "stiffness"):
