@@ -9,6 +9,7 @@ shared: CPU time, not wall time); the medians, their ratios to the fixed step's,
 each run's events and right-hand-side calls (machine-independent) are printed.
 
 Usage: PYTHONPATH=. python benchmarks/loop/duty_cost.py [--repeats 7] [--period "5 s"]
+[--periods N] (N > 1: a run of N periods is timed too)
 """
 
 from __future__ import annotations
@@ -59,6 +60,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--period", default="5 s")
+    parser.add_argument("--periods", type=int, default=1, help="a run of this many periods too")
     args = parser.parse_args()
     result = od.solve(PROBLEM, ranges=False, sensitivities=False, diagnose=False)
     cases = {
@@ -66,6 +68,10 @@ def main() -> None:
         "2 s step, path plant": lambda: od.simulate(result, horizon="2 s", plant="path"),
         f"one duty period ({args.period})": lambda: od.simulate(result, "duty", period=args.period),
     }
+    if args.periods > 1:
+        cases[f"{args.periods} duty periods"] = lambda: od.simulate(
+            result, "duty", period=args.period, periods=args.periods
+        )
     times = {name: [] for name in cases}
     for _ in range(args.repeats):
         for name, run in cases.items():
