@@ -91,6 +91,8 @@ INTERNAL_UNITS: dict[str, str] = {
     "angular_acceleration": "rad/s**2",
     # the position loop's integral gain: motor torque per fin angle per second
     "integral_gain": "N*mm/rad/s",
+    # the cascade's position gain: the speed asked per angle of error, (rad/s)/rad
+    "rate": "1/s",
 }
 
 #: The unit suggested to a user for each dimension (error messages, ``bare="refuse"``).
@@ -112,6 +114,7 @@ SUGGESTED_UNITS: dict[str, str] = {
     "frequency": "Hz",
     "angular_acceleration": "deg/s^2",
     "integral_gain": "N*m/(rad*s)",
+    "rate": "1/s",
 }
 
 #: How a dimension is named in messages ("expected a moment").
@@ -133,6 +136,7 @@ _DIMENSION_NAMES: dict[str, str] = {
     "frequency": "a frequency (cycles per time, or an angle per time)",
     "angular_acceleration": "an angular acceleration, an angle per time squared",
     "integral_gain": "an integral gain, a moment per angle per time",
+    "rate": "a rate, per time (a speed per angle: (rad/s)/rad)",
 }
 
 #: The angle exponents a quantity of each dimension may have (see the module docstring).
@@ -157,6 +161,7 @@ ANGLE_EXPONENTS: dict[str, tuple[int, ...]] = {
     "frequency": (0, 1),
     "angular_acceleration": (1,),
     "integral_gain": (-1,),
+    "rate": (0,),
 }
 
 #: Largest magnitude accepted in internal units: 1e15 mm is a billion kilometres; beyond
@@ -279,6 +284,7 @@ FAST_UNITS: dict[str, dict[str, float]] = {
     "frequency": {"Hz": 1.0, "kHz": 1e3},
     "angular_acceleration": {"rad/s^2": 1.0, "deg/s^2": _DEG},
     "integral_gain": {"N*m/(rad*s)": 1e3, "N*mm/(rad*s)": 1.0},
+    "rate": {"1/s": 1.0},
 }
 
 _FAST = re.compile(r"([+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)\s*(\S+)")

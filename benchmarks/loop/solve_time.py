@@ -1,8 +1,8 @@
 """What the loop's rows cost a solve: ``od.solve(problem, ranges=False)`` (sensitivities
 and neighbouring items included) of ``fin_actuator_motor``, of the same with
 ``fin_actuator_loop``'s ``[loop]`` and rows but ``resonance_margin_min = 2.7`` (the same
-optimum, the same search), and of ``fin_actuator_loop``, interleaved, ``--runs`` times
-each. Prints each run's summary ``time`` (the solve), the whole ``od.solve``, the NLP
+optimum, the same search), of ``fin_actuator_loop`` and of ``fin_actuator_cascade`` (its
+loop a position/speed cascade), interleaved, ``--runs`` times each. Prints each run's summary ``time`` (the solve), the whole ``od.solve``, the NLP
 solves of the branch and bound, and the medians.
 
     python benchmarks/loop/solve_time.py --runs 3
@@ -36,6 +36,7 @@ def main() -> None:
         "fin_actuator_motor": _data("fin_actuator_motor"),
         "the same with [loop] and rows, resonance_margin_min = 2.7": same_search,
         "fin_actuator_loop": _data("fin_actuator_loop"),
+        "fin_actuator_cascade": _data("fin_actuator_cascade"),
     }
     rows: dict[str, list[tuple[float, float, int]]] = {k: [] for k in cases}
     for k in range(args.runs):

@@ -13,16 +13,20 @@ the damping gated to the contact has the same N as the spring.
 
 Lur'e form. Cut the loop at the dead zone: its input is d, its output v, and the chain's
 torque is (k + c s) v. With the reference at zero, D_2 = J_2 s^2 + c_f s + k_h (the fin
-on its air spring, without the chain), J_1 = J_m f'^2 and K(s) = G(s)(kd s^2 + kp s +
-ki)/s the controller and current loop,
+on its air spring, without the chain), J_1 = J_m f'^2 and the controller and current loop
+(:mod:`optdesign.models.loop_linear`'s rational form) split by the angle each term reads,
+u = -K_phi phi - K_psi psi: for the PID K(s) = G(s)(kd s^2 + kp s + ki)/s on the measured
+angle; for the cascade G(s)(kp s + ki)/s on the measured angle and G(s)(kd s^2 + kv_i s)/s
+on psi (the motor's speed),
 
     phi = (k + c s) v / D_2,
-    J_1 s^2 psi = -f' K y - (k + c s) v,   y = phi ("fin") or psi ("motor"),
+    J_1 s^2 psi = -f' (K_phi phi + K_psi psi) - (k + c s) v,
 
 so d = psi - phi = -L_d(s) v with
 
-    fin:    L_d = (k + c s) (J_1 s^2 + D_2 + f' K) / (J_1 s^2 D_2)
-    motor:  L_d = (k + c s) (J_1 s^2 + D_2 + f' K) / ((J_1 s^2 + f' K) D_2)
+    L_d = (k + c s) (J_1 s^2 + D_2 + f' (K_phi + K_psi)) / ((J_1 s^2 + f' K_psi) D_2)
+
+(fin feedback: K_psi = 0; motor feedback: K_phi = 0).
 
 At N = 1 (the gap closed), 1 + L_d = 0 is the linear loop's characteristic equation of
 :mod:`optdesign.models.loop_linear`. A cycle is 1 + N(A) L_d(jw) = 0: N is real in [0, 1),
@@ -65,7 +69,7 @@ from optdesign.models.harmonic_balance import (
     polynomial_loop,
 )
 from optdesign.models.loop_linear import frequency_range
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import CONTROLLERS, Controller, DrivePlant
 from optdesign.models.validity import Validity
 
 LOOP_GAIN = Validity(
@@ -85,29 +89,43 @@ LOOP_GAIN = Validity(
 VALIDITY: tuple[Validity, ...] = (LOOP_GAIN,)
 
 
-def _parts(plant: DrivePlant, loop: PositionLoop):
+def _parts(plant: DrivePlant, loop: Controller):
+    """The plant's pieces and f' K_phi, f' K_psi's numerators over s_lag = s^q (tau_i s + 1)
+    (None for an angle no term reads)."""
     J1 = plant.motor_inertia_at_fin
     d2 = np.array([plant.fin_inertia, plant.fin_damping, plant.hinge_spring])
     motor = np.array([J1, 0.0, 0.0])
     lag = np.array([loop.current_lag, 1.0])
-    if loop.ki > 0:
-        ctrl, s = np.array([loop.kd, loop.kp, loop.ki]), np.array([1.0, 0.0])
-    else:
-        ctrl, s = np.array([loop.kd, loop.kp]), np.array([1.0])
+    kp, kd, ki, kv_i = loop.kp, loop.kd, loop.ki, loop.speed_ki
+    integral = ki > 0
+    s = np.array([1.0, 0.0]) if integral else np.array([1.0])
     s_lag = np.polymul(s, lag)
-    return J1, d2, motor, s_lag, plant.ratio * ctrl
+    terms: dict[str, np.ndarray | None] = {"fin": None, "motor": None}
+    if loop.speed_feedback == loop.feedback:
+        # the PID's kd s^2 + kp s + ki (kv_i = 0 adds nothing), all on the measured angle
+        ctrl = np.array([kd, kp + kv_i, ki] if integral else [kd, kp + kv_i])
+        terms[loop.feedback] = plant.ratio * ctrl
+    else:
+        ref = np.array([kp, ki] if integral else [kp])
+        rate = np.array([kd, kv_i, 0.0] if integral else [kd, kv_i])
+        terms[loop.feedback] = plant.ratio * ref
+        terms[loop.speed_feedback] = plant.ratio * rate
+    return J1, d2, motor, s_lag, terms["fin"], terms["motor"]
 
 
-def deflection_loop(plant: DrivePlant, loop: PositionLoop) -> tuple[np.ndarray, np.ndarray]:
+def deflection_loop(plant: DrivePlant, loop: Controller) -> tuple[np.ndarray, np.ndarray]:
     """L_d(s), the linear part seen by the chain's dead zone (module docstring), as
     (numerator, denominator) coefficients, highest power first."""
-    _, d2, motor, s_lag, fctrl = _parts(plant, loop)
+    _, d2, motor, s_lag, f_phi, f_psi = _parts(plant, loop)
     chain = np.array([plant.damping, plant.stiffness])
-    inner = np.polyadd(np.polymul(s_lag, np.polyadd(motor, d2)), fctrl)
+    inner = np.polymul(s_lag, np.polyadd(motor, d2))
+    for term in (f_phi, f_psi):
+        if term is not None:
+            inner = np.polyadd(inner, term)
     num = np.polymul(chain, inner)
     motor_side = np.polymul(s_lag, motor)
-    if loop.feedback == "motor":
-        motor_side = np.polyadd(motor_side, fctrl)
+    if f_psi is not None:
+        motor_side = np.polyadd(motor_side, f_psi)
     den = np.polymul(motor_side, d2)
     return np.trim_zeros(num, "f"), np.trim_zeros(den, "f")
 
@@ -180,7 +198,7 @@ class BacklashCycles:
         return max((c.fin_amplitude for c in self.cycles if c.stable), default=0.0)
 
 
-def limit_cycles(plant: DrivePlant, loop: PositionLoop, points: int = 8000) -> BacklashCycles:
+def limit_cycles(plant: DrivePlant, loop: Controller, points: int = 8000) -> BacklashCycles:
     """The limit cycles of the chain's clearance in the position loop (harmonic balance
     of the dead zone on the chain's deflection; module docstring).
 
@@ -200,8 +218,8 @@ def limit_cycles(plant: DrivePlant, loop: PositionLoop, points: int = 8000) -> B
     """
     if not isinstance(plant, DrivePlant):
         raise InputError("plant", f"must be a DrivePlant, got {plant!r}")
-    if not isinstance(loop, PositionLoop):
-        raise InputError("loop", f"must be a PositionLoop, got {loop!r}")
+    if not isinstance(loop, CONTROLLERS):
+        raise InputError("loop", f"must be a PositionLoop or a CascadeLoop, got {loop!r}")
     b = plant.backlash
     if b == 0.0:
         return BacklashCycles((), "the chain has no clearance (backlash = 0)", 0.0, None)

@@ -2,8 +2,9 @@
 bandwidth, margins and stability (docs/loop.md).
 
 The plant and controller are :class:`~optdesign.models.loop_plant.DrivePlant` and
-:class:`~optdesign.models.loop_plant.PositionLoop`, here with the gap closed and without
-friction or limits. In the fin coordinate (psi = theta / f', J_1 = J_m f'^2, the motor
+:data:`~optdesign.models.loop_plant.Controller` (a PID :class:`~optdesign.models.
+loop_plant.PositionLoop` or a :class:`~optdesign.models.loop_plant.CascadeLoop`), here
+with the gap closed and without friction or limits. In the fin coordinate (psi = theta / f', J_1 = J_m f'^2, the motor
 torque u acting as f' u on psi):
 
     J_1 psi'' = f' u - tau,      J_2 phi'' = tau - k_h phi - c_f phi',
@@ -14,18 +15,21 @@ and the determinant Delta = D_1 D_2 - (c s + k)^2,
 
     phi / u = f' (c s + k) / Delta,     psi / u = f' D_2 / Delta.
 
-The controller u = G(s) [(kp + ki/s)(r - y) - kd s y], G = 1/(tau_i s + 1) the current
-loop, y = phi (``feedback="fin"``) or psi (``"motor"``). Broken at the torque command the
-open loop is
+The controller u = G(s) [(kp + ki/s)(r - y) - (kd + kv_i/s) s v], G = 1/(tau_i s + 1)
+the current loop, y = phi (``feedback="fin"``) or psi (``"motor"``) the measured angle, v
+the angle whose speed is measured (``speed_feedback``: y for the PID, whose kv_i = 0; psi
+for the cascade, :class:`~optdesign.models.loop_plant.CascadeLoop`, kv_i its
+``speed_ki``). Broken at the torque command the open loop is
 
-    L(s) = (kd s^2 + kp s + ki) N_y(s) / (s (tau_i s + 1) Delta(s))
+    L(s) = ((kp s + ki) N_y(s) + (kd s^2 + kv_i s) N_v(s)) / (s (tau_i s + 1) Delta(s))
 
-(N_y the numerator of y / u; without integral action the s cancels and is left out), and
-the closed loop from the reference to the fin's angle is
+(N_y, N_v the numerators of y / u and v / u; without integral action the s cancels and is
+left out), and the closed loop from the reference to the fin's angle is
 
-    T(s) = (kp s + ki) f' (c s + k) / (s (tau_i s + 1) Delta + (kd s^2 + kp s + ki) N_y).
+    T(s) = (kp s + ki) f' (c s + k) / (s (tau_i s + 1) Delta + C(s))
 
-The derivative acts on the measurement: it is in L but not in T's numerator.
+with C(s) the numerator of L. For the PID (v = y) it reads (kd s^2 + kp s + ki) N_y. The
+speed terms act on the measurement: they are in L but not in T's numerator.
 
 Rigid drive (k -> infinity): phi/u -> f' / ((J_1 + J_2) s^2 + c_f s + k_h), so a PD loop
 without lag is the second-order loop omega_n^2 = (f' kp + k_h) / (J_1 + J_2),
@@ -57,7 +61,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.errors import InputError
-from optdesign.models.loop_plant import FEEDBACKS, DrivePlant, PositionLoop
+from optdesign.models.loop_plant import FEEDBACKS, Controller, DrivePlant
 from optdesign.models.validity import Validity
 
 FREQUENCY = Validity(
@@ -125,6 +129,8 @@ def loop_response(
     current_lag,
     omega,
     feedback: str = "fin",
+    speed_ki=0.0,
+    speed_feedback: str | None = None,
 ) -> LoopResponse:
     """L(jw) and T(jw) of the linear loop, real and imaginary parts apart.
 
@@ -141,12 +147,18 @@ def loop_response(
         The :class:`~optdesign.models.loop_plant.DrivePlant` quantities (t*mm^2, motor rad
         per fin rad, t*mm^2, N*mm/rad, N*mm*s/rad, N*mm/rad, N*mm*s/rad).
     kp, kd, ki, current_lag
-        The :class:`~optdesign.models.loop_plant.PositionLoop` gains (motor torque per fin
-        angle: N*mm/rad, N*mm*s/rad, N*mm/(rad*s)) and the current loop's time constant (s).
+        The controller's gains (:data:`~optdesign.models.loop_plant.Controller`: motor
+        torque per fin angle, N*mm/rad, N*mm*s/rad, N*mm/(rad*s)) and the current loop's
+        time constant (s).
     omega
         Frequency w > 0 (rad/s).
     feedback
         ``"fin"`` or ``"motor"``: the measured angle.
+    speed_ki
+        The integral gain on the measured speed kv_i (N*mm/rad; 0 for a PID).
+    speed_feedback
+        ``"fin"`` or ``"motor"``: the angle whose speed kd and kv_i read; None: the
+        measured angle (the PID's).
 
     Returns
     -------
@@ -156,11 +168,16 @@ def loop_response(
     Raises
     ------
     InputError
-        ``feedback`` unknown, or a numeric ``omega`` infinite or not positive (NaN, a
+        ``feedback`` or ``speed_feedback`` unknown, or a numeric ``omega`` infinite or not positive (NaN, a
         design that does not assemble, gives NaN).
     """
     if feedback not in FEEDBACKS:
         raise InputError("feedback", f"expected one of {', '.join(FEEDBACKS)}, got {feedback!r}")
+    rate_on = feedback if speed_feedback is None else speed_feedback
+    if rate_on not in FEEDBACKS:
+        raise InputError(
+            "speed_feedback", f"expected one of {', '.join(FEEDBACKS)}, got {speed_feedback!r}"
+        )
     if not m.is_symbolic(omega):
         # NaN passes through: a design of a population that does not assemble has no
         # frequency, and its rows are NaN (the NumPy path's answer), not an error
@@ -179,18 +196,31 @@ def loop_response(
     cp2 = _cmul(cp, cp)
     delta = (prod[0] - cp2[0], prod[1] - cp2[1])
     n_phi = (ratio * cp[0], ratio * cp[1])
-    n_y = n_phi if feedback == "fin" else (ratio * d2[0], ratio * d2[1])
+    n_psi = (ratio * d2[0], ratio * d2[1])
+    n_y = n_phi if feedback == "fin" else n_psi
     # s (tau_i s + 1) Delta: the integrator's s is kept in both L and T; it cancels in L's
     # value when ki = 0, and keeps one formula for every gain
     s_lag = _cmul((0.0 * w, w), (1.0 + 0.0 * w, current_lag * w))
     den_open = _cmul(s_lag, delta)
-    ctrl = (ki - kd * w2, kp * w)  # kd s^2 + kp s + ki at s = jw
     ref = (ki + 0.0 * w, kp * w)  # kp s + ki
-    num_open = _cmul(ctrl, n_y)
+    if rate_on != feedback:  # the cascade's speed on the motor, its angle on the fin
+        rate = (-kd * w2, speed_ki * w)  # kd s^2 + kv_i s
+        on_y, on_v = _cmul(ref, n_y), _cmul(rate, n_psi if rate_on == "motor" else n_phi)
+        num_open = (on_y[0] + on_v[0], on_y[1] + on_v[1])
+    else:
+        # kd s^2 + (kp + kv_i) s + ki at s = jw; a PID's kv_i = 0 is left out, so that its
+        # expressions (and an NLP's graph) are the ones without the speed term
+        gain = kp if _is_zero(speed_ki) else kp + speed_ki
+        num_open = _cmul((ki - kd * w2, gain * w), n_y)
     L = _cdiv(num_open, den_open)
     char = (den_open[0] + num_open[0], den_open[1] + num_open[1])
     T = _cdiv(_cmul(ref, n_phi), char)
     return LoopResponse(L[0], L[1], T[0], T[1])
+
+
+def _is_zero(x) -> bool:
+    """True for a number (or array) that is 0 everywhere; a CasADi symbol is not."""
+    return not m.is_symbolic(x) and bool(np.all(np.asarray(x) == 0.0))
 
 
 def closed_loop_gain_squared(response: LoopResponse):
@@ -204,7 +234,7 @@ def return_difference_squared(response: LoopResponse):
     return (1.0 + response.open_re) ** 2 + response.open_im**2
 
 
-def plant_arguments(plant: DrivePlant, loop: PositionLoop) -> dict[str, float]:
+def plant_arguments(plant: DrivePlant, loop: Controller) -> dict[str, float]:
     """The keyword arguments of :func:`loop_response` from the two records (no omega)."""
     return {
         "motor_inertia": plant.motor_inertia,
@@ -219,12 +249,12 @@ def plant_arguments(plant: DrivePlant, loop: PositionLoop) -> dict[str, float]:
         "ki": loop.ki,
         "current_lag": loop.current_lag,
         "feedback": loop.feedback,
+        "speed_ki": loop.speed_ki,
+        "speed_feedback": loop.speed_feedback,
     }
 
 
-def frequency_response(
-    plant: DrivePlant, loop: PositionLoop, omega
-) -> tuple[np.ndarray, np.ndarray]:
+def frequency_response(plant: DrivePlant, loop: Controller, omega) -> tuple[np.ndarray, np.ndarray]:
     """L(jw) and T(jw) as complex NumPy arrays at ``omega`` (rad/s, > 0)."""
     with np.errstate(divide="ignore", invalid="ignore"):  # an undamped pole on the axis
         r = loop_response(**plant_arguments(plant, loop), omega=np.asarray(omega, dtype=float))
@@ -265,10 +295,11 @@ def _mul(a, b) -> np.ndarray:
     return np.convolve(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
 
 
-def loop_polynomials(plant: DrivePlant, loop: PositionLoop) -> LoopPolynomials:
+def loop_polynomials(plant: DrivePlant, loop: Controller) -> LoopPolynomials:
     """L(s) and T(s) of the linear loop as polynomial coefficients (module docstring).
 
-    Without integral action (ki = 0) the common factor s is left out of L and T.
+    Without integral action (ki = 0) the common factor s is left out of L and T (kv_i, if
+    any, is then a gain on v itself).
     """
     J1, J2 = plant.motor_inertia_at_fin, plant.fin_inertia
     k, c, fr = plant.stiffness, plant.damping, plant.ratio
@@ -277,14 +308,21 @@ def loop_polynomials(plant: DrivePlant, loop: PositionLoop) -> LoopPolynomials:
     coupling = np.array([c, k])
     delta = np.polysub(_mul(d1, d2), _mul(coupling, coupling))
     n_phi = fr * coupling
-    n_y = n_phi if loop.feedback == "fin" else fr * d2
+    n_psi = fr * d2
+    n_y = n_phi if loop.feedback == "fin" else n_psi
     lag = np.array([loop.current_lag, 1.0])
-    if loop.ki > 0:
-        ctrl, ref, s = np.array([loop.kd, loop.kp, loop.ki]), np.array([loop.kp, loop.ki]), [1, 0]
-    else:
-        ctrl, ref, s = np.array([loop.kd, loop.kp]), np.array([loop.kp]), [1]
+    kp, kd, ki, kv_i = loop.kp, loop.kd, loop.ki, loop.speed_ki
+    integral = ki > 0
+    ref, s = (np.array([kp, ki]), [1, 0]) if integral else (np.array([kp]), [1])
+    rate = np.array([kd, kv_i, 0.0] if integral else [kd, kv_i])  # (kd s + kv_i) s^q
     den_open = _mul(_mul(s, lag), delta)
-    num_open = _mul(ctrl, n_y)
+    if loop.speed_feedback == loop.feedback:
+        # one polynomial on y, kd s^2 + (kp + kv_i) s + ki (as the PID's was built)
+        ctrl = np.array([kd, kp + kv_i, ki] if integral else [kd, kp + kv_i])
+        num_open = _mul(ctrl, n_y)
+    else:
+        n_v = n_psi if loop.speed_feedback == "motor" else n_phi
+        num_open = np.polyadd(_mul(ref, n_y), _mul(rate, n_v))
     char = np.polyadd(den_open, num_open)
     return LoopPolynomials(_trim(num_open), _trim(den_open), _trim(_mul(ref, n_phi)), _trim(char))
 
@@ -305,12 +343,12 @@ def scaled_roots(coefficients) -> np.ndarray:
     return np.concatenate([np.roots(scaled / scaled[0]) * w0, np.zeros(zeros_at_origin)])
 
 
-def closed_loop_poles(plant: DrivePlant, loop: PositionLoop) -> np.ndarray:
+def closed_loop_poles(plant: DrivePlant, loop: Controller) -> np.ndarray:
     """The closed loop's poles (rad/s), the roots of its characteristic polynomial."""
     return scaled_roots(loop_polynomials(plant, loop).closed_denominator)
 
 
-def is_stable(plant: DrivePlant, loop: PositionLoop) -> bool:
+def is_stable(plant: DrivePlant, loop: Controller) -> bool:
     """True when every closed-loop pole lies in the open left half-plane.
 
     A pole counts as on the axis (not stable) when its real part is above -1e-9 times
@@ -321,7 +359,7 @@ def is_stable(plant: DrivePlant, loop: PositionLoop) -> bool:
 
 
 # --- frequency-domain figures ------------------------------------------------------------
-def frequency_range(plant: DrivePlant, loop: PositionLoop) -> tuple[float, float]:
+def frequency_range(plant: DrivePlant, loop: Controller) -> tuple[float, float]:
     """Frequencies that hold every crossing (rad/s): two decades beyond the loop's
     corners (the moduli of the poles and zeros of L and T)."""
     pol = loop_polynomials(plant, loop)
@@ -338,7 +376,7 @@ def frequency_range(plant: DrivePlant, loop: PositionLoop) -> tuple[float, float
     return float(corners.min() * 1e-2), float(corners.max() * 1e2)
 
 
-def _grid(plant: DrivePlant, loop: PositionLoop) -> np.ndarray:
+def _grid(plant: DrivePlant, loop: Controller) -> np.ndarray:
     lo, hi = frequency_range(plant, loop)
     return np.geomspace(lo, hi, int(np.log10(hi / lo) * _POINTS_PER_DECADE) + 2)
 
@@ -370,7 +408,7 @@ def _roots_of(fn, w: np.ndarray) -> list[float]:
     return out
 
 
-def bandwidth(plant: DrivePlant, loop: PositionLoop) -> float:
+def bandwidth(plant: DrivePlant, loop: Controller) -> float:
     """The closed loop's bandwidth (rad/s): the first frequency where |T(jw)| falls to
     |T(0)| / sqrt(2), half the static gain's power (python-control's ``bandwidth`` with
     ``dbdrop = -3.0103``; its default -3 dB is 0.1 % higher).
@@ -442,7 +480,7 @@ def _minimum(fn, w: np.ndarray) -> tuple[float, float]:
     return float(v[i]), float(w[i])
 
 
-def margins(plant: DrivePlant, loop: PositionLoop) -> Margins:
+def margins(plant: DrivePlant, loop: Controller) -> Margins:
     """Gain and phase margins of L, the modulus margin, and T's resonance peak.
 
     Crossings are bracketed on a log grid over :func:`frequency_range` (400 points per
@@ -475,7 +513,7 @@ def margins(plant: DrivePlant, loop: PositionLoop) -> Margins:
     return Margins(float(gm), float(wpc), pm, float(wgc), sm, wsm, -neg_peak, wr)
 
 
-def rigid_natural_frequency(plant: DrivePlant, loop: PositionLoop) -> float:
+def rigid_natural_frequency(plant: DrivePlant, loop: Controller) -> float:
     """omega_n = sqrt((f' kp + k_h) / (J_1 + J_2)) (rad/s): the closed loop of a rigid
     drive under P control (the module's docstring); ``nan`` when f' kp + k_h <= 0."""
     num = plant.ratio * loop.kp + plant.hinge_spring

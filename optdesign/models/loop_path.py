@@ -441,8 +441,9 @@ class PathSystem(_System):
         return self.path.at(x[0])[0] * self.command(t, x) + self._generalised(x, mode[0])[1]
 
     def rhs(self, mode):
-        """x' = f(t, x) in ``mode``: the module docstring's equations, the controller's
-        output as the fixed plant's (:meth:`command`, the same arithmetic)."""
+        """x' = f(t, x) in ``mode``: the module docstring's equations, the controller (a
+        PID or the cascade) as the fixed plant's: its output by :meth:`command`, its
+        integral's rate by the same arithmetic."""
         fn = self._rhs.get(mode)
         if fn is not None:
             return fn
@@ -452,6 +453,7 @@ class PathSystem(_System):
         friction = motor * path.friction_torque
         lag, top, corner = self.c.current_lag, self.top, self.corner
         fin, r, command, saturated = self.fin, self.r, self.command, self.saturated_command
+        rate_fin, zv = self.rate_fin, self.rate_weight  # the cascade's speed integrator
         moment = self.moment
         turning = motor in (1, -1)
 
@@ -475,8 +477,10 @@ class PathSystem(_System):
             else:
                 dd_psi = 0.0
             dT = (T_sat - x[4]) / lag if lag > 0 else 0.0
+            # z' as the fixed plant's: the error, less the cascade's weighted speed
             y = x1 if fin else x0
-            return [x2, x3, dd_psi, dd_phi, dT, r(t) - y]
+            e = r(t) - y
+            return [x2, x3, dd_psi, dd_phi, dT, e - zv * (x3 if rate_fin else x2) if zv else e]
 
         self._rhs[mode] = rhs
         return rhs

@@ -30,6 +30,24 @@ loop as a first-order lag of time constant ``current_lag`` and the motor's peak 
 as a saturation. Gains are motor torque per fin angle: kp in N*mm/rad, kd in N*mm*s/rad,
 ki in N*mm/(rad*s).
 
+The cascade (:class:`CascadeLoop`): an outer position P loop asking a speed
+w_ref = Kpos (r - y) of an inner PI loop on the motor's measured speed psi' (the encoder,
+seen at the fin),
+
+    T_cmd = Kv (w_ref - psi') + (Kv / Ti) int(w_ref - psi') dt
+
+(``position_gain`` Kpos in 1/s, ``speed_gain`` Kv in N*mm*s/rad, ``speed_integral_time``
+Ti in s, 0 for a P speed loop), then the same current loop and saturation.
+
+Both are one rational controller (the :data:`Controller` protocol every consumer reads):
+
+    T_cmd = C_e(s) (r - y) - C_v(s) s v,   C_e = kp + ki / s,   C_v = kd + speed_ki / s
+
+with v the angle whose speed is measured (``speed_feedback``): y itself for the PID
+(speed_ki = 0), psi for the cascade, whose kp = Kv Kpos, ki = Kv Kpos / Ti, kd = Kv and
+speed_ki = Kv / Ti. A P speed loop is the PID's PD on the motor's speed: kp = Kv Kpos,
+kd = Kv.
+
 Units: mm, t, s, N, rad (README "Units"): inertia in t*mm^2, torque in N*mm, stiffness
 in N*mm/rad, damping in N*mm*s/rad, speed in rad/s.
 
@@ -46,7 +64,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import Literal
+from typing import Literal, TypeAlias
 
 from optdesign.errors import InputError
 from optdesign.models.validity import Validity
@@ -156,6 +174,24 @@ class DrivePlant:
         return self.motor_inertia * self.ratio**2
 
 
+def _check_controller(record, positive: tuple[str, ...], nonnegative: tuple[str, ...]) -> None:
+    """Store a controller record's gains as floats; refuse (naming ``loop.<field>``) one
+    that is not finite, not positive (``positive``) or negative (``nonnegative``), and an
+    unknown ``feedback``."""
+    for name in (*positive, *nonnegative):
+        object.__setattr__(record, name, _finite("loop", name, getattr(record, name)))
+    for name in positive:
+        if not getattr(record, name) > 0:
+            raise InputError(f"loop.{name}", f"must be positive, got {getattr(record, name)!r}")
+    for name in nonnegative:
+        if getattr(record, name) < 0:
+            raise InputError(f"loop.{name}", f"cannot be negative, got {getattr(record, name)!r}")
+    if record.feedback not in FEEDBACKS:
+        raise InputError(
+            "loop.feedback", f"expected one of {', '.join(FEEDBACKS)}, got {record.feedback!r}"
+        )
+
+
 @dataclass(frozen=True)
 class PositionLoop:
     """The position controller and the current loop (see the module's docstring).
@@ -181,14 +217,84 @@ class PositionLoop:
     feedback: Literal["fin", "motor"] = "fin"
 
     def __post_init__(self) -> None:
-        for name in ("kp", "kd", "ki", "current_lag"):
-            object.__setattr__(self, name, _finite("loop", name, getattr(self, name)))
-        if not self.kp > 0:
-            raise InputError("loop.kp", f"must be positive, got {self.kp!r}")
-        for name in ("kd", "ki", "current_lag"):
-            if getattr(self, name) < 0:
-                raise InputError(f"loop.{name}", f"cannot be negative, got {getattr(self, name)!r}")
-        if self.feedback not in FEEDBACKS:
-            raise InputError(
-                "loop.feedback", f"expected one of {', '.join(FEEDBACKS)}, got {self.feedback!r}"
-            )
+        _check_controller(self, ("kp",), ("kd", "ki", "current_lag"))
+
+    @property
+    def speed_ki(self) -> float:
+        """The integral gain on the measured speed (none in a PID: 0.0)."""
+        return 0.0
+
+    @property
+    def speed_feedback(self) -> str:
+        """The angle whose speed the derivative reads: the measured one."""
+        return self.feedback
+
+
+@dataclass(frozen=True)
+class CascadeLoop:
+    """The position/speed cascade and the current loop (see the module's docstring).
+
+    Parameters
+    ----------
+    position_gain
+        Kpos, the speed asked per angle of error (1/s: fin rad/s per fin rad), > 0.
+    speed_gain
+        Kv, motor torque per fin rad/s of speed error (N*mm*s/rad), > 0.
+    speed_integral_time
+        Ti, the speed loop's integral time (s), >= 0; 0 for a P speed loop.
+    current_lag
+        Time constant of the current loop (s), >= 0.
+    feedback
+        The angle the position loop measures: ``"fin"`` or ``"motor"``. The speed is the
+        motor's (its encoder) either way.
+    """
+
+    position_gain: float
+    speed_gain: float
+    speed_integral_time: float = 0.0
+    current_lag: float = 0.0
+    feedback: Literal["fin", "motor"] = "fin"
+
+    def __post_init__(self) -> None:
+        _check_controller(
+            self, ("position_gain", "speed_gain"), ("speed_integral_time", "current_lag")
+        )
+
+    # the rational form C_e = kp + ki / s on the error, C_v = kd + speed_ki / s on psi'
+    @property
+    def kp(self) -> float:
+        """Kv Kpos (N*mm/rad)."""
+        return self.speed_gain * self.position_gain
+
+    @property
+    def ki(self) -> float:
+        """Kv Kpos / Ti (N*mm/(rad*s)); 0 for a P speed loop."""
+        if self.speed_integral_time == 0.0:
+            return 0.0
+        return self.kp / self.speed_integral_time
+
+    @property
+    def kd(self) -> float:
+        """Kv (N*mm*s/rad)."""
+        return self.speed_gain
+
+    @property
+    def speed_ki(self) -> float:
+        """Kv / Ti (N*mm/rad): the speed integrator's gain on psi' (0 for a P loop)."""
+        if self.speed_integral_time == 0.0:
+            return 0.0
+        return self.speed_gain / self.speed_integral_time
+
+    @property
+    def speed_feedback(self) -> str:
+        """The motor's: the speed loop closes on the encoder."""
+        return "motor"
+
+
+#: A position controller: a record with kp, ki, kd, speed_ki, current_lag, feedback and
+#: speed_feedback (the rational form of the module's docstring); speed_ki > 0 only with
+#: ki > 0, so one integrator state serves both terms.
+Controller: TypeAlias = PositionLoop | CascadeLoop
+
+#: The controller records, for ``isinstance``.
+CONTROLLERS = (PositionLoop, CascadeLoop)

@@ -15,10 +15,12 @@ with, piece by piece:
   push. Each change is an event: the integration stops there and restarts in the new
   contact state, so the jump of the damping torque c d' at the closing is resolved
   exactly;
-* the controller T_cmd = kp e + ki z - kd y', z' = e = r - y, saturated at
-  +-``peak_torque``, then the current loop T' = (T_cmd,sat - T) / tau_i (T = T_cmd,sat
-  when ``current_lag`` = 0). No anti-windup: the integral keeps integrating while the
-  torque is saturated;
+* the controller T_cmd = kp e + ki z - kd v', z' = e - (kv_i / ki) v', e = r - y (the
+  rational form of :mod:`optdesign.models.loop_plant`: for the PID v = y and kv_i = 0,
+  z the error's integral; for the cascade v = psi, and ki z = (Kv / Ti) int(w_ref - psi'),
+  the speed loop's integral), saturated at +-``peak_torque``, then the current loop
+  T' = (T_cmd,sat - T) / tau_i (T = T_cmd,sat when ``current_lag`` = 0). No anti-windup:
+  the integral keeps integrating while the torque is saturated;
 * Coulomb friction at the motor, event-handled (not smoothed): while the motor turns,
   T_fr = T_f sign(theta'); when theta' reaches zero the motor sticks if the torque on it,
   |f' T - tau| <= f' T_f, and stays stuck (theta' = 0) until that torque reaches the
@@ -57,7 +59,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.errors import InputError
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import CONTROLLERS, Controller, DrivePlant
 from optdesign.models.loop_references import (
     MAX_HORIZON,
     MAX_SAMPLES,
@@ -146,12 +148,12 @@ class LoopSimulation:
     event_times: tuple[float, ...]
     event_kinds: tuple[str, ...]
     plant: Any
-    loop: PositionLoop
+    loop: Controller
     input_reference: Reference
 
 
 # --- the equations -------------------------------------------------------------------------
-# state x = [psi, phi, psi', phi', T (current loop), z (integral of the error)]
+# state x = [psi, phi, psi', phi', T (current loop), z (the controller's integral)]
 # mode = (contact, side, motor): contact in {-1, 0, +1}; side in {-1, 0, +1} the flank
 # whose overlap persists while unloaded (contact 0); motor: +-1 turning, 0 stuck
 
@@ -159,13 +161,17 @@ class LoopSimulation:
 class _System:
     breaks: tuple[float, ...] = ()  # times where a load on the fin jumps: none here
 
-    def __init__(self, plant: DrivePlant, loop: PositionLoop, reference):
+    def __init__(self, plant: DrivePlant, loop: Controller, reference):
         self.p, self.c, self.reference = plant, loop, reference
         # the reference's left limit at a jump ending the current segment: the segment's
         # last point must not see the jump (its events would fire on it, again and again)
         self.left_of = math.inf
         self.J1 = plant.motor_inertia_at_fin
         self.fin = loop.feedback == "fin"
+        # the speed the controller reads (the cascade's: the motor's), and the weight of
+        # its speed integrator in z' = e - (kv_i / ki) v' (0 for a PID)
+        self.rate_fin = loop.speed_feedback == "fin"
+        self.rate_weight = loop.speed_ki / loop.ki if loop.ki > 0 else 0.0
         self.w_lim = plant.max_speed / plant.ratio  # psi' at the speed limit
         self.w_band = self.w_lim * (1.0 - SPEED_BAND)  # ... and where its corner begins
         # without clearance the chain is one linear, two-way spring: no contact events
@@ -190,8 +196,9 @@ class _System:
 
     def saturated_command(self, t, x) -> float:
         c = self.c
-        y, yd = (x[1], x[3]) if self.fin else (x[0], x[2])
-        T = c.kp * (self.r(t) - y) + c.ki * x[5] - c.kd * yd
+        y = x[1] if self.fin else x[0]
+        vd = x[3] if self.rate_fin else x[2]
+        T = c.kp * (self.r(t) - y) + c.ki * x[5] - c.kd * vd
         peak = self.p.peak_torque
         return min(max(T, -peak), peak)
 
@@ -237,6 +244,7 @@ class _System:
         ratio, friction = p.ratio, motor * p.friction_torque
         kp, kd, ki, lag = c.kp, c.kd, c.ki, c.current_lag
         peak, fin, r = p.peak_torque, self.fin, self.r
+        rate_fin, zv = self.rate_fin, self.rate_weight
         w_lim, w_band = self.w_lim, self.w_band
         turning = motor in (1, -1)
 
@@ -244,9 +252,10 @@ class _System:
             x0, x1, x2, x3, x4 = x[0], x[1], x[2], x[3], x[4]
             tau = k * (x0 - x1 - b) + cc * (x2 - x3) if contact else 0.0
             dd_phi = (tau - kh * x1 - cf * x3) / J2
-            y, yd = (x1, x3) if fin else (x0, x2)
+            y = x1 if fin else x0
+            vd = x3 if rate_fin else x2
             ref = r(t)
-            T_sat = kp * (ref - y) + ki * x[5] - kd * yd
+            T_sat = kp * (ref - y) + ki * x[5] - kd * vd
             T_sat = min(max(T_sat, -peak), peak)
             if turning:
                 T = min(max(x4, -peak), peak) if lag > 0 else T_sat
@@ -256,7 +265,7 @@ class _System:
             else:
                 dd_psi = 0.0
             dT = (T_sat - x4) / lag if lag > 0 else 0.0
-            return [x2, x3, dd_psi, dd_phi, dT, ref - y]
+            return [x2, x3, dd_psi, dd_phi, dT, ref - y - zv * vd if zv else ref - y]
 
         self._rhs[mode] = rhs
         return rhs
@@ -389,7 +398,7 @@ def _positive(field: str, value, limit: float) -> float:
 
 def simulate(
     plant: DrivePlant,
-    loop: PositionLoop,
+    loop: Controller,
     reference: Reference,
     horizon: float,
     samples: int = 2001,
@@ -442,8 +451,8 @@ def simulate(
         raise InputError("plant", f"must be a DrivePlant or a DrivePath, got {plant!r}")
     if load is not None and isinstance(plant, DrivePlant):
         raise InputError("load", "must be a LoadHistory, with a DrivePath plant")
-    if not isinstance(loop, PositionLoop):
-        raise InputError("loop", f"must be a PositionLoop, got {loop!r}")
+    if not isinstance(loop, CONTROLLERS):
+        raise InputError("loop", f"must be a PositionLoop or a CascadeLoop, got {loop!r}")
     if not isinstance(reference, StepReference | SineReference | SampledReference):
         raise InputError(
             "reference", f"must be a step, sine or sampled reference, got {reference!r}"

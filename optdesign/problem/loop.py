@@ -10,8 +10,9 @@ clearance chain's worst-case backlash) and the problem's ``[motor]``, ``[load]``
   the grid (CasADi on the solver path, NumPy arrays on the checking path), which the
   requirement rows (:mod:`optdesign.problem.loop_requirements`) are built from;
 * :func:`drive_plants` and :func:`position_loop`: one :class:`~optdesign.models.
-  loop_plant.DrivePlant` per grid angle and the :class:`~optdesign.models.loop_plant.
-  PositionLoop`, numbers, for the post-solve analyses (poles, limit cycles, simulation).
+  loop_plant.DrivePlant` per grid angle and the controller (a :class:`~optdesign.models.
+  loop_plant.PositionLoop` or :class:`~optdesign.models.loop_plant.CascadeLoop`),
+  numbers, for the post-solve analyses (poles, limit cycles, simulation).
 
 Internal units: mm, t, s, N, rad (the current loop's lag is read from the file in h).
 """
@@ -26,7 +27,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import InputError, ProblemError
 from optdesign.models import loop_linear as ll
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import CascadeLoop, Controller, DrivePlant, PositionLoop
 
 #: The chain's damping ratio when ``[loop]`` gives none: 2 % of critical, a steel drive
 #: of bearings, a ball nut and pins (a lightly damped structure, 1-5 %).
@@ -69,15 +70,28 @@ class PlantGrid:
 
 @dataclass(frozen=True)
 class LoopGains:
-    """The controller of ``[loop]`` (kp, kd, ki: motor torque per fin angle, internal
-    units; ``current_lag`` in s): numbers for fixed gains, design expressions for gains
-    placed from a bandwidth (:func:`loop_gains`)."""
+    """The controller of ``[loop]`` in the rational form of :mod:`optdesign.models.
+    loop_plant` (kp, kd, ki, speed_ki: motor torque per fin angle, internal units;
+    ``current_lag`` in s): numbers for fixed gains, design expressions for gains placed
+    from a bandwidth (:func:`loop_gains`). A cascade's own gains (``position_gain`` in
+    1/s, ``speed_gain``, ``speed_integral_time`` in s) make its record."""
 
     kp: Any
     kd: Any
-    ki: float
+    ki: Any
     current_lag: float
     feedback: str
+    speed_ki: Any = 0.0
+    speed_feedback: str | None = None
+    structure: str = "pid"
+    position_gain: Any = None
+    speed_gain: Any = None
+    speed_integral_time: float = 0.0
+
+    @property
+    def speed_on(self) -> str:
+        """The angle whose speed kd and speed_ki read."""
+        return self.feedback if self.speed_feedback is None else self.speed_feedback
 
 
 def _need_loop(q):
@@ -165,11 +179,46 @@ def loop_gains(q) -> LoopGains:
     ``damping_ratio`` on the rigid drive at the design's mean ratio: with J = J_m f'^2 +
     J_fin (J_m and f' their grid means), f' kp = J w_n^2 - k_h and f' kd = 2 zeta w_n J -
     c_fin, w_n = 2 pi bandwidth / :func:`bandwidth_factor`. One controller for the stroke:
-    at an angle whose ratio is above the mean the loop is faster, below it slower."""
+    at an angle whose ratio is above the mean the loop is faster, below it slower.
+
+    A cascade is placed as the P speed loop equal to that PD on the motor's speed
+    (:func:`cascade_gains`): Kv = kd, Kpos = kp / kd; its ``speed_integral_time``, if
+    any, is the file's."""
     loop = _need_loop(q)
     lag = loop.current_lag * HOUR
     if loop.bandwidth is None:
+        if loop.structure == "cascade":
+            return cascade_gains(loop.position_gain * loop.speed_gain, loop.speed_gain, loop, lag)
         return LoopGains(loop.kp, loop.kd or 0.0, loop.ki, lag, loop.feedback)
+    kp, kd = _placed(q, loop)
+    if loop.structure == "cascade":
+        return cascade_gains(kp, kd, loop, lag)
+    return LoopGains(kp, kd, loop.ki, lag, loop.feedback)
+
+
+def cascade_gains(kp: Any, kd: Any, loop, lag: float) -> LoopGains:
+    """The cascade of ``[loop]`` with Kv Kpos = ``kp`` and Kv = ``kd`` (numbers or design
+    expressions) in the rational form: ki = kp / Ti, speed_ki = kd / Ti on the motor's
+    speed (0 without ``speed_integral_time``)."""
+    ti = (loop.speed_integral_time or 0.0) * HOUR
+    ki, speed_ki = (kp / ti, kd / ti) if ti > 0 else (0.0, 0.0)
+    return LoopGains(
+        kp,
+        kd,
+        ki,
+        lag,
+        loop.feedback,
+        speed_ki=speed_ki,
+        speed_feedback="motor",
+        structure="cascade",
+        position_gain=loop.position_gain,  # None when placed: kp / kd, a design's
+        speed_gain=kd,
+        speed_integral_time=ti,
+    )
+
+
+def _placed(q, loop) -> tuple[Any, Any]:
+    """kp and kd for ``[loop]``'s bandwidth and damping ratio (:func:`loop_gains`)."""
     load = q.problem.spec.load
     f = _on_grid(m.grid_mean(q.ratio), q.ratio)
     Jm = _on_grid(m.grid_mean(q.motor_side_inertia + 0.0 * q.ratio), q.ratio)
@@ -177,7 +226,7 @@ def loop_gains(q) -> LoopGains:
     wn = 2.0 * np.pi * loop.bandwidth / bandwidth_factor(loop.zeta)
     kp = (J * wn**2 - load.hinge_spring) / f
     kd = m.fmax(2.0 * loop.zeta * wn * J - load.damping, 0.0) / f
-    return LoopGains(kp, kd, loop.ki, lag, loop.feedback)
+    return kp, kd
 
 
 def loop_angles(problem) -> np.ndarray:
@@ -217,6 +266,8 @@ def response(grid: PlantGrid, gains: LoopGains, omega) -> ll.LoopResponse:
         gains.current_lag,
         omega,
         gains.feedback,
+        gains.speed_ki,
+        gains.speed_on,
     )
 
 
@@ -264,11 +315,10 @@ def population_size(q) -> int:
 
 def drive_plants_of(
     q, angles=None, strict: bool = True
-) -> list[tuple[list[DrivePlant], PositionLoop] | None]:
+) -> list[tuple[list[DrivePlant], Controller] | None]:
     """For each design of the NumPy quantities ``q`` (one design, or a population: one
     row per design), its :class:`~optdesign.models.loop_plant.DrivePlant` at every grid
-    angle (or at the grid indices ``angles``) and its :class:`~optdesign.models.
-    loop_plant.PositionLoop`.
+    angle (or at the grid indices ``angles``) and its controller (:func:`controller`).
 
     ``strict`` False: a design whose drive is no plant (a ratio that is not positive: a
     dead point inside the stroke; a linkage that does not assemble: NaN; a loop gain
@@ -280,7 +330,7 @@ def drive_plants_of(
     names = [f.name for f in fields(DrivePlant) if f.name != "angle"]
     values = {n: _rows(getattr(grid, n), pop, width) for n in names}
     kp, kd = _rows(gains.kp, pop, 1)[:, 0], _rows(gains.kd, pop, 1)[:, 0]
-    out: list[tuple[list[DrivePlant], PositionLoop] | None] = []
+    out: list[tuple[list[DrivePlant], Controller] | None] = []
     for i in range(pop):
         try:
             if not kp[i] > 0:
@@ -289,7 +339,7 @@ def drive_plants_of(
                     "fin's hinge spring alone is stiffer than the loop asked for: raise the "
                     "bandwidth"
                 )
-            loop = PositionLoop(kp[i], kd[i], gains.ki, gains.current_lag, gains.feedback)
+            loop = controller(gains, float(kp[i]), float(kd[i]))
             plants = [
                 DrivePlant(**{n: float(values[n][i, k]) for n in names}, angle=float(phi[k]))
                 for k in (range(width) if angles is None else angles)
@@ -303,14 +353,34 @@ def drive_plants_of(
     return out
 
 
+def controller(gains: LoopGains, kp: float, kd: float) -> Controller:
+    """The controller record of one design whose kp and kd are ``kp`` and ``kd`` (a
+    cascade's Kv Kpos and Kv): a :class:`~optdesign.models.loop_plant.PositionLoop`, or a
+    :class:`~optdesign.models.loop_plant.CascadeLoop` (a placed Kpos = kp / kd; a placed
+    Kv that is not positive, the fin's own damping above the loop's, refused naming
+    ``loop.bandwidth``)."""
+    if gains.structure != "cascade":
+        return PositionLoop(kp, kd, gains.ki, gains.current_lag, gains.feedback)
+    if not kd > 0:
+        raise ProblemError(
+            f"loop.bandwidth: places speed_gain = {kd:.4g} N*mm*s/rad at this design; the "
+            "fin's own damping is more than the loop asked for: raise the bandwidth or "
+            "the damping_ratio"
+        )
+    position_gain = kp / kd if gains.position_gain is None else gains.position_gain
+    return CascadeLoop(
+        float(position_gain), kd, gains.speed_integral_time, gains.current_lag, gains.feedback
+    )
+
+
 def drive_plants(q) -> list[DrivePlant]:
     """One :class:`~optdesign.models.loop_plant.DrivePlant` per grid angle of the design
     whose NumPy quantities are ``q`` (one design)."""
     return drive_plants_of(q)[0][0]
 
 
-def position_loop(q) -> PositionLoop:
-    """The :class:`~optdesign.models.loop_plant.PositionLoop` of the design whose NumPy
+def position_loop(q) -> Controller:
+    """The controller (:func:`controller`) of the design whose NumPy
     quantities are ``q``; a placed kp that is not positive (a bandwidth below the fin's
     own frequency on its stabilising hinge spring) refused naming ``loop.bandwidth``."""
     return drive_plants_of(q)[0][1]
@@ -336,12 +406,25 @@ def check_loop(problem) -> None:
     spec = problem.spec
     rigid = -spec.load.hinge_spring / plant.ratio  # f' kp + k_h > 0, the rigid loop's
     raise ProblemError(
-        f"loop: the position loop (kp = {loop.kp * 1e-3:.4g} N*m/rad, kd = "
-        f"{loop.kd * 1e-3:.4g} N*m*s/rad, ki = {loop.ki * 1e-3:.4g} N*m/(rad*s), current "
+        f"loop: the position loop ({_gains_text(loop)}, current "
         f"lag {loop.current_lag * 1e3:.3g} ms, {loop.feedback} feedback) is unstable at "
         f"every one of its {len(plants)} angles at the start design: a closed-loop pole at Re s = {worst:.4g} "
         f"rad/s at {np.degrees(plant.angle):+.1f} deg. Check the gains: the rigid loop "
         f"alone needs f' kp + k_h > 0 (kp > {max(rigid, 0.0) * 1e-3:.4g} N*m/rad there) "
         "and kd > 0; with integral action, ki < (f' kd + c_fin) (f' kp + k_h) / (f' J), "
         "J = J_m f'^2 + J_fin"
+    )
+
+
+def _gains_text(loop: Controller) -> str:
+    """The controller's gains as a message shows them (N*m for the torques)."""
+    if isinstance(loop, CascadeLoop):
+        return (
+            f"cascade: position_gain = {loop.position_gain:.4g} 1/s, speed_gain = "
+            f"{loop.speed_gain * 1e-3:.4g} N*m*s/rad, speed_integral_time = "
+            f"{loop.speed_integral_time * 1e3:.4g} ms; kp = Kv Kpos = {loop.kp * 1e-3:.4g} N*m/rad"
+        )
+    return (
+        f"kp = {loop.kp * 1e-3:.4g} N*m/rad, kd = {loop.kd * 1e-3:.4g} N*m*s/rad, ki = "
+        f"{loop.ki * 1e-3:.4g} N*m/(rad*s)"
     )

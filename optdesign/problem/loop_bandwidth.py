@@ -27,7 +27,7 @@ import numpy as np
 
 from optdesign import math as m
 from optdesign.models import loop_linear as ll
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import Controller, DrivePlant
 from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
@@ -50,13 +50,13 @@ START_MARGIN = 1.1
 
 
 @lru_cache(maxsize=CACHED_PLANTS)
-def _bandwidth(plant: DrivePlant, loop: PositionLoop) -> float:
+def _bandwidth(plant: DrivePlant, loop: Controller) -> float:
     # frozen records: the same plant met again (sensitivities, a front's neighbours) is
     # answered from the cache, as the loop's stability and cycles are
     return ll.bandwidth(plant, loop)
 
 
-def _period(plant: DrivePlant, loop: PositionLoop) -> float:
+def _period(plant: DrivePlant, loop: Controller) -> float:
     """1 / f (s) of the loop at one plant."""
     return 2.0 * math.pi / _bandwidth(plant, loop)
 

@@ -16,7 +16,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import Controller, DrivePlant
 from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
@@ -84,7 +84,7 @@ def soft_least_return_difference(q, grid: PlantGrid, gains: LoopGains, idx) -> A
 
 
 @lru_cache(maxsize=CACHED_PLANTS)
-def _largest_cycle(plant: DrivePlant, loop: PositionLoop) -> float:
+def _largest_cycle(plant: DrivePlant, loop: Controller) -> float:
     return float(np.degrees(limit_cycles(plant, loop, CYCLE_POINTS).largest_stable_fin_amplitude))
 
 

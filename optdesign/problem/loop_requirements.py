@@ -55,7 +55,7 @@ import numpy as np
 from optdesign import math as m
 from optdesign.errors import ProblemError
 from optdesign.models import loop_linear as ll
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import Controller, DrivePlant
 from optdesign.problem.evaluation import RowsOnDemand
 from optdesign.problem.loop import (
     CACHED_PLANTS,
@@ -88,7 +88,7 @@ LOOP_REQUIREMENTS = (
 
 
 @lru_cache(maxsize=CACHED_PLANTS)
-def _least_damping(plant: DrivePlant, loop: PositionLoop) -> float:
+def _least_damping(plant: DrivePlant, loop: Controller) -> float:
     # the records are frozen, so a plant met again (the sensitivities evaluate the same
     # two designs under every moved requirement) is answered from the cache
     poles = ll.closed_loop_poles(plant, loop)

@@ -54,6 +54,7 @@ Frequency = Annotated[float, _quantity("frequency")]
 Speed = Annotated[float, _quantity("speed")]
 AngularAcceleration = Annotated[float, _quantity("angular_acceleration")]
 IntegralGain = Annotated[float, _quantity("integral_gain")]
+Rate = Annotated[float, _quantity("rate")]
 
 #: dimension name -> annotated type of a parsed quantity.
 QUANTITY_TYPES: dict[str, Any] = {

@@ -23,7 +23,7 @@ from scipy.integrate import solve_ivp
 from optdesign.errors import InputError
 from optdesign.models import loop_simulation as ls
 from optdesign.models.loop_path import DrivePath, LoadHistory, duty_history
-from optdesign.models.loop_plant import DrivePlant, PositionLoop
+from optdesign.models.loop_plant import CascadeLoop, DrivePlant, PositionLoop
 
 B = math.radians(0.1)
 GRID = np.linspace(-0.6, 0.6, 61)
@@ -35,14 +35,21 @@ def _constant_path(plant: DrivePlant) -> DrivePath:
 
 # --- (a) a constant path is the fixed plant -----------------------------------------------
 @pytest.mark.parametrize(
-    "reference",
-    [ls.StepReference(math.radians(1.0)), ls.SineReference(math.radians(0.5), 40.0)],
-    ids=["step", "sine"],
+    "reference, loop",
+    [
+        (ls.StepReference(math.radians(1.0)), PositionLoop(kp=1500.0, kd=45.0, current_lag=1e-4)),
+        (ls.SineReference(math.radians(0.5), 40.0), PositionLoop(kp=1500.0, kd=45.0, ki=2e3)),
+        (
+            ls.StepReference(math.radians(1.0)),
+            CascadeLoop(25.0, 60.0, speed_integral_time=0.1, current_lag=1e-4),
+        ),
+    ],
+    ids=["step, PD and lag", "sine, PID", "step, PI cascade"],
 )
-def test_a_path_of_equal_plants_responds_as_the_fixed_plant(reference):
+def test_a_path_of_equal_plants_responds_as_the_fixed_plant(reference, loop):
     """The gap, friction (stick and slip), the peak torque, the speed limit and the
-    current loop: every event of the fixed plant, at the same times, and the samples to
-    1e-9 of their range."""
+    current loop, under a PID or the position/speed cascade: every event of the fixed
+    plant, at the same times, and the samples to 1e-9 of their range."""
     plant = DrivePlant(
         **loop_drives.TWO_MASS,
         backlash=B,
@@ -50,7 +57,6 @@ def test_a_path_of_equal_plants_responds_as_the_fixed_plant(reference):
         peak_torque=60.0,
         max_speed=200.0,
     )
-    loop = PositionLoop(kp=1500.0, kd=45.0, current_lag=1e-4)
     fixed = ls.simulate(plant, loop, reference, 0.3, samples=3001)
     path = ls.simulate(_constant_path(plant), loop, reference, 0.3, samples=3001)
     assert len(fixed.event_kinds) > 20 and path.event_kinds == fixed.event_kinds

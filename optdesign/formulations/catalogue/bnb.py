@@ -90,6 +90,11 @@ from optdesign.solvers.multistart import improves
 from optdesign.solvers.result import Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
+#: The key of a node result's ``details`` set when the node was solved on the thinned
+#: grid (a relaxation of the node: its value bounds the box's, its design may miss a row):
+#: the thinned grid's number of angles.
+RELAXED = "relaxed_grid"
+
 Box = Mapping[str, tuple[float, float]]
 
 #: Split last the catalogue variables whose item data only the rows read (neither the
@@ -323,6 +328,12 @@ def branch_and_bound_warm(
     first = [v for v in dvars if v.name not in last]
     order = first + [v for v in dvars if v.name in last]
 
+    def relaxable(box: Box) -> bool:
+        # a node's value on the thinned grid bounds its box's, but the variables split
+        # last take the first item the node's design meets on every row of the problem:
+        # a box wide only in those is solved on the problem itself
+        return any(box[v.name][0] != box[v.name][1] for v in first)
+
     def leaf_solve(box: Box, x, floor: float | None) -> Result:
         # A combination solved before (from another node's optimum) is solved again only
         # from the new start: the rest of its multistart is the same Sobol points. The
@@ -359,7 +370,7 @@ def branch_and_bound_warm(
             r = leaf_solve(child, x, below)
         else:
             test = partial(_prunes_box, prunes, child)
-            r = ns.solve(child, x, warm=True, prunes=test, floor=below)
+            r = ns.solve(child, x, warm=True, prunes=test, floor=below, relaxed=relaxable(child))
         stats["nodes"] += 1
         gain = pseudo.gain(bound, r)
         if not r.success:
@@ -387,7 +398,7 @@ def branch_and_bound_warm(
             if warm_from is not None and not _earlier_prunes(ns, prunes, box):
                 # a bound from the warm start alone: pruned only on the full multistart
                 # (or on a bound an earlier search of the front trusted)
-                res = ns.solve(box, warm_from, floor=floor)
+                res = ns.solve(box, warm_from, floor=floor, relaxed=relaxable(box))
                 stats["nodes"] += 1
                 if not res.success:
                     stats["infeasible"] += 1
@@ -399,6 +410,25 @@ def branch_and_bound_warm(
             stats["pruned"] += 1
             _bound_proof(ns, box, res)
             continue
+        if (
+            res.details.get(RELAXED)
+            and any(box[n][0] != box[n][1] for n in last)
+            and on_items(first, box, res)[0] is None
+        ):
+            # the node's design sits on items of every variable split first, so the items
+            # of those split last are decided from its design (first_items_met): solved again on the problem itself,
+            # from there (the design of the thinned grid may miss a row between its
+            # angles), as a node is without the thinned grid
+            test = partial(_prunes_box, prunes, box)
+            res = ns.solve(box, ns.x_of(res), warm=True, prunes=test, floor=floor)
+            stats["nodes"] += 1
+            if not res.success:
+                stats["infeasible"] += 1
+                continue
+            if prunes(res.objective, box):
+                stats["pruned"] += 1
+                _bound_proof(ns, box, res)
+                continue
         x = ns.x_of(res)
         # the children's floor: this node's value when the search trusts it, else the
         # floor it had itself (a sub-box's value is never below its box's)

@@ -68,6 +68,10 @@ class CatalogueDetails:
     relaxation_bound, relaxation_status, relaxation_design
         The continuous relaxation (every catalogue range at once): its optimum (None when
         it failed), status and design - a lower bound of the catalogue optimum.
+    relaxation_angles
+        The grid angles the relaxation was solved on: fewer than the problem's when the
+        branch and bound solved it on the thinned grid (a relaxation of the relaxation,
+        so still a lower bound, a little weaker); None: the problem's own grid.
     starts_per_node
         Multistart of each node's NLP.
     enumerated
@@ -85,6 +89,8 @@ class CatalogueDetails:
         What the MINLP back-end did (method ``"minlp"`` only).
     nlp_solves
         NLP solves spent.
+    thinned_solves
+        Of those, the solves on the thinned grid (nodes of several item combinations).
     items
         The items chosen (None: no feasible combination).
     gap_to_relaxation_rel
@@ -98,6 +104,7 @@ class CatalogueDetails:
     relaxation_status: str
     relaxation_design: dict[str, float | None]
     starts_per_node: int
+    relaxation_angles: int | None = None
     enumerated: list[CatalogueCombination] | None = None
     nodes: int | None = None
     pruned: int | None = None
@@ -108,6 +115,7 @@ class CatalogueDetails:
     implied_infeasible: int | None = None
     minlp: MINLPDetails | None = None
     nlp_solves: int = 0
+    thinned_solves: int = 0
     items: dict[str, float] | None = None
     gap_to_relaxation_rel: float | None = None
     #: The boxes the search proved infeasible, with the epsilon limits of each proof

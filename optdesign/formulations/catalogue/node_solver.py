@@ -12,11 +12,16 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.formulations.catalogue.bnb import trusted
+from optdesign.formulations.catalogue.bnb import RELAXED, trusted
 from optdesign.formulations.catalogue.discrete import (
     discrete_variables,
 )
-from optdesign.formulations.nlp.solve import _objective_set, solver_for, solver_options
+from optdesign.formulations.nlp.solve import (
+    _objective_set,
+    search_stand_in,
+    solver_for,
+    solver_options,
+)
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
 from optdesign.programs.nlp import Bounds
@@ -71,6 +76,7 @@ class NodeSolver:
         free_rows: tuple[int, ...] = (),
         workers: int = 1,
         agree: int = 0,
+        thinned: bool = True,
     ):
         self.problem = problem
         #: A node's multistart stops once this many of its starts agree on the best value
@@ -95,6 +101,9 @@ class NodeSolver:
             # the caller's.
             options = {**node, **solver_options(problem, solver), **(options or {})}
         self.backend = solver_for(problem, solver, options, names)
+        self._relaxed_args = (solver, options, names)
+        # built on the first relaxed node (see :meth:`relaxed_backend`); False: none
+        self._relaxed = None if thinned else False
         self.verdicts = solver_hints(solver).infeasible_verdicts
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
@@ -102,6 +111,8 @@ class NodeSolver:
         self.seed = seed
         self.names = [v.name for v in problem.free]
         self.n_solves = 0
+        self.n_thinned = 0  # of those, on the thinned grid
+        self.relaxed_angles = 0  # the thinned grid's angles, once built
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
         self.n_implied = 0
@@ -123,6 +134,7 @@ class NodeSolver:
         if self.workers <= 1:
             yield
             return
+        self.relaxed_backend()  # built once, before the workers inherit it
         with InheritedWorkers(self._solve_start, self.workers) as workers:
             self._workers = workers
             try:
@@ -130,14 +142,33 @@ class NodeSolver:
             finally:
                 self._workers = None
 
-    def _solve_start(self, item: tuple[Bounds, np.ndarray]) -> Result:
-        box, x0 = item
-        return self.backend.solve(
-            self.nlp.start(x0=x0, parameters=box.parameters), self.target, box
-        )
+    def relaxed_backend(self):
+        """The solver of the problem on its search's thinned grid
+        (:func:`~optdesign.formulations.nlp.solve.search_stand_in`), for a node that holds
+        more than one item combination: its rows are a subset of the problem's, so its
+        optimum is a relaxation of the node's, never above it - a valid bound for the
+        search, at about half the cost of a start. None when the grid is not thinned, or
+        when rows are left free by index (the diagnosis), which index the problem's rows."""
+        if self._relaxed is None:
+            stand_in = search_stand_in(self.problem)
+            if stand_in is self.problem or self.free_rows.size:
+                self._relaxed = False
+            else:
+                self._relaxed = solver_for(stand_in, *self._relaxed_args)
+                self.relaxed_angles = len(stand_in.phi)
+        return self._relaxed or None
 
-    def _starts(self, box: Bounds, points, stop: Callable[[list[Result]], bool]) -> list[Result]:
-        items = [(box, np.asarray(p, dtype=float)) for p in points]
+    def _solve_start(self, item: tuple[Bounds, np.ndarray, bool]) -> Result:
+        box, x0, relaxed = item
+        backend = self.relaxed_backend() if relaxed else self.backend
+        target = self.target if backend is self.backend else backend.nlp.target(self.objective)
+        return backend.solve(backend.nlp.start(x0=x0, parameters=box.parameters), target, box)
+
+    def _starts(
+        self, box: Bounds, points, stop: Callable[[list[Result]], bool], backend
+    ) -> list[Result]:
+        relaxed = backend is not self.backend
+        items = [(box, np.asarray(p, dtype=float), relaxed) for p in points]
         if self._workers is None:
             return map_serial(self._solve_start, items, stop)
         return self._workers.map(items, stop)
@@ -150,6 +181,7 @@ class NodeSolver:
         prunes: Callable[[float], bool] | None = None,
         fallback: bool = True,
         floor: float | None = None,
+        relaxed: bool = False,
     ) -> Result:
         """Best of the multistart on the box where ``bounds`` replace the catalogue
         variables' ranges; ``x_hint`` (e.g. the parent's optimum, clipped) is the first start.
@@ -168,6 +200,9 @@ class NodeSolver:
         end below it. A start that reaches it (within the tie tolerance) ends the
         multistart: the node's value is settled (``multistart.stopped_early``), whether
         the search would prune it or not.
+        ``relaxed``: a box of more than one item combination may be solved on the thinned
+        grid (:meth:`relaxed_backend`): its value bounds the box's from below, which is
+        all a node of the search needs; a leaf is always solved on the problem itself.
         """
         nodes = None if self.memo is None else self.memo.nodes
         if self.memo is not None and (
@@ -199,7 +234,9 @@ class NodeSolver:
             # e.g. a (d0, p) box that holds no screw of the catalogue: nothing to solve
             return no_item(self.backend.name, "no catalogue item in this box")
         params = self.problem.parameter_values(node)
-        box = self.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
+        one = all(lo_ == hi_ for lo_, hi_ in node.values())
+        backend = (None if one or not relaxed else self.relaxed_backend()) or self.backend
+        box = backend.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
         if self.free_rows.size:
             from dataclasses import replace
 
@@ -220,7 +257,7 @@ class NodeSolver:
 
         results: list[Result] = []
         if warm and x_hint is not None:
-            results.append(self._solve_start((box, pts.pop(0))))
+            results.append(self._solve_start((box, pts.pop(0), backend is not self.backend)))
             first_ok = results[0]
             if first_ok.success and (
                 prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
@@ -242,7 +279,7 @@ class NodeSolver:
                 done = before + new
                 return at_floor(new[-1]) or agreed(done) or self.verdicts_decide(done)
 
-            new = self._starts(box, points, stop)
+            new = self._starts(box, points, stop, backend)
             results.extend(new)
             return bool(new) and (at_floor(new[-1]) or agreed(results))
 
@@ -258,6 +295,8 @@ class NodeSolver:
                 if self.proofs is not None and self.proofs is not self.memo:
                     self.proofs.add_infeasible(bounds, self.eps)
         self.n_solves += len(results)
+        if backend is not self.backend:
+            self.n_thinned += len(results)
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
         best.multistart = MultistartInfo(
@@ -272,10 +311,14 @@ class NodeSolver:
             n_planned=n_planned,
             stopped_early=settled,
         )
+        if backend is not self.backend:
+            best.details[RELAXED] = self.relaxed_angles
         if nodes is not None:
             # its value and result only when trusted (a full multistart, or at its floor)
             ok = best.success and trusted(best, self.starts)
             value, kept = (best.objective, best) if ok else (None, None)
+            if backend is not self.backend:
+                kept = None  # a relaxation's value bounds the box; its result is no optimum
             x = self.x_of(best) if best.success else None
             nodes.add(bounds, self.eps, self.objective, value, x, kept)
         return best

@@ -25,7 +25,7 @@ from typing import Any
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.catalogue.bnb import PRUNE_TOL as PRUNE_TOL
-from optdesign.formulations.catalogue.bnb import InfeasibleBoxes, trusted_value
+from optdesign.formulations.catalogue.bnb import RELAXED, InfeasibleBoxes, trusted_value
 from optdesign.formulations.catalogue.bnb import branch_and_bound_warm as branch_and_bound
 from optdesign.formulations.catalogue.bnb import cannot_improve as cannot_improve
 from optdesign.formulations.catalogue.bnb import fixed_box as _fixed
@@ -101,6 +101,7 @@ def solve_catalogue(
     ties: bool = True,
     workers: int = 1,
     agree: int | None = None,
+    thinned_nodes: bool = True,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -138,6 +139,15 @@ def solve_catalogue(
     agree
         A node's multistart stops once this many starts agree on the best value (default:
         the problem file's ``[solver] agree``; 0: every start).
+    thinned_nodes
+        Solve a branch-and-bound node that holds several item combinations on the
+        problem's thinned grid (:meth:`NodeSolver.relaxed_backend`): a relaxation, cheaper
+        by about half, whose value still bounds the node's; each leaf on the whole grid.
+        Only with ``ties``: a search that prunes a node whose bound ties with the
+        incumbent (``ties`` False) prunes none on a thinned bound, which lies below the
+        tie wherever the objective peaks between the thinned angles (a front's first
+        stage of the motor-torque anchor: 16 -> 164 NLP solves on
+        cs_min_backlash_catalogue).
 
     Returns
     -------
@@ -177,7 +187,16 @@ def solve_catalogue(
     seed = seed if seed is not None else problem.spec.solver.seed
     agree = agree if agree is not None else problem.spec.solver.agree
     ns = NodeSolver(
-        problem, objective, n_starts, seed, solver, options, eps, workers=workers, agree=agree
+        problem,
+        objective,
+        n_starts,
+        seed,
+        solver,
+        options,
+        eps,
+        workers=workers,
+        agree=agree,
+        thinned=thinned_nodes and ties,
     )
     with ns.on_workers():
         ns.memo = memo
@@ -189,7 +208,7 @@ def solve_catalogue(
             if memo is not None
             else InfeasibleBoxes({v.name: (v.lower, v.upper) for v in dvars})
         )
-        root = ns.solve({})
+        root = ns.solve({}, relaxed=method not in ("enumerate", "minlp"))
         info = CatalogueDetails(
             method=method,
             combinations=n_comb,
@@ -197,6 +216,7 @@ def solve_catalogue(
             relaxation_bound=root.objective if root.success else None,
             relaxation_status=root.status,
             relaxation_design={k: root.design.get(k) for k in ns.names} if root.design else {},
+            relaxation_angles=root.details.get(RELAXED),
             starts_per_node=n_starts,
         )
         if method == "enumerate":
@@ -213,7 +233,7 @@ def solve_catalogue(
             info.infeasible, info.leaves = stats["infeasible"], stats["leaves"]
             info.seeded = stats["seeded"]
             info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
-        info.nlp_solves = ns.n_solves
+        info.nlp_solves, info.thinned_solves = ns.n_solves, ns.n_thinned
         info.infeasible_boxes = ns.proofs.proofs
         wall = time.perf_counter() - t0
         if best is None:
@@ -249,8 +269,13 @@ def solve_catalogue(
         best.details["catalogue"] = info
         best.bound = root.objective if root.success else None
         items = ", ".join(f"{v.name} = {best.design[v.name]:g} {v.unit}".rstrip() for v in dvars)
+        on = (
+            ""
+            if info.relaxation_angles is None
+            else f" on {info.relaxation_angles} of the {len(problem.phi)} grid angles"
+        )
         bound = (
-            f"continuous relaxation bound {root.objective:.8g} (discrete optimum "
+            f"continuous relaxation bound {root.objective:.8g}{on} (discrete optimum "
             f"{100 * (info.gap_to_relaxation_rel or 0.0):+.3f} % above it)"
             if root.success
             else f"continuous relaxation: {root.status}"
@@ -258,6 +283,7 @@ def solve_catalogue(
         how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
         best.notes.append(
             f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
+            + (f" ({info.thinned_solves} on the thinned grid)" if info.thinned_solves else "")
         )
         if excluded:
             best.notes.append("excluded before the search: " + "; ".join(excluded))

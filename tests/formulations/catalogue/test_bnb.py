@@ -73,7 +73,9 @@ class TiedNodes:
         self.starts = 1
         self.boxes: list[dict] = []
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         self.boxes.append(dict(box))
         lo_a, hi_a = box.get("a", (A_ITEMS[0], A_ITEMS[-1]))
         _, hi_b = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
@@ -166,7 +168,9 @@ class TrapNodes(TiedNodes):
     """The relaxation of every wide box sits on (2, top of b), but the combination
     (2, 4) is infeasible with its own items (its box's data were the most favourable)."""
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         result = super().solve(box, x_hint, warm, prunes, fallback, floor)
         fixed = all(box.get(n, (0, 1))[0] == box.get(n, (0, 1))[1] for n in self.names)
         if fixed and (box["a"][0], box["b"][0]) == (2.0, 4.0):
@@ -192,7 +196,9 @@ class CountedNodes(TiedNodes):
         super().__init__()
         self.calls: list[tuple[dict, bool]] = []
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         self.calls.append((dict(box), warm and x_hint is not None and not fallback))
         return super().solve(box, x_hint, warm, prunes, fallback, floor)
 
@@ -220,7 +226,9 @@ class NearItemNodes(TiedNodes):
         super().__init__()
         self.problem = _Problem([_Var("a", (1.0,)), _Var("b", B_ITEMS)])
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         self.boxes.append(dict(box))
         lo, hi = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
         b = min(max(3.9, lo), hi)
@@ -255,7 +263,9 @@ class WarmTrapNodes(TiedNodes):
         self.problem = _Problem([_Var("a", (1.0,)), _Var("b", B_ITEMS)])
         self.starts = 4
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         self.boxes.append(dict(box))
         lo, hi = box.get("b", (B_ITEMS[0], B_ITEMS[-1]))
         b = min(max(2.5, lo), hi)
@@ -346,7 +356,9 @@ class WarmThenInfeasibleNodes(WarmTrapNodes):
     """As WarmTrapNodes, but the box b <= 2 has no feasible design: its one warm start
     stopped on a poor point, its full multistart finds none."""
 
-    def solve(self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, box, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         result = super().solve(box, x_hint, warm, prunes, fallback, floor)
         if box.get("b", (1.0, 4.0))[1] <= 2.0 and not warm:
             return _infeasible()

@@ -139,8 +139,13 @@ def test_shipped_catalogue_problem_equals_exhaustive_enumeration():
     bnb = solve_catalogue(problem, method="bnb", starts=3)
     enum = solve_catalogue(problem, method="enumerate", starts=2)
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-6)
-    assert relaxation_bound(bnb) == pytest.approx(RELAXED, rel=1e-5)
-    assert relaxation_bound(bnb) < bnb.objective
+    # the enumeration's relaxation is on the whole grid; the branch and bound's on the
+    # thinned grid (13 of 61 angles), a relaxation of it: lower, and still a bound
+    assert relaxation_bound(enum) == pytest.approx(RELAXED, rel=1e-5)
+    assert enum.details.catalogue.relaxation_angles is None
+    assert bnb.details.catalogue.relaxation_angles == 13
+    assert relaxation_bound(bnb) == pytest.approx(0.0339507, rel=1e-5)
+    assert relaxation_bound(bnb) < relaxation_bound(enum) < bnb.objective
     assert bnb.details.catalogue.items == {"p": 6, "d": 6}
 
 
@@ -419,7 +424,9 @@ class QuadNodes:
     def value(self, point: dict) -> float:
         return sum((point[n] - self.centre[n]) ** 2 for n in self.names)
 
-    def solve(self, bounds, x_hint=None, warm=False, prunes=None, fallback=True, floor=None):
+    def solve(
+        self, bounds, x_hint=None, warm=False, prunes=None, fallback=True, floor=None, relaxed=False
+    ):
         self.calls.append((dict(bounds), warm, floor))
         self.hints.append(None if x_hint is None else np.asarray(x_hint).tolist())
         box = {v.name: bounds.get(v.name, (v.lower, v.upper)) for v in self.problem.free}
@@ -1611,12 +1618,15 @@ def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x
     monkeypatch.setattr(catalogue.NodeSolver, "solve", counted)
     bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
     info = bnb.details.catalogue
-    # the relaxation, 7 boxes of 20 item pairs, and the box whose warm bound (one start)
-    # would prune it, solved again with the full multistart before it is pruned
-    assert info.nodes == len(solves) == 9
+    # the relaxation, 8 boxes of 20 item pairs, and the box whose warm bound (one start)
+    # would prune it, solved again with the full multistart before it is pruned; every
+    # box of several pairs on the thinned grid, the one leaf on the whole grid
+    assert info.nodes == len(solves) == 10
     assert info.infeasible == solves.count(False) == 2
-    # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
-    assert (info.leaves, info.pruned) == (1, 1)
+    # the one leaf (p = 6, d = 6) prunes the two boxes left open when it was found
+    assert (info.leaves, info.pruned) == (1, 2)
+    assert 0 < info.thinned_solves < info.nlp_solves
+    assert info.relaxation_angles == 13 < len(problem.phi)
     assert len(enum.details.catalogue.enumerated) == 20
     assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
     assert bnb.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
