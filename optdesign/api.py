@@ -502,14 +502,18 @@ def simulate(
     design: Mapping[str, float] | None = None,
     amplitude: Any = "1 deg",
     angle: Any = None,
-    horizon: Any = "0.5 s",
+    horizon: Any = None,
     frequency: Any = "5 Hz",
     samples: int = 2001,
     csv: str | Path | None = None,
+    plant: str | None = None,
+    periods: int = 1,
+    period: Any = None,
 ) -> Any:
     """The time response of a solved design in its position loop (docs/loop.md): the
-    drive at the grid angle nearest ``angle`` with its elastic backlash, friction and the
-    motor's limits (:func:`optdesign.models.loop_simulation.simulate`).
+    drive at the grid angle nearest ``angle``, or following the fin along the stroke,
+    with its elastic backlash, friction and the motor's limits
+    (:func:`optdesign.models.loop_simulation.simulate`).
 
     Parameters
     ----------
@@ -519,15 +523,23 @@ def simulate(
     design
         With a problem: the design (every free variable, internal units: mm, rad).
     reference
-        ``"step"`` (of ``amplitude`` at t = 0) or ``"sine"`` (``amplitude`` at
-        ``frequency``).
+        ``"step"`` (of ``amplitude`` at t = 0), ``"sine"`` (``amplitude`` at
+        ``frequency``) or ``"duty"`` (``requirements.duty_cycle``'s deflection history
+        and hinge moments, over ``periods`` periods).
     amplitude, angle, horizon, frequency
         Quantities (``"1 deg"``, ``"0 deg"``, ``"0.5 s"``, ``"5 Hz"``) or numbers in rad,
-        rad, s, Hz; ``angle`` None: the middle of the stroke.
+        rad, s, Hz; ``angle`` None: the middle of the stroke; ``horizon`` None: 0.5 s (a
+        duty run lasts its periods and takes none).
     samples
         Output samples (2 to 10^6).
     csv
         A file to write the samples to, one column per quantity with its unit.
+    plant
+        ``"angle"`` (the plant of the grid angle, held; a step's and a sine's default) or
+        ``"path"`` (following the fin along the stroke; the duty cycle's only plant).
+    periods, period
+        The duty cycle's periods (>= 1) and its length (a time, or a number in s;
+        default ``requirements.duty_period``), at most 600 s in all.
 
     Returns
     -------
@@ -555,7 +567,19 @@ def simulate(
         if problem is None or not getattr(result, "design", None):
             raise InputError("result", "a result of od.solve with a design (and its problem)")
         values = result.design
-    sim = simulate_design(problem, values, reference, amplitude, angle, horizon, frequency, samples)
+    sim = simulate_design(
+        problem,
+        values,
+        reference,
+        amplitude,
+        angle,
+        horizon,
+        frequency,
+        samples,
+        plant=plant,
+        periods=periods,
+        period=period,
+    )
     if csv is not None:
         atomic_write_text(Path(csv), simulation_csv(sim))
     return sim

@@ -24,11 +24,34 @@ MAX_RESULT_BYTES = 1 << 22
 def _simulate(sub):
     p = sub.add_parser("simulate", help="the time response of a design in its position loop")
     p.add_argument("file", type=Path, help="problem file (TOML, solved first) or result.json")
-    p.add_argument("--reference", choices=("step", "sine"), default="step")
+    p.add_argument(
+        "--reference",
+        choices=("step", "sine", "duty"),
+        default="step",
+        help="a step, a sine, or requirements.duty_cycle's deflection history and loads",
+    )
     p.add_argument("--amplitude", default="1 deg", help='the step or the sine (e.g. "1 deg")')
     p.add_argument("--angle", default=None, help="grid angle simulated (default: mid-stroke)")
-    p.add_argument("--horizon", default="0.5 s", help='time simulated (at most "600 s")')
+    p.add_argument(
+        "--horizon", default=None, help='time of a step or a sine (default "0.5 s", at most 600 s)'
+    )
     p.add_argument("--frequency", default="5 Hz", help="the sine's frequency")
+    p.add_argument(
+        "--plant",
+        choices=("angle", "path"),
+        default=None,
+        help="the plant of one grid angle (a step's and a sine's default) or following "
+        "the fin along the stroke (the duty cycle's)",
+    )
+    p.add_argument(
+        "--periods",
+        type=checked(lambda a, v: check.integer(a, v, 1, 1_000_000), literal),
+        default=1,
+        help="duty cycles simulated (their time at most 600 s)",
+    )
+    p.add_argument(
+        "--period", default=None, help="the duty cycle's length (default: requirements.duty_period)"
+    )
     p.add_argument(
         "--samples",
         type=checked(lambda a, v: check.integer(a, v, 2, 1_000_000), literal),
@@ -62,14 +85,29 @@ def run_simulate_command(args) -> int:
     import optdesign as od
     from optdesign import storage
     from optdesign.problem import load_problem
-    from optdesign.problem.loop_time import simulation_arguments, simulation_csv
+    from optdesign.problem.loop_time import (
+        duty_simulation_history,
+        simulation_arguments,
+        simulation_csv,
+    )
 
     with as_options():  # refused before any solve
-        simulation_arguments(args.reference, args.amplitude, args.horizon, args.frequency)
+        checked_args = simulation_arguments(
+            args.reference,
+            args.amplitude,
+            args.horizon,
+            args.frequency,
+            args.plant,
+            args.periods,
+            args.period,
+        )
     if args.file.suffix.lower() == ".json":
         problem, design = _design_of(args.file)
     else:
         problem = load_problem(args.file)
+        if checked_args.duty:
+            with as_options():  # what the duty cycle needs of the problem, before the solve
+                duty_simulation_history(problem, checked_args)
         with as_options():
             result = od.solve(problem, ranges=False, sensitivities=False, diagnose=False)
         if not result.success:
@@ -85,6 +123,9 @@ def run_simulate_command(args) -> int:
             horizon=args.horizon,
             frequency=args.frequency,
             samples=args.samples,
+            plant=args.plant,
+            periods=args.periods,
+            period=args.period,
         )
     with output_folder(args.out, f"simulate-{problem.name}") as out, storage.lock_folder(out):
         storage.ensure_writable(out)
@@ -94,5 +135,10 @@ def run_simulate_command(args) -> int:
             from optdesign.plots.loop_response import plot_loop_response
 
             save_figure(plot_loop_response(sim), out / "simulation.png")
-        print(f"simulated {problem.name} at {sim.angle * 57.29577951308232:+.1f} deg: {out}")
+        where = (
+            "over the duty cycle"
+            if sim.duty is not None
+            else f"at {sim.angle * 57.29577951308232:+.1f} deg"
+        )
+        print(f"simulated {problem.name} {where}: {out}")
     return 0

@@ -74,6 +74,12 @@ class StepReference:
         return self.amplitude if t >= self.time else 0.0
 
     @property
+    def span(self) -> tuple[float, float]:
+        """The least and the largest angle the reference takes (rad)."""
+        before = self.amplitude if self.time == 0 else 0.0
+        return min(self.amplitude, before), max(self.amplitude, before)
+
+    @property
     def breaks(self) -> tuple[float, ...]:
         """Times where the reference jumps (the integration restarts there)."""
         return (self.time,) if self.time > 0 else ()
@@ -97,6 +103,11 @@ class SineReference:
 
     def __call__(self, t: float) -> float:
         return self.offset + self.amplitude * math.sin(self.frequency * t)
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The least and the largest angle the reference takes (rad)."""
+        return self.offset - abs(self.amplitude), self.offset + abs(self.amplitude)
 
     @property
     def breaks(self) -> tuple[float, ...]:
@@ -134,6 +145,11 @@ class SampledReference:
 
     def __call__(self, t: float) -> float:
         return float(np.interp(t, self._t, self._a))
+
+    @property
+    def span(self) -> tuple[float, float]:
+        """The least and the largest angle the reference takes (rad)."""
+        return float(np.min(self._a)), float(np.max(self._a))
 
     @property
     def breaks(self) -> tuple[float, ...]:

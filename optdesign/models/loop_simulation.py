@@ -34,6 +34,9 @@ with, piece by piece:
   recorded as events ("speed limit", "speed released") without stopping the
   integration (docs/loop.md: why not a held speed).
 
+A :class:`~optdesign.models.loop_path.DrivePath` for the plant: the same equations with
+the ratio, stiffness, damping and gap following the angle, and a load on the fin.
+
 Units: mm, t, s, N, rad. Angles in rad at the fin (the motor's as psi = theta / f'),
 torques in N*mm (the motor's at its shaft, the chain's at the fin), times in s.
 
@@ -51,6 +54,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -120,13 +124,15 @@ class LoopSimulation:
         in the direction of motion near the top speed.
     chain_torque
         The chain's torque on the fin (N*mm).
+    hinge_moment
+        The air's moment on the fin (N*mm): -k_h phi and the external load.
     contact
         +1 / -1 while the + / - flank transmits torque, 0 in the gap or unloaded.
     event_times, event_kinds
         When the contact closed, opened or unloaded, the motor stuck or slipped, or the
         speed limit began or ended (s; a word each).
     plant, loop, input_reference
-        What was simulated.
+        What was simulated (the plant a ``DrivePlant`` or a ``DrivePath``).
     """
 
     times: np.ndarray
@@ -137,10 +143,11 @@ class LoopSimulation:
     motor_rate: np.ndarray
     motor_torque: np.ndarray
     chain_torque: np.ndarray
+    hinge_moment: np.ndarray
     contact: np.ndarray
     event_times: tuple[float, ...]
     event_kinds: tuple[str, ...]
-    plant: DrivePlant
+    plant: Any
     loop: Controller
     input_reference: Reference
 
@@ -152,6 +159,8 @@ class LoopSimulation:
 
 
 class _System:
+    breaks: tuple[float, ...] = ()  # times where a load on the fin jumps: none here
+
     def __init__(self, plant: DrivePlant, loop: Controller, reference):
         self.p, self.c, self.reference = plant, loop, reference
         # the reference's left limit at a jump ending the current segment: the segment's
@@ -200,6 +209,10 @@ class _System:
 
     def chain(self, x, mode) -> float:
         return self.raw_chain(x, mode[0]) if mode[0] else 0.0
+
+    def hinge_moment(self, t, x) -> float:
+        """The air's moment on the fin (N*mm)."""
+        return -self.p.hinge_spring * x[1]
 
     def motor_torque(self, t, x, mode) -> float:
         """The torque the motor applies (N*mm): the command, less in the direction of
@@ -311,9 +324,15 @@ class _System:
         return out
 
     # -- the mode after an event, or at the start ----------------------------------------
+    def gap_at(self, x) -> float:  # b and f' where the drive is (a path's vary)
+        return self.p.backlash
+
+    def ratio_at(self, x) -> float:
+        return self.p.ratio
+
     def initial_mode(self, t, x) -> tuple[tuple[int, int, int], np.ndarray]:
         """The mode of a state at rest or in motion (the start of the run)."""
-        b = self.p.backlash
+        b = self.gap_at(x)
         d = x[0] - x[1]
         cm = (1, 0) if self.bilateral else (0, 0)
         for f in (1, -1):
@@ -328,7 +347,7 @@ class _System:
     def stick_check(self, t, x, mode):
         """At theta' = 0: stuck while |f' T - tau| <= f' T_f, else turning with it."""
         F = self.drive_force(t, x, mode)
-        if abs(F) <= self.p.ratio * self.p.friction_torque:
+        if abs(F) <= self.ratio_at(x) * self.p.friction_torque:
             x = x.copy()
             x[2] = 0.0
             return (mode[0], mode[1], 0), x
@@ -387,13 +406,15 @@ def simulate(
     initial_fin_angle: float = 0.0,
     rtol: float = 1e-6,
     max_events: int = 20_000,
+    load: Any = None,
 ) -> LoopSimulation:
     """The drive's response in its loop from rest (module docstring).
 
     Parameters
     ----------
     plant, loop
-        The drive at one fin angle and its controller.
+        The drive at one fin angle, or along the stroke (a ``DrivePath``: its angles the
+        fin's own, the reference within its grid), and the controller.
     reference
         :class:`StepReference`, :class:`SineReference` or :class:`SampledReference`.
     horizon
@@ -408,6 +429,9 @@ def simulate(
     max_events
         The most events (contact changes, sticks, speed limits) allowed, 1 to 200000; a
         run that needs more (a chattering contact) is refused.
+    load
+        A ``LoadHistory``, a moment on the fin: with a ``DrivePath`` only (the fixed
+        plant is linearised about its angle without a mean load); None: none.
 
     Returns
     -------
@@ -422,8 +446,11 @@ def simulate(
     """
     from scipy.integrate import solve_ivp
 
-    if not isinstance(plant, DrivePlant):
-        raise InputError("plant", f"must be a DrivePlant, got {plant!r}")
+    # a DrivePath (loop_path, which builds on this module) brings its own equations
+    if not isinstance(plant, DrivePlant) and not hasattr(plant, "equations"):
+        raise InputError("plant", f"must be a DrivePlant or a DrivePath, got {plant!r}")
+    if load is not None and isinstance(plant, DrivePlant):
+        raise InputError("load", "must be a LoadHistory, with a DrivePath plant")
     if not isinstance(loop, CONTROLLERS):
         raise InputError("loop", f"must be a PositionLoop or a CascadeLoop, got {loop!r}")
     if not isinstance(reference, StepReference | SineReference | SampledReference):
@@ -443,10 +470,15 @@ def simulate(
     psi0 = angle_value("initial_motor_angle", initial_motor_angle)
     phi0 = angle_value("initial_fin_angle", initial_fin_angle)
 
-    sys = _System(plant, loop, reference)
+    if isinstance(plant, DrivePlant):
+        sys = _System(plant, loop, reference)
+        gap, stiffness = plant.backlash, plant.stiffness
+    else:
+        sys = plant.equations(loop, reference, psi0, phi0, load)
+        gap, stiffness = plant.backlash_scale, plant.stiffness_scale
     # absolute tolerances from the plant's scales: an angle of the gap or the reference
-    angle = max(plant.backlash, _reference_scale(reference), abs(psi0), abs(phi0), 1e-6)
-    rate = angle * math.sqrt(plant.stiffness / plant.fin_inertia)
+    angle = max(gap, *map(abs, reference.span), abs(psi0), abs(phi0), 1e-6)
+    rate = angle * math.sqrt(stiffness / plant.fin_inertia)
     torque = max(loop.kp * angle, 1e-9)
     atol = rtol * np.array([angle, angle, rate, rate, torque, angle * horizon]) * 1e-2
 
@@ -458,7 +490,8 @@ def simulate(
     t = 0.0
     mode, x = sys.initial_mode(t, x)
     band = sys.band_events()
-    stops = [b for b in sorted(reference.breaks) if 0.0 < b < horizon] + [horizon]
+    breaks = sorted(set(reference.breaks) | set(sys.breaks))
+    stops = [b for b in breaks if 0.0 < b < horizon] + [horizon]
     event_times: list[float] = []
     event_kinds: list[str] = []
     done = 0  # samples already taken
@@ -525,19 +558,12 @@ def simulate(
     return _record(sys, pieces, event_times, event_kinds, reference)
 
 
-def _reference_scale(reference) -> float:
-    if isinstance(reference, StepReference):
-        return abs(reference.amplitude)
-    if isinstance(reference, SineReference):
-        return abs(reference.amplitude) + abs(reference.offset)
-    return float(np.max(np.abs(reference._a)))
-
-
 def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSimulation:
     ts = np.concatenate([p[0] for p in pieces])
     X = np.concatenate([p[1] for p in pieces], axis=1)
     torque = np.empty(ts.size)
     chain = np.empty(ts.size)
+    hinge = np.empty(ts.size)
     contact = np.zeros(ts.size, dtype=int)
     i = 0
     for tp, Xp, mode in pieces:
@@ -545,6 +571,7 @@ def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSi
             x = Xp[:, j]
             torque[i] = sys.motor_torque(tp[j], x, mode)
             chain[i] = sys.chain(x, mode)
+            hinge[i] = sys.hinge_moment(tp[j], x)
             contact[i] = int(np.sign(chain[i])) if sys.bilateral else mode[0]
             i += 1
     ref = np.array([reference(tk) for tk in ts])
@@ -557,6 +584,7 @@ def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSi
         motor_rate=X[2],
         motor_torque=torque,
         chain_torque=chain,
+        hinge_moment=hinge,
         contact=contact,
         event_times=tuple(event_times),
         event_kinds=tuple(event_kinds),

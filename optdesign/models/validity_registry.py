@@ -47,6 +47,7 @@ MODEL_MODULES = (
     "loop_backlash",
     "loop_references",
     "loop_simulation",
+    "loop_path",
 )
 
 

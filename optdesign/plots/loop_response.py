@@ -22,8 +22,14 @@ def plot_loop_response(sim):
     top.plot(t, np.degrees(r.motor_angle), lw=0.8, label="motor (at the fin)")
     top.plot(t, np.degrees(r.fin_angle), lw=1.2, label="fin")
     top.set_ylabel("angle [deg]")
-    top.set_title(f"response in the loop at {math.degrees(sim.angle):+.1f} deg of the stroke")
-    top.legend(loc="lower right")
+    if sim.duty is not None:
+        title = "response in the loop over the duty cycle (the plant following the fin)"
+    elif sim.plant == "path":
+        title = f"response in the loop about {math.degrees(sim.angle):+.1f} deg (plant following the fin)"
+    else:
+        title = f"response in the loop at {math.degrees(sim.angle):+.1f} deg of the stroke"
+    top.set_title(title)
+    top.legend(loc="best" if sim.duty is not None else "lower right")
     # the motor's torque is the chain's over the ratio (hundreds): an axis of its own
     bottom.plot(t, np.asarray(r.chain_torque) * 1e-3, "C1", lw=0.8)
     bottom.set_ylabel("chain torque at the fin [N*m]", color="C1")
