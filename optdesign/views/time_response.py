@@ -24,7 +24,7 @@ import numpy as np
 from optdesign.models import loop_linear as ll
 from optdesign.models.harmonic_balance import FILTER_HYPOTHESIS
 from optdesign.models.loop_backlash import limit_cycles
-from optdesign.models.loop_simulation import steady_oscillation
+from optdesign.models.loop_run import steady_oscillation
 from optdesign.problem.loop_time import DesignSimulation, design_plant, simulate_design
 
 #: The step of the fin the report simulates (rad).

@@ -18,7 +18,7 @@ from cli_refusal import command_line_refusal
 import optdesign as od
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_backlash import limit_cycles
-from optdesign.models.loop_simulation import steady_oscillation
+from optdesign.models.loop_run import steady_oscillation
 from optdesign.problem.loop_time import design_path
 from optdesign.problem.motor_drive import duty_torques
 
