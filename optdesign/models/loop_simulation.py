@@ -498,7 +498,7 @@ def simulate(
                 raise InputError(
                     "max_events",
                     f"more than {max_events} events by t = {t:.6g} s (the last: {kind}): "
-                    "a chattering contact, or a horizon too long for the limit",
+                    + _chatter(event_kinds[-100:]),
                 )
             mode, x = sys.next_mode(t, x, mode, kind)
         elif mode[2] == 0:  # a jump of the reference: a stuck motor may slip at once
@@ -507,6 +507,25 @@ def simulate(
                 event_times.append(t)
                 event_kinds.append("slips")
     return _record(sys, pieces, event_times, event_kinds, reference)
+
+
+#: The events of the motor's friction (:meth:`_System.next_mode`).
+_FRICTION_EVENTS = ("stops", "sticks", "slips")
+
+
+def _chatter(kinds: list[str]) -> str:
+    """What the last events say of a run past its event limit: the motor sticking and
+    slipping ever faster at its friction (an integral action, e.g. a cascade's speed
+    integrator, winding up against it: the hybrid friction model has no dwell, so the
+    switches accumulate), a chattering contact, or a horizon too long for the limit."""
+    friction = sum(kind in _FRICTION_EVENTS for kind in kinds)
+    if friction > len(kinds) // 2:
+        return (
+            "the motor sticks and slips ever faster at its friction torque (an integral "
+            "action winding up against it); a shorter horizon, no integral action, or "
+            "[motor] friction_torque = 0 simulates it"
+        )
+    return "a chattering contact, or a horizon too long for the limit"
 
 
 def _record(sys: _System, pieces, event_times, event_kinds, reference) -> LoopSimulation:

@@ -16,8 +16,11 @@ import pytest
 from cli_refusal import command_line_refusal
 
 import optdesign as od
+from optdesign.errors import InputError
 from optdesign.models import loop_linear as ll
 from optdesign.models.loop_plant import CascadeLoop, PositionLoop
+from optdesign.models.loop_references import StepReference
+from optdesign.models.loop_simulation import simulate
 from optdesign.problem.loop import (
     bandwidth_factor,
     drive_plants_of,
@@ -25,6 +28,7 @@ from optdesign.problem.loop import (
     loop_gains,
     position_loop,
 )
+from optdesign.problem.loop_time import design_plant
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBLEMS = ROOT / "problems"
@@ -173,6 +177,12 @@ def test_fin_actuator_cascade_keeps_the_10_mm_pins(problem):
     tail = np.degrees(r.fin_angle[r.times > 0.8])
     assert tail.mean() == pytest.approx(1.0, abs=2e-3)
     assert np.ptp(tail) < 1e-3
+    # held longer, the speed integrator winds up against the motor's friction at rest and
+    # the motor sticks and slips ever faster (the hybrid friction has no dwell): the run
+    # is refused at its event limit saying so, not returned as a number
+    at = design_plant(problem, result.design, "0 deg")
+    with pytest.raises(InputError, match=r"^max_events: .*the motor sticks and slips ever"):
+        simulate(at.plant, at.loop, StepReference(math.radians(1.0)), 2.0, 101, max_events=300)
 
 
 # --- refusals ---------------------------------------------------------------------------
