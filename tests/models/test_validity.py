@@ -93,6 +93,7 @@ def test_every_model_declares_its_ranges_once_and_says_why():
         "_checks",
         "validity_registry",
         "impossibility",  # the record of a mechanism's proof: no model, no range
+        "loop_run",  # the record of a simulated run: its ranges are loop_simulation's
     }
     ranges = validity_registry.declared_ranges()
     for module in validity_registry.MODEL_MODULES:
