@@ -96,7 +96,8 @@ class NodeSolver:
             # the caller's.
             options = {**node, **solver_options(problem, solver), **(options or {})}
         self.backend = solver_for(problem, solver, options, names)
-        self._relaxed_args = (solver, options, names)
+        # the options solver_for built the backend with, for the relaxed backend's
+        self._options = {**solver_options(problem, solver), **(options or {})}
         # built on the first relaxed node (see :meth:`relaxed_backend`); False: none
         self._relaxed = None if thinned else False
         self.verdicts = solver_hints(solver).infeasible_verdicts
@@ -140,30 +141,28 @@ class NodeSolver:
     def relaxed_backend(self):
         """The solver of the node NLP with the rows of every other grid angle only
         (:func:`thinned_angles`: 31 of 61), for a node that holds more than one item
-        combination. Only rows are
-        left out - the objective, the variables and every row not tied to one angle
-        (a mean ratio, the nut travel, the life, the epsilon rows) are the node's own -
-        so its optimum is a relaxation of the node's, never above it: a valid bound for
-        the search, at a lower cost per start (Ipopt's time per iteration follows the
-        rows). (The stand-in problem of the NLP's global search, a problem on fewer
-        angles, is not one: its grid's mean ratio is another number.) None when
-        the grid is not thinned, or when rows are left free by index (the diagnosis)."""
+        combination. Only rows are left out - the objective, the variables, the targets
+        and every row not tied to one angle (a mean ratio, the nut travel, the life, the
+        epsilon rows) are the node's own - so its optimum is a relaxation of the node's,
+        never above it: a valid bound for the search, at a lower cost per start (Ipopt's
+        time per iteration follows the rows). (The stand-in problem of the NLP's global
+        search, a problem on fewer angles, is not one: its grid's mean ratio is another
+        number.) None when the grid is not thinned, or when rows are left free by index
+        (the diagnosis)."""
         if self._relaxed is None:
             keep = thinned_rows(self.problem, self.nlp)
             if keep is None or self.free_rows.size:
                 self._relaxed = False
             else:
-                solver, options, _ = self._relaxed_args
-                opts = {**solver_options(self.problem, solver), **(options or {})}
-                self._relaxed = make_solver(with_rows(self.nlp, keep), solver, opts)
+                self._relaxed = make_solver(with_rows(self.nlp, keep), self.solver, self._options)
                 self.relaxed_angles = len(thinned_angles(len(self.problem.phi)))
         return self._relaxed or None
 
     def _solve_start(self, item: tuple[Bounds, np.ndarray, bool]) -> Result:
         box, x0, relaxed = item
         backend = self.relaxed_backend() if relaxed else self.backend
-        target = self.target if backend is self.backend else backend.nlp.target(self.objective)
-        return backend.solve(backend.nlp.start(x0=x0, parameters=box.parameters), target, box)
+        # with_rows keeps the targets: the node's target serves both back-ends
+        return backend.solve(backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box)
 
     def _starts(
         self, box: Bounds, points, stop: Callable[[list[Result]], bool], backend
