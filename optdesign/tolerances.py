@@ -21,3 +21,10 @@ FEASIBILITY_TOL = 1e-6
 #: |value| and 1e-12: the multistart's agreement and best start, the catalogue search's
 #: pruning and incumbent, the optimal set's ranges.
 OBJECTIVE_TIE_TOL = 1e-6
+
+#: A constraint row a solve left out (a solve on a subset of the rows: every other grid
+#: angle) counts as met at that solve's point when it is within this of its bound on the
+#: solver's scaled rows - the NLP back-ends' own constraint tolerance (Ipopt's
+#: ``constr_viol_tol``), so the point is what a solve on every row could have returned
+#: (:func:`optdesign.solvers.base.on_every_row`).
+LEFT_OUT_ROW_TOL = 1e-9

@@ -24,7 +24,7 @@ from optdesign.solvers.result import (
     TerminationCondition,
 )
 from optdesign.solvers.solved_point import SOLVED_STATUSES
-from optdesign.tolerances import FEASIBILITY_TOL
+from optdesign.tolerances import FEASIBILITY_TOL, LEFT_OUT_ROW_TOL
 
 
 @dataclass
@@ -158,6 +158,56 @@ def make_result(
         max_violation=float(max_viol),
         raw={"z": z, "lam_x": np.asarray(lam_x, dtype=float).ravel(), "lam_g": lam_g},
     )
+
+
+def on_every_row(
+    result: Result,
+    nlp: NLP,
+    rows: np.ndarray,
+    target: Target,
+    bounds: Bounds,
+    tol: float = LEFT_OUT_ROW_TOL,
+) -> tuple[Result, bool]:
+    """A solve of ``with_rows(nlp, rows)`` as a solve of ``nlp`` itself.
+
+    The point, its multipliers (zero on every row left out) and its reports on every row
+    of ``nlp`` under ``bounds`` (the whole problem's); True when every row left out is met
+    within ``tol`` at the point. Then the point is a KKT point of ``nlp`` to the solver's
+    tolerances (the rows left out are inactive there, with zero multipliers), i.e. what a
+    solve of ``nlp`` could have returned; otherwise the result is not one (a solved
+    status then reads ``infeasible``, as :func:`make_result` calls a point that misses a
+    row)."""
+    z = result.raw.get("z")
+    if z is None:  # nothing solved (an evaluation error): no point to lift
+        return result, False
+    rows = np.asarray(rows, dtype=int)
+    lam_g = np.zeros(len(nlp.g_names))
+    if result.raw.get("lam_g") is not None:
+        lam_g[rows] = np.asarray(result.raw["lam_g"], dtype=float).ravel()
+    theta = nlp.parameter_values(bounds.parameters)
+    g = np.asarray(nlp.g_fun(z, theta), dtype=float).ravel()
+    lo, hi = np.asarray(bounds.lbg, dtype=float), np.asarray(bounds.ubg, dtype=float)
+    with np.errstate(invalid="ignore"):
+        miss = np.maximum(lo - g, g - hi)
+    left_out = np.ones(g.size, dtype=bool)
+    left_out[rows] = False
+    met = bool(np.all(miss[left_out] <= tol))  # NaN: not met
+    lifted = make_result(
+        result.solver,
+        nlp,
+        target,
+        bounds,
+        z,
+        result.raw.get("lam_x", np.zeros_like(z)),
+        lam_g,
+        result.status,
+        result.termination,
+        result.message,
+        result.iterations,
+        dict(result.n_evals),
+        result.wall_time_s,
+    )
+    return lifted, met
 
 
 def failed_result(

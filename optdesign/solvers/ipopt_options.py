@@ -30,9 +30,13 @@ IPOPT_RANGE: dict[str, Any] = {**IPOPT_WARM, "tol": 1e-7}
 #: small initial barrier parameter and bound push keep Ipopt there instead of pushing it
 #: back into the interior. A tie-break that converges takes a few dozen iterations; one
 #: that stalls on the degenerate set is given up at 150 (the caller then tries Ipopt's
-#: defaults) rather than at the default 500.
+#: defaults) rather than at the default 500. The barrier starts at 1e-4: from 1e-5 the
+#: adaptive barrier stalled on cs_min_backlash's ripple tie-break (150 iterations, then
+#: the fallback's 47), which 1e-4 solves in 26; over the tie-breaks of 8 fronts of four
+#: mechanisms none falls back, the fronts equal to 1e-7 (benchmarks/README.md, "Catalogue
+#: starts checked on every other grid angle").
 IPOPT_TIE: dict[str, Any] = {
-    "mu_init": 1e-5,
+    "mu_init": 1e-4,
     "bound_push": 1e-6,
     "bound_frac": 1e-6,
     "max_iter": 150,

@@ -92,6 +92,11 @@ class CatalogueDetails:
     thinned_solves
         Of those, the solves on every other grid angle (nodes of several item
         combinations).
+    checked_starts, resolved_starts
+        Starts solved on every other grid angle first (each leaf's, each node's of a
+        search that prunes ties): those whose point met every row left out and was kept
+        (a KKT point of the node's own NLP, no solve on the whole grid), and those solved
+        again on the whole grid from there (each counted twice in ``nlp_solves``).
     items
         The items chosen (None: no feasible combination).
     gap_to_relaxation_rel
@@ -117,6 +122,8 @@ class CatalogueDetails:
     minlp: MINLPDetails | None = None
     nlp_solves: int = 0
     thinned_solves: int = 0
+    checked_starts: int = 0
+    resolved_starts: int = 0
     items: dict[str, float] | None = None
     gap_to_relaxation_rel: float | None = None
     #: The boxes the search proved infeasible, with the epsilon limits of each proof

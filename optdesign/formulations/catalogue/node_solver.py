@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -16,11 +17,17 @@ from optdesign.formulations.catalogue.bnb import RELAXED, trusted
 from optdesign.formulations.catalogue.discrete import (
     discrete_variables,
 )
-from optdesign.formulations.nlp.solve import _objective_set, solver_for, solver_options
+from optdesign.formulations.nlp.solve import (
+    _objective_set,
+    rows_solver_for,
+    solver_for,
+    solver_options,
+)
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
-from optdesign.programs.nlp import NLP, Bounds, with_rows
+from optdesign.programs.nlp import NLP, Bounds
 from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
+from optdesign.solvers.base import on_every_row
 from optdesign.solvers.multistart import (
     best_of,
     improves,
@@ -28,9 +35,13 @@ from optdesign.solvers.multistart import (
     sobol_starts,
     start_outcome,
 )
-from optdesign.solvers.registry import default_solver, make_solver, solver_hints
+from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.solvers.result import MultistartInfo, Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
+
+#: The key of a start's ``raw`` record when it was solved on the thinned grid first
+#: (:meth:`NodeSolver._solve_checked`): ``"kept"`` or ``"solved again"``.
+THINNED_START = "thinned_start"
 
 #: Starts per node when neither the caller nor the problem file sets them.
 NODE_STARTS = 4
@@ -72,6 +83,8 @@ class NodeSolver:
         workers: int = 1,
         agree: int = 0,
         thinned: bool = True,
+        checked: bool = True,
+        objectives: Sequence[str] = (),
     ):
         self.problem = problem
         #: A node's multistart stops once this many of its starts agree on the best value
@@ -85,8 +98,12 @@ class NodeSolver:
         self.free_rows = np.asarray(free_rows, dtype=int)
         self.objective = objective or problem.objective_names[0]
         self.eps = dict(eps or {})
+        # the problem's objectives, then every other one named (``objectives``, the
+        # epsilon limits', this one's) in one order, so that searches of other targets
+        # and limits over the same objectives share one NLP and its solvers
         names = _objective_set(problem, self.objective)
-        names = tuple(dict.fromkeys([*names, *sorted(self.eps)]))
+        others = sorted({*objectives, *self.eps, *names} - set(problem.objective_names))
+        names = tuple(dict.fromkeys([*problem.objective_names, *others]))
         solver = self.solver = solver or default_solver("nlp")
         node = solver_hints(solver).node_options
         if node is not None:
@@ -98,8 +115,15 @@ class NodeSolver:
         self.backend = solver_for(problem, solver, options, names)
         # the options solver_for built the backend with, for the relaxed backend's
         self._options = {**solver_options(problem, solver), **(options or {})}
-        # built on the first relaxed node (see :meth:`relaxed_backend`); False: none
-        self._relaxed = None if thinned else False
+        # the solver of the thinned grid, built on first use (see :meth:`relaxed_backend`;
+        # False: the grid is not thinned), and its rows
+        self._thinned = None
+        self._thinned_rows: np.ndarray | None = None
+        #: nodes of several item combinations are solved on the thinned grid (relaxations)
+        self.thinned_nodes = bool(thinned)
+        #: every other start first on the thinned grid, kept when its point meets every row
+        #: (:meth:`_solve_checked`)
+        self.checked = bool(checked)
         self.verdicts = solver_hints(solver).infeasible_verdicts
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
@@ -107,7 +131,11 @@ class NodeSolver:
         self.seed = seed
         self.names = [v.name for v in problem.free]
         self.n_solves = 0
-        self.n_thinned = 0  # of those, on the thinned grid
+        self.n_thinned = 0  # of those, on the thinned grid (relaxations)
+        #: starts solved on the thinned grid whose point met every row (no solve on the
+        #: whole grid), and those solved again on the whole grid from there
+        self.n_checked = 0
+        self.n_resolved = 0
         self.relaxed_angles = 0  # the thinned grid's angles, once built
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
@@ -130,7 +158,7 @@ class NodeSolver:
         if self.workers <= 1:
             yield
             return
-        self.relaxed_backend()  # built once, before the workers inherit it
+        self.thinned_backend()  # built once, before the workers inherit it
         with InheritedWorkers(self._solve_start, self.workers) as workers:
             self._workers = workers
             try:
@@ -138,37 +166,96 @@ class NodeSolver:
             finally:
                 self._workers = None
 
-    def relaxed_backend(self):
+    def thinned_backend(self):
         """The solver of the node NLP with the rows of every other grid angle only
-        (:func:`thinned_angles`: 31 of 61), for a node that holds more than one item
-        combination. Only rows are left out - the objective, the variables, the targets
-        and every row not tied to one angle (a mean ratio, the nut travel, the life, the
-        epsilon rows) are the node's own - so its optimum is a relaxation of the node's,
-        never above it: a valid bound for the search, at a lower cost per start (Ipopt's
+        (:func:`thinned_angles`: 31 of 61). Only rows are left out - the objective, the
+        variables, the targets and every row not tied to one angle (a mean ratio, the
+        nut travel, the life, the epsilon rows) are the node's own - so its optimum is a
+        relaxation of the node's, never above it, at a lower cost per start (Ipopt's
         time per iteration follows the rows). (The stand-in problem of the NLP's global
         search, a problem on fewer angles, is not one: its grid's mean ratio is another
         number.) None when the grid is not thinned, or when rows are left free by index
         (the diagnosis)."""
-        if self._relaxed is None:
+        if self._thinned is None:
             keep = thinned_rows(self.problem, self.nlp)
             if keep is None or self.free_rows.size:
-                self._relaxed = False
+                self._thinned = False
             else:
-                self._relaxed = make_solver(with_rows(self.nlp, keep), self.solver, self._options)
+                self._thinned = rows_solver_for(self.backend, keep, self._options)
+                self._thinned_rows = np.asarray(keep, dtype=int)
                 self.relaxed_angles = len(thinned_angles(len(self.problem.phi)))
-        return self._relaxed or None
+        return self._thinned or None
 
-    def _solve_start(self, item: tuple[Bounds, np.ndarray, bool]) -> Result:
-        box, x0, relaxed = item
-        backend = self.relaxed_backend() if relaxed else self.backend
-        # with_rows keeps the targets: the node's target serves both back-ends
-        return backend.solve(backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box)
+    def relaxed_backend(self):
+        """The thinned grid's solver (:meth:`thinned_backend`) for a node that holds more
+        than one item combination, when such nodes may be relaxed (``thinned``): its
+        value bounds the box's, which is all a node of the search needs. None otherwise."""
+        return self.thinned_backend() if self.thinned_nodes else None
+
+    def _mode(self, backend) -> str:
+        """How a node's starts are solved: ``"relaxed"`` (on the thinned grid's back-end,
+        ``backend``), ``"checked"`` (:meth:`_solve_checked`) or ``"whole"``. Checked while
+        it pays: while no more of this solver's checked starts were solved again than were
+        kept. Where a row between the kept angles binds at every design (e.g. an objective
+        that is a peak over the stroke, which falls between them as often as not), each
+        checked start costs a thinned solve more, so after the first such node the
+        starts are solved on the whole grid. Decided here, in this process, per node:
+        any number of workers solves the same starts the same way."""
+        if backend is not self.backend:
+            return "relaxed"
+        if self.checked and self.n_resolved <= self.n_checked and self.thinned_backend():
+            return "checked"
+        return "whole"
+
+    def _solve_start(self, item: tuple[Bounds, np.ndarray, str]) -> Result:
+        box, x0, mode = item
+        if mode == "relaxed":
+            backend = self.relaxed_backend()
+            # with_rows keeps the targets: the node's target serves both back-ends
+            return backend.solve(
+                backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box
+            )
+        if mode == "checked":
+            return self._solve_checked(self.thinned_backend(), box, x0)
+        return self.backend.solve(
+            self.backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box
+        )
+
+    def _solve_checked(self, thinned, box: Bounds, x0: np.ndarray) -> Result:
+        """One start of a node solved on the whole grid, first on the thinned grid.
+
+        The thinned solve's point is kept when it meets every row left out within the
+        back-end's own constraint tolerance (:func:`~optdesign.solvers.base.on_every_row`):
+        it is then a KKT point of the node's NLP, what a solve on every row could have
+        returned, at about half the cost per iteration and often in fewer iterations.
+        Otherwise the node's NLP is solved from that point (a row between the kept
+        angles binds: a few iterations more). A thinned start that ends otherwise is
+        the start's outcome: the back-end's verdict of local infeasibility (no point
+        near it meets the kept rows, so none meets them all), or a stop (iteration
+        limit, error) that leaves the node to its other starts and retries, as on the
+        whole grid. ``raw[THINNED_START]`` says which (``"kept"``,
+        ``"solved again"``)."""
+        rows = self._thinned_rows
+        tbox = replace(box, lbg=np.asarray(box.lbg)[rows], ubg=np.asarray(box.ubg)[rows])
+        first = thinned.solve(
+            thinned.nlp.start(x0=x0, parameters=box.parameters), self.target, tbox
+        )
+        lifted, met = on_every_row(first, self.nlp, rows, self.target, box)
+        if met or not first.success:
+            lifted.raw[THINNED_START] = "kept"
+            return lifted
+        result = self.backend.solve(self.nlp.start(z0=first.raw["z"]), self.target, box)
+        result.raw[THINNED_START] = "solved again"
+        result.wall_time_s = (result.wall_time_s or 0.0) + (first.wall_time_s or 0.0)
+        if result.iterations is not None and first.iterations is not None:
+            result.iterations += first.iterations
+        return result
 
     def _starts(
         self, box: Bounds, points, stop: Callable[[list[Result]], bool], backend
     ) -> list[Result]:
-        relaxed = backend is not self.backend
-        items = [(box, np.asarray(p, dtype=float), relaxed) for p in points]
+        mode = self._mode(backend)
+        items = [(box, np.asarray(p, dtype=float), mode) for p in points]
         if self._workers is None:
             return map_serial(self._solve_start, items, stop)
         return self._workers.map(items, stop)
@@ -238,8 +325,6 @@ class NodeSolver:
         backend = (None if one or not relaxed else self.relaxed_backend()) or self.backend
         box = backend.nlp.bounds(eps=self.eps, box=bounds, parameters=params)
         if self.free_rows.size:
-            from dataclasses import replace
-
             lbg, ubg = np.array(box.lbg, dtype=float), np.array(box.ubg, dtype=float)
             lbg[self.free_rows], ubg[self.free_rows] = -np.inf, np.inf
             box = replace(box, lbg=lbg, ubg=ubg)
@@ -257,7 +342,7 @@ class NodeSolver:
 
         results: list[Result] = []
         if warm and x_hint is not None:
-            results.append(self._solve_start((box, pts.pop(0), backend is not self.backend)))
+            results.append(self._solve_start((box, pts.pop(0), self._mode(backend))))
             first_ok = results[0]
             if first_ok.success and (
                 prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
@@ -297,6 +382,12 @@ class NodeSolver:
         self.n_solves += len(results)
         if backend is not self.backend:
             self.n_thinned += len(results)
+        for r in results:
+            how = r.raw.get(THINNED_START)
+            self.n_checked += how == "kept"
+            if how == "solved again":  # two NLP solves for this start
+                self.n_resolved += 1
+                self.n_solves += 1
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
         best.multistart = MultistartInfo(

@@ -102,6 +102,8 @@ def solve_catalogue(
     workers: int = 1,
     agree: int | None = None,
     thinned_nodes: bool = True,
+    thinned_starts: bool = True,
+    objectives: Sequence[str] = (),
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -147,6 +149,15 @@ def solve_catalogue(
         with the incumbent (``ties`` False, an anchor's first stage) prunes none on a
         thinned bound, which lies below the tie wherever the objective peaks between the
         kept angles.
+    thinned_starts
+        Solve every other start (a leaf's, a node's of an anchor's first stage) on the
+        thinned grid first and keep its point when it meets every row left out
+        (:meth:`NodeSolver._solve_checked`): a KKT point of the node's own NLP; otherwise
+        solve the node's NLP from there.
+    objectives
+        Other objectives the node NLP holds (as targets, unbounded unless in ``eps``):
+        a front passes both of its objectives to each of its searches, so that the
+        anchors, tie-breaks and points share one NLP and its solvers, built once.
 
     Returns
     -------
@@ -196,6 +207,8 @@ def solve_catalogue(
         workers=workers,
         agree=agree,
         thinned=thinned_nodes and ties,
+        checked=thinned_starts,
+        objectives=objectives,
     )
     with ns.on_workers():
         ns.memo = memo
@@ -233,6 +246,7 @@ def solve_catalogue(
             info.seeded = stats["seeded"]
             info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
         info.nlp_solves, info.thinned_solves = ns.n_solves, ns.n_thinned
+        info.checked_starts, info.resolved_starts = ns.n_checked, ns.n_resolved
         info.infeasible_boxes = ns.proofs.proofs
         wall = time.perf_counter() - t0
         if best is None:
@@ -282,11 +296,26 @@ def solve_catalogue(
         how = f"{method} ({info.minlp.solver} {info.minlp.algorithm})" if info.minlp else method
         best.notes.append(
             f"catalogue items chosen: {items}; {bound}; {how}, {info.nlp_solves} NLP solves"
-            + (f" ({info.thinned_solves} on every other grid angle)" if info.thinned_solves else "")
+            + _grid_note(info)
         )
         if excluded:
             best.notes.append("excluded before the search: " + "; ".join(excluded))
         return finish(problem, best, objective)
+
+
+def _grid_note(info: CatalogueDetails) -> str:
+    """What the summary says of the solves on every other grid angle: the relaxed nodes,
+    and the starts solved there first (kept where their point met every row)."""
+    parts = []
+    if info.thinned_solves:
+        parts.append(f"{info.thinned_solves} node solves on every other grid angle")
+    if info.checked_starts:
+        parts.append(
+            f"{info.checked_starts} starts solved there and kept: their points met every row"
+        )
+    if info.resolved_starts:
+        parts.append(f"{info.resolved_starts} starts solved there, then on the whole grid")
+    return f" ({'; '.join(parts)})" if parts else ""
 
 
 def relaxation_bound(result: Result) -> float:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import threading
 from collections import OrderedDict
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,7 @@ from optdesign.formulations.verify import nan_notes, verify_design
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
-from optdesign.programs.nlp import NLP, VAR, build_nlp
+from optdesign.programs.nlp import NLP, VAR, build_nlp, with_rows
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.search.global_phase import default_max_starts, global_search, search_globality
 from optdesign.search.starts import TiltedStarts, problem_evaluator
@@ -100,6 +100,25 @@ def solver_for(
     opts.update(options or {})
     key = (nlp.fingerprint, name, json.dumps(opts, sort_keys=True, default=str))
     return _remember(_SOLVERS, key, lambda: make_solver(nlp, name, opts))
+
+
+def rows_solver_for(backend, rows: Sequence[int], options: Mapping[str, Any]):
+    """The back-end of ``backend``'s NLP with only the constraint rows ``rows``
+    (:func:`~optdesign.programs.nlp.with_rows`; a catalogue node on every other grid
+    angle), with ``options``: built once per process, NLP, rows and options, as
+    :func:`solver_for` builds the whole NLP's (every search of a front, each with its
+    own node solver, shares it)."""
+    nlp = backend.nlp
+    opts = dict(options)
+    rows = tuple(int(k) for k in rows)
+    key = (
+        nlp.fingerprint,
+        "rows",
+        rows,
+        backend.name,
+        json.dumps(opts, sort_keys=True, default=str),
+    )
+    return _remember(_SOLVERS, key, lambda: make_solver(with_rows(nlp, rows), backend.name, opts))
 
 
 def phase_one_for(

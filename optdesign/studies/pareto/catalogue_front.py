@@ -71,6 +71,7 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
         # an anchor's first stage gives its tie-break the optimal value (and a first
         # incumbent); the tie-break decides the design, so the first stage leaves ties
         ties=task["kind"] != "anchor-multistart",
+        objectives=task.get("objectives", ()),
         **front_knowledge(task, deps),
     )
     if task["kind"] == "anchor-multistart" and not result.success and not result.design:
@@ -144,7 +145,12 @@ class CatalogueEpsilon(FrontMethod):
 
     def trace(self, ctx: FrontRun) -> Traced:
         a, b = ctx.objectives
-        common = {"problem": ctx.problem, "starts": ctx.starts, "seed": ctx.seed}
+        common = {
+            "problem": ctx.problem,
+            "starts": ctx.starts,
+            "seed": ctx.seed,
+            "objectives": (a, b),  # one node NLP for every search of the front
+        }
         tasks = []
         for first, second in ((a, b), (b, a)):
             tasks.append(
