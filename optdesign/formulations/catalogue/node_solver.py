@@ -457,17 +457,19 @@ def thinned_angles(points: int) -> list[int]:
 def thinned_rows(problem: DesignProblem, nlp: NLP) -> list[int] | None:
     """The rows of ``nlp`` a node of several item combinations keeps: every row not
     labelled with a grid angle, and those of :func:`thinned_angles` (the NLP's rows are
-    named ``NAME[phi=+12.0deg]``); None when every angle is kept."""
+    named ``NAME[phi=+12.0deg]``); None when every angle is kept, or when no row is left
+    out (no row of the NLP names an angle the thinned grid leaves out)."""
     angles = thinned_angles(len(problem.phi))
     if len(angles) == len(problem.phi):
         return None
     labels = set(problem.phi_labels)
     kept = {problem.phi_labels[k] for k in angles}
-    return [
+    rows = [
         k
         for k, name in enumerate(nlp.g_names)
         if not (lab := _angle_label(name)) or lab not in labels or lab in kept
     ]
+    return rows if len(rows) < len(nlp.g_names) else None
 
 
 def _angle_label(name: str) -> str:

@@ -81,3 +81,15 @@ def test_a_thinned_node_bounds_the_same_node_on_the_whole_grid(fin, box):
     assert thinned.details["relaxed_grid"] == 31 and "relaxed_grid" not in whole.details
     assert thinned.success and whole.success
     assert thinned.objective <= whole.objective * (1 + 1e-7)
+
+
+def test_an_nlp_whose_rows_name_no_angle_is_not_thinned(fin):
+    """A user's rows without grid-angle labels: nothing to leave out, so no second solver
+    of the same rows (and no start solved twice on it)."""
+    from types import SimpleNamespace
+
+    problem, nlp = fin
+    unlabelled = SimpleNamespace(g_names=[f"row_{k}" for k in range(len(nlp.g_names))])
+    assert thinned_rows(problem, unlabelled) is None
+    one_left_out = SimpleNamespace(g_names=["mean_ratio", f"stress[{problem.phi_labels[1]}]"])
+    assert thinned_rows(problem, one_left_out) == [0]

@@ -180,6 +180,7 @@ def test_a_point_limits_its_first_objective_between_the_anchors(problem, asked):
     # the nearer anchor's design first (0.25: the ripple anchor), then the other
     assert kw["incumbents"] == [{"R": 40.0}, {"R": 60.0}]
     assert kw["memo"] is None
+    assert kw["objectives"] == ()  # a task written before the front passed its objectives
 
 
 def test_a_frame_whose_far_anchor_lies_below_the_near_one_is_held_at_the_near_limit(problem, asked):
@@ -305,6 +306,8 @@ def test_the_plan_two_anchors_in_two_stages_then_evenly_spaced_points(problem):
         assert t["after"] == ["anchor-ripple", "anchor-backlash"]
         assert t["eps_name"] == "ripple"
     assert all((t["problem"], t["starts"], t["seed"]) == (problem, 2, 5) for t in tasks)
+    # every search holds both objectives: one node NLP (and its solvers) for the front
+    assert all(t["objectives"] == ("ripple", "backlash") for t in tasks)
     # run side by side: no chain, no memo
     assert not any("memo" in t or "previous" in t for t in tasks)
     assert [r.id for r in traced.records] == [t["id"] for t in tasks[4:]]
@@ -441,3 +444,22 @@ def test_every_search_of_a_catalogue_front_takes_the_fronts_seed(monkeypatch, tm
     monkeypatch.setattr(catalogue_front, "solve_catalogue", spy)
     od.pareto(problem, ["backlash", "motor_torque"], 3, out=tmp_path, starts=1, seed=5)
     assert seeds and set(seeds) == {5}
+
+
+def test_every_search_of_a_catalogue_front_solves_one_node_nlp(small_front, monkeypatch):
+    """The anchors' first stages, their tie-breaks and the points pass both objectives to
+    their node solvers: one NLP, so its solvers are built once for the front."""
+    from optdesign.formulations.catalogue import node_solver
+
+    problem, _, _ = small_front
+    seen = []
+    init = node_solver.NodeSolver.__init__
+
+    def record(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        seen.append((self.objective, self.nlp.fingerprint))
+
+    monkeypatch.setattr(node_solver.NodeSolver, "__init__", record)
+    od.pareto(problem, ["backlash", "motor_torque"], points=3, starts=2, workers=1, files=False)
+    assert {objective for objective, _ in seen} == {"backlash", "motor_torque"}
+    assert len({fingerprint for _, fingerprint in seen}) == 1
