@@ -253,11 +253,22 @@ def _judge(case: Case, code: Any, out: str, err: str, json_mode: bool) -> str:
         value = doc["objective"]["value"]
         if code == 0:
             return "success" if value is not None and math.isfinite(value) else "NaN success"
-        named = doc.get("violated") or (doc.get("diagnosis") or {}).get("note")
+        diagnosis = doc.get("diagnosis") or {}
+        # violated rows at the best point, the diagnosis's relaxations, or a proof before
+        # any solve that names the requirements no design can meet together
+        named = (
+            doc.get("violated")
+            or diagnosis.get("note")
+            or any(entry.get("requirements") for entry in diagnosis.get("impossible") or [])
+        )
         return "infeasible" if named else "infeasible naming nothing"
     if code == 0:
         return "success" if re.search(r"^objective \S+ = [-0-9.]", out, re.M) else "NaN success"
-    named = "violated requirements:" in out or "diagnosis:" in out
+    named = (
+        "violated requirements:" in out
+        or "diagnosis:" in out
+        or "no design within the bounds can meet these together" in out
+    )
     return "infeasible" if named else "infeasible naming nothing"
 
 

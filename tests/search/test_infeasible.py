@@ -1,6 +1,6 @@
 """optdesign.search.infeasible through the global search: a search whose starts fail
-stops once the phase-1 solves of ``min(agree, max_starts)`` starts certify a positive
-least violation, marked infeasible with its outcomes; a phase-1 solve that meets every
+stops once the phase-1 solves of ``min(agree, max_starts)`` starts certify the same
+positive least violation, marked infeasible with its outcomes; a phase-1 solve that meets every
 row sends it back to the full solves, whose starts are then those of a search without
 phase 1; a search that converges never asks for one."""
 
@@ -55,7 +55,8 @@ class Calls:
 
 
 def test_starts_that_agree_on_a_positive_least_violation_stop_the_search_as_infeasible():
-    calls = Calls(_failed, lambda k, end: _least(0.2 + 0.1 * (k > 1)))
+    # the same minimum to within the tie (1e-4 relative) from three starts
+    calls = Calls(_failed, lambda k, end: _least(0.2 * (1 + 1e-6 * k)))
     best = global_search(
         calls.solve, _starts(), max_starts=32, agree=3, least_violation=calls.least_violation
     )
@@ -67,7 +68,32 @@ def test_starts_that_agree_on_a_positive_least_violation_stop_the_search_as_infe
     assert ms.outcomes == ["iteration limit", CERTIFIED, CERTIFIED]
     assert ms.n_starts == 3 and ms.n_converged == 0
     assert "least violation 0.2 (phase 1, 3 starts)" in best.message
-    assert any("1 of them reached it" in note for note in best.notes)
+    assert any("3 of them reached it" in note for note in best.notes)
+
+
+def test_starts_at_different_positive_minima_do_not_agree_on_infeasibility():
+    """Each start certifies a positive least violation, but not the same one (a
+    violation with several local minima, where another start may reach zero): the
+    search runs on to its limit of failed starts and says no start was feasible, never
+    that the problem is infeasible."""
+    calls = Calls(_failed, lambda k, end: _least(0.2 if k == 1 else 0.3 + 0.1 * k))
+    best = global_search(
+        calls.solve, _starts(), max_starts=32, agree=3, least_violation=calls.least_violation
+    )
+    assert best.multistart.stop == "no feasible start"
+    assert best.status == "max_iterations" and "phase 1" not in best.message
+    assert calls.phase_ones == 8  # FAILED_LIMIT starts, each certified, none agreeing
+
+
+def test_a_later_start_at_the_least_violation_completes_the_agreement():
+    values = iter([0.2, 0.35, 0.2, 0.5, 0.2])
+    calls = Calls(_failed, lambda k, end: _least(next(values)))
+    best = global_search(
+        calls.solve, _starts(), max_starts=32, agree=3, least_violation=calls.least_violation
+    )
+    assert best.multistart.stop == "least violation" and best.status == "infeasible"
+    assert calls.phase_ones == 5
+    assert any("3 of them reached it" in note for note in best.notes)
 
 
 def test_the_agreement_needed_is_capped_by_the_starts_allowed():
