@@ -987,10 +987,16 @@ def test_an_enumerated_catalogue_result_records_its_search():
     assert len(info.enumerated) == 6 and info.nlp_solves >= 7
     note = next(n for n in r.notes if n.startswith("catalogue items chosen"))
     gap = 100 * info.gap_to_relaxation_rel
+    # enumeration relaxes no node; its combinations' starts are solved on every other
+    # grid angle first, kept or solved again on the whole grid (both counted)
+    assert info.thinned_solves == 0 and info.checked_starts + info.resolved_starts > 0
+    grid = [f"{info.checked_starts} starts first, kept: their points met every row"]
+    if info.resolved_starts:
+        grid.append(f"{info.resolved_starts} starts first, then on the whole grid")
     assert note == (
         f"catalogue items chosen: p = 6 mm, d = 6; continuous relaxation bound "
         f"{r.bound:.8g} (discrete optimum {gap:+.3f} % above it); enumerate, "
-        f"{info.nlp_solves} NLP solves"
+        f"{info.nlp_solves} NLP solves (on every other grid angle: {'; '.join(grid)})"
     )
 
 
