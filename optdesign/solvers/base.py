@@ -160,6 +160,16 @@ def make_result(
     )
 
 
+def row_misses(nlp: NLP, z: np.ndarray, bounds: Bounds) -> np.ndarray:
+    """How far the point ``z`` misses each row of ``nlp`` under ``bounds`` (scaled, as
+    the solver sees the rows; <= 0 met, NaN where a row is not a number)."""
+    theta = nlp.parameter_values(bounds.parameters)
+    g = np.asarray(nlp.g_fun(z, theta), dtype=float).ravel()
+    lo, hi = np.asarray(bounds.lbg, dtype=float), np.asarray(bounds.ubg, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.maximum(lo - g, g - hi)
+
+
 def on_every_row(
     result: Result,
     nlp: NLP,
@@ -184,12 +194,8 @@ def on_every_row(
     lam_g = np.zeros(len(nlp.g_names))
     if result.raw.get("lam_g") is not None:
         lam_g[rows] = np.asarray(result.raw["lam_g"], dtype=float).ravel()
-    theta = nlp.parameter_values(bounds.parameters)
-    g = np.asarray(nlp.g_fun(z, theta), dtype=float).ravel()
-    lo, hi = np.asarray(bounds.lbg, dtype=float), np.asarray(bounds.ubg, dtype=float)
-    with np.errstate(invalid="ignore"):
-        miss = np.maximum(lo - g, g - hi)
-    left_out = np.ones(g.size, dtype=bool)
+    miss = row_misses(nlp, z, bounds)
+    left_out = np.ones(miss.size, dtype=bool)
     left_out[rows] = False
     met = bool(np.all(miss[left_out] <= tol))  # NaN: not met
     lifted = make_result(

@@ -6,7 +6,7 @@ on forked workers (:class:`NodeSolver`). The search over the boxes is
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import replace
 from typing import Any
@@ -27,7 +27,7 @@ from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
 from optdesign.programs.nlp import NLP, Bounds
 from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
-from optdesign.solvers.base import on_every_row
+from optdesign.solvers.base import on_every_row, row_misses
 from optdesign.solvers.multistart import (
     best_of,
     improves,
@@ -37,11 +37,14 @@ from optdesign.solvers.multistart import (
 )
 from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.tolerances import OBJECTIVE_TIE_TOL
+from optdesign.tolerances import LEFT_OUT_ROW_TOL, OBJECTIVE_TIE_TOL
 
 #: The key of a start's ``raw`` record when it was solved on the thinned grid first
 #: (:meth:`NodeSolver._solve_checked`): ``"kept"`` or ``"solved again"``.
 THINNED_START = "thinned_start"
+#: The key of a checked start's ``raw`` record that lists the grid angles (labels) of the
+#: rows left out that its thinned point missed (:meth:`NodeSolver._solve_checked`).
+MISSED_ANGLES = "missed_angles"
 
 #: Starts per node when neither the caller nor the problem file sets them.
 NODE_STARTS = 4
@@ -119,6 +122,14 @@ class NodeSolver:
         # False: the grid is not thinned), and its rows
         self._thinned = None
         self._thinned_rows: np.ndarray | None = None
+        #: grid angles (labels) the thinned grid keeps besides its own: those where a
+        #: checked start's point missed a row left out (:meth:`_solve_checked`); the
+        #: thinned solver is built again for them before the next node
+        self.learned_angles: frozenset[str] = frozenset()
+        self._thinned_for: frozenset[str] | None = None
+        self._regrids = 0
+        #: (checked, resolved) starts before the thinned grid last changed
+        self._counted_from = (0, 0)
         #: nodes of several item combinations are solved on the thinned grid (relaxations)
         self.thinned_nodes = bool(thinned)
         #: every other start first on the thinned grid, kept when its point meets every row
@@ -168,7 +179,8 @@ class NodeSolver:
 
     def thinned_backend(self):
         """The solver of the node NLP with the rows of every other grid angle only
-        (:func:`thinned_angles`: 31 of 61). Only rows are left out - the objective, the
+        (:func:`thinned_angles`: 31 of 61), and of the angles this search learnt
+        (:attr:`learned_angles`; built again when they change). Only rows are left out - the objective, the
         variables, the targets and every row not tied to one angle (a mean ratio, the
         nut travel, the life, the epsilon rows) are the node's own - so its optimum is a
         relaxation of the node's, never above it, at a lower cost per start (Ipopt's
@@ -176,14 +188,16 @@ class NodeSolver:
         search, a problem on fewer angles, is not one: its grid's mean ratio is another
         number.) None when the grid is not thinned, or when rows are left free by index
         (the diagnosis)."""
-        if self._thinned is None:
-            keep = thinned_rows(self.problem, self.nlp)
+        if self._thinned is None or (self._thinned and self._thinned_for != self.learned_angles):
+            keep = thinned_rows(self.problem, self.nlp, self.learned_angles)
             if keep is None or self.free_rows.size:
                 self._thinned = False
             else:
                 self._thinned = rows_solver_for(self.backend, keep, self._options)
                 self._thinned_rows = np.asarray(keep, dtype=int)
-                self.relaxed_angles = len(thinned_angles(len(self.problem.phi)))
+                self._thinned_for = self.learned_angles
+                kept = {self.problem.phi_labels[k] for k in thinned_angles(len(self.problem.phi))}
+                self.relaxed_angles = len(kept | self.learned_angles)
         return self._thinned or None
 
     def relaxed_backend(self):
@@ -196,32 +210,42 @@ class NodeSolver:
         """How a node's starts are solved: ``"relaxed"`` (on the thinned grid's back-end,
         ``backend``), ``"checked"`` (:meth:`_solve_checked`) or ``"whole"``. Checked while
         it pays: while no more of this solver's checked starts were solved again than were
-        kept. Where a row between the kept angles binds at every design (e.g. an objective
-        that is a peak over the stroke, which falls between them as often as not), each
-        checked start costs a thinned solve more, so after the first such node the
-        starts are solved on the whole grid. Decided here, in this process, per node:
-        any number of workers solves the same starts the same way."""
+        kept since the thinned grid last changed. A start solved again names the angles
+        of the rows its thinned point missed (a peak between the kept angles: of a lock
+        force, a bearing pressure), and the next nodes' thinned grid keeps them, at most
+        :data:`MAX_REGRIDS` times a search; where the misses go on at new angles, the
+        starts are solved on the whole grid. Decided here, in this process, per node
+        and from the nodes before it: any number of workers solves the same starts the
+        same way."""
         if backend is not self.backend:
             return "relaxed"
-        if self.checked and self.n_resolved <= self.n_checked and self.thinned_backend():
+        checked, resolved = self._counted_from
+        if (
+            self.checked
+            and self.n_resolved - resolved <= self.n_checked - checked
+            and self.thinned_backend()
+        ):
             return "checked"
         return "whole"
 
-    def _solve_start(self, item: tuple[Bounds, np.ndarray, str]) -> Result:
-        box, x0, mode = item
+    def _solve_start(self, item: tuple[Bounds, np.ndarray, str, tuple[int, ...]]) -> Result:
+        box, x0, mode, rows = item
+        if mode in ("relaxed", "checked"):
+            # the node's thinned grid (a worker process builds it once for these rows;
+            # here it is the one built already)
+            backend = rows_solver_for(self.backend, rows, self._options)
         if mode == "relaxed":
-            backend = self.relaxed_backend()
             # with_rows keeps the targets: the node's target serves both back-ends
             return backend.solve(
                 backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box
             )
         if mode == "checked":
-            return self._solve_checked(self.thinned_backend(), box, x0)
+            return self._solve_checked(backend, np.asarray(rows, dtype=int), box, x0)
         return self.backend.solve(
             self.backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box
         )
 
-    def _solve_checked(self, thinned, box: Bounds, x0: np.ndarray) -> Result:
+    def _solve_checked(self, thinned, rows: np.ndarray, box: Bounds, x0: np.ndarray) -> Result:
         """One start of a node solved on the whole grid, first on the thinned grid.
 
         The thinned solve's point is kept when it meets every row left out within the
@@ -234,8 +258,7 @@ class NodeSolver:
         near it meets the kept rows, so none meets them all), or a stop (iteration
         limit, error) that leaves the node to its other starts and retries, as on the
         whole grid. ``raw[THINNED_START]`` says which (``"kept"``,
-        ``"solved again"``)."""
-        rows = self._thinned_rows
+        ``"solved again"``), ``raw[MISSED_ANGLES]`` where the rows it missed lie."""
         tbox = replace(box, lbg=np.asarray(box.lbg)[rows], ubg=np.asarray(box.ubg)[rows])
         first = thinned.solve(
             thinned.nlp.start(x0=x0, parameters=box.parameters), self.target, tbox
@@ -246,16 +269,23 @@ class NodeSolver:
             return lifted
         result = self.backend.solve(self.nlp.start(z0=first.raw["z"]), self.target, box)
         result.raw[THINNED_START] = "solved again"
+        result.raw[MISSED_ANGLES] = missed_angles(self.nlp, first.raw["z"], box, rows)
         result.wall_time_s = (result.wall_time_s or 0.0) + (first.wall_time_s or 0.0)
         if result.iterations is not None and first.iterations is not None:
             result.iterations += first.iterations
         return result
 
+    def _item(self, box: Bounds, x0, backend) -> tuple[Bounds, np.ndarray, str, tuple[int, ...]]:
+        """A start as :meth:`_solve_start` takes it (here or in a worker process): the
+        box, the point, how it is solved (:meth:`_mode`) and the thinned grid's rows."""
+        mode = self._mode(backend)
+        rows = () if mode == "whole" else tuple(int(k) for k in self._thinned_rows)
+        return box, np.asarray(x0, dtype=float), mode, rows
+
     def _starts(
         self, box: Bounds, points, stop: Callable[[list[Result]], bool], backend
     ) -> list[Result]:
-        mode = self._mode(backend)
-        items = [(box, np.asarray(p, dtype=float), mode) for p in points]
+        items = [self._item(box, p, backend) for p in points]
         if self._workers is None:
             return map_serial(self._solve_start, items, stop)
         return self._workers.map(items, stop)
@@ -342,7 +372,7 @@ class NodeSolver:
 
         results: list[Result] = []
         if warm and x_hint is not None:
-            results.append(self._solve_start((box, pts.pop(0), self._mode(backend))))
+            results.append(self._solve_start(self._item(box, pts.pop(0), backend)))
             first_ok = results[0]
             if first_ok.success and (
                 prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
@@ -382,12 +412,7 @@ class NodeSolver:
         self.n_solves += len(results)
         if backend is not self.backend:
             self.n_thinned += len(results)
-        for r in results:
-            how = r.raw.get(THINNED_START)
-            self.n_checked += how == "kept"
-            if how == "solved again":  # two NLP solves for this start
-                self.n_resolved += 1
-                self.n_solves += 1
+        self._note_checks(results)
         best, n_at_best = best_of(results)
         outcomes = [start_outcome(r) for r in results]
         best.multistart = MultistartInfo(
@@ -414,6 +439,23 @@ class NodeSolver:
             nodes.add(bounds, self.eps, self.objective, value, x, kept)
         return best
 
+    def _note_checks(self, results: Sequence[Result]) -> None:
+        """Count a node's checked starts (kept, or solved again: two NLP solves) and
+        learn the angles where the solved-again ones missed a row (:meth:`_mode`)."""
+        missed: set[str] = set()
+        for r in results:
+            how = r.raw.get(THINNED_START)
+            self.n_checked += how == "kept"
+            if how == "solved again":
+                self.n_resolved += 1
+                self.n_solves += 1
+                missed.update(r.raw.get(MISSED_ANGLES, ()))
+        if missed - self.learned_angles and self._regrids < MAX_REGRIDS:
+            # the next nodes' thinned grid keeps them, and its checks are counted afresh
+            self.learned_angles |= missed
+            self._regrids += 1
+            self._counted_from = (self.n_checked, self.n_resolved)
+
     def verdicts_decide(self, results: Sequence[Result]) -> bool:
         """Whether the starts so far call a node infeasible, without its other starts
         and the retries: at least two starts, every one ended with the back-end's own
@@ -435,6 +477,10 @@ class NodeSolver:
         return np.array([result.design[n] for n in self.names])
 
 
+#: Times a search adds to its thinned grid the angles where its checked starts missed a
+#: row (each change builds one more solver, ~0.05 s, once per process and row set).
+MAX_REGRIDS = 3
+
 #: A node of several item combinations keeps every this-many-th grid angle's rows ...
 NODE_ANGLE_STEP = 2
 
@@ -454,22 +500,34 @@ def thinned_angles(points: int) -> list[int]:
     return sorted({*range(0, points, NODE_ANGLE_STEP), points - 1})
 
 
-def thinned_rows(problem: DesignProblem, nlp: NLP) -> list[int] | None:
+def thinned_rows(problem: DesignProblem, nlp: NLP, extra: Iterable[str] = ()) -> list[int] | None:
     """The rows of ``nlp`` a node of several item combinations keeps: every row not
-    labelled with a grid angle, and those of :func:`thinned_angles` (the NLP's rows are
-    named ``NAME[phi=+12.0deg]``); None when every angle is kept, or when no row is left
-    out (no row of the NLP names an angle the thinned grid leaves out)."""
+    labelled with a grid angle, and those of :func:`thinned_angles` and of the angles
+    ``extra`` (labels; the NLP's rows are named ``NAME[phi=+12.0deg]``); None when every
+    angle is kept, or when no row is left out (no row of the NLP names an angle the
+    thinned grid leaves out)."""
     angles = thinned_angles(len(problem.phi))
     if len(angles) == len(problem.phi):
         return None
     labels = set(problem.phi_labels)
-    kept = {problem.phi_labels[k] for k in angles}
+    kept = {problem.phi_labels[k] for k in angles} | set(extra)
     rows = [
         k
         for k, name in enumerate(nlp.g_names)
         if not (lab := _angle_label(name)) or lab not in labels or lab in kept
     ]
     return rows if len(rows) < len(nlp.g_names) else None
+
+
+def missed_angles(nlp: NLP, z: np.ndarray, bounds: Bounds, rows: np.ndarray) -> list[str]:
+    """The grid angles (labels) of the rows of ``nlp`` left out of ``rows`` that the
+    point ``z`` misses beyond :data:`~optdesign.tolerances.LEFT_OUT_ROW_TOL` (or where a
+    row is not a number) under ``bounds``."""
+    miss = row_misses(nlp, z, bounds)
+    left_out = np.ones(miss.size, dtype=bool)
+    left_out[rows] = False
+    bad = left_out & ~(miss <= LEFT_OUT_ROW_TOL)
+    return sorted({lab for k in np.flatnonzero(bad) if (lab := _angle_label(nlp.g_names[k]))})
 
 
 def _angle_label(name: str) -> str:

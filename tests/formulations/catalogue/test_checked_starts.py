@@ -9,8 +9,16 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
-from optdesign.formulations.catalogue.node_solver import THINNED_START, NodeSolver
+from optdesign.formulations.catalogue.node_solver import (
+    MAX_REGRIDS,
+    MISSED_ANGLES,
+    THINNED_START,
+    NodeSolver,
+    _angle_label,
+    thinned_rows,
+)
 from optdesign.formulations.catalogue.search import solve_catalogue
+from optdesign.solvers.result import Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -36,18 +44,38 @@ def test_a_leaf_whose_rows_are_met_keeps_the_thinned_points(fin):
 
 
 def test_a_leaf_whose_peak_falls_between_the_kept_angles_is_solved_again(fin):
-    """Ripple peaks between the kept angles at every start: each start costs two
-    solves, its point meets every row, and the next node is solved on the whole grid."""
+    """Ripple peaks between the kept angles (at +-15 deg) at every start: each start
+    costs two solves, its point meets every row, and the search learns those angles:
+    the next node's thinned grid keeps them, and its thinned points are kept (the
+    same verdict as on the whole grid)."""
     checked = NodeSolver(fin, objective="ripple", starts=3)
     whole = NodeSolver(fin, objective="ripple", starts=3, checked=False)
     a, b = checked.solve(LEAF), whole.solve(LEAF)
     assert a.raw[THINNED_START] == "solved again"
+    assert sorted(a.raw[MISSED_ANGLES]) == ["phi=+15.0deg", "phi=-15.0deg"]
     assert (checked.n_checked, checked.n_resolved, checked.n_solves) == (0, 3, 6)
     assert a.success and not a.violated
     assert a.objective == pytest.approx(b.objective, rel=OBJECTIVE_TIE_TOL)
-    nxt = checked.solve(OTHER_LEAF)
-    assert THINNED_START not in nxt.raw
-    assert (checked.n_checked, checked.n_resolved) == (0, 3)  # one NLP solve per start
+    assert checked.learned_angles == {"phi=+15.0deg", "phi=-15.0deg"}
+    assert {"phi=+15.0deg", "phi=-15.0deg"} <= {
+        _angle_label(checked.nlp.g_names[k])
+        for k in thinned_rows(fin, checked.nlp, checked.learned_angles)
+    }
+    nxt, ref = checked.solve(OTHER_LEAF), whole.solve(OTHER_LEAF)
+    assert nxt.raw[THINNED_START] == "kept" and checked.n_resolved == 3
+    assert nxt.status == ref.status == "infeasible"  # d0 = 20 mm cannot carry it
+
+
+def test_a_search_learns_the_angles_of_missed_rows_a_bounded_number_of_times(fin):
+    """Every node missing rows at new angles: the thinned grid changes MAX_REGRIDS
+    times, then the checks are counted as before (more solved again than kept: the
+    whole grid)."""
+    ns = NodeSolver(fin, objective="ripple", starts=1)
+    labels = iter(fin.phi_labels[1::2])  # angles the thinned grid leaves out
+    for _ in range(MAX_REGRIDS + 2):
+        ns._note_checks([_resolved({next(labels)})])
+    assert len(ns.learned_angles) == MAX_REGRIDS
+    assert ns._mode(ns.backend) == "whole"
 
 
 def test_the_search_finds_the_same_items_and_value_either_way(fin):
@@ -57,3 +85,24 @@ def test_the_search_finds_the_same_items_and_value_either_way(fin):
     assert on.objective == pytest.approx(off.objective, rel=OBJECTIVE_TIE_TOL)
     assert on.details.catalogue.checked_starts > 0 and off.details.catalogue.checked_starts == 0
     assert on.details.catalogue.nlp_solves == off.details.catalogue.nlp_solves
+
+
+def _resolved(angles: set[str]) -> Result:
+    """A start solved again after its thinned point missed rows at ``angles``."""
+    r = Result(status="optimal", objective=1.0, solver="ipopt", formulation="catalogue")
+    r.raw[THINNED_START] = "solved again"
+    r.raw[MISSED_ANGLES] = sorted(angles)
+    return r
+
+
+def test_a_first_stage_keeps_checked_starts_once_it_learnt_the_missed_angles(fin):
+    """The first stage of a front's anchor (``ties=False``): its root's thinned points
+    miss the lock force's peak between the kept angles; with those angles learnt, its
+    later nodes keep their thinned points, and it finds the whole grid's items and
+    value."""
+    on = solve_catalogue(fin, objective="motor_torque", ties=False)
+    off = solve_catalogue(fin, objective="motor_torque", ties=False, thinned_starts=False)
+    info = on.details.catalogue
+    assert info.resolved_starts > 0 and info.checked_starts > info.resolved_starts
+    assert info.items == off.details.catalogue.items
+    assert on.objective == pytest.approx(off.objective, rel=OBJECTIVE_TIE_TOL)
