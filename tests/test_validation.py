@@ -439,9 +439,11 @@ def test_overwrite_starts_a_front_afresh_through_the_api(tmp_path):
     with pytest.raises(OptDesignError, match=r"epsilon-catalogue\.jsonl holds \d+ records"):
         od.pareto(*args, points=3, out=tmp_path, workers=1)
     again = od.pareto(*args, points=3, out=tmp_path, workers=1, overwrite=True)
-    # the same front, solved again (not read back): the catalogue front's node memo of
-    # this process seeds the second run, so the points agree to rounding, not bit for bit
-    np.testing.assert_allclose(again.F, first.F, rtol=1e-9)
+    # the same front, solved again (not read back): the catalogue front's memo of this
+    # process (node bounds, proofs, the thinned grid's learnt angles) seeds the second
+    # run, whose points are the same optima reached by another path: equal to Ipopt's
+    # tolerances (2e-9 relative), not bit for bit
+    np.testing.assert_allclose(again.F, first.F, rtol=1e-8)
     assert len(store.read_text().splitlines()) == len(written)  # a new store, not appended
 
 

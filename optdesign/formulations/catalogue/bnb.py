@@ -178,6 +178,10 @@ class InfeasibleBoxes:
         #: the nodes the searches solved (their bounds and optima), when the memo is a
         #: front's (:func:`shared_memo`); None for a single search's proofs
         self.nodes: NodeBounds | None = None
+        #: grid angles where the searches' thinned points missed a row left out
+        #: (:attr:`~optdesign.formulations.catalogue.node_solver.NodeSolver.learned_angles`):
+        #: the next searches of a front start with them (and share their solver)
+        self.learned_angles: frozenset[str] = frozenset()
 
     def __len__(self) -> int:
         return len(self._proofs)

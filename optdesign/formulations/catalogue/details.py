@@ -97,6 +97,10 @@ class CatalogueDetails:
         search that prunes ties): those whose point met every row left out and was kept
         (a KKT point of the node's own NLP, no solve on the whole grid), and those solved
         again on the whole grid from there (each counted twice in ``nlp_solves``).
+    learned_angles
+        Grid angles (labels) the thinned grid kept besides every other one: where a
+        checked start's point missed a row left out (this search's, or an earlier one's
+        of the same front).
     items
         The items chosen (None: no feasible combination).
     gap_to_relaxation_rel
@@ -124,6 +128,7 @@ class CatalogueDetails:
     thinned_solves: int = 0
     checked_starts: int = 0
     resolved_starts: int = 0
+    learned_angles: list[str] = field(default_factory=list)
     items: dict[str, float] | None = None
     gap_to_relaxation_rel: float | None = None
     #: The boxes the search proved infeasible, with the epsilon limits of each proof

@@ -451,10 +451,13 @@ class NodeSolver:
                 self.n_solves += 1
                 missed.update(r.raw.get(MISSED_ANGLES, ()))
         if missed - self.learned_angles and self._regrids < MAX_REGRIDS:
-            # the next nodes' thinned grid keeps them, and its checks are counted afresh
+            # the next nodes' thinned grid keeps them, and its checks are counted afresh;
+            # so do the next searches of a front (its memo)
             self.learned_angles |= missed
             self._regrids += 1
             self._counted_from = (self.n_checked, self.n_resolved)
+            if self.memo is not None:
+                self.memo.learned_angles |= missed
 
     def verdicts_decide(self, results: Sequence[Result]) -> bool:
         """Whether the starts so far call a node infeasible, without its other starts

@@ -212,6 +212,8 @@ def solve_catalogue(
     )
     with ns.on_workers():
         ns.memo = memo
+        if memo is not None:  # the angles the front's earlier searches learnt
+            ns.learned_angles = frozenset(memo.learned_angles)
         # the proofs of this search (a front's memo, or this search's own, which it does not
         # read: a single search solves the nodes it always did), for the optimum's
         # neighbouring items (studies.catalogue_sensitivity)
@@ -247,6 +249,7 @@ def solve_catalogue(
             info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
         info.nlp_solves, info.thinned_solves = ns.n_solves, ns.n_thinned
         info.checked_starts, info.resolved_starts = ns.n_checked, ns.n_resolved
+        info.learned_angles = sorted(ns.learned_angles, key=_angle_degrees)
         info.infeasible_boxes = ns.proofs.proofs
         wall = time.perf_counter() - t0
         if best is None:
@@ -304,10 +307,11 @@ def solve_catalogue(
 
 
 def _grid_note(info: CatalogueDetails) -> str:
-    """What the summary says of the solves on every other grid angle: the relaxed nodes,
-    and the starts solved there first (kept where their point met every row), e.g.
-    `` (on every other grid angle: 18 node solves; 4 starts first, kept: their points met
-    every row)``; empty when there were none."""
+    """What the summary says of the solves on every other grid angle (and on the angles
+    learnt where rows were missed): the relaxed nodes, and the starts solved there first
+    (kept where their point met every row), e.g. `` (on every other grid angle and at
+    phi=+15.0deg: 18 node solves; 4 starts first, kept: their points met every row)``;
+    empty when there were none."""
     parts = []
     if info.thinned_solves:
         parts.append(f"{info.thinned_solves} node solves")
@@ -315,7 +319,17 @@ def _grid_note(info: CatalogueDetails) -> str:
         parts.append(f"{info.checked_starts} starts first, kept: their points met every row")
     if info.resolved_starts:
         parts.append(f"{info.resolved_starts} starts first, then on the whole grid")
-    return f" (on every other grid angle: {'; '.join(parts)})" if parts else ""
+    if not parts:
+        return ""
+    grid = "every other grid angle"
+    if info.learned_angles:
+        grid += " and at " + ", ".join(info.learned_angles)
+    return f" (on {grid}: {'; '.join(parts)})"
+
+
+def _angle_degrees(label: str) -> float:
+    """The angle of a grid label ``phi=+15.0deg``, for sorting."""
+    return float(label.removeprefix("phi=").removesuffix("deg"))
 
 
 def relaxation_bound(result: Result) -> float:

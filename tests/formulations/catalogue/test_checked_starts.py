@@ -9,6 +9,8 @@ from pathlib import Path
 import pytest
 
 import optdesign as od
+from optdesign.formulations.catalogue.bnb import InfeasibleBoxes
+from optdesign.formulations.catalogue.discrete import discrete_variables
 from optdesign.formulations.catalogue.node_solver import (
     MAX_REGRIDS,
     MISSED_ANGLES,
@@ -104,5 +106,27 @@ def test_a_first_stage_keeps_checked_starts_once_it_learnt_the_missed_angles(fin
     off = solve_catalogue(fin, objective="motor_torque", ties=False, thinned_starts=False)
     info = on.details.catalogue
     assert info.resolved_starts > 0 and info.checked_starts > info.resolved_starts
+    # the summary names the angles the thinned grid kept besides every other one
+    assert info.learned_angles and all(a.startswith("phi=") for a in info.learned_angles)
+    note = next(n for n in on.notes if n.startswith("catalogue items chosen"))
+    assert f"(on every other grid angle and at {', '.join(info.learned_angles)}: " in note
     assert info.items == off.details.catalogue.items
     assert on.objective == pytest.approx(off.objective, rel=OBJECTIVE_TIE_TOL)
+
+
+def test_a_fronts_next_search_starts_with_the_angles_its_memo_learnt(fin):
+    """The searches of a front share a memo: the angles one learnt are the next one's
+    thinned grid from its root on (one solver for both), with the same answer as a search
+    that learns them itself."""
+    dvars = discrete_variables(fin)
+    memo = InfeasibleBoxes(
+        {v.name: (v.lower, v.upper) for v in dvars}, {v.name: v.values for v in dvars}
+    )
+    first = solve_catalogue(fin, objective="motor_torque", ties=False, memo=memo)
+    assert memo.learned_angles and first.details.catalogue.resolved_starts > 0
+    learnt = set(memo.learned_angles)
+    second = solve_catalogue(fin, objective="backlash", ties=False, memo=memo)
+    alone = solve_catalogue(fin, objective="backlash", ties=False)
+    assert learnt <= memo.learned_angles
+    assert second.details.catalogue.items == alone.details.catalogue.items
+    assert second.objective == pytest.approx(alone.objective, rel=OBJECTIVE_TIE_TOL)

@@ -993,10 +993,11 @@ def test_an_enumerated_catalogue_result_records_its_search():
     grid = [f"{info.checked_starts} starts first, kept: their points met every row"]
     if info.resolved_starts:
         grid.append(f"{info.resolved_starts} starts first, then on the whole grid")
+    learnt = " and at " + ", ".join(info.learned_angles) if info.learned_angles else ""
     assert note == (
         f"catalogue items chosen: p = 6 mm, d = 6; continuous relaxation bound "
         f"{r.bound:.8g} (discrete optimum {gap:+.3f} % above it); enumerate, "
-        f"{info.nlp_solves} NLP solves (on every other grid angle: {'; '.join(grid)})"
+        f"{info.nlp_solves} NLP solves (on every other grid angle{learnt}: {'; '.join(grid)})"
     )
 
 
