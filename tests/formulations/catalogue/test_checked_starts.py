@@ -20,6 +20,7 @@ from optdesign.formulations.catalogue.node_solver import (
     thinned_rows,
 )
 from optdesign.formulations.catalogue.search import solve_catalogue
+from optdesign.runtime.processes import forks_workers
 from optdesign.solvers.result import Result
 from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
@@ -31,6 +32,12 @@ OTHER_LEAF = {"d0": (20.0, 20.0), "p": (5.0, 5.0), "d": (6.0, 6.0)}
 @pytest.fixture(scope="module")
 def fin():
     return od.load(ROOT / "problems" / "fin_actuator.toml")
+
+
+@pytest.fixture(scope="module")
+def first_stage(fin):
+    """The first stage of a front's motor-torque anchor (``ties=False``), 4 starts a node."""
+    return solve_catalogue(fin, objective="motor_torque", ties=False, starts=4)
 
 
 def test_a_leaf_whose_rows_are_met_keeps_the_thinned_points(fin):
@@ -97,13 +104,13 @@ def _resolved(angles: set[str]) -> Result:
     return r
 
 
-def test_a_first_stage_keeps_checked_starts_once_it_learnt_the_missed_angles(fin):
+def test_a_first_stage_keeps_checked_starts_once_it_learnt_the_missed_angles(fin, first_stage):
     """The first stage of a front's anchor (``ties=False``): its root's thinned points
     miss the lock force's peak between the kept angles; with those angles learnt, its
     later nodes keep their thinned points, and it finds the whole grid's items and
     value."""
-    on = solve_catalogue(fin, objective="motor_torque", ties=False)
-    off = solve_catalogue(fin, objective="motor_torque", ties=False, thinned_starts=False)
+    on = first_stage
+    off = solve_catalogue(fin, objective="motor_torque", ties=False, starts=4, thinned_starts=False)
     info = on.details.catalogue
     assert info.resolved_starts > 0 and info.checked_starts > info.resolved_starts
     # the summary names the angles the thinned grid kept besides every other one
@@ -114,19 +121,38 @@ def test_a_first_stage_keeps_checked_starts_once_it_learnt_the_missed_angles(fin
     assert on.objective == pytest.approx(off.objective, rel=OBJECTIVE_TIE_TOL)
 
 
-def test_a_fronts_next_search_starts_with_the_angles_its_memo_learnt(fin):
-    """The searches of a front share a memo: the angles one learnt are the next one's
-    thinned grid from its root on (one solver for both), with the same answer as a search
-    that learns them itself."""
+def test_a_fronts_next_search_starts_with_the_angles_its_memo_learnt(fin, first_stage):
+    """The searches of a front share a memo: the angles one learnt (here the motor-torque
+    anchor's first stage's) are the next one's thinned grid from its root on (one solver
+    for both), with the same answer as a search that learns them itself."""
     dvars = discrete_variables(fin)
     memo = InfeasibleBoxes(
         {v.name: (v.lower, v.upper) for v in dvars}, {v.name: v.values for v in dvars}
     )
-    first = solve_catalogue(fin, objective="motor_torque", ties=False, memo=memo)
-    assert memo.learned_angles and first.details.catalogue.resolved_starts > 0
-    learnt = set(memo.learned_angles)
+    learnt = frozenset(first_stage.details.catalogue.learned_angles)
+    memo.learned_angles = learnt
     second = solve_catalogue(fin, objective="backlash", ties=False, memo=memo)
     alone = solve_catalogue(fin, objective="backlash", ties=False)
+    assert learnt and learnt <= set(second.details.catalogue.learned_angles)
     assert learnt <= memo.learned_angles
+    assert not learnt <= set(alone.details.catalogue.learned_angles)
     assert second.details.catalogue.items == alone.details.catalogue.items
     assert second.objective == pytest.approx(alone.objective, rel=OBJECTIVE_TIE_TOL)
+
+
+@pytest.mark.skipif(not forks_workers(), reason="local workers are forked (Linux)")
+def test_a_search_that_learns_angles_on_two_workers_is_the_search_on_one(fin, first_stage):
+    """The starts carry the thinned grid's rows to the worker processes (each builds
+    that grid's solver once): the same angles learnt, nodes, solves and optimum as on
+    one worker, bit for bit."""
+    one = first_stage
+    two = solve_catalogue(fin, objective="motor_torque", ties=False, starts=4, workers=2)
+    a, b = one.details.catalogue, two.details.catalogue
+    assert a.learned_angles and b.learned_angles == a.learned_angles
+    assert (b.nlp_solves, b.nodes, b.checked_starts, b.resolved_starts) == (
+        a.nlp_solves,
+        a.nodes,
+        a.checked_starts,
+        a.resolved_starts,
+    )
+    assert two.objective == one.objective and two.design == one.design
