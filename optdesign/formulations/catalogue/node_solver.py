@@ -180,14 +180,14 @@ class NodeSolver:
     def thinned_backend(self):
         """The solver of the node NLP with the rows of every other grid angle only
         (:func:`thinned_angles`: 31 of 61), and of the angles this search learnt
-        (:attr:`learned_angles`; built again when they change). Only rows are left out - the objective, the
-        variables, the targets and every row not tied to one angle (a mean ratio, the
-        nut travel, the life, the epsilon rows) are the node's own - so its optimum is a
-        relaxation of the node's, never above it, at a lower cost per start (Ipopt's
-        time per iteration follows the rows). (The stand-in problem of the NLP's global
-        search, a problem on fewer angles, is not one: its grid's mean ratio is another
-        number.) None when the grid is not thinned, or when rows are left free by index
-        (the diagnosis)."""
+        (:attr:`learned_angles`; built again when they change). Only rows are left out -
+        the objective, the variables, the targets and every row not tied to one angle (a
+        mean ratio, the nut travel, the life, the epsilon rows) are the node's own - so
+        its optimum is a relaxation of the node's, never above it, at a lower cost per
+        start (Ipopt's time per iteration follows the rows). (The stand-in problem of the
+        NLP's global search, a problem on fewer angles, is not one: its grid's mean ratio
+        is another number.) None when the grid is not thinned, or when rows are left free
+        by index (the diagnosis)."""
         if self._thinned is None or (self._thinned and self._thinned_for != self.learned_angles):
             keep = thinned_rows(self.problem, self.nlp, self.learned_angles)
             if keep is None or self.free_rows.size:
