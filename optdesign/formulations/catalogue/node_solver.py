@@ -121,7 +121,7 @@ class NodeSolver:
         # the solver of the thinned grid, built on first use (see :meth:`relaxed_backend`;
         # False: the grid is not thinned), and its rows
         self._thinned = None
-        self._thinned_rows: np.ndarray | None = None
+        self._thinned_rows: tuple[int, ...] = ()
         #: grid angles (labels) the thinned grid keeps besides its own: those where a
         #: checked start's point missed a row left out (:meth:`_solve_checked`); the
         #: thinned solver is built again for them before the next node
@@ -194,7 +194,7 @@ class NodeSolver:
                 self._thinned = False
             else:
                 self._thinned = rows_solver_for(self.backend, keep, self._options)
-                self._thinned_rows = np.asarray(keep, dtype=int)
+                self._thinned_rows = tuple(keep)
                 self._thinned_for = self.learned_angles
                 kept = {self.problem.phi_labels[k] for k in thinned_angles(len(self.problem.phi))}
                 self.relaxed_angles = len(kept | self.learned_angles)
@@ -279,7 +279,7 @@ class NodeSolver:
         """A start as :meth:`_solve_start` takes it (here or in a worker process): the
         box, the point, how it is solved (:meth:`_mode`) and the thinned grid's rows."""
         mode = self._mode(backend)
-        rows = () if mode == "whole" else tuple(int(k) for k in self._thinned_rows)
+        rows = () if mode == "whole" else self._thinned_rows
         return box, np.asarray(x0, dtype=float), mode, rows
 
     def _starts(
