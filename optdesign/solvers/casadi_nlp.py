@@ -49,8 +49,12 @@ from optdesign.solvers.result import Result, TerminationCondition
 #:   put the first iterates far from the central path;
 #: - the Hessian's regularisation capped at 1e4: on the scaled problem (variables in
 #:   [0, 1], rows ~1) a larger one only comes from a start stuck at a linkage's singular
-#:   position, where Ipopt would refactorise up to 1e20 at every iteration; capped, such a
-#:   start fails at once and the search goes on.
+#:   position, where Ipopt would refactorise up to 1e20 at every iteration;
+#: - a restoration phase ended after 200 successive iterations: at the cap above, a stuck
+#:   start's restoration phase goes on with zero steps until the iteration limit (19 of the
+#:   six-bar's 72 ripple starts, 25 of its 32 s of Ipopt); the restoration phases of every
+#:   shipped problem's searches are shorter (the same iterations at 100, on the catalogue
+#:   nodes too; at 50 some nodes' verdicts change).
 IPOPT_DEFAULTS: dict[str, Any] = {
     "print_level": 0,
     "sb": "yes",
@@ -62,6 +66,7 @@ IPOPT_DEFAULTS: dict[str, Any] = {
     "mumps_pivot_order": 0,
     "bound_mult_init_method": "mu-based",
     "max_hessian_perturbation": 1e4,
+    "max_resto_iter": 200,
 }
 
 _IPOPT_STATUS = {

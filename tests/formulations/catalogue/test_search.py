@@ -171,10 +171,13 @@ def test_node_solver_ipopt_options_file_wins_over_node_defaults():
     assert solver_hints("ipopt").node_options["expect_infeasible_problem"] == "yes"
     default = NodeSolver(_small_catalogue())
     assert default.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
+    # a restoration phase that makes no progress ends after 200 iterations, not at 500
+    assert default.backend.options["ipopt"]["max_resto_iter"] == 200
     data = tomllib.loads(CATALOGUE.read_text())
-    data["solver"] = {"ipopt": {"expect_infeasible_problem": "no"}}
+    data["solver"] = {"ipopt": {"expect_infeasible_problem": "no", "max_resto_iter": 400}}
     own = NodeSolver(problem_from_dict(data))
     assert own.backend.options["ipopt"]["expect_infeasible_problem"] == "no"
+    assert own.backend.options["ipopt"]["max_resto_iter"] == 400
     caller = NodeSolver(problem_from_dict(data), options={"expect_infeasible_problem": "yes"})
     assert caller.backend.options["ipopt"]["expect_infeasible_problem"] == "yes"
 
