@@ -146,6 +146,28 @@ def test_a_catalogue_relaxation_is_enough(tmp_path):
     assert od.solve(path, starts=1, ranges=False).success
 
 
+def test_a_catalogue_relaxation_is_sought_from_the_problems_start_too(tmp_path):
+    """With a nut travel of 1 mm the search's best point sits at a dead point (its backlash
+    is not a number), and the continuous relaxation started there alone reported every
+    requirement "relaxing it alone gave no feasible design". Started from the problem's
+    own start too, as the continuous diagnosis is, the travel is relaxed to what the mean
+    ratio forces: the nut moves mean(v) x stroke with v = ratio p / (2 pi i_a), at least
+    200 x 2 mm x 60 deg / (2 pi x 2) = 33.33 mm at the 2 mm lead it names; and the relaxed
+    file solves."""
+    text = (ROOT / "problems" / "cs_min_backlash_catalogue.toml").read_text()
+    shipped = 'nut_travel_max = "110 mm"'
+    tight = text.replace(shipped, 'nut_travel_max = "1 mm"')
+    result = od.solve(od.load(tomllib.loads(tight)), ranges=False)
+    assert result.status == "infeasible"
+    travel = {r.name: r for r in result.diagnosis.relaxations}["nut_travel"]
+    assert "p = 2 mm" in travel.at
+    assert travel.needed == pytest.approx(200 * 2.0 * math.radians(60) / (4 * math.pi), rel=5e-3)
+    relaxed = text.replace(shipped, f'nut_travel_max = "{travel.needed * 1.001} mm"')
+    path = tmp_path / "relaxed.toml"
+    path.write_text(relaxed)
+    assert od.solve(path, starts=1, ranges=False).success
+
+
 def test_fixed_design_is_checked_not_optimised(tmp_path, capsys):
     """No free variable: the design is checked (formulation "fixed"); infeasible, the
     exact relaxation is its own value (the crank-slider with n < R cos 30 deg travels

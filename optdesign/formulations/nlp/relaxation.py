@@ -281,6 +281,9 @@ class Site:
     x_start: np.ndarray | None = None
     z_start: np.ndarray | None = None
     label: str = ""
+    #: designs to start from after ``x_start`` (clipped to the box), e.g. the problem's
+    #: own start beside a best point that may sit where the models are not defined
+    also_from: tuple[np.ndarray, ...] = ()
 
 
 class _Prepared:
@@ -291,14 +294,17 @@ class _Prepared:
         self.bounds = nlp.bounds(box=site.box, parameters=site.parameters)
         self.theta = nlp.parameter_values(self.bounds.parameters)
         first = problem.start() if site.x_start is None else np.asarray(site.x_start, float)
+        lo, hi = problem.lower().copy(), problem.upper().copy()
         if site.box:
-            lo, hi = problem.lower().copy(), problem.upper().copy()
             for k, v in enumerate(problem.free):
                 if v.name in site.box:
                     lo[k], hi[k] = site.box[v.name]
-            first = np.clip(first, lo, hi)
         self.starts = [nlp.start(z0=site.z_start)] if site.z_start is not None else []
-        self.starts.append(nlp.start(x0=first, parameters=self.bounds.parameters))
+        for x in (first, *site.also_from):
+            x = np.asarray(x, dtype=float)
+            if site.box:
+                x = np.clip(x, lo, hi)
+            self.starts.append(nlp.start(x0=x, parameters=self.bounds.parameters))
 
 
 def _need(g: np.ndarray, row: Any, hi_side: bool) -> float:
