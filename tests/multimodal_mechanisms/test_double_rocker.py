@@ -27,6 +27,7 @@ if str(HERE.parent) not in sys.path:
 
 from multimodal_mechanisms import double_rocker as plugin  # noqa: E402
 from multimodal_mechanisms import double_rocker_reference as ref  # noqa: E402
+from multimodal_mechanisms import first_passing  # noqa: E402
 
 OPTIMUM = HERE / "double_rocker_optimum.json"
 SPEC = ref.default_spec("backlash")
@@ -49,25 +50,20 @@ def random_designs(n: int, seed: int) -> list[dict[str, float]]:
     finite differences lose their digits)."""
     rng = np.random.default_rng(seed)
     X = rng.uniform(SPEC.lower, SPEC.upper, (20000, len(SPEC.free)))
-    picked: list[int] = []
-    # the draws are judged in chunks, in order, until n pass: the same first n designs
-    # as judging all 20000 at once, for a tenth of the model evaluations (at collection)
-    for start in range(0, len(X), 2000):
-        chunk = X[start : start + 2000]
+
+    def passes(chunk: np.ndarray) -> np.ndarray:
         v = {k: np.asarray(val, dtype=float) for k, val in SPEC.fixed.items()}
         v.update({name: chunk[:, j : j + 1] for j, name in enumerate(SPEC.free)})
-        with np.errstate(all="ignore"):
-            rows = ref.constraint_rows(SPEC, ref.model(SPEC, v))
+        rows = ref.constraint_rows(SPEC, ref.model(SPEC, v))
         ok = np.ones(len(chunk), dtype=bool)
         for key in ("four_bar_reach", "rod_reach", "ratio_positive"):
             ok &= np.all(rows[key] >= 0.0, axis=-1)
         for key in ("horn", "rocker"):
             for side in ("min", "max"):
                 ok &= np.all(rows[f"transmission_{key}_{side}"] >= -np.radians(20.0), axis=-1)
-        picked += [start + int(i) for i in np.flatnonzero(ok)]
-        if len(picked) >= n:
-            break
-    picked = picked[:n]
+        return ok
+
+    picked = first_passing(X, passes, n, chunk=2000)
     assert len(picked) == n, f"only {len(picked)} such designs in 20000 draws"
     return [SPEC.design(X[i]) for i in picked]
 

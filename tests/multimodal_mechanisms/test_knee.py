@@ -14,7 +14,7 @@ import pytest
 
 import optdesign as od
 
-from . import knee
+from . import first_passing, knee
 from . import knee_reference as ref
 
 M_H = knee.REQUIREMENTS["hinge_moment"]
@@ -26,21 +26,22 @@ def _assembling_designs(count: int, seed: int = 20260) -> list[dict]:
     """Seeded designs drawn in the bounds that assemble over the stroke, move the nut
     forward (ratio > 1) and keep their members loaded (the reference's checks)."""
     rng = np.random.default_rng(seed)
+
+    def passes(X: np.ndarray) -> np.ndarray:
+        q = ref.quantities(X)
+        g = ref.constraints(q)
+        ok = np.all(np.isfinite(q["ratio"]), axis=-1) & np.all(q["ratio"] > 1.0, axis=-1)
+        for name in ("knee_reach", "push_reach", "push_angle_min", "push_angle_max"):
+            ok &= np.all(g[name] > 0.0, axis=-1)
+        return ok
+
     out = []
     while len(out) < count:
-        # drawn 4000 at a time, judged 500 at a time until enough pass: the same designs
-        # as judging the 4000 at once, for less of the collection's time
         X = ref.LO + rng.random((4000, len(ref.NAMES))) * (ref.HI - ref.LO)
-        for chunk in np.split(X, 8):
-            if len(out) >= count:
-                break
-            with np.errstate(all="ignore"):
-                q = ref.quantities(chunk)
-                g = ref.constraints(q)
-            ok = np.all(np.isfinite(q["ratio"]), axis=-1) & np.all(q["ratio"] > 1.0, axis=-1)
-            for name in ("knee_reach", "push_reach", "push_angle_min", "push_angle_max"):
-                ok &= np.all(g[name] > 0.0, axis=-1)
-            out += [dict(zip(ref.NAMES, x, strict=True)) for x in chunk[ok][: count - len(out)]]
+        out += [
+            dict(zip(ref.NAMES, X[k], strict=True))
+            for k in first_passing(X, passes, count - len(out), chunk=500)
+        ]
     return out
 
 

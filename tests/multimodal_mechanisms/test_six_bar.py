@@ -23,6 +23,7 @@ HERE = Path(__file__).resolve().parent
 if str(HERE.parent) not in sys.path:
     sys.path.insert(0, str(HERE.parent))
 
+from multimodal_mechanisms import first_passing  # noqa: E402
 from multimodal_mechanisms import six_bar as plugin  # noqa: E402
 from multimodal_mechanisms import six_bar_reference as ref  # noqa: E402
 
@@ -47,18 +48,14 @@ def random_designs(n, seed=0):
     point the reference's finite differences lose their digits)."""
     rng = np.random.default_rng(seed)
     Z = rng.random((2000, ref.NV))
-    found: list[int] = []
-    # judged 250 at a time until n pass: the same designs as judging the 2000 at once
-    for start in range(0, len(Z), 250):
-        with np.errstate(all="ignore"):
-            q = ref.analyse(ref._design_of(Z[start : start + 250]))
-            ok = np.all(q["rod_reach"] > 0.1, axis=1) & np.all(q["push_reach"] > 0.3, axis=1)
-            ok &= np.all(q["ratio"] > 5.0, axis=1)
-            ok &= np.all(np.isfinite(q["backlash_deg"]), axis=1)
-        found += [start + int(i) for i in np.flatnonzero(ok)]
-        if len(found) >= n:
-            break
-    chosen = np.asarray(found[:n], dtype=int)
+
+    def passes(chunk: np.ndarray) -> np.ndarray:
+        q = ref.analyse(ref._design_of(chunk))
+        ok = np.all(q["rod_reach"] > 0.1, axis=1) & np.all(q["push_reach"] > 0.3, axis=1)
+        ok &= np.all(q["ratio"] > 5.0, axis=1)
+        return ok & np.all(np.isfinite(q["backlash_deg"]), axis=1)
+
+    chosen = np.asarray(first_passing(Z, passes, n, chunk=250), dtype=int)
     assert chosen.size == n, f"only {chosen.size} designs assemble"
     return [
         {**ref.FIXED, **{k: float(v[0]) for k, v in ref._design_of(Z[j]).items()}} for j in chosen

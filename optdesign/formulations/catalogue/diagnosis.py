@@ -117,9 +117,7 @@ def catalogue_diagnosis(problem: DesignProblem, result: Result, how: Relaxing) -
     def sites_for(name: str, at):
         # from the best point and from the problem's own start, as the continuous
         # diagnosis starts: the best point may sit at a dead point, where the models are
-        # not defined, and a relaxation that fails from there alone proves nothing (a
-        # nut travel of 1 mm was reported "no feasible design even relaxed alone", where
-        # the file's start finds its 33.3 mm)
+        # not defined, and a relaxation that fails from there alone proves nothing
         t, relaxed = at(Site(None, full, x, also_from=(problem.start(),)))
         if t is None or not relaxed.design:
             return  # even the continuous relaxation needs more than this requirement

@@ -300,11 +300,14 @@ class _Prepared:
                 if v.name in site.box:
                     lo[k], hi[k] = site.box[v.name]
         self.starts = [nlp.start(z0=site.z_start)] if site.z_start is not None else []
+        designs: list[np.ndarray] = []
         for x in (first, *site.also_from):
             x = np.asarray(x, dtype=float)
             if site.box:
                 x = np.clip(x, lo, hi)
-            self.starts.append(nlp.start(x0=x, parameters=self.bounds.parameters))
+            if not any(np.array_equal(x, seen) for seen in designs):  # a start solved once
+                designs.append(x)
+                self.starts.append(nlp.start(x0=x, parameters=self.bounds.parameters))
 
 
 def _need(g: np.ndarray, row: Any, hi_side: bool) -> float:
