@@ -90,6 +90,33 @@ class LeastViolation:
         return self.status == "Infeasible_Problem_Detected"
 
 
+@dataclass(frozen=True)
+class _Sides:
+    """A phase-1 problem on Ipopt: ``upper`` and ``lower`` the rows (indices) whose
+    upper and lower sides it holds, with a weight of ``t`` each."""
+
+    upper: np.ndarray
+    lower: np.ndarray
+    solver: Any
+
+    @staticmethod
+    def build(nlp: NLP, upper: np.ndarray, lower: np.ndarray, settings: dict) -> _Sides:
+        up, lo = np.flatnonzero(upper), np.flatnonzero(lower)
+        t = ca.SX.sym("t")
+        wu = ca.SX.sym("wu", up.size)
+        wl = ca.SX.sym("wl", lo.size)
+        g = nlp.g
+        rows = ca.vertcat(g[up.tolist()] - wu * t, g[lo.tolist()] + wl * t)
+        with solver_call():
+            solver = ca.nlpsol(
+                "optdesign_phase1",
+                "ipopt",
+                {"x": ca.vertcat(nlp.z, t), "p": ca.vertcat(nlp.theta, wu, wl), "f": t, "g": rows},
+                settings,
+            )
+        return _Sides(up, lo, solver)
+
+
 class PhaseOneSolver:
     """The phase-1 problem of ``nlp`` on Ipopt, built once and solved many times.
 
@@ -104,41 +131,42 @@ class PhaseOneSolver:
 
     def __init__(self, nlp: NLP, options: Mapping[str, Any] | None = None):
         self.nlp = nlp
-        self.upper = np.flatnonzero(np.isfinite(nlp.ubg))
-        self.lower = np.flatnonzero(np.isfinite(nlp.lbg))
-        t = ca.SX.sym("t")
-        wu = ca.SX.sym("wu", self.upper.size)
-        wl = ca.SX.sym("wl", self.lower.size)
-        g = nlp.g
-        rows = ca.vertcat(g[self.upper.tolist()] - wu * t, g[self.lower.tolist()] + wl * t)
         opts = {k: v for k, v in (options or {}).items() if k != DEADLINE_OPTION}
-        settings = without_option_files(
+        self._settings = without_option_files(
             {
                 "print_time": False,
                 "ipopt": {**IPOPT_DEFAULTS, "max_iter": PHASE_ONE_MAX_ITER, **opts},
             }
         )
-        with solver_call():
-            self.solver = ca.nlpsol(
-                "optdesign_phase1",
-                "ipopt",
-                {
-                    "x": ca.vertcat(nlp.z, t),
-                    "p": ca.vertcat(nlp.theta, wu, wl),
-                    "f": t,
-                    "g": rows,
-                },
-                settings,
-            )
+        #: One phase-1 problem per set of limited row sides (upper rows, lower rows); the
+        #: NLP's own is built now, another only for a call that limits more sides (an
+        #: epsilon limit, ``NLP.bounds(eps=...)``, on a row the NLP leaves unlimited).
+        self._problems: dict[bytes, _Sides] = {}
+        own = self._sides(np.isfinite(nlp.ubg), np.isfinite(nlp.lbg))
+        self.upper, self.lower = own.upper, own.lower
 
-    def weights(self, rows: np.ndarray | None = None, per_row: np.ndarray | None = None):
+    def _sides(self, upper: np.ndarray, lower: np.ndarray) -> _Sides:
+        """The phase-1 problem whose rows are the ``upper`` and ``lower`` (masks) sides."""
+        key = np.concatenate([upper, lower]).tobytes()
+        if key not in self._problems:
+            self._problems[key] = _Sides.build(self.nlp, upper, lower, self._settings)
+        return self._problems[key]
+
+    def weights(
+        self,
+        rows: np.ndarray | None = None,
+        per_row: np.ndarray | None = None,
+        sides: _Sides | None = None,
+    ):
         """(wu, wl): weight ``per_row[k]`` (default 1) on rows ``rows`` (default: all),
-        0 on the others, for the finite sides of each row."""
+        0 on the others, for the limited sides of each row (``sides``: default the
+        NLP's own)."""
+        sides = sides or self._sides(np.isfinite(self.nlp.ubg), np.isfinite(self.nlp.lbg))
         m = len(self.nlp.g_names)
         w = np.zeros(m)
         chosen = np.arange(m) if rows is None else np.asarray(rows, dtype=int)
         w[chosen] = 1.0 if per_row is None else np.asarray(per_row, dtype=float)
-        return w[self.upper], w[self.lower]
+        return w[sides.upper], w[sides.lower]
 
     @one_blas_thread()
     def solve(
@@ -154,36 +182,40 @@ class PhaseOneSolver:
         nlp = self.nlp
         bounds = bounds if bounds is not None else nlp.bounds()
         theta = nlp.parameter_values(bounds.parameters)
-        wu, wl = self.weights(rows, per_row)
         z0 = np.clip(np.asarray(z0, dtype=float).ravel(), bounds.lbz, bounds.ubz)
         lbg = np.asarray(bounds.lbg, dtype=float)
         ubg = np.asarray(bounds.ubg, dtype=float)
+        # the NLP's limited sides, and any this call adds (a side it frees stays, open)
+        sides = self._sides(
+            np.isfinite(nlp.ubg) | np.isfinite(ubg), np.isfinite(nlp.lbg) | np.isfinite(lbg)
+        )
+        wu, wl = self.weights(rows, per_row, sides)
         g0 = np.asarray(nlp.g_fun(z0, theta), dtype=float).ravel()
-        t0 = _start_t(g0, lbg, ubg, self.upper, self.lower, wu, wl)
-        m_u = self.upper.size
+        t0 = _start_t(g0, lbg, ubg, sides.upper, sides.lower, wu, wl)
+        m_u = sides.upper.size
         args = {
             "x0": np.append(z0, t0),
             "p": np.concatenate([theta, wu, wl]),
             "lbx": np.append(bounds.lbz, 0.0),
             "ubx": np.append(bounds.ubz, np.inf),
-            "lbg": np.concatenate([np.full(m_u, -np.inf), lbg[self.lower]]),
-            "ubg": np.concatenate([ubg[self.upper], np.full(self.lower.size, np.inf)]),
+            "lbg": np.concatenate([np.full(m_u, -np.inf), lbg[sides.lower]]),
+            "ubg": np.concatenate([ubg[sides.upper], np.full(sides.lower.size, np.inf)]),
         }
         started = time.perf_counter()
         try:
             with solver_call():
-                sol = self.solver(**args)
+                sol = sides.solver(**args)
         except RuntimeError as exc:  # an evaluation CasADi cannot recover from
             wall = time.perf_counter() - started
             return self._point(z0, np.nan, "failed", str(exc).splitlines()[0], bounds, target, wall)
         wall = time.perf_counter() - started
-        stats = self.solver.stats()
+        stats = sides.solver.stats()
         status = str(stats.get("return_status", ""))
         x = np.asarray(sol["x"], dtype=float).ravel()
         lam = np.asarray(sol["lam_g"], dtype=float).ravel()
         lam_g = np.zeros(len(nlp.g_names))
-        np.add.at(lam_g, self.upper, lam[:m_u])
-        np.add.at(lam_g, self.lower, lam[m_u:])
+        np.add.at(lam_g, sides.upper, lam[:m_u])
+        np.add.at(lam_g, sides.lower, lam[m_u:])
         value = float(x[-1]) if status in _CONVERGED else np.nan
         out = self._point(x[:-1], value, status, status, bounds, target, wall, lam_g)
         out.result.iterations = stats.get("iter_count")

@@ -6,6 +6,7 @@ requirement's rows it is that requirement's relaxation with the other rows held.
 from __future__ import annotations
 
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -71,3 +72,39 @@ def test_weights_on_one_requirement_give_its_relaxation_with_the_others_held(tig
     # the hand bound of a mean ratio >= 200 over +-30 deg with p >= 2 mm, i_a = 2, within
     # what the 13 grid angles' mean ratio allows
     assert travel == pytest.approx(200 * (np.pi / 3) * 2 / (2 * np.pi * 2), rel=0.01)
+
+
+def test_an_epsilon_limit_on_an_objective_is_a_row_the_least_violation_holds():
+    # The backlash (an objective, in deg) has no upper limit in the NLP; NLP.bounds(eps=...)
+    # gives it one per call. Below its least value (0.0362 deg at these 13 angles'
+    # optimum) no design meets it: the least violation is positive there, and the row of
+    # the limit is violated; at 0.05 deg a design meets every row.
+    problem = _problem("110 mm")
+    nlp = formulation_for(problem, ("backlash",))
+    solver = PhaseOneSolver(nlp)
+    z0 = nlp.z_from_x(problem.midpoint())
+    row = nlp.eps_rows["backlash"]
+    tight = solver.solve(z0, nlp.bounds(eps={"backlash": 0.03}))
+    assert tight.certified
+    assert nlp.g_names[row] in {r.name for r in tight.result.violated}
+    g = np.asarray(nlp.g_fun(tight.z, nlp.parameter_values(None)), dtype=float).ravel()
+    assert g[row] * nlp.g_scale[row] > 0.03
+    loose = solver.solve(z0, nlp.bounds(eps={"backlash": 0.05}))
+    assert loose.feasible
+
+
+def test_a_lower_limit_a_call_adds_to_a_row_is_held():
+    # nut_travel has an upper limit only (110 mm); a call that also asks for at least
+    # 100 mm gets a phase-1 problem holding both sides, and a design within them (the
+    # NLP's own phase-1 problem, which ignores it, ends at 80 mm from this start).
+    problem = _problem("110 mm")
+    nlp = formulation_for(problem)
+    (row,) = [k for k, g in enumerate(nlp.g_names) if g == "nut_travel"]
+    assert not np.isfinite(nlp.lbg[row])
+    bounds = nlp.bounds()
+    lbg = np.array(bounds.lbg, dtype=float)
+    lbg[row] = 100.0 / nlp.g_scale[row]
+    found = PhaseOneSolver(nlp).solve(nlp.z_from_x(problem.midpoint()), replace(bounds, lbg=lbg))
+    assert found.feasible
+    g = np.asarray(nlp.g_fun(found.z, nlp.parameter_values(None)), dtype=float).ravel()
+    assert 100.0 * (1 - 1e-6) <= g[row] * nlp.g_scale[row] <= 110.0 * (1 + 1e-6)
