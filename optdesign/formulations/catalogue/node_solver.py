@@ -193,7 +193,7 @@ class NodeSolver:
             if keep is None or self.free_rows.size:
                 self._thinned = False
             else:
-                self._thinned = rows_solver_for(self.backend, keep, self._options)
+                self._thinned = rows_solver_for(self.backend, keep, self._options, self.solver)
                 self._thinned_rows = tuple(keep)
                 self._thinned_for = self.learned_angles
                 kept = {self.problem.phi_labels[k] for k in thinned_angles(len(self.problem.phi))}
@@ -233,7 +233,7 @@ class NodeSolver:
         if mode in ("relaxed", "checked"):
             # the node's thinned grid (a worker process builds it once for these rows;
             # here it is the one built already)
-            backend = rows_solver_for(self.backend, rows, self._options)
+            backend = rows_solver_for(self.backend, rows, self._options, self.solver)
         if mode == "relaxed":
             # with_rows keeps the targets: the node's target serves both back-ends
             return backend.solve(

@@ -102,8 +102,9 @@ def solver_for(
     return _remember(_SOLVERS, key, lambda: make_solver(nlp, name, opts))
 
 
-def rows_solver_for(backend, rows: Sequence[int], options: Mapping[str, Any]):
-    """The back-end of ``backend``'s NLP with only the constraint rows ``rows``
+def rows_solver_for(backend, rows: Sequence[int], options: Mapping[str, Any], solver: str):
+    """The back-end ``solver`` (its registry name, as ``backend`` was built by
+    :func:`solver_for`) of ``backend``'s NLP with only the constraint rows ``rows``
     (:func:`~optdesign.programs.nlp.with_rows`; a catalogue node on every other grid
     angle), with ``options``: built once per process, NLP, rows and options, as
     :func:`solver_for` builds the whole NLP's (every search of a front, each with its
@@ -115,10 +116,10 @@ def rows_solver_for(backend, rows: Sequence[int], options: Mapping[str, Any]):
         nlp.fingerprint,
         "rows",
         rows,
-        backend.name,
+        solver,
         json.dumps(opts, sort_keys=True, default=str),
     )
-    return _remember(_SOLVERS, key, lambda: make_solver(with_rows(nlp, rows), backend.name, opts))
+    return _remember(_SOLVERS, key, lambda: make_solver(with_rows(nlp, rows), solver, opts))
 
 
 def phase_one_for(

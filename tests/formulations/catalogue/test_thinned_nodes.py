@@ -93,3 +93,17 @@ def test_an_nlp_whose_rows_name_no_angle_is_not_thinned(fin):
     assert thinned_rows(problem, unlabelled) is None
     one_left_out = SimpleNamespace(g_names=["mean_ratio", f"stress[{problem.phi_labels[1]}]"])
     assert thinned_rows(problem, one_left_out) == [0]
+
+
+def test_a_node_solver_of_another_back_end_thins_its_nodes_with_it(fin):
+    """The thinned grid's solver is built by the registry name the node solver was given
+    (``slsqp``), not by its back-end's own name (``scipy-slsqp-exact``, unknown to the
+    registry: ``optdesign solve fin_actuator.toml --solver slsqp`` stopped there)."""
+    problem, _ = fin
+    ns = NodeSolver(problem, starts=2, solver="slsqp")
+    box = {"d": (6.0, 10.0)}
+    thinned = ns.solve(box, relaxed=True)
+    assert ns.relaxed_backend().name == ns.backend.name == "scipy-slsqp-exact"
+    assert thinned.details["relaxed_grid"] == 31 and thinned.success
+    whole = ns.solve(box)
+    assert whole.success and thinned.objective <= whole.objective * (1 + 1e-7)
