@@ -106,8 +106,9 @@ def linkage_panel(problem, design: dict, title: str = "") -> SketchPanel:
     return SketchPanel(str(title), frames)
 
 
-def draw_panel(ax, panel: SketchPanel) -> None:
-    """Draw a :class:`SketchPanel` on ``ax``."""
+def draw_panel(ax, panel: SketchPanel, legend: bool = True) -> bool:
+    """Draw a :class:`SketchPanel` on ``ax``, with its legend when ``legend``; whether
+    it drew a sketch."""
     drawn = False
     for j, (label, sk) in enumerate(panel.frames):
         if sk is None:
@@ -140,9 +141,11 @@ def draw_panel(ax, panel: SketchPanel) -> None:
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x (mm)", fontsize=7)
         ax.set_ylabel("y (mm)", fontsize=7)
-        ax.legend(fontsize=6, loc="best")
+        if legend:
+            ax.legend(fontsize=6, loc="best")
     ax.set_title(plain(panel.title), fontsize=8)
     ax.tick_params(labelsize=7)
+    return drawn
 
 
 def draw_linkage(ax, problem, design: dict, title: str = "") -> None:
@@ -235,8 +238,12 @@ def draw_front(figure: FrontFigure, ax=None):
     )
     if ax.get_legend_handles_labels()[0]:  # a front with no point has nothing to list
         ax.legend(fontsize=7)
+    # The panels sketch one mechanism at the same stroke angles: their legends would
+    # repeat one another, so the first panel with a sketch carries it for all.
+    legend = True
     for k, panel in enumerate(panels):
-        draw_panel(fig.add_subplot(gs[k % 2, 1 + k // 2]), panel)
+        drawn = draw_panel(fig.add_subplot(gs[k % 2, 1 + k // 2]), panel, legend)
+        legend = legend and not drawn
     return fig
 
 
