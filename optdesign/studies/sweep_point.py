@@ -13,12 +13,11 @@ from typing import Any
 
 import numpy as np
 
-from optdesign.formulations.nlp.solution import nlp_solution
+from optdesign.formulations.nlp.solution import has_multipliers, nlp_solution
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.parameters import at_values
 from optdesign.problem.request import SolveRequest
 from optdesign.solvers.multistart import tie_width
-from optdesign.solvers.registry import solver_hints
 from optdesign.studies.sweep_grid import (  # noqa: F401 - the grid's names, as before
     MAX_AXES,
     MAX_GRID,
@@ -238,7 +237,7 @@ def _outcome(task, problem: DesignProblem, best, shared, found_by: str) -> dict[
     if (
         request.sensitivities
         and best.success
-        and solver_hints(best.solver).multipliers
+        and has_multipliers(best, request.solver)
         and nlp_solution(best) is not None
     ):
         from optdesign.formulations.nlp.sensitivities import nlp_sensitivities

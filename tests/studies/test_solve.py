@@ -412,6 +412,16 @@ def test_slsqp_back_end_solves_and_prices_its_limits():
     assert not any("not computed" in n for n in result.notes), result.notes
 
 
+def test_a_robust_problem_solves_with_the_slsqp_back_end():
+    # the robust formulation asked the registry for the hints of the run's label
+    # (scipy-slsqp-exact), unknown there: "unknown nlp solver" before any answer
+    robust = od.load(ROOT / "problems" / "cs_min_backlash_robust.toml")
+    result = od.solve(robust, solver="slsqp", workers=1, ranges=False)
+    assert result.success and result.formulation == "robust-saa"
+    # Ipopt's CVaR_0.9 of the backlash over the same 32 samples: 0.0320601906 deg
+    assert result.objective == pytest.approx(0.0320601906, rel=1e-6)
+
+
 def test_target_odds_keeps_the_search_going_until_its_estimate_is_below_it(ripple):
     # one optimum: the rule alone stops at 10 counted starts (2 per free variable), with
     # an estimate 2 / (10 * 9); a target of 0.5 % needs n (n - 1) >= 400, n = 21

@@ -13,13 +13,14 @@ import numpy as np
 
 from optdesign.errors import ProblemError
 from optdesign.formulations.gp.details import ExactNLP, GPDetails, GPRows
+from optdesign.formulations.nlp.solution import has_multipliers
 from optdesign.formulations.nlp.solve import finish, solve_nlp
 from optdesign.formulations.reference import attach_reference, reference_design
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.request import SolveRequest
 from optdesign.programs.gp import GPData, build_gp
 from optdesign.solvers.details import GPTiming
-from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind, solver_hints
+from optdesign.solvers.registry import default_solver, make_solver, solver_for_kind
 from optdesign.solvers.result import Globality, Result
 
 
@@ -114,7 +115,7 @@ def solve_gp_problem(
             starts=nlp.multistart.n_starts if nlp.multistart else 1,
         )
         details.gap_gp_nlp_rel = gap
-        if nlp.success and solver_hints(nlp.solver).multipliers:
+        if nlp.success and has_multipliers(nlp):
             from optdesign.formulations.nlp.sensitivities import nlp_sensitivities
 
             result.sensitivities = nlp_sensitivities(problem, nlp)

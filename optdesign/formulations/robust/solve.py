@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from optdesign.display.tables import format_table
+from optdesign.formulations.nlp.solution import has_multipliers
 from optdesign.formulations.nlp.solve import (
     continuous_only,
     finish,
@@ -48,7 +49,7 @@ from optdesign.problem.objective_refusals import smooth_form_refusal
 from optdesign.problem.request import SolveRequest
 from optdesign.runtime.inherited_map import map_inherited
 from optdesign.solvers.multistart import multistart
-from optdesign.solvers.registry import make_solver, solver_hints
+from optdesign.solvers.registry import make_solver
 from optdesign.solvers.result import Globality, Result
 from optdesign.tolerances import FEASIBILITY_TOL
 
@@ -251,7 +252,7 @@ def solve_robust(
         free = {v.name: result.design[v.name] for v in problem.free}
         values, _ = sample_values(problem, free, samples, objective)
         details.saa_check = risk_value(values, risk, alpha, k)
-    if sensitivities and result.success and solver_hints(result.solver).multipliers:
+    if sensitivities and result.success and has_multipliers(result, solver):
         _attach_sensitivities(problem, result, nlp, samples, objective)
     return result
 
