@@ -100,3 +100,23 @@ def test_a_continuous_front_imports_no_catalogue_search(tmp_path):
         modules=catalogue,
     )
     assert out["code"] == 0 and out["heavy"] == []
+
+
+def test_a_front_whose_stderr_is_no_terminal_imports_no_progress_bar(tmp_path):
+    # tqdm draws nothing there (disable=None): its import, asyncio with it, is spared
+    out = loaded(
+        "pareto",
+        str(ROOT / "problems" / "cs_min_backlash.toml"),
+        "--objectives",
+        "ripple,backlash",
+        "--points",
+        "4",
+        "--workers",
+        "1",
+        "--no-plot",
+        "--no-report",
+        "--out",
+        str(tmp_path / "out"),
+        modules=("tqdm", "asyncio"),
+    )
+    assert out["code"] == 0 and out["heavy"] == []

@@ -21,6 +21,7 @@ from optdesign.cli import (
     flags,
     literal,
     output_folder,
+    progress_bar,
     time_limit_option,
 )
 
@@ -137,7 +138,7 @@ def _run_locked(args, problems, out: Path) -> int:
             workers=args.workers,
             scheduler=args.scheduler,
             resume=args.resume,
-            progress=not args.no_progress,
+            progress=progress_bar(args),
             time_limit=args.time_limit,
             hard_timeout=args.hard_timeout,
             overwrite=args.overwrite,

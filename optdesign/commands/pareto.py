@@ -19,6 +19,7 @@ from optdesign.cli import (
     flags,
     literal,
     output_folder,
+    progress_bar,
     time_limit_option,
 )
 
@@ -172,7 +173,7 @@ def _run_locked(args, problem, objectives, methods, out: Path, figures) -> int:
         scheduler=args.scheduler,
         resume=args.resume,
         overwrite=args.overwrite,
-        progress=not args.no_progress,
+        progress=progress_bar(args),
     )
     if args.time_limit is not None:
         run["time_limit"] = args.time_limit

@@ -14,7 +14,15 @@ import re
 from pathlib import Path
 
 from optdesign import validation as check
-from optdesign.cli import as_options, checked, command, flags, literal, output_folder
+from optdesign.cli import (
+    as_options,
+    checked,
+    command,
+    flags,
+    literal,
+    output_folder,
+    progress_bar,
+)
 from optdesign.errors import InputError
 
 _RANGE = re.compile(
@@ -176,7 +184,7 @@ def run_sweep_command(args) -> int:
                 out=out,
                 resume=args.resume,
                 overwrite=args.overwrite,
-                progress=not args.no_progress and not args.json,
+                progress=progress_bar(args) and not args.json,
                 sensitivities=args.sensitivities,
                 workers=args.workers,
                 scheduler=args.scheduler,
