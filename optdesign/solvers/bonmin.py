@@ -109,7 +109,14 @@ def solve_minlp(minlp: Any, x0: Any, options: Mapping[str, Any] | None = None):
         "optdesign_bonmin",
         "bonmin",
         {"x": minlp.x, "f": minlp.f, "g": minlp.g},
-        {"discrete": minlp.discrete, "print_time": False, "bonmin": opts},
+        # a trial point where a model is undefined (NaN) is Bonmin's to handle, as it is
+        # Ipopt's: CasADi's warning on each would only alarm
+        {
+            "discrete": minlp.discrete,
+            "print_time": False,
+            "show_eval_warnings": False,
+            "bonmin": opts,
+        },
     )
     with solver_call(), quiet_stdout():
         try:
