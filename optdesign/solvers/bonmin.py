@@ -8,13 +8,12 @@ exact only for convex problems. On a continuous NLP it runs its Ipopt.
 
 from __future__ import annotations
 
-import contextlib
 import os
-import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 from optdesign.errors import InputError
+from optdesign.solvers.quiet import quiet_stdout
 
 #: Bonmin's algorithms (``bonmin.algorithm``) offered as choices and bench configurations.
 BONMIN_ALGORITHMS = ("B-BB", "B-OA", "B-Hyb")
@@ -52,26 +51,6 @@ def refuse_options_file() -> None:
             "files it may write); options come from the problem file's [solver] or "
             "options=. Remove it or run from another folder",
         )
-
-
-@contextlib.contextmanager
-def quiet_stdout() -> Iterator[None]:
-    """Bonmin and Cbc write some lines to the C-level stdout whatever their log levels:
-    send file descriptor 1 to /dev/null for the call."""
-    sys.stdout.flush()
-    try:
-        saved = os.dup(1)
-    except OSError:  # no stdout at all
-        yield
-        return
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 1)
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
 
 
 def bonmin_options(options: Mapping[str, Any] | None) -> dict[str, Any]:

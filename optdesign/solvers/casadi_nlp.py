@@ -34,6 +34,7 @@ from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.deadline import passed as deadline_passed
 from optdesign.solvers.ipopt_options import IPOPT_WARM  # noqa: F401 (its users import it here)
+from optdesign.solvers.quiet import quiet_stdout
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults, each chosen for the shape of these problems (a few scaled design
@@ -311,11 +312,33 @@ class CasadiNLPSolver:
         # from the working directory.
         opts = without_option_files(opts)
         self.options = opts
-        with solver_call():
-            self.solver = ca.nlpsol(
-                "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts
-            )
+        self.solver = self._build()
         rescan_blas()  # the plugin may have loaded CasADi's OpenBLAS, for one_blas_thread
+
+    def _build(self) -> ca.Function:
+        nlp = self.nlp
+        # qpOASES (sqpmethod's QP solver) prints its licence banner to the C stdout when
+        # it is built, whatever its print level; Ipopt prints nothing at print_level 0
+        quiet = quiet_stdout() if self.plugin != "ipopt" else contextlib.nullcontext()
+        with solver_call(), quiet:
+            return ca.nlpsol(
+                "optdesign",
+                self.plugin,
+                {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g},
+                self.options,
+            )
+
+    def _forget(self) -> None:
+        """After a failed solve, a plugin other than Ipopt gets a new Function. sqpmethod's
+        QP solver (qpOASES) starts each QP from the last one's working set, across
+        solves: after failed ones, every later solve of the Function failed too (a
+        catalogue box that converges alone did not after an infeasible one). A new
+        Function has fresh memory; Ipopt keeps no such state. The old one goes first:
+        destroyed after the new one's qpOASES is set up, it made qpOASES's error
+        messages visible again."""
+        if self.plugin != "ipopt":
+            self.solver = None
+            self.solver = self._build()
 
     @property
     def name(self) -> str:
@@ -346,10 +369,13 @@ class CasadiNLPSolver:
                 sol = self.solver(**args)
         except RuntimeError as exc:  # CasADi raises on evaluation errors it cannot recover
             wall = time.perf_counter() - t0
+            self._forget()
             return failed_result(self.plugin, nlp, target, str(exc).splitlines()[0], wall)
         wall = time.perf_counter() - t0
         stats = self.solver.stats()
         return_status = str(stats.get("return_status", ""))
+        if not stats.get("success"):
+            self._forget()
         if return_status == "User_Requested_Stop" and deadline_passed():
             return_status = "Maximum_WallTime_Exceeded"  # the study's time limit stopped it
         if return_status == "NonIpopt_Exception_Thrown":

@@ -1695,3 +1695,20 @@ def test_first_feasible_finds_a_feasible_catalogue_design_or_none(enumerated_4x5
     # pins of 4 mm only: too weak for the hinge moment whatever the lead (every pair fails)
     weak = _catalogue((4, 5, 6, 8), (4,))
     assert catalogue_bnb.first_feasible(catalogue.NodeSolver(weak, starts=2)) is None
+
+
+def test_sqpmethod_nodes_after_failed_ones_solve_as_on_a_fresh_solver():
+    """CasADi's sqpmethod starts each QP from qpOASES's last working set, across solves:
+    after the failed starts of a box it cannot solve (d in [4, 5] mm), every start of a
+    box it solves alone (d in [6, 25] mm) failed too, and the catalogue search with
+    ``--solver sqpmethod`` found no design. The back-end is built anew after a failed
+    solve."""
+    from optdesign.formulations.catalogue.search import NodeSolver
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
+    ns = NodeSolver(problem, "backlash", 4, 0, "sqpmethod", agree=3)
+    failed = ns.solve({"p": (2.0, 10.0), "d": (4.0, 5.0)}, relaxed=True)
+    after = ns.solve({"p": (2.0, 10.0), "d": (6.0, 25.0)}, relaxed=True)
+    assert not failed.success and after.success
+    # the box's least backlash on the thinned grid, as Ipopt and a fresh sqpmethod find it
+    assert after.objective == pytest.approx(0.0340646215, rel=1e-8)
