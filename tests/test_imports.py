@@ -79,44 +79,30 @@ def test_solve_json_shows_written_units_without_pint():
     assert out["code"] == 0 and out["heavy"] == []
 
 
+#: A 4-point continuous front on one worker, with no figure or report.
+_FRONT = (
+    "pareto",
+    str(ROOT / "problems" / "cs_min_backlash.toml"),
+    "--objectives",
+    "ripple,backlash",
+    "--points",
+    "4",
+    "--workers",
+    "1",
+    "--no-plot",
+    "--no-report",
+)
+
+
 def test_a_continuous_front_imports_no_catalogue_search(tmp_path):
     # the catalogue front's search (branch and bound, diagnosis) is for problems with
     # catalogue variables only
     catalogue = ("optdesign.formulations.catalogue.bnb", "optdesign.formulations.catalogue.search")
-    out = loaded(
-        "pareto",
-        str(ROOT / "problems" / "cs_min_backlash.toml"),
-        "--objectives",
-        "ripple,backlash",
-        "--points",
-        "4",
-        "--workers",
-        "1",
-        "--no-plot",
-        "--no-report",
-        "--no-progress",
-        "--out",
-        str(tmp_path / "out"),
-        modules=catalogue,
-    )
+    out = loaded(*_FRONT, "--no-progress", "--out", str(tmp_path / "out"), modules=catalogue)
     assert out["code"] == 0 and out["heavy"] == []
 
 
 def test_a_front_whose_stderr_is_no_terminal_imports_no_progress_bar(tmp_path):
     # tqdm draws nothing there (disable=None): its import, asyncio with it, is spared
-    out = loaded(
-        "pareto",
-        str(ROOT / "problems" / "cs_min_backlash.toml"),
-        "--objectives",
-        "ripple,backlash",
-        "--points",
-        "4",
-        "--workers",
-        "1",
-        "--no-plot",
-        "--no-report",
-        "--out",
-        str(tmp_path / "out"),
-        modules=("tqdm", "asyncio"),
-    )
+    out = loaded(*_FRONT, "--out", str(tmp_path / "out"), modules=("tqdm", "asyncio"))
     assert out["code"] == 0 and out["heavy"] == []
