@@ -89,7 +89,9 @@ def multistart_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
     # No per-start Ipopt fallback first: a start that fails is just a failed start.
     best = run(False)
     n_solves = best.multistart.n_starts + best.multistart.polished
-    if best.multistart.n_at_best == 0 and solver.has_fallback:
+    # again with the fallback where no start succeeded, or where the best one's polish on
+    # the whole grid did not
+    if (best.multistart.n_at_best == 0 or not best.success) and solver.has_fallback:
         best = run(True)
         n_solves += best.multistart.n_starts + best.multistart.polished
     ms = best.multistart

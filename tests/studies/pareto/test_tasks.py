@@ -999,6 +999,38 @@ def test_an_anchor_multistart_whose_starts_succeed_is_not_solved_again_with_the_
         assert record["objectives"]["backlash"] == pytest.approx(0.0362197, rel=1e-5)
 
 
+def test_an_anchor_whose_best_start_fails_its_polish_is_searched_again_with_the_fallback(
+    monkeypatch,
+):
+    """A search whose starts agree on the thinned grid but whose polish on the whole grid
+    fails has no optimum: it runs again with the fallback back-end, as one with no
+    successful start does (CasADi's sqpmethod as a front's primary left the pivoting
+    screw's ripple anchor at such a point: "no feasible design found")."""
+    import dataclasses
+
+    from optdesign.studies.pareto import tasks
+
+    problem = od.load(ROOT / "problems" / "cs_min_backlash.toml")
+    searched = tasks.global_search
+    calls: list[bool] = []
+
+    def search(solve, *args, **kw):
+        best = searched(solve, *args, **kw)
+        calls.append(best.success)
+        if len(calls) == 1:  # the first search's optimum, as if its polish had failed
+            return dataclasses.replace(best, status="failed", message="polish stopped")
+        return best
+
+    monkeypatch.setattr(tasks, "global_search", search)
+    order = ["backlash", "size"]
+    task = {"problem": problem, "order": order, "objectives": order, "starts": 1,
+            "seed": 0, "agree": None, "id": "anchor-backlash-ms"}  # fmt: skip
+    record = tasks.multistart_task(task, {})
+    assert len(calls) == 2  # searched again, with the fallback behind the primary
+    assert record["status"] == "optimal"
+    assert record["objectives"]["backlash"] == pytest.approx(0.0362197, rel=1e-5)
+
+
 def test_an_arc_step_back_starts_from_the_tighter_of_the_neighbours_value_and_limit():
     """Stepping back along the arc (the target lies before the neighbour), the new limit
     is a step below the lower of the neighbour's value and its own limit."""
