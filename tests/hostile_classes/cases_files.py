@@ -193,7 +193,11 @@ def class4() -> list[Case]:
     c: list[Case] = []
     travel = 'nut_travel_max = "110 mm"'
     c += [
-        file_case("4", "catalogue infeasible travel", sub(CATALOGUE, travel, 'nut_travel_max = "1 mm"'), infeasible("nut_travel"), fast=True),
+        # 13.7 s through the CLI: in the slow corpus only. The fast suite's class-4
+        # verdict through the CLI is the continuous one below (2.2 s); this file's
+        # catalogue diagnosis is tests/formulations/test_diagnosis.py's
+        # test_a_catalogue_relaxation_is_sought_from_the_problems_start_too (4.8 s).
+        file_case("4", "catalogue infeasible travel", sub(CATALOGUE, travel, 'nut_travel_max = "1 mm"'), infeasible("nut_travel")),
         file_case("4", "catalogue infeasible ratio", sub(CATALOGUE, "min = 200, max = 260", "min = 2000, max = 2100"), infeasible("mean_ratio")),
         file_case("4", "catalogue infeasible pressure", sub(CATALOGUE, '"100 MPa"', '"0.01 MPa"'), infeasible("pin_bearing_pressure")),
         file_case("4", "fin_actuator infeasible lock", sub(FIN, 'force_max = "30 N"', 'force_max = "0.001 N"'), infeasible("lock_force", "force_max")),
@@ -205,7 +209,7 @@ def class4() -> list[Case]:
         file_case("4", "drive infeasible efficiency", add(DRIVE, "requirements", "efficiency_min = 0.999"), infeasible("efficiency")),
         file_case("4", "drive infeasible stiffness", sub(DRIVE, '"600 kN*m/rad"', '"1e9 kN*m/rad"'), infeasible("stiffness")),
         file_case("4", "drive self-locking ball screw", sub(DRIVE, 'back_drive = "required"', 'back_drive = "forbidden"'), infeasible("back_drive")),
-        file_case("4", "continuous infeasible default mode", sub(BACKLASH, travel, 'nut_travel_max = "1 mm"'), infeasible("nut_travel")),
+        file_case("4", "continuous infeasible default mode", sub(BACKLASH, travel, 'nut_travel_max = "1 mm"'), infeasible("nut_travel"), fast=True),
     ]  # fmt: skip
     c += [
         Case("4:pareto catalogue infeasible", "4", infeasible("nut_travel"), argv=_pareto("backlash,ripple"), text=sub(CATALOGUE, travel, 'nut_travel_max = "1 mm"'), json=False, api=_api_pareto(["backlash", "ripple"])),
