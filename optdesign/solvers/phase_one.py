@@ -142,8 +142,7 @@ class PhaseOneSolver:
         #: NLP's own is built now, another only for a call that limits more sides (an
         #: epsilon limit, ``NLP.bounds(eps=...)``, on a row the NLP leaves unlimited).
         self._problems: dict[bytes, _Sides] = {}
-        own = self._sides(np.isfinite(nlp.ubg), np.isfinite(nlp.lbg))
-        self.upper, self.lower = own.upper, own.lower
+        self._own = self._sides(np.isfinite(nlp.ubg), np.isfinite(nlp.lbg))
 
     def _sides(self, upper: np.ndarray, lower: np.ndarray) -> _Sides:
         """The phase-1 problem whose rows are the ``upper`` and ``lower`` (masks) sides."""
@@ -161,7 +160,7 @@ class PhaseOneSolver:
         """(wu, wl): weight ``per_row[k]`` (default 1) on rows ``rows`` (default: all),
         0 on the others, for the limited sides of each row (``sides``: default the
         NLP's own)."""
-        sides = sides or self._sides(np.isfinite(self.nlp.ubg), np.isfinite(self.nlp.lbg))
+        sides = sides or self._own
         m = len(self.nlp.g_names)
         w = np.zeros(m)
         chosen = np.arange(m) if rows is None else np.asarray(rows, dtype=int)
