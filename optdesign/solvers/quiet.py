@@ -1,13 +1,15 @@
-"""Solver libraries that print to the C-level stdout whatever their print options (Bonmin
-and Cbc some lines; qpOASES, inside CasADi's sqpmethod, its licence banner when built and
-its errors once a new instance has made them visible): their calls run with file
-descriptor 1 on /dev/null."""
+"""Solver libraries that print whatever their print options (Bonmin and Cbc some lines to
+the C-level stdout; qpOASES, inside CasADi's sqpmethod, its licence banner each time a
+memory of the solver is set up, through CasADi's output, which CasADi's Python module
+sends to ``sys.stdout``): their calls run with file descriptor 1 on /dev/null and
+``sys.stdout`` on a sink (in a notebook, ``sys.stdout`` is not file descriptor 1)."""
 
 from __future__ import annotations
 
 import contextlib
 import ctypes
 import functools
+import io
 import os
 import sys
 from collections.abc import Iterator
@@ -32,20 +34,23 @@ def _flush_c_stdout() -> None:
 
 @contextlib.contextmanager
 def quiet_stdout() -> Iterator[None]:
-    """Send file descriptor 1 to /dev/null for the call (Python's and the C library's
-    buffered output is flushed first, so nothing printed before is lost, and again
-    before fd 1 is restored, so nothing printed inside leaks out)."""
+    """Send file descriptor 1 to /dev/null and ``sys.stdout`` to a sink for the call
+    (Python's and the C library's buffered output is flushed first, so nothing printed
+    before is lost, and the C library's again before fd 1 is restored, so nothing
+    printed inside leaks out)."""
     sys.stdout.flush()
     _flush_c_stdout()
     try:
         saved = os.dup(1)
     except OSError:  # no stdout at all
-        yield
+        with contextlib.redirect_stdout(io.StringIO()):
+            yield
         return
     devnull = os.open(os.devnull, os.O_WRONLY)
     try:
         os.dup2(devnull, 1)
-        yield
+        with contextlib.redirect_stdout(io.StringIO()):
+            yield
     finally:
         _flush_c_stdout()
         os.dup2(saved, 1)

@@ -163,7 +163,7 @@ def test_resume_with_other_method_settings_or_version_is_refused(run, monkeypatc
         StoreError, match=r"method's settings changed \(method.points: stored 3, now 4"
     ):
         od.pareto(p, OBJECTIVES, points=4, out=out, workers=1, starts=1, resume=True)
-    with pytest.raises(StoreError, match=r'solver\.back_end: stored "slsqp", now "ipopt"'):
+    with pytest.raises(StoreError, match=r'solver\.back_end: stored "sqpmethod", now "ipopt"'):
         od.pareto(
             p, OBJECTIVES, points=3, out=out, workers=1, starts=1, resume=True, solver="ipopt"
         )

@@ -60,13 +60,14 @@ def test_the_registry_holds_each_back_ends_hints_and_the_defaults():
     assert ipopt.file_options == "ipopt" and ipopt.deadline_options
     assert ipopt.time_limit(2) == {"max_wall_time": 2.0, "max_cpu_time": 2.0}
     assert solver_hints("slsqp").sweep_options == {"maxiter": 200}
+    assert solver_hints("sqpmethod").sweep_options["hessian_approximation"] == "limited-memory"
     assert solver_hints("scs", "gp").time_limit(3) == {"time_limit_secs": 3.0}
     assert solver_hints("sqpmethod").time_limit(3) == {}  # none: the hard timeout covers it
     assert solver_hints(None) is ipopt  # None: the default NLP back-end's
     assert (default_solver("nlp"), default_solver("gp")) == ("ipopt", "clarabel")
     assert solver_for_kind("slsqp", "gp") == "clarabel" and solver_for_kind("scs", "gp") == "scs"
     assert (FRONT_SOLVERS.primary, FRONT_SOLVERS.fallback, FRONT_SOLVERS.tie) == (
-        "slsqp",
+        "sqpmethod",
         "ipopt",
         "ipopt",
     )

@@ -9,8 +9,8 @@ epsilon row enters with the bound it had in that solve, ``min(eps, the requireme
 limit)``: a requirement that caps an objective (``ripple_max``) costs only where it, not
 the epsilon bound, binds.
 
-SLSQP, the front's primary back-end, returns the rows' multipliers but none of the bounds
-(``lam_x`` zero). They follow from stationarity, ``grad f + J' lam_g + lam_x = 0``: at a
+SLSQP (a front's sweep with ``solver="slsqp"``) returns the rows' multipliers but none of
+the bounds (``lam_x`` zero). They follow from stationarity, ``grad f + J' lam_g + lam_x = 0``: at a
 variable on a bound ``lam_x = -(grad f + J' lam_g)``, with the sign of that bound. What
 stationarity leaves at the other variables tells whether the multipliers are those of a
 KKT point at all (:data:`KKT_TOL`); when they are not, the costs are not shown.

@@ -8,11 +8,13 @@ any other solve.
 
 The back-ends of each role are the solver registry's
 (:data:`~optdesign.solvers.registry.FRONT_SOLVERS`), with the options each back-end
-declares (:class:`~optdesign.solvers.registry.SolverHints`). The primary back-end is SLSQP
-with exact CasADi first derivatives and its sweep options (quick to build, and several
-times faster per solve than Ipopt on these NLPs: benchmarks/README.md, "Figures behind comments in the code"); a start it does not solve (failure, or an iterate
-that violates a row) is solved again by the fallback, Ipopt (exact Hessian), from the same
-start. The lexicographic tie-breaks use the tie back-end (Ipopt) with its restart options.
+declares (:class:`~optdesign.solvers.registry.SolverHints`). The primary back-end is
+CasADi's sqpmethod with its sweep options (a limited-memory Hessian and qpOASES: several
+times faster per solve than Ipopt on these NLPs, about twice SLSQP's speed, with no SciPy
+import; benchmarks/README.md, "A front's primary: sqpmethod, each solve on a memory of
+its own"); a start it does not solve (failure, or an iterate that violates a row) is
+solved again by the fallback, Ipopt (exact Hessian), from the same start. ``method`` =
+``"slsqp"`` sweeps with SciPy's SLSQP instead. The lexicographic tie-breaks use the tie back-end (Ipopt) with its restart options.
 ``method`` = the fallback (``"ipopt"``) uses it throughout, warm-started primal and dual
 with its warm-start options.
 """
@@ -45,8 +47,8 @@ class EpsSolver:
     objectives
         The front's objectives: the formulation's objective set.
     method
-        The primary back-end (default: the registry's front primary, SLSQP, with the
-        fallback's solves behind it), or the fallback (Ipopt) throughout.
+        The primary back-end (default: the registry's front primary, sqpmethod, with the
+        fallback's solves behind it; or SLSQP), or the fallback (Ipopt) throughout.
     """
 
     def __init__(
@@ -118,7 +120,8 @@ class EpsSolver:
         warm = use is None and not self.has_fallback
         backend = self.backend(use or ("warm" if warm else "primary"))
         if self.has_fallback or use is not None:
-            # The primary takes no dual start (SLSQP), and a tie-break's duals belong to
+            # The primary takes a primal start only (SLSQP takes no dual one, and
+            # sqpmethod's L-BFGS gains nothing from it), and a tie-break's duals belong to
             # another target.
             start = Start(start.z0)
         result = backend.solve(start, target, bounds)

@@ -85,7 +85,8 @@ class EpsilonConstraint(FrontMethod):
     solver
         The sweep's back-end, one of the registry's
         :data:`~optdesign.solvers.registry.FRONT_SOLVERS` choices: its primary (default,
-        ``"slsqp"``: SLSQP sweep, Ipopt fallback and tie-breaks) or its fallback
+        ``"sqpmethod"``: CasADi's SQP sweep, Ipopt fallback and tie-breaks), ``"slsqp"``
+        (SciPy's SLSQP sweep, the same fallback and tie-breaks) or its fallback
         (``"ipopt"`` throughout).
     retry_starts, extra_starts
         Sobol starts for a point that fails, worsens or jumps; at every point.

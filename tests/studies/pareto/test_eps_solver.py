@@ -66,9 +66,9 @@ def backends(monkeypatch, cs):
 
 
 # --- the solver and its back-ends -------------------------------------------------------
-def test_a_front_solver_is_the_sorted_objectives_formulation_with_slsqp_first(cs, nlp):
+def test_a_front_solver_is_the_sorted_objectives_formulation_with_sqpmethod_first(cs, nlp):
     solver = EpsSolver(cs, OBJECTIVES)
-    assert solver.method == "slsqp" and solver.has_fallback is True
+    assert solver.method == "sqpmethod" and solver.has_fallback is True
     assert solver.objectives == ("backlash", "size") and solver.problem is cs
     assert solver.nlp is nlp and solver.fingerprint == nlp.fingerprint
     ipopt = EpsSolver(cs, OBJECTIVES, "ipopt")
@@ -79,20 +79,23 @@ def test_a_front_solver_is_the_sorted_objectives_formulation_with_slsqp_first(cs
 def test_a_front_solver_of_an_unknown_back_end_is_refused_naming_the_choices(cs):
     with pytest.raises(ProblemError) as caught:
         EpsSolver(cs, OBJECTIVES, "bonmin")
-    assert str(caught.value) == "solver 'bonmin': use one of slsqp, ipopt"
+    assert str(caught.value) == "solver 'bonmin': use one of sqpmethod, slsqp, ipopt"
 
 
 def test_each_role_gets_its_back_end_with_the_options_it_declares(cs, backends):
-    slsqp, ipopt = EpsSolver(cs, OBJECTIVES), EpsSolver(cs, OBJECTIVES, "ipopt")
-    sweep = solver_hints("slsqp").sweep_options
+    sqp, ipopt = EpsSolver(cs, OBJECTIVES), EpsSolver(cs, OBJECTIVES, "ipopt")
+    slsqp = EpsSolver(cs, OBJECTIVES, "slsqp")
+    sweep = solver_hints("sqpmethod").sweep_options
     restart = solver_hints("ipopt").restart_options
     warm = solver_hints("ipopt").warm_start_options
     assert sweep and restart and warm
     objectives = ("backlash", "size")
     for solver, use, expected in [
-        (slsqp, "primary", ("slsqp", sweep)),
-        (slsqp, "tie", ("ipopt", restart)),
-        (slsqp, "warm", ("ipopt", warm)),
+        (sqp, "primary", ("sqpmethod", sweep)),
+        (sqp, "tie", ("ipopt", restart)),
+        (sqp, "warm", ("ipopt", warm)),
+        (sqp, "fallback", ("ipopt", None)),
+        (slsqp, "primary", ("slsqp", solver_hints("slsqp").sweep_options)),
         (slsqp, "fallback", ("ipopt", None)),
         (ipopt, "primary", ("ipopt", warm)),  # the fallback throughout: warm-started
         (ipopt, "tie", ("ipopt", restart)),
@@ -102,8 +105,8 @@ def test_each_role_gets_its_back_end_with_the_options_it_declares(cs, backends):
         solver.backend(use)
         assert backends["built"] == [(*expected, objectives)], (solver.method, use)
     backends["built"].clear()
-    slsqp.backend()
-    assert backends["built"] == [("slsqp", sweep, objectives)]
+    sqp.backend()
+    assert backends["built"] == [("sqpmethod", sweep, objectives)]
 
 
 # --- starts ------------------------------------------------------------------------------------
@@ -148,7 +151,7 @@ def test_a_solve_sends_the_primal_start_the_target_and_the_finite_limits(cs, nlp
     backends["answers"] = [_result()]
     result = solver.solve("size", {"backlash": 0.05, "ripple": math.inf}, start)
     ((name, sent, target, bounds),) = backends["solves"]
-    assert name == "slsqp" and target == "size" and result.details.fallback == ""
+    assert name == "sqpmethod" and target == "size" and result.details.fallback == ""
     assert np.array_equal(sent.z0, start.z0) and sent.lam_g0 is None and sent.lam_x0 is None
     expected = nlp.bounds(eps={"backlash": 0.05})
     assert np.array_equal(bounds.ubg, expected.ubg) and np.array_equal(bounds.lbz, expected.lbz)
@@ -160,7 +163,7 @@ def test_a_start_the_primary_fails_is_solved_again_by_the_fallback(cs, nlp, back
     start = nlp.start(x0=cs.start(), lam_g0=np.ones(len(nlp.lbg)))
     backends["answers"] = [_result("failed", "Iteration limit", 0.25), _result(wall=0.5)]
     result = solver.solve("backlash", {"size": 200.0}, start)
-    assert [(s[0], s[2]) for s in backends["solves"]] == [("slsqp", "backlash"),
+    assert [(s[0], s[2]) for s in backends["solves"]] == [("sqpmethod", "backlash"),
                                                           ("ipopt", "backlash")]  # fmt: skip
     assert backends["built"][-1] == ("ipopt", None, ("backlash", "size"))
     again = backends["solves"][1]
@@ -255,11 +258,11 @@ def test_an_ipopt_front_warm_starts_its_sweep_solves(cs_min_backlash):
 
 def test_a_front_solvers_back_end_is_its_primary_by_default(cs_min_backlash):
     """``EpsSolver.backend()`` with no use named is the primary back-end (the registry's
-    front primary, SLSQP), the one every sweep solve tries first."""
+    front primary, CasADi's sqpmethod), the one every sweep solve tries first."""
     from optdesign.studies.pareto.eps_solver import EpsSolver
 
     eps = EpsSolver(cs_min_backlash, ["backlash", "size"])
     assert eps.has_fallback
     assert eps.backend() is eps.backend("primary")
-    assert eps.backend().name == "scipy-slsqp-exact"
+    assert eps.backend().name == "sqpmethod"
     assert eps.backend("fallback").name == "ipopt"
