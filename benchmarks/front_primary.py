@@ -1,12 +1,11 @@
-"""A front's primary back-end: SciPy's SLSQP (the default) against CasADi's sqpmethod
-with qpOASES, on the same fronts, one process per run.
+"""A front's primary back-end: CasADi's sqpmethod with qpOASES (the default) against
+SciPy's SLSQP, on the same fronts, one process per run.
 
-Why: each worker of a front imports ``scipy.optimize`` for SLSQP (~0.3 s), the largest
+Why: each worker of a front imported ``scipy.optimize`` for SLSQP (~0.3 s), the largest
 fixed cost of the pareto command's front after the interpreter's start-up
 (benchmarks/README.md, "The pareto command's fixed cost"). CasADi's own SQP needs no
-SciPy. The registry lets a caller name only ``slsqp`` or ``ipopt`` as a front's sweep
-back-end, so this script swaps the registry's front roles before optdesign's studies are
-imported (an experiment, not an API).
+SciPy. ``--options`` (JSON) are added to sqpmethod's sweep options
+(``optdesign.solvers.registry.SQPMETHOD_SWEEP``) for the run.
 
 For each run it prints one JSON line: CPU seconds of the front (one worker, no files),
 points, NLP solves, starts the primary failed (solved again by Ipopt), failed points,
@@ -15,8 +14,7 @@ from the point at the same epsilon (``(f_point - f_ipopt) / |f_ipopt|``: how far
 a KKT point the primary stopped). Run from the repository root:
 
     python benchmarks/front_primary.py --primary slsqp --case cs_min_backlash:ripple,backlash
-    python benchmarks/front_primary.py --primary sqpmethod \\
-        --options '{"hessian_approximation": "limited-memory"}' --case knee:backlash,ripple
+    python benchmarks/front_primary.py --primary sqpmethod --case knee:backlash,ripple
 
 A case is ``PROBLEM:OBJ1,OBJ2`` with PROBLEM a file of problems/ (without .toml) or one of
 the user-written linkages of tests/multimodal_mechanisms (knee, six_bar, double_rocker).
@@ -26,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import collections
-import dataclasses
 import importlib
 import json
 import sys
@@ -40,32 +37,18 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--primary", default="slsqp", choices=("slsqp", "sqpmethod"))
+    ap.add_argument("--primary", default="sqpmethod", choices=("sqpmethod", "slsqp"))
     ap.add_argument("--options", default="{}", help="sqpmethod options (JSON)")
     ap.add_argument("--case", action="append", required=True, help="PROBLEM:OBJ1,OBJ2")
     ap.add_argument("--points", type=int, default=30)
     args = ap.parse_args()
 
+    import optdesign as od
+    import optdesign.studies.pareto.eps_solver as eps_solver
     from optdesign.solvers import registry
 
     if args.primary == "sqpmethod":
-        sweep = {"qpsol": "qpoases", "max_iter": 200, **json.loads(args.options)}
-        registry.FRONT_SOLVERS = dataclasses.replace(
-            registry.FRONT_SOLVERS, primary="sqpmethod", choices=("slsqp", "ipopt", "sqpmethod")
-        )
-        declared = registry.solver_hints
-
-        def hints(name=None, kind=None):
-            found = declared(name, kind)
-            if name == "sqpmethod":
-                return dataclasses.replace(found, sweep_options=sweep)
-            return found
-
-        registry.solver_hints = hints
-    import optdesign as od
-    import optdesign.studies.pareto.eps_solver as eps_solver
-
-    eps_solver.solver_hints = registry.solver_hints
+        registry.SQPMETHOD_SWEEP.update(json.loads(args.options))
     sys.path.insert(0, str(ROOT / "tests"))
     for case in args.case:
         name, _, objectives = case.partition(":")
@@ -76,7 +59,9 @@ def main() -> None:
         else:
             problem = od.load(ROOT / "problems" / f"{name}.toml")
         t0 = time.process_time()
-        front = od.pareto(problem, objs, points=args.points, workers=1, files=False)
+        front = od.pareto(
+            problem, objs, points=args.points, workers=1, files=False, solver=args.primary
+        )
         cpu = time.process_time() - t0
         again = eps_solver.EpsSolver(problem, objs)
         gaps = []

@@ -12,7 +12,9 @@ import functools
 import io
 import os
 import sys
+import threading
 from collections.abc import Iterator
+from typing import Any
 
 
 @functools.cache
@@ -32,27 +34,60 @@ def _flush_c_stdout() -> None:
         libc.fflush(None)
 
 
+class _Quiet:
+    """The process's one quiet window: fd 1 and ``sys.stdout`` are redirected when the
+    first caller enters and restored when the last leaves. Threads (a threaded Dask
+    worker) and nested calls share it: two windows each saving and restoring on their
+    own would, interleaved, leave stdout on /dev/null for good."""
+
+    lock = threading.Lock()
+    depth = 0
+    saved_fd: int | None = None
+    devnull: int | None = None
+    saved_stdout: Any = None
+
+    @classmethod
+    def enter(cls) -> None:
+        with cls.lock:
+            cls.depth += 1
+            if cls.depth > 1:
+                return
+            if sys.stdout is not None:
+                sys.stdout.flush()
+            _flush_c_stdout()
+            try:
+                cls.saved_fd = os.dup(1)
+            except OSError:  # no stdout at all
+                cls.saved_fd = None
+            else:
+                cls.devnull = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(cls.devnull, 1)
+            cls.saved_stdout, sys.stdout = sys.stdout, io.StringIO()
+
+    @classmethod
+    def leave(cls) -> None:
+        with cls.lock:
+            cls.depth -= 1
+            if cls.depth > 0:
+                return
+            sys.stdout = cls.saved_stdout
+            cls.saved_stdout = None
+            if cls.saved_fd is not None:
+                _flush_c_stdout()
+                os.dup2(cls.saved_fd, 1)
+                os.close(cls.saved_fd)
+                os.close(cls.devnull)
+            cls.saved_fd = cls.devnull = None
+
+
 @contextlib.contextmanager
 def quiet_stdout() -> Iterator[None]:
     """Send file descriptor 1 to /dev/null and ``sys.stdout`` to a sink for the call
     (Python's and the C library's buffered output is flushed first, so nothing printed
     before is lost, and the C library's again before fd 1 is restored, so nothing
-    printed inside leaks out)."""
-    sys.stdout.flush()
-    _flush_c_stdout()
+    printed inside leaks out). Nested and concurrent calls share one window."""
+    _Quiet.enter()
     try:
-        saved = os.dup(1)
-    except OSError:  # no stdout at all
-        with contextlib.redirect_stdout(io.StringIO()):
-            yield
-        return
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 1)
-        with contextlib.redirect_stdout(io.StringIO()):
-            yield
+        yield
     finally:
-        _flush_c_stdout()
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
+        _Quiet.leave()

@@ -19,6 +19,7 @@ from optdesign.errors import InfeasibleRequirementsError
 from optdesign.formulations.diagnosis import violated_text
 from optdesign.studies.pareto.records import PointRecord
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 
 def anchor_tasks(
@@ -89,6 +90,16 @@ def check_anchor(rec: PointRecord, name: str, problem: Any = None) -> None:
         raise NoFeasibleAnchor(name, rec, problem)
 
 
+def ideal_reached(anchor_a: PointRecord, optimum_b: PointRecord, b: str) -> bool:
+    """Whether anchor A (the least A, then the least B there) also has the least B
+    (``optimum_b``'s, to the tie tolerance): that design is then at least as good as any
+    other in both objectives, and the front is that one point. Swept anyway, its points
+    are the same design up to the solver's tolerance (a front of near-copies that
+    differ in the 8th digit)."""
+    least = optimum_b.objectives[b]
+    return anchor_a.objectives[b] <= least + OBJECTIVE_TIE_TOL * max(abs(least), 1e-300)
+
+
 class TwoChains:
     """The tasks of a two-objective sweep, decided as records come in.
 
@@ -123,6 +134,8 @@ class TwoChains:
         self.n, self.name, self.common, self.spacing = n, name, dict(common), spacing
         self.eps_values = None if eps_values is None else [float(v) for v in eps_values]
         self.frame: dict[str, float] | None = None
+        #: the anchors reach both objectives' least values: the front is one point
+        self.single = False
         self.claimed: set[int] = set()
         self.tasks: list[dict[str, Any]] = []
 
@@ -144,7 +157,10 @@ class TwoChains:
                 check_anchor(far, b, self.common.get("problem"))
                 tie = PointRecord.from_dict(done[tie_b]) if tie_b in done else None
                 self._make_frame(rec_a, far, tie)
+                self.single = ideal_reached(rec_a, far, b)
                 new.append(self._point(0, +1, tie_a, done))
+        if self.single:
+            return new  # point 0 is the front
         if self.frame is not None and tie_b in done and n - 1 not in self.claimed:
             check_anchor(PointRecord.from_dict(done[tie_b]), b, self.common.get("problem"))
             new.append(self._point(n - 1, -1, tie_b, done))

@@ -55,7 +55,7 @@ from optdesign.studies.pareto.template import (
     has_catalogue,
     leaves_catalogue,
 )
-from optdesign.tolerances import FEASIBILITY_TOL
+from optdesign.tolerances import FEASIBILITY_TOL, OBJECTIVE_TIE_TOL
 
 
 def _common(
@@ -163,7 +163,7 @@ class EpsilonConstraint(FrontMethod):
                 )
                 done = phase(anchor_list, resume=run.resume, expand=sweep)
                 anchors = _anchors(done, objectives, run)
-                tasks = sweep.tasks
+                tasks, single = sweep.tasks, sweep.single
                 done, latest = _polish(phase, done, tasks, self.name, common)
             else:
                 # Three objectives: the rows need every anchor (the nadir of B), so the
@@ -176,14 +176,19 @@ class EpsilonConstraint(FrontMethod):
                 known = {f"anchor-{k}": done[f"anchor-{k}"] for k in objectives}
                 # the anchors are in the store already: resume over them
                 done = phase(tasks, resume=True, known=known)
-                latest = {}
+                latest, single = {}, False
         recs = [
             PointRecord.from_dict(done[latest.get(t["id"], t["id"])])
             for t in sorted(tasks, key=lambda t: t["index"])
             if t["id"] in done  # a time limit leaves the points not begun out
         ]
         notes = []
-        if len(recs) < n_points:
+        if single:
+            notes.append(
+                f"{objectives[0]}'s optimum also has the least {objectives[1]} (to a relative "
+                f"{OBJECTIVE_TIE_TOL:g}): the front is that one design, not swept"
+            )
+        elif len(recs) < n_points:
             notes.append(
                 f"time limit of {run.time_limit:g} s reached: {n_points - len(recs)} of "
                 f"{n_points} points not computed (no point begins after the limit; "

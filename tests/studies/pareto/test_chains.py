@@ -18,6 +18,7 @@ from optdesign.studies.pareto.chains import (
     anchor_message,
     anchor_tasks,
     check_anchor,
+    ideal_reached,
     three_objective_tasks,
 )
 from optdesign.studies.pareto.records import PointRecord
@@ -262,6 +263,35 @@ def test_a_degenerate_frame_keeps_positive_ranges():
     ch({"id": "anchor-B-ms"}, {}, {**DONE_A, **same})
     assert ch.frame["ra"] == 1e-300 and ch.frame["rb"] == 1e-300
     assert ch.frame["a_hi"] == LO  # never below the first limit
+    # anchor A has B's least value too: point 0 is the whole front, nothing else is added
+    assert ch.single and [t["id"] for t in ch.tasks] == ["front-0000"]
+    done = {**DONE_A, **same, "anchor-B": _rec("anchor-B", 1.0, 10.0)}
+    assert ch({"id": "anchor-B"}, {}, done) == [] and ch(ch.tasks[0], {}, done) == []
+
+
+@pytest.mark.parametrize(
+    ("b_of_a", "single"),
+    [(10.0 * (1 + 0.9e-6), True), (10.0 * (1 + 1.1e-6), False), (9.0, True)],
+)
+def test_a_front_is_one_design_when_anchor_a_has_the_least_b_to_the_tie_tolerance(b_of_a, single):
+    """Anchor A (least A, then least B) with B's least value (10, from B's optimum) to a
+    relative 1e-6 dominates every design in both objectives."""
+    assert ideal_reached(PointRecord.from_dict(_rec("anchor-A", 1.0, b_of_a)),
+                         PointRecord.from_dict(_rec("anchor-B-ms", 2.0, 10.0)), "B") is single  # fmt: skip
+
+
+def test_a_front_whose_anchors_coincide_is_one_point_with_a_note_saying_why():
+    """The pivoting screw's backlash optimum has its least ripple too. Swept, its 30
+    points were copies of one design that differed in the 8th digit (three of them kept
+    as non-dominated with sqpmethod as the sweep's primary); it is one point, not swept."""
+    problem = od.load(PROBLEMS / "pivot_min_backlash.toml")
+    front = od.pareto(problem, ["backlash", "ripple"], points=6, workers=1, files=False)
+    assert len(front.points) == 1 and front.rejected == []
+    (note,) = [n for n in front.notes if "one design" in n]
+    assert note.startswith("backlash's optimum also has the least ripple")
+    point, anchor = front.points[0], front.anchors["backlash"]
+    assert point.objectives["backlash"] == pytest.approx(anchor["backlash"], rel=1e-6)
+    assert point.objectives["ripple"] == pytest.approx(anchor["ripple"], rel=1e-6)
 
 
 # --- three objectives ------------------------------------------------------------------------------
