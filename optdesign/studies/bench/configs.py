@@ -325,10 +325,9 @@ def _register_defaults() -> None:
             "front-epsilon",
             "front",
             _eps_front,
-            "epsilon-constraint front (SLSQP sweep, Ipopt tie-breaks)",
+            "epsilon-constraint front (sqpmethod sweep, Ipopt tie-breaks)",
             dict(FRONT_OPTIONS),
             time_factor=10.0,
-            preload=SCIPY_MODULES,
         )
     )
     register_config(
