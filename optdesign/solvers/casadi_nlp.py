@@ -284,6 +284,22 @@ _SOLVE_INPUTS = ("x0", "p", "lbx", "ubx", "lbg", "ubg", "lam_x0", "lam_g0")
 _SOLVE_OUTPUTS = ("x", "f", "g", "lam_x", "lam_g", "lam_p")
 
 
+def _asks_to_print(options: Mapping[str, Any]) -> bool:
+    """Whether CasADi options ask a solver for output: a ``print_*`` or ``verbose`` option
+    set, or a QP solver's print level other than none (``print_time``, which CasADi
+    prints after the call from Python, is not counted)."""
+    for key, value in options.items():
+        if key == "print_time":
+            continue
+        if (key.startswith("print_") or key.startswith("verbose")) and value:
+            return True
+        if key.endswith("_options") and isinstance(value, Mapping):
+            level = value.get("printLevel", value.get("print_level"))
+            if level not in (None, "none", 0) or _asks_to_print(value):
+                return True
+    return False
+
+
 def _through_call_node(solver: ca.Function) -> ca.Function:
     """``solver`` behind an MX call node with the same inputs and outputs: the node
     checks a memory of ``solver`` out of its pool for each evaluation and releases it
@@ -338,6 +354,9 @@ class CasadiNLPSolver:
         #: the plugin keeps state from one solve to the next in its memory (see
         #: :meth:`_call`): each solve then gets a memory of its own
         self.keeps_state = plugin != "ipopt"
+        #: solves print nothing unless the options ask for output (qpOASES's banner at
+        #: each new memory is not output anybody asked for)
+        self._quiet = not _asks_to_print(opts)
         self._retired: list[int] = []
         self.solver = self._build()
         rescan_blas()  # the plugin may have loaded CasADi's OpenBLAS, for one_blas_thread
@@ -370,7 +389,8 @@ class CasadiNLPSolver:
         the next solve gets a new one, as on a new Function, for ~0.3 ms instead of a
         rebuild's ~30 ms. Every :data:`RETIRED_MEMORIES` solves the Function is built
         again, which frees them. qpOASES prints its licence banner when a memory is set
-        up: the call runs with the C stdout on /dev/null. Ipopt keeps no such state and
+        up: unless the options ask for output, the call runs with stdout silenced
+        (:func:`~optdesign.solvers.quiet.quiet_stdout`). Ipopt keeps no such state and
         is called directly.
         """
         if not self.keeps_state:
@@ -378,8 +398,9 @@ class CasadiNLPSolver:
                 sol = self.solver(**args)
             return sol, self.solver.stats()
         solver = self.solver
+        quiet = quiet_stdout() if self._quiet else contextlib.nullcontext()
         try:
-            with solver_call(), quiet_stdout():
+            with solver_call(), quiet:
                 sol = self._wrapped(**args)
         finally:
             # the memory the call node released after its evaluation (or its failure)

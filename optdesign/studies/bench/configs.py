@@ -325,7 +325,7 @@ def _register_defaults() -> None:
             "front-epsilon",
             "front",
             _eps_front,
-            "epsilon-constraint front (sqpmethod sweep, Ipopt tie-breaks)",
+            "epsilon-constraint front (the default sweep back-end, Ipopt tie-breaks)",
             dict(FRONT_OPTIONS),
             time_factor=10.0,
         )
