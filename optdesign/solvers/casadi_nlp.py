@@ -408,7 +408,9 @@ class CasadiNLPSolver:
             self._retired.append(used)
         stats = solver.stats(used)
         if len(self._retired) >= RETIRED_MEMORIES:
-            self.solver = None  # the old one goes first: see _build
+            # the old one (and the call node that holds it) goes first: destroyed after
+            # the new one's qpOASES was set up, it made qpOASES's error messages visible
+            self.solver = self._wrapped = None
             self.solver = self._build()
         return sol, stats
 

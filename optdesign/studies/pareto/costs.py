@@ -10,10 +10,10 @@ limit)``: a requirement that caps an objective (``ripple_max``) costs only where
 the epsilon bound, binds.
 
 SLSQP (a front's sweep with ``solver="slsqp"``) returns the rows' multipliers but none of
-the bounds (``lam_x`` zero). They follow from stationarity, ``grad f + J' lam_g + lam_x = 0``: at a
-variable on a bound ``lam_x = -(grad f + J' lam_g)``, with the sign of that bound. What
-stationarity leaves at the other variables tells whether the multipliers are those of a
-KKT point at all (:data:`KKT_TOL`); when they are not, the costs are not shown.
+the bounds (``lam_x`` zero). They follow from stationarity, ``grad f + J' lam_g + lam_x =
+0``: at a variable on a bound ``lam_x = -(grad f + J' lam_g)``, with the sign of that
+bound. What stationarity leaves at the other variables tells whether the multipliers are
+those of a KKT point at all (:data:`KKT_TOL`); when they are not, the costs are not shown.
 
 A point whose costs cannot be known says why (:attr:`PointCosts.why`): a point of
 NSGA-II (no gradient solver, no multipliers), of a weighted sum (its multipliers price the

@@ -14,9 +14,9 @@ times faster per solve than Ipopt on these NLPs, about twice SLSQP's speed, with
 import; benchmarks/README.md, "A front's primary: sqpmethod, each solve on a memory of
 its own"); a start it does not solve (failure, or an iterate that violates a row) is
 solved again by the fallback, Ipopt (exact Hessian), from the same start. ``method`` =
-``"slsqp"`` sweeps with SciPy's SLSQP instead. The lexicographic tie-breaks use the tie back-end (Ipopt) with its restart options.
-``method`` = the fallback (``"ipopt"``) uses it throughout, warm-started primal and dual
-with its warm-start options.
+``"slsqp"`` sweeps with SciPy's SLSQP instead. The lexicographic tie-breaks use the tie
+back-end (Ipopt) with its restart options. ``method`` = the fallback (``"ipopt"``) uses
+it throughout, warm-started primal and dual with its warm-start options.
 """
 
 from __future__ import annotations
