@@ -106,3 +106,10 @@ def test_a_front_whose_stderr_is_no_terminal_imports_no_progress_bar(tmp_path):
     # tqdm draws nothing there (disable=None): its import, asyncio with it, is spared
     out = loaded(*_FRONT, "--out", str(tmp_path / "out"), modules=("tqdm", "asyncio"))
     assert out["code"] == 0 and out["heavy"] == []
+
+
+def test_a_front_imports_no_scipy_optimize(tmp_path):
+    # the sweep's primary is CasADi's sqpmethod: SLSQP's import (scipy.optimize, ~0.3 s in
+    # each worker) was the largest fixed cost of a front after the interpreter's start-up
+    out = loaded(*_FRONT, "--out", str(tmp_path / "out"), modules=("scipy.optimize",))
+    assert out["code"] == 0 and out["heavy"] == []
