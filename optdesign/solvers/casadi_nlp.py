@@ -357,7 +357,6 @@ class CasadiNLPSolver:
         #: solves print nothing unless the options ask for output (qpOASES's banner at
         #: each new memory is not output anybody asked for)
         self._quiet = not _asks_to_print(opts)
-        self._retired: list[int] = []
         self.solver = self._build()
         rescan_blas()  # the plugin may have loaded CasADi's OpenBLAS, for one_blas_thread
 
@@ -373,7 +372,8 @@ class CasadiNLPSolver:
                 {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g},
                 self.options,
             )
-        self._retired = []
+        #: the memories this Function's solves used, never handed out again
+        self._retired: list[int] = []
         self._wrapped = _through_call_node(solver) if self.keeps_state else None
         return solver
 

@@ -1701,8 +1701,8 @@ def test_sqpmethod_nodes_after_failed_ones_solve_as_on_a_fresh_solver():
     """CasADi's sqpmethod starts each QP from qpOASES's last working set, across solves:
     after the failed starts of a box it cannot solve (d in [4, 5] mm), every start of a
     box it solves alone (d in [6, 25] mm) failed too, and the catalogue search with
-    ``--solver sqpmethod`` found no design. The back-end is built anew after a failed
-    solve."""
+    ``--solver sqpmethod`` found no design. Each solve now runs on a memory of its own
+    (optdesign.solvers.casadi_nlp)."""
     from optdesign.formulations.catalogue.search import NodeSolver
 
     problem = od.load(ROOT / "problems" / "cs_min_backlash_catalogue.toml")
