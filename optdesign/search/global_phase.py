@@ -34,11 +34,12 @@ import numpy as np
 from optdesign.search.infeasible import (
     LeastViolationFrom,
     PhaseOne,
+    VerdictRule,
     mark_infeasible,
     no_feasible_end,
     phase_one_starts,
 )
-from optdesign.search.odds import odds, settled
+from optdesign.search.odds import distinct_optima, odds, settled
 from optdesign.search.starts import CHUNK, TiltedStarts
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.deadline import deadline, passed
@@ -90,20 +91,6 @@ def default_max_starts(dimension: int) -> int:
     """The cap on a search's starts when the caller gives none: grows with the number of
     free variables (:data:`STARTS_PER_DIMENSION` each, at least :data:`MIN_MAX_STARTS`)."""
     return max(MIN_MAX_STARTS, STARTS_PER_DIMENSION * int(dimension))
-
-
-def distinct_optima(
-    values: Sequence[float], rel_tol: float = OBJECTIVE_TIE_TOL, abs_tol: float = 0.0
-) -> list[float]:
-    """The distinct local optima among converged starts' objective values, best first:
-    sorted values chained while each is within ``rel_tol`` (relative) or ``abs_tol``
-    (absolute: what the local solver resolves, its tolerance on the objective's scale) of
-    the group's first."""
-    out: list[float] = []
-    for v in sorted(v for v in values if math.isfinite(v)):
-        if not out or v > out[-1] + max(tie_width(out[-1], rel_tol), abs_tol):
-            out.append(v)
-    return out
 
 
 @dataclass(frozen=True)
@@ -209,9 +196,11 @@ def global_search(
         solve, :class:`~optdesign.solvers.phase_one.PhaseOneSolver`). Given, a start that fails
         before any start reached a feasible design is followed by it, and while each
         certifies a positive least violation the next starts solve it alone
-        (:func:`optdesign.search.infeasible.phase_one_starts`): once ``min(agree,
-        max_starts)`` of them agree on it the search stops, its answer marked infeasible
-        (stop ``"least violation"``); a phase-1 solve that meets every row sends the
+        (:func:`optdesign.search.infeasible.phase_one_starts`): once they settle a
+        verdict by the count an optimum needs (:class:`~optdesign.search.infeasible.
+        VerdictRule`) the search stops, its answer marked infeasible (stop ``"least
+        violation"``); a phase-1 solve that meets every row, or (with ``polish``) the
+        problem itself solved from the verdict's point meeting every row, sends the
         search back to the full solves of the starts it skipped, so a feasible problem's
         starts are those of a search without it.
 
@@ -232,11 +221,14 @@ def global_search(
     rule = StopRule(
         min(len(own), cap), agree, target, rel_tol, abs_tol, min_counted_starts(dimension)
     )
+    verdict_rule = VerdictRule(min(agree, cap), min(rule.min_counted, cap), target)
     results: list[Result] = []
     points: list[np.ndarray] = []  # each start's point, in start order
     planned = 0
     watch = least_violation is not None and agree > 0
     verdict: PhaseOne | None = None
+    polished: Polished | None = None
+    refuted: Result | None = None
     with one_blas_thread(), deadline(time_limit):
         while len(results) < cap and (not results or not rule(results)):
             n = min(cap, len(results) + (CHUNK if results or not own else len(own)))
@@ -263,21 +255,25 @@ def global_search(
                     lambda a, b: _starts_between(own, starts, a, b),
                     results,
                     cap,
-                    min(agree, cap),
-                    FAILED_LIMIT,
+                    verdict_rule,
                     workers,
                     parallel_map,
                 )
                 planned = max(planned, verdict.end)
+                watch = verdict.feasible is None  # a feasible design seen: never again
+                if verdict.proved and polish is not None:
+                    # the verdict's point to report: the problem itself, which may refute it
+                    polished = _polish(results, points, polish, rule, 1)
+                    if _feasible(polished.best):
+                        refuted, polished, watch = polished.best, None, False
+                        verdict.stop = ""
                 if verdict.stop:
                     break
-                watch = verdict.feasible is None  # a feasible design seen: never again
         why = (verdict.stop if verdict else "") or rule.reason(results) or "all starts run"
-    polished = None
-    if polish is not None:
-        # a verdict of infeasibility needs the problem's own point of its best start only
-        limit = 1 if verdict is not None and verdict.proved else MAX_POLISHED
-        polished = polish_optima(results, lambda k: polish(points[k], results[k]), rule, limit)
+    if polish is not None and polished is None:
+        polished = _polish(results, points, polish, rule, MAX_POLISHED)
+    if refuted is not None:
+        polished = _with_refuting(polished, refuted)
     best = _best_with_record(
         results,
         rule,
@@ -298,6 +294,40 @@ def global_search(
 
 #: Most local optima of a stand-in search solved again on the problem itself.
 MAX_POLISHED = 4
+
+
+def _feasible(r: Result) -> bool:
+    return _converged(r) or bool(r.verified)
+
+
+def _polish(
+    results: Sequence[Result],
+    points: Sequence[np.ndarray],
+    polish: Callable[[np.ndarray, Result], Result],
+    rule: StopRule,
+    limit: int,
+) -> Polished:
+    return polish_optima(results, lambda k: polish(points[k], results[k]), rule, limit)
+
+
+def _with_refuting(polished: Polished | None, refuting: Result) -> Polished:
+    """The answer of a search whose verdict of infeasibility the problem itself refuted
+    (a stand-in's least violated start, solved again, met every row): the better of that
+    design and the search's own answer, noted."""
+    refuting.notes.append(
+        "the stand-in's phase-1 starts agreed on a positive least violation, but the "
+        "problem itself, solved from the least violated of them, met every row: the "
+        "search went on with full solves"
+    )
+    if polished is None or not _feasible(polished.best):
+        return Polished(refuting, (polished.count if polished else 0) + 1)
+    if refuting.objective < polished.best.objective - tie_width(
+        polished.best.objective, CHOICE_TOL
+    ):
+        return Polished(refuting, polished.count + 1)
+    polished.best.notes.append(refuting.notes[-1])
+    return Polished(polished.best, polished.count + 1)
+
 
 #: How far (relative) above the best polished value a stand-in optimum may lie, beyond
 #: the largest rise seen from stand-in to problem, and still be polished: the stand-in's

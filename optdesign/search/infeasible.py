@@ -1,5 +1,5 @@
 """The global search's verdict on a problem with no feasible design: starts that agree on
-a positive least violation.
+a positive least violation, counted as the starts of an optimum are.
 
 A start that fails before any start reached a feasible design is followed by a phase-1
 solve from its point (the least violation of the rows,
@@ -7,19 +7,21 @@ solve from its point (the least violation of the rows,
 feasible design lies near that start; the next starts then solve that cheaper problem
 alone (:func:`phase_one_starts`) until the search can stop:
 
-- ``min(agree, max_starts)`` of them certified the same positive least violation (the
-  least one found, within :data:`LEAST_VIOLATION_TIE`): the search's answer is
-  infeasible (stop ``"least violation"``), an evidence of the kind the odds give an
-  optimum - local solves from independent starts agreeing on one value, as ``agree``
-  starts must agree on an optimum - never a proof. Starts that end at different positive
-  minima do not agree: the violation has several local minima there, and a start of
-  another basin may reach zero (Watt's six-bar for its least ripple, seed 2: its first
-  three starts certified 0.200, 0.147 and 18.8, three minima, and the fourth met every
-  row; counting certified starts called it infeasible there);
+- the phase-1 solves settle a verdict (:class:`VerdictRule`) by the count an optimum
+  needs: ``agree`` starts at the least positive least violation found (within
+  :data:`LEAST_VIOLATION_TIE`), the counted starts a search of that dimension reads its
+  odds after (two per free variable), and Boender and Rinnooy Kan's odds of a lower
+  minimum, over the distinct positive minima certified, settled. The search's answer is
+  then infeasible (stop ``"least violation"``): local solves from independent starts
+  agreeing on one value, the evidence the odds give an optimum, never a proof. Fewer do
+  not suffice: a ten-variable knee linkage at 350 N*m had three starts agree on a least
+  violation of 0.0194, yet a quarter of its starts reach feasible designs; and starts
+  that end at different positive minima do not agree (Watt's six-bar for its least
+  ripple, seed 2: 0.200, 0.147 and 18.8, then a fourth start met every row);
 - one of them met every row: a feasible design exists, and the search goes back to the
   full solves of the starts it skipped (its starts are those of a search without phase 1);
-- :data:`~optdesign.search.global_phase.FAILED_LIMIT` starts in all without a feasible
-  end, or the cap on starts, without agreement: stop ``"no feasible start"`` as before.
+- the search's cap on starts or the time limit, unsettled: stop
+  ``"no feasible start"``.
 
 The decisions read the starts in their order (each map returns the shortest prefix on
 which its stop rule holds), so the answer does not depend on the number of workers.
@@ -32,11 +34,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from optdesign.search.odds import distinct_optima, odds, settled
 from optdesign.search.starts import CHUNK
 from optdesign.solvers.deadline import passed
 from optdesign.solvers.multistart import tie_width
 from optdesign.solvers.phase_one import LeastViolation
-from optdesign.solvers.result import Result, SolutionStatus, TerminationCondition
+from optdesign.solvers.result import Odds, Result, SolutionStatus, TerminationCondition
 
 #: Two least violations closer than this (relative) are one minimum: a phase-1 solve
 #: converges to Ipopt's tight tolerance, so starts at one minimum agree far closer.
@@ -90,9 +93,44 @@ class PhaseOne:
         )
 
     @property
+    def minima(self) -> list[float]:
+        """The distinct positive least violations certified, least first."""
+        values = [v.value for v in self.found if v.certified]
+        return distinct_optima(values, LEAST_VIOLATION_TIE)
+
+    @property
+    def odds(self) -> Odds:
+        """The odds of a lower positive minimum, from the certified solves."""
+        return odds(self.certified, len(self.minima))
+
+    @property
     def outcomes(self) -> list[str]:
         """The outcomes of the starts that solved only their least violation."""
         return [CERTIFIED if v.certified else UNSETTLED for v in self.found[1:]]
+
+
+@dataclass(frozen=True)
+class VerdictRule:
+    """When phase-1 solves settle a verdict of infeasibility: the count an optimum needs
+    (:class:`~optdesign.search.global_phase.StopRule`).
+
+    ``agree``: solves at the least positive least violation; ``min_counted``: solves that
+    certified a positive least violation before the odds are read; ``target``: the
+    estimated probability of a lower minimum the odds must also reach (None: Boender and
+    Rinnooy Kan's rule alone). At the search's cap on starts the odds are not asked (as an
+    optimum's search ends there, "all starts run"); unsettled there, the search stops
+    ``"no feasible start"``."""
+
+    agree: int
+    min_counted: int = 0
+    target: float | None = None
+
+    def settles(self, verdict: PhaseOne, at_cap: bool = False) -> bool:
+        """Whether these phase-1 solves settle the verdict (``at_cap``: the search can
+        run no more starts)."""
+        if verdict.agreeing < self.agree or verdict.certified < self.min_counted:
+            return False
+        return at_cap or settled(verdict.odds, self.target)
 
 
 def no_feasible_end(results: Sequence[Result]) -> bool:
@@ -145,16 +183,16 @@ def phase_one_starts(
     starts_between: Callable[[int, int], np.ndarray],
     results: Sequence[Result],
     cap: int,
-    need: int,
-    limit: int,
+    rule: VerdictRule,
     workers: int = 1,
     parallel_map: Callable[..., list] | None = None,
 ) -> PhaseOne:
     """The phase-1 solves from the last of ``results`` (a start that failed with no
     feasible design seen) and, while they certify a positive least violation, from the
     next starts (``starts_between(a, b)``: starts ``a`` to ``b - 1``;
-    :func:`phase_one_attempt`), until ``need`` agree, one finds a feasible design,
-    ``limit`` starts in all have run, the cap ``cap`` or the time limit."""
+    :func:`phase_one_attempt`), until they settle the verdict (``rule``), one finds a
+    feasible design, the cap ``cap`` (starts in all, the failed full solve's included) or
+    the time limit."""
     failed = len(results) - 1
     x_failed = starts_between(failed, failed + 1)[0]
     out = PhaseOne(failed, [after_failure(least_violation, x_failed, results[-1])])
@@ -164,16 +202,15 @@ def phase_one_starts(
     if not out.found[0].certified:
         return out
 
-    def settled(found: list[LeastViolation]) -> bool:
-        trial = PhaseOne(failed, found)
-        return trial.agreeing >= need or found[-1].feasible
+    def done(found: list[LeastViolation]) -> bool:
+        return found[-1].feasible or rule.settles(PhaseOne(failed, found))
 
-    while not settled(out.found) and out.end < min(cap, limit) and not passed():
-        batch = list(starts_between(out.end, min(cap, limit, out.end + CHUNK)))
+    while not done(out.found) and out.end < cap and not passed():
+        batch = list(starts_between(out.end, min(cap, out.end + CHUNK)))
         before = list(out.found)
 
         def stop(tail: list[LeastViolation], before=before) -> bool:
-            return settled(before + tail)
+            return done(before + tail)
 
         if workers > 1 and len(batch) > 1 and parallel_map is not None:
             out.found = before + parallel_map(attempt, batch, workers, stop=stop)
@@ -184,7 +221,7 @@ def phase_one_starts(
                     break
     if out.found[-1].feasible:
         out.feasible = out.end - 1
-    elif out.agreeing >= need:
+    elif rule.settles(out, at_cap=out.end >= cap):
         out.stop = "least violation"
     elif passed():
         out.stop = "time limit"
@@ -199,6 +236,13 @@ def mark_infeasible(best: Result, verdict: PhaseOne) -> None:
     best.termination = TerminationCondition.INFEASIBLE
     best.solution_status = SolutionStatus.INFEASIBLE
     n, least, at_least = verdict.certified, verdict.least, verdict.agreeing
+    found = verdict.odds
+    odds_said = (
+        f"{found.optima} distinct positive minima, a lower one unseen with an estimated "
+        f"probability of {found.p_better:.2g}"
+        if settled(found)
+        else "the cap on starts came before the odds of a lower minimum settled"
+    )
     best.message = (best.message + "; " if best.message else "") + (
         f"least violation {least:.3g} (phase 1, {n} starts)"
     )
@@ -206,6 +250,6 @@ def mark_infeasible(best: Result, verdict: PhaseOne) -> None:
         f"no feasible design found from {n} starts (a local verdict, not a proof): the "
         f"violation of the requirements (the largest, each row scaled by its limit) "
         f"minimised from each stays positive, at least {least:.3g} ({at_least} of them "
-        "reached it); a positive local minimum says no feasible design lies near its start, "
-        "not that none exists within the bounds"
+        f"reached it; {odds_said}); a positive local minimum says no feasible design lies "
+        "near its start, not that none exists within the bounds"
     )

@@ -33,8 +33,11 @@ measures both against many seeds of mechanisms with several optima.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
+from optdesign.solvers.multistart import tie_width
 from optdesign.solvers.result import Odds
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: Boender and Rinnooy Kan's rule: stop once fewer than this many optima are expected unseen.
 UNSEEN_LIMIT = 0.5
@@ -62,3 +65,18 @@ def settled(o: Odds, target: float | None = None) -> bool:
     if o.optima == 0 or not o.expected_optima - o.optima < UNSEEN_LIMIT:
         return False
     return target is None or o.p_better <= target
+
+
+def distinct_optima(
+    values: Sequence[float], rel_tol: float = OBJECTIVE_TIE_TOL, abs_tol: float = 0.0
+) -> list[float]:
+    """The distinct local optima among converged starts' values, best first: sorted values
+    chained while each is within ``rel_tol`` (relative) or ``abs_tol`` (absolute: what the
+    local solver resolves, its tolerance on the value's scale) of the group's first. The
+    values are objectives for an optimum, least violations for a verdict of
+    infeasibility."""
+    out: list[float] = []
+    for v in sorted(v for v in values if math.isfinite(v)):
+        if not out or v > out[-1] + max(tie_width(out[-1], rel_tol), abs_tol):
+            out.append(v)
+    return out
