@@ -34,7 +34,7 @@ from optdesign.solvers.base import failed_result, make_result, resolve
 from optdesign.solvers.blas import one_blas_thread, rescan_blas
 from optdesign.solvers.deadline import passed as deadline_passed
 from optdesign.solvers.ipopt_options import IPOPT_WARM  # noqa: F401 (its users import it here)
-from optdesign.solvers.quiet import quiet_stdout
+from optdesign.solvers.nlpsol_call import NlpsolFunction
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: Ipopt defaults, each chosen for the shape of these problems (a few scaled design
@@ -276,45 +276,6 @@ class _DeadlineCallback(ca.Callback):
         return [1 if deadline_passed() else 0]
 
 
-#: Solves of a plugin that keeps state (sqpmethod) before its Function is built again,
-#: freeing the memories they retired (~0.1 MB each on a front's NLP of 550 rows).
-RETIRED_MEMORIES = 64
-
-_SOLVE_INPUTS = ("x0", "p", "lbx", "ubx", "lbg", "ubg", "lam_x0", "lam_g0")
-_SOLVE_OUTPUTS = ("x", "f", "g", "lam_x", "lam_g", "lam_p")
-
-
-def _asks_to_print(options: Mapping[str, Any]) -> bool:
-    """Whether CasADi options ask a solver for output: a ``print_*`` or ``verbose`` option
-    set, or a QP solver's print level other than none (``print_time``, which CasADi
-    prints after the call from Python, is not counted)."""
-    for key, value in options.items():
-        if key == "print_time":
-            continue
-        if (key.startswith("print_") or key.startswith("verbose")) and value:
-            return True
-        if key.endswith("_options") and isinstance(value, Mapping):
-            level = value.get("printLevel", value.get("print_level"))
-            if level not in (None, "none", 0) or _asks_to_print(value):
-                return True
-    return False
-
-
-def _through_call_node(solver: ca.Function) -> ca.Function:
-    """``solver`` behind an MX call node with the same inputs and outputs: the node
-    checks a memory of ``solver`` out of its pool for each evaluation and releases it
-    after (a direct call always uses the Function's first memory)."""
-    inputs = [ca.MX.sym(name, solver.sparsity_in(name)) for name in _SOLVE_INPUTS]
-    out = solver(**dict(zip(_SOLVE_INPUTS, inputs, strict=True)))
-    return ca.Function(
-        "optdesign_call",
-        inputs,
-        [out[name] for name in _SOLVE_OUTPUTS],
-        list(_SOLVE_INPUTS),
-        list(_SOLVE_OUTPUTS),
-    )
-
-
 class CasadiNLPSolver:
     """A reusable CasADi NLP solver for one :class:`NLP`.
 
@@ -351,68 +312,11 @@ class CasadiNLPSolver:
         # from the working directory.
         opts = without_option_files(opts)
         self.options = opts
-        #: the plugin keeps state from one solve to the next in its memory (see
-        #: :meth:`_call`): each solve then gets a memory of its own
-        self.keeps_state = plugin != "ipopt"
-        #: solves print nothing unless the options ask for output (qpOASES's banner at
-        #: each new memory is not output anybody asked for)
-        self._quiet = not _asks_to_print(opts)
-        self.solver = self._build()
+        #: the solver, called as a stateless solve (:mod:`optdesign.solvers.nlpsol_call`)
+        self.function = NlpsolFunction(
+            "optdesign", plugin, {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g}, opts
+        )
         rescan_blas()  # the plugin may have loaded CasADi's OpenBLAS, for one_blas_thread
-
-    def _build(self) -> ca.Function:
-        nlp = self.nlp
-        # qpOASES (sqpmethod's QP solver) prints its licence banner to the C stdout when
-        # it is built, whatever its print level; Ipopt prints nothing at print_level 0
-        quiet = quiet_stdout() if self.plugin != "ipopt" else contextlib.nullcontext()
-        with solver_call(), quiet:
-            solver = ca.nlpsol(
-                "optdesign",
-                self.plugin,
-                {"x": nlp.z, "p": nlp.p, "f": nlp.f, "g": nlp.g},
-                self.options,
-            )
-        #: the memories this Function's solves used, never handed out again
-        self._retired: list[int] = []
-        self._wrapped = _through_call_node(solver) if self.keeps_state else None
-        return solver
-
-    def _call(self, args: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-        """One solve: the solution and the solver's statistics.
-
-        sqpmethod's QP solver (qpOASES) starts each QP from the last one's working set,
-        across solves: a result then depended on what the same object solved before (a
-        front differed in its 16th digit between 1 and 2 workers, and after failed
-        solves every later one failed). Its solves therefore go through a call node
-        (:func:`_through_call_node`), which takes a memory from the Function's pool for
-        each evaluation; that memory is then retired (checked out for good), so that
-        the next solve gets a new one, as on a new Function, for ~0.3 ms instead of a
-        rebuild's ~30 ms. Every :data:`RETIRED_MEMORIES` solves the Function is built
-        again, which frees them. qpOASES prints its licence banner when a memory is set
-        up: unless the options ask for output, the call runs with stdout silenced
-        (:func:`~optdesign.solvers.quiet.quiet_stdout`). Ipopt keeps no such state and
-        is called directly.
-        """
-        if not self.keeps_state:
-            with solver_call():  # a signal meanwhile is raised here, not made a result
-                sol = self.solver(**args)
-            return sol, self.solver.stats()
-        solver = self.solver
-        quiet = quiet_stdout() if self._quiet else contextlib.nullcontext()
-        try:
-            with solver_call(), quiet:
-                sol = self._wrapped(**args)
-        finally:
-            # the memory the call node released after its evaluation (or its failure)
-            used = solver.checkout()
-            self._retired.append(used)
-        stats = solver.stats(used)
-        if len(self._retired) >= RETIRED_MEMORIES:
-            # the old one (and the call node that holds it) goes first: destroyed after
-            # the new one's qpOASES was set up, it made qpOASES's error messages visible
-            self.solver = self._wrapped = None
-            self.solver = self._build()
-        return sol, stats
 
     @property
     def name(self) -> str:
@@ -439,7 +343,7 @@ class CasadiNLPSolver:
             args["lam_g0"] = start.lam_g0
         t0 = time.perf_counter()
         try:
-            sol, stats = self._call(args)
+            sol, stats = self.function(**args)
         except RuntimeError as exc:  # CasADi raises on evaluation errors it cannot recover
             wall = time.perf_counter() - t0
             return failed_result(self.plugin, nlp, target, str(exc).splitlines()[0], wall)

@@ -1,4 +1,5 @@
-"""The least violation of an NLP's rows (a phase-1 problem) on Ipopt.
+"""The least violation of an NLP's rows (a phase-1 problem) on Ipopt (or another of
+CasADi's nlpsol plugins).
 
 For an :class:`~optdesign.programs.nlp.NLP` with rows ``lbg <= g(z) <= ubg`` this
 builds, once, the problem
@@ -11,6 +12,8 @@ each call, as are the bounds and the problem's parameters. Two uses:
 - every weight 1: ``t`` is the largest violation of the scaled rows, and a positive local
   minimum is a certificate that no feasible design lies near the start (what the global
   search asks of a start that failed, :mod:`optdesign.search.global_phase`);
+- every weight 1, on sqpmethod: a catalogue node's starts that sqpmethod, its first
+  solver, did not solve (:mod:`optdesign.formulations.catalogue.node_solver`);
 - weights ``1 / scale`` on one requirement's rows and 0 elsewhere: ``t`` is the
   relaxation of that requirement, in its own unit, that the others allow - the smallest
   one, found by a single solve where a bisection on feasibility needs a dozen
@@ -28,13 +31,13 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from optdesign.interrupts import solver_call
 from optdesign.programs.nlp import NLP, Bounds, Target
-from optdesign.safe_io import without_option_files
+from optdesign.safe_io import refuse_file_options, without_option_files
 from optdesign.solvers.base import make_result
 from optdesign.solvers.blas import one_blas_thread
 from optdesign.solvers.casadi_nlp import IPOPT_DEFAULTS
 from optdesign.solvers.deadline import DEADLINE_OPTION
+from optdesign.solvers.nlpsol_call import NlpsolFunction
 from optdesign.solvers.result import Result, TerminationCondition
 
 #: A least violation above this (scaled rows: about relative to each limit) is a
@@ -48,7 +51,7 @@ CERTIFY_ABOVE = 1e-6
 #: cost little.
 PHASE_ONE_MAX_ITER = 300
 
-#: Ipopt return statuses that end at a minimum of ``t``.
+#: Return statuses that end at a minimum of ``t`` (Ipopt's; sqpmethod's first).
 _CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
@@ -92,33 +95,29 @@ class LeastViolation:
 
 @dataclass(frozen=True)
 class _Sides:
-    """A phase-1 problem on Ipopt: ``upper`` and ``lower`` the rows (indices) whose
-    upper and lower sides it holds, with a weight of ``t`` each."""
+    """A phase-1 problem: ``upper`` and ``lower`` the rows (indices) whose upper and
+    lower sides it holds, with a weight of ``t`` each."""
 
     upper: np.ndarray
     lower: np.ndarray
-    solver: Any
+    solver: NlpsolFunction
 
     @staticmethod
-    def build(nlp: NLP, upper: np.ndarray, lower: np.ndarray, settings: dict) -> _Sides:
+    def build(
+        nlp: NLP, upper: np.ndarray, lower: np.ndarray, plugin: str, settings: dict
+    ) -> _Sides:
         up, lo = np.flatnonzero(upper), np.flatnonzero(lower)
         t = ca.SX.sym("t")
         wu = ca.SX.sym("wu", up.size)
         wl = ca.SX.sym("wl", lo.size)
         g = nlp.g
         rows = ca.vertcat(g[up.tolist()] - wu * t, g[lo.tolist()] + wl * t)
-        with solver_call():
-            solver = ca.nlpsol(
-                "optdesign_phase1",
-                "ipopt",
-                {"x": ca.vertcat(nlp.z, t), "p": ca.vertcat(nlp.theta, wu, wl), "f": t, "g": rows},
-                settings,
-            )
-        return _Sides(up, lo, solver)
+        problem = {"x": ca.vertcat(nlp.z, t), "p": ca.vertcat(nlp.theta, wu, wl), "f": t, "g": rows}
+        return _Sides(up, lo, NlpsolFunction("optdesign_phase1", plugin, problem, settings))
 
 
 class PhaseOneSolver:
-    """The phase-1 problem of ``nlp`` on Ipopt, built once and solved many times.
+    """The phase-1 problem of ``nlp``, built once and solved many times.
 
     Parameters
     ----------
@@ -126,18 +125,24 @@ class PhaseOneSolver:
         The formulation whose rows are relaxed.
     options
         Ipopt options over :data:`~optdesign.solvers.casadi_nlp.IPOPT_DEFAULTS` (the
-        problem file's and the caller's, as for the NLP itself).
+        problem file's and the caller's, as for the NLP itself); another plugin's own
+        options, complete (e.g. :func:`~optdesign.solvers.registry.nlpsol_options`).
+    plugin
+        CasADi's nlpsol plugin: ``"ipopt"`` (default) or ``"sqpmethod"`` (each solve on a
+        memory of its own, :mod:`optdesign.solvers.nlpsol_call`).
     """
 
-    def __init__(self, nlp: NLP, options: Mapping[str, Any] | None = None):
+    def __init__(self, nlp: NLP, options: Mapping[str, Any] | None = None, plugin: str = "ipopt"):
         self.nlp = nlp
+        self.plugin = plugin
         opts = {k: v for k, v in (options or {}).items() if k != DEADLINE_OPTION}
-        self._settings = without_option_files(
-            {
-                "print_time": False,
-                "ipopt": {**IPOPT_DEFAULTS, "max_iter": PHASE_ONE_MAX_ITER, **opts},
-            }
-        )
+        if plugin == "ipopt":
+            ipopt = {**IPOPT_DEFAULTS, "max_iter": PHASE_ONE_MAX_ITER, **opts}
+            settings = {"print_time": False, "ipopt": ipopt}
+        else:
+            refuse_file_options(opts, "options")
+            settings = {"print_time": False, **opts}
+        self._settings = without_option_files(settings)
         #: One phase-1 problem per set of limited row sides (upper rows, lower rows); the
         #: NLP's own is built now, another only for a call that limits more sides (an
         #: epsilon limit, ``NLP.bounds(eps=...)``, on a row the NLP leaves unlimited).
@@ -148,7 +153,7 @@ class PhaseOneSolver:
         """The phase-1 problem whose rows are the ``upper`` and ``lower`` (masks) sides."""
         key = np.concatenate([upper, lower]).tobytes()
         if key not in self._problems:
-            self._problems[key] = _Sides.build(self.nlp, upper, lower, self._settings)
+            self._problems[key] = _Sides.build(self.nlp, upper, lower, self.plugin, self._settings)
         return self._problems[key]
 
     def weights(
@@ -202,13 +207,11 @@ class PhaseOneSolver:
         }
         started = time.perf_counter()
         try:
-            with solver_call():
-                sol = sides.solver(**args)
+            sol, stats = sides.solver(**args)
         except RuntimeError as exc:  # an evaluation CasADi cannot recover from
             wall = time.perf_counter() - started
             return self._point(z0, np.nan, "failed", str(exc).splitlines()[0], bounds, target, wall)
         wall = time.perf_counter() - started
-        stats = sides.solver.stats()
         status = str(stats.get("return_status", ""))
         x = np.asarray(sol["x"], dtype=float).ravel()
         lam = np.asarray(sol["lam_g"], dtype=float).ravel()
@@ -235,7 +238,7 @@ class PhaseOneSolver:
         lam_g = np.zeros(len(nlp.g_names)) if lam_g is None else lam_g
         found = status in _CONVERGED and value <= CERTIFY_ABOVE
         result = make_result(
-            "ipopt",
+            self.plugin,
             nlp,
             nlp.target(target),
             bounds,

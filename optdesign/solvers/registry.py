@@ -29,6 +29,18 @@ from optdesign.solvers.ipopt_options import IPOPT_NODE, IPOPT_RANGE, IPOPT_TIE, 
 
 
 @dataclass(frozen=True)
+class NodeFirst:
+    """A back-end that tries the starts of a catalogue node before the node's own.
+
+    ``solver``: its registry name; ``options``: its options there. Its converged points
+    are kept; a start it does not solve goes to the node's back-end from the same point,
+    so that every verdict of local infeasibility is the node back-end's."""
+
+    solver: str
+    options: Mapping[str, Any]
+
+
+@dataclass(frozen=True)
 class SolverHints:
     """What a back-end declares, so that a study can use it without naming it (every
     field empty: the back-end is used with the caller's options only)."""
@@ -43,6 +55,9 @@ class SolverHints:
     restart_options: Mapping[str, Any] | None = None
     #: options of a solve that may meet an infeasible sub-problem (a catalogue node)
     node_options: Mapping[str, Any] | None = None
+    #: a quicker back-end that solves each start of a catalogue node on its thinned grid
+    #: first, this one solving the start again where it does not converge (None: none)
+    node_first: NodeFirst | None = None
     #: the back-end's return messages (``Result.message``) by which it declares that it
     #: converged to a point of local infeasibility, as opposed to a stop (iterations,
     #: errors) or a solved point that fails the check: a catalogue node whose every
@@ -267,14 +282,40 @@ SQPMETHOD_SWEEP: dict[str, Any] = {
 }
 
 
-def _sqpmethod(nlp, options):
-    from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+#: sqpmethod as the first solver of a catalogue node's starts on its thinned grid (the
+#: parent's or a neighbour's optimum nearby, :data:`IPOPT_NODE`'s back-end behind it):
+#: the sweep's L-BFGS and qpOASES, to tolerances near Ipopt's, since a leaf's converged
+#: point is the design reported. A start it has not solved in 45 iterations (a converged
+#: one takes about 8 to 14) is more likely an infeasible box, which Ipopt decides.
+SQPMETHOD_NODE: dict[str, Any] = {
+    **SQPMETHOD_SWEEP,
+    "max_iter": 45,
+    "tol_du": 1e-9,
+    "tol_pr": 1e-10,
+}
 
+
+def sqpmethod_options(options: Mapping[str, Any]) -> dict[str, Any]:
+    """The CasADi options an sqpmethod solver of the registry is built with: ``options``
+    over :data:`SQPMETHOD_QUIET`, qpOASES silent unless they say otherwise (the NLP
+    back-end's, and a catalogue node's phase-1 problem on it)."""
     merged = {**SQPMETHOD_QUIET, **options}
     if options.get("qpsol", "qpoases") == "qpoases":
         qp = dict(options.get("qpsol_options") or {})
         merged["qpsol_options"] = {"printLevel": "none", "error_on_fail": False, **qp}
-    return CasadiNLPSolver(nlp, "sqpmethod", merged)
+    return merged
+
+
+def nlpsol_options(plugin: str, options: Mapping[str, Any]) -> dict[str, Any]:
+    """The CasADi options the registry builds CasADi's ``plugin`` with, from ``options``
+    (sqpmethod: :func:`sqpmethod_options`; any other: as given)."""
+    return sqpmethod_options(options) if plugin == "sqpmethod" else dict(options)
+
+
+def _sqpmethod(nlp, options):
+    from optdesign.solvers.casadi_nlp import CasadiNLPSolver
+
+    return CasadiNLPSolver(nlp, "sqpmethod", sqpmethod_options(options))
 
 
 def _bonmin(nlp, options):
@@ -319,6 +360,7 @@ def _builtins() -> None:
         range_options=IPOPT_RANGE,
         restart_options=IPOPT_TIE,
         node_options=IPOPT_NODE,
+        node_first=NodeFirst("sqpmethod", SQPMETHOD_NODE),
         infeasible_verdicts=("Infeasible_Problem_Detected",),
         iteration_option="max_iter",
         deadline_options={DEADLINE_OPTION: True},

@@ -1,5 +1,6 @@
-"""CasADi's nlpsol back-ends (optdesign.solvers.casadi_nlp): a solve of sqpmethod depends
-on its own start only, not on what the same back-end solved before."""
+"""CasADi's nlpsol back-ends (optdesign.solvers.casadi_nlp, through
+optdesign.solvers.nlpsol_call): a solve of sqpmethod depends on its own start only, not on
+what the same back-end solved before."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import pytest
 
 import optdesign as od
 from optdesign.formulations.nlp.solve import formulation_for
-from optdesign.solvers import casadi_nlp
+from optdesign.solvers import nlpsol_call
 from optdesign.solvers.casadi_nlp import CasadiNLPSolver
 from optdesign.solvers.registry import SQPMETHOD_SWEEP, make_solver
 
@@ -60,14 +61,14 @@ def test_an_sqpmethod_back_end_is_built_again_once_its_retired_memories_reach_th
     """The memories that solves retire are freed by building the Function again every
     RETIRED_MEMORIES solves; the solves on either side agree bit for bit."""
     problem, formulation = nlp
-    monkeypatch.setattr(casadi_nlp, "RETIRED_MEMORIES", 2)
+    monkeypatch.setattr(nlpsol_call, "RETIRED_MEMORIES", 2)
     solver = _sqp(formulation)
-    first = solver.solver
+    first = solver.function.function
     start = _start(problem, formulation, 5)
     results = [solver.solve(start, "ripple") for _ in range(3)]
-    assert solver.solver is not first  # built again after the second solve
+    assert solver.function.function is not first  # built again after the second solve
     assert all(np.array_equal(r.raw["z"], results[0].raw["z"]) for r in results)
-    assert len(solver._retired) == 1
+    assert len(solver.function.retired) == 1
 
 
 def test_an_ipopt_solve_goes_straight_to_its_function(nlp):
@@ -75,5 +76,5 @@ def test_an_ipopt_solve_goes_straight_to_its_function(nlp):
     problem, formulation = nlp
     solver = CasadiNLPSolver(formulation)
     result = solver.solve(_start(problem, formulation, 2), "backlash")
-    assert result.success and not solver.keeps_state
-    assert solver._wrapped is None and solver._retired == []
+    assert result.success and not solver.function.keeps_state
+    assert solver.function.wrapped is None and solver.function.retired == []

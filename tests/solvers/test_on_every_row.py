@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.formulations.catalogue.node_solver import thinned_rows
+from optdesign.formulations.catalogue.thinned_grid import thinned_rows
 from optdesign.programs.nlp import build_nlp, with_rows
 from optdesign.solvers.base import on_every_row
 from optdesign.solvers.registry import make_solver

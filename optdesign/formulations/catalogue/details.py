@@ -97,6 +97,13 @@ class CatalogueDetails:
         search that prunes ties): those whose point met every row left out and was kept
         (a KKT point of the node's own NLP, no solve on the whole grid), and those solved
         again on the whole grid from there (each counted twice in ``nlp_solves``).
+    first_solver, first_starts, first_failed, first_certified
+        The back-end that tried the starts of nodes of several item combinations first
+        (:class:`~optdesign.solvers.registry.NodeFirst`; None: none), the starts it
+        tried, those it did not solve (each counted twice in ``nlp_solves``), and of
+        those the ones its phase 1 certified locally infeasible; the others the node's
+        back-end solved again from the same point
+        (:mod:`~optdesign.formulations.catalogue.first_solver`).
     learned_angles
         Grid angles (labels) the thinned grid kept besides every other one: where a
         checked start's point missed a row left out (this search's, or an earlier one's
@@ -128,6 +135,10 @@ class CatalogueDetails:
     thinned_solves: int = 0
     checked_starts: int = 0
     resolved_starts: int = 0
+    first_solver: str | None = None
+    first_starts: int = 0
+    first_failed: int = 0
+    first_certified: int = 0
     learned_angles: list[str] = field(default_factory=list)
     items: dict[str, float] | None = None
     gap_to_relaxation_rel: float | None = None
@@ -153,6 +164,7 @@ class CatalogueDetails:
                 "minlp",
                 "items",
                 "gap_to_relaxation_rel",
+                "first_solver",
             ),
         )
         if self.enumerated is not None:

@@ -6,7 +6,7 @@ on forked workers (:class:`NodeSolver`). The search over the boxes is
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import replace
 from typing import Any
@@ -17,6 +17,19 @@ from optdesign.formulations.catalogue.bnb import RELAXED, trusted
 from optdesign.formulations.catalogue.discrete import (
     discrete_variables,
 )
+from optdesign.formulations.catalogue.first_solver import (
+    CERTIFIED,
+    FIRST_SOLVER,
+    KEPT,
+    SOLVED_AGAIN,
+    first_try,
+    prepare,
+)
+from optdesign.formulations.catalogue.thinned_grid import (
+    missed_angles,
+    thinned_angles,
+    thinned_rows,
+)
 from optdesign.formulations.nlp.solve import (
     _objective_set,
     rows_solver_for,
@@ -25,9 +38,9 @@ from optdesign.formulations.nlp.solve import (
 )
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.problem.drive import box_has_item
-from optdesign.programs.nlp import NLP, Bounds
+from optdesign.programs.nlp import Bounds
 from optdesign.runtime.inherited_map import InheritedWorkers, map_serial
-from optdesign.solvers.base import on_every_row, row_misses
+from optdesign.solvers.base import on_every_row
 from optdesign.solvers.multistart import (
     best_of,
     improves,
@@ -37,7 +50,7 @@ from optdesign.solvers.multistart import (
 )
 from optdesign.solvers.registry import default_solver, solver_hints
 from optdesign.solvers.result import MultistartInfo, Result
-from optdesign.tolerances import LEFT_OUT_ROW_TOL, OBJECTIVE_TIE_TOL
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 #: The key of a start's ``raw`` record when it was solved on the thinned grid first
 #: (:meth:`NodeSolver._solve_checked`): ``"kept"`` or ``"solved again"``.
@@ -88,6 +101,7 @@ class NodeSolver:
         thinned: bool = True,
         checked: bool = True,
         objectives: Sequence[str] = (),
+        first: bool = True,
     ):
         self.problem = problem
         #: A node's multistart stops once this many of its starts agree on the best value
@@ -108,6 +122,7 @@ class NodeSolver:
         others = sorted({*objectives, *self.eps, *names} - set(problem.objective_names))
         names = tuple(dict.fromkeys([*problem.objective_names, *others]))
         solver = self.solver = solver or default_solver("nlp")
+        asked = bool(options)  # the caller's own options for the node back-end
         node = solver_hints(solver).node_options
         if node is not None:
             # The back-end's node options (infeasible boxes are common; a node still
@@ -136,6 +151,11 @@ class NodeSolver:
         #: (:meth:`_solve_checked`)
         self.checked = bool(checked)
         self.verdicts = solver_hints(solver).infeasible_verdicts
+        #: the back-end that tries each start on the thinned grid first (``first``, the
+        #: node back-end declares one and the caller set none of its options: a cap or a
+        #: tolerance asked of the back-end is not the first solver's; :meth:`_thinned_solve`),
+        #: else None
+        self.first = solver_hints(solver).node_first if first and not asked else None
         self.nlp = self.backend.nlp
         self.target = self.nlp.target(self.objective)
         self.starts = max(1, starts)
@@ -147,6 +167,12 @@ class NodeSolver:
         #: whole grid), and those solved again on the whole grid from there
         self.n_checked = 0
         self.n_resolved = 0
+        #: starts the first solver tried, those it did not solve, and of those the ones
+        #: its phase 1 certified infeasible
+        self.n_first = 0
+        self.n_first_failed = 0
+        self.n_first_certified = 0
+        self.n_polished = 0  # leaves whose first solver's best start Ipopt solved again
         self.relaxed_angles = 0  # the thinned grid's angles, once built
         #: warm nodes that fell back to the multistart; nodes proved infeasible by the memo
         self.n_cold = 0
@@ -169,7 +195,9 @@ class NodeSolver:
         if self.workers <= 1:
             yield
             return
-        self.thinned_backend()  # built once, before the workers inherit it
+        if self.thinned_backend() and self.first is not None:
+            # the first solver and its phase 1 too (each worker would build its own)
+            prepare(self.backend, self.first, self._thinned_rows)
         with InheritedWorkers(self._solve_start, self.workers) as workers:
             self._workers = workers
             try:
@@ -228,24 +256,24 @@ class NodeSolver:
             return "checked"
         return "whole"
 
-    def _solve_start(self, item: tuple[Bounds, np.ndarray, str, tuple[int, ...]]) -> Result:
-        box, x0, mode, rows = item
+    def _solve_start(self, item: tuple[Bounds, np.ndarray, str, tuple[int, ...], bool]) -> Result:
+        box, x0, mode, rows, quick = item
         if mode in ("relaxed", "checked"):
             # the node's thinned grid (a worker process builds it once for these rows;
             # here it is the one built already)
             backend = rows_solver_for(self.backend, rows, self._options, self.solver)
         if mode == "relaxed":
             # with_rows keeps the targets: the node's target serves both back-ends
-            return backend.solve(
-                backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box
-            )
+            return self._thinned_solve(backend, rows, box, x0, quick)
         if mode == "checked":
-            return self._solve_checked(backend, np.asarray(rows, dtype=int), box, x0)
+            return self._solve_checked(backend, np.asarray(rows, dtype=int), box, x0, quick)
         return self.backend.solve(
             self.backend.nlp.start(x0=x0, parameters=box.parameters), self.target, box
         )
 
-    def _solve_checked(self, thinned, rows: np.ndarray, box: Bounds, x0: np.ndarray) -> Result:
+    def _solve_checked(
+        self, thinned, rows: np.ndarray, box: Bounds, x0: np.ndarray, quick: bool = False
+    ) -> Result:
         """One start of a node solved on the whole grid, first on the thinned grid.
 
         The thinned solve's point is kept when it meets every row left out within the
@@ -260,32 +288,65 @@ class NodeSolver:
         whole grid. ``raw[THINNED_START]`` says which (``"kept"``,
         ``"solved again"``), ``raw[MISSED_ANGLES]`` where the rows it missed lie."""
         tbox = replace(box, lbg=np.asarray(box.lbg)[rows], ubg=np.asarray(box.ubg)[rows])
-        first = thinned.solve(
-            thinned.nlp.start(x0=x0, parameters=box.parameters), self.target, tbox
-        )
+        first = self._thinned_solve(thinned, rows, tbox, x0, quick)
         lifted, met = on_every_row(first, self.nlp, rows, self.target, box)
+        tried = {FIRST_SOLVER: first.raw[FIRST_SOLVER]} if FIRST_SOLVER in first.raw else {}
         if met or not first.success:
-            lifted.raw[THINNED_START] = "kept"
+            lifted.raw.update({THINNED_START: "kept", **tried})
             return lifted
         result = self.backend.solve(self.nlp.start(z0=first.raw["z"]), self.target, box)
-        result.raw[THINNED_START] = "solved again"
+        result.raw.update({THINNED_START: "solved again", **tried})
         result.raw[MISSED_ANGLES] = missed_angles(self.nlp, first.raw["z"], box, rows)
         result.wall_time_s = (result.wall_time_s or 0.0) + (first.wall_time_s or 0.0)
         if result.iterations is not None and first.iterations is not None:
             result.iterations += first.iterations
         return result
 
-    def _item(self, box: Bounds, x0, backend) -> tuple[Bounds, np.ndarray, str, tuple[int, ...]]:
+    def _thinned_solve(
+        self, thinned, rows, box: Bounds, x0: np.ndarray, quick: bool = False
+    ) -> Result:
+        """A start on the thinned grid (``thinned``: its back-end, ``box``: its bounds):
+        with ``quick``, by the first solver (:attr:`first`, :func:`~optdesign.
+        formulations.catalogue.first_solver.first_try`): its point, or its phase 1's
+        verdict of local infeasibility; otherwise by ``thinned`` from the same start.
+        ``raw[FIRST_SOLVER]`` says which."""
+        if quick and self.first is not None:
+            tried = first_try(self.backend, self.first, rows, box, x0, self.target)
+            if tried is not None:
+                return tried
+        result = thinned.solve(
+            thinned.nlp.start(x0=x0, parameters=box.parameters), self.target, box
+        )
+        if quick and self.first is not None:
+            result.raw[FIRST_SOLVER] = SOLVED_AGAIN
+        return result
+
+    def _item(
+        self, box: Bounds, x0, backend, own: bool = False
+    ) -> tuple[Bounds, np.ndarray, str, tuple[int, ...], bool]:
         """A start as :meth:`_solve_start` takes it (here or in a worker process): the
-        box, the point, how it is solved (:meth:`_mode`) and the thinned grid's rows."""
+        box, the point, how it is solved (:meth:`_mode`), the thinned grid's rows and
+        whether the first solver tries it: not when ``own`` (a leaf's first start, whose
+        design is the one reported unless another start beats it)."""
         mode = self._mode(backend)
         rows = () if mode == "whole" else self._thinned_rows
-        return box, np.asarray(x0, dtype=float), mode, rows
+        quick = self.first is not None and mode != "whole" and not own
+        return box, np.asarray(x0, dtype=float), mode, rows, quick
 
     def _starts(
-        self, box: Bounds, points, stop: Callable[[list[Result]], bool], backend
+        self,
+        box: Bounds,
+        points,
+        stop: Callable[[list[Result]], bool],
+        backend,
+        leaf: bool,
+        offset: int,
     ) -> list[Result]:
-        items = [self._item(box, p, backend) for p in points]
+        """The node's starts ``offset`` on (``points``), in order, up to ``stop``: a
+        leaf's first start by the node back-end alone (:meth:`_item`)."""
+        items = [
+            self._item(box, p, backend, leaf and offset + k == 0) for k, p in enumerate(points)
+        ]
         if self._workers is None:
             return map_serial(self._solve_start, items, stop)
         return self._workers.map(items, stop)
@@ -372,7 +433,7 @@ class NodeSolver:
 
         results: list[Result] = []
         if warm and x_hint is not None:
-            results.append(self._solve_start(self._item(box, pts.pop(0), backend)))
+            results.append(self._solve_start(self._item(box, pts.pop(0), backend, one)))
             first_ok = results[0]
             if first_ok.success and (
                 prunes is None or not prunes(first_ok.objective) or at_floor(first_ok)
@@ -394,7 +455,7 @@ class NodeSolver:
                 done = before + new
                 return at_floor(new[-1]) or agreed(done) or self.verdicts_decide(done)
 
-            new = self._starts(box, points, stop, backend)
+            new = self._starts(box, points, stop, backend, one, len(before))
             results.extend(new)
             return bool(new) and (at_floor(new[-1]) or agreed(results))
 
@@ -414,6 +475,8 @@ class NodeSolver:
             self.n_thinned += len(results)
         self._note_checks(results)
         best, n_at_best = best_of(results)
+        if one and best.success and best.raw.get(FIRST_SOLVER) == KEPT:
+            best = self._polished(best, box)
         outcomes = [start_outcome(r) for r in results]
         best.multistart = MultistartInfo(
             len(results),
@@ -439,11 +502,28 @@ class NodeSolver:
             nodes.add(bounds, self.eps, self.objective, value, x, kept)
         return best
 
+    def _polished(self, best: Result, box: Bounds) -> Result:
+        """A leaf's best start when the first solver found it (it beat the back-end's
+        own first start beyond the tie): solved again by the node's back-end from its
+        point, so that the design reported carries the back-end's tolerances and
+        multipliers; the first solver's point when that solve does not converge."""
+        again = self.backend.solve(self.nlp.start(z0=best.raw["z"]), self.target, box)
+        self.n_solves += 1
+        self.n_polished += 1
+        return again if again.success else best
+
     def _note_checks(self, results: Sequence[Result]) -> None:
-        """Count a node's checked starts (kept, or solved again: two NLP solves) and
+        """Count a node's checked starts (kept, or solved again: two NLP solves), its
+        starts tried by the first solver (those it did not solve: two NLP solves), and
         learn the angles where the solved-again ones missed a row (:meth:`_mode`)."""
         missed: set[str] = set()
         for r in results:
+            first = r.raw.get(FIRST_SOLVER)
+            self.n_first += first is not None
+            if first in (SOLVED_AGAIN, CERTIFIED):  # two NLP solves
+                self.n_first_failed += 1
+                self.n_first_certified += first == CERTIFIED
+                self.n_solves += 1
             how = r.raw.get(THINNED_START)
             self.n_checked += how == "kept"
             if how == "solved again":
@@ -463,7 +543,9 @@ class NodeSolver:
         """Whether the starts so far call a node infeasible, without its other starts
         and the retries: at least two starts, every one ended with the back-end's own
         verdict of local infeasibility
-        (:attr:`~optdesign.solvers.registry.SolverHints.infeasible_verdicts`). A start
+        (:attr:`~optdesign.solvers.registry.SolverHints.infeasible_verdicts`), or with
+        its first solver's phase 1 certifying a positive least violation
+        (:mod:`~optdesign.formulations.catalogue.first_solver`). A start
         stopped by its iteration limit or an error, or a solved point that fails the
         check, leaves the node to its other starts and the retries; a node solver of one
         start (the neighbouring items of an optimum, the diagnosis) decides on its start
@@ -471,7 +553,9 @@ class NodeSolver:
         return (
             len(results) >= 2
             and bool(self.verdicts)
-            and all(r.message in self.verdicts for r in results)
+            and all(
+                r.message in self.verdicts or r.raw.get(FIRST_SOLVER) == CERTIFIED for r in results
+            )
         )
 
     def x_of(self, result: Result) -> np.ndarray | None:
@@ -483,62 +567,6 @@ class NodeSolver:
 #: Times a search adds to its thinned grid the angles where its checked starts missed a
 #: row (each change builds one more solver, ~0.05 s, once per process and row set).
 MAX_REGRIDS = 3
-
-#: A node of several item combinations keeps every this-many-th grid angle's rows ...
-NODE_ANGLE_STEP = 2
-
-#: ... when the grid has at least this many angles (fewer: the node's own rows).
-NODE_THIN_FROM = 21
-
-
-def thinned_angles(points: int) -> list[int]:
-    """The grid angles (indices) whose rows a node of several item combinations keeps
-    (its thinned grid): every :data:`NODE_ANGLE_STEP`-th and both ends; every angle below
-    :data:`NODE_THIN_FROM`. Every other angle: with a sparser subset (13 of 61) the
-    nodes of the motor's problems met rows between the kept angles that their leaves
-    then missed, and the search solved more nodes than it saved (benchmarks/README.md,
-    "Catalogue nodes on every other grid angle")."""
-    if points < NODE_THIN_FROM:
-        return list(range(points))
-    return sorted({*range(0, points, NODE_ANGLE_STEP), points - 1})
-
-
-def thinned_rows(problem: DesignProblem, nlp: NLP, extra: Iterable[str] = ()) -> list[int] | None:
-    """The rows of ``nlp`` a node of several item combinations keeps: every row not
-    labelled with a grid angle, and those of :func:`thinned_angles` and of the angles
-    ``extra`` (labels; the NLP's rows are named ``NAME[phi=+12.0deg]``); None when every
-    angle is kept, or when no row is left out (no row of the NLP names an angle the
-    thinned grid leaves out)."""
-    angles = thinned_angles(len(problem.phi))
-    if len(angles) == len(problem.phi):
-        return None
-    labels = set(problem.phi_labels)
-    kept = {problem.phi_labels[k] for k in angles} | set(extra)
-    rows = [
-        k
-        for k, name in enumerate(nlp.g_names)
-        if not (lab := _angle_label(name)) or lab not in labels or lab in kept
-    ]
-    return rows if len(rows) < len(nlp.g_names) else None
-
-
-def missed_angles(nlp: NLP, z: np.ndarray, bounds: Bounds, rows: np.ndarray) -> list[str]:
-    """The grid angles (labels) of the rows of ``nlp`` left out of ``rows`` that the
-    point ``z`` misses beyond :data:`~optdesign.tolerances.LEFT_OUT_ROW_TOL` (or where a
-    row is not a number) under ``bounds``."""
-    miss = row_misses(nlp, z, bounds)
-    left_out = np.ones(miss.size, dtype=bool)
-    left_out[rows] = False
-    bad = left_out & ~(miss <= LEFT_OUT_ROW_TOL)
-    return sorted({lab for k in np.flatnonzero(bad) if (lab := _angle_label(nlp.g_names[k]))})
-
-
-def _angle_label(name: str) -> str:
-    """The grid angle's label in a row's name (``phi=+12.0deg``, also of a row's piece
-    ``phi=+12.0deg (2)``), or ""."""
-    inside = name[name.find("[") + 1 : name.rfind("]")] if "[" in name else ""
-    words = inside.replace(",", " ").split()
-    return next((word for word in words if word.startswith("phi=")), "")
 
 
 def no_item(solver: str, message: str) -> Result:

@@ -104,6 +104,7 @@ def solve_catalogue(
     thinned_nodes: bool = True,
     thinned_starts: bool = True,
     objectives: Sequence[str] = (),
+    first_solver: bool = True,
 ) -> Result:
     """Exact catalogue optimum of ``problem`` with its continuous-relaxation bound.
 
@@ -158,6 +159,14 @@ def solve_catalogue(
         Other objectives the node NLP holds (as targets, unbounded unless in ``eps``):
         a front passes both of its objectives to each of its searches, so that the
         anchors, tie-breaks and points share one NLP and its solvers, built once.
+    first_solver
+        Let the node back-end's first solver (:class:`~optdesign.solvers.registry.NodeFirst`,
+        Ipopt's: CasADi's sqpmethod) try the starts of the nodes on their thinned grid
+        (:mod:`~optdesign.formulations.catalogue.first_solver`): its converged points
+        kept, its phase 1's certificates of local infeasibility taken as verdicts, the
+        other starts solved again by the back-end. A leaf's first start, whose design is
+        reported unless another start beats it, is the back-end's alone, and a start of
+        the first solver that beats it is solved again by the back-end from its point.
 
     Returns
     -------
@@ -209,6 +218,7 @@ def solve_catalogue(
         thinned=thinned_nodes and ties,
         checked=thinned_starts,
         objectives=objectives,
+        first=first_solver,
     )
     with ns.on_workers():
         ns.memo = memo
@@ -249,6 +259,10 @@ def solve_catalogue(
             info.warm_fallbacks, info.implied_infeasible = ns.n_cold, ns.n_implied
         info.nlp_solves, info.thinned_solves = ns.n_solves, ns.n_thinned
         info.checked_starts, info.resolved_starts = ns.n_checked, ns.n_resolved
+        if ns.n_first:
+            info.first_solver = ns.first.solver if ns.first is not None else None
+            info.first_starts, info.first_failed = ns.n_first, ns.n_first_failed
+            info.first_certified = ns.n_first_certified
         info.learned_angles = sorted(ns.learned_angles, key=_angle_degrees)
         info.infeasible_boxes = ns.proofs.proofs
         wall = time.perf_counter() - t0
@@ -319,6 +333,19 @@ def _grid_note(info: CatalogueDetails) -> str:
         parts.append(f"{info.checked_starts} starts first, kept: their points met every row")
     if info.resolved_starts:
         parts.append(f"{info.resolved_starts} starts first, then on the whole grid")
+    if info.first_starts:
+        failed = info.first_failed
+        again = failed - info.first_certified
+        parts.append(
+            f"{info.first_starts} starts of nodes with several item combinations by "
+            f"{info.first_solver} first"
+            + (
+                f" ({failed} not solved: {info.first_certified} certified locally "
+                f"infeasible by its phase 1, {again} solved again by the node's back-end)"
+                if failed
+                else ""
+            )
+        )
     if not parts:
         return ""
     grid = "every other grid angle"

@@ -21,7 +21,11 @@ from optdesign.formulations.catalogue.search import solve_catalogue
 from optdesign.formulations.diagnosis import Relaxing, diagnose
 from optdesign.problem.design_problem import DesignProblem
 from optdesign.solvers.registry import FRONT_SOLVERS
-from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
+from optdesign.studies.pareto.catalogue_knowledge import (
+    chain_points,
+    front_knowledge,
+    previous_holds,
+)
 from optdesign.studies.pareto.records import PointRecord, record_from_result
 from optdesign.studies.pareto.tasks import ANCHOR_SLACK
 from optdesign.studies.pareto.template import FrontMethod, FrontRun, Traced, has_catalogue
@@ -62,6 +66,10 @@ def catalogue_task(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[str
             return _end_of_front(task, lo_rec, dict(lo_rec.eps), t0)
         if task["eps_frac"] == 1.0:
             return _end_of_front(task, hi_rec, eps, t0)
+    held = previous_holds(task, deps, eps)
+    if held is not None:
+        held.wall_time_s = time.perf_counter() - t0
+        return held.to_dict()
     result = solve_catalogue(
         problem,
         starts=task["starts"],

@@ -11,6 +11,8 @@
   anchors, then the points from the loosest epsilon limit to the tightest - and they
   share one :class:`~optdesign.formulations.catalogue.bnb.InfeasibleBoxes` memo (a box proved
   infeasible under looser limits is not solved again).
+- The previous point's optimum: when its design meets this point's tighter limits with
+  room, it is this point's optimum, and the point is not searched (:func:`previous_holds`).
 - Node bounds and starts: the same memo keeps every node's trusted value and optimum
   (:class:`~optdesign.formulations.catalogue.node_bounds.NodeBounds`); a value bounds the
   nodes of the searches under tighter limits from below (their floor, or a prune with no
@@ -25,8 +27,10 @@ from typing import Any
 
 from optdesign.formulations.catalogue.bnb import shared_memo
 from optdesign.formulations.catalogue.discrete import discrete_variables
+from optdesign.formulations.catalogue.node_bounds import looser_or_equal
 from optdesign.runtime.identity import problem_digest
 from optdesign.studies.pareto.records import PointRecord
+from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 
 def chain_points(tasks: list[dict], points: list[dict], sequential: bool) -> None:
@@ -74,3 +78,32 @@ def front_knowledge(task: Mapping[str, Any], deps: Mapping[str, Any]) -> dict[st
         items = {v.name: v.values for v in dvars}
         memo = shared_memo((problem_digest(problem), task["starts"], task["seed"]), full, items)
     return {"incumbents": incumbents, "memo": memo}
+
+
+def previous_holds(
+    task: Mapping[str, Any], deps: Mapping[str, Any], eps: Mapping[str, float]
+) -> PointRecord | None:
+    """The record of the point before ``task`` (its looser neighbour, when the points run
+    one after another: :func:`chain_points`) as this point's, when its design meets this
+    point's limits ``eps`` with room (each below its limit by more than the tie
+    tolerance). That design is the optimum of a catalogue search over a feasible set that
+    holds this point's: it is this point's optimum too - the set shrank around it, and
+    among its ties (decided by their items) it stays the winner. None otherwise: the
+    point is searched."""
+    key = task.get("previous")
+    if key is None or key not in deps or not eps:
+        return None
+    rec = PointRecord.from_dict(deps[key])
+    if not (rec.success and rec.design) or not looser_or_equal(rec.eps, eps):
+        return None
+    room = all(
+        name in rec.objectives
+        and rec.objectives[name] < limit - OBJECTIVE_TIE_TOL * max(abs(limit), 1e-12)
+        for name, limit in eps.items()
+    )
+    if not room:
+        return None
+    rec.id, rec.kind, rec.eps = task["id"], task["kind"], dict(eps)
+    rec.message = f"{rec.message}; the design of {key}, inside this point's limits".lstrip("; ")
+    rec.n_solves = 0
+    return rec

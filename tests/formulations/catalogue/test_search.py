@@ -192,9 +192,10 @@ def _weak_pins():
 
 
 def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
-    """Ipopt's own verdict on every start decides the node: 2 starts, no retries; a
-    start stopped by its iteration limit, or a single start, still gets the
-    RETRY_STARTS retries."""
+    """A verdict on every start decides the node: 2 starts, no retries (the leaf's first
+    start Ipopt's own verdict, its second the least violation that sqpmethod, its first
+    solver, certified: two NLP solves); a start stopped by its iteration limit, or a
+    single start, still gets the RETRY_STARTS retries."""
     from optdesign.formulations.catalogue.search import RETRY_STARTS, NodeSolver
 
     box = {"p": (5.0, 5.0), "d": (4.0, 4.0)}
@@ -202,7 +203,7 @@ def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
     r = ns.solve(box)
     assert r.status == "infeasible"
     assert r.multistart.outcomes == ["locally infeasible"] * 2
-    assert ns.n_solves == r.multistart.n_starts == 2
+    assert r.multistart.n_starts == 2 and ns.n_solves == 3 and ns.n_first_certified == 1
     assert ns.verdicts == ("Infeasible_Problem_Detected",)
     # 5 iterations stop every start before a verdict: the retries run
     capped = NodeSolver(_weak_pins(), starts=2, options={"max_iter": 5})
@@ -218,7 +219,7 @@ def test_a_node_whose_starts_all_say_locally_infeasible_is_not_retried():
     # two verdicts end a larger multistart too: its other starts are not run
     four = NodeSolver(_weak_pins(), starts=4)
     r = four.solve(box)
-    assert r.status == "infeasible" and four.n_solves == r.multistart.n_starts == 2
+    assert r.status == "infeasible" and r.multistart.n_starts == 2 and four.n_solves == 3
     assert r.multistart.n_planned == 4
 
 
@@ -996,6 +997,17 @@ def test_an_enumerated_catalogue_result_records_its_search():
     grid = [f"{info.checked_starts} starts first, kept: their points met every row"]
     if info.resolved_starts:
         grid.append(f"{info.resolved_starts} starts first, then on the whole grid")
+    # the root holds several combinations: its starts are sqpmethod's first
+    assert info.first_solver == "sqpmethod" and info.first_starts >= 2
+    failed = (
+        f" ({info.first_failed} not solved: {info.first_certified} certified locally "
+        f"infeasible by its phase 1, {info.first_failed - info.first_certified} solved "
+        "again by the node's back-end)"
+    )
+    grid.append(
+        f"{info.first_starts} starts of nodes with several item combinations by sqpmethod "
+        f"first{failed if info.first_failed else ''}"
+    )
     learnt = " and at " + ", ".join(info.learned_angles) if info.learned_angles else ""
     assert note == (
         f"catalogue items chosen: p = 6 mm, d = 6; continuous relaxation bound "
@@ -1012,9 +1024,12 @@ def test_an_infeasible_catalogue_names_the_relaxation_as_infeasible():
     info = r.details.catalogue
     assert info.relaxation_bound is None and info.relaxation_status != "optimal"
     assert info.items is None and info.nodes == 1 and r.design == {}
-    # the root's two starts both end with Ipopt's verdict: no retries, and the whole box
-    # is this search's one proof
-    assert info.nlp_solves == 2
+    # the root's two starts: sqpmethod (the first solver) solves neither, and its phase 1
+    # certifies a positive least violation from each - two verdicts: no retries (four NLP
+    # solves), and the whole box is this search's one proof
+    assert (info.first_solver, info.first_starts, info.first_failed) == ("sqpmethod", 2, 2)
+    assert info.first_certified == 2
+    assert info.nlp_solves == 4
     assert info.infeasible_boxes == [({"p": (5.0, 6.0), "d": (4.0, 5.0)}, {})]
 
 
@@ -1616,7 +1631,8 @@ def test_is_on_catalogue_takes_only_the_items_themselves():
 @pytest.mark.slow  # its fixture enumerates a 4 x 5 catalogue: 9-17 s
 def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x5):
     """4 leads x 5 pins: branch and bound equals enumeration, and its counts are those of
-    the node solves it made (counted here by a wrapper around the node solver)."""
+    the node solves it made (counted here by a wrapper around the node solver), with
+    sqpmethod trying the nodes' starts first and with Ipopt alone."""
     problem, enum = enumerated_4x5
     solves: list[bool] = []
     original = catalogue.NodeSolver.solve
@@ -1627,20 +1643,30 @@ def test_branch_and_bound_counts_every_node_it_solves(monkeypatch, enumerated_4x
         return result
 
     monkeypatch.setattr(catalogue.NodeSolver, "solve", counted)
-    bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
-    info = bnb.details.catalogue
+    alone = catalogue.solve_catalogue(problem, method="bnb", starts=2, first_solver=False)
+    info = alone.details.catalogue
     # the relaxation, 7 boxes of 20 item pairs, and the box whose warm bound (one start)
     # would prune it, solved again with the full multistart before it is pruned; every
     # box of several pairs on every other grid angle, the one leaf on the whole grid
-    assert info.nodes == len(solves) == 9
+    assert info.nodes == len(solves) == 9 and info.first_starts == 0
     assert info.infeasible == solves.count(False) == 2
     # the one leaf (p = 6, d = 6) prunes the one box left open when it was found
     assert (info.leaves, info.pruned) == (1, 1)
+    solves.clear()
+    bnb = catalogue.solve_catalogue(problem, method="bnb", starts=2)
+    info = bnb.details.catalogue
+    # with sqpmethod first the values differ in their last digits and the search takes
+    # another path to the same answer (two nodes fewer, one more pruned); its phase 1
+    # certifies the two infeasible boxes (two starts each)
+    assert info.nodes == len(solves) == 7 and (info.leaves, info.pruned) == (1, 2)
+    assert info.infeasible == solves.count(False) == 2
+    assert info.first_certified == 4 and info.first_starts > info.first_failed == 4
     assert 0 < info.thinned_solves < info.nlp_solves
     assert info.relaxation_angles == 31 < len(problem.phi) == 61
     assert len(enum.details.catalogue.enumerated) == 20
-    assert bnb.objective == pytest.approx(enum.objective, rel=1e-9)
-    assert bnb.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
+    for found in (alone, bnb):
+        assert found.objective == pytest.approx(enum.objective, rel=1e-9)
+        assert found.details.catalogue.items == enum.details.catalogue.items == {"p": 6, "d": 6}
 
 
 def test_the_catalogue_formulation_takes_the_callers_settings():

@@ -1,5 +1,5 @@
 """A catalogue node of several item combinations solved on every other grid angle
-(``node_solver.thinned_rows``, ``programs.nlp.with_rows``): the same NLP with fewer rows,
+(``thinned_grid.thinned_rows``, ``programs.nlp.with_rows``): the same NLP with fewer rows,
 hence a relaxation whose value bounds the node's on the whole grid."""
 
 from __future__ import annotations
@@ -10,11 +10,8 @@ import numpy as np
 import pytest
 
 import optdesign as od
-from optdesign.formulations.catalogue.node_solver import (
-    NodeSolver,
-    thinned_angles,
-    thinned_rows,
-)
+from optdesign.formulations.catalogue.node_solver import NodeSolver
+from optdesign.formulations.catalogue.thinned_grid import thinned_angles, thinned_rows
 from optdesign.programs.nlp import build_nlp, with_rows
 
 ROOT = Path(__file__).resolve().parents[3]

@@ -9,7 +9,11 @@ import pytest
 import optdesign as od
 from optdesign.formulations.catalogue import bnb as catalogue_bnb
 from optdesign.formulations.catalogue.discrete import discrete_variables
-from optdesign.studies.pareto.catalogue_knowledge import chain_points, front_knowledge
+from optdesign.studies.pareto.catalogue_knowledge import (
+    chain_points,
+    front_knowledge,
+    previous_holds,
+)
 from optdesign.studies.pareto.records import PointRecord
 
 PROBLEMS = Path(__file__).resolve().parents[3] / "problems"
@@ -120,3 +124,46 @@ def test_tasks_with_a_memo_share_one_per_problem_starts_and_seed():
     assert first.full == {v.name: (v.lower, v.upper) for v in dvars}
     assert first.items == {v.name: tuple(sorted(v.values)) for v in dvars}
     catalogue_bnb._MEMOS.clear()
+
+
+def _looser_point(backlash: float, limit: float = 0.0403, status: str = "optimal") -> dict:
+    return PointRecord(
+        id="eps-2",
+        kind="eps",
+        target="motor_torque",
+        status=status,
+        verified=True,
+        design={"d0": 25.0, "p": 5.0, "d": 6.0},
+        objectives={"backlash": backlash, "motor_torque": 2189.9},
+        eps={"backlash": limit},
+        n_solves=28,
+    ).to_dict()
+
+
+def test_the_looser_points_optimum_inside_a_tighter_limit_is_that_points_optimum():
+    """Point 0.0389 of fin_actuator's front: the design of point 0.0403, whose backlash
+    is 0.0379, is its optimum too (the feasible set shrank around it): no search."""
+    task = {"id": "eps-3", "kind": "eps", "previous": "eps-2"}
+    rec = previous_holds(task, {"eps-2": _looser_point(0.0379)}, {"backlash": 0.0389})
+    assert rec is not None and (rec.id, rec.kind) == ("eps-3", "eps")
+    assert rec.eps == {"backlash": 0.0389} and rec.n_solves == 0
+    assert rec.design == {"d0": 25.0, "p": 5.0, "d": 6.0}
+    assert "the design of eps-2, inside this point's limits" in rec.message
+
+
+@pytest.mark.parametrize(
+    ("backlash", "limit", "status", "previous"),
+    [
+        (0.0389 * (1 - 1e-7), 0.0403, "optimal", "eps-2"),  # on the limit, within the tie
+        (0.0395, 0.0403, "optimal", "eps-2"),  # beyond the tighter limit
+        (0.0379, 0.0385, "optimal", "eps-2"),  # solved under a tighter limit than this one
+        (0.0379, 0.0403, "infeasible", "eps-2"),  # no optimum
+        (0.0379, 0.0403, "optimal", None),  # the points run in parallel: no neighbour
+    ],
+)
+def test_the_looser_points_design_is_not_taken_without_room_or_an_optimum(
+    backlash, limit, status, previous
+):
+    task = {"id": "eps-3", "kind": "eps", "previous": previous}
+    deps = {"eps-2": _looser_point(backlash, limit, status)}
+    assert previous_holds(task, deps, {"backlash": 0.0389}) is None
