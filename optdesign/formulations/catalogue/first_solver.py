@@ -11,9 +11,9 @@ node_solver.NodeSolver._thinned_solve`).
   minimum (:data:`~optdesign.solvers.phase_one.CERTIFY_ABOVE`) certifies that no feasible
   design lies near the start: the start's verdict of local infeasibility
   (``CERTIFIED``), the same evidence as Ipopt's own verdict (a converged minimum of the
-  infeasibility), for a sixth of its cost. A node needs two such verdicts, Ipopt's or
-  these, to be called infeasible (:meth:`~optdesign.formulations.catalogue.node_solver.
-  NodeSolver.verdicts_decide`).
+  infeasibility), for about half its cost, the failed try included. A node needs two
+  such verdicts, Ipopt's or these, to be called infeasible (:meth:`~optdesign.
+  formulations.catalogue.node_solver.NodeSolver.verdicts_decide`).
 - Otherwise (a feasible point found, or no convergence) the node's back-end solves the
   start from the same point (``SOLVED_AGAIN``), as it would have alone.
 """
