@@ -75,11 +75,14 @@ class NodeSolver:
     tried again from :data:`RETRY_STARTS` Sobol points of ``seed + 1`` (points it has not
     tried) before it counts as infeasible, so a poor
     first start (e.g. a declared one) that stops at an iteration limit or an error never
-    makes a feasible problem look infeasible. Two starts that both end with the back-end's
-    own verdict of local infeasibility (:meth:`verdicts_decide`) end the multistart: the
-    node is infeasible on those two starts (over the catalogue instance family, no later
-    start or retry ever found a feasible point after two such verdicts:
-    benchmarks/README.md, "Catalogue searches"). As the problem's own
+    makes a feasible problem look infeasible. Two starts that both end with a verdict of
+    local infeasibility - the back-end's own, or its first solver's certified least
+    violation (:mod:`~optdesign.formulations.catalogue.first_solver`) - end the
+    multistart (:meth:`verdicts_decide`): the node is infeasible on those two starts
+    (over the catalogue instance family, no later start or retry ever found a feasible
+    point after two such verdicts: benchmarks/README.md, "Catalogue searches"). The
+    starts on the node's thinned grid are tried by the back-end's first solver
+    (sqpmethod for Ipopt), a leaf's first start excepted. As the problem's own
     multistart, a node's multistart stops once :attr:`agree` starts agree on the best
     value (the file's ``[solver] agree``, 3 by default, through :func:`solve_catalogue`;
     over the same cases no later start beat a value that 3 starts agreed on:
