@@ -58,6 +58,24 @@ def test_an_infeasible_problems_least_violation_is_the_largest_scaled_violation_
     assert found.result.status == "infeasible"
 
 
+def test_the_least_violation_on_sqpmethod_is_ipopts(tight):
+    """The phase-1 problem on sqpmethod (a catalogue node's first solver certifies its
+    failed starts with it) reaches Ipopt's least violation from the same start, and its
+    solves do not depend on the solves before (a memory each)."""
+    from optdesign.solvers.registry import SQPMETHOD_NODE, nlpsol_options
+
+    problem, nlp, ipopt = tight
+    sqp = PhaseOneSolver(nlp, nlpsol_options("sqpmethod", SQPMETHOD_NODE), plugin="sqpmethod")
+    z0 = nlp.z_from_x(problem.midpoint())
+    a, b = ipopt.solve(z0), sqp.solve(z0)
+    assert a.certified and b.certified and b.result.solver == "sqpmethod"
+    assert b.value == pytest.approx(a.value, rel=1e-6)
+    assert b.value == pytest.approx(_scaled_violation(nlp, b.z), rel=1e-6)
+    sqp.solve(nlp.z_from_x(problem.lower() + 0.3 * (problem.upper() - problem.lower())))
+    again = sqp.solve(z0)
+    assert np.array_equal(again.z, b.z) and again.value == b.value
+
+
 def test_weights_on_one_requirement_give_its_relaxation_with_the_others_held(tight):
     problem, nlp, solver = tight
     rows = np.array([k for k, g in enumerate(nlp.g_names) if g == "nut_travel"])
