@@ -83,6 +83,16 @@ def looser_or_equal(stored: Mapping[str, float], eps: Mapping[str, float]) -> bo
     return all(k in eps and eps[k] <= v for k, v in stored.items())
 
 
+def within_limits_with_room(values: Mapping[str, float], eps: Mapping[str, float]) -> bool:
+    """Whether ``values`` (objective name -> value) hold every limit of ``eps`` with room:
+    each below its limit by more than the tie tolerance (relative), so that no limit
+    binds - an optimum under looser limits that does so is an optimum under ``eps``."""
+    return all(
+        k in values and values[k] < v - OBJECTIVE_TIE_TOL * max(abs(v), 1e-12)
+        for k, v in eps.items()
+    )
+
+
 def inside(box: Box, wide: Box) -> bool:
     """Whether ``box`` lies in ``wide`` (to a rounding of 1e-12 relative)."""
     return all(
@@ -179,11 +189,7 @@ class NodeBounds:
         for e in reversed(self._by_box.get(self._key(box), [])):
             if e.result is None or e.objective != objective or not looser_or_equal(e.eps, eps):
                 continue
-            values = e.result.objectives
-            if all(
-                k in values and values[k] < v - OBJECTIVE_TIE_TOL * max(abs(v), 1e-12)
-                for k, v in eps.items()
-            ):
+            if within_limits_with_room(e.result.objectives, eps):
                 return copy.deepcopy(e.result)
         return None
 

@@ -27,10 +27,12 @@ from typing import Any
 
 from optdesign.formulations.catalogue.bnb import shared_memo
 from optdesign.formulations.catalogue.discrete import discrete_variables
-from optdesign.formulations.catalogue.node_bounds import looser_or_equal
+from optdesign.formulations.catalogue.node_bounds import (
+    looser_or_equal,
+    within_limits_with_room,
+)
 from optdesign.runtime.identity import problem_digest
 from optdesign.studies.pareto.records import PointRecord
-from optdesign.tolerances import OBJECTIVE_TIE_TOL
 
 
 def chain_points(tasks: list[dict], points: list[dict], sequential: bool) -> None:
@@ -96,12 +98,7 @@ def previous_holds(
     rec = PointRecord.from_dict(deps[key])
     if not (rec.success and rec.design) or not looser_or_equal(rec.eps, eps):
         return None
-    room = all(
-        name in rec.objectives
-        and rec.objectives[name] < limit - OBJECTIVE_TIE_TOL * max(abs(limit), 1e-12)
-        for name, limit in eps.items()
-    )
-    if not room:
+    if not within_limits_with_room(rec.objectives, eps):
         return None
     rec.id, rec.kind, rec.eps = task["id"], task["kind"], dict(eps)
     rec.message = f"{rec.message}; the design of {key}, inside this point's limits".lstrip("; ")
